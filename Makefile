@@ -1,0 +1,127 @@
+# souptet - one non-recursive GNU Makefile.
+#
+#   make                  library and tools into build/ (build/bin/<tool>)
+#   make check            install missing Debian packages, build, run all tests
+#   make demo             the main job on the bundled model
+#   make bench            measurements against peers (bench/results/)
+#   make install PREFIX=/usr/local DESTDIR=
+#   make config=debug|sanitize ...   (objects go to build/ or build-<config>/)
+
+config ?= release
+PREFIX ?= /usr/local
+DESTDIR ?=
+VERSION := 0.1.0
+
+ifeq ($(config),release)
+  BUILD := build
+  OPT := -O2 -g
+else ifeq ($(config),debug)
+  BUILD := build-debug
+  OPT := -O0 -g3
+else ifeq ($(config),sanitize)
+  BUILD := build-sanitize
+  OPT := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+else
+  $(error config must be release, debug or sanitize)
+endif
+
+CC ?= cc
+CXX ?= c++
+# -ffp-contract=off: fused multiply-adds would change rounding behind the
+# back of the error bounds in the predicates and the exact distances.
+WARN := -Wall -Wextra -Wshadow -Wpointer-arith -Wformat=2 -Wundef
+CFLAGS_ALL := -std=c11 -D_POSIX_C_SOURCE=200809L $(OPT) $(WARN) -Wstrict-prototypes \
+              -ffp-contract=off -fno-fast-math -fopenmp -Iinclude -MMD -MP \
+              -DSOUPTET_VERSION='"$(VERSION)"' $(CFLAGS)
+CXXFLAGS_ALL := -std=c++17 $(OPT) -Wall -Wextra -ffp-contract=off -fopenmp -Iinclude \
+                -I/usr/include/vtk-9.1 -MMD -MP -DSOUPTET_VERSION='"$(VERSION)"' $(CXXFLAGS)
+LIBS := -lopenvdb -ltbb -lImath-3_1 \
+        -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
+        -lvtkCommonDataModel-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1 \
+        -lgomp -lpthread -lm
+LDFLAGS_ALL := $(OPT) -fopenmp $(LDFLAGS)
+
+LIB_C   := $(sort $(wildcard src/*.c))
+LIB_CXX := $(sort $(wildcard src/adapters/*.cpp))
+TOOLS   := $(basename $(notdir $(sort $(wildcard src/tools/*.c))))
+TESTS_C := $(basename $(notdir $(sort $(wildcard tests/test_*.c))))
+
+LIB_OBJ := $(LIB_C:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/obj/%.o)
+CLI_OBJ := $(patsubst src/%.c,$(BUILD)/obj/%.o,$(sort $(wildcard src/cli/*.c)))
+LIBA    := $(BUILD)/libsouptet.a
+TOOL_BIN := $(TOOLS:%=$(BUILD)/bin/%)
+TEST_BIN := $(TESTS_C:%=$(BUILD)/tests/%)
+
+.PHONY: all check test demo bench setup install uninstall clean fuzz
+all: $(LIBA) $(TOOL_BIN) $(TEST_BIN)
+
+$(BUILD)/obj/%.o: src/%.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -c $< -o $@
+$(BUILD)/obj/%.o: src/%.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) -c $< -o $@
+$(BUILD)/obj/cli/%.o: src/cli/%.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -c $< -o $@
+$(BUILD)/obj/tools/%.o: src/tools/%.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -c $< -o $@
+$(BUILD)/obj/tests/%.o: tests/%.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -Itests -c $< -o $@
+
+$(LIBA): $(LIB_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@
+	ar rcs $@ $^
+
+# Tools and tests link with the C++ driver: the adapters need libstdc++.
+$(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(CLI_OBJ) $(LIBA)
+	@mkdir -p $(dir $@)
+	$(CXX) $(LDFLAGS_ALL) $< $(CLI_OBJ) $(LIBA) $(LIBS) -o $@
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA)
+	@mkdir -p $(dir $@)
+	$(CXX) $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
+
+# scripts/setup installs what is missing and returns in a second otherwise.
+setup:
+	@scripts/setup
+
+# The README's test command. Unit tests are TAP programs; tool tests are
+# TAP shell scripts; prove runs them all and prints the count.
+check: setup
+	$(MAKE) --no-print-directory all
+	SOUPTET_BIN=$(CURDIR)/$(BUILD)/bin SOUPTET_TESTBIN=$(CURDIR)/$(BUILD)/tests \
+	  prove --exec '' --timer $(TEST_BIN) $(sort $(wildcard tests/tools/*.t))
+
+test: check
+
+demo: setup
+	$(MAKE) --no-print-directory all
+	scripts/demo $(BUILD)/bin
+
+bench: setup
+	$(MAKE) --no-print-directory all
+	scripts/bench $(BUILD) $(STAGE)
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig \
+	  $(DESTDIR)$(PREFIX)/include/souptet $(DESTDIR)$(PREFIX)/share/man/man1
+	install -m 755 $(TOOL_BIN) $(DESTDIR)$(PREFIX)/bin/
+	install -m 644 $(LIBA) $(DESTDIR)$(PREFIX)/lib/
+	install -m 644 include/souptet/*.h $(DESTDIR)$(PREFIX)/include/souptet/
+	install -m 644 man/man1/*.1 $(DESTDIR)$(PREFIX)/share/man/man1/
+	sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@VERSION@|$(VERSION)|g' \
+	    -e 's|@LIBS@|$(LIBS)|g' souptet.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/souptet.pc
+
+uninstall:
+	rm -f $(TOOLS:%=$(DESTDIR)$(PREFIX)/bin/%) $(DESTDIR)$(PREFIX)/lib/libsouptet.a \
+	  $(DESTDIR)$(PREFIX)/lib/pkgconfig/souptet.pc
+	rm -rf $(DESTDIR)$(PREFIX)/include/souptet
+	rm -f $(TOOLS:%=$(DESTDIR)$(PREFIX)/share/man/man1/%.1)
+
+clean:
+	rm -rf build build-debug build-sanitize
+
+-include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

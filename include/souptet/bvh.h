@@ -1,0 +1,49 @@
+/*
+ * bvh.h - a bounding volume hierarchy over the triangles of a soup.
+ *
+ * Axis-aligned boxes, median splits on the longest axis of the centroids,
+ * at most ST_BVH_LEAF triangles per leaf. Queries are read-only and may run
+ * from many threads at once.
+ */
+#ifndef SOUPTET_BVH_H
+#define SOUPTET_BVH_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "souptet/err.h"
+#include "souptet/soup.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define ST_BVH_LEAF 4
+
+typedef struct st_bvh_node {
+    double lo[3], hi[3];
+    uint32_t start;   /* leaf: first slot in order[]; inner: left child */
+    uint32_t count;   /* leaf: number of triangles; inner: 0 */
+} st_bvh_node;
+
+typedef struct st_bvh {
+    const st_soup *soup;   /* borrowed; must outlive the BVH */
+    st_bvh_node *nodes;
+    size_t nnodes;
+    uint32_t *order;       /* triangle indices, grouped by leaf */
+} st_bvh;
+
+/* Build over every triangle of s (s is borrowed, not copied). */
+st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err);
+void st_bvh_free(st_bvh *b);   /* safe on NULL */
+
+/* The nearest triangle to p among those closer than sqrt(max_d2): returns
+ * its squared distance and sets *tri (and *closest when not NULL). When no
+ * triangle is that close, returns max_d2 and sets *tri to -1. Pass
+ * INFINITY for an unbounded search; a tight max_d2 makes it fast. */
+double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
+                      int64_t *tri, double closest[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

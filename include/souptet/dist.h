@@ -1,0 +1,72 @@
+/*
+ * dist.h - unsigned distance fields of triangle soups.
+ *
+ * The grid covers the bounding box of the soup's triangles padded by `pad`
+ * voxels on every side. With `cells` the voxel size is the longest side of
+ * the box divided by cells (so `cells` voxels span it); with `voxel` it is
+ * given. Voxel centers sample the field.
+ *
+ * Band mode: every voxel whose distance is below band * voxel holds that
+ * distance exactly (to rounding of the float it is stored in); the others
+ * hold band * voxel. Full mode (band = INFINITY): every voxel holds its
+ * exact distance: the band is computed first, then each other voxel asks a
+ * BVH for its nearest triangle within a bound taken from its neighbour in
+ * the row (d(p) <= d(q) + |p - q|), which keeps the query local.
+ *
+ * Results are identical for any number of threads: each voxel's value is a
+ * minimum over triangles, which does not depend on the order of evaluation.
+ */
+#ifndef SOUPTET_DIST_H
+#define SOUPTET_DIST_H
+
+#include <stddef.h>
+#include "souptet/err.h"
+#include "souptet/grid.h"
+#include "souptet/progress.h"
+#include "souptet/soup.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The band a distance field gets by default, in voxels. A ray along any of
+ * the 26 lattice directions passes a voxel center within sqrt(3)/2 voxels
+ * of every surface it crosses, so three voxels hold every volume event the
+ * sign voting looks for, with room to spare; the project allows no less. */
+#define ST_DIST_DEFAULT_BAND 3.0
+#define ST_DIST_MIN_BAND 3.0
+#define ST_DIST_DEFAULT_CELLS 128
+
+typedef struct st_dist_params {
+    size_t cells;       /* voxels along the longest side; used if voxel == 0 */
+    double voxel;       /* voxel size in model units; 0: from cells */
+    long pad;           /* voxels of padding per side; < 0: the default */
+    double band;        /* band in voxels (>= ST_DIST_MIN_BAND) or INFINITY */
+    size_t max_bytes;   /* limit for the grid; 0: none */
+} st_dist_params;
+
+/* Parameters with every default filled in. */
+st_dist_params st_dist_params_default(void);
+
+/* The default padding for a band: enough that the outermost voxels lie
+ * beyond the band (rays start outside the model, clamped) plus two. */
+long st_dist_default_pad(double band);
+
+/* Grid placement for soup s: dims, origin (center of voxel 0) and voxel
+ * size. The box is centered in the grid. Errors: a soup without extent,
+ * a voxel size that is not positive, a grid over max_bytes. */
+st_status st_dist_layout(const st_soup *s, const st_dist_params *p,
+                         size_t dims[3], double origin[3], double *voxel,
+                         st_error *err);
+
+/* Compute the unsigned distance field of s. *out gets a grid of kind
+ * ST_GRID_DISTANCE with band (model units) set, and metadata "triangles",
+ * "vertices", "band_voxels". */
+st_status st_dist_field(st_grid **out, const st_soup *s,
+                        const st_dist_params *p, const st_progress *progress,
+                        st_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

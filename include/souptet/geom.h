@@ -1,0 +1,59 @@
+/*
+ * geom.h - small vector helpers and point-triangle distance.
+ *
+ * Distances are computed in double from the input coordinates; no tolerance
+ * decides anything topological here (those decisions go through pred.h).
+ */
+#ifndef SOUPTET_GEOM_H
+#define SOUPTET_GEOM_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+static inline double st_dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+static inline void st_sub3(double out[3], const double a[3], const double b[3])
+{
+    out[0] = a[0] - b[0];
+    out[1] = a[1] - b[1];
+    out[2] = a[2] - b[2];
+}
+static inline void st_cross3(double out[3], const double a[3], const double b[3])
+{
+    double x = a[1] * b[2] - a[2] * b[1];
+    double y = a[2] * b[0] - a[0] * b[2];
+    double z = a[0] * b[1] - a[1] * b[0];
+    out[0] = x;
+    out[1] = y;
+    out[2] = z;
+}
+
+/* Euclidean length, scaled so that tiny or huge components neither
+ * underflow nor overflow when squared. */
+double st_norm3(const double v[3]);
+
+/* Squared distance from p to the closed segment [a, b]; a == b is a point.
+ * If closest is not NULL it receives the closest point. */
+double st_point_segment_dist2(const double p[3], const double a[3],
+                              const double b[3], double closest[3]);
+
+/* Squared distance from p to the closed triangle (a, b, c), and the closest
+ * point when `closest` is not NULL. Works for every triangle, including
+ * degenerate ones (collinear or repeated vertices: the distance to its
+ * edges). A triangle is treated as degenerate when its doubled area is at
+ * most ST_DEGENERATE_AREA_RATIO times the square of its longest edge: the
+ * plane through it is then too ill-conditioned to project onto, while the
+ * distance to its edges differs from the true one by at most its width,
+ * which is below that ratio times the longest edge. */
+#define ST_DEGENERATE_AREA_RATIO 1e-8
+double st_point_triangle_dist2(const double p[3], const double a[3],
+                               const double b[3], const double c[3],
+                               double closest[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

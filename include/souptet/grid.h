@@ -1,0 +1,67 @@
+/*
+ * grid.h - dense scalar fields on a regular grid of voxels.
+ *
+ * Values live at voxel centers: voxel (i, j, k) is centered at
+ * origin + voxel * (i, j, k). Storage is x fastest:
+ * data[i + nx * (j + ny * k)].
+ *
+ * A distance field holds unsigned distances (in model units) that are exact
+ * (to rounding) where they are below `band` and clamped to `band` beyond; a
+ * full field has band = INFINITY. A signed field is negative inside the
+ * pseudo volume.
+ */
+#ifndef SOUPTET_GRID_H
+#define SOUPTET_GRID_H
+
+#include <stddef.h>
+#include "souptet/err.h"
+#include "souptet/meta.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum st_grid_kind {
+    ST_GRID_UNKNOWN = 0,
+    ST_GRID_DISTANCE,   /* unsigned distance to a soup */
+    ST_GRID_SIGNED      /* signed: negative inside the pseudo volume */
+} st_grid_kind;
+
+typedef struct st_grid {
+    size_t nx, ny, nz;    /* voxels along each axis, each >= 1 */
+    double origin[3];     /* center of voxel (0, 0, 0), model units */
+    double voxel;         /* edge length of a voxel, > 0 */
+    float *data;          /* nx * ny * nz values, x fastest */
+    st_grid_kind kind;
+    double band;          /* values >= band are clamped; INFINITY if none */
+    st_meta meta;         /* source, triangles, parameters, history, ... */
+} st_grid;
+
+/* A grid of the given size with data set to `fill`. Sizes are checked for
+ * overflow; ST_ELIMIT when more than max_bytes would be allocated
+ * (max_bytes 0: no limit). */
+st_status st_grid_new(st_grid **out, size_t nx, size_t ny, size_t nz,
+                      const double origin[3], double voxel, float fill,
+                      size_t max_bytes, st_error *err);
+void st_grid_free(st_grid *g);   /* safe on NULL */
+
+/* Number of voxels (never overflows for a grid that exists). */
+size_t st_grid_count(const st_grid *g);
+/* Linear index of voxel (i, j, k). */
+static inline size_t st_grid_index(const st_grid *g, size_t i, size_t j,
+                                   size_t k)
+{
+    return i + g->nx * (j + g->ny * k);
+}
+/* World position of the center of voxel (i, j, k). */
+void st_grid_center(const st_grid *g, size_t i, size_t j, size_t k,
+                    double p[3]);
+
+/* "distance", "signed" or "unknown", and back (UNKNOWN for other text). */
+const char *st_grid_kind_name(st_grid_kind kind);
+st_grid_kind st_grid_kind_from_name(const char *name);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

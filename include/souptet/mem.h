@@ -1,0 +1,34 @@
+/*
+ * mem.h - checked allocation.
+ *
+ * Every array allocation goes through these: the element count times the
+ * element size is checked for overflow before anything is allocated, so a
+ * count read from an untrusted file can never wrap into a small buffer.
+ */
+#ifndef SOUPTET_MEM_H
+#define SOUPTET_MEM_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* *out = a * b; returns 0, or -1 (and leaves *out alone) on overflow. */
+int st_size_mul(size_t *out, size_t a, size_t b);
+/* *out = a + b; returns 0, or -1 on overflow. */
+int st_size_add(size_t *out, size_t a, size_t b);
+
+/* malloc/calloc/realloc of n elements of size bytes; NULL on overflow or
+ * when the system has no memory. n == 0 returns a valid unique pointer. */
+void *st_malloc_array(size_t n, size_t size);
+void *st_calloc_array(size_t n, size_t size);
+void *st_realloc_array(void *p, size_t n, size_t size);
+
+/* strdup that returns NULL on failure; NULL in gives NULL out. */
+char *st_strdup(const char *s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,47 @@
+/*
+ * meta.h - string metadata carried by fields and meshes.
+ *
+ * An ordered list of key/value strings. Every tool appends its command line
+ * to the "history" key (lines joined by '\n'), so every output says how it
+ * was made (after Radiance's headers).
+ */
+#ifndef SOUPTET_META_H
+#define SOUPTET_META_H
+
+#include <stddef.h>
+#include "souptet/err.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct st_meta_entry {
+    char *key;
+    char *value;
+} st_meta_entry;
+
+typedef struct st_meta {
+    st_meta_entry *entries;
+    size_t count;
+    size_t capacity;
+} st_meta;
+
+/* An empty list needs no allocation: st_meta m = {0}. */
+void st_meta_clear(st_meta *m);                 /* frees everything */
+/* Set key to value, replacing an existing value. ST_ENOMEM on failure. */
+st_status st_meta_set(st_meta *m, const char *key, const char *value);
+/* The value of key, or NULL. */
+const char *st_meta_get(const st_meta *m, const char *key);
+/* Append one line to the "history" entry. */
+st_status st_meta_history_append(st_meta *m, const char *line);
+/* Deep copy of src into dst (dst's old contents are freed). */
+st_status st_meta_copy(st_meta *dst, const st_meta *src);
+
+/* A command line as one string, arguments with spaces or quotes shell-quoted.
+ * Caller frees. NULL on allocation failure. */
+char *st_command_line(int argc, char *const argv[]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

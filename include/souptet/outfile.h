@@ -1,0 +1,50 @@
+/*
+ * outfile.h - output that appears whole or not at all.
+ *
+ * st_outfile_begin creates a temporary file beside the target (same
+ * directory, so the final rename is atomic); st_outfile_commit checks every
+ * write, closes, and renames it over the target; st_outfile_abort removes
+ * it. "-" (or NULL) means stdout, where nothing is renamed.
+ *
+ * Temporary names in flight are remembered so a tool's signal handler can
+ * remove them with st_outfile_unlink_pending(), which is async-signal-safe.
+ */
+#ifndef SOUPTET_OUTFILE_H
+#define SOUPTET_OUTFILE_H
+
+#include <stdio.h>
+#include "souptet/err.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct st_outfile {
+    char *path;      /* target path; NULL for stdout */
+    char *tmp;       /* temporary path being written; NULL for stdout */
+    FILE *fp;        /* open stream on tmp (or stdout) when requested */
+    int slot;        /* index in the pending list, -1 if none */
+} st_outfile;
+
+/* Start an output. With open_stream, o->fp is open for binary writing
+ * (stdout for "-"); without, the empty temporary file exists at o->tmp for
+ * a library that writes by name (VTK, OpenVDB). Errors name the target. */
+st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
+                           st_error *err);
+/* Flush and close (checking for write errors), then rename tmp to path.
+ * On failure the temporary file is removed. */
+st_status st_outfile_commit(st_outfile *o, st_error *err);
+/* Close and remove the temporary file. Safe after commit and on a zeroed
+ * st_outfile. */
+void st_outfile_abort(st_outfile *o);
+
+/* Unlink every temporary file still in flight; async-signal-safe. */
+void st_outfile_unlink_pending(void);
+
+/* 1 when path names stdout ("-" or NULL). */
+int st_path_is_stdio(const char *path);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

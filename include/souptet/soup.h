@@ -1,0 +1,92 @@
+/*
+ * soup.h - triangle soups and the surface readers.
+ *
+ * A soup is a vertex array and a triangle array, exactly as the file gives
+ * them: vertices are never welded, duplicated or degenerate triangles are
+ * kept, orientation is whatever the file says. Polygons are fan-triangulated
+ * (v0 v1 v2, v0 v2 v3, ...). All OBJ groups and objects form one soup.
+ *
+ * Formats: OBJ (v/f, negative indices), OFF (also COFF/NOFF/...), PLY (ascii,
+ * binary_little_endian, binary_big_endian; any scalar property type; the
+ * face list may be named vertex_indices or vertex_index), STL (ASCII and
+ * binary).
+ *
+ * Readers parse a memory buffer (so fuzzers and pipes use the same code) and
+ * never trust a count from the file for an allocation: arrays grow with the
+ * data actually present, and a header count is checked against the bytes
+ * left before anything is reserved. Every error names the file and a line
+ * (text) or a byte offset (binary).
+ */
+#ifndef SOUPTET_SOUP_H
+#define SOUPTET_SOUP_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "souptet/err.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum st_soup_format {
+    ST_SOUP_UNKNOWN = 0,
+    ST_SOUP_OBJ,
+    ST_SOUP_OFF,
+    ST_SOUP_PLY,
+    ST_SOUP_STL
+} st_soup_format;
+
+/* A zero-initialised st_soup is a valid empty soup. Grow xyz and tris only
+ * through st_soup_add_vertex / st_soup_add_triangle: their capacity is
+ * derived from the counts. */
+typedef struct st_soup {
+    double *xyz;        /* 3 * nverts coordinates, all finite */
+    size_t nverts;
+    uint32_t *tris;     /* 3 * ntris vertex indices, each < nverts */
+    size_t ntris;
+} st_soup;
+
+/* An empty soup; NULL when out of memory. */
+st_soup *st_soup_new(void);
+/* Safe on NULL. */
+void st_soup_free(st_soup *s);
+
+/* Append a vertex / a triangle, growing the arrays geometrically.
+ * ST_ENOMEM, or ST_ELIMIT past UINT32_MAX vertices; add_triangle refuses
+ * indices >= nverts (ST_EINPUT). */
+st_status st_soup_add_vertex(st_soup *s, double x, double y, double z,
+                             st_error *err);
+st_status st_soup_add_triangle(st_soup *s, uint32_t a, uint32_t b, uint32_t c,
+                               st_error *err);
+
+/* Parse a whole file held in memory (format must be known: ST_SOUP_UNKNOWN
+ * is an error). name is used in messages only. Numbers with more than 19
+ * significant digits or unusual exponents go through strtod, which follows
+ * the C locale's decimal point: tools run in the "C" locale.
+ * On success *out owns a soup with at least one triangle. On failure *out
+ * is NULL and err says what and where. */
+st_status st_soup_parse(st_soup **out, st_soup_format format,
+                        const unsigned char *data, size_t size,
+                        const char *name, st_error *err);
+
+/* The format named by a path's extension (case-insensitive), or UNKNOWN. */
+st_soup_format st_soup_format_from_path(const char *path);
+/* The format recognised from a file's first bytes (for stdin), or UNKNOWN. */
+st_soup_format st_soup_format_sniff(const unsigned char *data, size_t size);
+/* "obj", "off", "ply", "stl" or "unknown". */
+const char *st_soup_format_name(st_soup_format format);
+
+/* Read a surface file; "-" reads stdin (format sniffed). The format comes
+ * from the extension, else from the content. Directories, missing and
+ * unreadable files, empty files and files without triangles are errors. */
+st_status st_soup_read(st_soup **out, const char *path, st_error *err);
+
+/* Axis-aligned bounds of the referenced vertices: lo[3], hi[3].
+ * Returns ST_EINPUT when the soup has no triangles. */
+st_status st_soup_bounds(const st_soup *s, double lo[3], double hi[3],
+                         st_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

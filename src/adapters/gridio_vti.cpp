@@ -1,0 +1,549 @@
+/*
+ * gridio_vti.cpp - st_grid <-> VTK XML ImageData (.vti), for ParaView and
+ * anything else built on VTK.
+ *
+ * Mapping (writing; reading inverts it):
+ *
+ *   image      extent 0..nx-1, 0..ny-1, 0..nz-1 (points = voxel centers,
+ *              so point (i,j,k) is voxel (i,j,k)), Origin = g->origin,
+ *              Spacing = (voxel, voxel, voxel), identity direction.
+ *   values     one vtkFloatArray point-data array named
+ *              st_grid_name_for_kind ("distance", "sdf", "field"), set as
+ *              the active scalars. Floats are stored in binary: exact.
+ *   metadata   field data: souptet_kind (vtkStringArray), band
+ *              (vtkDoubleArray, +inf as is), origin (3-component
+ *              vtkDoubleArray) and voxel_size (vtkDoubleArray) - the last
+ *              two because VTK writes the Origin and Spacing attributes as
+ *              decimal text that does not round-trip every double - and
+ *              every st_meta entry as a one-value vtkStringArray named by
+ *              its key, in st_meta order (field data keeps its order). A
+ *              key that is empty, starts with "souptet_meta:" or is one of
+ *              the names above is stored as "souptet_meta:" + key.
+ *   encoding   appended raw binary (not base64), zlib compression, 64-bit
+ *              block headers (no 4 GiB limit on an array).
+ *
+ * Reading accepts foreign files too: the point array is the active scalars
+ * if they are one-component float or double, else the first such array;
+ * anything else is refused. Spacing must be uniform and the direction the
+ * identity. The exact origin/voxel_size field data are used when they
+ * agree with the image's own origin and spacing (they disagree when a tool
+ * moved the image but carried the field data along: then the image wins).
+ * Without souptet_kind the kind is UNKNOWN and the band INFINITY.
+ *
+ * VTK reports problems through its logger and its global output window,
+ * both of which print to stderr. The library must not print: unless the
+ * program installed an output window of its own, a collecting output
+ * window replaces VTK's default once and the logger's stderr output is
+ * turned off; the text VTK reported during a call goes into that call's
+ * st_error. (This is process-wide VTK state: any other VTK user in the
+ * library gets the same silence.)
+ */
+#include "souptet/gridio.h"
+#include "souptet/meta.h"
+#include "souptet/outfile.h"
+#include "gridio_internal.h"
+
+#include <vtkAbstractArray.h>
+#include <vtkDataArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkErrorCode.h>
+#include <vtkFieldData.h>
+#include <vtkFloatArray.h>
+#include <vtkImageData.h>
+#include <vtkInformation.h>
+#include <vtkLogger.h>
+#include <vtkMatrix3x3.h>
+#include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkOutputWindow.h>
+#include <vtkPointData.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkStringArray.h>
+#include <vtkXMLImageDataReader.h>
+#include <vtkXMLImageDataWriter.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <new>
+#include <string>
+#include <sys/stat.h>
+
+namespace {
+
+const char *const kMetaPrefix = "souptet_meta:";
+
+/* What VTK reported on this thread since the last reset. Thread-local so
+ * that two threads reading two files do not get each other's messages. */
+thread_local std::string t_errors;
+thread_local std::string t_warnings;
+
+/* VTK's output window replaced by one that collects instead of printing. */
+class CaptureWindow : public vtkOutputWindow {
+public:
+    static CaptureWindow *New();
+    vtkTypeMacro(CaptureWindow, vtkOutputWindow);
+
+    void DisplayText(const char *text) override
+    {
+        if (!text)
+            return;
+        std::string &to = GetCurrentMessageType() == MESSAGE_TYPE_ERROR
+                              ? t_errors
+                              : t_warnings;
+        if (to.size() < 16384)      // a runaway loop must not eat memory
+            to += text;
+    }
+
+protected:
+    CaptureWindow() = default;
+    ~CaptureWindow() override = default;
+};
+vtkStandardNewMacro(CaptureWindow);
+
+void install_capture()
+{
+    static const bool done = [] {
+        // Respect an output window the program chose; replace only VTK's
+        // default one (which writes to stderr).
+        vtkOutputWindow *cur = vtkOutputWindow::GetInstance();
+        if (cur && std::strcmp(cur->GetClassName(), "vtkOutputWindow") == 0) {
+            CaptureWindow *w = CaptureWindow::New();
+            vtkOutputWindow::SetInstance(w);
+            w->Delete();    // SetInstance holds a reference
+            // VTK 9 also hands every error and warning to its logger
+            // (loguru) before the output window, and the logger writes
+            // ERROR and WARNING lines to stderr by default, whole pipeline
+            // dumps included. A program that left VTK's messaging at its
+            // defaults wants none of that from a library: stderr logging
+            // off (file and callback sinks are untouched).
+            vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+        }
+        return true;
+    }();
+    (void)done;
+}
+
+void reset_capture()
+{
+    t_errors.clear();
+    t_warnings.clear();
+}
+
+/* One VTK message without its "ERROR: In FILE, line N" header and the
+ * "ClassName (0x...): " prefix, on one line. */
+std::string clean_message(std::string s)
+{
+    size_t nl = s.find('\n');
+    if (s.compare(0, 3, "ERR") == 0 || s.compare(0, 4, "Warn") == 0 ||
+        s.compare(0, 7, "Generic") == 0)
+        s = nl == std::string::npos ? "" : s.substr(nl + 1);
+    size_t p = s.find("): ");
+    if (p != std::string::npos && p < 80)
+        s = s.substr(p + 3);
+    for (char &c : s)
+        if (c == '\n' || c == '\r')
+            c = ' ';
+    while (!s.empty() && s.back() == ' ')
+        s.pop_back();
+    return s;
+}
+
+/* The messages VTK reported (each ends with a blank line), joined with
+ * "; ". The executive's "Algorithm ... returned failure for request"
+ * (followed by a dump of the whole request) says nothing new: left out. */
+std::string vtk_message(const std::string &all)
+{
+    std::string out;
+    size_t start = 0;
+    while (start < all.size() && out.size() < 400) {
+        size_t end = all.find("\n\n", start);
+        if (end == std::string::npos)
+            end = all.size();
+        std::string m = clean_message(all.substr(start, end - start));
+        start = end + 2;
+        if (m.empty() || m.find("returned failure for request") !=
+                             std::string::npos ||
+            out.find(m) != std::string::npos)
+            continue;
+        out += (out.empty() ? "" : "; ") + m;
+    }
+    if (out.size() > 400)
+        out = out.substr(0, 400) + "...";
+    return out;
+}
+
+bool is_reserved_name(const std::string &n)
+{
+    return n == "souptet_kind" || n == "band" || n == "origin" ||
+           n == "voxel_size";
+}
+
+std::string escape_key(const std::string &key)
+{
+    if (key.empty() || is_reserved_name(key) ||
+        key.compare(0, std::strlen(kMetaPrefix), kMetaPrefix) == 0)
+        return kMetaPrefix + key;
+    return key;
+}
+
+/* Pre-checks by path so that the usual failures get the system's words,
+ * not VTK's. */
+st_status check_input_file(const char *path, st_error *err)
+{
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
+                            std::strerror(errno));
+    if (S_ISDIR(st.st_mode))
+        return st_error_set(err, ST_EIO, path, 0, "is a directory");
+    if (S_ISREG(st.st_mode) && st.st_size == 0)
+        return st_error_set(err, ST_EINPUT, path, 0, "empty file");
+    FILE *fp = std::fopen(path, "rb");
+    if (!fp)
+        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
+                            std::strerror(errno));
+    std::fclose(fp);
+    return ST_OK;
+}
+
+st_status vtk_failed(const char *name, const char *what, st_error *err)
+{
+    std::string m = vtk_message(t_errors);
+    return st_error_set(err, ST_EINPUT, name, 0, "%s%s%s", what,
+                        m.empty() ? "" : ": ", m.c_str());
+}
+
+/* The point array holding the field, or null. */
+vtkDataArray *field_array(vtkImageData *img)
+{
+    vtkPointData *pd = img->GetPointData();
+    if (!pd)
+        return nullptr;
+    auto usable = [](vtkDataArray *a) {
+        return a && a->GetNumberOfComponents() == 1 &&
+               (vtkFloatArray::SafeDownCast(a) ||
+                vtkDoubleArray::SafeDownCast(a));
+    };
+    if (usable(pd->GetScalars()))
+        return pd->GetScalars();
+    for (int i = 0; i < pd->GetNumberOfArrays(); i++)
+        if (usable(pd->GetArray(i)))
+            return pd->GetArray(i);
+    return nullptr;
+}
+
+/* One double from field data array `n` with `comps` components, if there. */
+bool field_doubles(vtkFieldData *fd, const char *n, int comps, double *v)
+{
+    vtkDoubleArray *a =
+        fd ? vtkDoubleArray::SafeDownCast(fd->GetAbstractArray(n)) : nullptr;
+    if (!a || a->GetNumberOfComponents() != comps || a->GetNumberOfTuples() < 1)
+        return false;
+    for (int c = 0; c < comps; c++)
+        v[c] = a->GetComponent(0, c);
+    return true;
+}
+
+bool close_to(double a, double b, double scale)
+{
+    return std::fabs(a - b) <= 1e-9 * scale;
+}
+
+/* Run a configured reader: information, limit check, data, conversion. */
+st_status read_with(vtkXMLImageDataReader *r, const char *name,
+                    size_t max_bytes, st_grid **out, st_error *err)
+{
+    reset_capture();
+    r->UpdateInformation();
+    vtkInformation *info = r->GetOutputInformation(0);
+    int ext[6];
+    if (!t_errors.empty() || r->GetErrorCode() != vtkErrorCode::NoError ||
+        !info || !info->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+        return vtk_failed(name, "not a readable VTK ImageData (.vti) file",
+                          err);
+    info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), ext);
+    long long d[3];
+    for (int a = 0; a < 3; a++)
+        d[a] = (long long)ext[2 * a + 1] - ext[2 * a] + 1;
+    if (d[0] < 1 || d[1] < 1 || d[2] < 1)
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "image extent %d..%d %d..%d %d..%d holds no "
+                            "points",
+                            ext[0], ext[1], ext[2], ext[3], ext[4], ext[5]);
+    // Allocate (and check max_bytes) before VTK reads the array: the
+    // limit must hold before anything of that size is allocated.
+    const double zero[3] = {0, 0, 0};
+    st_grid *g = nullptr;
+    if (st_status s = st_grid_new(&g, size_t(d[0]), size_t(d[1]),
+                                  size_t(d[2]), zero, 1.0, 0.0f, max_bytes,
+                                  err)) {
+        if (err && !err->file[0])
+            std::snprintf(err->file, sizeof err->file, "%s", name);
+        return s;
+    }
+    struct Guard {
+        st_grid *g;
+        ~Guard() { st_grid_free(g); }
+    } guard{g};
+
+    r->Update();
+    vtkImageData *img = r->GetOutput();
+    if (!t_errors.empty() || r->GetErrorCode() != vtkErrorCode::NoError ||
+        !img)
+        return vtk_failed(name,
+                          "cannot read the image data (truncated or "
+                          "corrupt file?)",
+                          err);
+    int *dims = img->GetDimensions();
+    if (dims[0] != d[0] || dims[1] != d[1] || dims[2] != d[2])
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "image is %dx%dx%d points, its header says "
+                            "%lldx%lldx%lld",
+                            dims[0], dims[1], dims[2], d[0], d[1], d[2]);
+    vtkDataArray *arr = field_array(img);
+    if (!arr)
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "no scalar point data (one float or double "
+                            "component) to read");
+    const size_t n = st_grid_count(g);
+    if (arr->GetNumberOfTuples() != vtkIdType(n))
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "point array '%s' has %lld values for %zu "
+                            "points (truncated file?)",
+                            arr->GetName() ? arr->GetName() : "",
+                            (long long)arr->GetNumberOfTuples(), n);
+
+    // Placement.
+    double sp[3], org[3];
+    img->GetSpacing(sp);
+    img->GetOrigin(org);
+    vtkMatrix3x3 *dir = img->GetDirectionMatrix();
+    if (dir && !dir->IsIdentity())
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "image has a rotated direction matrix, which is "
+                            "not supported");
+    if (!(sp[0] > 0) || !std::isfinite(sp[0]) ||
+        !close_to(sp[1], sp[0], sp[0]) || !close_to(sp[2], sp[0], sp[0]))
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "spacing %g %g %g is not uniform and positive",
+                            sp[0], sp[1], sp[2]);
+    double voxel = sp[0], origin[3];
+    for (int a = 0; a < 3; a++)     // the point at the extent's start
+        origin[a] = org[a] + sp[a] * ext[2 * a];
+    vtkFieldData *fd = img->GetFieldData();
+    double fv, fo[3];
+    if (field_doubles(fd, "voxel_size", 1, &fv) && close_to(fv, voxel, voxel))
+        voxel = fv;
+    if (field_doubles(fd, "origin", 3, fo) &&
+        close_to(fo[0], origin[0], std::fabs(origin[0]) + voxel) &&
+        close_to(fo[1], origin[1], std::fabs(origin[1]) + voxel) &&
+        close_to(fo[2], origin[2], std::fabs(origin[2]) + voxel))
+        for (int a = 0; a < 3; a++)
+            origin[a] = fo[a];
+    for (int a = 0; a < 3; a++)
+        if (!std::isfinite(origin[a]))
+            return st_error_set(err, ST_EINPUT, name, 0,
+                                "image origin is not finite");
+    g->voxel = voxel;
+    for (int a = 0; a < 3; a++)
+        g->origin[a] = origin[a];
+
+    // Values.
+    if (vtkFloatArray *f = vtkFloatArray::SafeDownCast(arr))
+        std::memcpy(g->data, f->GetPointer(0), n * sizeof(float));
+    else {
+        vtkDoubleArray *dd = vtkDoubleArray::SafeDownCast(arr);
+        const double *src = dd->GetPointer(0);
+        for (size_t i = 0; i < n; i++)
+            g->data[i] = float(src[i]);
+    }
+
+    // Kind, band, metadata.
+    g->kind = ST_GRID_UNKNOWN;
+    g->band = INFINITY;
+    double band;
+    if (field_doubles(fd, "band", 1, &band) && !std::isnan(band))
+        g->band = band;
+    for (int i = 0; fd && i < fd->GetNumberOfArrays(); i++) {
+        vtkStringArray *s =
+            vtkStringArray::SafeDownCast(fd->GetAbstractArray(i));
+        if (!s || !s->GetName() || s->GetNumberOfValues() < 1)
+            continue;
+        std::string key = s->GetName();
+        const std::string value = s->GetValue(0);
+        if (key == "souptet_kind") {
+            g->kind = st_grid_kind_from_name(value.c_str());
+            continue;
+        }
+        if (is_reserved_name(key))
+            continue;
+        if (key.compare(0, std::strlen(kMetaPrefix), kMetaPrefix) == 0)
+            key = key.substr(std::strlen(kMetaPrefix));
+        if (st_meta_set(&g->meta, key.c_str(), value.c_str()))
+            return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
+    }
+    guard.g = nullptr;
+    *out = g;
+    return ST_OK;
+}
+
+/* Every exception into an st_error naming the file. */
+template <class F>
+st_status guarded(const char *name, const char *what, st_error *err, F &&f)
+{
+    try {
+        install_capture();
+        return f();
+    } catch (const std::bad_alloc &) {
+        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory %s",
+                            what);
+    } catch (const std::exception &e) {
+        return st_error_set(err, ST_EINPUT, name, 0, "error %s: %s", what,
+                            e.what());
+    } catch (...) {
+        return st_error_set(err, ST_EINTERNAL, name, 0,
+                            "unknown exception %s", what);
+    }
+}
+
+st_status write_vti(const st_grid *g, const char *path, st_error *err)
+{
+    if (!g || !g->data)
+        return st_error_set(err, ST_EINTERNAL, path, 0, "no grid to write");
+    const size_t lim = size_t(std::numeric_limits<int>::max());
+    if (g->nx > lim || g->ny > lim || g->nz > lim)
+        return st_error_set(err, ST_ELIMIT, path, 0,
+                            "grid size %zux%zux%zu does not fit VTK's int "
+                            "extents",
+                            g->nx, g->ny, g->nz);
+    vtkNew<vtkImageData> img;
+    img->SetExtent(0, int(g->nx - 1), 0, int(g->ny - 1), 0, int(g->nz - 1));
+    img->SetOrigin(g->origin[0], g->origin[1], g->origin[2]);
+    img->SetSpacing(g->voxel, g->voxel, g->voxel);
+
+    vtkNew<vtkFloatArray> values;
+    values->SetName(st_grid_name_for_kind(g->kind));
+    values->SetNumberOfComponents(1);
+    // Borrow the grid's array instead of copying it (save = 1: VTK never
+    // frees it); the writer only reads.
+    values->SetArray(const_cast<float *>(g->data), vtkIdType(st_grid_count(g)),
+                     1);
+    img->GetPointData()->SetScalars(values);
+
+    vtkFieldData *fd = img->GetFieldData();
+    auto add_string = [&](const std::string &n, const char *v) {
+        vtkNew<vtkStringArray> s;
+        s->SetName(n.c_str());
+        s->InsertNextValue(v ? v : "");
+        fd->AddArray(s);
+    };
+    auto add_doubles = [&](const char *n, const double *v, int comps) {
+        vtkNew<vtkDoubleArray> a;
+        a->SetName(n);
+        a->SetNumberOfComponents(comps);
+        a->InsertNextTuple(v);
+        fd->AddArray(a);
+    };
+    add_string("souptet_kind", st_grid_kind_name(g->kind));
+    add_doubles("band", &g->band, 1);
+    add_doubles("origin", g->origin, 3);
+    add_doubles("voxel_size", &g->voxel, 1);
+    for (size_t i = 0; i < g->meta.count; i++)
+        add_string(escape_key(g->meta.entries[i].key),
+                   g->meta.entries[i].value);
+
+    st_outfile o;
+    if (st_status s = st_outfile_begin(&o, path, 0, err))
+        return s;
+    // Removes the temporary file on every way out but the commit,
+    // exceptions included.
+    struct Abort {
+        st_outfile *o;
+        ~Abort()
+        {
+            if (o)
+                st_outfile_abort(o);
+        }
+    } abort_tmp{&o};
+    vtkNew<vtkXMLImageDataWriter> w;
+    w->SetInputData(img);
+    w->SetFileName(o.tmp);
+    w->SetDataModeToAppended();
+    w->EncodeAppendedDataOff();     // raw binary, not base64
+    w->SetCompressorTypeToZLib();
+    w->SetHeaderTypeToUInt64();
+    reset_capture();
+    errno = 0;
+    const int ok = w->Write();
+    const int e = errno;
+    if (!ok || !t_errors.empty() ||
+        w->GetErrorCode() != vtkErrorCode::NoError) {
+        std::string m = vtk_message(t_errors);
+        if (m.empty() && e)
+            m = std::strerror(e);
+        return st_error_set(err, ST_EIO, path, 0, "write failed%s%s",
+                            m.empty() ? "" : ": ", m.c_str());
+    }
+    abort_tmp.o = nullptr;   // commit removes it itself on failure
+    return st_outfile_commit(&o, err);
+}
+
+} // namespace
+
+extern "C" {
+
+st_status st_grid_write_vti(const st_grid *g, const char *path, st_error *err)
+{
+    if (st_path_is_stdio(path))
+        return st_error_set(err, ST_EINPUT, ST_GRIDIO_STDOUT_NAME, 0,
+                            "standard output carries OpenVDB streams only; "
+                            "write .vti to a file");
+    return guarded(path, "writing", err,
+                   [&] { return write_vti(g, path, err); });
+}
+
+st_status st_gridio_read_vti_mem(st_grid **out, const unsigned char *data,
+                                 size_t size, const char *name,
+                                 size_t max_bytes, st_error *err)
+{
+    *out = nullptr;
+    if (size == 0)
+        return st_error_set(err, ST_EINPUT, name, 0, "empty input");
+    return guarded(name, "reading", err, [&] {
+        vtkNew<vtkXMLImageDataReader> r;
+        r->ReadFromInputStringOn();
+        r->SetInputString(
+            std::string(reinterpret_cast<const char *>(data), size));
+        return read_with(r, name, max_bytes, out, err);
+    });
+}
+
+st_status st_grid_read_vti(st_grid **out, const char *path, size_t max_bytes,
+                           st_error *err)
+{
+    *out = nullptr;
+    if (st_path_is_stdio(path)) {
+        unsigned char *data;
+        size_t size;
+        if (st_status s = st_gridio_read_stdin(&data, &size, err))
+            return s;
+        st_status s = st_gridio_read_vti_mem(out, data, size,
+                                             ST_GRIDIO_STDIN_NAME, max_bytes,
+                                             err);
+        std::free(data);
+        return s;
+    }
+    if (st_status s = check_input_file(path, err))
+        return s;
+    return guarded(path, "reading", err, [&] {
+        vtkNew<vtkXMLImageDataReader> r;
+        r->SetFileName(path);
+        return read_with(r, path, max_bytes, out, err);
+    });
+}
+
+} // extern "C"

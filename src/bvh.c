@@ -1,0 +1,246 @@
+/*
+ * bvh.c - bounding volume hierarchy over soup triangles (see bvh.h).
+ *
+ * Build: top-down, splitting at the median centroid along the longest axis
+ * of the centroid box (quickselect), so the tree is balanced and its depth
+ * is about log2(n / ST_BVH_LEAF) whatever the input. Nearest query:
+ * depth-first with an explicit stack, the nearer child first, pruning boxes
+ * whose distance is not below the best so far.
+ */
+#include "souptet/bvh.h"
+#include "souptet/geom.h"
+#include "souptet/mem.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A median-split tree over n >= 1 leaves of >= 1 triangle has < 2n nodes and
+ * depth below 64 for any n a uint32 can count. */
+#define STACK_DEPTH 128
+
+typedef struct build_ctx {
+    const st_soup *s;
+    double *cent;          /* 3 per triangle */
+    uint32_t *order;
+    st_bvh_node *nodes;
+    size_t nnodes;
+} build_ctx;
+
+static void tri_box(const st_soup *s, uint32_t t, double lo[3], double hi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        lo[a] = INFINITY;
+        hi[a] = -INFINITY;
+    }
+    for (int k = 0; k < 3; k++) {
+        const double *v = s->xyz + 3 * (size_t)s->tris[3 * (size_t)t + k];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], v[a]);
+            hi[a] = fmax(hi[a], v[a]);
+        }
+    }
+}
+
+/* Partition order[lo..hi) so the element at position mid is the one a sort
+ * by centroid coordinate `axis` would put there: quickselect with Hoare's
+ * partition (pivot at the lower middle, which keeps both sides non-empty,
+ * so every round makes progress). */
+static void select_median(build_ctx *c, size_t lo, size_t hi, size_t mid,
+                          int axis)
+{
+    uint32_t *o = c->order;
+    ptrdiff_t l = (ptrdiff_t)lo, r = (ptrdiff_t)hi - 1, m = (ptrdiff_t)mid;
+    while (l < r) {
+        double pivot = c->cent[3 * (size_t)o[l + (r - l) / 2] + axis];
+        ptrdiff_t i = l - 1, j = r + 1;
+        for (;;) {
+            do
+                i++;
+            while (c->cent[3 * (size_t)o[i] + axis] < pivot);
+            do
+                j--;
+            while (c->cent[3 * (size_t)o[j] + axis] > pivot);
+            if (i >= j)
+                break;
+            uint32_t t = o[i];
+            o[i] = o[j];
+            o[j] = t;
+        }
+        /* [l, j] <= pivot <= [j+1, r], with l <= j < r */
+        if (m <= j)
+            r = j;
+        else
+            l = j + 1;
+    }
+}
+
+static void build(build_ctx *c, size_t node, size_t lo, size_t hi)
+{
+    /* Explicit stack of (node, lo, hi) to stay off the call stack. */
+    size_t stack[STACK_DEPTH][3];
+    int sp = 0;
+    stack[sp][0] = node;
+    stack[sp][1] = lo;
+    stack[sp][2] = hi;
+    sp++;
+    while (sp > 0) {
+        sp--;
+        size_t nd = stack[sp][0], a = stack[sp][1], b = stack[sp][2];
+        st_bvh_node *n = &c->nodes[nd];
+        double clo[3] = {INFINITY, INFINITY, INFINITY};
+        double chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int k = 0; k < 3; k++) {
+            n->lo[k] = INFINITY;
+            n->hi[k] = -INFINITY;
+        }
+        for (size_t i = a; i < b; i++) {
+            double tlo[3], thi[3];
+            tri_box(c->s, c->order[i], tlo, thi);
+            const double *ce = c->cent + 3 * (size_t)c->order[i];
+            for (int k = 0; k < 3; k++) {
+                n->lo[k] = fmin(n->lo[k], tlo[k]);
+                n->hi[k] = fmax(n->hi[k], thi[k]);
+                clo[k] = fmin(clo[k], ce[k]);
+                chi[k] = fmax(chi[k], ce[k]);
+            }
+        }
+        if (b - a <= ST_BVH_LEAF) {
+            n->start = (uint32_t)a;
+            n->count = (uint32_t)(b - a);
+            continue;
+        }
+        int axis = 0;
+        for (int k = 1; k < 3; k++)
+            if (chi[k] - clo[k] > chi[axis] - clo[axis])
+                axis = k;
+        size_t mid = a + (b - a) / 2;
+        select_median(c, a, b, mid, axis);
+        size_t left = c->nnodes;
+        c->nnodes += 2;
+        n->start = (uint32_t)left;
+        n->count = 0;
+        stack[sp][0] = left;
+        stack[sp][1] = a;
+        stack[sp][2] = mid;
+        sp++;
+        stack[sp][0] = left + 1;
+        stack[sp][1] = mid;
+        stack[sp][2] = b;
+        sp++;
+    }
+}
+
+st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
+{
+    *out = NULL;
+    if (s->ntris == 0)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "no triangles");
+    if (s->ntris > UINT32_MAX / 2)
+        return st_error_set(err, ST_ELIMIT, NULL, 0,
+                            "too many triangles for the BVH (%zu)", s->ntris);
+    build_ctx c = {0};
+    c.s = s;
+    st_bvh *b = calloc(1, sizeof *b);
+    c.cent = st_malloc_array(s->ntris, 3 * sizeof(double));
+    c.order = st_malloc_array(s->ntris, sizeof(uint32_t));
+    c.nodes = st_malloc_array(2 * s->ntris, sizeof(st_bvh_node));
+    if (!b || !c.cent || !c.order || !c.nodes) {
+        free(b);
+        free(c.cent);
+        free(c.order);
+        free(c.nodes);
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory for a BVH over %zu triangles",
+                            s->ntris);
+    }
+    for (size_t t = 0; t < s->ntris; t++) {
+        c.order[t] = (uint32_t)t;
+        for (int a = 0; a < 3; a++) {
+            double sum = 0.0;
+            for (int k = 0; k < 3; k++)
+                sum += s->xyz[3 * (size_t)s->tris[3 * t + k] + a];
+            c.cent[3 * t + a] = sum / 3.0;
+        }
+    }
+    c.nnodes = 1;
+    build(&c, 0, 0, s->ntris);
+    free(c.cent);
+    b->soup = s;
+    b->nodes = c.nodes;
+    b->nnodes = c.nnodes;
+    b->order = c.order;
+    *out = b;
+    return ST_OK;
+}
+
+void st_bvh_free(st_bvh *b)
+{
+    if (!b)
+        return;
+    free(b->nodes);
+    free(b->order);
+    free(b);
+}
+
+static double box_dist2(const st_bvh_node *n, const double p[3])
+{
+    double d2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        double d = 0.0;
+        if (p[a] < n->lo[a])
+            d = n->lo[a] - p[a];
+        else if (p[a] > n->hi[a])
+            d = p[a] - n->hi[a];
+        d2 += d * d;
+    }
+    return d2;
+}
+
+double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
+                      int64_t *tri, double closest[3])
+{
+    const st_soup *s = b->soup;
+    double best = max_d2;
+    int64_t best_tri = -1;
+    uint32_t stack[STACK_DEPTH];
+    int sp = 0;
+    if (box_dist2(&b->nodes[0], p) < best)
+        stack[sp++] = 0;
+    while (sp > 0) {
+        const st_bvh_node *n = &b->nodes[stack[--sp]];
+        if (box_dist2(n, p) >= best)
+            continue;           /* best shrank since this was pushed */
+        if (n->count) {
+            for (uint32_t i = 0; i < n->count; i++) {
+                uint32_t t = b->order[n->start + i];
+                const uint32_t *v = s->tris + 3 * (size_t)t;
+                double q[3];
+                double d2 = st_point_triangle_dist2(
+                    p, s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
+                    s->xyz + 3 * (size_t)v[2], q);
+                if (d2 < best) {
+                    best = d2;
+                    best_tri = t;
+                    if (closest)
+                        memcpy(closest, q, sizeof q);
+                }
+            }
+            continue;
+        }
+        uint32_t l = n->start, r = n->start + 1;
+        double dl = box_dist2(&b->nodes[l], p), dr = box_dist2(&b->nodes[r], p);
+        /* Push the farther first so the nearer is searched first. */
+        if (dl > dr) {
+            uint32_t t = l; l = r; r = t;
+            double d = dl; dl = dr; dr = d;
+        }
+        if (dr < best)
+            stack[sp++] = r;
+        if (dl < best)
+            stack[sp++] = l;
+    }
+    *tri = best_tri;
+    return best;
+}

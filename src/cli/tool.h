@@ -1,0 +1,79 @@
+/*
+ * tool.h - what every souptet tool's main() shares (not part of the
+ * library: this is where printing and exiting happen).
+ *
+ * Shape of a tool (after Netpbm): parse options into a settings struct,
+ * open input ("-" = stdin), one library call per stage, write output
+ * through st_outfile (temporary name, renamed at the end), exit 0 ok,
+ * 1 bad input or failure, 2 usage. Messages go to stderr as
+ * "tool: file:line: what".
+ */
+#ifndef SOUPTET_CLI_TOOL_H
+#define SOUPTET_CLI_TOOL_H
+
+#include <stddef.h>
+#include "souptet/err.h"
+#include "souptet/meta.h"
+#include "souptet/progress.h"
+
+#define TOOL_EXIT_OK 0
+#define TOOL_EXIT_FAIL 1
+#define TOOL_EXIT_USAGE 2
+
+typedef struct tool_ctx {
+    const char *name;      /* program name for messages */
+    int verbosity;         /* 0 with -q, 1 default, 2 with -v */
+    char *command_line;    /* the whole command line, for history */
+    double t0;             /* start time, seconds */
+} tool_ctx;
+
+/* Set up a tool: name, command line, signal handlers that remove
+ * temporary outputs (SIGINT, SIGTERM, SIGHUP, SIGPIPE). */
+void tool_init(tool_ctx *t, const char *name, int argc, char *argv[]);
+void tool_finish(tool_ctx *t);
+
+/* Print "name: FILE:LINE: msg" and return TOOL_EXIT_FAIL. */
+int tool_fail(const tool_ctx *t, const st_error *err);
+/* Print "name: msg" and "Try 'name --help'." and return TOOL_EXIT_USAGE. */
+int tool_usage_error(const tool_ctx *t, const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Print "name: msg" to stderr when verbosity >= level. */
+void tool_say(const tool_ctx *t, int level, const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Strict number parsing for option values: the whole string must be a
+ * number within [min, max]. Return 0 ok, or print a usage error and return
+ * -1. */
+int tool_parse_size(const tool_ctx *t, const char *opt, const char *arg,
+                    size_t min, size_t max, size_t *out);
+int tool_parse_double(const tool_ctx *t, const char *opt, const char *arg,
+                      double min, double max, double *out);
+/* A byte count with an optional K, M, G or T suffix (powers of 1024). */
+int tool_parse_bytes(const tool_ctx *t, const char *opt, const char *arg,
+                     size_t *out);
+
+/* The default memory limit: 80% of physical memory (0 if unknown). */
+size_t tool_default_max_memory(void);
+
+/* Set the OpenMP thread count (0: leave the default). */
+void tool_set_threads(size_t threads);
+
+/* A progress reporter that draws one line on stderr when stderr is a
+ * terminal and verbosity >= 1; otherwise it does nothing. */
+st_progress tool_progress(tool_ctx *t);
+/* Clear the progress line if one was drawn. */
+void tool_progress_end(tool_ctx *t);
+
+/* Wall-clock seconds since an arbitrary origin. */
+double tool_now(void);
+
+/* Print the version line "name (souptet) X.Y.Z". */
+void tool_print_version(const tool_ctx *t);
+
+#endif

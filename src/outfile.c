@@ -1,0 +1,163 @@
+/*
+ * outfile.c - atomic outputs (see outfile.h).
+ *
+ * The temporary file is created with mkstemp in the target's directory, so
+ * rename(2) replaces the target in one step and a crash or a signal never
+ * leaves a half-written file under the target's name.
+ */
+#include "souptet/outfile.h"
+#include "souptet/mem.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* Temporary paths in flight, for st_outfile_unlink_pending. A tool has at
+ * most a few outputs open at once. The signal handler only reads them. */
+#define PENDING_MAX 16
+static char *volatile pending[PENDING_MAX];
+
+int st_path_is_stdio(const char *path)
+{
+    return path == NULL || strcmp(path, "-") == 0;
+}
+
+static int pending_add(char *tmp)
+{
+    for (int i = 0; i < PENDING_MAX; i++)
+        if (!pending[i]) {
+            pending[i] = tmp;
+            return i;
+        }
+    return -1;
+}
+
+static void pending_remove(int slot)
+{
+    if (slot >= 0 && slot < PENDING_MAX)
+        pending[slot] = NULL;
+}
+
+void st_outfile_unlink_pending(void)
+{
+    for (int i = 0; i < PENDING_MAX; i++) {
+        char *p = pending[i];
+        if (p)
+            unlink(p);
+    }
+}
+
+st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
+                           st_error *err)
+{
+    memset(o, 0, sizeof *o);
+    o->slot = -1;
+    if (st_path_is_stdio(path)) {
+        if (open_stream)
+            o->fp = stdout;
+        return ST_OK;
+    }
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return st_error_set(err, ST_EIO, path, 0, "is a directory");
+    size_t n = strlen(path);
+    o->path = st_strdup(path);
+    o->tmp = malloc(n + 16);
+    if (!o->path || !o->tmp) {
+        st_outfile_abort(o);
+        return st_error_set(err, ST_ENOMEM, path, 0, "out of memory");
+    }
+    /* Beside the target, hidden, so a reader never mistakes it for output:
+     * "dir/.name.XXXXXX". */
+    const char *slash = strrchr(path, '/');
+    size_t dirlen = slash ? (size_t)(slash - path) + 1 : 0;
+    memcpy(o->tmp, path, dirlen);
+    o->tmp[dirlen] = '.';
+    strcpy(o->tmp + dirlen + 1, path + dirlen);
+    strcat(o->tmp, ".XXXXXX");
+    int fd = mkstemp(o->tmp);
+    if (fd < 0) {
+        int e = errno;
+        free(o->tmp);
+        o->tmp = NULL;
+        st_outfile_abort(o);
+        return st_error_set(err, ST_EIO, path, 0, "cannot create: %s",
+                            strerror(e));
+    }
+    /* mkstemp makes the file 0600; outputs are ordinary files. */
+    mode_t mask = umask(0);
+    umask(mask);
+    fchmod(fd, 0666 & ~mask);
+    o->slot = pending_add(o->tmp);
+    if (open_stream) {
+        o->fp = fdopen(fd, "wb");
+        if (!o->fp) {
+            int e = errno;
+            close(fd);
+            st_outfile_abort(o);
+            return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
+                                strerror(e));
+        }
+    } else {
+        close(fd);
+    }
+    return ST_OK;
+}
+
+st_status st_outfile_commit(st_outfile *o, st_error *err)
+{
+    if (!o->path) {             /* stdout */
+        if (o->fp && fflush(o->fp) != 0) {
+            int e = errno;
+            return st_error_set(err, ST_EIO, "<stdout>", 0,
+                                "write failed: %s", strerror(e));
+        }
+        o->fp = NULL;
+        return ST_OK;
+    }
+    if (o->fp) {
+        int bad = ferror(o->fp);
+        int e = errno;
+        if (fclose(o->fp) != 0 && !bad) {
+            bad = 1;
+            e = errno;
+        }
+        o->fp = NULL;
+        if (bad) {
+            st_error_set(err, ST_EIO, o->path, 0, "write failed: %s",
+                         strerror(e));
+            st_outfile_abort(o);
+            return ST_EIO;
+        }
+    }
+    if (rename(o->tmp, o->path) != 0) {
+        int e = errno;
+        st_error_set(err, ST_EIO, o->path, 0, "cannot rename into place: %s",
+                     strerror(e));
+        st_outfile_abort(o);
+        return ST_EIO;
+    }
+    pending_remove(o->slot);
+    free(o->tmp);
+    free(o->path);
+    o->tmp = o->path = NULL;
+    o->slot = -1;
+    return ST_OK;
+}
+
+void st_outfile_abort(st_outfile *o)
+{
+    if (o->fp && o->fp != stdout)
+        fclose(o->fp);
+    o->fp = NULL;
+    if (o->tmp) {
+        pending_remove(o->slot);
+        unlink(o->tmp);
+        free(o->tmp);
+    }
+    free(o->path);
+    o->tmp = o->path = NULL;
+    o->slot = -1;
+}

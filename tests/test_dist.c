@@ -1,0 +1,283 @@
+/* test_dist.c - distance fields against brute force, layout, determinism. */
+#include "souptet/bvh.h"
+#include "souptet/dist.h"
+#include "souptet/geom.h"
+#include "souptet/soup.h"
+#include "tap.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+static double brute_dist(const st_soup *s, const double p[3])
+{
+    double best = INFINITY;
+    for (size_t t = 0; t < s->ntris; t++) {
+        const uint32_t *v = s->tris + 3 * t;
+        double d2 = st_point_triangle_dist2(p, s->xyz + 3 * (size_t)v[0],
+                                            s->xyz + 3 * (size_t)v[1],
+                                            s->xyz + 3 * (size_t)v[2], NULL);
+        if (d2 < best)
+            best = d2;
+    }
+    return sqrt(best);
+}
+
+static st_soup *soup_from(const double *xyz, size_t nv, const uint32_t *tri,
+                          size_t nt)
+{
+    st_soup *s = st_soup_new();
+    for (size_t i = 0; i < nv; i++)
+        st_soup_add_vertex(s, xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2], NULL);
+    for (size_t i = 0; i < nt; i++)
+        st_soup_add_triangle(s, tri[3 * i], tri[3 * i + 1], tri[3 * i + 2], NULL);
+    return s;
+}
+
+static unsigned rng = 777;
+static double urand(void)
+{
+    rng = rng * 1103515245u + 12345u;
+    return (double)((rng >> 8) & 0xffffff) / 16777216.0;
+}
+
+/* Random triangles of all sizes and orientations, some degenerate. */
+static st_soup *random_soup(size_t n)
+{
+    st_soup *s = st_soup_new();
+    for (size_t t = 0; t < n; t++) {
+        double c[3] = {urand(), urand(), urand()};
+        double size = t % 7 == 0 ? 0.8 : 0.05 + 0.1 * urand();
+        for (int k = 0; k < 3; k++) {
+            double x = c[0] + size * (urand() - 0.5);
+            double y = c[1] + size * (urand() - 0.5);
+            double z = c[2] + size * (urand() - 0.5);
+            if (t % 11 == 0 && k == 2) {   /* collinear: degenerate */
+                const double *a = s->xyz + 3 * (s->nverts - 2);
+                const double *b = s->xyz + 3 * (s->nverts - 1);
+                x = 2 * b[0] - a[0];
+                y = 2 * b[1] - a[1];
+                z = 2 * b[2] - a[2];
+            }
+            st_soup_add_vertex(s, x, y, z, NULL);
+        }
+        uint32_t v = (uint32_t)(3 * t);
+        st_soup_add_triangle(s, v, v + 1, v + 2, NULL);
+    }
+    return s;
+}
+
+/* Every voxel against brute force: exact (float rounding) within the band,
+ * clamped beyond it. Returns the number of mismatches. */
+static size_t check_field(const st_grid *g, const st_soup *s, double *max_err)
+{
+    size_t bad = 0;
+    *max_err = 0.0;
+    for (size_t k = 0; k < g->nz; k++)
+        for (size_t j = 0; j < g->ny; j++)
+            for (size_t i = 0; i < g->nx; i++) {
+                double p[3];
+                st_grid_center(g, i, j, k, p);
+                double ref = brute_dist(s, p);
+                double got = g->data[st_grid_index(g, i, j, k)];
+                double want = ref < g->band ? ref : g->band;
+                /* float storage: half an ulp of the value, plus the double
+                 * computation's rounding */
+                double tol = 1e-6 * fmax(want, g->voxel);
+                double e = fabs(got - want);
+                if (ref >= g->band && got == (float)g->band)
+                    e = 0.0;
+                if (e > *max_err)
+                    *max_err = e;
+                if (e > tol)
+                    bad++;
+            }
+    return bad;
+}
+
+static void test_band_exact_on_random_soup(void)
+{
+    st_soup *s = random_soup(60);
+    st_dist_params p = st_dist_params_default();
+    p.cells = 24;
+    st_grid *g;
+    st_error err;
+    TAP_CHECK(st_dist_field(&g, s, &p, NULL, &err) == ST_OK, "random soup field");
+    double e;
+    size_t bad = check_field(g, s, &e);
+    TAP_CHECK(bad == 0, "band field equals brute force within the band (%zu bad, max err %.3g)", bad, e);
+    TAP_CHECK(g->kind == ST_GRID_DISTANCE && fabs(g->band - 3 * g->voxel) < 1e-12,
+              "kind distance, band 3 voxels");
+    st_grid_free(g);
+
+    p.band = INFINITY;
+    TAP_CHECK(st_dist_field(&g, s, &p, NULL, &err) == ST_OK, "random soup full field");
+    bad = check_field(g, s, &e);
+    TAP_CHECK(bad == 0 && isinf(g->band), "full field equals brute force everywhere (%zu bad, max err %.3g)", bad, e);
+    st_grid_free(g);
+    st_soup_free(s);
+}
+
+/* One huge triangle crossing the whole grid diagonally: the row intervals
+ * must not cut off any band voxel. */
+static void test_large_oblique_triangle(void)
+{
+    const double xyz[] = {0, 0, 0, 1, 0.1, 0.9, 0.2, 1, 0.5, 0.0, 0.0, 1.0};
+    const uint32_t tri[] = {0, 1, 2, 0, 2, 3};
+    st_soup *s = soup_from(xyz, 4, tri, 2);
+    st_dist_params p = st_dist_params_default();
+    p.cells = 40;
+    p.band = 4.5;
+    st_grid *g;
+    st_error err;
+    TAP_CHECK(st_dist_field(&g, s, &p, NULL, &err) == ST_OK, "large triangle field");
+    double e;
+    size_t bad = check_field(g, s, &e);
+    TAP_CHECK(bad == 0, "large oblique triangles: band exact (%zu bad)", bad);
+    st_grid_free(g);
+    st_soup_free(s);
+}
+
+static void test_layout(void)
+{
+    const double xyz[] = {0, 0, 0, 4, 0, 0, 0, 2, 1};
+    const uint32_t tri[] = {0, 1, 2};
+    st_soup *s = soup_from(xyz, 3, tri, 1);
+    st_dist_params p = st_dist_params_default();
+    p.cells = 8;
+    size_t dims[3];
+    double origin[3], h;
+    st_error err;
+    TAP_CHECK(st_dist_layout(s, &p, dims, origin, &h, &err) == ST_OK, "layout ok");
+    long pad = st_dist_default_pad(3.0);
+    TAP_CHECK(pad == 5, "default pad is band + 2 = 5 (%ld)", pad);
+    TAP_NEAR(h, 0.5, 1e-15, "voxel = longest side / cells");
+    TAP_CHECK(dims[0] == 8 + 10 && dims[1] == 4 + 10 && dims[2] == 2 + 10,
+              "dims = cells per side + 2 pad (%zu %zu %zu)", dims[0], dims[1], dims[2]);
+    /* box centered in the grid */
+    TAP_NEAR(origin[0] + 0.5 * (double)(dims[0] - 1) * h, 2.0, 1e-12, "centered in x");
+    TAP_NEAR(origin[2] + 0.5 * (double)(dims[2] - 1) * h, 0.5, 1e-12, "centered in z");
+    /* a flat soup still gets a grid along its flat axis */
+    const double flat[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    st_soup *f = soup_from(flat, 3, tri, 1);
+    TAP_CHECK(st_dist_layout(f, &p, dims, origin, &h, &err) == ST_OK && dims[2] == 11,
+              "flat soup: 1 + 2 pad voxels across (%zu)", dims[2]);
+    /* a soup whose vertices coincide has no extent for -r */
+    const double pt[] = {1, 1, 1, 1, 1, 1, 1, 1, 1};
+    st_soup *q = soup_from(pt, 3, tri, 1);
+    TAP_CHECK(st_dist_layout(q, &p, dims, origin, &h, &err) == ST_EINPUT,
+              "a point soup is refused with -r: %s", err.msg);
+    p.voxel = 0.1;
+    TAP_CHECK(st_dist_layout(q, &p, dims, origin, &h, &err) == ST_OK,
+              "a point soup works with a voxel size");
+    /* limits */
+    p.voxel = 1e-13;
+    TAP_CHECK(st_dist_layout(s, &p, dims, origin, &h, &err) == ST_ELIMIT,
+              "absurd voxel size refused: %s", err.msg);
+    p.voxel = 0;
+    p.cells = 8;
+    p.max_bytes = 1000;
+    st_grid *g;
+    TAP_CHECK(st_dist_field(&g, s, &p, NULL, &err) == ST_ELIMIT,
+              "grid over max_bytes refused: %s", err.msg);
+    p.max_bytes = 0;
+    p.band = 2.0;
+    TAP_CHECK(st_dist_field(&g, s, &p, NULL, &err) == ST_EINPUT,
+              "band below 3 voxels refused: %s", err.msg);
+    st_soup_free(s);
+    st_soup_free(f);
+    st_soup_free(q);
+}
+
+static void test_bvh_nearest(void)
+{
+    st_soup *s = random_soup(300);
+    st_bvh *b;
+    st_error err;
+    TAP_CHECK(st_bvh_build(&b, s, &err) == ST_OK, "bvh build");
+    int bad = 0;
+    for (int i = 0; i < 300; i++) {
+        double p[3] = {urand() * 1.6 - 0.3, urand() * 1.6 - 0.3, urand() * 1.6 - 0.3};
+        int64_t tri;
+        double d = sqrt(st_bvh_nearest(b, p, INFINITY, &tri, NULL));
+        if (fabs(d - brute_dist(s, p)) > 1e-12 || tri < 0)
+            bad++;
+    }
+    TAP_CHECK(bad == 0, "bvh nearest equals brute force (%d bad)", bad);
+    double p[3] = {5, 5, 5};
+    int64_t tri;
+    double d2 = st_bvh_nearest(b, p, 1.0, &tri, NULL);
+    TAP_CHECK(tri == -1 && d2 == 1.0, "bvh: nothing within the bound gives -1");
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
+static void test_threads_identical(void)
+{
+#ifdef _OPENMP
+    st_soup *s = random_soup(400);
+    st_dist_params p = st_dist_params_default();
+    p.cells = 48;
+    p.band = INFINITY;
+    st_grid *g1, *g2;
+    st_error err;
+    omp_set_num_threads(1);
+    st_dist_field(&g1, s, &p, NULL, &err);
+    omp_set_num_threads(3);
+    st_dist_field(&g2, s, &p, NULL, &err);
+    TAP_CHECK(memcmp(g1->data, g2->data, st_grid_count(g1) * sizeof(float)) == 0,
+              "1 and 3 threads give identical fields");
+    st_grid_free(g1);
+    st_grid_free(g2);
+    st_soup_free(s);
+#else
+    TAP_CHECK(1, "# SKIP no OpenMP");
+#endif
+}
+
+/* A real model: sampled voxels against brute force. */
+static void test_real_model(void)
+{
+    st_soup *s;
+    st_error err;
+    if (st_soup_read(&s, "corpus/bunny.obj", &err) != ST_OK) {
+        TAP_CHECK(0, "read corpus/bunny.obj: %s", err.msg);
+        return;
+    }
+    st_dist_params p = st_dist_params_default();
+    p.cells = 64;
+    st_grid *g;
+    TAP_CHECK(st_dist_field(&g, s, &p, NULL, &err) == ST_OK, "bunny field at 64 cells");
+    size_t n = st_grid_count(g), bad = 0, inband = 0, checked = 0;
+    for (size_t idx = 0; idx < n; idx += 37) {   /* every 37th voxel */
+        size_t i = idx % g->nx, j = (idx / g->nx) % g->ny, k = idx / (g->nx * g->ny);
+        double q[3];
+        st_grid_center(g, i, j, k, q);
+        double ref = brute_dist(s, q);
+        double want = ref < g->band ? ref : g->band;
+        if (ref < g->band)
+            inband++;
+        if (fabs(g->data[idx] - want) > 1e-6 * fmax(want, g->voxel))
+            bad++;
+        checked++;
+    }
+    TAP_CHECK(bad == 0 && inband > 100,
+              "bunny: %zu sampled voxels (%zu in band) equal brute force (%zu bad)",
+              checked, inband, bad);
+    st_grid_free(g);
+    st_soup_free(s);
+}
+
+int main(void)
+{
+    test_layout();
+    test_band_exact_on_random_soup();
+    test_large_oblique_triangle();
+    test_bvh_nearest();
+    test_threads_identical();
+    test_real_model();
+    return tap_done();
+}

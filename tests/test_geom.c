@@ -1,0 +1,140 @@
+/* test_geom.c - point-segment and point-triangle distance. */
+#include "souptet/geom.h"
+#include "tap.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* The right triangle (0,0,0) (1,0,0) (0,1,0): known answers in each of its
+ * seven Voronoi regions, at height z = 2. */
+static void test_voronoi_regions(void)
+{
+    const double a[3] = {0, 0, 0}, b[3] = {1, 0, 0}, c[3] = {0, 1, 0};
+    struct { double p[3]; double d2; double q[3]; const char *region; } cases[] = {
+        {{0.2, 0.2, 2}, 4.0, {0.2, 0.2, 0}, "face"},
+        {{-1, -1, 2}, 2.0 + 4.0, {0, 0, 0}, "vertex a"},
+        {{2, -1, 2}, 1.0 + 1.0 + 4.0, {1, 0, 0}, "vertex b"},
+        {{-1, 2, 2}, 1.0 + 1.0 + 4.0, {0, 1, 0}, "vertex c"},
+        {{0.5, -1, 2}, 1.0 + 4.0, {0.5, 0, 0}, "edge ab"},
+        {{-1, 0.5, 2}, 1.0 + 4.0, {0, 0.5, 0}, "edge ca"},
+        {{1, 1, 2}, 0.5 + 4.0, {0.5, 0.5, 0}, "edge bc"},
+        {{0.25, 0.25, 0}, 0.0, {0.25, 0.25, 0}, "on the face"},
+        {{0.25, 0.25, -3}, 9.0, {0.25, 0.25, 0}, "face from below"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        double q[3];
+        double d2 = st_point_triangle_dist2(cases[i].p, a, b, c, q);
+        TAP_NEAR(d2, cases[i].d2, 1e-14, "distance in region %s", cases[i].region);
+        double e = fabs(q[0] - cases[i].q[0]) + fabs(q[1] - cases[i].q[1]) +
+                   fabs(q[2] - cases[i].q[2]);
+        TAP_NEAR(e, 0.0, 1e-14, "closest point in region %s", cases[i].region);
+    }
+}
+
+static void test_degenerate_triangles(void)
+{
+    const double p[3] = {0.5, 1.0, 0.0};
+    /* collinear: the segment from 0 to 2 on the x axis */
+    const double a[3] = {0, 0, 0}, b[3] = {1, 0, 0}, c[3] = {2, 0, 0};
+    TAP_NEAR(st_point_triangle_dist2(p, a, b, c, NULL), 1.0, 1e-15,
+             "collinear triangle is its longest segment");
+    const double far[3] = {3, 0, 0};
+    TAP_NEAR(st_point_triangle_dist2(far, a, b, c, NULL), 1.0, 1e-15,
+             "collinear triangle: beyond the end vertex");
+    /* repeated vertex: a segment */
+    TAP_NEAR(st_point_triangle_dist2(p, a, b, b, NULL), 1.0, 1e-15,
+             "triangle with a repeated vertex is a segment");
+    /* all three equal: a point */
+    const double q[3] = {3, 4, 0};
+    TAP_NEAR(st_point_triangle_dist2(q, a, a, a, NULL), 25.0, 1e-15,
+             "triangle with one vertex three times is a point");
+    /* a needle: nearly collinear, width 1e-12 */
+    const double n1[3] = {0, 0, 0}, n2[3] = {1, 1e-12, 0}, n3[3] = {2, 0, 0};
+    double d2 = st_point_triangle_dist2(p, n1, n2, n3, NULL);
+    TAP_CHECK(isfinite(d2) && fabs(sqrt(d2) - 1.0) < 1e-11,
+              "needle triangle gives a finite, right distance (%.17g)", sqrt(d2));
+    /* huge and tiny coordinates */
+    const double h1[3] = {1e15, 0, 0}, h2[3] = {1e15 + 1e3, 0, 0},
+                 h3[3] = {1e15, 1e3, 0}, hp[3] = {1e15 + 100, 100, 50};
+    TAP_NEAR(st_point_triangle_dist2(hp, h1, h2, h3, NULL), 2500.0, 1e-2,
+             "triangle far from the origin");
+    /* 1e-150: the squared distance (1e-300) is still a normal double, but
+     * the squared normal (1e-600) would not be. */
+    const double t1[3] = {0, 0, 0}, t2[3] = {1e-150, 0, 0},
+                 t3[3] = {0, 1e-150, 0}, tp[3] = {2e-151, 2e-151, 1e-150};
+    double td = st_point_triangle_dist2(tp, t1, t2, t3, NULL);
+    TAP_CHECK(isfinite(td) && fabs(sqrt(td) / 1e-150 - 1.0) < 1e-9,
+              "triangle with tiny coordinates (%.3g)", sqrt(td));
+}
+
+static double urand(unsigned *s)
+{
+    *s = *s * 1103515245u + 12345u;
+    return (double)((*s >> 8) & 0xffffff) / 16777216.0;
+}
+
+/* Random triangles and points: the closest point lies in the triangle,
+ * matches the returned distance, and no sampled point of the triangle is
+ * closer. */
+static void test_random_against_sampling(void)
+{
+    unsigned seed = 12345;
+    int bad_in = 0, bad_d = 0, bad_min = 0;
+    const int trials = 2000, samples = 40;
+    for (int t = 0; t < trials; t++) {
+        double v[3][3], p[3];
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++)
+                v[k][a] = urand(&seed) * 2 - 1;
+        for (int a = 0; a < 3; a++)
+            p[a] = urand(&seed) * 4 - 2;
+        double q[3];
+        double d2 = st_point_triangle_dist2(p, v[0], v[1], v[2], q);
+        /* barycentrics of q by least squares on the two edges */
+        double e1[3], e2[3], w[3];
+        st_sub3(e1, v[1], v[0]);
+        st_sub3(e2, v[2], v[0]);
+        st_sub3(w, q, v[0]);
+        double a11 = st_dot3(e1, e1), a12 = st_dot3(e1, e2), a22 = st_dot3(e2, e2);
+        double b1 = st_dot3(w, e1), b2 = st_dot3(w, e2), det = a11 * a22 - a12 * a12;
+        double s = (b1 * a22 - b2 * a12) / det, u = (a11 * b2 - a12 * b1) / det;
+        if (s < -1e-9 || u < -1e-9 || s + u > 1 + 1e-9)
+            bad_in++;
+        double pq[3];
+        st_sub3(pq, p, q);
+        if (fabs(st_dot3(pq, pq) - d2) > 1e-12)
+            bad_d++;
+        for (int i = 0; i <= samples; i++)
+            for (int j = 0; i + j <= samples; j++) {
+                double x[3];
+                for (int a = 0; a < 3; a++)
+                    x[a] = v[0][a] + e1[a] * i / samples + e2[a] * j / samples;
+                double px[3];
+                st_sub3(px, p, x);
+                if (st_dot3(px, px) < d2 - 1e-12)
+                    bad_min++;
+            }
+    }
+    TAP_CHECK(bad_in == 0, "closest point lies in the triangle (%d of %d off)", bad_in, trials);
+    TAP_CHECK(bad_d == 0, "returned distance is the distance to the closest point (%d off)", bad_d);
+    TAP_CHECK(bad_min == 0, "no sample of the triangle is closer (%d closer)", bad_min);
+}
+
+static void test_segment(void)
+{
+    const double a[3] = {0, 0, 0}, b[3] = {2, 0, 0};
+    const double p1[3] = {1, 1, 0}, p2[3] = {-1, 0, 0}, p3[3] = {4, 0, 3};
+    TAP_NEAR(st_point_segment_dist2(p1, a, b, NULL), 1.0, 0, "segment interior");
+    TAP_NEAR(st_point_segment_dist2(p2, a, b, NULL), 1.0, 0, "segment start");
+    TAP_NEAR(st_point_segment_dist2(p3, a, b, NULL), 13.0, 0, "segment end");
+    TAP_NEAR(st_point_segment_dist2(p1, a, a, NULL), 2.0, 0, "zero-length segment");
+}
+
+int main(void)
+{
+    test_voronoi_regions();
+    test_degenerate_triangles();
+    test_segment();
+    test_random_against_sampling();
+    return tap_done();
+}
