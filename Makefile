@@ -37,7 +37,7 @@ CXXFLAGS_ALL := -std=c++17 $(OPT) -Wall -Wextra -ffp-contract=off -fopenmp -Iinc
                 -I/usr/include/vtk-9.1 -MMD -MP -DSOUPTET_VERSION='"$(VERSION)"' $(CXXFLAGS)
 LIBS := -lopenvdb -ltbb -lImath-3_1 \
         -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
-        -lvtkCommonDataModel-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1 \
+        -lvtkCommonDataModel-9.1 -lvtkCommonMath-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1 \
         -lgomp -lpthread -lm
 LDFLAGS_ALL := $(OPT) -fopenmp $(LDFLAGS)
 
@@ -84,6 +84,12 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA)
 	@mkdir -p $(dir $@)
 	$(CXX) $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
 
+# Peers for make bench (not installed).
+BENCH_BIN := $(BUILD)/bench/vdb_udf
+$(BUILD)/bench/%: bench/%.cpp $(LIBA)
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
+
 # scripts/setup installs what is missing and returns in a second otherwise.
 setup:
 	@scripts/setup
@@ -102,7 +108,7 @@ demo: setup
 	scripts/demo $(BUILD)/bin
 
 bench: setup
-	$(MAKE) --no-print-directory all
+	$(MAKE) --no-print-directory all $(BENCH_BIN)
 	scripts/bench $(BUILD) $(STAGE)
 
 install: all

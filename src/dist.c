@@ -1,15 +1,17 @@
 /*
  * dist.c - unsigned distance fields of triangle soups (see dist.h).
  *
- * Band pass. The grid's z layers are cut into chunks; every triangle is
- * binned into the chunks its band-expanded box reaches, and the chunks are
- * processed in parallel, so no two threads write the same voxel. Within a
- * chunk, each triangle visits the voxels of its expanded box row by row,
- * rows running along the axis closest to its normal: on such a row the
- * distance to the triangle's plane is linear in the index, so the voxels
- * whose plane distance is below the band form an interval computed up
- * front. A large triangle (CAD) thus costs its area times the band, not its
- * bounding box. Each voxel keeps the minimum squared distance.
+ * Band pass. The grid is cut into bricks of 4^3 voxels. Every triangle is
+ * binned into the bricks its band may reach (near its bounding ball and,
+ * for a large CAD triangle, near its plane, so it costs its area times the
+ * band and not its bounding box). Bricks are processed in parallel, each
+ * writing only its own voxels. A brick sorts its candidates by a lower
+ * bound on their distance (from the brick's center, less the triangle's
+ * radius and the brick's half diagonal); each voxel then walks that list
+ * and stops at the first candidate whose bound is not below its best so
+ * far. Candidates that survive a per-voxel ball bound and a plane bound are
+ * measured exactly. The minimum is the same whatever the order, so the
+ * pruning changes the work, never the answer.
  *
  * Full field. Voxels the band did not reach ask the BVH for their nearest
  * triangle, bounded by the previous voxel of the row plus one voxel: the
@@ -28,10 +30,6 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-
-/* z layers per parallel chunk: small enough for load balance on a 128^3
- * grid, large enough that triangles rarely straddle chunks. */
-#define CHUNK_LAYERS 4
 
 st_dist_params st_dist_params_default(void)
 {
@@ -105,6 +103,39 @@ typedef struct tri_setup {
     int dom;             /* axis of the largest normal component */
 } tri_setup;
 
+/* fmin/fmax are library calls when NaN rules must be kept; nothing here is
+ * NaN (coordinates are finite), so plain comparisons do. */
+#define MIN2(a, b) ((a) < (b) ? (a) : (b))
+#define MAX2(a, b) ((a) > (b) ? (a) : (b))
+
+/* A ball around a triangle: the cheap part of a triangle, for binning and
+ * for the lower bounds that order and prune the candidates. */
+typedef struct tri_ball {
+    double c[3];
+    double r;
+} tri_ball;
+
+static void triangle_ball(tri_ball *b, const st_soup *s, size_t tri)
+{
+    const double *v[3];
+    for (int k = 0; k < 3; k++)
+        v[k] = s->xyz + 3 * (size_t)s->tris[3 * tri + k];
+    for (int a = 0; a < 3; a++) {
+        double lo = MIN2(v[0][a], MIN2(v[1][a], v[2][a]));
+        double hi = MAX2(v[0][a], MAX2(v[1][a], v[2][a]));
+        b->c[a] = 0.5 * (lo + hi);
+    }
+    double r2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double w[3];
+        st_sub3(w, v[k], b->c);
+        r2 = MAX2(r2, st_dot3(w, w));
+    }
+    /* Slightly more than the farthest vertex, so rounding never makes the
+     * ball miss a point of the triangle. */
+    b->r = sqrt(r2) * (1.0 + 1e-12);
+}
+
 static void setup_triangle(tri_setup *t, const st_soup *s, size_t tri)
 {
     for (int k = 0; k < 3; k++)
@@ -156,184 +187,331 @@ static inline double tri_dist2(const tri_setup *t, const double p[3],
                                double plane_d)
 {
     if (t->degenerate) {
-        double d = edge_dist2(t, 0, p);
-        d = fmin(d, edge_dist2(t, 1, p));
-        return fmin(d, edge_dist2(t, 2, p));
+        double d = edge_dist2(t, 0, p), d1 = edge_dist2(t, 1, p),
+               d2 = edge_dist2(t, 2, p);
+        d = MIN2(d, d1);
+        return MIN2(d, d2);
     }
     int out0 = st_dot3(p, t->m[0]) < t->mo[0];
     int out1 = st_dot3(p, t->m[1]) < t->mo[1];
     int out2 = st_dot3(p, t->m[2]) < t->mo[2];
     if (!(out0 | out1 | out2))
         return plane_d * plane_d;
-    double d = INFINITY;
+    double d = INFINITY, x;
     if (out0)
         d = edge_dist2(t, 0, p);
-    if (out1)
-        d = fmin(d, edge_dist2(t, 1, p));
-    if (out2)
-        d = fmin(d, edge_dist2(t, 2, p));
+    if (out1 && (x = edge_dist2(t, 1, p)) < d)
+        d = x;
+    if (out2 && (x = edge_dist2(t, 2, p)) < d)
+        d = x;
     return d;
 }
 
-/* Visit the voxels of triangle t within distance B (model units) whose z
- * index lies in [kz0, kz1], lowering data (squared distances) there. */
-static void splat_triangle(const st_grid *g, float *data, const tri_setup *t,
-                           double B, long kz0, long kz1)
+/* Bricks: BRICK^3 voxels whose candidate triangles are gathered once. Four
+ * keeps a brick's candidate list short for a band of three voxels while
+ * the per-brick sort is amortised over 64 voxels. */
+#define BRICK 4
+
+typedef struct brick_grid {
+    size_t n[3];        /* bricks per axis */
+    double half_diag;   /* from a brick's center to its farthest voxel center */
+} brick_grid;
+
+static void brick_center(const st_grid *g, const size_t b[3], double c[3])
 {
-    const double h = g->voxel;
-    const long n[3] = {(long)g->nx, (long)g->ny, (long)g->nz};
-    const size_t stride[3] = {1, g->nx, g->nx * g->ny};
-    long lo[3], hi[3];
+    const size_t n[3] = {g->nx, g->ny, g->nz};
     for (int a = 0; a < 3; a++) {
-        double mn = fmin(t->v[0][a], fmin(t->v[1][a], t->v[2][a])) - B;
-        double mx = fmax(t->v[0][a], fmax(t->v[1][a], t->v[2][a])) + B;
-        double l = ceil((mn - g->origin[a]) / h);
-        double u = floor((mx - g->origin[a]) / h);
-        lo[a] = l < 0.0 ? 0 : (long)l;
-        hi[a] = u > (double)(n[a] - 1) ? n[a] - 1 : (long)u;
-        if (lo[a] > hi[a])
-            return;
-    }
-    if (lo[2] < kz0)
-        lo[2] = kz0;
-    if (hi[2] > kz1)
-        hi[2] = kz1;
-    if (lo[2] > hi[2])
-        return;
-    const int d = t->dom, u = (d + 1) % 3, w = (d + 2) % 3;
-    const double B2 = B * B;
-    /* Plane distance moves by this much per voxel along the row. */
-    const double step = t->nu[d] * h;
-    double p[3];
-    for (long iw = lo[w]; iw <= hi[w]; iw++) {
-        p[w] = g->origin[w] + h * (double)iw;
-        for (long iu = lo[u]; iu <= hi[u]; iu++) {
-            p[u] = g->origin[u] + h * (double)iu;
-            long r0 = lo[d], r1 = hi[d];
-            p[d] = g->origin[d];
-            double pd0 = 0.0;
-            if (!t->degenerate) {
-                double q[3];
-                st_sub3(q, p, t->v[0]);
-                pd0 = st_dot3(q, t->nu);   /* plane distance at index 0 */
-                /* |pd0 + i * step| < B on an interval of i; widen by one
-                 * voxel each side against rounding. */
-                double ta = (-B - pd0) / step, tb = (B - pd0) / step;
-                if (ta > tb) {
-                    double x = ta; ta = tb; tb = x;
-                }
-                ta = floor(ta) - 1.0;
-                tb = ceil(tb) + 1.0;
-                if (ta > (double)r0)
-                    r0 = ta > (double)r1 ? r1 + 1 : (long)ta;
-                if (tb < (double)r1)
-                    r1 = tb < (double)r0 ? r0 - 1 : (long)tb;
-            }
-            size_t base = (size_t)iw * stride[w] + (size_t)iu * stride[u];
-            for (long id = r0; id <= r1; id++) {
-                p[d] = g->origin[d] + h * (double)id;
-                double pd = pd0 + step * (double)id;
-                if (pd * pd >= B2)
-                    continue;
-                double d2 = tri_dist2(t, p, pd);
-                float *cell = &data[base + (size_t)id * stride[d]];
-                if (d2 < B2 && (float)d2 < *cell)
-                    *cell = (float)d2;
-            }
-        }
+        size_t lo = b[a] * BRICK;
+        size_t hi = lo + BRICK - 1 < n[a] - 1 ? lo + BRICK - 1 : n[a] - 1;
+        c[a] = g->origin[a] + g->voxel * 0.5 * (double)(lo + hi);
     }
 }
 
-/* Lowest and highest z index the band around triangle tri reaches. */
-static void tri_zrange(const st_grid *g, const st_soup *s, size_t tri,
-                       double B, long *k0, long *k1)
+/* Call visit(b, ctx) for every brick the band around triangle t may reach:
+ * bricks meeting its B-expanded box whose center is within reach of both
+ * its ball and (for a proper triangle) its plane. */
+typedef void (*brick_visit)(size_t brick, void *ctx);
+
+static void triangle_bricks(const st_grid *g, const brick_grid *bg,
+                            const st_soup *s, size_t tri,
+                            const tri_ball *ball, double B,
+                            brick_visit visit, void *ctx)
 {
-    double mn = INFINITY, mx = -INFINITY;
-    for (int k = 0; k < 3; k++) {
-        double z = s->xyz[3 * (size_t)s->tris[3 * tri + k] + 2];
-        mn = fmin(mn, z);
-        mx = fmax(mx, z);
+    const double h = g->voxel;
+    const size_t n[3] = {g->nx, g->ny, g->nz};
+    const double *v[3];
+    for (int k = 0; k < 3; k++)
+        v[k] = s->xyz + 3 * (size_t)s->tris[3 * tri + k];
+    size_t lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        double mn = MIN2(v[0][a], MIN2(v[1][a], v[2][a])) - B;
+        double mx = MAX2(v[0][a], MAX2(v[1][a], v[2][a])) + B;
+        double l = ceil((mn - g->origin[a]) / h);
+        double u = floor((mx - g->origin[a]) / h);
+        if (u < 0.0 || l > (double)(n[a] - 1) || l > u)
+            return;
+        lo[a] = l < 0.0 ? 0 : (size_t)l;
+        hi[a] = u > (double)(n[a] - 1) ? n[a] - 1 : (size_t)u;
+        lo[a] /= BRICK;
+        hi[a] /= BRICK;
     }
-    double l = ceil((mn - B - g->origin[2]) / g->voxel);
-    double u = floor((mx + B - g->origin[2]) / g->voxel);
-    double top = (double)g->nz - 1.0;
-    *k0 = l < 0.0 ? 0 : (l > top ? (long)g->nz : (long)l);
-    *k1 = u > top ? (long)g->nz - 1 : (u < 0.0 ? -1 : (long)u);
+    double e1[3], e2[3], nrm[3];
+    st_sub3(e1, v[1], v[0]);
+    st_sub3(e2, v[2], v[0]);
+    st_cross3(nrm, e1, e2);
+    double nl = st_norm3(nrm);
+    int use_plane = nl > 0.0;
+    if (use_plane)
+        for (int a = 0; a < 3; a++)
+            nrm[a] /= nl;
+    /* Small slack: these tests only prune, so erring wide is safe. */
+    const double reach = (B + bg->half_diag) * (1.0 + 1e-9) + 1e-12 * h;
+    const double reach_ball = reach + ball->r;
+    size_t b[3];
+    for (b[2] = lo[2]; b[2] <= hi[2]; b[2]++)
+        for (b[1] = lo[1]; b[1] <= hi[1]; b[1]++)
+            for (b[0] = lo[0]; b[0] <= hi[0]; b[0]++) {
+                double c[3], w[3];
+                brick_center(g, b, c);
+                st_sub3(w, c, ball->c);
+                if (st_dot3(w, w) > reach_ball * reach_ball)
+                    continue;
+                if (use_plane) {
+                    st_sub3(w, c, v[0]);
+                    if (fabs(st_dot3(w, nrm)) > reach)
+                        continue;
+                }
+                visit(b[0] + bg->n[0] * (b[1] + bg->n[1] * b[2]), ctx);
+            }
+}
+
+typedef struct bin_ctx {
+    size_t *count;     /* per brick (counting pass) */
+    size_t *fill;      /* per brick write position (fill pass) */
+    uint32_t *list;
+    uint32_t tri;
+} bin_ctx;
+
+static void count_visit(size_t brick, void *ctx)
+{
+    ((bin_ctx *)ctx)->count[brick + 1]++;
+}
+
+static void fill_visit(size_t brick, void *ctx)
+{
+    bin_ctx *c = ctx;
+    c->list[c->fill[brick]++] = c->tri;
+}
+
+/* Candidate order within a brick: by lower bound, then by index, so the
+ * order (and with it the result) never depends on anything but the input. */
+typedef struct cand {
+    double key;        /* |brick center - ball center| - ball radius */
+    tri_ball ball;     /* copied: the voxel loop then reads memory in order */
+    uint32_t tri;
+    uint32_t slot;     /* where its setup is cached, or UINT32_MAX */
+} cand;
+
+static int cand_cmp(const void *a, const void *b)
+{
+    const cand *x = a, *y = b;
+    if (x->key != y->key)
+        return x->key < y->key ? -1 : 1;
+    return x->tri < y->tri ? -1 : (x->tri > y->tri);
+}
+
+typedef struct brick_scratch {
+    cand *cands;
+    tri_setup *setups;
+    size_t cap;
+} brick_scratch;
+
+static int scratch_reserve(brick_scratch *sc, size_t m)
+{
+    if (m <= sc->cap)
+        return 0;
+    size_t cap = m < 64 ? 64 : m;
+    cand *c = st_realloc_array(sc->cands, cap, sizeof *c);
+    if (!c)
+        return -1;
+    sc->cands = c;
+    tri_setup *t = st_realloc_array(sc->setups, cap, sizeof *t);
+    if (!t)
+        return -1;
+    sc->setups = t;
+    sc->cap = cap;
+    return 0;
+}
+
+/* Exact band distances for the voxels of one brick. */
+static void process_brick(st_grid *g, const st_soup *s, const tri_ball *balls,
+                          const brick_grid *bg, size_t brick,
+                          const uint32_t *list, size_t m, double B,
+                          brick_scratch *sc)
+{
+    const size_t n[3] = {g->nx, g->ny, g->nz};
+    size_t b[3] = {brick % bg->n[0], (brick / bg->n[0]) % bg->n[1],
+                   brick / (bg->n[0] * bg->n[1])};
+    size_t lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = b[a] * BRICK;
+        hi[a] = lo[a] + BRICK < n[a] ? lo[a] + BRICK : n[a];
+    }
+    const float Bf = (float)B;
+    const double B2 = B * B;
+    if (m == 0) {
+        for (size_t k = lo[2]; k < hi[2]; k++)
+            for (size_t j = lo[1]; j < hi[1]; j++)
+                for (size_t i = lo[0]; i < hi[0]; i++)
+                    g->data[st_grid_index(g, i, j, k)] = Bf;
+        return;
+    }
+    double bc[3];
+    brick_center(g, b, bc);
+    cand *cs = sc->cands;
+    for (size_t q = 0; q < m; q++) {
+        const tri_ball *tb = &balls[list[q]];
+        double w[3];
+        st_sub3(w, bc, tb->c);
+        /* From the brick's center; a voxel subtracts its own offset. */
+        cs[q].key = sqrt(st_dot3(w, w)) - tb->r;
+        cs[q].ball = *tb;
+        cs[q].tri = list[q];
+        cs[q].slot = UINT32_MAX;
+    }
+    qsort(cs, m, sizeof *cs, cand_cmp);
+    uint32_t nsetup = 0;
+    double p[3];
+    for (size_t k = lo[2]; k < hi[2]; k++) {
+        p[2] = g->origin[2] + g->voxel * (double)k;
+        for (size_t j = lo[1]; j < hi[1]; j++) {
+            p[1] = g->origin[1] + g->voxel * (double)j;
+            for (size_t i = lo[0]; i < hi[0]; i++) {
+                p[0] = g->origin[0] + g->voxel * (double)i;
+                double off[3];
+                st_sub3(off, p, bc);
+                /* |p - c| - r >= key - |p - bc|: once that reaches the best
+                 * distance so far, no later candidate can improve it. The
+                 * relative shave keeps rounding on the safe side. */
+                const double offset = sqrt(st_dot3(off, off)) * (1.0 + 1e-9) +
+                                      1e-12 * g->voxel;
+                double cur = B2, curd = B;
+                for (size_t q = 0; q < m; q++) {
+                    if (cs[q].key - offset >= curd)
+                        break;          /* sorted: no later one is closer */
+                    const tri_ball *tb = &cs[q].ball;
+                    double w[3];
+                    st_sub3(w, p, tb->c);
+                    double reach = curd + tb->r;
+                    if (st_dot3(w, w) >= reach * reach)
+                        continue;       /* its ball is too far */
+                    if (cs[q].slot == UINT32_MAX) {
+                        cs[q].slot = nsetup++;
+                        setup_triangle(&sc->setups[cs[q].slot], s, cs[q].tri);
+                    }
+                    const tri_setup *t = &sc->setups[cs[q].slot];
+                    double pd = 0.0;
+                    if (!t->degenerate) {
+                        double v0p[3];
+                        st_sub3(v0p, p, t->v[0]);
+                        pd = st_dot3(v0p, t->nu);
+                        if (pd * pd >= cur)
+                            continue;   /* its plane is too far */
+                    }
+                    double d2 = tri_dist2(t, p, pd);
+                    if (d2 < cur) {
+                        cur = d2;
+                        curd = sqrt(d2);
+                    }
+                }
+                g->data[st_grid_index(g, i, j, k)] =
+                    cur >= B2 ? Bf : (float)curd;
+            }
+        }
+    }
 }
 
 static st_status band_pass(st_grid *g, const st_soup *s, double B,
                            const st_progress *progress, st_error *err)
 {
-    const size_t nchunks = (g->nz + CHUNK_LAYERS - 1) / CHUNK_LAYERS;
-    size_t *start = st_calloc_array(nchunks + 1, sizeof(size_t));
-    if (!start)
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
-    /* Counting sort of (chunk, triangle) pairs: triangles stay in input
-     * order within a chunk. */
-    for (size_t t = 0; t < s->ntris; t++) {
-        long k0, k1;
-        tri_zrange(g, s, t, B, &k0, &k1);
-        if (k0 > k1)
-            continue;
-        for (long c = k0 / CHUNK_LAYERS; c <= k1 / CHUNK_LAYERS; c++)
-            start[c + 1]++;
-    }
-    for (size_t c = 0; c < nchunks; c++)
-        start[c + 1] += start[c];
-    uint32_t *list = st_malloc_array(start[nchunks], sizeof(uint32_t));
-    size_t *fill = st_malloc_array(nchunks, sizeof(size_t));
-    if (!list || !fill) {
+    if (s->ntris > UINT32_MAX)
+        return st_error_set(err, ST_ELIMIT, NULL, 0,
+                            "too many triangles (%zu)", s->ntris);
+    brick_grid bg;
+    bg.n[0] = (g->nx + BRICK - 1) / BRICK;
+    bg.n[1] = (g->ny + BRICK - 1) / BRICK;
+    bg.n[2] = (g->nz + BRICK - 1) / BRICK;
+    bg.half_diag = 0.5 * sqrt(3.0) * (double)(BRICK - 1) * g->voxel;
+    const size_t nb = bg.n[0] * bg.n[1] * bg.n[2];
+
+    tri_ball *balls = st_malloc_array(s->ntris, sizeof *balls);
+    size_t *start = st_calloc_array(nb + 1, sizeof(size_t));
+    size_t *fill = st_malloc_array(nb, sizeof(size_t));
+    if (!balls || !start || !fill) {
+        free(balls);
         free(start);
-        free(list);
         free(fill);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     }
-    memcpy(fill, start, nchunks * sizeof(size_t));
+    #pragma omp parallel for schedule(static)
+    for (size_t t = 0; t < s->ntris; t++)
+        triangle_ball(&balls[t], s, t);
+    /* Counting sort of (brick, triangle) pairs, triangles in input order. */
+    bin_ctx bc = {start, NULL, NULL, 0};
+    for (size_t t = 0; t < s->ntris; t++)
+        triangle_bricks(g, &bg, s, t, &balls[t], B, count_visit, &bc);
+    for (size_t b = 0; b < nb; b++)
+        start[b + 1] += start[b];
+    const size_t npairs = start[nb];
+    uint32_t *list = st_malloc_array(npairs, sizeof(uint32_t));
+    if (!list) {
+        free(balls);
+        free(start);
+        free(fill);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for "
+                            "%zu brick candidates", npairs);
+    }
+    memcpy(fill, start, nb * sizeof(size_t));
+    bc.fill = fill;
+    bc.list = list;
     for (size_t t = 0; t < s->ntris; t++) {
-        long k0, k1;
-        tri_zrange(g, s, t, B, &k0, &k1);
-        if (k0 > k1)
-            continue;
-        for (long c = k0 / CHUNK_LAYERS; c <= k1 / CHUNK_LAYERS; c++)
-            list[fill[c]++] = (uint32_t)t;
+        bc.tri = (uint32_t)t;
+        triangle_bricks(g, &bg, s, t, &balls[t], B, fill_visit, &bc);
     }
     free(fill);
 
-    const float B2f = (float)(B * B);
-    const size_t nvox = st_grid_count(g);
-    #pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < nvox; i++)
-        g->data[i] = B2f;
-
+    int oom = 0;
     size_t done = 0;
-    #pragma omp parallel for schedule(dynamic, 1)
-    for (size_t c = 0; c < nchunks; c++) {
-        long kz0 = (long)(c * CHUNK_LAYERS);
-        long kz1 = kz0 + CHUNK_LAYERS - 1;
-        for (size_t i = start[c]; i < start[c + 1]; i++) {
-            tri_setup t;
-            setup_triangle(&t, s, list[i]);
-            splat_triangle(g, g->data, &t, B, kz0, kz1);
-        }
-        size_t now;
-        #pragma omp atomic capture
-        now = ++done;
+    #pragma omp parallel
+    {
+        brick_scratch sc = {NULL, NULL, 0};
+        #pragma omp for schedule(dynamic, 16)
+        for (size_t b = 0; b < nb; b++) {
+            size_t m = start[b + 1] - start[b];
+            if (scratch_reserve(&sc, m)) {
+                #pragma omp atomic write
+                oom = 1;
+                continue;
+            }
+            process_brick(g, s, balls, &bg, b, list + start[b], m, B, &sc);
+            size_t now;
+            #pragma omp atomic capture
+            now = ++done;
 #ifdef _OPENMP
-        if (omp_get_thread_num() == 0)
+            if (omp_get_thread_num() == 0 && (now & 1023) == 0)
 #endif
-            st_progress_report(progress, "distance band",
-                               (double)now / (double)nchunks);
+                st_progress_report(progress, "distance band",
+                                   (double)now / (double)nb);
+        }
+        free(sc.cands);
+        free(sc.setups);
     }
     free(list);
     free(start);
-
-    /* Squared distances to distances; everything at or past B is B. */
-    const float Bf = (float)B;
-    #pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < nvox; i++) {
-        float d2 = g->data[i];
-        g->data[i] = d2 >= B2f ? Bf : (float)sqrt((double)d2);
-    }
+    free(balls);
+    if (oom)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    st_progress_report(progress, "distance band", 1.0);
     return ST_OK;
 }
 
@@ -403,8 +581,9 @@ st_status st_dist_field(st_grid **out, const st_soup *s,
     st_grid *g;
     double band_vox = full ? ST_DIST_DEFAULT_BAND : p->band;
     double B = band_vox * h;
-    st = st_grid_new(&g, dims[0], dims[1], dims[2], origin, h, (float)B,
-                     p->max_bytes, err);
+    /* The band pass writes every voxel. */
+    st = st_grid_new_unset(&g, dims[0], dims[1], dims[2], origin, h,
+                           p->max_bytes, err);
     if (st)
         return st;
     g->kind = ST_GRID_DISTANCE;

@@ -6,9 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-st_status st_grid_new(st_grid **out, size_t nx, size_t ny, size_t nz,
-                      const double origin[3], double voxel, float fill,
-                      size_t max_bytes, st_error *err)
+static st_status grid_new(st_grid **out, size_t nx, size_t ny, size_t nz,
+                          const double origin[3], double voxel,
+                          const float *fill, size_t max_bytes, st_error *err)
 {
     *out = NULL;
     if (nx == 0 || ny == 0 || nz == 0)
@@ -42,8 +42,9 @@ st_status st_grid_new(st_grid **out, size_t nx, size_t ny, size_t nz,
                             "out of memory for a %zux%zux%zu grid (%.1f MiB)",
                             nx, ny, nz, (double)bytes / 1048576.0);
     }
-    for (size_t i = 0; i < n; i++)
-        data[i] = fill;
+    if (fill)
+        for (size_t i = 0; i < n; i++)
+            data[i] = *fill;
     g->nx = nx;
     g->ny = ny;
     g->nz = nz;
@@ -54,6 +55,20 @@ st_status st_grid_new(st_grid **out, size_t nx, size_t ny, size_t nz,
     g->band = INFINITY;
     *out = g;
     return ST_OK;
+}
+
+st_status st_grid_new(st_grid **out, size_t nx, size_t ny, size_t nz,
+                      const double origin[3], double voxel, float fill,
+                      size_t max_bytes, st_error *err)
+{
+    return grid_new(out, nx, ny, nz, origin, voxel, &fill, max_bytes, err);
+}
+
+st_status st_grid_new_unset(st_grid **out, size_t nx, size_t ny, size_t nz,
+                            const double origin[3], double voxel,
+                            size_t max_bytes, st_error *err)
+{
+    return grid_new(out, nx, ny, nz, origin, voxel, NULL, max_bytes, err);
 }
 
 void st_grid_free(st_grid *g)

@@ -567,6 +567,27 @@ static void errors(void)
                       == 0 && file_size(unk) < 0,
               "unknown extension on write: refused, nothing written");
 
+    /* stdout that cannot take the stream: an I/O error, not silence */
+    {
+        fflush(stdout);
+        int saved1 = dup(1);
+        int devfull = open("/dev/full", O_WRONLY);
+        if (devfull >= 0) {
+            dup2(devfull, 1);
+            close(devfull);
+            s = st_grid_write(g, "-", &err);
+            clearerr(stdout);
+            dup2(saved1, 1);
+            close(saved1);
+            TAP_CHECK(s == ST_EIO && strcmp(err.file, "<stdout>") == 0,
+                      "stream to a full stdout (/dev/full): I/O error");
+            note_error(&err);
+        } else {
+            close(saved1);
+            TAP_NOTE("no /dev/full: skipped the full-stdout test");
+        }
+    }
+
     g->data[7] = NAN;
     const char *nan = tpath("nan.vdb");
     s = st_grid_write(g, nan, &err);

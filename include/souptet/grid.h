@@ -43,6 +43,12 @@ typedef struct st_grid {
 st_status st_grid_new(st_grid **out, size_t nx, size_t ny, size_t nz,
                       const double origin[3], double voxel, float fill,
                       size_t max_bytes, st_error *err);
+/* As st_grid_new, but the values are left unset: for a caller that writes
+ * every voxel itself (in parallel, so the pages are first touched by the
+ * threads that use them). */
+st_status st_grid_new_unset(st_grid **out, size_t nx, size_t ny, size_t nz,
+                            const double origin[3], double voxel,
+                            size_t max_bytes, st_error *err);
 void st_grid_free(st_grid *g);   /* safe on NULL */
 
 /* Number of voxels (never overflows for a grid that exists). */

@@ -37,9 +37,10 @@ st_status st_gridio_read_vti_mem(st_grid **out, const unsigned char *data,
 
 /* Test hook: write a .vdb that souptet did not make, to exercise the
  * reader's foreign paths. which = 0: only a Vec3s grid (no float grid);
- * 1: a FloatGrid "density" without souptet metadata, voxel 0.5, a few
- * active voxels in index box (2,-3,4)..(5,1,6) valued i+10j+100k,
- * transform translated by (1,2,3); 2: an OpenVDB level-set sphere of
+ * 1: a FloatGrid "density" without souptet metadata, background -1,
+ * voxel 0.5, transform translated by (1,2,3), active voxels where i+j+k
+ * is even (and at both corners) of index box (2,-3,4)..(5,1,6), valued
+ * i+10j+100k, string metadata note=foreign; 2: an OpenVDB level-set sphere of
  * radius 2 at the origin, voxel 0.25, half width 3 voxels, named "ls". */
 st_status st_gridio_write_foreign_vdb(const char *path, int which,
                                       st_error *err);

@@ -57,7 +57,7 @@
  *
  * Files and streams: a file is written in OpenVDB's file format (grid
  * offsets, default compression: Blosc if built in, else zlib); stdout gets
- * the stream format (see STREAM_COMPRESSION below). Both are read through
+ * the stream format (see ST_VDB_STREAM_COMPRESSION below). Both are read through
  * one sequential io::Stream reader, which accepts either format, so a
  * .vdb file's bytes on stdin work too. Input streams have exceptions
  * enabled: OpenVDB does not check its reads, and a truncated file would
@@ -79,7 +79,6 @@
 #include <openvdb/tools/Prune.h>
 
 #include <cerrno>
-#include <dlfcn.h>
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
@@ -94,6 +93,7 @@
 #include <set>
 #include <streambuf>
 #include <string>
+#include <dlfcn.h>
 #include <sys/stat.h>
 #include <vector>
 

@@ -12,15 +12,17 @@
  *              the active scalars. Floats are stored in binary: exact.
  *   metadata   field data: souptet_kind (vtkStringArray), band
  *              (vtkDoubleArray, +inf as is), origin (3-component
- *              vtkDoubleArray) and voxel_size (vtkDoubleArray) - the last
- *              two because VTK writes the Origin and Spacing attributes as
- *              decimal text that does not round-trip every double - and
+ *              vtkDoubleArray) and voxel_size (vtkDoubleArray) - binary
+ *              copies of the Origin and Spacing attributes, which are
+ *              decimal text (VTK 9.1 prints 17 digits, which round-trips,
+ *              but other writers need not) - and
  *              every st_meta entry as a one-value vtkStringArray named by
  *              its key, in st_meta order (field data keeps its order). A
  *              key that is empty, starts with "souptet_meta:" or is one of
  *              the names above is stored as "souptet_meta:" + key.
- *   encoding   appended raw binary (not base64), zlib compression, 64-bit
- *              block headers (no 4 GiB limit on an array).
+ *   encoding   appended raw binary (not base64), zlib compression, UInt64
+ *              block headers (VTK's advice for arrays whose byte counts
+ *              may not fit 32 bits: a 1024^3 field is 4 GiB).
  *
  * Reading accepts foreign files too: the point array is the active scalars
  * if they are one-component float or double, else the first such array;
@@ -52,7 +54,6 @@
 #include <vtkImageData.h>
 #include <vtkInformation.h>
 #include <vtkLogger.h>
-#include <vtkMatrix3x3.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
 #include <vtkOutputWindow.h>
@@ -275,7 +276,10 @@ st_status read_with(vtkXMLImageDataReader *r, const char *name,
                             "points",
                             ext[0], ext[1], ext[2], ext[3], ext[4], ext[5]);
     // Allocate (and check max_bytes) before VTK reads the array: the
-    // limit must hold before anything of that size is allocated.
+    // limit must hold before anything of that size is allocated. VTK then
+    // holds its own copy while we convert, so reading a .vti peaks at about
+    // twice the dense size (VTK arrays are new[]-allocated; st_grid data
+    // is malloc'd and freed with free(), so the array cannot be adopted).
     const double zero[3] = {0, 0, 0};
     st_grid *g = nullptr;
     if (st_status s = st_grid_new(&g, size_t(d[0]), size_t(d[1]),
@@ -321,11 +325,24 @@ st_status read_with(vtkXMLImageDataReader *r, const char *name,
     double sp[3], org[3];
     img->GetSpacing(sp);
     img->GetOrigin(org);
-    vtkMatrix3x3 *dir = img->GetDirectionMatrix();
-    if (dir && !dir->IsIdentity())
-        return st_error_set(err, ST_EINPUT, name, 0,
-                            "image has a rotated direction matrix, which is "
-                            "not supported");
+    // The direction matrix must be the identity: index steps must move
+    // along the axes. Checked through the index-to-world transform rather
+    // than vtkMatrix3x3, which lives in a library the link line lacks.
+    double p0[3];
+    img->TransformContinuousIndexToPhysicalPoint(0, 0, 0, p0);
+    for (int a = 0; a < 3; a++) {
+        double e[3] = {0, 0, 0}, pa[3];
+        e[a] = 1;
+        img->TransformContinuousIndexToPhysicalPoint(e, pa);
+        for (int b = 0; b < 3; b++) {
+            const double want = b == a ? sp[a] : 0.0;
+            if (!close_to(pa[b] - p0[b], want,
+                          std::fabs(sp[a]) + std::fabs(p0[b])))
+                return st_error_set(err, ST_EINPUT, name, 0,
+                                    "image has a rotated direction matrix, "
+                                    "which is not supported");
+        }
+    }
     if (!(sp[0] > 0) || !std::isfinite(sp[0]) ||
         !close_to(sp[1], sp[0], sp[0]) || !close_to(sp[2], sp[0], sp[0]))
         return st_error_set(err, ST_EINPUT, name, 0,
