@@ -1,0 +1,146 @@
+/* test_core.c - errors, checked sizes, metadata, grids, atomic output. */
+#include "souptet/err.h"
+#include "souptet/grid.h"
+#include "souptet/mem.h"
+#include "souptet/meta.h"
+#include "souptet/outfile.h"
+#include "tap.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static void test_error_format(void)
+{
+    st_error e;
+    char buf[256];
+    st_error_set(&e, ST_EINPUT, "m.obj", 12, "face index %d out of range", 9);
+    TAP_CHECK(strcmp(st_error_format(&e, buf, sizeof buf),
+                     "m.obj:12: face index 9 out of range") == 0,
+              "text errors read FILE:LINE: what (%s)", buf);
+    st_error_set_offset(&e, ST_EINPUT, "m.stl", 80, "count disagrees");
+    TAP_CHECK(strcmp(st_error_format(&e, buf, sizeof buf),
+                     "m.stl: byte 80: count disagrees") == 0,
+              "binary errors name the byte offset (%s)", buf);
+    st_error_set(&e, ST_EIO, "x", 0, "gone");
+    TAP_CHECK(strcmp(st_error_format(&e, buf, sizeof buf), "x: gone") == 0,
+              "errors without a place read FILE: what");
+    TAP_CHECK(st_error_set(NULL, ST_ENOMEM, NULL, 0, "x") == ST_ENOMEM,
+              "a NULL error record still returns the status");
+}
+
+static void test_checked_sizes(void)
+{
+    size_t r = 7;
+    TAP_CHECK(st_size_mul(&r, SIZE_MAX / 2 + 1, 2) == -1 && r == 7,
+              "overflowing multiplication is refused and leaves the result");
+    TAP_CHECK(st_size_mul(&r, 1u << 20, 1u << 10) == 0 && r == (size_t)1 << 30,
+              "exact multiplication");
+    TAP_CHECK(st_size_add(&r, SIZE_MAX, 1) == -1, "overflowing addition is refused");
+    TAP_CHECK(st_malloc_array((size_t)1 << 62, 16) == NULL,
+              "an array whose byte size overflows is never allocated");
+    void *p = st_malloc_array(0, 8);
+    TAP_CHECK(p != NULL, "zero elements give a valid pointer");
+    free(p);
+}
+
+static void test_meta(void)
+{
+    st_meta m = {0};
+    st_meta_set(&m, "source", "a.obj");
+    st_meta_set(&m, "source", "b.obj");
+    TAP_CHECK(m.count == 1 && strcmp(st_meta_get(&m, "source"), "b.obj") == 0,
+              "setting a key again replaces its value");
+    st_meta_history_append(&m, "soupdist a.obj");
+    st_meta_history_append(&m, "soupsign");
+    TAP_CHECK(strcmp(st_meta_get(&m, "history"), "soupdist a.obj\nsoupsign") == 0,
+              "history lines accumulate, one per tool");
+    st_meta c = {0};
+    st_meta_copy(&c, &m);
+    st_meta_clear(&m);
+    TAP_CHECK(c.count == 2 && strcmp(st_meta_get(&c, "source"), "b.obj") == 0,
+              "a copy outlives its original");
+    TAP_CHECK(st_meta_get(&c, "missing") == NULL, "a missing key is NULL");
+    st_meta_clear(&c);
+    char *argv[] = {"soupdist", "-o", "my file.vdb", "it's", "x\ny"};
+    char *cl = st_command_line(5, argv);
+    TAP_CHECK(strcmp(cl, "soupdist -o 'my file.vdb' 'it'\\''s' 'x y'") == 0,
+              "command lines are shell-quoted on one line (%s)", cl);
+    free(cl);
+}
+
+static void test_grid(void)
+{
+    st_grid *g;
+    st_error e;
+    const double o[3] = {1.0, -2.0, 0.5};
+    TAP_CHECK(st_grid_new(&g, 4, 3, 2, o, 0.25, 7.0f, 0, &e) == ST_OK, "grid 4x3x2");
+    TAP_CHECK(st_grid_count(g) == 24 && st_grid_index(g, 3, 2, 1) == 23 &&
+              st_grid_index(g, 1, 0, 0) == 1 && st_grid_index(g, 0, 1, 0) == 4 &&
+              st_grid_index(g, 0, 0, 1) == 12, "x fastest, then y, then z");
+    double p[3];
+    st_grid_center(g, 2, 1, 1, p);
+    TAP_CHECK(p[0] == 1.5 && p[1] == -1.75 && p[2] == 0.75,
+              "voxel centers are origin + voxel * index");
+    TAP_CHECK(g->data[17] == 7.0f && isinf(g->band) && g->kind == ST_GRID_UNKNOWN,
+              "filled, no band, no kind yet");
+    st_grid_free(g);
+    TAP_CHECK(st_grid_new(&g, 0, 3, 2, o, 0.25, 0, 0, &e) == ST_EINPUT, "zero-size grid refused: %s", e.msg);
+    TAP_CHECK(st_grid_new(&g, 2, 3, 2, o, 0.0, 0, 0, &e) == ST_EINPUT, "voxel size 0 refused: %s", e.msg);
+    TAP_CHECK(st_grid_new(&g, 2, 3, 2, o, -1.0, 0, 0, &e) == ST_EINPUT, "negative voxel size refused");
+    TAP_CHECK(st_grid_new(&g, SIZE_MAX / 2, SIZE_MAX / 2, 2, o, 1.0, 0, 0, &e) == ST_ELIMIT,
+              "overflowing grid size refused: %s", e.msg);
+    TAP_CHECK(st_grid_new(&g, 1000, 1000, 1000, o, 1.0, 0, 1u << 20, &e) == ST_ELIMIT &&
+              strstr(e.msg, "max-memory") != NULL,
+              "a grid over the limit is refused, saying what to change: %s", e.msg);
+    TAP_CHECK(st_grid_kind_from_name(st_grid_kind_name(ST_GRID_SIGNED)) == ST_GRID_SIGNED &&
+              st_grid_kind_from_name("nonsense") == ST_GRID_UNKNOWN, "kind names round-trip");
+}
+
+static void test_outfile(void)
+{
+    char dir[] = "/tmp/souptet-outfile.XXXXXX";
+    TAP_CHECK(mkdtemp(dir) != NULL, "temp dir");
+    char path[256];
+    snprintf(path, sizeof path, "%s/out.txt", dir);
+    st_outfile o;
+    st_error e;
+    TAP_CHECK(st_outfile_begin(&o, path, 1, &e) == ST_OK, "begin");
+    struct stat st;
+    TAP_CHECK(stat(path, &st) != 0, "nothing at the target while writing");
+    fputs("hello\n", o.fp);
+    TAP_CHECK(st_outfile_commit(&o, &e) == ST_OK && stat(path, &st) == 0 && st.st_size == 6,
+              "commit puts the whole file in place");
+    TAP_CHECK(st_outfile_begin(&o, path, 1, &e) == ST_OK, "begin again over it");
+    fputs("partial", o.fp);
+    st_outfile_abort(&o);
+    TAP_CHECK(stat(path, &st) == 0 && st.st_size == 6,
+              "abort leaves the old file untouched");
+    snprintf(path, sizeof path, "%s/missing/out.txt", dir);
+    TAP_CHECK(st_outfile_begin(&o, path, 1, &e) == ST_EIO && strstr(e.file, "missing"),
+              "a missing directory is an error naming the target: %s", e.msg);
+    TAP_CHECK(st_outfile_begin(&o, dir, 1, &e) == ST_EIO, "a directory as target is refused");
+    snprintf(path, sizeof path, "%s/out.txt", dir);
+    TAP_CHECK(st_outfile_begin(&o, path, 0, &e) == ST_OK && o.tmp != NULL, "begin by name");
+    char tmp[256];
+    snprintf(tmp, sizeof tmp, "%s", o.tmp);
+    st_outfile_unlink_pending();
+    TAP_CHECK(stat(tmp, &st) != 0, "the signal-safe cleanup removes temporaries in flight");
+    st_outfile_abort(&o);
+    unlink(path);
+    rmdir(dir);
+}
+
+int main(void)
+{
+    test_error_format();
+    test_checked_sizes();
+    test_meta();
+    test_grid();
+    test_outfile();
+    return tap_done();
+}
