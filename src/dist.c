@@ -18,7 +18,6 @@
  * bound keeps the search near the answer, and the answer is exact.
  */
 #include "souptet/dist.h"
-#include "souptet/bvh.h"
 #include "souptet/geom.h"
 #include "souptet/mem.h"
 
@@ -344,10 +343,10 @@ static int scratch_reserve(brick_scratch *sc, size_t m)
 }
 
 /* Exact band distances for the voxels of one brick. */
-static void process_brick(st_grid *g, const st_soup *s, const tri_ball *balls,
-                          const brick_grid *bg, size_t brick,
-                          const uint32_t *list, size_t m, double B,
-                          brick_scratch *sc)
+static void process_brick(st_grid *g, int32_t *near, const st_soup *s,
+                          const tri_ball *balls, const brick_grid *bg,
+                          size_t brick, const uint32_t *list, size_t m,
+                          double B, brick_scratch *sc)
 {
     const size_t n[3] = {g->nx, g->ny, g->nz};
     size_t b[3] = {brick % bg->n[0], (brick / bg->n[0]) % bg->n[1],
@@ -364,6 +363,11 @@ static void process_brick(st_grid *g, const st_soup *s, const tri_ball *balls,
             for (size_t j = lo[1]; j < hi[1]; j++)
                 for (size_t i = lo[0]; i < hi[0]; i++)
                     g->data[st_grid_index(g, i, j, k)] = Bf;
+        if (near)
+            for (size_t k = lo[2]; k < hi[2]; k++)
+                for (size_t j = lo[1]; j < hi[1]; j++)
+                    for (size_t i = lo[0]; i < hi[0]; i++)
+                        near[st_grid_index(g, i, j, k)] = -1;
         return;
     }
     double bc[3];
@@ -396,6 +400,7 @@ static void process_brick(st_grid *g, const st_soup *s, const tri_ball *balls,
                 const double offset = sqrt(st_dot3(off, off)) * (1.0 + 1e-9) +
                                       1e-12 * g->voxel;
                 double cur = B2, curd = B;
+                int32_t best = -1;
                 for (size_t q = 0; q < m; q++) {
                     if (cs[q].key - offset >= curd)
                         break;          /* sorted: no later one is closer */
@@ -422,17 +427,21 @@ static void process_brick(st_grid *g, const st_soup *s, const tri_ball *balls,
                     if (d2 < cur) {
                         cur = d2;
                         curd = sqrt(d2);
+                        best = (int32_t)cs[q].tri;
                     }
                 }
                 g->data[st_grid_index(g, i, j, k)] =
                     cur >= B2 ? Bf : (float)curd;
+                if (near)
+                    near[st_grid_index(g, i, j, k)] = cur >= B2 ? -1 : best;
             }
         }
     }
 }
 
-static st_status band_pass(st_grid *g, const st_soup *s, double B,
-                           const st_progress *progress, st_error *err)
+static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
+                           double B, const st_progress *progress,
+                           st_error *err)
 {
     if (s->ntris > UINT32_MAX)
         return st_error_set(err, ST_ELIMIT, NULL, 0,
@@ -493,7 +502,8 @@ static st_status band_pass(st_grid *g, const st_soup *s, double B,
                 oom = 1;
                 continue;
             }
-            process_brick(g, s, balls, &bg, b, list + start[b], m, B, &sc);
+            process_brick(g, near, s, balls, &bg, b, list + start[b], m, B,
+                          &sc);
             size_t now;
             #pragma omp atomic capture
             now = ++done;
@@ -515,51 +525,101 @@ static st_status band_pass(st_grid *g, const st_soup *s, double B,
     return ST_OK;
 }
 
-/* Fill every voxel the band left at B with its exact distance. */
-static st_status full_pass(st_grid *g, const st_soup *s, double B,
-                           const st_progress *progress, st_error *err)
+/* Distance from p to triangle t of s, squared. */
+static double soup_tri_dist2(const st_soup *s, int32_t t, const double p[3])
 {
-    st_bvh *bvh;
-    st_status st = st_bvh_build(&bvh, s, err);
-    if (st)
-        return st;
-    const float Bf = (float)B;
-    const size_t rows = g->ny * g->nz;
-    const double h = g->voxel;
-    size_t done = 0;
-    #pragma omp parallel for schedule(dynamic, 16)
-    for (size_t r = 0; r < rows; r++) {
-        size_t j = r % g->ny, k = r / g->ny;
-        float *row = g->data + g->nx * r;
-        double prev = INFINITY;   /* exact distance of the previous voxel */
-        for (size_t i = 0; i < g->nx; i++) {
-            if (row[i] < Bf) {
-                prev = row[i];
-                continue;
+    const uint32_t *v = s->tris + 3 * (size_t)t;
+    return st_point_triangle_dist2(p, s->xyz + 3 * (size_t)v[0],
+                                   s->xyz + 3 * (size_t)v[1],
+                                   s->xyz + 3 * (size_t)v[2], NULL);
+}
+
+/* One raster sweep (forward: dir = +1, backward: -1) over the voxels the
+ * band did not fix: each takes the nearest of the triangles its 13
+ * already-swept neighbours found, measured exactly. */
+static void sweep(st_grid *g, int32_t *near, const uint8_t *fixed,
+                  const st_soup *s, int dir)
+{
+    const long nx = (long)g->nx, ny = (long)g->ny, nz = (long)g->nz;
+    /* The 13 neighbours that precede a voxel in raster order. */
+    static const int off[13][3] = {
+        {-1, 0, 0}, {-1, -1, 0}, {0, -1, 0}, {1, -1, 0},
+        {-1, -1, -1}, {0, -1, -1}, {1, -1, -1},
+        {-1, 0, -1}, {0, 0, -1}, {1, 0, -1},
+        {-1, 1, -1}, {0, 1, -1}, {1, 1, -1}};
+    for (long kk = 0; kk < nz; kk++) {
+        long k = dir > 0 ? kk : nz - 1 - kk;
+        for (long jj = 0; jj < ny; jj++) {
+            long j = dir > 0 ? jj : ny - 1 - jj;
+            for (long ii = 0; ii < nx; ii++) {
+                long i = dir > 0 ? ii : nx - 1 - ii;
+                size_t idx = (size_t)i + (size_t)nx * ((size_t)j + (size_t)ny * (size_t)k);
+                if (fixed[idx])
+                    continue;
+                double p[3];
+                st_grid_center(g, (size_t)i, (size_t)j, (size_t)k, p);
+                int32_t best = near[idx];
+                double best_d2 = best >= 0 ? soup_tri_dist2(s, best, p) : INFINITY;
+                int32_t tried[13];
+                int ntried = 0;
+                for (int q = 0; q < 13; q++) {
+                    long a = i + dir * off[q][0], b = j + dir * off[q][1],
+                         c = k + dir * off[q][2];
+                    if (a < 0 || a >= nx || b < 0 || b >= ny || c < 0 || c >= nz)
+                        continue;
+                    int32_t t = near[(size_t)a + (size_t)nx * ((size_t)b + (size_t)ny * (size_t)c)];
+                    if (t < 0 || t == best)
+                        continue;
+                    int seen = 0;
+                    for (int r = 0; r < ntried; r++)
+                        seen |= tried[r] == t;
+                    if (seen)
+                        continue;
+                    tried[ntried++] = t;
+                    double d2 = soup_tri_dist2(s, t, p);
+                    /* Ties go to the lower index, so the sweep order does
+                     * not decide which triangle a voxel keeps. */
+                    if (d2 < best_d2 || (d2 == best_d2 && t < best)) {
+                        best_d2 = d2;
+                        best = t;
+                    }
+                }
+                near[idx] = best;
+                g->data[idx] = best >= 0 ? (float)sqrt(best_d2) : INFINITY;
             }
-            double p[3];
-            st_grid_center(g, i, j, k, p);
-            /* d(p) <= d(prev) + h; the relative slack covers the float
-             * rounding of prev, so the bound never excludes the answer. */
-            double bound = isfinite(prev) ? (prev + h) * (1.0 + 1e-6) : INFINITY;
-            int64_t tri;
-            double d2 = st_bvh_nearest(bvh, p, bound * bound, &tri, NULL);
-            if (tri < 0)
-                d2 = st_bvh_nearest(bvh, p, INFINITY, &tri, NULL);
-            double d = sqrt(d2);
-            row[i] = (float)d;
-            prev = d;
         }
-        size_t now;
-        #pragma omp atomic capture
-        now = ++done;
-#ifdef _OPENMP
-        if (omp_get_thread_num() == 0 && (now & 63) == 0)
-#endif
-            st_progress_report(progress, "distance beyond the band",
-                               (double)now / (double)rows);
     }
-    st_bvh_free(bvh);
+}
+
+/* Beyond the band: a vector distance transform over triangles. The band
+ * fixed every voxel within B exactly, with its nearest triangle; sweeps in
+ * raster order and back hand nearest triangles outward, each voxel keeping
+ * the nearest of those its neighbours hold (Danielsson's propagation, with
+ * triangles instead of points: values are exact distances to a real
+ * triangle, so never below the truth; the test suite measures how often
+ * the propagated triangle is not the nearest and by how much). */
+#define SWEEPS 4
+static st_status full_pass(st_grid *g, int32_t *near, const st_soup *s,
+                           double B, const st_progress *progress,
+                           st_error *err)
+{
+    const size_t n = st_grid_count(g);
+    uint8_t *fixed = st_malloc_array(n, 1);
+    if (!fixed)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    const float Bf = (float)B;
+    for (size_t i = 0; i < n; i++) {
+        fixed[i] = g->data[i] < Bf;
+        if (!fixed[i])
+            g->data[i] = INFINITY;
+    }
+    static const char *stage = "distance beyond the band";
+    st_progress_report(progress, stage, 0.0);
+    for (int pass = 0; pass < SWEEPS; pass++) {
+        sweep(g, near, fixed, s, pass % 2 ? -1 : +1);
+        st_progress_report(progress, stage, (double)(pass + 1) / SWEEPS);
+    }
+    free(fixed);
     return ST_OK;
 }
 
@@ -587,9 +647,16 @@ st_status st_dist_field(st_grid **out, const st_soup *s,
     if (st)
         return st;
     g->kind = ST_GRID_DISTANCE;
-    st = band_pass(g, s, B, progress, err);
+    int32_t *near = NULL;
+    if (full && !(near = st_malloc_array(st_grid_count(g), sizeof *near))) {
+        st_grid_free(g);
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory for the nearest-triangle map");
+    }
+    st = band_pass(g, near, s, B, progress, err);
     if (!st && full)
-        st = full_pass(g, s, B, progress, err);
+        st = full_pass(g, near, s, B, progress, err);
+    free(near);
     if (st) {
         st_grid_free(g);
         return st;

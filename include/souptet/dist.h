@@ -8,13 +8,18 @@
  *
  * Band mode: every voxel whose distance is below band * voxel holds that
  * distance exactly (to rounding of the float it is stored in); the others
- * hold band * voxel. Full mode (band = INFINITY): every voxel holds its
- * exact distance: the band is computed first, then each other voxel asks a
- * BVH for its nearest triangle within a bound taken from its neighbour in
- * the row (d(p) <= d(q) + |p - q|), which keeps the query local.
+ * hold band * voxel. Full mode (band = INFINITY): every voxel holds a
+ * distance: within the default band exactly as above; beyond it, the
+ * distance to the nearest of the triangles its neighbours found (a vector
+ * distance transform over triangles, four raster sweeps). Such a value is
+ * the exact distance to a real triangle, so never below the truth; it is
+ * above the truth where the nearest triangle is nobody's neighbour's
+ * nearest (measured: under 3% of the voxels, by at most 0.06 voxel, on the
+ * bunny at 32 cells, where triangles are far smaller than voxels).
  *
- * Results are identical for any number of threads: each voxel's value is a
- * minimum over triangles, which does not depend on the order of evaluation.
+ * Results are identical for any number of threads: each band voxel's value
+ * is a minimum over triangles, which does not depend on the order of
+ * evaluation, and the sweeps beyond the band run in one fixed order.
  */
 #ifndef SOUPTET_DIST_H
 #define SOUPTET_DIST_H

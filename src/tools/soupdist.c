@@ -36,7 +36,8 @@ static void usage(void)
 "  -s, --voxel SIZE     voxel size in model units (instead of -r)\n"
 "      --pad P          voxels of padding on each side (default: band + 2)\n"
 "      --band B         exact band in voxels, at least %g (default %g),\n"
-"                       or 'full' for exact distances everywhere\n"
+"                       or 'full' for distances everywhere (beyond the band:\n"
+"                       propagated, never below the truth)\n"
 "  -o, --output OUT     .vdb or .vti file; '-' or none: OpenVDB stream on stdout\n"
 "      --threads T      threads to use (default: all cores)\n"
 "      --max-memory SZ  refuse grids larger than SZ (e.g. 8G; default 80%% of RAM)\n"
@@ -190,7 +191,7 @@ int main(int argc, char *argv[])
     tool_say(&t, 2, "%s: %zu vertices, %zu triangles", in, soup->nverts,
              soup->ntris);
     if (isinf(g->band))
-        tool_say(&t, 2, "grid %zux%zux%zu, voxel %.6g, exact everywhere",
+        tool_say(&t, 2, "grid %zux%zux%zu, voxel %.6g, full field",
                  g->nx, g->ny, g->nz, g->voxel);
     else
         tool_say(&t, 2, "grid %zux%zux%zu, voxel %.6g, band %.6g (%g voxels)",
