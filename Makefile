@@ -85,10 +85,14 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA)
 	$(CXX) $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
 
 # Peers for make bench (not installed).
-BENCH_BIN := $(BUILD)/bench/vdb_udf
+BENCH_BIN := $(BUILD)/bench/vdb_udf $(BUILD)/bench/stream26
 $(BUILD)/bench/%: bench/%.cpp $(LIBA)
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
+$(BUILD)/bench/%: bench/%.c $(LIBA)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -c $< -o $@.o
+	$(CXX) $(LDFLAGS_ALL) $@.o $(LIBA) $(LIBS) -o $@
 
 # scripts/setup installs what is missing and returns in a second otherwise.
 setup:

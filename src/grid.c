@@ -1,32 +1,10 @@
 /* grid.c - dense voxel grids (see grid.h). */
-#define _DEFAULT_SOURCE          /* madvise, MADV_HUGEPAGE */
 #include "souptet/grid.h"
 #include "souptet/mem.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
-
-/* Large grids ask for transparent huge pages: first touching a 350 MB grid
- * in 4 KiB pages cost 0.94 s on this project's (virtual) machines, in 2 MiB
- * pages 0.02 s (measured with a page-touching loop). Without THP support
- * this is plain aligned memory. */
-#define HUGE_PAGE ((size_t)2 << 20)
-
-static float *alloc_voxels(size_t bytes)
-{
-    if (bytes < 4 * HUGE_PAGE)
-        return malloc(bytes ? bytes : 1);
-    void *p = NULL;
-    size_t rounded = (bytes + HUGE_PAGE - 1) / HUGE_PAGE * HUGE_PAGE;
-    if (posix_memalign(&p, HUGE_PAGE, rounded) != 0)
-        return NULL;
-#ifdef MADV_HUGEPAGE
-    madvise(p, rounded, MADV_HUGEPAGE);   /* advice only: failure is fine */
-#endif
-    return p;
-}
 
 static st_status grid_new(st_grid **out, size_t nx, size_t ny, size_t nz,
                           const double origin[3], double voxel,
@@ -57,7 +35,8 @@ static st_status grid_new(st_grid **out, size_t nx, size_t ny, size_t nz,
                             nx, ny, nz, (double)bytes / 1048576.0,
                             (double)max_bytes / 1048576.0);
     st_grid *g = calloc(1, sizeof *g);
-    float *data = g ? alloc_voxels(bytes) : NULL;
+    /* Large grids ask for transparent huge pages (see st_malloc_big). */
+    float *data = g ? st_malloc_big(bytes) : NULL;
     if (!data) {
         free(g);
         return st_error_set(err, ST_ENOMEM, NULL, 0,

@@ -26,12 +26,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define MARK_S 1u   /* forward ray toggles here */
-#define MARK_R 2u   /* backward ray toggles here */
+#define MARK_S 1u    /* forward ray toggles here */
+#define MARK_R 2u    /* backward ray toggles here */
+#define MARK_LAST 4u /* the line's last R: beyond it the backward ray sees out */
 
-/* The 13 lines of the 26-neighbourhood; the first four stay in a layer. */
+/* The per-voxel steps must inline into the sweeps (GCC declined at -O2). */
+#if defined(__GNUC__)
+#define HOT static inline __attribute__((always_inline))
+#else
+#define HOT static inline
+#endif
+
+/* The 13 lines of the 26-neighbourhood, each walked so that it moves
+ * forward in memory; the first four stay in a layer. */
 static const int DIRS[13][3] = {
-    {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, -1, 0},
+    {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {-1, 1, 0},
     {0, 0, 1}, {1, 0, 1}, {-1, 0, 1}, {0, 1, 1}, {0, -1, 1},
     {1, 1, 1}, {-1, 1, 1}, {1, -1, 1}, {-1, -1, 1}};
 #define IN_LAYER 4
@@ -97,11 +106,12 @@ double st_sign_event_distance(const st_sign_params *p, const st_grid *g)
 #define L_CR_ODD 8u     /* pass 2: R marks strictly before the voxel, mod 2 */
 #define L_ANY 16u       /* the line has an event (pass 1 result) */
 #define L_SEEN 32u      /* pass 2: an S mark at or before the voxel */
+#define L_PAST 64u      /* pass 2: past the line's last R mark */
 
 typedef struct run_state {
     float min;
     size_t start, last, argmin;
-    size_t last_r;        /* the line's last R mark (pass 1 result) */
+    size_t last_r;        /* the latest R mark on the line */
 } run_state;
 
 typedef struct sweep_ctx {
@@ -112,7 +122,6 @@ typedef struct sweep_ctx {
     uint8_t *valid;       /* valid votes (only when ignoring odd lines) */
     uint8_t *hidden;      /* rays that meet an event before the voxel */
     float t_axis;         /* event distance for an axis direction */
-    int reverse;          /* this direction's steps move back in memory */
 } sweep_ctx;
 
 static inline float event_distance(const sweep_ctx *c, const int d[3])
@@ -127,14 +136,17 @@ static inline float event_distance(const sweep_ctx *c, const int d[3])
 
 /* Pass 1, one voxel: is_last says the line ends here. A line starts with
  * its flags cleared. Returns 1 when an event ended here. */
-static inline unsigned pass1_step(const sweep_ctx *c, uint8_t *fl,
+HOT unsigned pass1_step(const sweep_ctx *c, uint8_t *fl,
                                   run_state *r, size_t idx, float t,
                                   int is_last)
 {
     float a = fabsf(c->g->data[idx]);
     int ev = a < t;
-    if (!ev && !(*fl & L_IN_RUN))
+    if (!ev && !(*fl & L_IN_RUN)) {
+        if (is_last && (*fl & L_ANY))
+            c->mark[r->last_r] |= MARK_LAST;
         return 0;                       /* far from the surface: the usual */
+    }
     if (ev) {
         if (!(*fl & L_IN_RUN)) {
             *fl |= L_IN_RUN;
@@ -158,23 +170,14 @@ static inline unsigned pass1_step(const sweep_ctx *c, uint8_t *fl,
         c->mark[r->last] |= MARK_R;
         r->last_r = r->last;
     }
+    if (is_last)
+        c->mark[r->last_r] |= MARK_LAST;
     return 1;
 }
 
-/* Is idx at or before pos on its line? Every step along a line moves
- * forward in memory except in the direction (1, -1, 0), whose stride
- * 1 - nx is negative (c->reverse). */
-static inline unsigned line_before_or_at(const sweep_ctx *c, size_t idx,
-                                         size_t pos)
-{
-    return c->reverse ? idx >= pos : idx <= pos;
-}
-
 /* Pass 2, one voxel: add this line's votes and clear the mark. The line
- * state's flags keep L_E_ODD and L_ANY from pass 1; r->last_r says where
- * the backward ray's first event is. Lines are walked forward. */
-static inline void pass2_step(const sweep_ctx *c, uint8_t *fl,
-                              const run_state *r, size_t idx)
+ * state's flags keep L_E_ODD and L_ANY from pass 1. */
+HOT void pass2_step(const sweep_ctx *c, uint8_t *fl, size_t idx)
 {
     uint8_t m = c->mark[idx];
     uint8_t f = *fl;
@@ -187,9 +190,11 @@ static inline void pass2_step(const sweep_ctx *c, uint8_t *fl,
         /* Forward: an event at or before; backward: one at or after. */
         unsigned h = (f & L_SEEN) != 0;
         if (c->p->rays == 26)
-            h += line_before_or_at(c, idx, r->last_r);
+            h += !(f & L_PAST);
         c->hidden[idx] = (uint8_t)(c->hidden[idx] + h);
     }
+    if (m & MARK_LAST)
+        f |= L_PAST;
     /* Backward parity at idx: R at or after idx = E - (R before idx). */
     unsigned back = ((f & L_E_ODD) != 0) ^ ((f & L_CR_ODD) != 0);
     unsigned fwd = (f & L_CS_ODD) != 0;
@@ -209,96 +214,221 @@ static inline void pass2_step(const sweep_ctx *c, uint8_t *fl,
     }
 }
 
-/* The four directions inside a layer: whole lines at a time, from each
- * line's start (the voxels whose predecessor is outside the layer). */
-static void sweep_in_layer(const sweep_ctx *c, const int d[3])
+/* Pass 2 where no voxel of the stretch is marked: the lines' flags do not
+ * change, so every voxel's votes follow from its line's flags alone.
+ * Branch-free, so the compiler can vectorise it. */
+HOT void pass2_unmarked(const sweep_ctx *c, const uint8_t *fl, size_t idx,
+                        long n)
+{
+    const unsigned two = c->p->rays == 26;
+    const unsigned ignore = (unsigned)c->p->ignore_odd;
+    uint8_t *votes = c->votes + idx, *valid = c->valid, *hidden = c->hidden;
+    for (long q = 0; q < n; q++) {
+        unsigned f = fl[q];
+        unsigned ok = !(ignore & (f >> 1));                 /* L_E_ODD */
+        unsigned fwd = (f >> 2) & 1u;                       /* L_CS_ODD */
+        unsigned back = ((f >> 1) ^ (f >> 3)) & 1u;         /* E ^ CR */
+        votes[q] = (uint8_t)(votes[q] + ok * (fwd + two * back));
+    }
+    if (valid)
+        for (long q = 0; q < n; q++) {
+            unsigned ok = !(ignore & (fl[q] >> 1));
+            valid[idx + (size_t)q] = (uint8_t)(valid[idx + (size_t)q] + ok * (1u + two));
+        }
+    if (hidden)
+        for (long q = 0; q < n; q++) {
+            unsigned f = fl[q];
+            unsigned any = (f >> 4) & 1u;                   /* L_ANY */
+            unsigned h = ((f >> 5) & 1u) + two * (1u - ((f >> 6) & 1u));
+            hidden[idx + (size_t)q] = (uint8_t)(hidden[idx + (size_t)q] + any * h);
+        }
+}
+
+/* Voxels in a chunk are on different lines; a chunk with nothing near the
+ * surface (pass 1) or no mark (pass 2) takes the fast path. */
+#define CHUNK 32
+
+/* One voxel of a row, the general way. */
+HOT void row_voxel(const sweep_ctx *c, int pass, const int d[3], float t,
+                   size_t vbase, size_t lbase, long nx, long i,
+                   int row_first, int row_last, uint8_t *flags,
+                   run_state *runs)
+{
+    size_t idx = vbase + (size_t)i;
+    uint8_t *fl = &flags[lbase + (size_t)i];
+    /* Only the two end columns can start or end a line mid-row. */
+    int edge = i == 0 || i == nx - 1;
+    int first = row_first || (edge && (i - d[0] < 0 || i - d[0] >= nx));
+    int last = row_last || (edge && (i + d[0] < 0 || i + d[0] >= nx));
+    if (pass == 1) {
+        if (first)
+            *fl = 0;
+        pass1_step(c, fl, &runs[lbase + (size_t)i], idx, t, last);
+    } else {
+        if (first)
+            *fl &= L_E_ODD | L_ANY;
+        pass2_step(c, fl, idx);
+    }
+}
+
+/* One row of voxels (fixed j, k), i from 0 to nx - 1, for a direction with
+ * d[1] == 1 or d[2] == 1: each voxel is on its own line, whose state sits
+ * at flags[lbase + i]. row_first / row_last: the lines of this row start /
+ * end here whatever i is (the row is the first / last the lines meet). */
+HOT void sweep_row(const sweep_ctx *c, int pass, const int d[3], float t,
+                   size_t vbase, size_t lbase, long nx, int row_first,
+                   int row_last, uint8_t *flags, run_state *runs)
+{
+    long i = 0;
+    if (!row_first && !row_last) {
+        /* Column 0 may start or end lines; then whole chunks; then the
+         * rest, including column nx - 1. */
+        row_voxel(c, pass, d, t, vbase, lbase, nx, i++, 0, 0, flags, runs);
+        const float *data = c->g->data;
+        for (; i + CHUNK < nx; i += CHUNK) {
+            size_t idx = vbase + (size_t)i;
+            const uint8_t *fl = &flags[lbase + (size_t)i];
+            unsigned act = 0;
+            if (pass == 1) {
+                for (long q = 0; q < CHUNK; q++)
+                    act |= (unsigned)(fabsf(data[idx + (size_t)q]) < t) |
+                           (fl[q] & L_IN_RUN);
+                if (!act)
+                    continue;
+            } else {
+                for (long q = 0; q < CHUNK; q++)
+                    act |= c->mark[idx + (size_t)q];
+                if (!act) {
+                    pass2_unmarked(c, fl, idx, CHUNK);
+                    continue;
+                }
+            }
+            for (long q = 0; q < CHUNK; q++)
+                row_voxel(c, pass, d, t, vbase, lbase, nx, i + q, 0, 0,
+                          flags, runs);
+        }
+    }
+    for (; i < nx; i++)
+        row_voxel(c, pass, d, t, vbase, lbase, nx, i, row_first, row_last,
+                  flags, runs);
+}
+
+/* The x direction: every row is a line, walked contiguously. Stretches
+ * far from the surface (pass 1) or without marks (pass 2) go fast: the
+ * line's parities are constant there. */
+static void sweep_x(const sweep_ctx *c, const int d[3])
 {
     const st_grid *g = c->g;
-    const long nx = (long)g->nx, ny = (long)g->ny, nz = (long)g->nz;
+    const size_t nx = g->nx, rows = g->ny * g->nz;
     const float t = event_distance(c, d);
-    const long stride = d[0] + d[1] * nx;
-    /* Starts: the edge i = i_edge (when dx != 0) and the edge j = j_edge
-     * (when dy != 0), each start once. */
-    const long i_edge = d[0] > 0 ? 0 : nx - 1, j_edge = d[1] > 0 ? 0 : ny - 1;
-    const long nstarts = (d[0] ? ny : 0) + (d[1] ? nx : 0);
-    #pragma omp parallel for schedule(dynamic, 1)
-    for (long k = 0; k < nz; k++) {
-        size_t layer = (size_t)nx * (size_t)ny * (size_t)k;
-        for (long q = 0; q < nstarts; q++) {
-            long i0, j0;
-            if (d[0] && q < ny) {
-                i0 = i_edge;
-                j0 = q;
-            } else {
-                i0 = d[0] ? q - ny : q;
-                j0 = j_edge;
-                if (d[0] && i0 == i_edge)
-                    continue;       /* the corner, already a start above */
+    #pragma omp parallel for schedule(static)
+    for (size_t r = 0; r < rows; r++) {
+        const size_t base = r * nx;
+        const float *data = g->data + base;
+        uint8_t fl = 0;
+        run_state run = {0};
+        size_t i = 0;
+        while (i < nx) {
+            if (!(fl & L_IN_RUN) && i + CHUNK < nx) {
+                unsigned act = 0;
+                for (size_t q = 0; q < CHUNK; q++)
+                    act |= (unsigned)(fabsf(data[i + q]) < t);
+                if (!act) {
+                    i += CHUNK;
+                    continue;
+                }
             }
-            /* Length of the line from (i0, j0). */
-            long len = LONG_MAX;
-            if (d[0] > 0)
-                len = nx - i0;
-            else if (d[0] < 0)
-                len = i0 + 1;
-            if (d[1] > 0 && ny - j0 < len)
-                len = ny - j0;
-            else if (d[1] < 0 && j0 + 1 < len)
-                len = j0 + 1;
-            size_t idx0 = layer + (size_t)i0 + (size_t)nx * (size_t)j0;
-            uint8_t fl = 0;
-            run_state r = {0};
-            size_t idx = idx0;
-            for (long s = 0; s < len; s++, idx += (size_t)stride)
-                pass1_step(c, &fl, &r, idx, t, s == len - 1);
-            fl &= L_E_ODD | L_ANY;
-            idx = idx0;
-            for (long s = 0; s < len; s++, idx += (size_t)stride)
-                pass2_step(c, &fl, &r, idx);
+            pass1_step(c, &fl, &run, base + i, t, i + 1 == nx);
+            i++;
+        }
+        fl &= L_E_ODD | L_ANY;
+        i = 0;
+        while (i < nx) {
+            if (i + CHUNK <= nx) {
+                unsigned act = 0;
+                for (size_t q = 0; q < CHUNK; q++)
+                    act |= c->mark[base + i + q];
+                if (!act) {
+                    uint8_t same[CHUNK];
+                    memset(same, fl, sizeof same);
+                    pass2_unmarked(c, same, base + i, CHUNK);
+                    i += CHUNK;
+                    continue;
+                }
+            }
+            pass2_step(c, &fl, base + i);
+            i++;
         }
     }
 }
 
-/* The nine directions that cross layers (d[2] == 1): a state per line,
- * layer after layer. A line is named by where it meets layer 0,
- * (i - dx k, j - dy k), shifted to be non-negative. */
+/* Directions within a layer other than x (d[1] == 1, d[2] == 0): layers
+ * are independent and run in parallel; in a layer, rows are streamed in
+ * order with one state per line, named by i - dx j (shifted). */
+static st_status sweep_in_layer(const sweep_ctx *c, const int d[3])
+{
+    const st_grid *g = c->g;
+    const long nx = (long)g->nx, ny = (long)g->ny, nz = (long)g->nz;
+    const float t = event_distance(c, d);
+    const long W = nx + (d[0] ? ny - 1 : 0);
+    const long off = d[0] > 0 ? ny - 1 : 0;
+    int oom = 0;
+    #pragma omp parallel
+    {
+        uint8_t *flags = malloc((size_t)W);
+        run_state *runs = malloc((size_t)W * sizeof *runs);
+        if (!flags || !runs) {
+            #pragma omp atomic write
+            oom = 1;
+        }
+        #pragma omp for schedule(dynamic, 1)
+        for (long k = 0; k < nz; k++) {
+            if (!flags || !runs)
+                continue;
+            for (int pass = 1; pass <= 2; pass++)
+                for (long j = 0; j < ny; j++) {
+                    size_t vbase = (size_t)nx * ((size_t)j + (size_t)ny * (size_t)k);
+                    size_t lbase = (size_t)(off - d[0] * j);
+                    sweep_row(c, pass, d, t, vbase, lbase, nx, j == 0,
+                              j == ny - 1, flags, runs);
+                }
+        }
+        free(flags);
+        free(runs);
+    }
+    return oom ? ST_ENOMEM : ST_OK;
+}
+
+/* The nine directions that cross layers (d[2] == 1): one state per line.
+ * A line is named by where it meets layer 0, (i - dx k, j - dy k), shifted
+ * to be non-negative. Lines are independent, so a thread owns a block of
+ * line rows (ly) and streams it through all layers, both passes, with no
+ * barrier between layers; in layer k its rows are j = ly + dy k - offy. */
+#define LINE_ROWS_PER_TASK 32
 static void sweep_across(const sweep_ctx *c, const int d[3], uint8_t *flags,
                          run_state *runs)
 {
     const st_grid *g = c->g;
     const long nx = (long)g->nx, ny = (long)g->ny, nz = (long)g->nz;
-    const long W = nx + (d[0] ? nz - 1 : 0);
+    const long W = nx + (d[0] ? nz - 1 : 0), H = ny + (d[1] ? nz - 1 : 0);
     const long offx = d[0] > 0 ? nz - 1 : 0, offy = d[1] > 0 ? nz - 1 : 0;
     const float t = event_distance(c, d);
-    for (int pass = 1; pass <= 2; pass++) {
-        for (long k = 0; k < nz; k++) {
-            #pragma omp parallel for schedule(static)
-            for (long j = 0; j < ny; j++) {
-                const long ly = j - d[1] * k + offy;
-                const size_t lbase = (size_t)(W * ly - d[0] * k + offx);
-                const size_t vbase = (size_t)nx * ((size_t)j + (size_t)ny * (size_t)k);
-                /* A line starts where its predecessor is outside the grid:
-                 * in layer 0, on the row edge it enters through, or at the
-                 * column it enters through. */
-                const int row_first = k == 0 || j - d[1] < 0 || j - d[1] >= ny;
-                const int row_last = k == nz - 1 || j + d[1] < 0 || j + d[1] >= ny;
-                for (long i = 0; i < nx; i++) {
-                    size_t idx = vbase + (size_t)i;
-                    uint8_t *fl = &flags[lbase + (size_t)i];
-                    int first = row_first || i - d[0] < 0 || i - d[0] >= nx;
-                    int last = row_last || i + d[0] < 0 || i + d[0] >= nx;
-                    if (pass == 1) {
-                        if (first)
-                            *fl = 0;
-                        pass1_step(c, fl, &runs[lbase + (size_t)i], idx, t, last);
-                    } else {
-                        if (first)
-                            *fl &= L_E_ODD | L_ANY;
-                        pass2_step(c, fl, &runs[lbase + (size_t)i], idx);
-                    }
+    #pragma omp parallel for schedule(dynamic, 1)
+    for (long ly0 = 0; ly0 < H; ly0 += LINE_ROWS_PER_TASK) {
+        long ly1 = ly0 + LINE_ROWS_PER_TASK < H ? ly0 + LINE_ROWS_PER_TASK : H;
+        for (int pass = 1; pass <= 2; pass++)
+            for (long k = 0; k < nz; k++)
+                for (long ly = ly0; ly < ly1; ly++) {
+                    long j = ly + d[1] * k - offy;
+                    if (j < 0 || j >= ny)
+                        continue;
+                    const size_t lbase = (size_t)(W * ly - d[0] * k + offx);
+                    const size_t vbase = (size_t)nx * ((size_t)j + (size_t)ny * (size_t)k);
+                    const int row_first = k == 0 || j - d[1] < 0 || j - d[1] >= ny;
+                    const int row_last = k == nz - 1 || j + d[1] < 0 || j + d[1] >= ny;
+                    sweep_row(c, pass, d, t, vbase, lbase, nx, row_first,
+                              row_last, flags, runs);
                 }
-            }
-        }
     }
 }
 
@@ -315,7 +445,7 @@ unsigned st_sign_line(const float *d, size_t n, float t,
     uint8_t *mark = calloc(n ? n : 1, 1);
     if (!mark)
         return 0;
-    sweep_ctx c = {&g, p, mark, votes, valid, NULL, t, 0};
+    sweep_ctx c = {&g, p, mark, votes, valid, NULL, t};
     uint8_t fl = 0;
     run_state r = {0};
     unsigned events = 0;
@@ -323,7 +453,7 @@ unsigned st_sign_line(const float *d, size_t n, float t,
         events += pass1_step(&c, &fl, &r, i, t, i + 1 == n);
     fl &= L_E_ODD | L_ANY;
     for (size_t i = 0; i < n; i++)
-        pass2_step(&c, &fl, &r, i);
+        pass2_step(&c, &fl, i);
     free(mark);
     return events;
 }
@@ -378,11 +508,10 @@ st_status st_sign_field(st_grid *g, const st_sign_params *p,
     c.p = p;
     double t = st_sign_event_distance(p, g);
     c.t_axis = (float)t;
-    c.mark = st_calloc_array(n, 1);
-    c.votes = st_calloc_array(n, 1);
-    c.valid = p->ignore_odd ? st_calloc_array(n, 1) : NULL;
-    c.hidden = p->nested_union ? st_calloc_array(n, 1) : NULL;
-    c.reverse = 0;
+    c.mark = st_calloc_big(n);
+    c.votes = st_calloc_big(n);
+    c.valid = p->ignore_odd ? st_calloc_big(n) : NULL;
+    c.hidden = p->nested_union ? st_calloc_big(n) : NULL;
     /* Line states for the widest crossing direction. */
     size_t W = g->nx + g->nz, H = g->ny + g->nz, nstates;
     uint8_t *flags = NULL;
@@ -402,14 +531,24 @@ st_status st_sign_field(st_grid *g, const st_sign_params *p,
         return st_error_set(err, ST_ENOMEM, NULL, 0,
                             "out of memory for the votes");
     }
-    for (int d = 0; d < 13; d++) {
-        c.reverse = DIRS[d][0] + DIRS[d][1] * (long)g->nx +
-                    DIRS[d][2] * (long)(g->nx * g->ny) < 0;
-        if (d < IN_LAYER)
-            sweep_in_layer(&c, DIRS[d]);
+    st_status st = ST_OK;
+    for (int d = 0; d < 13 && !st; d++) {
+        if (d == 0)
+            sweep_x(&c, DIRS[d]);
+        else if (d < IN_LAYER)
+            st = sweep_in_layer(&c, DIRS[d]);
         else
             sweep_across(&c, DIRS[d], flags, runs);
         st_progress_report(progress, "signs", (d + 1) / 13.0);
+    }
+    if (st) {
+        free(c.mark);
+        free(c.votes);
+        free(c.valid);
+        free(c.hidden);
+        free(flags);
+        free(runs);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     }
     const int per_line = p->rays == 26 ? 2 : 1;
     #pragma omp parallel for schedule(static)

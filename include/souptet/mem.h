@@ -25,6 +25,14 @@ void *st_malloc_array(size_t n, size_t size);
 void *st_calloc_array(size_t n, size_t size);
 void *st_realloc_array(void *p, size_t n, size_t size);
 
+/* n zeroed bytes for a large array that is about to be touched in full:
+ * aligned to, and advised to use, transparent huge pages, because first
+ * touching hundreds of MB in 4 KiB pages costs about a second on this
+ * project's (virtual) machines. Zeroed in parallel. Release with free(). */
+void *st_calloc_big(size_t n);
+/* The same without zeroing. */
+void *st_malloc_big(size_t n);
+
 /* strdup that returns NULL on failure; NULL in gives NULL out. */
 char *st_strdup(const char *s);
 
