@@ -112,6 +112,7 @@ demo: setup
 	scripts/demo $(BUILD)/bin
 
 bench: setup
+	@scripts/setup --bench
 	$(MAKE) --no-print-directory all $(BENCH_BIN)
 	scripts/bench $(BUILD) $(STAGE)
 

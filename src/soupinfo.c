@@ -1,0 +1,507 @@
+/*
+ * soupinfo.c - the damage report of a triangle soup (see soupinfo.h for
+ * what every count means).
+ *
+ * Algorithm, in passes over the soup:
+ *
+ *   1. Weld: an open-addressing hash table keyed on the bit patterns of the
+ *      three coordinates (-0.0 folded onto 0.0) maps every referenced
+ *      vertex to a welded id; ids are handed out in vertex order, so the
+ *      result does not depend on hashing details.
+ *   2. Per triangle: its three welded corners; degenerate when two agree.
+ *   3. Duplicates: sort the triangles' sorted corner triples; equal
+ *      neighbours are copies.
+ *   4. Edges: sort the half-edges of non-degenerate triangles by their
+ *      unordered welded endpoints (ties by half-edge index, so the order is
+ *      total and the result deterministic). Each run of equal keys is one
+ *      edge; its length and the directions of its half-edges classify it.
+ *      The same pass joins triangles into pieces (union-find), joins the
+ *      boundary edges' endpoints (for the cycle rank), joins the corners
+ *      on both sides of a manifold edge (for fans) and records manifold
+ *      neighbours (for orientation propagation).
+ *   5. Per piece: faces, edges, bad edges, fans and distinct vertices give
+ *      whether it is a closed 2-manifold and its Euler characteristic; a
+ *      breadth-first propagation of orientation across manifold edges says
+ *      whether it is orientable.
+ *
+ * Union-find joins toward the smaller index, so every root is the smallest
+ * member of its set: pieces are numbered by their first triangle.
+ */
+#include "souptet/soupinfo.h"
+#include "souptet/geom.h"
+#include "souptet/mem.h"
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NONE UINT32_MAX
+
+/* ---- union-find ---------------------------------------------------------- */
+
+static uint32_t uf_find(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]]; /* path halving */
+        x = parent[x];
+    }
+    return x;
+}
+
+static void uf_union(uint32_t *parent, uint32_t a, uint32_t b)
+{
+    a = uf_find(parent, a);
+    b = uf_find(parent, b);
+    if (a < b)
+        parent[b] = a;
+    else if (b < a)
+        parent[a] = b;
+}
+
+static uint32_t *uf_new(size_t n)
+{
+    uint32_t *p = st_malloc_array(n, sizeof *p);
+    if (p)
+        for (size_t i = 0; i < n; i++)
+            p[i] = (uint32_t)i;
+    return p;
+}
+
+/* ---- welding ------------------------------------------------------------- */
+
+static uint64_t mix64(uint64_t x)
+{
+    /* splitmix64's finaliser: every input bit affects every output bit */
+    x ^= x >> 30;
+    x *= 0xbf58476d1ce4e5b9ULL;
+    x ^= x >> 27;
+    x *= 0x94d049bb133111ebULL;
+    x ^= x >> 31;
+    return x;
+}
+
+static uint64_t coord_bits(double x)
+{
+    /* -0.0 == 0.0 compares equal, so both must hash alike. */
+    if (x == 0.0)
+        x = 0.0;
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+static uint64_t point_hash(const double *p)
+{
+    return mix64(coord_bits(p[0]) ^
+                 mix64(coord_bits(p[1]) ^ mix64(coord_bits(p[2]))));
+}
+
+/* weld[v] = welded id of referenced vertex v (NONE when unreferenced);
+ * returns the number of welded ids, or -1 when out of memory. */
+static long long weld_vertices(uint32_t *weld, const st_soup *s)
+{
+    size_t nref = 0;
+    for (size_t v = 0; v < s->nverts; v++)
+        weld[v] = NONE;
+    for (size_t i = 0; i < 3 * s->ntris; i++) {
+        if (weld[s->tris[i]] == NONE) {
+            weld[s->tris[i]] = 0; /* mark: referenced */
+            nref++;
+        }
+    }
+    /* A load factor of at most 1/2 keeps probe sequences short. */
+    size_t cap = 16;
+    while (cap < 2 * nref)
+        cap *= 2;
+    uint32_t *table = st_malloc_array(cap, sizeof *table);
+    uint32_t *rep = st_malloc_array(nref ? nref : 1, sizeof *rep);
+    if (!table || !rep) {
+        free(table);
+        free(rep);
+        return -1;
+    }
+    for (size_t i = 0; i < cap; i++)
+        table[i] = NONE;
+    uint32_t n = 0;
+    for (size_t v = 0; v < s->nverts; v++) {
+        if (weld[v] == NONE)
+            continue;
+        const double *p = s->xyz + 3 * v;
+        size_t slot = (size_t)point_hash(p) & (cap - 1);
+        for (;;) {
+            uint32_t w = table[slot];
+            if (w == NONE) {
+                table[slot] = n;
+                rep[n] = (uint32_t)v;
+                weld[v] = n++;
+                break;
+            }
+            const double *q = s->xyz + 3 * (size_t)rep[w];
+            if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) {
+                weld[v] = w;
+                break;
+            }
+            slot = (slot + 1) & (cap - 1);
+        }
+    }
+    free(table);
+    free(rep);
+    return n;
+}
+
+/* ---- sorting ------------------------------------------------------------- */
+
+typedef struct triple {
+    uint32_t k[3]; /* sorted welded corners */
+    uint32_t t;
+} triple;
+
+static int cmp_triple(const void *pa, const void *pb)
+{
+    const triple *a = pa, *b = pb;
+    for (int i = 0; i < 3; i++)
+        if (a->k[i] != b->k[i])
+            return a->k[i] < b->k[i] ? -1 : 1;
+    return (a->t > b->t) - (a->t < b->t);
+}
+
+typedef struct halfedge {
+    uint64_t key; /* min endpoint << 32 | max endpoint */
+    uint32_t h;   /* 3 * triangle + slot of its start corner */
+} halfedge;
+
+static int cmp_halfedge(const void *pa, const void *pb)
+{
+    const halfedge *a = pa, *b = pb;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->h > b->h) - (a->h < b->h);
+}
+
+static int cmp_u64(const void *pa, const void *pb)
+{
+    uint64_t a = *(const uint64_t *)pa, b = *(const uint64_t *)pb;
+    return (a > b) - (a < b);
+}
+
+static uint32_t next_corner(uint32_t h)
+{
+    return h % 3 == 2 ? h - 2 : h + 1;
+}
+
+/* ---- the report ---------------------------------------------------------- */
+
+st_status st_soupinfo_compute(st_soupinfo *out, const st_soup *s,
+                              st_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!s || s->ntris == 0)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "no triangles");
+    /* Corners and half-edges are indexed in 32 bits. */
+    if (s->ntris > (size_t)(UINT32_MAX - 3) / 3)
+        return st_error_set(err, ST_ELIMIT, NULL, 0,
+                            "%zu triangles: soupinfo handles at most %lu",
+                            s->ntris, (unsigned long)((UINT32_MAX - 3) / 3));
+    st_status st = st_soup_bounds(s, out->lo, out->hi, err);
+    if (st)
+        return st;
+    double d[3];
+    st_sub3(d, out->hi, out->lo);
+    out->diagonal = st_norm3(d);
+    out->vertices = s->nverts;
+    out->triangles = s->ntris;
+
+    const size_t nt = s->ntris, nc = 3 * nt;
+    uint32_t *weld = NULL, *W = NULL, *tri_uf = NULL, *corner_uf = NULL,
+             *vert_uf = NULL, *nbr = NULL, *piece = NULL, *queue = NULL,
+             *fans = NULL;
+    uint8_t *deg = NULL, *mark = NULL, *same = NULL, *flip = NULL;
+    triple *trip = NULL;
+    halfedge *he = NULL;
+    uint64_t *pv = NULL;
+    size_t *pF = NULL, *pE = NULL, *pBad = NULL, *pFans = NULL, *pV = NULL;
+    uint8_t *pNonori = NULL;
+    st = ST_ENOMEM;
+
+    /* 1. weld */
+    weld = st_malloc_array(s->nverts, sizeof *weld);
+    if (!weld)
+        goto done;
+    long long nw = weld_vertices(weld, s);
+    if (nw < 0)
+        goto done;
+    out->welded_vertices = (size_t)nw;
+    out->unreferenced_vertices = 0;
+    for (size_t v = 0; v < s->nverts; v++)
+        if (weld[v] == NONE)
+            out->unreferenced_vertices++;
+
+    /* 2. welded corners, degenerate triangles */
+    W = st_malloc_array(nc, sizeof *W);
+    deg = st_calloc_array(nt, 1);
+    if (!W || !deg)
+        goto done;
+    size_t nnd = 0; /* non-degenerate triangles */
+    for (size_t i = 0; i < nc; i++)
+        W[i] = weld[s->tris[i]];
+    for (size_t t = 0; t < nt; t++) {
+        const uint32_t *c = W + 3 * t;
+        if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
+            deg[t] = 1;
+            out->degenerate_triangles++;
+        } else {
+            nnd++;
+        }
+    }
+    free(weld);
+    weld = NULL;
+
+    /* 3. duplicated triangles */
+    trip = st_malloc_array(nt, sizeof *trip);
+    if (!trip)
+        goto done;
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t a = W[3 * t], b = W[3 * t + 1], c = W[3 * t + 2], x;
+        if (a > b) { x = a; a = b; b = x; }
+        if (b > c) { x = b; b = c; c = x; }
+        if (a > b) { x = a; a = b; b = x; }
+        trip[t].k[0] = a;
+        trip[t].k[1] = b;
+        trip[t].k[2] = c;
+        trip[t].t = (uint32_t)t;
+    }
+    qsort(trip, nt, sizeof *trip, cmp_triple);
+    for (size_t t = 1; t < nt; t++)
+        if (memcmp(trip[t].k, trip[t - 1].k, sizeof trip[t].k) == 0)
+            out->duplicated_triangles++;
+    free(trip);
+    trip = NULL;
+
+    /* 4. edges */
+    size_t nh = 3 * nnd;
+    he = st_malloc_array(nh, sizeof *he);
+    tri_uf = uf_new(nt);
+    corner_uf = uf_new(nc);
+    vert_uf = uf_new((size_t)nw);
+    mark = st_calloc_array((size_t)nw, 1);
+    nbr = st_malloc_array(nc, sizeof *nbr);
+    same = st_calloc_array(nc, 1);
+    if (!he || !tri_uf || !corner_uf || !vert_uf || !mark || !nbr || !same)
+        goto done;
+    size_t k = 0;
+    for (uint32_t h = 0; h < nc; h++) {
+        nbr[h] = NONE;
+        if (deg[h / 3])
+            continue;
+        uint64_t a = W[h], b = W[next_corner(h)];
+        he[k].key = a < b ? (a << 32 | b) : (b << 32 | a);
+        he[k].h = h;
+        k++;
+    }
+    qsort(he, nh, sizeof *he, cmp_halfedge);
+    size_t bverts = 0, bcomps = 0;
+    for (size_t i = 0, j; i < nh; i = j) {
+        for (j = i + 1; j < nh && he[j].key == he[i].key; j++)
+            uf_union(tri_uf, he[i].h / 3, he[j].h / 3);
+        size_t n = j - i;
+        out->edges++;
+        if (n == 1) {
+            uint32_t u = (uint32_t)(he[i].key >> 32),
+                     v = (uint32_t)(he[i].key & 0xffffffffu);
+            out->boundary_edges++;
+            mark[u] = mark[v] = 1;
+            uf_union(vert_uf, u, v);
+        } else if (n == 2) {
+            uint32_t h1 = he[i].h, h2 = he[i + 1].h;
+            out->manifold_edges++;
+            /* Same start corner: both traverse the edge the same way. */
+            int samedir = W[h1] == W[h2];
+            if (samedir)
+                out->inconsistent_edges++;
+            nbr[h1] = h2 / 3;
+            nbr[h2] = h1 / 3;
+            same[h1] = same[h2] = (uint8_t)samedir;
+            /* Join the corners at each endpoint across the edge: the
+             * corner of h1 at its start meets the corner of h2 at the same
+             * point, which is h2's start or end. */
+            uint32_t e1 = next_corner(h1), e2 = next_corner(h2);
+            if (samedir) {
+                uf_union(corner_uf, h1, h2);
+                uf_union(corner_uf, e1, e2);
+            } else {
+                uf_union(corner_uf, h1, e2);
+                uf_union(corner_uf, e1, h2);
+            }
+        } else {
+            out->nonmanifold_edges++;
+        }
+    }
+    for (size_t v = 0; v < (size_t)nw; v++) {
+        if (!mark[v])
+            continue;
+        bverts++;
+        if (uf_find(vert_uf, (uint32_t)v) == v)
+            bcomps++;
+    }
+    /* Cycle rank of the boundary graph; never negative (a forest has
+     * E = V - C). */
+    out->holes = out->boundary_edges + bcomps - bverts;
+    free(vert_uf);
+    vert_uf = NULL;
+
+    /* non-manifold vertices: more than one fan (root corner) per point;
+     * Euler characteristic of the non-degenerate part */
+    fans = st_calloc_array((size_t)nw, sizeof *fans);
+    if (!fans)
+        goto done;
+    memset(mark, 0, (size_t)nw);
+    size_t nv_nd = 0;
+    for (uint32_t c = 0; c < nc; c++) {
+        if (deg[c / 3])
+            continue;
+        if (uf_find(corner_uf, c) == c)
+            fans[W[c]]++;
+        if (!mark[W[c]]) {
+            mark[W[c]] = 1;
+            nv_nd++;
+        }
+    }
+    for (size_t v = 0; v < (size_t)nw; v++)
+        if (fans[v] > 1)
+            out->nonmanifold_vertices++;
+    out->euler = (long long)nv_nd - (long long)out->edges + (long long)nnd;
+    out->closed = out->edges > 0 && out->boundary_edges == 0 &&
+                  out->nonmanifold_edges == 0;
+    out->consistently_oriented = out->inconsistent_edges == 0;
+
+    /* 5. pieces, numbered by their first triangle */
+    piece = st_malloc_array(nt, sizeof *piece);
+    if (!piece)
+        goto done;
+    size_t np = 0;
+    for (size_t t = 0; t < nt; t++) {
+        piece[t] = NONE;
+        if (!deg[t] && uf_find(tri_uf, (uint32_t)t) == t)
+            piece[t] = (uint32_t)np++;
+    }
+    for (size_t t = 0; t < nt; t++)
+        if (!deg[t])
+            piece[t] = piece[uf_find(tri_uf, (uint32_t)t)];
+    out->pieces = np;
+    pF = st_calloc_array(np, sizeof *pF);
+    pE = st_calloc_array(np, sizeof *pE);
+    pBad = st_calloc_array(np, sizeof *pBad);
+    pFans = st_calloc_array(np, sizeof *pFans);
+    pV = st_calloc_array(np, sizeof *pV);
+    pNonori = st_calloc_array(np, 1);
+    if (!pF || !pE || !pBad || !pFans || !pV || !pNonori)
+        goto done;
+    for (size_t t = 0; t < nt; t++)
+        if (!deg[t])
+            pF[piece[t]]++;
+    for (size_t i = 0, j; i < nh; i = j) {
+        for (j = i + 1; j < nh && he[j].key == he[i].key; j++)
+            ;
+        uint32_t p = piece[he[i].h / 3];
+        pE[p]++;
+        if (j - i != 2)
+            pBad[p]++;
+    }
+    free(he);
+    he = NULL;
+
+    /* distinct (piece, point) pairs among the fans */
+    size_t nfans = 0;
+    for (uint32_t c = 0; c < nc; c++)
+        if (!deg[c / 3] && uf_find(corner_uf, c) == c)
+            nfans++;
+    pv = st_malloc_array(nfans, sizeof *pv);
+    if (!pv)
+        goto done;
+    k = 0;
+    for (uint32_t c = 0; c < nc; c++) {
+        if (!deg[c / 3] && uf_find(corner_uf, c) == c) {
+            uint32_t p = piece[c / 3];
+            pFans[p]++;
+            pv[k++] = (uint64_t)p << 32 | W[c];
+        }
+    }
+    qsort(pv, nfans, sizeof *pv, cmp_u64);
+    for (size_t i = 0; i < nfans; i++)
+        if (i == 0 || pv[i] != pv[i - 1])
+            pV[pv[i] >> 32]++;
+    free(pv);
+    pv = NULL;
+
+    /* orientation propagation across manifold edges */
+    flip = st_malloc_array(nt, 1);
+    queue = st_malloc_array(nt, sizeof *queue);
+    if (!flip || !queue)
+        goto done;
+    memset(flip, 2, nt); /* 2: not reached yet */
+    for (size_t t0 = 0; t0 < nt; t0++) {
+        if (deg[t0] || flip[t0] != 2)
+            continue;
+        size_t qh = 0, qt = 0;
+        flip[t0] = 0;
+        queue[qt++] = (uint32_t)t0;
+        while (qh < qt) {
+            uint32_t t = queue[qh++];
+            for (uint32_t h = 3 * t; h < 3 * t + 3; h++) {
+                uint32_t o = nbr[h];
+                if (o == NONE)
+                    continue;
+                /* Traversing the shared edge the same way means one of the
+                 * two must flip to agree with the other. */
+                uint8_t want = (uint8_t)(flip[t] ^ same[h]);
+                if (flip[o] == 2) {
+                    flip[o] = want;
+                    queue[qt++] = o;
+                } else if (flip[o] != want) {
+                    pNonori[piece[t]] = 1;
+                }
+            }
+        }
+    }
+    for (size_t p = 0; p < np; p++) {
+        if (pNonori[p])
+            out->nonorientable_pieces++;
+        if (pBad[p] != 0 || pFans[p] != pV[p])
+            continue;
+        out->closed_pieces++;
+        if (!pNonori[p]) {
+            long long chi = (long long)pV[p] - (long long)pE[p] +
+                            (long long)pF[p];
+            out->genus += (2 - chi) / 2;
+        }
+    }
+    st = ST_OK;
+
+done:
+    if (st == ST_ENOMEM)
+        st_error_set(err, ST_ENOMEM, NULL, 0,
+                     "out of memory analysing %zu triangles", nt);
+    free(weld);
+    free(W);
+    free(deg);
+    free(trip);
+    free(he);
+    free(tri_uf);
+    free(corner_uf);
+    free(vert_uf);
+    free(mark);
+    free(nbr);
+    free(same);
+    free(fans);
+    free(piece);
+    free(pF);
+    free(pE);
+    free(pBad);
+    free(pFans);
+    free(pV);
+    free(pNonori);
+    free(pv);
+    free(flip);
+    free(queue);
+    return st;
+}

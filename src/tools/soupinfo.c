@@ -1,0 +1,244 @@
+/*
+ * soupinfo - what is wrong with a triangle soup.
+ *
+ *   soupinfo [--json] [-q|-v] INPUT...
+ *
+ * Reads each surface (.obj .off .ply .stl, or stdin) and reports the counts
+ * of soupinfo.h: vertices, welded points, degenerate and duplicated
+ * triangles, edges by kind, holes, pieces, Euler characteristic and genus,
+ * as a table per file or as one JSON array. See man/man1/soupinfo.1.
+ */
+#define _GNU_SOURCE
+#include "../cli/tool.h"
+#include "souptet/soup.h"
+#include "souptet/soupinfo.h"
+
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void usage(void)
+{
+    printf(
+"Usage: soupinfo [OPTION]... [INPUT]...\n"
+"Report what is wrong with triangle soups: welded points, degenerate and\n"
+"duplicated triangles, boundary, non-manifold and inconsistently oriented\n"
+"edges, holes, pieces, Euler characteristic and genus.\n"
+"\n"
+"INPUT is a surface (.obj .off .ply .stl); '-' or none reads stdin.\n"
+"Vertices are welded where their coordinates are exactly equal (no\n"
+"tolerance) before edges and pieces are counted.\n"
+"\n"
+"      --json           one JSON array, an object per input (default: a table)\n"
+"  -q, --quiet          no messages but errors\n"
+"  -v, --verbose        report read and analysis times on stderr\n"
+"      --help           show this help and exit\n"
+"      --version        show the version and exit\n"
+"\n"
+"Examples:\n"
+"  soupinfo bunny.obj\n"
+"  soupinfo --json scan-*.ply > report.json\n"
+"\n"
+"Exit status: 0 ok, 1 an input could not be read, 2 usage error.\n");
+}
+
+/* ---- output ---------------------------------------------------------------- */
+
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\')
+            fprintf(f, "\\%c", *p);
+        else if (*p < 0x20)
+            fprintf(f, "\\u%04x", *p);
+        else
+            fputc(*p, f);
+    }
+    fputc('"', f);
+}
+
+/* The shortest of 15, 16 or 17 significant digits that reads back as
+ * exactly x: 17 always does, fewer keep 0.1 from printing as
+ * 0.10000000000000001. */
+static const char *num(char buf[32], double x)
+{
+    for (int digits = 15; digits <= 17; digits++) {
+        snprintf(buf, 32, "%.*g", digits, x);
+        if (strtod(buf, NULL) == x)
+            break;
+    }
+    return buf;
+}
+
+/* One JSON object. */
+static void print_json(FILE *f, const char *name, const st_soupinfo *r)
+{
+    char b[7][32];
+    fprintf(f, "{\"file\": ");
+    json_string(f, name);
+    fprintf(f,
+            ",\n  \"vertices\": %zu, \"triangles\": %zu, "
+            "\"unreferenced_vertices\": %zu,\n"
+            "  \"lo\": [%s, %s, %s], \"hi\": [%s, %s, %s], "
+            "\"diagonal\": %s,\n"
+            "  \"welded_vertices\": %zu, \"degenerate_triangles\": %zu, "
+            "\"duplicated_triangles\": %zu,\n"
+            "  \"edges\": %zu, \"boundary_edges\": %zu, \"manifold_edges\": %zu, "
+            "\"nonmanifold_edges\": %zu, \"inconsistent_edges\": %zu,\n"
+            "  \"nonmanifold_vertices\": %zu, \"holes\": %zu, \"pieces\": %zu, "
+            "\"closed_pieces\": %zu, \"nonorientable_pieces\": %zu,\n"
+            "  \"euler\": %lld, \"genus\": %lld, \"closed\": %s, "
+            "\"consistently_oriented\": %s}",
+            r->vertices, r->triangles, r->unreferenced_vertices,
+            num(b[0], r->lo[0]), num(b[1], r->lo[1]), num(b[2], r->lo[2]),
+            num(b[3], r->hi[0]), num(b[4], r->hi[1]), num(b[5], r->hi[2]),
+            num(b[6], r->diagonal),
+            r->welded_vertices, r->degenerate_triangles,
+            r->duplicated_triangles, r->edges, r->boundary_edges,
+            r->manifold_edges, r->nonmanifold_edges, r->inconsistent_edges,
+            r->nonmanifold_vertices, r->holes, r->pieces, r->closed_pieces,
+            r->nonorientable_pieces, r->euler, r->genus,
+            r->closed ? "true" : "false",
+            r->consistently_oriented ? "true" : "false");
+}
+
+static void print_table(FILE *f, const char *name, const st_soupinfo *r)
+{
+#define ROW(label, fmt, ...) fprintf(f, "  %-24s " fmt "\n", label, __VA_ARGS__)
+    fprintf(f, "%s:\n", name);
+    ROW("vertices", "%zu", r->vertices);
+    ROW("  unreferenced", "%zu", r->unreferenced_vertices);
+    ROW("  welded (distinct)", "%zu", r->welded_vertices);
+    ROW("triangles", "%zu", r->triangles);
+    ROW("  degenerate", "%zu", r->degenerate_triangles);
+    ROW("  duplicated", "%zu", r->duplicated_triangles);
+    ROW("edges", "%zu", r->edges);
+    ROW("  boundary", "%zu", r->boundary_edges);
+    ROW("  manifold", "%zu", r->manifold_edges);
+    ROW("  non-manifold", "%zu", r->nonmanifold_edges);
+    ROW("  inconsistent", "%zu", r->inconsistent_edges);
+    ROW("non-manifold vertices", "%zu", r->nonmanifold_vertices);
+    ROW("holes", "%zu", r->holes);
+    ROW("pieces", "%zu", r->pieces);
+    ROW("  closed", "%zu", r->closed_pieces);
+    ROW("  non-orientable", "%zu", r->nonorientable_pieces);
+    ROW("euler characteristic", "%lld", r->euler);
+    ROW("genus (closed pieces)", "%lld", r->genus);
+    ROW("closed", "%s", r->closed ? "yes" : "no");
+    ROW("consistently oriented", "%s", r->consistently_oriented ? "yes" : "no");
+    ROW("bounds", "%.9g %.9g %.9g .. %.9g %.9g %.9g", r->lo[0], r->lo[1],
+        r->lo[2], r->hi[0], r->hi[1], r->hi[2]);
+    ROW("diagonal", "%.9g", r->diagonal);
+#undef ROW
+}
+
+/* ---- main ------------------------------------------------------------------ */
+
+enum { OPT_JSON = 256, OPT_HELP, OPT_VERSION };
+
+int main(int argc, char *argv[])
+{
+    tool_ctx t;
+    tool_init(&t, "soupinfo", argc, argv);
+    int json = 0;
+    static const struct option opts[] = {
+        {"json", no_argument, NULL, OPT_JSON},
+        {"quiet", no_argument, NULL, 'q'},
+        {"verbose", no_argument, NULL, 'v'},
+        {"help", no_argument, NULL, OPT_HELP},
+        {"version", no_argument, NULL, OPT_VERSION},
+        {NULL, 0, NULL, 0}};
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":qv", opts, NULL)) != -1) {
+        switch (c) {
+        case OPT_JSON:
+            json = 1;
+            break;
+        case 'q':
+            t.verbosity = 0;
+            break;
+        case 'v':
+            t.verbosity = 2;
+            break;
+        case OPT_HELP:
+            usage();
+            tool_finish(&t);
+            return TOOL_EXIT_OK;
+        case OPT_VERSION:
+            tool_print_version(&t);
+            tool_finish(&t);
+            return TOOL_EXIT_OK;
+        case ':':
+            tool_finish(&t);
+            return tool_usage_error(&t, "option '%s' needs a value",
+                                    argv[optind - 1]);
+        default:
+            tool_finish(&t);
+            return tool_usage_error(&t, "unknown option '%s'",
+                                    argv[optind - 1]);
+        }
+    }
+    static char *const stdin_only[] = {"-", NULL};
+    char *const *inputs = optind < argc ? argv + optind : stdin_only;
+    int ninputs = optind < argc ? argc - optind : 1;
+    int nstdin = 0;
+    for (int i = 0; i < ninputs; i++)
+        nstdin += strcmp(inputs[i], "-") == 0;
+    if (nstdin > 1) {
+        tool_finish(&t);
+        return tool_usage_error(&t, "standard input ('-') given %d times",
+                                nstdin);
+    }
+
+    /* A bad input is reported and skipped: the others are still worth a
+     * report (as wc does), and the exit status says something failed. */
+    int rc = TOOL_EXIT_OK, printed = 0;
+    if (json)
+        fputs("[", stdout);
+    for (int i = 0; i < ninputs; i++) {
+        const char *in = inputs[i];
+        const char *name = strcmp(in, "-") == 0 ? "<stdin>" : in;
+        st_error err;
+        st_error_clear(&err);
+        st_soup *soup = NULL;
+        st_soupinfo r;
+        double t_read = tool_now();
+        if (st_soup_read(&soup, in, &err)) {
+            rc = tool_fail(&t, &err);
+            continue;
+        }
+        double t_info = tool_now();
+        if (st_soupinfo_compute(&r, soup, &err)) {
+            if (!err.file[0])
+                snprintf(err.file, sizeof err.file, "%s", name);
+            rc = tool_fail(&t, &err);
+            st_soup_free(soup);
+            continue;
+        }
+        double t_end = tool_now();
+        st_soup_free(soup);
+        if (json) {
+            fputs(printed ? ",\n " : "", stdout);
+            print_json(stdout, name, &r);
+        } else {
+            if (printed)
+                fputc('\n', stdout);
+            print_table(stdout, name, &r);
+        }
+        printed++;
+        tool_say(&t, 2, "%s: read %.3f s, analysis %.3f s", name,
+                 t_info - t_read, t_end - t_info);
+    }
+    if (json)
+        fputs("]\n", stdout);
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        st_error err;
+        st_error_set(&err, ST_EIO, NULL, 0, "cannot write to standard output");
+        rc = tool_fail(&t, &err);
+    }
+    tool_finish(&t);
+    return rc;
+}
