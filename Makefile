@@ -85,7 +85,7 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA)
 	$(CXX) $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
 
 # Peers for make bench (not installed).
-BENCH_BIN := $(BUILD)/bench/vdb_udf $(BUILD)/bench/stream26
+BENCH_BIN := $(BUILD)/bench/vdb_udf $(BUILD)/bench/stream26 $(BUILD)/bench/iou
 $(BUILD)/bench/%: bench/%.cpp $(LIBA)
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
@@ -103,6 +103,7 @@ setup:
 check: setup
 	$(MAKE) --no-print-directory all
 	SOUPTET_BIN=$(CURDIR)/$(BUILD)/bin SOUPTET_TESTBIN=$(CURDIR)/$(BUILD)/tests \
+	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
 	  prove --exec '' --timer $(TEST_BIN) $(sort $(wildcard tests/tools/*.t))
 
 test: check

@@ -73,7 +73,7 @@ static void test_rays(void)
     /* An odd line (a ray through a hole): kept by the paper, dropped on
      * request, both directions. */
     const float o[] = {3, 2, 0, 2, 3};
-    unsigned char valid[8] = {0};
+    unsigned char valid[32] = {0};
     memset(v, 0, sizeof v);
     st_sign_line(o, N(o), 0.5f, &p, v, NULL);
     const unsigned char wo[] = {1, 1, 2, 1, 1};

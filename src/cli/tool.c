@@ -18,6 +18,7 @@
 #endif
 
 static const char *g_name = "souptet";
+static char *g_command_line;   /* freed at exit, whatever path main takes */
 static int g_progress_drawn;
 static double g_progress_last;
 
@@ -35,12 +36,19 @@ double tool_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+static void free_command_line(void)
+{
+    free(g_command_line);
+    g_command_line = NULL;
+}
+
 void tool_init(tool_ctx *t, const char *name, int argc, char *argv[])
 {
     t->name = name;
     g_name = name;
     t->verbosity = 1;
-    t->command_line = st_command_line(argc, argv);
+    t->command_line = g_command_line = st_command_line(argc, argv);
+    atexit(free_command_line);
     t->t0 = tool_now();
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -53,7 +61,7 @@ void tool_init(tool_ctx *t, const char *name, int argc, char *argv[])
 
 void tool_finish(tool_ctx *t)
 {
-    free(t->command_line);
+    free_command_line();
     t->command_line = NULL;
 }
 
