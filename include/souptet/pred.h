@@ -1,0 +1,85 @@
+/*
+ * pred.h - exact orientation predicates.
+ *
+ * Every topological decision in souptet (which side of a plane, whether two
+ * triangles cross, whether a lattice tet touches the surface, whether a ray
+ * crosses a face) comes down to the sign of one of these determinants. The
+ * sign returned is always the sign of the exact determinant of the given
+ * doubles, never of a rounded one: a floating-point filter with a proven
+ * error bound answers almost every call, and an exact evaluation in
+ * floating-point expansion arithmetic (Shewchuk 1997) answers the rest.
+ * The magnitude returned is only an approximation (within a factor of 2
+ * when the exact stage answers, and clamped to the double range).
+ *
+ * Range. The filter is valid for every finite input (overflow sends the
+ * call to the exact stage; underflow is covered by an absolute term in the
+ * bound). The exact stage first scales the input by a power of two, so what
+ * limits it is the *spread* of the coordinates, not their size: the sign is
+ * exact whenever every coordinate of the call is an integer multiple of
+ * 2^Q and smaller than 2^(Q + ST_PRED_SPREAD_BITS) in magnitude, for some
+ * Q. Since a double is a multiple of its own ulp, that holds whenever the
+ * nonzero coordinates of the call lie within a factor 2^588 (about 1e177)
+ * of each other, whatever their size: all in [1e-150, 1e20], or in [1e-60,
+ * 1e100], or in [1e-300, 1e-150]. Zeros never count. Models in metres or
+ * millimetres are far inside. Inputs must be finite (soups are: soup.h
+ * guarantees it).
+ *
+ * Conventions (those of Shewchuk's predicates):
+ *   st_orient2d(a, b, c) > 0  when a, b, c turn counterclockwise,
+ *                        < 0  clockwise, = 0 collinear. It equals
+ *                        det | a-c ; b-c | = ((b - a) x (c - a)).z.
+ *   st_orient3d(a, b, c, d) > 0 when d lies below the plane through a, b, c,
+ *                        "below" meaning opposite the side from which a, b,
+ *                        c appear counterclockwise: it equals
+ *                        det | a-d ; b-d ; c-d | = -(d - a) . ((b - a) x (c - a)).
+ *                        = 0 when the four points are coplanar.
+ *
+ * All functions are pure and thread-safe.
+ *
+ * Reference: J. R. Shewchuk, "Adaptive Precision Floating-Point Arithmetic
+ * and Fast Robust Geometric Predicates", Discrete & Computational Geometry
+ * 18:305-363, 1997. The code is written here from the paper.
+ */
+#ifndef SOUPTET_PRED_H
+#define SOUPTET_PRED_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The exact stage is exact when the call's coordinates, written as integer
+ * multiples of their finest common power of two, are all below
+ * 2^ST_PRED_SPREAD_BITS in magnitude (pred.c derives it). */
+#define ST_PRED_SPREAD_BITS 640
+
+/* Sign of det | a-c ; b-c | for 2-D points (see the conventions above). */
+double st_orient2d(const double a[2], const double b[2], const double c[2]);
+
+/* st_orient2d of the 3-D points projected onto the coordinate plane that
+ * drops axis `drop` (0, 1 or 2), keeping the cyclic order of the two other
+ * axes: drop 0 uses (y, z), drop 1 uses (z, x), drop 2 uses (x, y). So the
+ * result has the sign of component `drop` of (b - a) x (c - a), and a
+ * triangle's three projections all vanish exactly when it is degenerate
+ * (its vertices collinear or coincident). */
+double st_orient2d_drop(const double a[3], const double b[3],
+                        const double c[3], int drop);
+
+/* Sign of det | a-d ; b-d ; c-d | (see the conventions above). */
+double st_orient3d(const double a[3], const double b[3], const double c[3],
+                   const double d[3]);
+
+/* -1, 0 or +1: the sign of x. For the results above. */
+static inline int st_sign(double x)
+{
+    return (x > 0.0) - (x < 0.0);
+}
+
+/* How many calls, since the program started, the filter could not decide
+ * and the exact stage answered (all threads together; relaxed atomic
+ * counters, for tests and measurements). */
+unsigned long long st_pred_exact_calls(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,89 @@
+/*
+ * tetmesh.h - tetrahedral meshes: points, tets, named arrays, metadata.
+ *
+ * A tet (a, b, c, d) is positively oriented when st_orient3d(a, b, c, d) < 0,
+ * i.e. d lies on the side of triangle (a, b, c) from which a, b, c appear
+ * counterclockwise; its signed volume (b-a).((c-a)x(d-a))/6 is then > 0.
+ * Every mesh souptet writes has only positively oriented tets; a mesh read
+ * from a file may have any, and the tools say so (tetstat counts them).
+ *
+ * Arrays: any number of named double arrays, each either per point or per
+ * cell, with 1..9 components (e.g. "min_dihedral" per cell, "h" as field
+ * data goes into meta instead). The .vtu writer adds the per-cell quality
+ * arrays min_dihedral, max_dihedral and volume itself.
+ *
+ * Module order: ... -> grid -> tetmesh -> tetio (VTK adapter) -> ...
+ */
+#ifndef SOUPTET_TETMESH_H
+#define SOUPTET_TETMESH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "souptet/err.h"
+#include "souptet/meta.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum st_tet_assoc {
+    ST_ON_POINTS = 0,
+    ST_ON_CELLS
+} st_tet_assoc;
+
+typedef struct st_tet_array {
+    char *name;
+    st_tet_assoc assoc;
+    int ncomp;            /* components per tuple, 1..9 */
+    double *values;       /* ncomp * (npoints or ntets) */
+} st_tet_array;
+
+/* A zero-initialised st_tetmesh is a valid empty mesh. Grow xyz and tets
+ * only through st_tetmesh_add_point / st_tetmesh_add_tet (or
+ * st_tetmesh_reserve followed by direct writes and count updates). */
+typedef struct st_tetmesh {
+    double *xyz;          /* 3 * npoints coordinates, all finite */
+    size_t npoints;
+    uint32_t *tets;       /* 4 * ntets point indices, each < npoints */
+    size_t ntets;
+    size_t cap_points, cap_tets;
+    st_tet_array *arrays;
+    size_t narrays;
+    st_meta meta;         /* source, lattice "h", parameters, history */
+} st_tetmesh;
+
+/* An empty mesh; NULL when out of memory. */
+st_tetmesh *st_tetmesh_new(void);
+void st_tetmesh_free(st_tetmesh *m);          /* safe on NULL */
+
+/* Capacity for at least npoints points and ntets tets (checked sizes). */
+st_status st_tetmesh_reserve(st_tetmesh *m, size_t npoints, size_t ntets,
+                             st_error *err);
+/* Append; ST_ELIMIT past UINT32_MAX points; add_tet refuses indices >=
+ * npoints (ST_EINPUT). Both invalidate per-point / per-cell arrays of the
+ * wrong length: callers add arrays after the geometry is final. */
+st_status st_tetmesh_add_point(st_tetmesh *m, const double p[3],
+                               st_error *err);
+st_status st_tetmesh_add_tet(st_tetmesh *m, uint32_t a, uint32_t b,
+                             uint32_t c, uint32_t d, st_error *err);
+
+/* Add (or replace) a named array of ncomp components, zero-filled, sized
+ * for the current point or tet count; *values points at its storage. */
+st_status st_tetmesh_add_array(st_tetmesh *m, const char *name,
+                               st_tet_assoc assoc, int ncomp,
+                               double **values, st_error *err);
+/* The array of that name and association, or NULL. */
+const st_tet_array *st_tetmesh_find_array(const st_tetmesh *m,
+                                          const char *name,
+                                          st_tet_assoc assoc);
+/* Remove every array (geometry and meta stay). */
+void st_tetmesh_clear_arrays(st_tetmesh *m);
+
+/* Drop points no tet uses and renumber (arrays on points follow). */
+st_status st_tetmesh_compact(st_tetmesh *m, st_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
