@@ -43,6 +43,13 @@ void st_bvh_free(st_bvh *b);   /* safe on NULL */
 double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
                       int64_t *tri, double closest[3]);
 
+/* Call visit(ctx, tri) for every triangle whose bounding box meets the
+ * closed box [lo, hi] (a superset of the triangles that meet the box: the
+ * caller decides exactly). Stops at the first nonzero return of visit and
+ * returns it; 0 when every visit returned 0. Thread-safe (read-only). */
+int st_bvh_query_box(const st_bvh *b, const double lo[3], const double hi[3],
+                     int (*visit)(void *ctx, uint32_t tri), void *ctx);
+
 #ifdef __cplusplus
 }
 #endif

@@ -83,6 +83,22 @@ void st_tetmesh_clear_arrays(st_tetmesh *m);
 /* Drop points no tet uses and renumber (arrays on points follow). */
 st_status st_tetmesh_compact(st_tetmesh *m, st_error *err);
 
+/* Face adjacency. nbr[4*t + i] is the tet across the face of t opposite
+ * its corner i, or -1 when that face is on the boundary. A face shared by
+ * more than two tets makes the mesh non-conforming: those faces are
+ * counted in *nonmanifold_faces (may be NULL) and their tets get -1 there.
+ * The caller frees *nbr with free(). Deterministic (no hashing order). */
+st_status st_tetmesh_neighbors(const st_tetmesh *m, int64_t **nbr,
+                               size_t *nonmanifold_faces, st_error *err);
+
+/* The boundary faces (those of exactly one tet), each oriented so that its
+ * normal (b-a)x(c-a) points out of the mesh for a positively oriented tet:
+ * faces[3*f..3*f+2] are point indices, face_tet[f] the owning tet (may be
+ * NULL). Sorted by (owning tet, corner). The caller frees with free(). */
+st_status st_tetmesh_boundary(const st_tetmesh *m, uint32_t **faces,
+                              uint32_t **face_tet, size_t *nfaces,
+                              st_error *err);
+
 #ifdef __cplusplus
 }
 #endif
