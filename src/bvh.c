@@ -5,10 +5,19 @@
  * of the centroid box (quickselect), so the tree is balanced and its depth
  * is about log2(n / ST_BVH_LEAF) whatever the input. Nearest query:
  * depth-first with an explicit stack, the nearer child first, pruning boxes
- * whose distance is not below the best so far.
+ * whose distance is not below the best so far. Box query: depth-first,
+ * left child first, every triangle whose own box meets the query box.
+ * Triangle query: the same walk, pruning every node whose box the query
+ * triangle does not meet (exact, isect.h), so a large slanted triangle
+ * visits the few leaves along it instead of all of its bounding box.
+ *
+ * Each triangle's box is computed once at build time and kept in slot
+ * order (tbox), so neither the build (node boxes at every level) nor the
+ * leaf scans of the queries recompute it from the soup.
  */
 #include "souptet/bvh.h"
 #include "souptet/geom.h"
+#include "souptet/isect.h"
 #include "souptet/mem.h"
 
 #include <math.h>
@@ -23,6 +32,7 @@
 typedef struct build_ctx {
     const st_soup *s;
     double *cent;          /* 3 per triangle */
+    double *box;           /* 6 per triangle: lo, hi */
     uint32_t *order;
     st_bvh_node *nodes;
     size_t nnodes;
@@ -96,14 +106,18 @@ static void build(build_ctx *c, size_t node, size_t lo, size_t hi)
             n->hi[k] = -INFINITY;
         }
         for (size_t i = a; i < b; i++) {
-            double tlo[3], thi[3];
-            tri_box(c->s, c->order[i], tlo, thi);
+            const double *tb = c->box + 6 * (size_t)c->order[i];
             const double *ce = c->cent + 3 * (size_t)c->order[i];
             for (int k = 0; k < 3; k++) {
-                n->lo[k] = fmin(n->lo[k], tlo[k]);
-                n->hi[k] = fmax(n->hi[k], thi[k]);
-                clo[k] = fmin(clo[k], ce[k]);
-                chi[k] = fmax(chi[k], ce[k]);
+                /* plain comparisons: coordinates are finite (soup.h) */
+                if (tb[k] < n->lo[k])
+                    n->lo[k] = tb[k];
+                if (tb[3 + k] > n->hi[k])
+                    n->hi[k] = tb[3 + k];
+                if (ce[k] < clo[k])
+                    clo[k] = ce[k];
+                if (ce[k] > chi[k])
+                    chi[k] = ce[k];
             }
         }
         if (b - a <= ST_BVH_LEAF) {
@@ -146,11 +160,15 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
     c.cent = st_malloc_array(s->ntris, 3 * sizeof(double));
     c.order = st_malloc_array(s->ntris, sizeof(uint32_t));
     c.nodes = st_malloc_array(2 * s->ntris, sizeof(st_bvh_node));
-    if (!b || !c.cent || !c.order || !c.nodes) {
+    c.box = st_malloc_array(s->ntris, 6 * sizeof(double));
+    double *tbox = st_malloc_array(s->ntris, 6 * sizeof(double));
+    if (!b || !c.cent || !c.order || !c.nodes || !c.box || !tbox) {
         free(b);
         free(c.cent);
         free(c.order);
         free(c.nodes);
+        free(c.box);
+        free(tbox);
         return st_error_set(err, ST_ENOMEM, NULL, 0,
                             "out of memory for a BVH over %zu triangles",
                             s->ntris);
@@ -163,10 +181,15 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
                 sum += s->xyz[3 * (size_t)s->tris[3 * t + k] + a];
             c.cent[3 * t + a] = sum / 3.0;
         }
+        tri_box(s, (uint32_t)t, c.box + 6 * t, c.box + 6 * t + 3);
     }
     c.nnodes = 1;
     build(&c, 0, 0, s->ntris);
+    for (size_t i = 0; i < s->ntris; i++)
+        memcpy(tbox + 6 * i, c.box + 6 * (size_t)c.order[i], 6 * sizeof(double));
     free(c.cent);
+    free(c.box);
+    b->tbox = tbox;
     b->soup = s;
     b->nodes = c.nodes;
     b->nnodes = c.nnodes;
@@ -181,6 +204,7 @@ void st_bvh_free(st_bvh *b)
         return;
     free(b->nodes);
     free(b->order);
+    free(b->tbox);
     free(b);
 }
 
@@ -243,4 +267,97 @@ double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
     }
     *tri = best_tri;
     return best;
+}
+
+static int boxes_meet(const double alo[3], const double ahi[3],
+                      const double blo[3], const double bhi[3])
+{
+    return alo[0] <= bhi[0] && blo[0] <= ahi[0] && alo[1] <= bhi[1] &&
+           blo[1] <= ahi[1] && alo[2] <= bhi[2] && blo[2] <= ahi[2];
+}
+
+/* Depth-first, left child first, so the visiting order is fixed for a given
+ * tree and box. Node boxes are the exact min/max of their triangles'
+ * coordinates, so no triangle whose box meets the query box is pruned; in
+ * a leaf each triangle's own box is checked, so exactly those triangles
+ * are visited. */
+int st_bvh_query_box(const st_bvh *b, const double lo[3], const double hi[3],
+                     int (*visit)(void *ctx, uint32_t tri), void *ctx)
+{
+    uint32_t stack[STACK_DEPTH];
+    int sp = 0;
+    if (b->nnodes == 0 || !boxes_meet(b->nodes[0].lo, b->nodes[0].hi, lo, hi))
+        return 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const st_bvh_node *n = &b->nodes[stack[--sp]];
+        if (n->count) {
+            for (uint32_t i = 0; i < n->count; i++) {
+                const double *tb = b->tbox + 6 * (size_t)(n->start + i);
+                if (boxes_meet(tb, tb + 3, lo, hi)) {
+                    int r = visit(ctx, b->order[n->start + i]);
+                    if (r)
+                        return r;
+                }
+            }
+            continue;
+        }
+        uint32_t l = n->start, r = n->start + 1;
+        /* Right pushed first so the left is visited first. */
+        if (boxes_meet(b->nodes[r].lo, b->nodes[r].hi, lo, hi))
+            stack[sp++] = r;
+        if (boxes_meet(b->nodes[l].lo, b->nodes[l].hi, lo, hi))
+            stack[sp++] = l;
+    }
+    return 0;
+}
+
+/* Node boxes are exact, and st_tri_box_intersect is exact for closed sets,
+ * so no node holding a triangle whose box meets the query triangle is
+ * pruned: the visits are a superset of the triangles meeting it. The box
+ * test first, since it rejects most nodes for a few comparisons. */
+static int node_meets_tri(const st_bvh_node *n, const double *q[3],
+                          const double qlo[3], const double qhi[3])
+{
+    return boxes_meet(n->lo, n->hi, qlo, qhi) &&
+           st_tri_box_intersect(q[0], q[1], q[2], n->lo, n->hi);
+}
+
+int st_bvh_query_tri(const st_bvh *b, const double a[3], const double bb[3],
+                     const double c[3], int (*visit)(void *ctx, uint32_t tri),
+                     void *ctx)
+{
+    const double *q[3] = {a, bb, c};
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; k++) {
+        lo[k] = a[k] < bb[k] ? a[k] : bb[k];
+        lo[k] = c[k] < lo[k] ? c[k] : lo[k];
+        hi[k] = a[k] > bb[k] ? a[k] : bb[k];
+        hi[k] = c[k] > hi[k] ? c[k] : hi[k];
+    }
+    uint32_t stack[STACK_DEPTH];
+    int sp = 0;
+    if (b->nnodes == 0 || !node_meets_tri(&b->nodes[0], q, lo, hi))
+        return 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const st_bvh_node *n = &b->nodes[stack[--sp]];
+        if (n->count) {
+            for (uint32_t i = 0; i < n->count; i++) {
+                const double *tb = b->tbox + 6 * (size_t)(n->start + i);
+                if (boxes_meet(tb, tb + 3, lo, hi)) {
+                    int r = visit(ctx, b->order[n->start + i]);
+                    if (r)
+                        return r;
+                }
+            }
+            continue;
+        }
+        uint32_t l = n->start, r = n->start + 1;
+        if (node_meets_tri(&b->nodes[r], q, lo, hi))
+            stack[sp++] = r;
+        if (node_meets_tri(&b->nodes[l], q, lo, hi))
+            stack[sp++] = l;
+    }
+    return 0;
 }

@@ -30,6 +30,8 @@ typedef struct st_bvh {
     st_bvh_node *nodes;
     size_t nnodes;
     uint32_t *order;       /* triangle indices, grouped by leaf */
+    double *tbox;          /* the box of the triangle in each slot of
+                              order[]: lo[3], hi[3] (6 per slot) */
 } st_bvh;
 
 /* Build over every triangle of s (s is borrowed, not copied). */
@@ -49,6 +51,16 @@ double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
  * returns it; 0 when every visit returned 0. Thread-safe (read-only). */
 int st_bvh_query_box(const st_bvh *b, const double lo[3], const double hi[3],
                      int (*visit)(void *ctx, uint32_t tri), void *ctx);
+
+/* Call visit(ctx, tri) for every triangle whose bounding box meets the
+ * closed box of triangle (a, b, c) and lies in a node whose box meets the
+ * closed triangle itself (exact): a superset of the triangles that meet
+ * (a, b, c), much smaller than st_bvh_query_box's for a large slanted
+ * triangle. Stops at the first nonzero return of visit and returns it.
+ * The visiting order is fixed for a given tree and triangle. Thread-safe. */
+int st_bvh_query_tri(const st_bvh *b, const double a[3], const double bb[3],
+                     const double c[3], int (*visit)(void *ctx, uint32_t tri),
+                     void *ctx);
 
 #ifdef __cplusplus
 }

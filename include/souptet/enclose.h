@@ -1,0 +1,105 @@
+/*
+ * enclose.h - does a tet mesh enclose a triangle soup? Exact point location
+ * in a tet mesh, and the two enclosure counts of DESIGN.md's metrics.
+ *
+ * A mesh M encloses a soup S when
+ *   (a) every vertex of S lies in the closed union of M's tets, and
+ *   (b) no triangle of S meets a boundary face of M (a face of exactly one
+ *       tet, st_tetmesh_boundary).
+ * When M is conforming and its tets are positively oriented, the
+ * boundary of the union is the union of the boundary faces, so together
+ * (a) and (b) put every triangle of S inside M (a triangle with its
+ * vertices inside that left M would cross that boundary). With inverted
+ * tets, two tets on one side of a shared face can leave that face on the
+ * union's boundary unnoticed; tetstat reports inverted tets separately.
+ * Both counts are decided exactly (st_point_in_tet, st_tri_tri_intersect)
+ * on the closed sets, so contact counts:
+ *   - a soup vertex exactly on a boundary face is INSIDE (the tets are
+ *     closed), but
+ *   - a soup triangle touching a boundary face (at one of its vertices,
+ *     along an edge, or lying in the face) COUNTS AS CROSSING.
+ * So a mesh whose boundary touches the soup does not enclose it: there must
+ * be room between them, which is what the consumers need (the surface
+ * strictly inside the mesh is safe to embed and to move).
+ * Tets of either orientation cover the same points: an inverted tet still
+ * covers its points; a flat tet covers its (planar) convex hull.
+ *
+ * Threads: the point locator is read-only after st_locator_new and may be
+ * queried from many threads at once. st_enclosure_compute runs OpenMP
+ * loops over soup vertices and boundary faces; its counts and per-item
+ * arrays do not depend on the thread count.
+ *
+ * Module order: ... -> pred -> isect -> bvh -> tetmesh -> enclose -> tetstat
+ */
+#ifndef SOUPTET_ENCLOSE_H
+#define SOUPTET_ENCLOSE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "souptet/bvh.h"
+#include "souptet/err.h"
+#include "souptet/isect.h"
+#include "souptet/soup.h"
+#include "souptet/tetmesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- point location ----------------------------------------------------- */
+
+/* Exact point location in the tets of a mesh: a uniform grid of bins over
+ * the bounding box of the tets' points, each bin listing (in increasing
+ * index order) the tets whose bounding boxes meet it. */
+typedef struct st_locator st_locator;
+
+/* Build a locator over m's tets. m is borrowed: it must outlive the
+ * locator and its points and tets must not change meanwhile (rebuild
+ * after moving points). A mesh without tets gives a locator that finds
+ * nothing. ST_ENOMEM, or ST_ELIMIT past UINT32_MAX tets. */
+st_status st_locator_new(st_locator **out, const st_tetmesh *m,
+                         st_error *err);
+void st_locator_free(st_locator *l);   /* safe on NULL */
+
+/* The lowest index of a tet whose closed point set contains p, or -1 when
+ * p lies in no tet. The lowest index makes the answer unique for a point on
+ * a face shared by several tets. *loc (may be NULL) gets p's location in
+ * that tet (ST_INSIDE or ST_ON_BOUNDARY; ST_OUTSIDE with -1). Exact,
+ * thread-safe. */
+int64_t st_locator_find(const st_locator *l, const double p[3],
+                        st_point_loc *loc);
+
+/* ---- enclosure ----------------------------------------------------------- */
+
+typedef struct st_enclosure {
+    size_t vertices;            /* soup vertices used by some triangle */
+    size_t vertices_inside;     /* of those, in the closed union of tets */
+    size_t vertices_outside;    /* vertices - vertices_inside */
+    double fraction_inside;     /* vertices_inside / vertices; 1 if none */
+    size_t boundary_faces;      /* faces of M with exactly one tet */
+    size_t crossing_triangles;  /* soup triangles meeting a boundary face */
+    int encloses;               /* vertices_outside == 0 and
+                                   crossing_triangles == 0 */
+} st_enclosure;
+
+/* Compute the enclosure of soup s by mesh m (see the top of this file).
+ * Only soup vertices that some triangle uses are tested (readers keep
+ * unreferenced vertices; they are not part of the surface).
+ *
+ * bvh: a BVH over s (st_bvh_build), or NULL to build one here.
+ * vertex_in: NULL, or s->nverts bytes: 1 inside, 0 outside, 2 for a vertex
+ *   no triangle uses (not tested).
+ * tri_crossing: NULL, or s->ntris bytes: 1 for a triangle meeting a
+ *   boundary face, else 0.
+ * A mesh without tets encloses nothing (every used vertex is outside).
+ * Errors: ST_ENOMEM; those of st_tetmesh_boundary and st_bvh_build. */
+st_status st_enclosure_compute(st_enclosure *out, const st_tetmesh *m,
+                               const st_soup *s, const st_bvh *bvh,
+                               unsigned char *vertex_in,
+                               unsigned char *tri_crossing, st_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
