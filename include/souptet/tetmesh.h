@@ -99,6 +99,17 @@ st_status st_tetmesh_boundary(const st_tetmesh *m, uint32_t **faces,
                               uint32_t **face_tet, size_t *nfaces,
                               st_error *err);
 
+/* A deep copy of src (geometry, arrays, meta) into a new mesh *out. */
+st_status st_tetmesh_copy(st_tetmesh **out, const st_tetmesh *src,
+                          st_error *err);
+
+/* Per-tet quality into caller-owned arrays of m->ntets values (any may be
+ * NULL): smallest and largest dihedral angle in degrees and the signed
+ * volume (tetqual.h). Parallel; the values do not depend on the thread
+ * count. */
+void st_tetmesh_quality(const st_tetmesh *m, double *min_deg,
+                        double *max_deg, double *volume);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,141 @@
+/*
+ * tetformat.h - the simulator tet-mesh formats, plain C, no library:
+ * Gmsh .msh (4.1 and 2.2, ASCII and binary), TetGen .node/.ele and
+ * Medit .mesh. (.vtu is tetio.h's; tetio.c dispatches here by extension.)
+ *
+ * What is kept. Points and tets, exactly (coordinates are written with 17
+ * significant digits or as raw doubles, so a round trip is bit-exact), and
+ * the mesh's meta entries (source, h, history, ...) as comments: Gmsh's
+ * $Comments section (which Gmsh and meshio skip), '#' lines in TetGen and
+ * Medit files, each "souptet KEY: VALUE", one line per history line. Named
+ * arrays are not written (use .vtu for per-cell quality).
+ *
+ * What is written.
+ *  - .msh 4.1: $MeshFormat, $Comments, $Entities (one volume, tag 1, in
+ *    physical group 1), $Nodes (one block, tags 1..n), $Elements (one block
+ *    of type 4, tags 1..m). 2.2: $MeshFormat, $Comments, $Nodes,
+ *    $Elements (type 4, tags: physical 1, elementary 1). Binary: native
+ *    byte order with the format's "1" marker, data size 8.
+ *  - .node/.ele: "n 3 0 0" / "m 4 0", numbered from 1.
+ *  - .mesh: MeshVersionFormatted 2, Dimension 3, Vertices (ref 0),
+ *    Tetrahedra (ref 1), End; 1-based.
+ * Tets keep their corner order; souptet's positive orientation (signed
+ * volume > 0, tetmesh.h) is also Gmsh's, TetGen's and Medit's.
+ *
+ * What is read. The same files and those other programs write: any node
+ * and element numbering (msh tags are mapped, TetGen's first index 0 or 1
+ * decides its base), node and element attributes and boundary markers
+ * (ignored), msh parametric coordinates and $Entities, $PhysicalNames,
+ * $NodeData, ... (skipped), lower-dimensional elements (points, lines,
+ * triangles, quads of any order: skipped), binary files of either byte
+ * order with 4- or 8-byte msh sizes. Refused with ST_EINPUT and the file
+ * and line (text) or byte offset (binary): other 3-D cells (hexahedra,
+ * prisms, pyramids, 10-node tets), unknown element types or sections where
+ * a length is needed, truncation, counts larger than the bytes left,
+ * duplicated node tags, indices out of range, NaN/Inf coordinates, a mesh
+ * without tets. No allocation is ever sized by a count before the bytes
+ * that would hold it are known to exist, and max_bytes (0: no limit) caps
+ * the mesh memory (24 bytes a point, 16 a tet): more is ST_ELIMIT.
+ *
+ * Module order: ... -> tetmesh -> tetformat -> tetio (dispatch) -> ...
+ */
+#ifndef SOUPTET_TETFORMAT_H
+#define SOUPTET_TETFORMAT_H
+
+#include <stddef.h>
+
+#include "souptet/err.h"
+#include "souptet/tetmesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum st_tetformat {
+    ST_TETFORMAT_NONE = 0,   /* not one of these (maybe .vtu: tetio.h) */
+    ST_TETFORMAT_MSH,        /* .msh */
+    ST_TETFORMAT_TETGEN,     /* .node or .ele (the pair) */
+    ST_TETFORMAT_MEDIT       /* .mesh */
+} st_tetformat;
+
+/* Writer options; a zeroed struct means the defaults. */
+typedef struct st_tetformat_opts {
+    int msh_version;  /* 41 (default, also 0 and 4) or 22 (also 2) */
+    int binary;       /* msh only: 0 ASCII (default), 1 binary */
+} st_tetformat_opts;
+
+/* The format of a path's extension (case-insensitive): .msh, .node, .ele,
+ * .mesh; NONE otherwise, for NULL and "-" too (these formats are never
+ * piped). A temporary name made by st_outfile_begin for such a path
+ * ("dir/.name.msh.XXXXXX") gives the target's format. */
+st_tetformat st_tetformat_from_path(const char *path);
+
+/* "msh", "tetgen", "medit" or "none". */
+const char *st_tetformat_name(st_tetformat f);
+
+/* The file's format from its first bytes ("$MeshFormat", "MeshVersion...")
+ * or NONE; TetGen files have no signature. */
+st_tetformat st_tetformat_sniff(const unsigned char *data, size_t size);
+
+/* ---- reading ------------------------------------------------------------ */
+
+/* Read a mesh from path in format f (NONE: from the extension, else the
+ * content). For TETGEN, path may be the .node, the .ele or the base name
+ * without extension; both files are read. On failure *out is NULL. */
+st_status st_tetformat_read(st_tetmesh **out, st_tetformat f,
+                            const char *path, size_t max_bytes,
+                            st_error *err);
+
+st_status st_tetmesh_read_msh(st_tetmesh **out, const char *path,
+                              size_t max_bytes, st_error *err);
+st_status st_tetmesh_read_tetgen(st_tetmesh **out, const char *path,
+                                 size_t max_bytes, st_error *err);
+st_status st_tetmesh_read_medit(st_tetmesh **out, const char *path,
+                                size_t max_bytes, st_error *err);
+
+/* The same parsers on memory (for fuzzers and tests); name is used in
+ * messages only. TetGen takes both files' bytes and names. */
+st_status st_tetmesh_parse_msh(st_tetmesh **out, const unsigned char *data,
+                               size_t size, const char *name,
+                               size_t max_bytes, st_error *err);
+st_status st_tetmesh_parse_tetgen(st_tetmesh **out,
+                                  const unsigned char *node, size_t node_size,
+                                  const char *node_name,
+                                  const unsigned char *ele, size_t ele_size,
+                                  const char *ele_name, size_t max_bytes,
+                                  st_error *err);
+st_status st_tetmesh_parse_medit(st_tetmesh **out, const unsigned char *data,
+                                 size_t size, const char *name,
+                                 size_t max_bytes, st_error *err);
+
+/* ---- writing ------------------------------------------------------------ */
+
+/* Write m exactly at path (no temporary file; see st_tetformat_save).
+ * version: 41 or 22 (0 means 41); binary 0 or 1. */
+st_status st_tetmesh_write_msh(const st_tetmesh *m, const char *path,
+                               int version, int binary, st_error *err);
+/* path: the .node, the .ele or the base name; writes base.node and
+ * base.ele. */
+st_status st_tetmesh_write_tetgen(const st_tetmesh *m, const char *path,
+                                  st_error *err);
+st_status st_tetmesh_write_medit(const st_tetmesh *m, const char *path,
+                                 st_error *err);
+
+/* Write m to path in format f (NONE: from the extension) with opts (NULL:
+ * defaults), exactly at path. */
+st_status st_tetformat_write(const st_tetmesh *m, st_tetformat f,
+                             const char *path, const st_tetformat_opts *opts,
+                             st_error *err);
+
+/* As st_tetformat_write, atomically for the tools: every file (both of a
+ * TetGen pair) goes to a temporary name beside its target and is renamed
+ * only when all were written, so a failure leaves nothing at the targets.
+ * Errors name the target. */
+st_status st_tetformat_save(const st_tetmesh *m, st_tetformat f,
+                            const char *path, const st_tetformat_opts *opts,
+                            st_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,109 @@
+/*
+ * tetstat.h - the quality and fit of a tet mesh: the metrics of DESIGN.md
+ * ("Metrics"), computed into a struct (the tetstat tool prints them).
+ *
+ * Over the mesh (st_tetstat_mesh):
+ *   counts of tets and points (and points no tet uses), bounds;
+ *   min and max dihedral angle over all tets, and a histogram of each
+ *   tet's smallest dihedral angle in 10-degree bins;
+ *   inverted tets (st_orient3d > 0: negative orientation, see tetmesh.h)
+ *   and degenerate tets (st_orient3d exactly 0), both decided exactly;
+ *   conformity: faces shared by more than two tets (non-manifold faces),
+ *   interior faces (shared by exactly two), boundary faces (one tet);
+ *   connected components (tets joined through interior faces);
+ *   total signed volume; the lattice cell width h from meta "h".
+ * Against a surface S (st_tetstat_surface):
+ *   min/max/mean distance from the boundary vertices of the mesh to S
+ *   (Cetra's columns; exact point-triangle distances through a BVH);
+ *   max distance from S to the mesh boundary, sampled at every vertex of
+ *   S and at ST_TETSTAT_TRI_SAMPLES interior points of every triangle of S
+ *   (so a lost feature shows even between vertices);
+ *   the volume of S, by the divergence theorem, only when S is closed and
+ *   consistently oriented (soupinfo.h), and the ratio mesh / S;
+ *   enclosure (enclose.h): the fraction of S's vertices inside the closed
+ *   mesh and the number of S triangles that meet a boundary face (exact;
+ *   a triangle touching the boundary counts as crossing).
+ * Against a signed field F (st_tetstat_field):
+ *   IoU of the voxels whose centers lie in the mesh (exact point in tet)
+ *   and the voxels with a negative value.
+ *
+ * All of it is deterministic and does not depend on the thread count.
+ *
+ * Module order: ... -> bvh -> tetmesh -> enclose -> tetstat
+ */
+#ifndef SOUPTET_TETSTAT_H
+#define SOUPTET_TETSTAT_H
+
+#include <stddef.h>
+
+#include "souptet/err.h"
+#include "souptet/grid.h"
+#include "souptet/soup.h"
+#include "souptet/tetmesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Bins of 10 degrees for the per-tet smallest dihedral angle: [0,10),
+ * [10,20), ..., [80,90]. A tet's smallest angle is at most 70.53 (the
+ * regular tet), so the last bins stay empty for any real mesh. */
+#define ST_TETSTAT_BINS 9
+#define ST_TETSTAT_BIN_DEG 10.0
+
+/* Interior points of each triangle of S at which S-to-boundary distance
+ * is sampled besides its corners: the centroid and the three points
+ * halfway between it and each corner. */
+#define ST_TETSTAT_TRI_SAMPLES 4
+
+typedef struct st_tetstat {
+    /* mesh */
+    size_t tets, points, unused_points;
+    double lo[3], hi[3];          /* bounds of the used points (0 if none) */
+    double min_dihedral, max_dihedral;   /* degrees; NAN with no tets */
+    size_t hist[ST_TETSTAT_BINS];        /* per-tet min dihedral */
+    size_t inverted, degenerate;
+    size_t nonmanifold_faces, interior_faces, boundary_faces;
+    int conforming;               /* no non-manifold face */
+    size_t components;
+    double volume;                /* sum of signed tet volumes */
+    int has_h;
+    double h;                     /* meta "h" when it is a number */
+
+    /* against a surface (has_surface) */
+    int has_surface;
+    size_t surface_vertices, surface_triangles;
+    size_t boundary_vertices;
+    double dist_min, dist_max, dist_mean;  /* boundary vertices -> S */
+    double surface_dist_max;               /* S -> boundary */
+    int surface_closed;           /* S closed and consistently oriented */
+    double surface_volume;        /* |signed volume of S|; NAN if not closed */
+    double volume_ratio;          /* volume / surface_volume; NAN if n/a */
+    int has_enclosure;            /* the two counts below were computed */
+    size_t vertices_inside;       /* S vertices in the closed mesh */
+    double fraction_inside;       /* vertices_inside / surface_vertices */
+    size_t crossing_triangles;    /* S triangles meeting the boundary */
+    int encloses;                 /* all inside and none crossing */
+
+    /* against a signed field (has_field) */
+    int has_field;
+    size_t field_voxels, field_inside, mesh_voxels, both_voxels;
+    double iou;                   /* both / (field + mesh - both); 1 if 0/0 */
+} st_tetstat;
+
+/* Fill the mesh part of *out (and reset the rest). */
+st_status st_tetstat_mesh(st_tetstat *out, const st_tetmesh *m,
+                          st_error *err);
+
+/* Fill the surface part of *out for surface s (at least one triangle). */
+st_status st_tetstat_surface(st_tetstat *out, const st_tetmesh *m,
+                             const st_soup *s, st_error *err);
+
+/* Fill the field part of *out for a signed field f. */
+st_status st_tetstat_field(st_tetstat *out, const st_tetmesh *m,
+                           const st_grid *f, st_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

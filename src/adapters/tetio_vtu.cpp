@@ -1,0 +1,626 @@
+/*
+ * tetio_vtu.cpp - st_tetmesh <-> VTK XML UnstructuredGrid (.vtu), for
+ * ParaView, simulators built on VTK, and the pipes between souptet's tools.
+ *
+ * Mapping (writing; reading inverts it):
+ *
+ *   points     one 3-component vtkDoubleArray (binary: exact).
+ *   cells      VTK_TETRA only, connectivity in the mesh's own corner order
+ *              (VTK's tetra has the same orientation convention as
+ *              tetmesh.h: a positive tet has positive signed volume).
+ *   cell data  min_dihedral, max_dihedral (degrees) and volume (signed,
+ *              model units^3), computed at every write (min_dihedral is
+ *              the active scalars, so ParaView colours by it at once),
+ *              then the mesh's own per-cell arrays; point data: the mesh's
+ *              per-point arrays. All vtkDoubleArray.
+ *   field data every st_meta entry (source, h, lattice, parameters,
+ *              history, ...) as a one-value vtkStringArray named by its key,
+ *              in st_meta order.
+ *   encoding   appended raw binary, zlib compression, UInt64 block headers
+ *              and Int64 ids (meshes beyond 2^31 entries stay readable).
+ *
+ * Reading accepts foreign files: float or double points, any numeric
+ * point/cell arrays of 1..9 components (converted to double), string
+ * field data as meta. The three quality arrays are derived data: they are
+ * not read back (every write recomputes them from the geometry, which a
+ * tool may have moved). Refused, with a message naming the file: input VTK
+ * cannot parse, cells that are not tetrahedra, point indices out of range,
+ * non-finite coordinates, arrays whose length does not match, more than
+ * max_bytes of mesh.
+ *
+ * VTK reports problems through its global output window (and its logger),
+ * which print to stderr. The field adapter (gridio_vti.cpp) replaces VTK's
+ * default window by one that collects, and silences the logger's stderr
+ * output; this file makes sure that has happened (by one call into the
+ * field adapter) and then wraps whatever window is installed in one that
+ * collects the messages of this adapter's own calls (thread-locally) and
+ * passes every other message on to the window it wraps. So each adapter
+ * sees only its own messages, whichever is used first.
+ */
+#include "souptet/tetio.h"
+#include "souptet/mem.h"
+#include "souptet/meta.h"
+#include "souptet/tetmesh.h"
+#include "gridio_internal.h"
+#include "tetio_internal.h"
+
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkCellType.h>
+#include <vtkDataArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkErrorCode.h>
+#include <vtkFieldData.h>
+#include <vtkIdTypeArray.h>
+#include <vtkLogger.h>
+#include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkOutputWindow.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkStringArray.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridReader.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <string>
+#include <sys/stat.h>
+
+namespace {
+
+/* ---- VTK's messages ---------------------------------------------------- */
+
+thread_local std::string t_errors;
+thread_local int t_capturing = 0;
+
+class TetioCaptureWindow : public vtkOutputWindow {
+public:
+    static TetioCaptureWindow *New();
+    vtkTypeMacro(TetioCaptureWindow, vtkOutputWindow);
+
+    void SetPrevious(vtkOutputWindow *w)
+    {
+        if (w)
+            w->Register(this);
+        prev_ = w;
+    }
+
+    void DisplayText(const char *text) override
+    {
+        if (!text)
+            return;
+        if (t_capturing) {
+            if (GetCurrentMessageType() == MESSAGE_TYPE_ERROR &&
+                t_errors.size() < 16384)   // a runaway loop must not eat memory
+                t_errors += text;
+            return;
+        }
+        if (!prev_)
+            return;
+        switch (GetCurrentMessageType()) {
+        case MESSAGE_TYPE_ERROR: prev_->DisplayErrorText(text); break;
+        case MESSAGE_TYPE_WARNING: prev_->DisplayWarningText(text); break;
+        case MESSAGE_TYPE_GENERIC_WARNING:
+            prev_->DisplayGenericWarningText(text);
+            break;
+        case MESSAGE_TYPE_DEBUG: prev_->DisplayDebugText(text); break;
+        default: prev_->DisplayText(text); break;
+        }
+    }
+
+protected:
+    TetioCaptureWindow() = default;
+    ~TetioCaptureWindow() override
+    {
+        if (prev_)
+            prev_->UnRegister(this);
+    }
+
+private:
+    vtkOutputWindow *prev_ = nullptr;
+};
+vtkStandardNewMacro(TetioCaptureWindow);
+
+void install_capture()
+{
+    static const bool done = [] {
+        // Let the field adapter install its collector first: it replaces
+        // only VTK's default window, so it must see that window.
+        st_grid *g = nullptr;
+        st_error e;
+        const unsigned char probe[1] = {'x'};
+        st_gridio_read_vti_mem(&g, probe, 1, "<probe>", 0, &e);
+        st_grid_free(g);
+        vtkOutputWindow *cur = vtkOutputWindow::GetInstance();
+        const bool is_default =
+            cur && std::strcmp(cur->GetClassName(), "vtkOutputWindow") == 0;
+        TetioCaptureWindow *w = TetioCaptureWindow::New();
+        // VTK's default window would print: wrap it only when it is not
+        // the default (the field adapter's, or one the program chose).
+        if (cur && !is_default)
+            w->SetPrevious(cur);
+        if (is_default)
+            vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+        vtkOutputWindow::SetInstance(w);
+        w->Delete();
+        return true;
+    }();
+    (void)done;
+}
+
+/* Collects VTK's errors for the lifetime of one call on this thread. */
+struct Capture {
+    Capture()
+    {
+        t_errors.clear();
+        t_capturing++;
+    }
+    ~Capture() { t_capturing--; }
+};
+
+/* VTK's message without its "ERROR: In FILE, line N" header and the
+ * "ClassName (0x...): " prefix, messages joined by "; ". */
+std::string vtk_message()
+{
+    std::string out;
+    size_t start = 0;
+    const std::string &all = t_errors;
+    while (start < all.size() && out.size() < 400) {
+        size_t end = all.find("\n\n", start);
+        if (end == std::string::npos)
+            end = all.size();
+        std::string s = all.substr(start, end - start);
+        start = end + 2;
+        if (s.compare(0, 3, "ERR") == 0) {
+            size_t nl = s.find('\n');
+            s = nl == std::string::npos ? "" : s.substr(nl + 1);
+        }
+        size_t p = s.find("): ");
+        if (p != std::string::npos && p < 80)
+            s = s.substr(p + 3);
+        for (char &c : s)
+            if (c == '\n' || c == '\r')
+                c = ' ';
+        while (!s.empty() && s.back() == ' ')
+            s.pop_back();
+        if (s.empty() ||
+            s.find("returned failure for request") != std::string::npos ||
+            out.find(s) != std::string::npos)
+            continue;
+        out += (out.empty() ? "" : "; ") + s;
+    }
+    if (out.size() > 400)
+        out = out.substr(0, 400) + "...";
+    return out;
+}
+
+st_status vtk_failed(const char *name, const char *what, st_error *err)
+{
+    std::string m = vtk_message();
+    return st_error_set(err, ST_EINPUT, name, 0, "%s%s%s", what,
+                        m.empty() ? "" : ": ", m.c_str());
+}
+
+template <class F>
+st_status guarded(const char *name, const char *what, st_error *err, F &&f)
+{
+    try {
+        install_capture();
+        return f();
+    } catch (const std::bad_alloc &) {
+        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory %s",
+                            what);
+    } catch (const std::exception &e) {
+        return st_error_set(err, ST_EINPUT, name, 0, "error %s: %s", what,
+                            e.what());
+    } catch (...) {
+        return st_error_set(err, ST_EINTERNAL, name, 0,
+                            "unknown exception %s", what);
+    }
+}
+
+bool is_quality_name(const char *n)
+{
+    return n && (std::strcmp(n, "min_dihedral") == 0 ||
+                 std::strcmp(n, "max_dihedral") == 0 ||
+                 std::strcmp(n, "volume") == 0);
+}
+
+/* ---- writing ----------------------------------------------------------- */
+
+/* The grid for m. Points and the mesh's arrays are borrowed (the writer
+ * only reads them); the grid must not outlive m. */
+st_status build_grid(vtkUnstructuredGrid *ug, const st_tetmesh *m,
+                     const char *name, st_error *err)
+{
+    vtkNew<vtkDoubleArray> xyz;
+    xyz->SetNumberOfComponents(3);
+    if (m->npoints)
+        xyz->SetArray(m->xyz, vtkIdType(3 * m->npoints), 1);
+    vtkNew<vtkPoints> pts;
+    pts->SetData(xyz);
+    ug->SetPoints(pts);
+
+    const vtkIdType nt = vtkIdType(m->ntets);
+    vtkNew<vtkIdTypeArray> offsets, conn;
+    offsets->SetNumberOfValues(nt + 1);
+    conn->SetNumberOfValues(4 * nt);
+    vtkIdType *o = offsets->GetPointer(0), *c = conn->GetPointer(0);
+    for (vtkIdType t = 0; t <= nt; t++)
+        o[t] = 4 * t;
+    for (vtkIdType i = 0; i < 4 * nt; i++)
+        c[i] = vtkIdType(m->tets[i]);
+    vtkNew<vtkCellArray> cells;
+    cells->SetData(offsets, conn);
+    ug->SetCells(VTK_TETRA, cells);
+
+    vtkCellData *cd = ug->GetCellData();
+    const char *qn[3] = {"min_dihedral", "max_dihedral", "volume"};
+    double *q[3];
+    for (int k = 0; k < 3; k++) {
+        vtkNew<vtkDoubleArray> a;
+        a->SetName(qn[k]);
+        a->SetNumberOfValues(nt);
+        q[k] = a->GetPointer(0);
+        cd->AddArray(a);
+    }
+    st_tetmesh_quality(m, q[0], q[1], q[2]);
+    cd->SetActiveScalars("min_dihedral");
+
+    for (size_t i = 0; i < m->narrays; i++) {
+        const st_tet_array *arr = &m->arrays[i];
+        const bool on_cells = arr->assoc == ST_ON_CELLS;
+        if (on_cells && is_quality_name(arr->name))
+            continue;   // recomputed above
+        const size_t n = on_cells ? m->ntets : m->npoints;
+        if (arr->ncomp < 1 || arr->ncomp > 9)
+            return st_error_set(err, ST_EINTERNAL, name, 0,
+                                "mesh array '%s' has %d components",
+                                arr->name, arr->ncomp);
+        vtkNew<vtkDoubleArray> a;
+        a->SetName(arr->name);
+        a->SetNumberOfComponents(arr->ncomp);
+        if (n)
+            a->SetArray(arr->values, vtkIdType(n * size_t(arr->ncomp)), 1);
+        if (on_cells)
+            cd->AddArray(a);
+        else
+            ug->GetPointData()->AddArray(a);
+    }
+
+    vtkFieldData *fd = ug->GetFieldData();
+    for (size_t i = 0; i < m->meta.count; i++) {
+        vtkNew<vtkStringArray> s;
+        s->SetName(m->meta.entries[i].key);
+        s->InsertNextValue(m->meta.entries[i].value ? m->meta.entries[i].value
+                                                    : "");
+        fd->AddArray(s);
+    }
+    return ST_OK;
+}
+
+void configure(vtkXMLUnstructuredGridWriter *w)
+{
+    w->SetDataModeToAppended();
+    w->EncodeAppendedDataOff();   // raw binary, not base64
+    w->SetCompressorTypeToZLib();
+    w->SetHeaderTypeToUInt64();
+    w->SetIdTypeToInt64();
+}
+
+st_status check_mesh(const st_tetmesh *m, const char *name, st_error *err)
+{
+    if (!m)
+        return st_error_set(err, ST_EINTERNAL, name, 0, "no mesh to write");
+    for (size_t i = 0; i < 4 * m->ntets; i++)
+        if (m->tets[i] >= m->npoints)
+            return st_error_set(err, ST_EINTERNAL, name, 0,
+                                "tet %zu refers to point %lu of %zu", i / 4,
+                                (unsigned long)m->tets[i], m->npoints);
+    return ST_OK;
+}
+
+st_status write_file(const st_tetmesh *m, const char *path, st_error *err)
+{
+    if (st_status s = check_mesh(m, path, err))
+        return s;
+    vtkNew<vtkUnstructuredGrid> ug;
+    if (st_status s = build_grid(ug, m, path, err))
+        return s;
+    vtkNew<vtkXMLUnstructuredGridWriter> w;
+    w->SetInputData(ug);
+    w->SetFileName(path);
+    configure(w);
+    Capture cap;
+    errno = 0;
+    const int ok = w->Write();
+    const int e = errno;
+    if (!ok || !t_errors.empty() ||
+        w->GetErrorCode() != vtkErrorCode::NoError) {
+        std::string msg = vtk_message();
+        if (msg.empty() && e)
+            msg = std::strerror(e);
+        return st_error_set(err, ST_EIO, path, 0, "write failed%s%s",
+                            msg.empty() ? "" : ": ", msg.c_str());
+    }
+    return ST_OK;
+}
+
+st_status write_mem(unsigned char **data, size_t *size, const st_tetmesh *m,
+                    st_error *err)
+{
+    const char *name = ST_TETIO_STDOUT_NAME;
+    if (st_status s = check_mesh(m, name, err))
+        return s;
+    vtkNew<vtkUnstructuredGrid> ug;
+    if (st_status s = build_grid(ug, m, name, err))
+        return s;
+    vtkNew<vtkXMLUnstructuredGridWriter> w;
+    w->SetInputData(ug);
+    w->WriteToOutputStringOn();
+    configure(w);
+    Capture cap;
+    const int ok = w->Write();
+    if (!ok || !t_errors.empty() ||
+        w->GetErrorCode() != vtkErrorCode::NoError) {
+        std::string msg = vtk_message();
+        return st_error_set(err, ST_EIO, name, 0, "write failed%s%s",
+                            msg.empty() ? "" : ": ", msg.c_str());
+    }
+    const std::string out = w->GetOutputString();
+    unsigned char *buf = static_cast<unsigned char *>(
+        std::malloc(out.size() ? out.size() : 1));
+    if (!buf)
+        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
+    std::memcpy(buf, out.data(), out.size());
+    *data = buf;
+    *size = out.size();
+    return ST_OK;
+}
+
+/* ---- reading ----------------------------------------------------------- */
+
+struct MeshGuard {
+    st_tetmesh *m;
+    ~MeshGuard() { st_tetmesh_free(m); }
+};
+
+/* Copy the usable numeric arrays of one attribute set into the mesh. */
+st_status read_arrays(st_tetmesh *m, vtkFieldData *src, st_tet_assoc assoc,
+                      const char *name, size_t *bytes, size_t max_bytes,
+                      st_error *err)
+{
+    if (!src)
+        return ST_OK;
+    const size_t n = assoc == ST_ON_CELLS ? m->ntets : m->npoints;
+    const char *what = assoc == ST_ON_CELLS ? "cell" : "point";
+    for (int i = 0; i < src->GetNumberOfArrays(); i++) {
+        vtkDataArray *a = src->GetArray(i);   // null for string arrays
+        if (!a || !a->GetName() || !a->GetName()[0])
+            continue;
+        if (assoc == ST_ON_CELLS && is_quality_name(a->GetName()))
+            continue;   // derived: recomputed by every write
+        const int nc = a->GetNumberOfComponents();
+        if (nc < 1 || nc > 9)
+            continue;   // not representable in an st_tetmesh: skipped
+        if (a->GetNumberOfTuples() != vtkIdType(n))
+            return st_error_set(err, ST_EINPUT, name, 0,
+                                "%s array '%s' has %lld tuples for %zu "
+                                "%ss",
+                                what, a->GetName(),
+                                (long long)a->GetNumberOfTuples(), n, what);
+        size_t add = n * size_t(nc) * sizeof(double);
+        if (st_size_add(bytes, *bytes, add) != 0 ||
+            (max_bytes && *bytes > max_bytes))
+            return st_error_set(err, ST_ELIMIT, name, 0,
+                                "mesh needs more than the memory limit of "
+                                "%zu bytes",
+                                max_bytes);
+        double *v;
+        if (st_status s = st_tetmesh_add_array(m, a->GetName(), assoc, nc,
+                                               &v, err)) {
+            if (err && !err->file[0])
+                std::snprintf(err->file, sizeof err->file, "%s", name);
+            return s;
+        }
+        for (size_t t = 0; t < n; t++)
+            for (int c = 0; c < nc; c++) {
+                const double x = a->GetComponent(vtkIdType(t), c);
+                v[t * size_t(nc) + size_t(c)] = x;
+            }
+    }
+    return ST_OK;
+}
+
+st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
+                    size_t max_bytes, st_tetmesh **out, st_error *err)
+{
+    Capture cap;
+    r->UpdateInformation();
+    if (!t_errors.empty() || r->GetErrorCode() != vtkErrorCode::NoError)
+        return vtk_failed(name,
+                          "not a readable VTK UnstructuredGrid (.vtu) file",
+                          err);
+    r->SetupUpdateExtent(0, 1, 0);
+    const long long np = (long long)r->GetNumberOfPoints();
+    const long long nc = (long long)r->GetNumberOfCells();
+    if (np < 0 || nc < 0)
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "negative point or cell count");
+    if ((unsigned long long)np >= UINT32_MAX)
+        return st_error_set(err, ST_ELIMIT, name, 0,
+                            "%lld points: more than a mesh can hold", np);
+    size_t bytes = 0, tmp;
+    if (st_size_mul(&bytes, size_t(np), 3 * sizeof(double)) != 0 ||
+        st_size_mul(&tmp, size_t(nc), 4 * sizeof(uint32_t)) != 0 ||
+        st_size_add(&bytes, bytes, tmp) != 0 ||
+        (max_bytes && bytes > max_bytes))
+        return st_error_set(err, ST_ELIMIT, name, 0,
+                            "%lld points and %lld cells need more than the "
+                            "memory limit of %zu bytes",
+                            np, nc, max_bytes);
+
+    r->Update();
+    vtkUnstructuredGrid *ug = r->GetOutput();
+    if (!t_errors.empty() || r->GetErrorCode() != vtkErrorCode::NoError ||
+        !ug)
+        return vtk_failed(name,
+                          "cannot read the mesh data (truncated or corrupt "
+                          "file?)",
+                          err);
+    const vtkIdType npts = ug->GetNumberOfPoints();
+    const vtkIdType ncells = ug->GetNumberOfCells();
+    if (npts != np || ncells != nc)
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "read %lld points and %lld cells, the header "
+                            "says %lld and %lld (truncated file?)",
+                            (long long)npts, (long long)ncells, np, nc);
+
+    st_tetmesh *m = st_tetmesh_new();
+    if (!m)
+        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
+    MeshGuard guard{m};
+    if (st_status s = st_tetmesh_reserve(m, size_t(npts), size_t(ncells),
+                                         err)) {
+        std::snprintf(err->file, sizeof err->file, "%s", name);
+        return s;
+    }
+    vtkPoints *pts = ug->GetPoints();
+    if (npts > 0 && !pts)
+        return st_error_set(err, ST_EINPUT, name, 0, "no points");
+    for (vtkIdType i = 0; i < npts; i++) {
+        double p[3];
+        pts->GetPoint(i, p);
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) ||
+            !std::isfinite(p[2]))
+            return st_error_set(err, ST_EINPUT, name, 0,
+                                "point %lld is not finite (%g %g %g)",
+                                (long long)i, p[0], p[1], p[2]);
+        std::memcpy(m->xyz + 3 * size_t(i), p, sizeof p);
+    }
+    m->npoints = size_t(npts);
+    for (vtkIdType c = 0; c < ncells; c++) {
+        const int type = ug->GetCellType(c);
+        vtkIdType n;
+        const vtkIdType *ids;
+        if (type != VTK_TETRA)
+            return st_error_set(err, ST_EINPUT, name, 0,
+                                "cell %lld is not a tetrahedron (VTK cell "
+                                "type %d; only type %d, VTK_TETRA, is "
+                                "accepted)",
+                                (long long)c, type, VTK_TETRA);
+        ug->GetCellPoints(c, n, ids);
+        if (n != 4)
+            return st_error_set(err, ST_EINPUT, name, 0,
+                                "tetrahedron %lld has %lld points",
+                                (long long)c, (long long)n);
+        uint32_t *t = m->tets + 4 * size_t(c);
+        for (int k = 0; k < 4; k++) {
+            if (ids[k] < 0 || ids[k] >= npts)
+                return st_error_set(err, ST_EINPUT, name, 0,
+                                    "tetrahedron %lld refers to point %lld "
+                                    "of %lld",
+                                    (long long)c, (long long)ids[k],
+                                    (long long)npts);
+            t[k] = uint32_t(ids[k]);
+        }
+    }
+    m->ntets = size_t(ncells);
+
+    if (st_status s = read_arrays(m, ug->GetCellData(), ST_ON_CELLS, name,
+                                  &bytes, max_bytes, err))
+        return s;
+    if (st_status s = read_arrays(m, ug->GetPointData(), ST_ON_POINTS, name,
+                                  &bytes, max_bytes, err))
+        return s;
+    vtkFieldData *fd = ug->GetFieldData();
+    for (int i = 0; fd && i < fd->GetNumberOfArrays(); i++) {
+        vtkStringArray *s =
+            vtkStringArray::SafeDownCast(fd->GetAbstractArray(i));
+        if (!s || !s->GetName() || !s->GetName()[0] ||
+            s->GetNumberOfValues() < 1)
+            continue;
+        if (st_meta_set(&m->meta, s->GetName(), s->GetValue(0).c_str()))
+            return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
+    }
+    guard.m = nullptr;
+    *out = m;
+    return ST_OK;
+}
+
+st_status check_input_file(const char *path, st_error *err)
+{
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
+                            std::strerror(errno));
+    if (S_ISDIR(st.st_mode))
+        return st_error_set(err, ST_EIO, path, 0, "is a directory");
+    if (S_ISREG(st.st_mode) && st.st_size == 0)
+        return st_error_set(err, ST_EINPUT, path, 0, "empty file");
+    FILE *fp = std::fopen(path, "rb");
+    if (!fp)
+        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
+                            std::strerror(errno));
+    std::fclose(fp);
+    return ST_OK;
+}
+
+} // namespace
+
+extern "C" {
+
+st_status st_tetio_write_vtu_file(const st_tetmesh *m, const char *path,
+                                  st_error *err)
+{
+    return guarded(path, "writing", err,
+                   [&] { return write_file(m, path, err); });
+}
+
+st_status st_tetio_write_vtu_mem(unsigned char **data, size_t *size,
+                                 const st_tetmesh *m, st_error *err)
+{
+    *data = nullptr;
+    *size = 0;
+    return guarded(ST_TETIO_STDOUT_NAME, "writing", err,
+                   [&] { return write_mem(data, size, m, err); });
+}
+
+st_status st_tetio_read_vtu_mem(st_tetmesh **out, const unsigned char *data,
+                                size_t size, const char *name,
+                                size_t max_bytes, st_error *err)
+{
+    *out = nullptr;
+    if (!name)
+        name = ST_TETIO_STDIN_NAME;
+    if (size == 0)
+        return st_error_set(err, ST_EINPUT, name, 0, "empty input");
+    return guarded(name, "reading", err, [&] {
+        vtkNew<vtkXMLUnstructuredGridReader> r;
+        r->ReadFromInputStringOn();
+        r->SetInputString(
+            std::string(reinterpret_cast<const char *>(data), size));
+        return read_with(r, name, max_bytes, out, err);
+    });
+}
+
+st_status st_tetio_read_vtu_file(st_tetmesh **out, const char *path,
+                                 size_t max_bytes, st_error *err)
+{
+    *out = nullptr;
+    if (st_status s = check_input_file(path, err))
+        return s;
+    return guarded(path, "reading", err, [&] {
+        vtkNew<vtkXMLUnstructuredGridReader> r;
+        r->SetFileName(path);
+        return read_with(r, path, max_bytes, out, err);
+    });
+}
+
+} // extern "C"

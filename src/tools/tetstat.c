@@ -1,0 +1,400 @@
+/*
+ * tetstat - the quality and fit of a tet mesh.
+ *
+ *   tetstat [--surface S] [--field F] [--json] [-q|-v] [--threads T] [MESH]
+ *
+ * Reads a tet mesh (.vtu, or stdin) and reports the metrics of tetstat.h:
+ * counts, dihedral angles and their histogram, inverted and degenerate
+ * tets, conformity, components, volume; with a surface the distances
+ * between the mesh boundary and the surface, the volume ratio and
+ * enclosure; with a signed field the IoU with its pseudo volume. A table,
+ * or one JSON object. See man/man1/tetstat.1.
+ */
+#define _GNU_SOURCE
+#include "../cli/tool.h"
+#include "souptet/gridio.h"
+#include "souptet/soup.h"
+#include "souptet/tetio.h"
+#include "souptet/tetstat.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void usage(void)
+{
+    printf(
+"Usage: tetstat [OPTION]... [MESH]\n"
+"Report the quality of a tet mesh and how well it fits a surface: tets and\n"
+"points, min and max dihedral angle and a histogram of each tet's smallest\n"
+"one, inverted and degenerate tets (exact), conformity (faces of more than\n"
+"two tets), connected components, boundary faces, volume, the lattice cell\n"
+"width h when the mesh records it.\n"
+"\n"
+"MESH is a .vtu tet mesh; '-' or none reads stdin.\n"
+"\n"
+"  -S, --surface S      also measure against surface S (.obj .off .ply .stl):\n"
+"                       distances boundary <-> S, volume ratio (when S is\n"
+"                       closed and oriented), enclosure of S by the mesh\n"
+"  -F, --field F        also give the IoU of the mesh with the pseudo volume\n"
+"                       (negative voxels) of signed field F (.vdb .vti)\n"
+"      --json           one JSON object (default: a table)\n"
+"      --threads T      threads to use (default: all cores)\n"
+"      --max-memory SZ  refuse meshes and fields larger than SZ (default 80%% of RAM)\n"
+"  -q, --quiet          no messages but errors (no warnings about the mesh)\n"
+"  -v, --verbose        report the time of each stage on stderr\n"
+"      --help           show this help and exit\n"
+"      --version        show the version and exit\n"
+"\n"
+"Examples:\n"
+"  tetstat bunny.vtu\n"
+"  tetstat --surface bunny.obj --json bunny.vtu > report.json\n"
+"  latticetet --density 0.5 bunny-sdf.vdb | tetstat --field bunny-sdf.vdb\n"
+"\n"
+"Exit status: 0 the report was made (whatever the mesh is like), 1 an input\n"
+"could not be read, 2 usage error.\n");
+}
+
+/* ---- output ---------------------------------------------------------------- */
+
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\')
+            fprintf(f, "\\%c", *p);
+        else if (*p < 0x20)
+            fprintf(f, "\\u%04x", *p);
+        else
+            fputc(*p, f);
+    }
+    fputc('"', f);
+}
+
+/* The shortest of 15..17 significant digits that reads back as x; "null"
+ * for NaN and infinities (JSON has neither). */
+static const char *num(char buf[32], double x)
+{
+    if (!isfinite(x))
+        return "null";
+    for (int digits = 15; digits <= 17; digits++) {
+        snprintf(buf, 32, "%.*g", digits, x);
+        if (strtod(buf, NULL) == x)
+            break;
+    }
+    return buf;
+}
+
+static const char *yesno(int b)
+{
+    return b ? "true" : "false";
+}
+
+static void print_json(FILE *f, const char *name, const char *sname,
+                       const char *fname, const st_tetstat *r)
+{
+    char b[12][32];
+    fprintf(f, "{\"file\": ");
+    json_string(f, name);
+    fprintf(f,
+            ",\n  \"tets\": %zu, \"points\": %zu, \"unused_points\": %zu,\n"
+            "  \"lo\": [%s, %s, %s], \"hi\": [%s, %s, %s],\n"
+            "  \"min_dihedral\": %s, \"max_dihedral\": %s,\n"
+            "  \"min_dihedral_histogram\": {\"bin_degrees\": %g, \"counts\": [",
+            r->tets, r->points, r->unused_points, num(b[0], r->lo[0]),
+            num(b[1], r->lo[1]), num(b[2], r->lo[2]), num(b[3], r->hi[0]),
+            num(b[4], r->hi[1]), num(b[5], r->hi[2]),
+            num(b[6], r->min_dihedral), num(b[7], r->max_dihedral),
+            ST_TETSTAT_BIN_DEG);
+    for (int i = 0; i < ST_TETSTAT_BINS; i++)
+        fprintf(f, "%s%zu", i ? ", " : "", r->hist[i]);
+    fprintf(f,
+            "]},\n"
+            "  \"inverted\": %zu, \"degenerate\": %zu,\n"
+            "  \"boundary_faces\": %zu, \"interior_faces\": %zu, "
+            "\"nonmanifold_faces\": %zu, \"conforming\": %s,\n"
+            "  \"components\": %zu, \"volume\": %s, \"h\": %s",
+            r->inverted, r->degenerate, r->boundary_faces, r->interior_faces,
+            r->nonmanifold_faces, yesno(r->conforming), r->components,
+            num(b[0], r->volume), r->has_h ? num(b[1], r->h) : "null");
+    if (r->has_surface) {
+        fprintf(f, ",\n  \"surface\": {\"file\": ");
+        json_string(f, sname);
+        fprintf(f,
+                ", \"vertices\": %zu, \"triangles\": %zu,\n"
+                "    \"boundary_vertices\": %zu, \"dist_min\": %s, "
+                "\"dist_max\": %s, \"dist_mean\": %s,\n"
+                "    \"surface_dist_max\": %s, \"closed\": %s, "
+                "\"surface_volume\": %s, \"volume_ratio\": %s",
+                r->surface_vertices, r->surface_triangles,
+                r->boundary_vertices, num(b[0], r->dist_min),
+                num(b[1], r->dist_max), num(b[2], r->dist_mean),
+                num(b[3], r->surface_dist_max), yesno(r->surface_closed),
+                num(b[4], r->surface_volume), num(b[5], r->volume_ratio));
+        if (r->has_enclosure)
+            fprintf(f,
+                    ",\n    \"vertices_inside\": %zu, \"fraction_inside\": "
+                    "%s, \"crossing_triangles\": %zu, \"encloses\": %s}",
+                    r->vertices_inside, num(b[6], r->fraction_inside),
+                    r->crossing_triangles, yesno(r->encloses));
+        else
+            fprintf(f, ",\n    \"vertices_inside\": null, "
+                       "\"fraction_inside\": null, \"crossing_triangles\": "
+                       "null, \"encloses\": null}");
+    }
+    if (r->has_field) {
+        fprintf(f, ",\n  \"field\": {\"file\": ");
+        json_string(f, fname);
+        fprintf(f,
+                ", \"voxels\": %zu, \"field_inside\": %zu, "
+                "\"mesh_inside\": %zu, \"both\": %zu, \"iou\": %s}",
+                r->field_voxels, r->field_inside, r->mesh_voxels,
+                r->both_voxels, num(b[0], r->iou));
+    }
+    fprintf(f, "}\n");
+}
+
+#define ROW(label, ...)                                                     \
+    do {                                                                    \
+        fprintf(f, "  %-28s ", label);                                      \
+        fprintf(f, __VA_ARGS__);                                            \
+        fputc('\n', f);                                                     \
+    } while (0)
+
+static void print_table(FILE *f, const char *name, const char *sname,
+                        const char *fname, const st_tetstat *r)
+{
+    fprintf(f, "%s:\n", name);
+    ROW("tets", "%zu", r->tets);
+    ROW("points", "%zu", r->points);
+    ROW("  unused", "%zu", r->unused_points);
+    ROW("bounds", "%.9g %.9g %.9g .. %.9g %.9g %.9g", r->lo[0], r->lo[1],
+        r->lo[2], r->hi[0], r->hi[1], r->hi[2]);
+    if (r->tets) {
+        ROW("min dihedral", "%.4f", r->min_dihedral);
+        ROW("max dihedral", "%.4f", r->max_dihedral);
+    } else {
+        ROW("min dihedral", "n/a");
+        ROW("max dihedral", "n/a");
+    }
+    fprintf(f, "  per-tet min dihedral:\n");
+    for (int i = 0; i < ST_TETSTAT_BINS; i++) {
+        char label[32];
+        double lo = i * ST_TETSTAT_BIN_DEG, hi = lo + ST_TETSTAT_BIN_DEG;
+        snprintf(label, sizeof label, "  %2.0f..%2.0f", lo, hi);
+        ROW(label, "%zu", r->hist[i]);
+    }
+    ROW("inverted tets", "%zu%s", r->inverted,
+        r->inverted ? "   <- INVERTED TETS" : "");
+    ROW("degenerate tets", "%zu%s", r->degenerate,
+        r->degenerate ? "   <- FLAT TETS" : "");
+    ROW("boundary faces", "%zu", r->boundary_faces);
+    ROW("interior faces", "%zu", r->interior_faces);
+    ROW("non-manifold faces", "%zu", r->nonmanifold_faces);
+    ROW("conforming", "%s", r->conforming ? "yes" : "no   <- NOT CONFORMING");
+    ROW("components", "%zu", r->components);
+    ROW("volume", "%.9g", r->volume);
+    if (r->has_h)
+        ROW("lattice h", "%.9g", r->h);
+    if (r->has_surface) {
+        fprintf(f, "surface %s:\n", sname);
+        ROW("vertices", "%zu", r->surface_vertices);
+        ROW("triangles", "%zu", r->surface_triangles);
+        ROW("boundary vertices", "%zu", r->boundary_vertices);
+        ROW("boundary -> S min", "%.9g", r->dist_min);
+        ROW("boundary -> S max", "%.9g", r->dist_max);
+        ROW("boundary -> S mean", "%.9g", r->dist_mean);
+        ROW("S -> boundary max", "%.9g", r->surface_dist_max);
+        if (r->surface_closed) {
+            ROW("surface volume", "%.9g", r->surface_volume);
+            ROW("volume ratio", "%.6f", r->volume_ratio);
+        } else {
+            ROW("surface volume", "n/a (S is not closed and oriented)");
+            ROW("volume ratio", "n/a");
+        }
+        if (r->has_enclosure) {
+            ROW("S vertices inside", "%zu of %zu (%.4f%%)",
+                r->vertices_inside, r->surface_vertices,
+                100.0 * r->fraction_inside);
+            ROW("S triangles crossing", "%zu", r->crossing_triangles);
+            ROW("encloses S", "%s",
+                r->encloses ? "yes" : "no   <- DOES NOT ENCLOSE");
+        } else {
+            ROW("encloses S", "n/a (enclosure test not available)");
+        }
+    }
+    if (r->has_field) {
+        fprintf(f, "field %s:\n", fname);
+        ROW("voxels", "%zu", r->field_voxels);
+        ROW("inside the field (< 0)", "%zu", r->field_inside);
+        ROW("inside the mesh", "%zu", r->mesh_voxels);
+        ROW("both", "%zu", r->both_voxels);
+        ROW("IoU", "%.6f", r->iou);
+    }
+}
+#undef ROW
+
+/* ---- main ------------------------------------------------------------------ */
+
+enum { OPT_JSON = 256, OPT_THREADS, OPT_MAXMEM, OPT_HELP, OPT_VERSION };
+
+int main(int argc, char *argv[])
+{
+    tool_ctx t;
+    tool_init(&t, "tetstat", argc, argv);
+    int json = 0;
+    size_t threads = 0, max_bytes = tool_default_max_memory();
+    const char *surface = NULL, *field = NULL;
+    static const struct option opts[] = {
+        {"surface", required_argument, NULL, 'S'},
+        {"field", required_argument, NULL, 'F'},
+        {"json", no_argument, NULL, OPT_JSON},
+        {"threads", required_argument, NULL, OPT_THREADS},
+        {"max-memory", required_argument, NULL, OPT_MAXMEM},
+        {"quiet", no_argument, NULL, 'q'},
+        {"verbose", no_argument, NULL, 'v'},
+        {"help", no_argument, NULL, OPT_HELP},
+        {"version", no_argument, NULL, OPT_VERSION},
+        {NULL, 0, NULL, 0}};
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":S:F:qv", opts, NULL)) != -1) {
+        switch (c) {
+        case 'S':
+            surface = optarg;
+            break;
+        case 'F':
+            field = optarg;
+            break;
+        case OPT_JSON:
+            json = 1;
+            break;
+        case OPT_THREADS:
+            if (tool_parse_size(&t, "--threads", optarg, 1, 4096, &threads)) {
+                tool_finish(&t);
+                return TOOL_EXIT_USAGE;
+            }
+            break;
+        case OPT_MAXMEM:
+            if (tool_parse_bytes(&t, "--max-memory", optarg, &max_bytes)) {
+                tool_finish(&t);
+                return TOOL_EXIT_USAGE;
+            }
+            break;
+        case 'q':
+            t.verbosity = 0;
+            break;
+        case 'v':
+            t.verbosity = 2;
+            break;
+        case OPT_HELP:
+            usage();
+            tool_finish(&t);
+            return TOOL_EXIT_OK;
+        case OPT_VERSION:
+            tool_print_version(&t);
+            tool_finish(&t);
+            return TOOL_EXIT_OK;
+        case ':':
+            tool_finish(&t);
+            return tool_usage_error(&t, "option '%s' needs a value",
+                                    argv[optind - 1]);
+        default:
+            tool_finish(&t);
+            return tool_usage_error(&t, "unknown option '%s'",
+                                    argv[optind - 1]);
+        }
+    }
+    if (argc - optind > 1) {
+        tool_finish(&t);
+        return tool_usage_error(&t, "one mesh at a time (got %d)",
+                                argc - optind);
+    }
+    const char *in = optind < argc ? argv[optind] : "-";
+    const char *name = strcmp(in, "-") == 0 ? "<stdin>" : in;
+    int nstdin = (strcmp(in, "-") == 0) + (surface && !strcmp(surface, "-")) +
+                 (field && !strcmp(field, "-"));
+    if (nstdin > 1) {
+        tool_finish(&t);
+        return tool_usage_error(&t, "standard input ('-') given %d times",
+                                nstdin);
+    }
+    tool_set_threads(threads);
+
+    st_error err;
+    st_error_clear(&err);
+    st_tetmesh *m = NULL;
+    st_soup *s = NULL;
+    st_grid *g = NULL;
+    st_tetstat r;
+    int rc = TOOL_EXIT_FAIL;
+    double t0 = tool_now();
+    /* Read every input first: a bad one gives no half report. */
+    if (st_tetmesh_read(&m, in, max_bytes, &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    if (surface && st_soup_read(&s, surface, &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    if (field && st_grid_read(&g, field, max_bytes, &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    double t1 = tool_now();
+    if (st_tetstat_mesh(&r, m, &err))
+        goto failed;
+    double t2 = tool_now();
+    if (s && st_tetstat_surface(&r, m, s, &err))
+        goto failed;
+    double t3 = tool_now();
+    if (g && st_tetstat_field(&r, m, g, &err))
+        goto failed;
+    double t4 = tool_now();
+    tool_say(&t, 2, "read %.3f s, mesh %.3f s, surface %.3f s, field %.3f s",
+             t1 - t0, t2 - t1, t3 - t2, t4 - t3);
+
+    const char *sname = surface && strcmp(surface, "-") ? surface : "<stdin>";
+    const char *fname = field && strcmp(field, "-") ? field : "<stdin>";
+    if (json)
+        print_json(stdout, name, sname, fname, &r);
+    else
+        print_table(stdout, name, sname, fname, &r);
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        st_error_set(&err, ST_EIO, NULL, 0, "cannot write to standard output");
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    /* The report is the result; what is wrong with the mesh is also said
+     * where a script's user sees it. */
+    if (r.inverted)
+        tool_say(&t, 1, "%s: warning: %zu inverted tet%s", name, r.inverted,
+                 r.inverted == 1 ? "" : "s");
+    if (r.degenerate)
+        tool_say(&t, 1, "%s: warning: %zu degenerate (flat) tet%s", name,
+                 r.degenerate, r.degenerate == 1 ? "" : "s");
+    if (r.nonmanifold_faces)
+        tool_say(&t, 1, "%s: warning: not conforming: %zu faces shared by "
+                 "more than two tets", name, r.nonmanifold_faces);
+    if (r.has_surface && r.has_enclosure && !r.encloses)
+        tool_say(&t, 1,
+                 "%s: warning: does not enclose %s: %zu of %zu vertices "
+                 "outside, %zu triangles crossing the boundary",
+                 name, sname, r.surface_vertices - r.vertices_inside,
+                 r.surface_vertices, r.crossing_triangles);
+    rc = TOOL_EXIT_OK;
+    goto done;
+failed:
+    if (!err.file[0])
+        snprintf(err.file, sizeof err.file, "%s", name);
+    rc = tool_fail(&t, &err);
+done:
+    st_tetmesh_free(m);
+    st_soup_free(s);
+    st_grid_free(g);
+    tool_finish(&t);
+    return rc;
+}
