@@ -1,0 +1,342 @@
+/*
+ * latticetet - a tet mesh of the pseudo volume from a lattice.
+ *
+ *   latticetet [FIELD] (--density RHO | --sculpt --surface S)
+ *              [--lattice cubic5|bcc] [--cells N | -h SIZE] [--seed S]
+ *              [-o OUT] [-q | -v] [--threads T]
+ *
+ * Reads a signed field (soupsign's output: .vdb, .vti, or an OpenVDB stream
+ * on stdin), lays a lattice over its box and keeps the tets whose
+ * pseudo-volume density is at least RHO (Spillmann et al. 2006, section 4),
+ * or sculpts a BCC lattice to the tets that overlap the pseudo volume or a
+ * triangle of S, with bomb repair (Stuart et al. 2013, section 3.2). Writes
+ * .vtu. See man/man1/latticetet.1, lattice.h and sculpt.h.
+ */
+#define _GNU_SOURCE
+#include "../cli/tool.h"
+#include "souptet/gridio.h"
+#include "souptet/lattice.h"
+#include "souptet/outfile.h"
+#include "souptet/sculpt.h"
+#include "souptet/soup.h"
+#include "souptet/tetio.h"
+
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static void usage(void)
+{
+    printf(
+"Usage: latticetet [OPTION]... (--density RHO | --sculpt --surface S) [FIELD]\n"
+"A tetrahedral mesh of the pseudo volume: a lattice laid over a signed field,\n"
+"filtered by density (Spillmann et al. 2006) or sculpted with bomb repair\n"
+"(Stuart et al. 2013).\n"
+"\n"
+"FIELD is a signed field from soupsign (.vdb or .vti); '-' or none reads an\n"
+"OpenVDB stream from stdin.\n"
+"\n"
+"      --density RHO    keep tets whose pseudo-volume density is >= RHO, in\n"
+"                       [0, 1] (the paper: 0.5)\n"
+"      --sculpt         keep every tet that overlaps the pseudo volume or a\n"
+"                       triangle of the surface, then repair bombs\n"
+"      --surface S      the surface the field was made from (with --sculpt)\n"
+"      --lattice KIND   cubic5 (5 tets per cube) or bcc (default: cubic5 for\n"
+"                       --density, bcc for --sculpt)\n"
+"      --cells N        cells along the longest side of the field's box\n"
+"                       (default 16 for --density, 10 for --sculpt)\n"
+"  -h, --size SIZE      cell width in model units (instead of --cells)\n"
+"      --seed S         random rotation and offset of the lattice (default 0:\n"
+"                       axis-aligned at the box's corner)\n"
+"      --no-repair      sculpt without bomb and manifold repair\n"
+"  -o, --output OUT     .vtu file (or .msh, .node/.ele, .mesh by extension,\n"
+"                       without the arrays); '-' or none: .vtu on stdout\n"
+"      --threads T      threads to use (default: all cores)\n"
+"      --max-memory SZ  refuse fields larger than SZ (default 80%% of RAM)\n"
+"  -q, --quiet          no messages but errors\n"
+"  -v, --verbose        report tets kept, bombs, timings\n"
+"      --help           show this help and exit\n"
+"      --version        show the version and exit\n"
+"\n"
+"Examples:\n"
+"  soupdist bunny.obj | soupsign | latticetet --density 0.5 -o bunny.vtu\n"
+"  soupdist bunny.obj | soupsign | latticetet --sculpt --surface bunny.obj \\\n"
+"      --cells 12 -o bunny-bcc.vtu\n"
+"\n"
+"Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
+}
+
+enum { OPT_DENSITY = 256, OPT_SCULPT, OPT_SURFACE, OPT_LATTICE, OPT_CELLS,
+       OPT_SEED, OPT_NOREPAIR, OPT_THREADS, OPT_MAXMEM, OPT_HELP,
+       OPT_VERSION };
+
+int main(int argc, char *argv[])
+{
+    tool_ctx t;
+    tool_init(&t, "latticetet", argc, argv);
+    size_t max_bytes = tool_default_max_memory(), threads = 0, cells = 0;
+    const char *out = NULL, *in = NULL, *surface = NULL, *lattice = NULL;
+    double rho = -1, size = 0;
+    int sculpt = 0, repair = 1;
+    uint64_t seed = 0;
+    static const struct option opts[] = {
+        {"density", required_argument, NULL, OPT_DENSITY},
+        {"sculpt", no_argument, NULL, OPT_SCULPT},
+        {"surface", required_argument, NULL, OPT_SURFACE},
+        {"lattice", required_argument, NULL, OPT_LATTICE},
+        {"cells", required_argument, NULL, OPT_CELLS},
+        {"size", required_argument, NULL, 'h'},
+        {"seed", required_argument, NULL, OPT_SEED},
+        {"no-repair", no_argument, NULL, OPT_NOREPAIR},
+        {"output", required_argument, NULL, 'o'},
+        {"threads", required_argument, NULL, OPT_THREADS},
+        {"max-memory", required_argument, NULL, OPT_MAXMEM},
+        {"quiet", no_argument, NULL, 'q'},
+        {"verbose", no_argument, NULL, 'v'},
+        {"help", no_argument, NULL, OPT_HELP},
+        {"version", no_argument, NULL, OPT_VERSION},
+        {NULL, 0, NULL, 0}};
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":h:o:qv", opts, NULL)) != -1) {
+        switch (c) {
+        case OPT_DENSITY:
+            if (tool_parse_double(&t, "--density", optarg, 0.0, 1.0, &rho))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_SCULPT:
+            sculpt = 1;
+            break;
+        case OPT_SURFACE:
+            surface = optarg;
+            break;
+        case OPT_LATTICE:
+            lattice = optarg;
+            break;
+        case OPT_CELLS:
+            if (tool_parse_size(&t, "--cells", optarg, 1, 100000, &cells))
+                return TOOL_EXIT_USAGE;
+            break;
+        case 'h':
+            if (tool_parse_double(&t, "-h", optarg, 1e-300, 1e300, &size))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_SEED: {
+            char *end;
+            errno = 0;
+            unsigned long long v = strtoull(optarg, &end, 10);
+            if (!*optarg || *end || errno || optarg[0] == '-')
+                return tool_usage_error(&t, "--seed wants a non-negative "
+                                            "integer, not '%s'", optarg);
+            seed = (uint64_t)v;
+            break;
+        }
+        case OPT_NOREPAIR:
+            repair = 0;
+            break;
+        case 'o':
+            out = optarg;
+            break;
+        case OPT_THREADS:
+            if (tool_parse_size(&t, "--threads", optarg, 1, 4096, &threads))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_MAXMEM:
+            if (tool_parse_bytes(&t, "--max-memory", optarg, &max_bytes))
+                return TOOL_EXIT_USAGE;
+            break;
+        case 'q':
+            t.verbosity = 0;
+            break;
+        case 'v':
+            t.verbosity = 2;
+            break;
+        case OPT_HELP:
+            usage();
+            return TOOL_EXIT_OK;
+        case OPT_VERSION:
+            tool_print_version(&t);
+            return TOOL_EXIT_OK;
+        case ':':
+            return tool_usage_error(&t, "option '%s' needs a value", argv[optind - 1]);
+        default:
+            return tool_usage_error(&t, "unknown option '%s'", argv[optind - 1]);
+        }
+    }
+    if (optind < argc)
+        in = argv[optind++];
+    if (optind < argc)
+        return tool_usage_error(&t, "one input field at most ('%s' is extra)", argv[optind]);
+    if (sculpt && rho >= 0)
+        return tool_usage_error(&t, "--density and --sculpt exclude each other");
+    if (!sculpt && rho < 0)
+        return tool_usage_error(&t, "say --density RHO or --sculpt --surface S");
+    if (sculpt && !surface)
+        return tool_usage_error(&t, "--sculpt needs --surface S (the input surface)");
+    if (!sculpt && surface)
+        return tool_usage_error(&t, "--surface goes with --sculpt");
+    if (cells && size > 0)
+        return tool_usage_error(&t, "--cells and -h exclude each other");
+    st_lattice_kind kind = sculpt ? ST_LATTICE_BCC : ST_LATTICE_CUBIC5;
+    if (lattice && st_lattice_kind_from_name(lattice, &kind))
+        return tool_usage_error(&t, "--lattice is cubic5 or bcc, not '%s'", lattice);
+    if (!cells)   /* sculpting keeps a layer more: coarser by default */
+        cells = sculpt ? 10 : 16;
+    if (!in)
+        in = "-";
+    if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
+        return tool_usage_error(&t, "no input: give a field or pipe one in "
+                                    "(soupdist m.obj | soupsign | latticetet ...)");
+    if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
+        return tool_usage_error(&t, "will not write a .vtu document to a "
+                                    "terminal: give -o FILE or pipe it");
+    if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
+        return tool_usage_error(&t, "cannot tell the format of '%s' (use .vtu, "
+                                    ".msh, .node, .ele or .mesh)", out);
+    tool_set_threads(threads);
+
+    st_error err;
+    st_error_clear(&err);
+    st_grid *g = NULL;
+    st_soup *soup = NULL;
+    st_lattice *L = NULL;
+    st_tetmesh *m = NULL;
+    int rc = TOOL_EXIT_FAIL;
+    const char *in_name = st_path_is_stdio(in) ? "<stdin>" : in;
+    double t0 = tool_now();
+    if (st_grid_read(&g, in, max_bytes, &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    if (g->kind != ST_GRID_SIGNED) {
+        st_error_set(&err, ST_EINPUT, in_name, 0,
+                     "the field is %s, not signed (run soupsign first)",
+                     st_grid_kind_name(g->kind));
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    if (sculpt && st_soup_read(&soup, surface, &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    double t1 = tool_now();
+    double lo[3], hi[3];
+    st_lattice_grid_box(g, lo, hi);
+    double h = size > 0 ? size : st_lattice_h_for_cells(lo, hi, cells);
+    /* 2^31 tets is far past what a coarse mesh needs; say so before
+     * running out of memory. */
+    const size_t max_tets = (size_t)1 << 31;
+    if (!sculpt) {
+        st_lattice_params lp = st_lattice_params_default();
+        lp.kind = kind;
+        lp.h = h;
+        lp.seed = seed;
+        lp.max_tets = max_tets;
+        st_density_stats ds;
+        if (st_lattice_build(&L, lo, hi, &lp, &err)) {
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        double t2 = tool_now();
+        if (st_lattice_density_filter(&m, &ds, L, g, rho, &err)) {
+            if (!err.file[0])
+                snprintf(err.file, sizeof err.file, "%s", in_name);
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        double t3 = tool_now();
+        tool_say(&t, 2, "grid %zux%zux%zu, voxel %.6g; %s lattice, h %.6g "
+                 "(%.3g voxels), %zux%zux%zu cells, seed %" PRIu64,
+                 g->nx, g->ny, g->nz, g->voxel, st_lattice_kind_name(kind), h,
+                 h / g->voxel, L->n[0], L->n[1], L->n[2], seed);
+        tool_say(&t, 2, "%zu of %zu lattice tets kept (rho >= %g); %zu decided "
+                 "by their centroid's voxel; %zu point tests",
+                 ds.kept, ds.lattice_tets, rho, ds.centroid_rule, ds.point_tests);
+        tool_say(&t, 2, "read %.3f s, lattice %.3f s, density %.3f s",
+                 t1 - t0, t2 - t1, t3 - t2);
+    } else {
+        st_sculpt_params sp = st_sculpt_params_default();
+        sp.kind = kind;
+        sp.h = h;
+        sp.seed = seed;
+        sp.max_tets = max_tets;
+        sp.repair_bombs = repair;
+        sp.repair_manifold = repair;
+        st_sculpt_stats ss;
+        if (st_sculpt(&m, &ss, g, soup, NULL, &sp, &err)) {
+            if (!err.file[0])
+                snprintf(err.file, sizeof err.file, "%s", in_name);
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        tool_say(&t, 2, "grid %zux%zux%zu, voxel %.6g; %s lattice, h %.6g "
+                 "(%.3g voxels), seed %" PRIu64 "; surface %s: %zu triangles",
+                 g->nx, g->ny, g->nz, g->voxel, st_lattice_kind_name(kind), h,
+                 h / g->voxel, seed, surface, soup->ntris);
+        tool_say(&t, 2, "%zu lattice tets: %zu overlap the pseudo volume, "
+                 "%zu more meet a triangle", ss.lattice_tets, ss.kept_volume,
+                 ss.kept_surface);
+        tool_say(&t, 2, "bombs: %zu found (%zu with 3 boundary faces, %zu "
+                 "isolated), %zu clusters (largest %zu; %zu searched exactly, "
+                 "%zu too large: greedy), %zu snowflakes add %zu tets "
+                 "(greedy: %zu), %zu rounds, %zu left",
+                 ss.bombs, ss.bombs_3faces, ss.bombs_4faces, ss.clusters,
+                 ss.largest_cluster, ss.clusters_exact, ss.clusters_greedy,
+                 ss.snowflakes, ss.bomb_tets, ss.greedy_tets, ss.repair_rounds,
+                 ss.bombs_left);
+        tool_say(&t, 2, "boundary: %zu non-manifold vertices, %zu edges; "
+                 "%zu tets added; %zu vertices, %zu edges left",
+                 ss.nonmanifold_vertices, ss.nonmanifold_edges,
+                 ss.manifold_tets, ss.nonmanifold_vertices_left,
+                 ss.nonmanifold_edges_left);
+        tool_say(&t, 2, "%zu tets; read %.3f s, lattice %.3f s, classify "
+                 "%.3f s, repair %.3f s, mesh %.3f s", ss.tets, t1 - t0,
+                 ss.t_lattice, ss.t_classify, ss.t_repair, ss.t_mesh);
+        if (ss.bombs_left)
+            tool_say(&t, 1, "warning: %zu bombs could not be repaired",
+                     ss.bombs_left);
+        if (ss.nonmanifold_vertices_left)
+            tool_say(&t, 1, "warning: the boundary is not manifold at %zu "
+                     "vertices", ss.nonmanifold_vertices_left);
+    }
+    if (m->ntets == 0)
+        tool_say(&t, 1, "warning: no tets kept (empty pseudo volume?)");
+    /* The field's metadata (source, history) carries over; the lattice's
+     * own keys win. */
+    {
+        st_meta keep_meta = {0};
+        int bad = st_meta_copy(&keep_meta, &m->meta) != ST_OK;
+        bad |= st_meta_copy(&m->meta, &g->meta) != ST_OK;
+        for (size_t k = 0; !bad && k < keep_meta.count; k++)
+            bad |= st_meta_set(&m->meta, keep_meta.entries[k].key,
+                               keep_meta.entries[k].value) != ST_OK;
+        st_meta_clear(&keep_meta);
+        bad |= st_meta_history_append(&m->meta, t.command_line ? t.command_line
+                                                               : "latticetet") != ST_OK;
+        if (bad) {
+            st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+    }
+    double tw = tool_now();
+    if (st_tetmesh_save(m, out, &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    tool_say(&t, 2, "%zu tets, %zu points; write %.3f s", m->ntets, m->npoints,
+             tool_now() - tw);
+    rc = TOOL_EXIT_OK;
+done:
+    st_tetmesh_free(m);
+    st_lattice_free(L);
+    st_soup_free(soup);
+    st_grid_free(g);
+    tool_finish(&t);
+    return rc;
+}

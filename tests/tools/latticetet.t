@@ -1,0 +1,70 @@
+#!/bin/sh
+# latticetet end to end: density and sculpting on the bunny, pipes,
+# determinism, refusals.
+. "$(dirname "$0")/lib.sh"
+BUNNY="$ROOT/corpus/bunny.obj"
+cd "$WORK" || exit 1
+
+check "--help exits 0" sh -c 'latticetet --help | grep -q "Usage: latticetet"'
+check "man page exists" test -s "$ROOT/man/man1/latticetet.1"
+check "soupdist | soupsign | latticetet --density 0.5 --cells 16" \
+    sh -c "soupdist '$BUNNY' | soupsign | latticetet --density 0.5 --cells 16 -o x.vtu"
+check "soupdist | soupsign | latticetet --sculpt --surface bunny --cells 12" \
+    sh -c "soupdist '$BUNNY' | soupsign | latticetet -v --sculpt --surface '$BUNNY' --cells 12 -o y.vtu 2> y.log"
+check "sculpting left no bomb and a manifold boundary" \
+    sh -c "grep -q ', 0 left' y.log && grep -q '; 0 vertices, 0 edges left' y.log"
+
+cat > mesh.py <<'PY'
+import sys, vtk
+from vtk.util.numpy_support import vtk_to_numpy
+r = vtk.vtkXMLUnstructuredGridReader(); r.SetFileName(sys.argv[1]); r.Update()
+m = r.GetOutput()
+n = m.GetNumberOfCells()
+lo, hi = int(sys.argv[2]), int(sys.argv[3])
+assert lo <= n <= hi, n
+assert all(m.GetCellType(i) == vtk.VTK_TETRA for i in range(n))
+vol = vtk_to_numpy(m.GetCellData().GetArray("volume"))
+assert (vol > 0).all(), "non-positive tet"
+fd = m.GetFieldData()
+names = [fd.GetAbstractArray(i).GetName() for i in range(fd.GetNumberOfArrays())]
+for key in ("h", "lattice", "seed", "history"):
+    assert key in names, (key, names)
+hist = fd.GetAbstractArray("history").GetValue(0)
+assert "latticetet" in hist and "soupsign" in hist, hist
+print(n)
+PY
+# The bunny's pseudo volume at 16 cells: a few thousand tets of 34K.
+check "density mesh: tets, positive volumes, h/lattice/seed/history" $PYVTK mesh.py x.vtu 1500 8000
+check "sculpted mesh: tets, positive volumes, metadata" $PYVTK mesh.py y.vtu 1500 12000
+
+soupdist -r 48 -o d.vdb "$BUNNY" 2>/dev/null
+soupsign -o s.vdb d.vdb
+check "a field file in, bcc density, -h" latticetet --density 0.3 --lattice bcc -h 0.9 -o b.vtu s.vdb
+check "a Gmsh .msh by extension" sh -c "latticetet --density 0.5 --cells 8 -o m.msh s.vdb && grep -q MeshFormat m.msh"
+check "stdout is a .vtu document" sh -c "latticetet --density 0.5 --cells 8 s.vdb | head -c 200 | grep -q VTKFile"
+mkdir t1 t2
+(cd t1 && OMP_NUM_THREADS=1 latticetet --sculpt --surface "$BUNNY" --cells 8 --seed 11 -o t.vtu ../s.vdb)
+(cd t2 && OMP_NUM_THREADS=2 latticetet --sculpt --surface "$BUNNY" --cells 8 --seed 11 -o t.vtu ../s.vdb)
+check "seeded sculpting: 1 and 2 threads write identical files" cmp t1/t.vtu t2/t.vtu
+(cd t1 && OMP_NUM_THREADS=1 latticetet --density 0.5 --cells 10 --seed 5 -o u.vtu ../s.vdb)
+(cd t2 && OMP_NUM_THREADS=2 latticetet --density 0.5 --cells 10 --seed 5 -o u.vtu ../s.vdb)
+check "seeded density: 1 and 2 threads write identical files" cmp t1/u.vtu t2/u.vtu
+
+expect_fail "a distance field (not signed) is refused" 1 "^latticetet: d.vdb: .*not signed" \
+    latticetet --density 0.5 -o z.vtu d.vdb
+expect_fail "a missing file" 1 "^latticetet: missing.vdb" latticetet --density 0.5 -o z.vtu missing.vdb
+printf 'not a vdb' > junk.vdb
+expect_fail "a file that is not a field" 1 "^latticetet: junk.vdb" latticetet --density 0.5 -o z.vtu junk.vdb
+expect_fail "a missing surface" 1 "^latticetet: nosurf.obj" \
+    latticetet --sculpt --surface nosurf.obj -o z.vtu s.vdb
+check "no partial output" test ! -e z.vtu
+expect_fail "neither --density nor --sculpt" 2 "density RHO or --sculpt" latticetet s.vdb
+expect_fail "both --density and --sculpt" 2 "exclude" latticetet --density 0.5 --sculpt --surface "$BUNNY" s.vdb
+expect_fail "--sculpt without --surface" 2 "needs --surface" latticetet --sculpt s.vdb
+expect_fail "--density out of range" 2 "density" latticetet --density 1.5 s.vdb
+expect_fail "unknown lattice" 2 "cubic5 or bcc" latticetet --density 0.5 --lattice hex s.vdb
+expect_fail "--cells and -h together" 2 "exclude" latticetet --density 0.5 --cells 4 -h 1 s.vdb
+expect_fail "a bad --seed" 2 "seed" latticetet --density 0.5 --seed -3 s.vdb
+expect_fail "an output format it cannot write" 2 "format" latticetet --density 0.5 -o m.xyz s.vdb
+
+done_testing
