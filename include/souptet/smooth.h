@@ -1,0 +1,170 @@
+/*
+ * smooth.h - moving the vertices of a tet mesh: Spillmann's volume-keeping
+ * boundary fairing, and Cetra's enclosing vertex adjustment followed by a
+ * quality pass.
+ *
+ * st_fair (Spillmann, Wagner, Teschner 2006, section 4): implicit fairing
+ * of the boundary surface (Desbrun et al. 1999), a local rescale along the
+ * vertex normals so the mesh keeps its volume, interior vertices carried
+ * along and relaxed.
+ *
+ * st_fit (Stuart, Levine, Jones, Bargteil 2013, section 3.3): every vertex
+ * moves toward the volume-weighted mean of the circumcenters of its tets
+ * (ODT), boundary vertices also toward the surface S, until every boundary
+ * vertex is within d_offset = offset_ratio * h of S; then a quality pass
+ * that raises the worst dihedral angles. Throughout, the mesh keeps
+ * enclosing S: after every accepted move every vertex of S that was inside
+ * the mesh still is, no boundary triangle that did not meet a triangle of S
+ * does, and every tet is positively oriented - all decided by the exact
+ * predicates (pred.h, isect.h). A move that would break it is halved a few
+ * times, then skipped.
+ *
+ * Both require every tet of the input to be positively oriented (tetmesh.h)
+ * and refuse the mesh otherwise; both never produce an inverted or flat tet.
+ * Vertices move in a fixed order (independent sets of a greedy colouring,
+ * each set in parallel), so the result does not depend on the thread count.
+ * No global state: calls on different meshes may run concurrently.
+ *
+ * Module order: ... -> bvh -> tetqual -> tetmesh -> smooth -> ...
+ */
+#ifndef SOUPTET_SMOOTH_H
+#define SOUPTET_SMOOTH_H
+
+#include <stddef.h>
+
+#include "souptet/bvh.h"
+#include "souptet/err.h"
+#include "souptet/progress.h"
+#include "souptet/soup.h"
+#include "souptet/tetmesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- fairing (st_fair) ------------------------------------------------ */
+
+typedef struct st_fair_params {
+    int iters;            /* fairing steps (default 3) */
+    double lambda_dt;     /* lambda*dt of each implicit step, for the
+                             uniform-weight (umbrella) graph Laplacian
+                             L = D - W of the boundary edges (default 1) */
+    int relax_iters;      /* ODT relaxation sweeps of the interior vertices
+                             after each step (default 3) */
+    double volume_tol;    /* relative volume change allowed (default 0.005);
+                             the rescale aims much closer than this */
+    double min_angle;     /* degrees: no move brings the score of its star
+                             (ST_FIT_MAX_WEIGHT below) under this, or under
+                             what it already was (default 20) */
+    int quality_rounds;   /* then rounds of st_fit's quality pass on the
+                             interior vertices (the volume does not change);
+                             0: none (default 40) */
+} st_fair_params;
+
+typedef struct st_fair_stats {
+    int iters;                    /* fairing steps done */
+    double volume_before, volume_after;
+    size_t moves, backoffs;       /* vertex moves accepted; halvings taken */
+    size_t stuck;                 /* moves backed off to zero (all steps) */
+    size_t boundary_vertices;
+    size_t quality_moves;         /* moves of the quality pass */
+    double min_dihedral_before, max_dihedral_before;
+    double min_dihedral_fair, max_dihedral_fair;    /* before the quality pass */
+    double min_dihedral_after, max_dihedral_after;
+    double seconds;
+} st_fair_stats;
+
+st_fair_params st_fair_params_default(void);
+
+/* Fair the boundary of m in place. Fails (ST_EINPUT) on a mesh with
+ * inverted or flat tets or without tets, and when the volume could not be
+ * kept within p->volume_tol (m is then left as the last valid state, every
+ * tet still positive; stats say how far it got). stats and prog may be
+ * NULL; p NULL means the defaults. */
+st_status st_fair(st_tetmesh *m, const st_fair_params *p,
+                  st_fair_stats *stats, const st_progress *prog,
+                  st_error *err);
+
+/* ---- enclosing fit (st_fit) ------------------------------------------- */
+
+/* What the fit reports after each iteration (and each quality round). */
+typedef struct st_fit_iter {
+    const char *phase;            /* "fit" or "quality" */
+    int iter;                     /* 1-based within the phase */
+    size_t boundary_vertices;
+    size_t within_offset;         /* boundary vertices within d_offset */
+    double max_distance;          /* largest boundary-vertex distance to S */
+    double min_dihedral, max_dihedral;
+    size_t moved, rejected;       /* vertex moves accepted / halvings taken */
+    double seconds;               /* since st_fit started */
+} st_fit_iter;
+
+typedef void (*st_fit_iter_fn)(void *ctx, const st_fit_iter *it);
+
+typedef struct st_fit_params {
+    double offset_ratio;   /* d_offset = offset_ratio * h (default 0.4) */
+    double cell_width;     /* h; 0: the mesh's meta "h" (default 0) */
+    double step;           /* tau, fraction of the way to the target per
+                              iteration, in (0, 1] (default 0.5) */
+    int max_iters;         /* fit iterations at most (default 300) */
+    int quality;           /* run the quality pass (default 1) */
+    int quality_rounds;    /* quality rounds at most (default 40) */
+    double quality_goal;   /* degrees: the pass works on tets whose min
+                              dihedral is below this or whose max is above
+                              180 - goal / ST_FIT_MAX_WEIGHT (default 35) */
+    st_fit_iter_fn on_iter;   /* called after every iteration; may be NULL */
+    void *on_iter_ctx;
+} st_fit_params;
+
+/* The quality score of a tet is min(min dihedral, ST_FIT_MAX_WEIGHT *
+ * (180 - max dihedral)): with the weight 0.75, a tet that scores 30 has
+ * its angles in [30, 140], the project's target. */
+#define ST_FIT_MAX_WEIGHT 0.75
+
+typedef struct st_fit_stats {
+    double h, d_offset;
+    int iters;                    /* fit iterations done */
+    int converged;                /* 1: every boundary vertex within d_offset */
+    size_t boundary_vertices;
+    size_t within_offset;         /* at the end */
+    size_t beyond_offset;         /* boundary vertices that did not get there */
+    double max_distance;          /* largest boundary-vertex distance to S */
+    double mean_distance;
+    size_t moves, rejected, skipped;  /* fit: accepted, halvings, given up */
+    int quality_rounds;
+    size_t quality_moves;
+    double min_dihedral_before, max_dihedral_before;   /* the input */
+    double min_dihedral_fit, max_dihedral_fit;         /* after the fit */
+    double min_dihedral_after, max_dihedral_after;     /* after quality */
+    /* Enclosure of S, counted over the whole mesh before and after (exact):
+     * S vertices outside the mesh, S triangles meeting a boundary face. */
+    size_t outside_before, crossing_before;
+    size_t outside_after, crossing_after;
+    double seconds_fit, seconds_quality;
+} st_fit_stats;
+
+st_fit_params st_fit_params_default(void);
+
+/* Fit m in place to the surface s. bvh is a BVH over s (NULL: st_fit
+ * builds one). The mesh need not enclose s on entry: what holds on entry
+ * (each S vertex inside, each boundary face clear of S) keeps holding,
+ * and stats report the global counts before and after. Fails with
+ * ST_EINPUT on inverted or flat tets, a mesh without tets, or no cell
+ * width (neither p->cell_width nor a meta "h" > 0). Not converging is not
+ * an error: stats->converged says it. stats and prog may be NULL. */
+st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
+                 const st_fit_params *p, st_fit_stats *stats,
+                 const st_progress *prog, st_error *err);
+
+/* Count, exactly, the vertices of s (those its triangles use) not in the
+ * closed union of m's tets, and the triangles of s that meet a boundary
+ * face of m (closed sets: touching counts). Enclosing means both are 0.
+ * bvh over s may be NULL. Thread-safe. */
+st_status st_enclosure_count(const st_tetmesh *m, const st_soup *s,
+                             const st_bvh *bvh, size_t *verts_outside,
+                             size_t *tris_crossing, st_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

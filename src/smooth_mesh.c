@@ -1,0 +1,336 @@
+/*
+ * smooth_mesh.c - incidence, colouring and local checks shared by the
+ * vertex-moving passes (fair.c, fit.c, quality.c); see smooth_internal.h.
+ *
+ * Colouring: greedy in vertex order over the edge graph. In a tet every
+ * pair of corners is an edge, so two vertices of one colour never share a
+ * tet: moving all of a colour at once, each checked against its own star,
+ * gives the same result as moving them one by one, in any thread order.
+ */
+#include "smooth_internal.h"
+
+#include "souptet/mem.h"
+#include "souptet/pred.h"
+#include "souptet/smooth.h"
+#include "souptet/tetqual.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Sort and deduplicate buf[0..n), dropping `self`; returns the new count. */
+static size_t sort_unique(uint32_t *buf, size_t n, uint32_t self)
+{
+    qsort(buf, n, sizeof *buf, cmp_u32);
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        if (buf[i] != self && (k == 0 || buf[k - 1] != buf[i]))
+            buf[k++] = buf[i];
+    return k;
+}
+
+void sm_mesh_free(sm_mesh *sm)
+{
+    if (!sm)
+        return;
+    free(sm->vt_off);
+    free(sm->vt);
+    free(sm->vv_off);
+    free(sm->vv);
+    free(sm->bf);
+    free(sm->vf_off);
+    free(sm->vf);
+    free(sm->onb);
+    free(sm->bv_off);
+    free(sm->bv);
+    free(sm->col_off);
+    free(sm->col_v);
+    memset(sm, 0, sizeof *sm);
+}
+
+/* CSR of vertex -> items, from n items with k vertices each (idx). */
+static st_status build_csr(size_t nv, const uint32_t *idx, size_t n, int k,
+                           size_t **off_out, uint32_t **items_out)
+{
+    size_t *off = st_calloc_array(nv + 1, sizeof *off);
+    size_t total;
+    if (!off || st_size_mul(&total, n, (size_t)k)) {
+        free(off);
+        return ST_ENOMEM;
+    }
+    uint32_t *items = st_malloc_array(total, sizeof *items);
+    size_t *fill = st_malloc_array(nv, sizeof *fill);
+    if (!items || !fill) {
+        free(off);
+        free(items);
+        free(fill);
+        return ST_ENOMEM;
+    }
+    for (size_t i = 0; i < n * (size_t)k; i++)
+        off[idx[i] + 1]++;
+    for (size_t v = 0; v < nv; v++)
+        off[v + 1] += off[v];
+    memcpy(fill, off, nv * sizeof *fill);
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < k; c++)
+            items[fill[idx[(size_t)k * i + (size_t)c]]++] = (uint32_t)i;
+    free(fill);
+    *off_out = off;
+    *items_out = items;
+    return ST_OK;
+}
+
+/* Neighbour lists from a vertex -> items CSR of items with k corners. */
+static st_status build_nbrs(size_t nv, const size_t *ioff, const uint32_t *items,
+                            const uint32_t *idx, int k, size_t **off_out,
+                            uint32_t **nb_out)
+{
+    size_t total = ioff[nv];
+    size_t cap;
+    if (st_size_mul(&cap, total, (size_t)(k - 1)))
+        return ST_ENOMEM;
+    size_t *off = st_calloc_array(nv + 1, sizeof *off);
+    uint32_t *nb = st_malloc_array(cap, sizeof *nb);
+    if (!off || !nb) {
+        free(off);
+        free(nb);
+        return ST_ENOMEM;
+    }
+    size_t w = 0;
+    for (size_t v = 0; v < nv; v++) {
+        size_t start = w;
+        for (size_t j = ioff[v]; j < ioff[v + 1]; j++)
+            for (int c = 0; c < k; c++)
+                nb[w++] = idx[(size_t)k * items[j] + (size_t)c];
+        size_t n = sort_unique(nb + start, w - start, (uint32_t)v);
+        w = start + n;
+        off[v + 1] = w;
+    }
+    *off_out = off;
+    *nb_out = nb;
+    return ST_OK;
+}
+
+st_status sm_mesh_build(sm_mesh *sm, st_tetmesh *m, st_error *err)
+{
+    memset(sm, 0, sizeof *sm);
+    sm->m = m;
+    sm->nv = m->npoints;
+    sm->nt = m->ntets;
+    if (m->ntets == 0)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "the mesh has no tets");
+    if (build_csr(sm->nv, m->tets, sm->nt, 4, &sm->vt_off, &sm->vt) ||
+        build_nbrs(sm->nv, sm->vt_off, sm->vt, m->tets, 4, &sm->vv_off, &sm->vv))
+        goto nomem;
+    st_status s = st_tetmesh_boundary(m, &sm->bf, NULL, &sm->nbf, err);
+    if (s) {
+        sm_mesh_free(sm);
+        return s;
+    }
+    if (build_csr(sm->nv, sm->bf, sm->nbf, 3, &sm->vf_off, &sm->vf) ||
+        build_nbrs(sm->nv, sm->vf_off, sm->vf, sm->bf, 3, &sm->bv_off, &sm->bv))
+        goto nomem;
+    sm->onb = st_calloc_array(sm->nv, 1);
+    if (!sm->onb)
+        goto nomem;
+    for (size_t i = 0; i < 3 * sm->nbf; i++)
+        sm->onb[sm->bf[i]] = 1;
+    for (size_t v = 0; v < sm->nv; v++)
+        sm->nbv += sm->onb[v];
+
+    /* greedy colouring in vertex order */
+    uint32_t *col = st_malloc_array(sm->nv, sizeof *col);
+    unsigned char *used = NULL;
+    size_t maxdeg = 0;
+    for (size_t v = 0; v < sm->nv; v++) {
+        size_t d = sm->vv_off[v + 1] - sm->vv_off[v];
+        if (d > maxdeg)
+            maxdeg = d;
+    }
+    used = st_calloc_array(maxdeg + 2, 1);
+    if (!col || !used) {
+        free(col);
+        free(used);
+        goto nomem;
+    }
+    size_t ncol = 0;
+    for (size_t v = 0; v < sm->nv; v++) {
+        for (size_t j = sm->vv_off[v]; j < sm->vv_off[v + 1]; j++)
+            if (sm->vv[j] < v && col[sm->vv[j]] <= maxdeg)
+                used[col[sm->vv[j]]] = 1;
+        uint32_t c = 0;
+        while (used[c])
+            c++;
+        col[v] = c;
+        if (c + 1 > ncol)
+            ncol = c + 1;
+        for (size_t j = sm->vv_off[v]; j < sm->vv_off[v + 1]; j++)
+            if (sm->vv[j] < v && col[sm->vv[j]] <= maxdeg)
+                used[col[sm->vv[j]]] = 0;
+    }
+    free(used);
+    sm->ncolours = ncol;
+    sm->col_off = st_calloc_array(ncol + 1, sizeof *sm->col_off);
+    sm->col_v = st_malloc_array(sm->nv, sizeof *sm->col_v);
+    if (!sm->col_off || !sm->col_v) {
+        free(col);
+        goto nomem;
+    }
+    for (size_t v = 0; v < sm->nv; v++)
+        sm->col_off[col[v] + 1]++;
+    for (size_t c = 0; c < ncol; c++)
+        sm->col_off[c + 1] += sm->col_off[c];
+    {
+        size_t *fill = st_malloc_array(ncol + 1, sizeof *fill);
+        if (!fill) {
+            free(col);
+            goto nomem;
+        }
+        memcpy(fill, sm->col_off, (ncol + 1) * sizeof *fill);
+        for (size_t v = 0; v < sm->nv; v++)
+            sm->col_v[fill[col[v]]++] = (uint32_t)v;
+        free(fill);
+    }
+    free(col);
+    return ST_OK;
+nomem:
+    sm_mesh_free(sm);
+    return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory (mesh incidence)");
+}
+
+size_t sm_count_nonpositive(const st_tetmesh *m)
+{
+    size_t bad = 0;
+    #pragma omp parallel for schedule(static) reduction(+ : bad) if (PAR_CHEAP(m->ntets))
+    for (size_t t = 0; t < m->ntets; t++) {
+        const uint32_t *c = m->tets + 4 * t;
+        if (!(st_orient3d(m->xyz + 3 * (size_t)c[0], m->xyz + 3 * (size_t)c[1],
+                          m->xyz + 3 * (size_t)c[2], m->xyz + 3 * (size_t)c[3]) < 0))
+            bad++;
+    }
+    return bad;
+}
+
+/* The corners of tet t with v replaced by p. */
+static void star_corners(const sm_mesh *sm, uint32_t t, uint32_t v,
+                         const double p[3], const double *q[4])
+{
+    const uint32_t *c = sm->m->tets + 4 * (size_t)t;
+    for (int k = 0; k < 4; k++)
+        q[k] = c[k] == v ? p : sm->m->xyz + 3 * (size_t)c[k];
+}
+
+int sm_star_positive(const sm_mesh *sm, uint32_t v, const double p[3])
+{
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
+        const double *q[4];
+        star_corners(sm, sm->vt[j], v, p, q);
+        /* positive orientation (tetmesh.h): orient3d < 0 */
+        if (!(st_orient3d(q[0], q[1], q[2], q[3]) < 0))
+            return 0;
+    }
+    return 1;
+}
+
+double sm_tet_score(const double *a, const double *b, const double *c,
+                    const double *d)
+{
+    double lo, hi;
+    st_tet_dihedral_range(a, b, c, d, &lo, &hi);
+    double s2 = ST_FIT_MAX_WEIGHT * (180.0 - hi);
+    return lo < s2 ? lo : s2;
+}
+
+double sm_star_score(const sm_mesh *sm, uint32_t v, const double p[3])
+{
+    double s = INFINITY;
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
+        const double *q[4];
+        star_corners(sm, sm->vt[j], v, p, q);
+        double x = sm_tet_score(q[0], q[1], q[2], q[3]);
+        if (x < s)
+            s = x;
+    }
+    return s;
+}
+
+void sm_dihedral_range(const st_tetmesh *m, double *mind, double *maxd)
+{
+    double lo = 180.0, hi = 0.0;
+    #pragma omp parallel for schedule(static) reduction(min : lo) reduction(max : hi) \
+        if (PAR_MOVES(m->ntets))
+    for (size_t t = 0; t < m->ntets; t++) {
+        const uint32_t *c = m->tets + 4 * t;
+        double a, b;
+        st_tet_dihedral_range(m->xyz + 3 * (size_t)c[0], m->xyz + 3 * (size_t)c[1],
+                              m->xyz + 3 * (size_t)c[2], m->xyz + 3 * (size_t)c[3],
+                              &a, &b);
+        if (a < lo)
+            lo = a;
+        if (b > hi)
+            hi = b;
+    }
+    if (mind)
+        *mind = lo;
+    if (maxd)
+        *maxd = hi;
+}
+
+void sm_odt_target(const sm_mesh *sm, uint32_t v, double out[3])
+{
+    double acc[3] = {0, 0, 0}, w = 0.0;
+    const double *x = sm->m->xyz + 3 * (size_t)v;
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
+        const double *q[4];
+        star_corners(sm, sm->vt[j], v, x, q);
+        double vol = st_tet_volume(q[0], q[1], q[2], q[3]);
+        double cc[3];
+        if (vol <= 0.0 || !st_tet_circumcenter(q[0], q[1], q[2], q[3], cc))
+            continue;
+        for (int a = 0; a < 3; a++)
+            acc[a] += vol * cc[a];
+        w += vol;
+    }
+    for (int a = 0; a < 3; a++)
+        out[a] = w > 0.0 ? acc[a] / w : x[a];
+    if (!(isfinite(out[0]) && isfinite(out[1]) && isfinite(out[2])))
+        memcpy(out, x, 3 * sizeof *out);
+}
+
+double sm_boundary_volume(const sm_mesh *sm, const double *xyz)
+{
+    if (sm->nbf == 0)
+        return 0.0;
+    /* relative to one boundary vertex, so far-from-origin models keep
+     * their digits */
+    const double *o = xyz + 3 * (size_t)sm->bf[0];
+    double v = 0.0;
+    for (size_t f = 0; f < sm->nbf; f++) {
+        const double *pa = xyz + 3 * (size_t)sm->bf[3 * f];
+        const double *pb = xyz + 3 * (size_t)sm->bf[3 * f + 1];
+        const double *pc = xyz + 3 * (size_t)sm->bf[3 * f + 2];
+        double a[3], b[3], c[3];
+        for (int k = 0; k < 3; k++) {
+            a[k] = pa[k] - o[k];
+            b[k] = pb[k] - o[k];
+            c[k] = pc[k] - o[k];
+        }
+        v += a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+             a[2] * (b[0] * c[1] - b[1] * c[0]);
+    }
+    return v / 6.0;
+}
+
+double sm_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}

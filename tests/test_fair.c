@@ -1,0 +1,225 @@
+/* test_fair.c - st_fair: volume kept, nothing inverted, corners rounded,
+ * deterministic for any thread count. Meshes are blocks of 5-tet cubes
+ * built here. */
+#include "souptet/pred.h"
+#include "souptet/smooth.h"
+#include "souptet/tetmesh.h"
+#include "souptet/tetqual.h"
+#include "tap.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* A 5-tet cube lattice of n^3 cells of width h from lo, keeping the cells
+ * for which keep(center) is nonzero (NULL: all); mirrored splits on
+ * alternating cells so shared faces match; every tet positive. */
+static st_tetmesh *lattice5(int n, double h, const double lo[3],
+                            int (*keep)(const double c[3], void *), void *ctx)
+{
+    st_tetmesh *m = st_tetmesh_new();
+    int np = n + 1;
+    for (int k = 0; k < np; k++)
+        for (int j = 0; j < np; j++)
+            for (int i = 0; i < np; i++) {
+                double p[3] = {lo[0] + i * h, lo[1] + j * h, lo[2] + k * h};
+                st_tetmesh_add_point(m, p, NULL);
+            }
+    for (int k = 0; k < n; k++)
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++) {
+                double c[3] = {lo[0] + (i + 0.5) * h, lo[1] + (j + 0.5) * h, lo[2] + (k + 0.5) * h};
+                if (keep && !keep(c, ctx))
+                    continue;
+                uint32_t v[8];
+                for (int b = 0; b < 8; b++)
+                    v[b] = (uint32_t)((i + (b & 1)) + np * ((j + ((b >> 1) & 1)) + np * (k + ((b >> 2) & 1))));
+                int odd = (i + j + k) & 1;
+                /* corner tets at the even (or odd) corners, the middle one
+                 * at the others */
+                static const int even_c[4] = {0, 3, 5, 6}, odd_c[4] = {1, 2, 4, 7};
+                const int *cor = odd ? odd_c : even_c, *mid = odd ? even_c : odd_c;
+                uint32_t t[5][4];
+                for (int q = 0; q < 4; q++) {
+                    int cc = cor[q];
+                    t[q][0] = v[cc];
+                    t[q][1] = v[cc ^ 1];
+                    t[q][2] = v[cc ^ 2];
+                    t[q][3] = v[cc ^ 4];
+                }
+                for (int q = 0; q < 4; q++)
+                    t[4][q] = v[mid[q]];
+                for (int q = 0; q < 5; q++) {
+                    const double *a = m->xyz + 3 * (size_t)t[q][0], *b = m->xyz + 3 * (size_t)t[q][1],
+                                 *d = m->xyz + 3 * (size_t)t[q][2], *e = m->xyz + 3 * (size_t)t[q][3];
+                    if (st_orient3d(a, b, d, e) > 0) {
+                        uint32_t s = t[q][0];
+                        t[q][0] = t[q][1];
+                        t[q][1] = s;
+                    }
+                    st_tetmesh_add_tet(m, t[q][0], t[q][1], t[q][2], t[q][3], NULL);
+                }
+            }
+    st_tetmesh_compact(m, NULL);
+    return m;
+}
+
+static double mesh_volume(const st_tetmesh *m)
+{
+    double v = 0.0;
+    for (size_t t = 0; t < m->ntets; t++) {
+        const uint32_t *k = m->tets + 4 * t;
+        v += st_tet_volume(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
+                           m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]);
+    }
+    return v;
+}
+
+static size_t nonpositive(const st_tetmesh *m)
+{
+    size_t bad = 0;
+    for (size_t t = 0; t < m->ntets; t++) {
+        const uint32_t *k = m->tets + 4 * t;
+        bad += !(st_orient3d(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
+                             m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]) < 0);
+    }
+    return bad;
+}
+
+static int in_ball(const double c[3], void *ctx)
+{
+    double r = *(const double *)ctx;
+    return c[0] * c[0] + c[1] * c[1] + c[2] * c[2] < r * r;
+}
+
+static void test_block(void)
+{
+    double lo[3] = {0, 0, 0};
+    st_tetmesh *m = lattice5(4, 1.0, lo, NULL, NULL);
+    TAP_CHECK(m->ntets == 320 && nonpositive(m) == 0, "a 4^3 block of 5-tet cubes: 320 positive tets");
+    double v0 = mesh_volume(m);
+    st_fair_stats st;
+    st_error err;
+    st_fair_params p = st_fair_params_default();
+    st_status s = st_fair(m, &p, &st, NULL, &err);
+    TAP_CHECK(s == ST_OK, "fairing a block succeeds (%s)", s ? err.msg : "ok");
+    TAP_CHECK(nonpositive(m) == 0, "no tet inverted or flat after fairing");
+    double v1 = mesh_volume(m);
+    TAP_NEAR(v1 / v0, 1.0, 0.005, "volume kept within 0.5%% (%.5f)", v1 / v0);
+    TAP_NEAR(st.volume_before, v0, 1e-9 * v0, "stats: volume before is the tet sum");
+    TAP_NEAR(st.volume_after, v1, 1e-9 * v0, "stats: volume after is the tet sum");
+    /* the corner (0,0,0) is point 0 (compact keeps the order): it moves
+     * inward, the block's corners get rounded */
+    double d = sqrt(m->xyz[0] * m->xyz[0] + m->xyz[1] * m->xyz[1] + m->xyz[2] * m->xyz[2]);
+    TAP_CHECK(d > 0.1, "the block's corner moved inward (by %.3f)", d);
+    /* the middle vertex (2,2,2) is interior: it stays near the middle */
+    size_t mid = 2 + 5 * (2 + 5 * 2);
+    TAP_NEAR(m->xyz[3 * mid], 2.0, 0.3, "the centre stays near the centre (x %.3f)", m->xyz[3 * mid]);
+    TAP_CHECK(st.min_dihedral_after > 0.0 && st.max_dihedral_after < 180.0,
+              "dihedral range after: %.1f..%.1f", st.min_dihedral_after, st.max_dihedral_after);
+    TAP_NOTE("block: %d iters, %zu moves, %zu back-offs, %zu stuck, dihedral %.1f-%.1f -> %.1f-%.1f",
+             st.iters, st.moves, st.backoffs, st.stuck, st.min_dihedral_before,
+             st.max_dihedral_before, st.min_dihedral_after, st.max_dihedral_after);
+    st_tetmesh_free(m);
+}
+
+static void test_ball_many_iters(void)
+{
+    double lo[3] = {-3, -3, -3}, r = 2.2;
+    st_tetmesh *m = lattice5(6, 1.0, lo, in_ball, &r);
+    double v0 = mesh_volume(m);
+    st_fair_params p = st_fair_params_default();
+    p.iters = 10;
+    p.lambda_dt = 3.0;   /* strong: a ball of 280 tets loses most of its volume */
+    st_fair_stats st;
+    st_error err;
+    st_status s = st_fair(m, &p, &st, NULL, &err);
+    TAP_CHECK(s == ST_OK, "strong fairing of a blocky ball succeeds (%s)", s ? err.msg : "ok");
+    TAP_CHECK(nonpositive(m) == 0, "strong fairing inverts nothing");
+    TAP_NEAR(mesh_volume(m) / v0, 1.0, 0.005, "strong fairing keeps the volume (%.5f)",
+             mesh_volume(m) / v0);
+    TAP_NOTE("ball: %zu tets, %zu back-offs, %zu stuck, dihedral %.1f-%.1f -> %.1f-%.1f",
+             m->ntets, st.backoffs, st.stuck, st.min_dihedral_before, st.max_dihedral_before,
+             st.min_dihedral_after, st.max_dihedral_after);
+    st_tetmesh_free(m);
+}
+
+static int in_slab(const double c[3], void *ctx)
+{
+    (void)ctx;
+    return c[2] < 1.0;   /* one cell thick */
+}
+
+static void test_thin_slab(void)
+{
+    /* a slab one cell thick: its boundary vertices are all on the rim or
+     * the faces, and strong fairing would fold it; the back-off must hold */
+    double lo[3] = {0, 0, 0};
+    st_tetmesh *m = lattice5(6, 1.0, lo, in_slab, NULL);
+    double v0 = mesh_volume(m);
+    st_fair_params p = st_fair_params_default();
+    p.lambda_dt = 20.0;
+    st_fair_stats st;
+    st_error err;
+    st_status s = st_fair(m, &p, &st, NULL, &err);
+    TAP_CHECK(s == ST_OK && st.backoffs > 0, "strong fairing of a thin slab backs off (%zu halvings)",
+              st.backoffs);
+    TAP_CHECK(nonpositive(m) == 0, "the slab has no inverted or flat tet");
+    TAP_NEAR(mesh_volume(m) / v0, 1.0, 0.005, "the slab keeps its volume (%.5f)", mesh_volume(m) / v0);
+    TAP_CHECK(st.min_dihedral_after >= p.min_angle, "no angle below the floor of %g degrees: %.2f",
+              p.min_angle, st.min_dihedral_after);
+    st_tetmesh_free(m);
+}
+
+static void test_threads(void)
+{
+#ifdef _OPENMP
+    double lo[3] = {-3, -3, -3}, r = 2.6;
+    st_tetmesh *a = lattice5(6, 1.0, lo, in_ball, &r);
+    st_tetmesh *b = lattice5(6, 1.0, lo, in_ball, &r);
+    int nt = omp_get_max_threads();
+    st_error err;
+    omp_set_num_threads(1);
+    st_status s1 = st_fair(a, NULL, NULL, NULL, &err);
+    omp_set_num_threads(3);
+    st_status s2 = st_fair(b, NULL, NULL, NULL, &err);
+    omp_set_num_threads(nt);
+    TAP_CHECK(s1 == ST_OK && s2 == ST_OK && a->npoints == b->npoints &&
+                  memcmp(a->xyz, b->xyz, 3 * a->npoints * sizeof(double)) == 0,
+              "1 and 3 threads give bit-identical points");
+    st_tetmesh_free(a);
+    st_tetmesh_free(b);
+#else
+    TAP_CHECK(1, "no OpenMP: one thread only");
+#endif
+}
+
+static void test_refusals(void)
+{
+    double lo[3] = {0, 0, 0};
+    st_tetmesh *m = lattice5(1, 1.0, lo, NULL, NULL);
+    uint32_t s = m->tets[0];
+    m->tets[0] = m->tets[1];
+    m->tets[1] = s;
+    st_error err;
+    st_status rc = st_fair(m, NULL, NULL, NULL, &err);
+    TAP_CHECK(rc == ST_EINPUT && strstr(err.msg, "inverted"), "an inverted tet is refused (%s)", err.msg);
+    st_tetmesh *e = st_tetmesh_new();
+    rc = st_fair(e, NULL, NULL, NULL, &err);
+    TAP_CHECK(rc == ST_EINPUT, "a mesh without tets is refused");
+    st_tetmesh_free(m);
+    st_tetmesh_free(e);
+}
+
+int main(void)
+{
+    test_block();
+    test_ball_many_iters();
+    test_thin_slab();
+    test_threads();
+    test_refusals();
+    return tap_done();
+}

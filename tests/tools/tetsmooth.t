@@ -1,0 +1,92 @@
+#!/bin/sh
+# tetsmooth end to end: fit on the bunny's sculpted lattice (encloses, in the
+# band, angles raised), fair on a density lattice (volume kept), pipes,
+# determinism, refusals, no partial output.
+. "$(dirname "$0")/lib.sh"
+BUNNY="$ROOT/corpus/bunny.obj"
+cd "$WORK" || exit 1
+
+check "--help exits 0" sh -c 'tetsmooth --help | grep -q "Usage: tetsmooth"'
+check "man page exists" test -s "$ROOT/man/man1/tetsmooth.1"
+
+soupdist -r 48 "$BUNNY" | soupsign -o s.vdb
+check "a sculpted lattice to fit (6 cells)" latticetet --sculpt --surface "$BUNNY" --cells 6 -o b6.vtu s.vdb
+check "a density lattice to fair (8 cells)" latticetet --density 0.5 --cells 8 -o d8.vtu s.vdb
+
+check "fit: file in, -o out, -v" sh -c "tetsmooth -v --fit --surface '$BUNNY' -o f6.vtu b6.vtu 2> fit.log"
+check "fit: -v prints per-iteration statistics" grep -Eq "fit +1: [0-9]+/[0-9]+ boundary vertices within offset" fit.log
+check "fit: the mesh still encloses the bunny (exact count, 0 -> 0)" \
+    grep -q "enclosure: S vertices outside 0 -> 0, S triangles crossing 0 -> 0" fit.log
+
+tetstat --json --surface "$BUNNY" f6.vtu > f6.json 2>/dev/null
+cat > q.py <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["inverted"] == 0 and r["degenerate"] == 0, r
+# the BCC lattice starts at 60..90; the fit and quality pass must end
+# inside [30, 140] on this closed model at R = 0.4 (measured 35.1..131.5)
+assert r["min_dihedral"] >= 30.0 and r["max_dihedral"] <= 140.0, (r["min_dihedral"], r["max_dihedral"])
+s = r["surface"]
+# boundary vertices within 0.4 h, all but a few held back at thin gaps
+assert s["dist_max"] <= 0.6 * r["h"], (s["dist_max"], r["h"])
+if s.get("encloses") is not None:
+    assert s["encloses"], s
+print(r["min_dihedral"], r["max_dihedral"])
+PY
+check "fit: no inverted tets, angles in [30, 140], boundary near the surface (tetstat)" \
+    /usr/bin/python3 q.py f6.json
+
+check "fit through pipes" sh -c "tetsmooth --fit --surface '$BUNNY' < b6.vtu | cat > p6.vtu && test -s p6.vtu"
+mkdir t1 t2
+(cd t1 && OMP_NUM_THREADS=1 tetsmooth --fit --surface "$BUNNY" -o f.vtu ../b6.vtu 2>/dev/null)
+(cd t2 && OMP_NUM_THREADS=2 tetsmooth --fit --surface "$BUNNY" -o f.vtu ../b6.vtu 2>/dev/null)
+check "fit: 1 and 2 threads write identical files" cmp t1/f.vtu t2/f.vtu
+check "fit --no-quality --max-iters 3" tetsmooth --fit --surface "$BUNNY" --no-quality --max-iters 3 -o n6.vtu b6.vtu
+
+check "fair" sh -c "tetsmooth -v --fair -o fd8.vtu d8.vtu 2> fair.log"
+tetstat --json d8.vtu > d8.json 2>/dev/null
+tetstat --json fd8.vtu > fd8.json 2>/dev/null
+cat > v.py <<'PY'
+import json, sys
+a = json.load(open(sys.argv[1])); b = json.load(open(sys.argv[2]))
+assert b["inverted"] == 0 and b["degenerate"] == 0, b
+assert abs(b["volume"] / a["volume"] - 1) <= 0.005, (a["volume"], b["volume"])
+assert b["min_dihedral"] > 0 and b["tets"] == a["tets"]
+print(a["volume"], b["volume"])
+PY
+check "fair: volume kept within 0.5%, nothing inverted (tetstat)" /usr/bin/python3 v.py d8.json fd8.json
+check "fair: the history records the command" sh -c \
+    "/usr/bin/python3 -c \"
+import vtk, sys
+r = vtk.vtkXMLUnstructuredGridReader(); r.SetFileName('fd8.vtu'); r.Update()
+fd = r.GetOutput().GetFieldData()
+h = [fd.GetAbstractArray(i) for i in range(fd.GetNumberOfArrays()) if fd.GetArrayName(i) == 'history']
+v = h[0].GetValue(0) if h else ''
+sys.exit(0 if 'tetsmooth -v --fair' in v and 'latticetet' in v else 1)
+\""
+
+cat > noh.py <<'PY'
+import sys, vtk
+r = vtk.vtkXMLUnstructuredGridReader(); r.SetFileName(sys.argv[1]); r.Update()
+g = r.GetOutput(); g.GetFieldData().RemoveArray("h")
+w = vtk.vtkXMLUnstructuredGridWriter(); w.SetFileName(sys.argv[2]); w.SetInputData(g); w.Write()
+PY
+/usr/bin/python3 noh.py b6.vtu noh.vtu
+expect_fail "a mesh without h and no --cell-width" 1 "^tetsmooth: .*cell width" \
+    tetsmooth --fit --surface "$BUNNY" -o x.vtu noh.vtu
+check "--cell-width stands in for h" tetsmooth --fit --surface "$BUNNY" --cell-width 2 --max-iters 2 \
+    --quality-rounds 2 -o cw.vtu noh.vtu
+check "fair --min-angle 25 --no-quality" sh -c "tetsmooth -v --fair --min-angle 25 --no-quality -o fa.vtu d8.vtu 2> fa.log && grep -q 'after fairing 2[5-9]' fa.log"
+
+expect_fail "no mode" 2 "--fair or --fit" tetsmooth b6.vtu
+expect_fail "--fit without --surface" 2 "needs --surface" tetsmooth --fit -o x.vtu b6.vtu
+expect_fail "--fair with --surface" 2 "go with --fit" tetsmooth --fair --surface "$BUNNY" -o x.vtu b6.vtu
+expect_fail "--fit with --iters" 2 "go with --fair" tetsmooth --fit --surface "$BUNNY" --iters 3 -o x.vtu b6.vtu
+expect_fail "bad --step" 2 "step" tetsmooth --fit --surface "$BUNNY" --step 2 -o x.vtu b6.vtu
+expect_fail "a missing mesh" 1 "^tetsmooth: missing.vtu" tetsmooth --fair -o x.vtu missing.vtu
+printf 'not a mesh' > junk.vtu
+expect_fail "a file that is not a mesh" 1 "^tetsmooth: junk.vtu" tetsmooth --fair -o x.vtu junk.vtu
+expect_fail "a missing surface" 1 "^tetsmooth: nosuch.obj" tetsmooth --fit --surface nosuch.obj -o x.vtu b6.vtu
+check "no partial output" test ! -e x.vtu
+
+done_testing
