@@ -23,14 +23,22 @@
  *      whether it is a closed 2-manifold and its Euler characteristic; a
  *      breadth-first propagation of orientation across manifold edges says
  *      whether it is orientable.
+ *   6. Self-intersections (a separate call): a BVH over the triangles; for
+ *      every triangle, the candidates whose boxes meet its box, each pair
+ *      decided once, exactly, by the rule for the corners it shares (see
+ *      soupinfo.h).
  *
  * Union-find joins toward the smaller index, so every root is the smallest
  * member of its set: pieces are numbered by their first triangle.
  */
 #include "souptet/soupinfo.h"
+#include "souptet/bvh.h"
 #include "souptet/geom.h"
+#include "souptet/isect.h"
 #include "souptet/mem.h"
+#include "souptet/pred.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -189,6 +197,15 @@ static uint32_t next_corner(uint32_t h)
     return h % 3 == 2 ? h - 2 : h + 1;
 }
 
+/* Three distinct points on one line: every projection of the triangle onto
+ * a coordinate plane has zero area (exactly). */
+static int collinear(const double *a, const double *b, const double *c)
+{
+    return st_orient2d_drop(a, b, c, 0) == 0.0 &&
+           st_orient2d_drop(a, b, c, 1) == 0.0 &&
+           st_orient2d_drop(a, b, c, 2) == 0.0;
+}
+
 /* ---- the report ---------------------------------------------------------- */
 
 st_status st_soupinfo_compute(st_soupinfo *out, const st_soup *s,
@@ -251,6 +268,10 @@ st_status st_soupinfo_compute(st_soupinfo *out, const st_soup *s,
             out->degenerate_triangles++;
         } else {
             nnd++;
+            const uint32_t *v = s->tris + 3 * t;
+            if (collinear(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
+                          s->xyz + 3 * (size_t)v[2]))
+                out->collinear_triangles++;
         }
     }
     free(weld);
@@ -503,5 +524,149 @@ done:
     free(pv);
     free(flip);
     free(queue);
+    return st;
+}
+
+/* ---- self-intersections --------------------------------------------------- */
+
+typedef struct si_ctx {
+    const st_soup *s;
+    const uint32_t *W;       /* welded corners, 3 per triangle */
+    const uint8_t *kind;     /* 0 ordinary, 1 collinear, 2 degenerate */
+    uint8_t *hit;            /* per triangle: in a pair */
+    uint32_t t;              /* the triangle being queried */
+    size_t pairs;            /* pairs (t, u > t) found */
+} si_ctx;
+
+static const double *corner(const st_soup *s, uint32_t t, int k)
+{
+    return s->xyz + 3 * (size_t)s->tris[3 * (size_t)t + (size_t)k];
+}
+
+/* The rule of soupinfo.h for triangles t and u (both non-degenerate). */
+static int pair_intersects(const si_ctx *c, uint32_t t, uint32_t u)
+{
+    const st_soup *s = c->s;
+    const uint32_t *A = c->W + 3 * (size_t)t, *B = c->W + 3 * (size_t)u;
+    int ia[3], ib[3], nshared = 0; /* slots of the shared corners */
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (A[i] == B[j]) {
+                ia[nshared] = i;
+                ib[nshared] = j;
+                nshared++;
+            }
+    if (nshared == 0)
+        return st_tri_tri_intersect(corner(s, t, 0), corner(s, t, 1),
+                                    corner(s, t, 2), corner(s, u, 0),
+                                    corner(s, u, 1), corner(s, u, 2));
+    if (c->kind[t] || c->kind[u])
+        return 0; /* a collinear triangle with a shared corner: untested */
+    if (nshared == 3)
+        return 1;
+    if (nshared == 1) {
+        /* the edges opposite the shared corner */
+        int a1 = (ia[0] + 1) % 3, a2 = (ia[0] + 2) % 3;
+        int b1 = (ib[0] + 1) % 3, b2 = (ib[0] + 2) % 3;
+        return st_segment_tri_intersect(corner(s, t, a1), corner(s, t, a2),
+                                        corner(s, u, 0), corner(s, u, 1),
+                                        corner(s, u, 2)) ||
+               st_segment_tri_intersect(corner(s, u, b1), corner(s, u, b2),
+                                        corner(s, t, 0), corner(s, t, 1),
+                                        corner(s, t, 2));
+    }
+    /* one shared edge (p, q); apexes a of t and b of u */
+    const double *p = corner(s, t, ia[0]), *q = corner(s, t, ia[1]);
+    const double *a = corner(s, t, 3 - ia[0] - ia[1]);
+    const double *b = corner(s, u, 3 - ib[0] - ib[1]);
+    if (st_orient3d(p, q, a, b) != 0.0)
+        return 0;
+    /* Coplanar: both have the same nonzero normal component on some
+     * axis; project along it and compare the apexes' sides of pq. */
+    for (int drop = 0; drop < 3; drop++) {
+        int sa = st_sign(st_orient2d_drop(p, q, a, drop));
+        if (sa != 0)
+            return sa == st_sign(st_orient2d_drop(p, q, b, drop));
+    }
+    return 0; /* not reached: t is not collinear */
+}
+
+static int si_visit(void *ctx, uint32_t u)
+{
+    si_ctx *c = ctx;
+    if (u <= c->t || c->kind[u] == 2)
+        return 0;
+    if (pair_intersects(c, c->t, u)) {
+        c->pairs++;
+#pragma omp atomic write
+        c->hit[c->t] = 1;
+#pragma omp atomic write
+        c->hit[u] = 1;
+    }
+    return 0;
+}
+
+st_status st_soupinfo_self_intersections(st_soupinfo *out, const st_soup *s,
+                                         unsigned char *flags, st_error *err)
+{
+    if (!s || s->ntris == 0)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "no triangles");
+    if (s->ntris > (size_t)(UINT32_MAX - 3) / 3)
+        return st_error_set(err, ST_ELIMIT, NULL, 0,
+                            "%zu triangles: soupinfo handles at most %lu",
+                            s->ntris, (unsigned long)((UINT32_MAX - 3) / 3));
+    const size_t nt = s->ntris;
+    st_status st = ST_ENOMEM;
+    uint32_t *weld = st_malloc_array(s->nverts, sizeof *weld);
+    uint32_t *W = st_malloc_array(3 * nt, sizeof *W);
+    uint8_t *kind = st_malloc_array(nt, 1);
+    uint8_t *hit = st_calloc_array(nt, 1);
+    st_bvh *bvh = NULL;
+    size_t pairs = 0;
+    if (!weld || !W || !kind || !hit || weld_vertices(weld, s) < 0)
+        goto done;
+    for (size_t i = 0; i < 3 * nt; i++)
+        W[i] = weld[s->tris[i]];
+    for (size_t t = 0; t < nt; t++) {
+        const uint32_t *w = W + 3 * t;
+        if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2])
+            kind[t] = 2;
+        else
+            kind[t] = (uint8_t)collinear(corner(s, (uint32_t)t, 0),
+                                         corner(s, (uint32_t)t, 1),
+                                         corner(s, (uint32_t)t, 2));
+    }
+    st = st_bvh_build(&bvh, s, err);
+    if (st)
+        goto done;
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : pairs)
+    for (size_t t = 0; t < nt; t++) {
+        if (kind[t] == 2)
+            continue;
+        si_ctx c = {s, W, kind, hit, (uint32_t)t, 0};
+        /* candidates: boxes meeting t's box, in nodes meeting t itself */
+        st_bvh_query_tri(bvh, corner(s, c.t, 0), corner(s, c.t, 1),
+                         corner(s, c.t, 2), si_visit, &c);
+        pairs += c.pairs;
+    }
+    out->self_checked = 1;
+    out->self_intersecting_pairs = pairs;
+    out->self_intersecting_triangles = 0;
+    for (size_t t = 0; t < nt; t++) {
+        out->self_intersecting_triangles += hit[t];
+        if (flags)
+            flags[t] = hit[t];
+    }
+    st = ST_OK;
+done:
+    if (st == ST_ENOMEM)
+        st_error_set(err, ST_ENOMEM, NULL, 0,
+                     "out of memory checking %zu triangles for "
+                     "self-intersections", nt);
+    st_bvh_free(bvh);
+    free(weld);
+    free(W);
+    free(kind);
+    free(hit);
     return st;
 }

@@ -407,6 +407,77 @@ static void test_errors(void)
     st_soup_free(s);
 }
 
+
+/* ---- self-intersections: one known answer per case of the definition ---- */
+
+/* Pairs found in a soup of the given triangles (each its own vertices, so
+ * sharing comes from exact welding). */
+static size_t si_pairs(const double (*v)[3], size_t nv, const uint32_t (*t)[3],
+                       size_t nt, size_t *collinear)
+{
+    st_soup *s = soup_or_die();
+    for (size_t i = 0; i < nt; i++) {
+        uint32_t a = vert(s, v[t[i][0]][0], v[t[i][0]][1], v[t[i][0]][2]);
+        uint32_t b = vert(s, v[t[i][1]][0], v[t[i][1]][1], v[t[i][1]][2]);
+        uint32_t c = vert(s, v[t[i][2]][0], v[t[i][2]][1], v[t[i][2]][2]);
+        tri(s, a, b, c);
+    }
+    (void)nv;
+    st_soupinfo r = info_of(s);
+    st_error err;
+    unsigned char flags[8];
+    if (st_soupinfo_self_intersections(&r, s, nt <= 8 ? flags : NULL, &err))
+        abort();
+    if (collinear)
+        *collinear = r.collinear_triangles;
+    st_soup_free(s);
+    return r.self_checked ? r.self_intersecting_pairs : (size_t)-1;
+}
+
+static void test_self_intersections(void)
+{
+    static const double v[][3] = {
+        {0, 0, 0}, {1, 0, 0}, {0, 1, 0},      /* 0-2: base triangle */
+        {0, 0, 1}, {1, 1, 0}, {0.5, 0.5, 1},  /* 3-5 */
+        {1, 1, 0.0}, {0.5, -1, 0},            /* 6, 7 */
+        {0.25, 0.25, -1}, {0.25, 0.25, 1},    /* 8, 9: a needle through 0-2 */
+        {0.2, 0.2, 0}, {2, 2, 1}, {2, 0, 1},  /* 10: in 0-2's interior */
+        {0.5, 0, 0}, {0.5, 0.5, 0},           /* 13, 14 */
+    };
+    static const uint32_t edge_bent[][3] = {{0, 1, 2}, {1, 0, 3}};
+    TAP_CHECK(si_pairs(v, 15, edge_bent, 2, NULL) == 0, "self: sharing an edge at an angle is no self-intersection");
+    static const uint32_t edge_open[][3] = {{0, 1, 2}, {1, 0, 7}};
+    TAP_CHECK(si_pairs(v, 15, edge_open, 2, NULL) == 0, "self: sharing an edge, coplanar, apexes on opposite sides: none");
+    static const uint32_t edge_fold[][3] = {{0, 1, 2}, {1, 0, 14}};
+    TAP_CHECK(si_pairs(v, 15, edge_fold, 2, NULL) == 1, "self: sharing an edge, folded flat onto each other: one pair");
+    static const uint32_t vert_apart[][3] = {{0, 1, 2}, {0, 3, 7}};
+    TAP_CHECK(si_pairs(v, 15, vert_apart, 2, NULL) == 0, "self: sharing only a vertex, apart elsewhere: none");
+    static const uint32_t vert_pierce[][3] = {{0, 1, 2}, {0, 8, 9}};
+    TAP_CHECK(si_pairs(v, 15, vert_pierce, 2, NULL) == 1, "self: sharing a vertex, the other's far edge through its interior: one pair");
+    static const uint32_t vert_cross[][3] = {{0, 1, 2}, {0, 11, 12}};
+    TAP_CHECK(si_pairs(v, 15, vert_cross, 2, NULL) == 0, "self: sharing a vertex, rising away from the base: none");
+    static const uint32_t touch[][3] = {{0, 1, 2}, {10, 11, 12}};
+    TAP_CHECK(si_pairs(v, 15, touch, 2, NULL) == 1, "self: no shared corner, touching at one point: one pair");
+    static const uint32_t dup[][3] = {{0, 1, 2}, {2, 1, 0}};
+    TAP_CHECK(si_pairs(v, 15, dup, 2, NULL) == 1, "self: a duplicate (reversed) covers its original: one pair");
+    static const uint32_t col[][3] = {{0, 13, 1}, {0, 1, 2}};
+    size_t ncol = 0;
+    size_t nc = si_pairs(v, 15, col, 2, &ncol);
+    TAP_CHECK(ncol == 1 && nc == 0, "self: a collinear triangle is counted and not tested against its neighbour (%zu, %zu)", ncol, nc);
+
+    /* The closed cube: none; two cubes overlapping: some. */
+    st_soup *s = soup_or_die();
+    add_cube(s, 0, 0, 0, 0, 0);
+    st_soupinfo r = info_of(s);
+    st_error err;
+    TAP_CHECK(st_soupinfo_self_intersections(&r, s, NULL, &err) == ST_OK && r.self_checked &&
+              r.self_intersecting_pairs == 0, "self: a closed cube has none");
+    add_cube(s, 0.5, 0.5, 0.5, 0, 0);
+    TAP_CHECK(st_soupinfo_self_intersections(&r, s, NULL, &err) == ST_OK && r.self_intersecting_pairs > 0 &&
+              r.self_intersecting_triangles > 0, "self: two overlapping cubes cross (%zu pairs)", r.self_intersecting_pairs);
+    st_soup_free(s);
+}
+
 int main(void)
 {
     test_cube_indexed();
@@ -423,5 +494,6 @@ int main(void)
     test_moebius();
     test_order_independent();
     test_errors();
+    test_self_intersections();
     return tap_done();
 }

@@ -44,8 +44,29 @@
  *   Orientability is decided by propagating orientation across manifold
  *   edges, so a closed piece with randomly flipped triangles is still
  *   orientable (and has a genus), a Klein bottle is not.
+ * - Collinear triangle: a non-degenerate one whose three distinct corners
+ *   lie on one line (decided exactly with pred.h). Counted apart; it takes
+ *   part in edges and pieces like any other.
+ * - Self-intersection (st_soupinfo_self_intersections, exact, isect.h):
+ *   a pair of distinct non-degenerate triangles whose closed point sets
+ *   share more than the welded corners they have in common:
+ *     no corner in common:  they share any point (touching counts);
+ *     one corner v:         they share a point other than v, which holds
+ *                           exactly when the edge opposite v in either
+ *                           one meets the other triangle (their
+ *                           intersection is convex and contains v, so a
+ *                           second point makes an extreme point other
+ *                           than v, and that lies on an opposite edge);
+ *     one edge uw:          they overlap beyond uw: coplanar, with their
+ *                           third corners on the same side of uw (a fold
+ *                           flat onto itself); two triangles meeting at an
+ *                           angle share only the edge;
+ *     all three corners:    always (a duplicate covers its original).
+ *   A collinear triangle is tested only against triangles with no corner
+ *   in common (its point set is a segment: "opposite edge" and "side"
+ *   have no meaning for it).
  *
- * Module order: err -> mem -> ... -> soup -> soupinfo.
+ * Module order: err -> mem -> ... -> pred -> isect -> soup -> bvh -> soupinfo.
  */
 #ifndef SOUPTET_SOUPINFO_H
 #define SOUPTET_SOUPINFO_H
@@ -86,6 +107,12 @@ typedef struct st_soupinfo {
     /* summary flags */
     int closed;                   /* no boundary and no non-manifold edge */
     int consistently_oriented;    /* no inconsistent edge */
+
+    size_t collinear_triangles;   /* distinct corners on one line */
+    /* filled by st_soupinfo_self_intersections only: */
+    int self_checked;             /* 1 once the two counts below are set */
+    size_t self_intersecting_pairs;
+    size_t self_intersecting_triangles;  /* in at least one pair */
 } st_soupinfo;
 
 /* Analyse a soup (see the definitions above). s must hold at least one
@@ -96,6 +123,17 @@ typedef struct st_soupinfo {
  * 2^32 / 3 triangles) / ST_EINPUT (no triangles) with err filled. */
 st_status st_soupinfo_compute(st_soupinfo *out, const st_soup *s,
                               st_error *err);
+
+/* The self-intersections of s (see the definition above), found with a
+ * BVH (bvh.h) over the triangles and decided exactly. Sets out's
+ * self_checked, self_intersecting_pairs and self_intersecting_triangles
+ * and leaves the rest of *out alone. flags, when not NULL, holds
+ * s->ntris bytes and gets 1 for every triangle in at least one pair, else
+ * 0. Parallel (OpenMP); the result does not depend on the thread count.
+ * ST_ENOMEM, ST_ELIMIT as above. */
+st_status st_soupinfo_self_intersections(st_soupinfo *out, const st_soup *s,
+                                         unsigned char *flags,
+                                         st_error *err);
 
 #ifdef __cplusplus
 }

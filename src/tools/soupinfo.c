@@ -1,12 +1,13 @@
 /*
  * soupinfo - what is wrong with a triangle soup.
  *
- *   soupinfo [--json] [-q|-v] INPUT...
+ *   soupinfo [--json] [--no-self-check] [-q|-v] INPUT...
  *
  * Reads each surface (.obj .off .ply .stl, or stdin) and reports the counts
  * of soupinfo.h: vertices, welded points, degenerate and duplicated
  * triangles, edges by kind, holes, pieces, Euler characteristic and genus,
- * as a table per file or as one JSON array. See man/man1/soupinfo.1.
+ * collinear and self-intersecting triangles (exact), as a table per file
+ * or as one JSON array. See man/man1/soupinfo.1.
  */
 #define _GNU_SOURCE
 #include "../cli/tool.h"
@@ -24,13 +25,15 @@ static void usage(void)
 "Usage: soupinfo [OPTION]... [INPUT]...\n"
 "Report what is wrong with triangle soups: welded points, degenerate and\n"
 "duplicated triangles, boundary, non-manifold and inconsistently oriented\n"
-"edges, holes, pieces, Euler characteristic and genus.\n"
+"edges, holes, pieces, Euler characteristic, genus, and self-intersecting\n"
+"triangles (exact).\n"
 "\n"
 "INPUT is a surface (.obj .off .ply .stl); '-' or none reads stdin.\n"
 "Vertices are welded where their coordinates are exactly equal (no\n"
 "tolerance) before edges and pieces are counted.\n"
 "\n"
 "      --json           one JSON array, an object per input (default: a table)\n"
+"      --no-self-check  skip the self-intersection test (the slowest part)\n"
 "  -q, --quiet          no messages but errors\n"
 "  -v, --verbose        report read and analysis times on stderr\n"
 "      --help           show this help and exit\n"
@@ -90,7 +93,8 @@ static void print_json(FILE *f, const char *name, const st_soupinfo *r)
             "  \"nonmanifold_vertices\": %zu, \"holes\": %zu, \"pieces\": %zu, "
             "\"closed_pieces\": %zu, \"nonorientable_pieces\": %zu,\n"
             "  \"euler\": %lld, \"genus\": %lld, \"closed\": %s, "
-            "\"consistently_oriented\": %s}",
+            "\"consistently_oriented\": %s,\n"
+            "  \"collinear_triangles\": %zu, ",
             r->vertices, r->triangles, r->unreferenced_vertices,
             num(b[0], r->lo[0]), num(b[1], r->lo[1]), num(b[2], r->lo[2]),
             num(b[3], r->hi[0]), num(b[4], r->hi[1]), num(b[5], r->hi[2]),
@@ -101,7 +105,15 @@ static void print_json(FILE *f, const char *name, const st_soupinfo *r)
             r->nonmanifold_vertices, r->holes, r->pieces, r->closed_pieces,
             r->nonorientable_pieces, r->euler, r->genus,
             r->closed ? "true" : "false",
-            r->consistently_oriented ? "true" : "false");
+            r->consistently_oriented ? "true" : "false",
+            r->collinear_triangles);
+    if (r->self_checked)
+        fprintf(f, "\"self_intersecting_pairs\": %zu, "
+                   "\"self_intersecting_triangles\": %zu}",
+                r->self_intersecting_pairs, r->self_intersecting_triangles);
+    else
+        fprintf(f, "\"self_intersecting_pairs\": null, "
+                   "\"self_intersecting_triangles\": null}");
 }
 
 static void print_table(FILE *f, const char *name, const st_soupinfo *r)
@@ -114,6 +126,13 @@ static void print_table(FILE *f, const char *name, const st_soupinfo *r)
     ROW("triangles", "%zu", r->triangles);
     ROW("  degenerate", "%zu", r->degenerate_triangles);
     ROW("  duplicated", "%zu", r->duplicated_triangles);
+    ROW("  collinear", "%zu", r->collinear_triangles);
+    if (r->self_checked) {
+        ROW("  self-intersecting", "%zu", r->self_intersecting_triangles);
+        ROW("self-intersecting pairs", "%zu", r->self_intersecting_pairs);
+    } else {
+        ROW("  self-intersecting", "%s", "not checked");
+    }
     ROW("edges", "%zu", r->edges);
     ROW("  boundary", "%zu", r->boundary_edges);
     ROW("  manifold", "%zu", r->manifold_edges);
@@ -136,15 +155,16 @@ static void print_table(FILE *f, const char *name, const st_soupinfo *r)
 
 /* ---- main ------------------------------------------------------------------ */
 
-enum { OPT_JSON = 256, OPT_HELP, OPT_VERSION };
+enum { OPT_JSON = 256, OPT_NOSELF, OPT_HELP, OPT_VERSION };
 
 int main(int argc, char *argv[])
 {
     tool_ctx t;
     tool_init(&t, "soupinfo", argc, argv);
-    int json = 0;
+    int json = 0, self_check = 1;
     static const struct option opts[] = {
         {"json", no_argument, NULL, OPT_JSON},
+        {"no-self-check", no_argument, NULL, OPT_NOSELF},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, OPT_HELP},
@@ -156,6 +176,9 @@ int main(int argc, char *argv[])
         switch (c) {
         case OPT_JSON:
             json = 1;
+            break;
+        case OPT_NOSELF:
+            self_check = 0;
             break;
         case 'q':
             t.verbosity = 0;
@@ -212,6 +235,14 @@ int main(int argc, char *argv[])
         }
         double t_info = tool_now();
         if (st_soupinfo_compute(&r, soup, &err)) {
+            if (!err.file[0])
+                snprintf(err.file, sizeof err.file, "%s", name);
+            rc = tool_fail(&t, &err);
+            st_soup_free(soup);
+            continue;
+        }
+        if (self_check &&
+            st_soupinfo_self_intersections(&r, soup, NULL, &err)) {
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", name);
             rc = tool_fail(&t, &err);

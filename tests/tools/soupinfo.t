@@ -89,4 +89,16 @@ check "a bad input among good ones: the others are reported, exit 1" sh -c "
 expect_fail "unknown option" 2 "unknown option" soupinfo --bogus "$BUNNY"
 expect_fail "stdin twice" 2 "standard input" soupinfo - -
 
+# Self-intersections (exact): none on the bunny; two overlapping cubes cross.
+check "bunny: no self-intersecting pairs" python3 want.py bunny.json self_intersecting_pairs=0 collinear_triangles=0
+awk 'BEGIN{print "OFF"; print "16 24 0";
+  for(c=0;c<2;c++) for(i=0;i<8;i++) print (i%2)+c*0.5, (int(i/2)%2)+c*0.5, int(i/4)+c*0.5;
+  split("0 2 1 1 2 3 4 5 6 5 7 6 0 1 4 1 5 4 2 6 3 3 6 7 0 4 2 2 4 6 1 3 5 3 7 5", f, " ");
+  for(c=0;c<2;c++) for(t=0;t<12;t++) print 3, f[3*t+1]+8*c, f[3*t+2]+8*c, f[3*t+3]+8*c}' > overlap.off
+check "two overlapping cubes: self-intersecting pairs found" sh -c \
+    "soupinfo --json overlap.off > o.json && python3 -c 'import json; r=json.load(open(\"o.json\"))[0]; assert r[\"self_intersecting_pairs\"] > 0 and r[\"closed\"], r'"
+check "--no-self-check: the keys are null" sh -c \
+    "soupinfo --json --no-self-check overlap.off | python3 -c 'import json,sys; assert json.load(sys.stdin)[0][\"self_intersecting_pairs\"] is None'"
+check "table: the self-intersecting row" sh -c "soupinfo overlap.off | grep -Eq '^  self-intersecting pairs +[1-9]'"
+
 done_testing

@@ -1,0 +1,117 @@
+#!/bin/sh
+# soupwrap end to end: a pipe from soupdist | soupsign, --surface, every
+# output format checked by soupinfo (closed, manifold, oriented, no
+# degenerate or self-intersecting triangles), history, refusals.
+. "$(dirname "$0")/lib.sh"
+BUNNY="$ROOT/corpus/bunny.obj"
+cd "$WORK" || exit 1
+
+check "--help exits 0" sh -c 'soupwrap --help | grep -q "Usage: soupwrap"'
+check "--version names the project" sh -c 'soupwrap --version | grep -q "(souptet)"'
+check "man page exists" test -s "$ROOT/man/man1/soupwrap.1"
+
+cat > good.py <<'PY'
+import json, sys
+# good.py REPORT.json [PIECES]: every report is a closed 2-manifold,
+# consistently oriented, without degenerate, collinear, duplicated or
+# self-intersecting triangles; with PIECES, that many pieces.
+for r in json.load(open(sys.argv[1])):
+    bad = {k: r[k] for k in ("boundary_edges", "nonmanifold_edges", "nonmanifold_vertices",
+                             "inconsistent_edges", "degenerate_triangles", "collinear_triangles",
+                             "duplicated_triangles", "self_intersecting_pairs") if r[k] != 0}
+    if not r["closed"] or bad:
+        sys.exit("%s: closed %s, %s" % (r["file"], r["closed"], bad))
+    # STL repeats each triangle's vertices; the others index them once
+    if not r["file"].endswith(".stl") and r["welded_vertices"] != r["vertices"]:
+        sys.exit("%s: vertices share points" % r["file"])
+    if len(sys.argv) > 2 and r["pieces"] != int(sys.argv[2]):
+        sys.exit("%s: %d pieces" % (r["file"], r["pieces"]))
+PY
+
+check "soupdist | soupsign | soupwrap -o .obj" sh -c "soupdist -r 40 '$BUNNY' | soupsign | soupwrap -o b.obj"
+check "the same field from a file, -o .off .ply .stl" sh -c \
+    "soupdist -r 40 '$BUNNY' | soupsign -o s.vdb && soupwrap -o b.off s.vdb && soupwrap -o b.ply s.vdb && soupwrap -o b.stl s.vdb"
+check "every format: closed, manifold, oriented, no self-intersections (soupinfo)" sh -c \
+    "soupinfo --json b.obj b.off b.ply b.stl > r.json && python3 good.py r.json 1"
+check "obj, off, ply hold the same vertices and faces" sh -c \
+    "soupinfo --json b.obj b.off b.ply | python3 -c 'import json,sys; d=json.load(sys.stdin); assert len(set((r[\"vertices\"], r[\"triangles\"]) for r in d)) == 1, d'"
+check "history: soupwrap's command line in the file" grep -q "soupwrap -o b.off s.vdb" b.off
+check "history: soupsign's and soupdist's too" sh -c "grep -q '^# soupsign' b.off && grep -q '^# soupdist' b.off"
+check "stdout is OBJ, the same surface" sh -c "soupwrap s.vdb > out.obj && grep -v '^#' out.obj > a.txt && grep -v '^#' b.obj > b.txt && cmp a.txt b.txt"
+
+# An exact cube soup (every triangle its own vertices, every other one flipped)
+cat > cube.off <<'END'
+OFF
+36 12 0
+0 0 0
+1 1 0
+1 0 0
+0 0 0
+0 1 0
+1 1 0
+0 0 1
+1 0 1
+1 1 1
+0 0 1
+1 1 1
+0 1 1
+0 0 0
+1 0 0
+1 0 1
+0 0 0
+1 0 1
+0 0 1
+0 1 0
+0 1 1
+1 1 1
+0 1 0
+1 1 1
+1 1 0
+0 0 0
+0 0 1
+0 1 1
+0 0 0
+0 1 1
+0 1 0
+1 0 0
+1 1 0
+1 1 1
+1 0 0
+1 1 1
+1 0 1
+3 0 1 2
+3 3 5 4
+3 6 7 8
+3 9 11 10
+3 12 13 14
+3 15 17 16
+3 18 19 20
+3 21 23 22
+3 24 25 26
+3 27 29 28
+3 30 31 32
+3 33 35 34
+END
+check "--surface: a flipped cube soup becomes one closed shell" sh -c \
+    "soupwrap --surface cube.off -r 24 -o c.ply && soupinfo --json c.ply > c.json && python3 good.py c.json 1"
+check "--smooth 2 and --adaptivity 0.5 stay valid" sh -c \
+    "soupwrap --smooth 2 -o sm.obj s.vdb && soupwrap --adaptivity 0.5 -o ad.obj s.vdb && soupinfo --json sm.obj ad.obj > sa.json && python3 good.py sa.json 1"
+check "adaptivity makes fewer faces" sh -c \
+    "[ \$(grep -c '^f ' ad.obj) -lt \$(grep -c '^f ' b.obj) ]"
+
+mkdir t1 t2
+(cd t1 && OMP_NUM_THREADS=1 soupwrap -o w.ply ../s.vdb)
+(cd t2 && OMP_NUM_THREADS=2 soupwrap -o w.ply ../s.vdb)
+check "1 and 2 threads write identical files" cmp t1/w.ply t2/w.ply
+
+soupdist -r 24 -o d.vdb cube.off
+expect_fail "an unsigned distance field is refused" 1 "^soupwrap: .*sign it first" soupwrap -o x.obj d.vdb
+expect_fail "a missing file" 1 "^soupwrap: missing.vdb" soupwrap -o x.obj missing.vdb
+expect_fail "a missing surface" 1 "^soupwrap: missing.obj" soupwrap --surface missing.obj -o x.obj
+check "no partial output" test ! -e x.obj
+expect_fail "unknown output format" 2 "cannot tell the format" soupwrap -o x.xyz s.vdb
+expect_fail "-r without --surface" 2 "needs --surface" soupwrap -r 32 s.vdb
+expect_fail "field and --surface" 2 "not both" soupwrap --surface cube.off s.vdb
+expect_fail "bad --adaptivity" 2 "adaptivity" soupwrap --adaptivity 2 s.vdb
+
+done_testing
