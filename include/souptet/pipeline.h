@@ -1,0 +1,107 @@
+/*
+ * pipeline.h - the whole job in one call: a soup in, a coarse tet mesh
+ * that encloses it out (what soupmesh runs).
+ *
+ *   distance field (dist.h) -> signs, the pseudo volume (sign.h)
+ *     -> per candidate: a seeded lattice, sculpted with bomb repair
+ *        (sculpt.h), fitted to the soup with the quality pass (smooth.h)
+ *     -> the best candidate.
+ *
+ * Candidates (Stuart et al. 2013, section 3.4). Candidate k lays its
+ * lattice with seed st_pipeline_candidate_seed(seed, k): a random rotation
+ * and offset per candidate (seed 0 and k 0: the axis-aligned lattice). The
+ * candidates run in parallel (one OpenMP thread each; each candidate's own
+ * loops then run on one thread), and the winner is chosen by a total order
+ * that does not depend on which finished first:
+ *   1. enclosing before not enclosing (no soup vertex outside the mesh, no
+ *      soup triangle meeting the boundary, counted exactly);
+ *   2. larger minimum dihedral angle;
+ *   3. smaller maximum dihedral angle;
+ *   4. smaller k.
+ * Every stage is deterministic for any thread count, so the output depends
+ * only on the soup and the parameters.
+ *
+ * The Spillmann mesher (density_rho > 0): the cubic5 lattice filtered by
+ * pseudo-volume density, then volume-preserving boundary fairing; it
+ * approximates the pseudo volume and does not try to enclose the soup
+ * (enclosure is still measured and reported).
+ *
+ * Module order: ... dist -> sign -> lattice -> sculpt -> smooth -> pipeline.
+ */
+#ifndef SOUPTET_PIPELINE_H
+#define SOUPTET_PIPELINE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "souptet/err.h"
+#include "souptet/progress.h"
+#include "souptet/soup.h"
+#include "souptet/tetmesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Most candidates one call runs. */
+#define ST_PIPELINE_MAX_TRIES 1024
+
+typedef struct st_pipeline_params {
+    size_t cells;          /* lattice cells along the longest side (10) */
+    size_t field_cells;    /* voxels along the longest side of the field;
+                              0: max(128, 8 * cells) */
+    double offset_ratio;   /* d_offset = offset_ratio * h (0.4) */
+    size_t tries;          /* candidates (1) */
+    uint64_t seed;         /* seed of candidate 0 (1) */
+    int quality;           /* run the quality pass after the fit (1) */
+    int fit_max_iters;     /* 0: smooth.h's default */
+    double density_rho;    /* > 0: the Spillmann mesher with this rho_min */
+    size_t max_bytes;      /* limit for the distance field (0: none) */
+} st_pipeline_params;
+
+st_pipeline_params st_pipeline_params_default(void);
+
+/* The lattice seed of candidate k (k 0: seed itself). */
+uint64_t st_pipeline_candidate_seed(uint64_t seed, size_t k);
+
+/* What happened to one candidate. */
+typedef struct st_pipeline_candidate {
+    uint64_t seed;
+    int failed;                    /* 1: a stage failed (message below) */
+    char message[256];
+    size_t tets, points;
+    size_t bombs, bombs_left;
+    int converged;                 /* every boundary vertex within d_offset */
+    size_t beyond_offset;
+    double max_distance;           /* boundary vertices to the soup */
+    double min_dihedral, max_dihedral;
+    size_t verts_outside, tris_crossing;   /* exact, 0 and 0: encloses */
+    double seconds_sculpt, seconds_fit;
+} st_pipeline_candidate;
+
+typedef struct st_pipeline_stats {
+    size_t field_dims[3];
+    double voxel, h;
+    double seconds_dist, seconds_sign, seconds_candidates, seconds_total;
+    size_t ncandidates;
+    st_pipeline_candidate *candidates;   /* ncandidates entries, caller
+                                            frees with free() */
+    size_t best;                         /* index of the chosen one */
+    int encloses;                        /* the chosen one encloses */
+} st_pipeline_stats;
+
+/* Mesh soup s. *out gets the chosen candidate's mesh, with meta "h",
+ * "lattice", "seed", "offset_ratio", "candidates", "encloses". stats may
+ * be NULL; when given, stats->candidates must be freed by the caller even
+ * on failure (it is NULL when nothing was allocated). Fails when the
+ * soup is empty or every candidate failed (the first candidate's message
+ * is reported). Not enclosing is not a failure: stats say it, and meta
+ * "encloses" is "no". */
+st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
+                          const st_soup *s, const st_pipeline_params *p,
+                          const st_progress *prog, st_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

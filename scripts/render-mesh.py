@@ -1,0 +1,172 @@
+#!/usr/bin/python3
+"""Render a tet mesh (.vtu) with its input surface to PNG, two views side
+by side: left, the mesh's boundary coloured by each tet's min dihedral
+angle with the input surface showing through; right, a cut-away (the tets
+on one side of a plane through the middle removed) showing the interior
+tets and the input surface inside them.
+
+    xvfb-run -a -s "-screen 0 1600x800x24" /usr/bin/python3 \\
+        scripts/render-mesh.py MESH.vtu OUT.png [SURFACE.obj|.ply|.stl|.off]
+
+Colours: blue-green-yellow-red = min dihedral 0..70 degrees (red is good);
+the input surface is grey. Uses Debian's python3-vtk9.
+"""
+import os
+import sys
+
+import vtk
+
+
+def read_surface(path):
+    ext = os.path.splitext(path)[1].lower()
+    readers = {".obj": vtk.vtkOBJReader, ".ply": vtk.vtkPLYReader,
+               ".stl": vtk.vtkSTLReader}
+    if ext == ".off":
+        # VTK has no OFF reader: parse the simple ASCII form here.
+        pts, polys = vtk.vtkPoints(), vtk.vtkCellArray()
+        toks = []
+        with open(path) as f:
+            for line in f:
+                line = line.split("#")[0].strip()
+                if line:
+                    toks.extend(line.split())
+        if toks and toks[0].upper().endswith("OFF"):
+            toks = toks[1:]
+        nv, nf = int(toks[0]), int(toks[1])
+        i = 3
+        for _ in range(nv):
+            pts.InsertNextPoint(float(toks[i]), float(toks[i + 1]), float(toks[i + 2]))
+            i += 3
+        for _ in range(nf):
+            n = int(toks[i])
+            polys.InsertNextCell(n, [int(x) for x in toks[i + 1:i + 1 + n]])
+            i += 1 + n
+        pd = vtk.vtkPolyData()
+        pd.SetPoints(pts)
+        pd.SetPolys(polys)
+        return pd
+    if ext not in readers:
+        sys.exit("render-mesh.py: %s: unknown surface format" % path)
+    r = readers[ext]()
+    r.SetFileName(path)
+    r.Update()
+    return r.GetOutput()
+
+
+def lut():
+    t = vtk.vtkLookupTable()
+    t.SetHueRange(0.66, 0.0)
+    t.SetTableRange(0.0, 70.0)
+    t.Build()
+    return t
+
+
+def surface_actor(surface, opacity):
+    m = vtk.vtkPolyDataMapper()
+    m.SetInputData(surface)
+    m.ScalarVisibilityOff()
+    a = vtk.vtkActor()
+    a.SetMapper(m)
+    a.GetProperty().SetColor(0.55, 0.55, 0.55)
+    a.GetProperty().SetOpacity(opacity)
+    return a
+
+
+def mesh_actor(grid, opacity, table):
+    geo = vtk.vtkDataSetSurfaceFilter()
+    geo.SetInputData(grid)
+    m = vtk.vtkDataSetMapper()
+    m.SetInputConnection(geo.GetOutputPort())
+    if grid.GetCellData().GetArray("min_dihedral") is not None:
+        m.SetScalarModeToUseCellFieldData()
+        m.SelectColorArray("min_dihedral")
+        m.SetLookupTable(table)
+        m.SetScalarRange(0.0, 70.0)
+        m.ScalarVisibilityOn()
+    else:
+        m.ScalarVisibilityOff()
+    a = vtk.vtkActor()
+    a.SetMapper(m)
+    a.GetProperty().EdgeVisibilityOn()
+    a.GetProperty().SetEdgeColor(0.1, 0.1, 0.1)
+    a.GetProperty().SetOpacity(opacity)
+    return a
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit(__doc__)
+    src, out = sys.argv[1], sys.argv[2]
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(src)
+    r.Update()
+    grid = r.GetOutput()
+    if grid.GetNumberOfCells() == 0:
+        sys.exit("render-mesh.py: %s: no tets" % src)
+    surface = read_surface(sys.argv[3]) if len(sys.argv) > 3 else None
+    table = lut()
+
+    # Left: the whole mesh, half transparent, the input inside.
+    left = vtk.vtkRenderer()
+    left.SetViewport(0.0, 0.0, 0.5, 1.0)
+    left.AddActor(mesh_actor(grid, 0.55 if surface else 1.0, table))
+    if surface:
+        left.AddActor(surface_actor(surface, 1.0))
+
+    # Right: tets whose centroid is on the far side of a plane through the
+    # middle (clip by whole cells, so the interior tets show as they are).
+    b = grid.GetBounds()
+    plane = vtk.vtkPlane()
+    plane.SetOrigin(0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5]))
+    plane.SetNormal(0, 0, 1)
+    keep = vtk.vtkExtractGeometry()
+    keep.SetInputData(grid)
+    keep.SetImplicitFunction(plane)
+    keep.ExtractInsideOn()
+    keep.ExtractBoundaryCellsOff()
+    keep.Update()
+    right = vtk.vtkRenderer()
+    right.SetViewport(0.5, 0.0, 1.0, 1.0)
+    right.AddActor(mesh_actor(keep.GetOutput(), 1.0, table))
+    if surface:
+        clip = vtk.vtkClipPolyData()
+        clip.SetInputData(surface)
+        clip.SetClipFunction(plane)
+        clip.InsideOutOn()
+        clip.Update()
+        right.AddActor(surface_actor(clip.GetOutput(), 1.0))
+
+    bar = vtk.vtkScalarBarActor()
+    bar.SetLookupTable(table)
+    bar.SetTitle("min dihedral")
+    bar.SetNumberOfLabels(4)
+    bar.SetWidth(0.08)
+    bar.SetHeight(0.5)
+    bar.GetTitleTextProperty().SetColor(0, 0, 0)
+    bar.GetLabelTextProperty().SetColor(0, 0, 0)
+    right.AddActor2D(bar)
+
+    win = vtk.vtkRenderWindow()
+    win.SetOffScreenRendering(1)
+    win.SetSize(1600, 800)
+    for ren in (left, right):
+        ren.SetBackground(1, 1, 1)
+        win.AddRenderer(ren)
+    cam = left.GetActiveCamera()
+    left.ResetCamera()
+    cam.Azimuth(30)
+    cam.Elevation(20)
+    left.ResetCamera()
+    right.SetActiveCamera(cam)
+    win.Render()
+    grab = vtk.vtkWindowToImageFilter()
+    grab.SetInput(win)
+    grab.Update()
+    w = vtk.vtkPNGWriter()
+    w.SetFileName(out)
+    w.SetInputConnection(grab.GetOutputPort())
+    w.Write()
+
+
+if __name__ == "__main__":
+    main()

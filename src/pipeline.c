@@ -1,0 +1,338 @@
+/*
+ * pipeline.c - distance, signs, candidates, the best one (see pipeline.h).
+ */
+#include "souptet/pipeline.h"
+
+#include "souptet/bvh.h"
+#include "souptet/dist.h"
+#include "souptet/grid.h"
+#include "souptet/lattice.h"
+#include "souptet/mem.h"
+#include "souptet/sculpt.h"
+#include "souptet/sign.h"
+#include "souptet/smooth.h"
+#include "souptet/tetqual.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+st_pipeline_params st_pipeline_params_default(void)
+{
+    st_pipeline_params p;
+    memset(&p, 0, sizeof p);
+    p.cells = 10;
+    p.field_cells = 0;
+    p.offset_ratio = 0.4;
+    p.tries = 1;
+    p.seed = 1;
+    p.quality = 1;
+    p.fit_max_iters = 0;
+    p.density_rho = 0.0;
+    p.max_bytes = 0;
+    return p;
+}
+
+/* splitmix64's finaliser: a bijection of 64-bit words that mixes well. */
+static uint64_t mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+uint64_t st_pipeline_candidate_seed(uint64_t seed, size_t k)
+{
+    if (k == 0)
+        return seed;
+    uint64_t s = mix64(seed + 0x9e3779b97f4a7c15ULL * (uint64_t)k);
+    return s ? s : 1;   /* 0 means "axis-aligned": keep candidates random */
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void dihedral_range(const st_tetmesh *m, double *lo, double *hi)
+{
+    double mn = 180.0, mx = 0.0;
+    for (size_t t = 0; t < m->ntets; t++) {
+        const uint32_t *v = m->tets + 4 * t;
+        double a, b;
+        st_tet_dihedral_range(m->xyz + 3 * v[0], m->xyz + 3 * v[1],
+                              m->xyz + 3 * v[2], m->xyz + 3 * v[3], &a, &b);
+        if (a < mn)
+            mn = a;
+        if (b > mx)
+            mx = b;
+    }
+    *lo = m->ntets ? mn : 0.0;
+    *hi = m->ntets ? mx : 0.0;
+}
+
+/* The Cetra candidate: sculpt, fit, quality pass. */
+static st_status run_sculpt_candidate(st_tetmesh **out,
+                                      st_pipeline_candidate *c,
+                                      const st_grid *g, const st_soup *s,
+                                      const st_bvh *bvh, double h,
+                                      const st_pipeline_params *p,
+                                      st_error *err)
+{
+    st_sculpt_params sp = st_sculpt_params_default();
+    sp.kind = ST_LATTICE_BCC;
+    sp.h = h;
+    sp.seed = c->seed;
+    st_sculpt_stats ss;
+    memset(&ss, 0, sizeof ss);
+    double t0 = now_seconds();
+    st_tetmesh *m = NULL;
+    st_status rc = st_sculpt(&m, &ss, g, s, bvh, &sp, err);
+    if (rc)
+        return rc;
+    c->bombs = ss.bombs;
+    c->bombs_left = ss.bombs_left;
+    double t1 = now_seconds();
+    c->seconds_sculpt = t1 - t0;
+
+    st_fit_params fp = st_fit_params_default();
+    fp.offset_ratio = p->offset_ratio;
+    fp.cell_width = h;
+    fp.quality = p->quality;
+    if (p->fit_max_iters > 0)
+        fp.max_iters = p->fit_max_iters;
+    st_fit_stats fs;
+    memset(&fs, 0, sizeof fs);
+    rc = st_fit(m, s, bvh, &fp, &fs, NULL, err);
+    if (rc) {
+        st_tetmesh_free(m);
+        return rc;
+    }
+    c->seconds_fit = now_seconds() - t1;
+    c->converged = fs.converged;
+    c->beyond_offset = fs.beyond_offset;
+    c->max_distance = fs.max_distance;
+    c->verts_outside = fs.outside_after;
+    c->tris_crossing = fs.crossing_after;
+    *out = m;
+    return ST_OK;
+}
+
+/* The Spillmann candidate: cubic5 lattice, density filter, fairing. */
+static st_status run_density_candidate(st_tetmesh **out,
+                                       st_pipeline_candidate *c,
+                                       const st_grid *g, const st_soup *s,
+                                       const st_bvh *bvh, double h,
+                                       const st_pipeline_params *p,
+                                       st_error *err)
+{
+    double lo[3], hi[3];
+    st_lattice_grid_box(g, lo, hi);
+    st_lattice_params lp = st_lattice_params_default();
+    lp.kind = ST_LATTICE_CUBIC5;
+    lp.h = h;
+    lp.seed = c->seed;
+    double t0 = now_seconds();
+    st_lattice *L = NULL;
+    st_status rc = st_lattice_build(&L, lo, hi, &lp, err);
+    if (rc)
+        return rc;
+    st_tetmesh *m = NULL;
+    rc = st_lattice_density_filter(&m, NULL, L, g, p->density_rho, err);
+    st_lattice_free(L);
+    if (rc)
+        return rc;
+    if (m->ntets == 0) {
+        st_tetmesh_free(m);
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "no tet has density >= %g at %zu cells: lower "
+                            "--density or raise --cells", p->density_rho,
+                            p->cells);
+    }
+    double t1 = now_seconds();
+    c->seconds_sculpt = t1 - t0;
+    rc = st_fair(m, NULL, NULL, NULL, err);
+    if (rc) {
+        st_tetmesh_free(m);
+        return rc;
+    }
+    rc = st_enclosure_count(m, s, bvh, &c->verts_outside, &c->tris_crossing,
+                            err);
+    if (rc) {
+        st_tetmesh_free(m);
+        return rc;
+    }
+    c->seconds_fit = now_seconds() - t1;
+    c->converged = 1;
+    *out = m;
+    return ST_OK;
+}
+
+/* 1 when candidate a is better than candidate b (see pipeline.h). */
+static int better(const st_pipeline_candidate *a, size_t ka,
+                  const st_pipeline_candidate *b, size_t kb)
+{
+    if (a->failed != b->failed)
+        return !a->failed;
+    int ea = a->verts_outside == 0 && a->tris_crossing == 0;
+    int eb = b->verts_outside == 0 && b->tris_crossing == 0;
+    if (ea != eb)
+        return ea;
+    if (a->min_dihedral != b->min_dihedral)
+        return a->min_dihedral > b->min_dihedral;
+    if (a->max_dihedral != b->max_dihedral)
+        return a->max_dihedral < b->max_dihedral;
+    return ka < kb;
+}
+
+static st_status set_meta(st_tetmesh *m, const st_pipeline_params *p,
+                          const st_pipeline_stats *st, st_error *err)
+{
+    char buf[64];
+    snprintf(buf, sizeof buf, "%.17g", p->offset_ratio);
+    if (st_meta_set(&m->meta, "offset_ratio", buf))
+        goto oom;
+    snprintf(buf, sizeof buf, "%zu", st->ncandidates);
+    if (st_meta_set(&m->meta, "candidates", buf))
+        goto oom;
+    if (st_meta_set(&m->meta, "encloses", st->encloses ? "yes" : "no"))
+        goto oom;
+    if (p->density_rho > 0) {
+        snprintf(buf, sizeof buf, "%.17g", p->density_rho);
+        if (st_meta_set(&m->meta, "rho_min", buf))
+            goto oom;
+    }
+    return ST_OK;
+oom:
+    return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+}
+
+st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
+                          const st_soup *s, const st_pipeline_params *p,
+                          const st_progress *prog, st_error *err)
+{
+    *out = NULL;
+    st_pipeline_stats local;
+    st_pipeline_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    if (!p || p->cells < 1)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "cells must be >= 1");
+    if (p->tries < 1 || p->tries > ST_PIPELINE_MAX_TRIES)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "tries must be in 1..%d", ST_PIPELINE_MAX_TRIES);
+    if (!(p->offset_ratio > 0) || !isfinite(p->offset_ratio))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "the offset ratio must be > 0");
+    if (!s || s->ntris == 0)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "the soup has no triangles");
+
+    double t_start = now_seconds();
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = p->field_cells ? p->field_cells
+                              : (p->cells * 8 > 128 ? p->cells * 8 : 128);
+    dp.max_bytes = p->max_bytes;
+    st_grid *g = NULL;
+    st_bvh *bvh = NULL;
+    st_tetmesh **meshes = NULL;
+    st_status rc = st_dist_field(&g, s, &dp, prog, err);
+    if (rc)
+        goto done;
+    double t_sign = now_seconds();
+    st->seconds_dist = t_sign - t_start;
+    st_sign_params sg = st_sign_params_default();
+    rc = st_sign_field(g, &sg, prog, err);
+    if (rc)
+        goto done;
+    double t_cand = now_seconds();
+    st->seconds_sign = t_cand - t_sign;
+    st->field_dims[0] = g->nx;
+    st->field_dims[1] = g->ny;
+    st->field_dims[2] = g->nz;
+    st->voxel = g->voxel;
+
+    rc = st_bvh_build(&bvh, s, err);
+    if (rc)
+        goto done;
+    double lo[3], hi[3];
+    rc = st_soup_bounds(s, lo, hi, err);
+    if (rc)
+        goto done;
+    double h = st_lattice_h_for_cells(lo, hi, p->cells);
+    st->h = h;
+
+    size_t K = p->tries;
+    st->candidates = calloc(K, sizeof *st->candidates);
+    meshes = calloc(K, sizeof *meshes);
+    if (!st->candidates || !meshes) {
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        goto done;
+    }
+    st->ncandidates = K;
+    for (size_t k = 0; k < K; k++)
+        st->candidates[k].seed = st_pipeline_candidate_seed(p->seed, k);
+
+    /* One thread per candidate when there are several; a single candidate
+     * keeps all threads for its own loops. */
+    size_t finished = 0;
+    int nthreads = K > 1 ? omp_get_max_threads() : 1;
+    if ((size_t)nthreads > K)
+        nthreads = (int)K;
+    #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+    for (size_t k = 0; k < K; k++) {
+        st_pipeline_candidate *c = &st->candidates[k];
+        st_error e;
+        st_error_clear(&e);
+        st_status r = p->density_rho > 0
+            ? run_density_candidate(&meshes[k], c, g, s, bvh, h, p, &e)
+            : run_sculpt_candidate(&meshes[k], c, g, s, bvh, h, p, &e);
+        if (r) {
+            c->failed = 1;
+            st_error_format(&e, c->message, sizeof c->message);
+        } else {
+            c->tets = meshes[k]->ntets;
+            c->points = meshes[k]->npoints;
+            dihedral_range(meshes[k], &c->min_dihedral, &c->max_dihedral);
+        }
+        #pragma omp critical(st_pipeline_progress)
+        {
+            finished++;
+            st_progress_report(prog, "candidates", (double)finished / (double)K);
+        }
+    }
+    st->seconds_candidates = now_seconds() - t_cand;
+
+    size_t best = 0;
+    for (size_t k = 1; k < K; k++)
+        if (better(&st->candidates[k], k, &st->candidates[best], best))
+            best = k;
+    if (st->candidates[best].failed) {
+        rc = st_error_set(err, ST_EINPUT, NULL, 0, "%s",
+                          st->candidates[0].message);
+        goto done;
+    }
+    st->best = best;
+    st->encloses = st->candidates[best].verts_outside == 0 &&
+                   st->candidates[best].tris_crossing == 0;
+    rc = set_meta(meshes[best], p, st, err);
+    if (rc)
+        goto done;
+    *out = meshes[best];
+    meshes[best] = NULL;
+    st->seconds_total = now_seconds() - t_start;
+done:
+    if (meshes)
+        for (size_t k = 0; k < st->ncandidates; k++)
+            st_tetmesh_free(meshes[k]);
+    free(meshes);
+    if (!stats) {
+        free(local.candidates);
+    }
+    st_bvh_free(bvh);
+    st_grid_free(g);
+    return rc;
+}

@@ -1,0 +1,319 @@
+/*
+ * soupmesh - a triangle soup in, a coarse high-quality tet mesh that
+ * encloses it out: distance, signs, sculpted BCC lattices with bomb
+ * repair, the enclosing fit and the quality pass, best of N candidates.
+ *
+ *   soupmesh INPUT [-o OUT] [--cells N] [--offset R] [--tries K] [--seed S]
+ *            [--density RHO] [--threads T]
+ *
+ * See man/man1/soupmesh.1 and pipeline.h.
+ */
+#define _GNU_SOURCE
+#include "../cli/tool.h"
+#include "souptet/embed.h"
+#include "souptet/mem.h"
+#include "souptet/outfile.h"
+#include "souptet/pipeline.h"
+#include "souptet/soup.h"
+#include "souptet/tetformat.h"
+#include "souptet/tetio.h"
+
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static void usage(void)
+{
+    printf(
+"Usage: soupmesh [OPTION]... INPUT\n"
+"Mesh a triangle soup (any orientation, holes, interpenetrating parts) into a\n"
+"coarse tetrahedral mesh that encloses it, with dihedral angles far from 0 and\n"
+"180 degrees (Stuart et al. 2013 on the pseudo volume of Spillmann et al. 2006).\n"
+"\n"
+"INPUT is a surface: .obj .off .ply .stl; '-' reads stdin (format sniffed).\n"
+"\n"
+"  -o, --output OUT     the mesh, by extension: .vtu (VTK), .msh (Gmsh), .node/.ele\n"
+"                       (TetGen), .mesh (Medit); '-' or none: .vtu on stdout\n"
+"      --msh-version V  Gmsh format 4 (4.1, default) or 2 (2.2)\n"
+"      --msh-binary     binary .msh instead of ASCII\n"
+"      --embed FILE     where each input vertex lies: its tet and barycentric\n"
+"                       coordinates, as text (.txt) or a point cloud (.vtu with\n"
+"                       point arrays embed_tet, embed_bary)\n"
+"      --cells N        BCC lattice cells along the longest side of the\n"
+"                       model's box (default 10; more cells, more tets)\n"
+"      --offset R       stop fitting when every boundary vertex is within\n"
+"                       R * h of the surface (h = cell width; default 0.4)\n"
+"      --tries K        candidates with randomly rotated and offset lattices,\n"
+"                       run in parallel; the best enclosing one is kept\n"
+"                       (default 1)\n"
+"      --seed S         seed of the first candidate's lattice (default 1;\n"
+"                       0: the axis-aligned lattice)\n"
+"      --density RHO    the Spillmann mesher instead: cubic lattice tets with\n"
+"                       pseudo-volume density >= RHO, boundary faired (does\n"
+"                       not enclose)\n"
+"      --field-cells N  voxels along the longest side of the distance field\n"
+"                       (default max(128, 8 * cells))\n"
+"      --max-iters N    fit iterations at most (default 300)\n"
+"      --no-quality     skip the quality pass after the fit\n"
+"      --threads T      threads to use (default: all cores)\n"
+"      --max-memory SZ  refuse fields larger than SZ (default 80%% of RAM)\n"
+"  -q, --quiet          no messages but errors\n"
+"  -v, --verbose        report every candidate and the timings\n"
+"      --help           show this help and exit\n"
+"      --version        show the version and exit\n"
+"\n"
+"Examples:\n"
+"  soupmesh -o bunny.vtu bunny.obj\n"
+"  soupmesh --cells 14 --tries 8 -o scan.vtu scan.ply && tetstat --surface scan.ply scan.vtu\n"
+"\n"
+"Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
+}
+
+enum { OPT_CELLS = 256, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
+       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED, OPT_THREADS, OPT_MAXMEM, OPT_HELP, OPT_VERSION };
+
+static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
+{
+    tool_say(t, 2, "field %zux%zux%zu, voxel %.6g; lattice cell h %.6g",
+             st->field_dims[0], st->field_dims[1], st->field_dims[2], st->voxel, st->h);
+    tool_say(t, 2, "distance %.3f s, signs %.3f s, %zu candidate%s %.3f s",
+             st->seconds_dist, st->seconds_sign, st->ncandidates,
+             st->ncandidates == 1 ? "" : "s", st->seconds_candidates);
+    for (size_t k = 0; k < st->ncandidates; k++) {
+        const st_pipeline_candidate *c = &st->candidates[k];
+        if (c->failed) {
+            tool_say(t, 2, "candidate %zu (seed %" PRIu64 "): failed: %s", k, c->seed,
+                     c->message);
+            continue;
+        }
+        tool_say(t, 2,
+                 "candidate %zu (seed %" PRIu64 "): %zu tets, dihedral %.2f..%.2f, "
+                 "%s%zu outside, %zu crossing, %s%s %.2f+%.2f s%s",
+                 k, c->seed, c->tets, c->min_dihedral, c->max_dihedral,
+                 "", c->verts_outside, c->tris_crossing,
+                 density ? "" : (c->converged ? "converged" : "not converged"),
+                 density ? "" : ",", c->seconds_sculpt, c->seconds_fit,
+                 k == st->best ? "  <- best" : "");
+    }
+}
+
+int main(int argc, char *argv[])
+{
+    tool_ctx t;
+    tool_init(&t, "soupmesh", argc, argv);
+    st_pipeline_params p = st_pipeline_params_default();
+    size_t threads = 0, max_iters = 0, seed = 1;
+    p.max_bytes = tool_default_max_memory();
+    const char *out = NULL, *in = NULL, *embed = NULL;
+    st_tetformat_opts fopts = {0, 0};
+    static const struct option opts[] = {
+        {"cells", required_argument, NULL, OPT_CELLS},
+        {"offset", required_argument, NULL, OPT_OFFSET},
+        {"tries", required_argument, NULL, OPT_TRIES},
+        {"seed", required_argument, NULL, OPT_SEED},
+        {"density", required_argument, NULL, OPT_DENSITY},
+        {"field-cells", required_argument, NULL, OPT_FIELD_CELLS},
+        {"max-iters", required_argument, NULL, OPT_MAX_ITERS},
+        {"no-quality", no_argument, NULL, OPT_NO_QUALITY},
+        {"msh-version", required_argument, NULL, OPT_MSH_VERSION},
+        {"msh-binary", no_argument, NULL, OPT_MSH_BINARY},
+        {"embed", required_argument, NULL, OPT_EMBED},
+        {"output", required_argument, NULL, 'o'},
+        {"threads", required_argument, NULL, OPT_THREADS},
+        {"max-memory", required_argument, NULL, OPT_MAXMEM},
+        {"quiet", no_argument, NULL, 'q'},
+        {"verbose", no_argument, NULL, 'v'},
+        {"help", no_argument, NULL, OPT_HELP},
+        {"version", no_argument, NULL, OPT_VERSION},
+        {NULL, 0, NULL, 0}};
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":o:qv", opts, NULL)) != -1) {
+        switch (c) {
+        case OPT_CELLS:
+            if (tool_parse_size(&t, "--cells", optarg, 1, 4096, &p.cells))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_OFFSET:
+            if (tool_parse_double(&t, "--offset", optarg, 1e-3, 10.0, &p.offset_ratio))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_TRIES:
+            if (tool_parse_size(&t, "--tries", optarg, 1, ST_PIPELINE_MAX_TRIES, &p.tries))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_SEED:
+            if (tool_parse_size(&t, "--seed", optarg, 0, SIZE_MAX, &seed))
+                return TOOL_EXIT_USAGE;
+            p.seed = (uint64_t)seed;
+            break;
+        case OPT_DENSITY:
+            if (tool_parse_double(&t, "--density", optarg, 1e-6, 1.0, &p.density_rho))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_FIELD_CELLS:
+            if (tool_parse_size(&t, "--field-cells", optarg, 8, 4096, &p.field_cells))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_MAX_ITERS:
+            if (tool_parse_size(&t, "--max-iters", optarg, 1, 100000, &max_iters))
+                return TOOL_EXIT_USAGE;
+            p.fit_max_iters = (int)max_iters;
+            break;
+        case OPT_NO_QUALITY:
+            p.quality = 0;
+            break;
+        case OPT_MSH_VERSION: {
+            size_t v;
+            if (tool_parse_size(&t, "--msh-version", optarg, 2, 41, &v))
+                return TOOL_EXIT_USAGE;
+            if (v != 2 && v != 4 && v != 22 && v != 41)
+                return tool_usage_error(&t, "--msh-version is 2 or 4 (2.2 or 4.1), not '%s'",
+                                        optarg);
+            fopts.msh_version = (int)v;
+            break;
+        }
+        case OPT_MSH_BINARY:
+            fopts.binary = 1;
+            break;
+        case OPT_EMBED:
+            embed = optarg;
+            break;
+        case 'o':
+            out = optarg;
+            break;
+        case OPT_THREADS:
+            if (tool_parse_size(&t, "--threads", optarg, 1, 4096, &threads))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_MAXMEM:
+            if (tool_parse_bytes(&t, "--max-memory", optarg, &p.max_bytes))
+                return TOOL_EXIT_USAGE;
+            break;
+        case 'q':
+            t.verbosity = 0;
+            break;
+        case 'v':
+            t.verbosity = 2;
+            break;
+        case OPT_HELP:
+            usage();
+            return TOOL_EXIT_OK;
+        case OPT_VERSION:
+            tool_print_version(&t);
+            return TOOL_EXIT_OK;
+        case ':':
+            return tool_usage_error(&t, "option '%s' needs a value", argv[optind - 1]);
+        default:
+            return tool_usage_error(&t, "unknown option '%s'", argv[optind - 1]);
+        }
+    }
+    if (optind < argc)
+        in = argv[optind++];
+    if (optind < argc)
+        return tool_usage_error(&t, "one input surface at most ('%s' is extra)", argv[optind]);
+    if (!in)
+        return tool_usage_error(&t, "no input surface (soupmesh -o out.vtu model.obj)");
+    if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
+        return tool_usage_error(&t, "will not read a surface from a terminal: give a file");
+    if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
+        return tool_usage_error(&t, "will not write a .vtu document to a terminal: "
+                                    "give -o FILE or pipe it");
+    if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
+        return tool_usage_error(&t, "cannot tell the format of '%s' (use .vtu, .msh, "
+                                    ".node, .ele or .mesh)", out);
+    size_t elen = embed ? strlen(embed) : 0;
+    int embed_text = elen > 4 && strcmp(embed + elen - 4, ".txt") == 0;
+    if (embed && !embed_text && !(elen > 4 && strcmp(embed + elen - 4, ".vtu") == 0))
+        return tool_usage_error(&t, "--embed writes .txt or .vtu, not '%s'", embed);
+    tool_set_threads(threads);
+
+    st_error err;
+    st_error_clear(&err);
+    st_soup *soup = NULL;
+    st_tetmesh *m = NULL;
+    st_pipeline_stats st;
+    memset(&st, 0, sizeof st);
+    int64_t *et = NULL;
+    double *eb = NULL;
+    st_tetmesh *side = NULL;
+    int rc = TOOL_EXIT_FAIL;
+    double t0 = tool_now();
+    if (st_soup_read(&soup, in, &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    tool_say(&t, 2, "%s: %zu vertices, %zu triangles", in, soup->nverts, soup->ntris);
+    st_progress prog = tool_progress(&t);
+    if (st_pipeline_run(&m, &st, soup, &p, &prog, &err)) {
+        tool_progress_end(&t);
+        if (!err.file[0])
+            snprintf(err.file, sizeof err.file, "%s", st_path_is_stdio(in) ? "<stdin>" : in);
+        report(&t, &st, p.density_rho > 0);
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    tool_progress_end(&t);
+    report(&t, &st, p.density_rho > 0);
+    if (st_meta_set(&m->meta, "source", st_path_is_stdio(in) ? "<stdin>" : in) ||
+        st_meta_history_append(&m->meta, t.command_line ? t.command_line : "soupmesh")) {
+        st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    if (st_tetformat_from_path(out) != ST_TETFORMAT_NONE
+            ? st_tetformat_save(m, ST_TETFORMAT_NONE, out, &fopts, &err)
+            : st_tetmesh_save(m, out, &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    if (embed) {
+        et = st_malloc_array(soup->nverts ? soup->nverts : 1, sizeof *et);
+        eb = st_malloc_array(soup->nverts ? soup->nverts : 1, 4 * sizeof *eb);
+        size_t nout = 0;
+        int64_t first = -1;
+        if (!et || !eb) {
+            st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        if (st_embed_compute(et, eb, &nout, &first, m, soup, &err) ||
+            (embed_text
+                 ? st_embed_write_text(embed, et, eb, soup->nverts, m->ntets,
+                                       st_path_is_stdio(out) ? "<stdout>" : out, in, &err)
+                 : (st_embed_to_tetmesh(&side, soup->xyz, et, eb, soup->nverts, &err) ||
+                    st_tetmesh_save(side, embed, &err)))) {
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        if (nout)
+            tool_say(&t, 1, "warning: %zu input vertices are in no tet (first: %lld)", nout,
+                     (long long)first);
+    }
+    const st_pipeline_candidate *b = &st.candidates[st.best];
+    tool_say(&t, 1, "%zu tets, %zu points, dihedral %.2f..%.2f degrees, %s "
+             "(%zu vertices outside, %zu triangles crossing), %.2f s",
+             b->tets, b->points, b->min_dihedral, b->max_dihedral,
+             st.encloses ? "encloses the input" : "DOES NOT enclose the input",
+             b->verts_outside, b->tris_crossing, tool_now() - t0);
+    if (!st.encloses && p.density_rho <= 0)
+        tool_say(&t, 1, "warning: the best of %zu candidates does not enclose the input; "
+                 "try more --cells or --tries", st.ncandidates);
+    else if (p.density_rho <= 0 && !b->converged)
+        tool_say(&t, 2, "%zu boundary vertices stayed farther than %.3g * h from the "
+                 "surface (thin gaps), up to %.4g", b->beyond_offset, p.offset_ratio,
+                 b->max_distance);
+    rc = TOOL_EXIT_OK;
+done:
+    free(et);
+    free(eb);
+    st_tetmesh_free(side);
+    free(st.candidates);
+    st_tetmesh_free(m);
+    st_soup_free(soup);
+    tool_finish(&t);
+    return rc;
+}

@@ -1,0 +1,56 @@
+#!/bin/sh
+# soupmesh end to end: the main job on the bundled bunny and on a damaged
+# copy of it, enclosure checked by tetstat, determinism, refusals.
+. "$(dirname "$0")/lib.sh"
+BUNNY="$ROOT/corpus/bunny.obj"
+cd "$WORK" || exit 1
+
+check "--help exits 0" sh -c 'soupmesh --help | grep -q "Usage: soupmesh"'
+check "man page exists" test -s "$ROOT/man/man1/soupmesh.1"
+check "the bunny meshes" soupmesh -q --cells 8 -o b.vtu "$BUNNY"
+
+cat > encl.py <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+surf = s["surface"]
+frac, cross, inv, mind = surf["fraction_inside"], surf["crossing_triangles"], s["inverted"], s["min_dihedral"]
+print(frac, cross, inv, mind)
+assert frac == 1.0 and cross == 0 and inv == 0, (frac, cross, inv)
+assert mind > float(sys.argv[2]), mind
+PY
+check "tetstat: it encloses the bunny, no inverted tet, min dihedral > 20" \
+    sh -c "tetstat --json --surface '$BUNNY' b.vtu > b.json && /usr/bin/python3 encl.py b.json 20"
+
+# An exact soup with every other triangle flipped: the same job must work.
+/usr/bin/python3 - "$BUNNY" soup.obj <<'PY'
+import sys
+v, f = [], []
+for line in open(sys.argv[1]):
+    t = line.split()
+    if t and t[0] == "v": v.append(t[1:4])
+    elif t and t[0] == "f": f.append([int(x.split("/")[0]) for x in t[1:]])
+with open(sys.argv[2], "w") as o:
+    n = 0
+    for i, tri in enumerate(f):
+        if i % 2: tri = tri[::-1]
+        for k in tri: o.write("v %s\n" % " ".join(v[k - 1]))
+        o.write("f %d %d %d\n" % (n + 1, n + 2, n + 3)); n += 3
+PY
+check "a flipped exact soup of the bunny meshes and is enclosed" \
+    sh -c "soupmesh -q --cells 8 -o s.vtu soup.obj && tetstat --json --surface soup.obj s.vtu > s.json && /usr/bin/python3 encl.py s.json 20"
+
+mkdir t1 t2
+check "1 and 2 threads, 2 tries: identical output (same command line)" sh -c \
+    "(cd t1 && OMP_NUM_THREADS=1 soupmesh -q --cells 6 --tries 2 -o m.vtu '$BUNNY') &&
+     (cd t2 && OMP_NUM_THREADS=2 soupmesh -q --cells 6 --tries 2 -o m.vtu '$BUNNY') &&
+     cmp t1/m.vtu t2/m.vtu"
+check "the Spillmann mesher (--density)" soupmesh -q --density 0.5 --cells 8 -o d.vtu "$BUNNY"
+
+expect_fail "a missing file" 1 "^soupmesh: missing.obj" soupmesh -o x.vtu missing.obj
+printf 'v 0 0 0\nv 1 0 0\nf 1 2 9\n' > bad.obj
+expect_fail "an index out of range names the line" 1 "^soupmesh: bad.obj:3: " soupmesh -o x.vtu bad.obj
+check "no partial output" test ! -e x.vtu
+expect_fail "bad --cells" 2 "cells" soupmesh --cells 0 -o x.vtu "$BUNNY"
+expect_fail "unknown output format" 2 "format" soupmesh -o x.abc "$BUNNY"
+
+done_testing
