@@ -113,8 +113,10 @@ def main():
     if surface:
         left.AddActor(surface_actor(surface, 1.0))
 
-    # Right: tets whose centroid is on the far side of a plane through the
-    # middle (clip by whole cells, so the interior tets show as they are).
+    # Right: the tets wholly on the far side of a plane through the middle
+    # (whole cells, so the interior tets show as they are), and the input
+    # clipped at the plane: it shows where the removed tets crossing the
+    # plane held it.
     b = grid.GetBounds()
     plane = vtk.vtkPlane()
     plane.SetOrigin(0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5]))
