@@ -5,6 +5,7 @@
 #   make demo             the main job on the bundled model
 #   make bench            measurements against peers (bench/results/)
 #   make install PREFIX=/usr/local DESTDIR=
+#   make fuzz [FUZZ_SECONDS=60]  libFuzzer on every reader (build-fuzz/)
 #   make config=debug|sanitize ...   (objects go to build/ or build-<config>/)
 
 config ?= release
@@ -21,12 +22,22 @@ else ifeq ($(config),debug)
 else ifeq ($(config),sanitize)
   BUILD := build-sanitize
   OPT := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+else ifeq ($(config),fuzz)
+  # libFuzzer harnesses (make fuzz): clang, the library instrumented for
+  # coverage, ASan and UBSan.
+  BUILD := build-fuzz
+  CC := clang
+  CXX := clang++
+  OMPLIB := -lomp
+  OPT := -O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer \
+         -fno-sanitize-recover=undefined
 else
-  $(error config must be release, debug or sanitize)
+  $(error config must be release, debug, sanitize or fuzz)
 endif
 
 CC ?= cc
 CXX ?= c++
+OMPLIB ?= -lgomp
 # -ffp-contract=off: fused multiply-adds would change rounding behind the
 # back of the error bounds in the predicates and the exact distances.
 WARN := -Wall -Wextra -Wshadow -Wpointer-arith -Wformat=2 -Wundef
@@ -38,7 +49,7 @@ CXXFLAGS_ALL := -std=c++17 $(OPT) -Wall -Wextra -ffp-contract=off -fopenmp -Iinc
 LIBS := -lopenvdb -ltbb -lImath-3_1 \
         -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
         -lvtkCommonDataModel-9.1 -lvtkCommonMath-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1 \
-        -lgomp -lpthread -lm
+        $(OMPLIB) -lpthread -lm
 LDFLAGS_ALL := $(OPT) -fopenmp $(LDFLAGS)
 
 LIB_C   := $(sort $(wildcard src/*.c))
@@ -85,7 +96,11 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA)
 	$(CXX) $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
 
 # Peers for make bench (not installed).
-BENCH_BIN := $(BUILD)/bench/vdb_udf $(BUILD)/bench/stream26 $(BUILD)/bench/iou
+BENCH_BIN := $(BUILD)/bench/vdb_udf $(BUILD)/bench/stream26 $(BUILD)/bench/iou \
+             $(BUILD)/bench/alpha_wrap $(BUILD)/bench/cgal_mesh3
+# CGAL's exact kernels need GMP and MPFR; its headers want -frounding-math.
+$(BUILD)/bench/alpha_wrap $(BUILD)/bench/cgal_mesh3: LIBS += -lgmp -lmpfr
+$(BUILD)/bench/alpha_wrap $(BUILD)/bench/cgal_mesh3: CXXFLAGS_ALL += -frounding-math -DNDEBUG
 $(BUILD)/bench/%: bench/%.cpp $(LIBA)
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
@@ -93,6 +108,24 @@ $(BUILD)/bench/%: bench/%.c $(LIBA)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -c $< -o $@.o
 	$(CXX) $(LDFLAGS_ALL) $@.o $(LIBA) $(LIBS) -o $@
+
+# libFuzzer harnesses, one per reader (fuzz/fuzz_*.c), built with clang in
+# build-fuzz/ and run by scripts/fuzz for FUZZ_SECONDS each.
+FUZZ_SECONDS ?= 60
+FUZZ_BIN := $(patsubst fuzz/%.c,$(BUILD)/fuzz/%,$(sort $(wildcard fuzz/fuzz_*.c)))
+$(BUILD)/fuzz/%: fuzz/%.c $(LIBA)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -fsanitize=fuzzer -c $< -o $@.o
+	$(CXX) $(LDFLAGS_ALL) -fsanitize=fuzzer $@.o $(LIBA) $(LIBS) -o $@
+
+ifeq ($(config),fuzz)
+fuzz: $(FUZZ_BIN)
+	scripts/fuzz $(BUILD)/fuzz $(FUZZ_SECONDS)
+else
+fuzz:
+	@scripts/setup --fuzz
+	$(MAKE) --no-print-directory config=fuzz fuzz
+endif
 
 # scripts/setup installs what is missing and returns in a second otherwise.
 setup:
@@ -134,6 +167,6 @@ uninstall:
 	rm -f $(TOOLS:%=$(DESTDIR)$(PREFIX)/share/man/man1/%.1)
 
 clean:
-	rm -rf build build-debug build-sanitize
+	rm -rf build build-debug build-sanitize build-fuzz
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

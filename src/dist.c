@@ -13,9 +13,11 @@
  * measured exactly. The minimum is the same whatever the order, so the
  * pruning changes the work, never the answer.
  *
- * Full field. Voxels the band did not reach ask the BVH for their nearest
- * triangle, bounded by the previous voxel of the row plus one voxel: the
- * bound keeps the search near the answer, and the answer is exact.
+ * Full field. Beyond the band, a vector distance transform over
+ * triangles: four raster sweeps hand each voxel the nearest of the
+ * triangles its already-swept neighbours hold, measured exactly (so never
+ * below the truth; dist.h says how far above it can be). The sweeps run
+ * on one thread, in one fixed order.
  */
 #include "souptet/dist.h"
 #include "souptet/geom.h"

@@ -16,6 +16,9 @@ void st_error_clear(st_error *err)
     err->msg[0] = '\0';
 }
 
+#ifdef __GNUC__
+__attribute__((format(printf, 6, 0)))
+#endif
 static st_status set_va(st_error *err, st_status status, const char *file,
                         long long line, long long offset, const char *fmt,
                         va_list ap)

@@ -34,8 +34,10 @@ static void usage(void)
 "                       1 counts surface crossings (Nooruddin-Turk parity)\n"
 "      --band D         c = 1/(D voxels) instead of 1/max|d| (a narrow band suffices)\n"
 "      --rays 13|26     one or both directions along the 13 lines (default 26)\n"
-"      --toggle first|nearest   where in an event run the parity toggles\n"
-"                       (default nearest: the voxel nearest the surface;\n"
+"      --toggle first|nearest|crossing  where in an event run the parity\n"
+"                       toggles (default crossing: where the surface crosses\n"
+"                       the line, beside the nearest voxel on the side of its\n"
+"                       nearer neighbour; nearest: on the nearest voxel;\n"
 "                       the paper: first)\n"
 "      --odd keep|ignore  keep or drop lines with an odd number of events\n"
 "                       (default keep: the paper)\n"
@@ -109,8 +111,11 @@ int main(int argc, char *argv[])
                 p.toggle = ST_TOGGLE_FIRST;
             else if (strcmp(optarg, "nearest") == 0)
                 p.toggle = ST_TOGGLE_NEAREST;
+            else if (strcmp(optarg, "crossing") == 0)
+                p.toggle = ST_TOGGLE_CROSSING;
             else
-                return tool_usage_error(&t, "--toggle is first or nearest, not '%s'", optarg);
+                return tool_usage_error(&t, "--toggle is first, nearest or crossing, not '%s'",
+                                        optarg);
             break;
         case OPT_ODD:
             if (strcmp(optarg, "keep") == 0)

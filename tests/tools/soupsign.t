@@ -10,6 +10,7 @@ check "soupdist | soupsign -o .vti" sh -c "soupdist -r 48 '$BUNNY' | soupsign -o
 check "soupdist | soupsign | cat (stream)" sh -c "soupdist -r 48 '$BUNNY' | soupsign | cat > s.vdb && test -s s.vdb"
 check "a .vdb file in, the paper's rule" sh -c "soupdist -r 48 -o d.vdb '$BUNNY' && soupsign --rule paper -o p.vdb d.vdb"
 check "k = 1 (parity)" soupsign -k 1 -o k1.vdb d.vdb
+check "every toggle rule runs" sh -c "soupsign --toggle first -o t1.vdb d.vdb && soupsign --toggle nearest -o t2.vdb d.vdb && soupsign --toggle crossing -o t3.vdb d.vdb"
 
 cat > inside.py <<'PY'
 import sys, vtk
@@ -38,5 +39,6 @@ check "no partial output" test ! -e x.vdb
 expect_fail "bad -k" 2 "-k wants" soupsign -k 0 d.vdb
 expect_fail "bad --rays" 2 "rays" soupsign --rays 7 d.vdb
 expect_fail "unknown rule" 2 "unknown rule" soupsign --rule magic d.vdb
+expect_fail "unknown toggle" 2 "--toggle is first, nearest or crossing" soupsign --toggle middle d.vdb
 
 done_testing

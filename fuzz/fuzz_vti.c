@@ -1,0 +1,3 @@
+/* fuzz_vti.c - libFuzzer harness for the .vti reader (see fuzz_grid.h). */
+#define FUZZ_READ st_gridio_read_vti_mem
+#include "fuzz_grid.h"

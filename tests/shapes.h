@@ -1,0 +1,85 @@
+/*
+ * shapes.h - small closed and damaged test surfaces built in code (header
+ * only, for the unit tests): exact soups of boxes and UV spheres.
+ */
+#ifndef SOUPTET_TESTS_SHAPES_H
+#define SOUPTET_TESTS_SHAPES_H
+
+#include <math.h>
+#include <stdint.h>
+
+#include "souptet/soup.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static inline void add_tri(st_soup *s, const double a[3], const double b[3], const double c[3], int flip)
+{
+    uint32_t v = (uint32_t)s->nverts;
+    st_soup_add_vertex(s, a[0], a[1], a[2], NULL);
+    st_soup_add_vertex(s, b[0], b[1], b[2], NULL);
+    st_soup_add_vertex(s, c[0], c[1], c[2], NULL);
+    if (flip)
+        st_soup_add_triangle(s, v, v + 2, v + 1, NULL);
+    else
+        st_soup_add_triangle(s, v, v + 1, v + 2, NULL);
+}
+
+/* An axis-aligned box as an exact soup, every other triangle flipped. */
+static inline void add_box(st_soup *s, const double lo[3], const double hi[3])
+{
+    for (int axis = 0; axis < 3; axis++)
+        for (int side = 0; side < 2; side++) {
+            int u = (axis + 1) % 3, w = (axis + 2) % 3;
+            double q[4][3];
+            for (int c = 0; c < 4; c++) {
+                q[c][axis] = side ? hi[axis] : lo[axis];
+                q[c][u] = (c == 1 || c == 2) ? hi[u] : lo[u];
+                q[c][w] = (c >= 2) ? hi[w] : lo[w];
+            }
+            add_tri(s, q[0], q[1], q[2], side);
+            add_tri(s, q[0], q[2], q[3], !side);
+        }
+}
+
+/* An axis-aligned box, consistently oriented (normals outward). */
+static inline void add_box_oriented(st_soup *s, const double lo[3], const double hi[3])
+{
+    for (int axis = 0; axis < 3; axis++)
+        for (int side = 0; side < 2; side++) {
+            int u = (axis + 1) % 3, w = (axis + 2) % 3;
+            double q[4][3];
+            for (int c = 0; c < 4; c++) {
+                q[c][axis] = side ? hi[axis] : lo[axis];
+                q[c][u] = (c == 1 || c == 2) ? hi[u] : lo[u];
+                q[c][w] = (c >= 2) ? hi[w] : lo[w];
+            }
+            /* (q0, q1, q2) faces +axis: flip it on the low side. */
+            add_tri(s, q[0], q[1], q[2], !side);
+            add_tri(s, q[0], q[2], q[3], !side);
+        }
+}
+
+/* A UV sphere of radius r at the origin, without the faces above z_cut. */
+static inline void add_sphere(st_soup *s, double r, double z_cut)
+{
+    const int nu = 32, nv = 16;
+    for (int i = 0; i < nv; i++)
+        for (int j = 0; j < nu; j++) {
+            double p[4][3];
+            for (int c = 0; c < 4; c++) {
+                int ii = i + (c >= 2), jj = j + (c == 1 || c == 2);
+                double th = M_PI * ii / nv, ph = 2 * M_PI * jj / nu;
+                p[c][0] = r * sin(th) * cos(ph);
+                p[c][1] = r * sin(th) * sin(ph);
+                p[c][2] = r * cos(th);
+            }
+            if (p[0][2] > z_cut || p[2][2] > z_cut)
+                continue;
+            add_tri(s, p[0], p[1], p[2], (i + j) & 1);
+            add_tri(s, p[0], p[2], p[3], 0);
+        }
+}
+
+#endif
