@@ -494,7 +494,6 @@ static void star_pts_collect(const fit_ctx *c, uint32_t v, star_pts *sp)
     sp->v = v;
 }
 
-
 /* The whole invariant for moving v to p, cheapest test first. */
 static int move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
 {

@@ -82,7 +82,7 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
                                       const st_grid *g, const st_soup *s,
                                       const st_bvh *bvh, double h,
                                       const st_pipeline_params *p,
-                                      st_error *err)
+                                      const st_progress *prog, st_error *err)
 {
     st_sculpt_params sp = st_sculpt_params_default();
     sp.kind = ST_LATTICE_BCC;
@@ -108,7 +108,7 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
         fp.max_iters = p->fit_max_iters;
     st_fit_stats fs;
     memset(&fs, 0, sizeof fs);
-    rc = st_fit(m, s, bvh, &fp, &fs, NULL, err);
+    rc = st_fit(m, s, bvh, &fp, &fs, prog, err);
     if (rc) {
         st_tetmesh_free(m);
         return rc;
@@ -277,7 +277,9 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         st->candidates[k].seed = st_pipeline_candidate_seed(p->seed, k);
 
     /* One thread per candidate when there are several; a single candidate
-     * keeps all threads for its own loops. */
+     * keeps all threads for its own loops, and reports the fit's progress
+     * (several report only as each one finishes: the reporter is not
+     * called from two threads at once). */
     size_t finished = 0;
     int nthreads = K > 1 ? omp_get_max_threads() : 1;
     if ((size_t)nthreads > K)
@@ -289,7 +291,8 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         st_error_clear(&e);
         st_status r = p->density_rho > 0
             ? run_density_candidate(&meshes[k], c, g, s, bvh, h, p, &e)
-            : run_sculpt_candidate(&meshes[k], c, g, s, bvh, h, p, &e);
+            : run_sculpt_candidate(&meshes[k], c, g, s, bvh, h, p,
+                                   K == 1 ? prog : NULL, &e);
         if (r) {
             c->failed = 1;
             st_error_format(&e, c->message, sizeof c->message);

@@ -9,6 +9,7 @@
  */
 #include "smooth_internal.h"
 
+#include "souptet/geom.h"
 #include "souptet/mem.h"
 #include "souptet/pred.h"
 #include "souptet/smooth.h"
@@ -239,11 +240,52 @@ int sm_star_positive(const sm_mesh *sm, uint32_t v, const double p[3])
     return 1;
 }
 
+/* Degrees per radian, as tetqual.c has it, so the angles agree. */
+#define SM_RAD2DEG (180.0 / 3.14159265358979323846)
+
+/* The score is asked for tens of times per trial move (the quality pass
+ * scores ~40 candidate positions of a star of ~20 tets): instead of six
+ * atan2 calls (st_tet_dihedral_range), the dihedral at each edge is kept
+ * as the pair (|u x v|, u . v) of tetqual.c's formula, the smallest and
+ * largest angles are found by comparing the pairs (atan2(y, x) with y > 0
+ * decreases as x / y grows: compare x_i y_j with x_j y_i), and only those
+ * two go through atan2. Degenerate cases (a face without area, parallel
+ * normals, non-finite values) go to st_tet_dihedral_range. */
 double sm_tet_score(const double *a, const double *b, const double *c,
                     const double *d)
 {
-    double lo, hi;
-    st_tet_dihedral_range(a, b, c, d, &lo, &hi);
+    const double *p[4] = {a, b, c, d};
+    static const int ed[6][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2},
+                                 {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};
+    double y[6], x[6];
+    for (int i = 0; i < 6; i++) {
+        const double *pi = p[ed[i][0]], *pj = p[ed[i][1]], *pk = p[ed[i][2]],
+                     *pl = p[ed[i][3]];
+        double e[3], f[3], g[3], u[3], v[3], w[3];
+        st_sub3(e, pj, pi);
+        st_sub3(f, pk, pi);
+        st_sub3(g, pl, pi);
+        st_cross3(u, e, f);
+        st_cross3(v, e, g);
+        st_cross3(w, u, v);
+        y[i] = st_norm3(w);
+        x[i] = st_dot3(u, v);
+        if (!(y[i] > 0.0) || !isfinite(y[i]) || !isfinite(x[i])) {
+            double lo, hi;
+            st_tet_dihedral_range(a, b, c, d, &lo, &hi);
+            double s2 = ST_FIT_MAX_WEIGHT * (180.0 - hi);
+            return lo < s2 ? lo : s2;
+        }
+    }
+    int imin = 0, imax = 0;   /* smallest angle: largest x / y */
+    for (int i = 1; i < 6; i++) {
+        if (x[i] * y[imin] > x[imin] * y[i])
+            imin = i;
+        if (x[i] * y[imax] < x[imax] * y[i])
+            imax = i;
+    }
+    double lo = atan2(y[imin], x[imin]) * SM_RAD2DEG;
+    double hi = atan2(y[imax], x[imax]) * SM_RAD2DEG;
     double s2 = ST_FIT_MAX_WEIGHT * (180.0 - hi);
     return lo < s2 ? lo : s2;
 }
