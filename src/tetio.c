@@ -140,10 +140,17 @@ st_status st_tetmesh_read_mem(st_tetmesh **out, const unsigned char *data,
         name = ST_TETIO_STDIN_NAME;
     if (size == 0)
         return st_error_set(err, ST_EINPUT, name, 0, "empty input");
+    /* Gmsh and Medit files say what they are in their first bytes (TetGen
+     * comes as two files and never on a pipe). */
+    st_tetformat tf = st_tetformat_sniff(data, size);
+    if (tf == ST_TETFORMAT_MSH)
+        return st_tetmesh_parse_msh(out, data, size, name, max_bytes, err);
+    if (tf == ST_TETFORMAT_MEDIT)
+        return st_tetmesh_parse_medit(out, data, size, name, max_bytes, err);
     if (!looks_like_xml(data, size))
         return st_error_set(err, ST_EINPUT, name, 0,
-                            "not a tet mesh: a .vtu (VTK XML) document "
-                            "starts with '<'");
+                            "not a tet mesh: expected a .vtu (VTK XML), "
+                            ".msh or .mesh document");
     return st_tetio_read_vtu_mem(out, data, size, name, max_bytes, err);
 }
 

@@ -173,13 +173,11 @@ if [ $have_soupmesh -eq 1 ]; then
     ok $? "soupmesh -o b4.node also wrote b4.ele, and no temporary file is left"
     grep -q '^souptet history: .*soupmesh.* -o b4.msh' b4.msh
     ok $? "the .msh records soupmesh's command line in \$Comments"
-    if soupmesh --help 2>/dev/null | grep -q -- --msh-version; then
-        soupmesh -q $SM --msh-version 2 -o b22.msh "$ROOT/corpus/bunny.obj"
-        sed -n 2p b22.msh | grep -q '^2\.2 0 8$'
-        ok $? "soupmesh --msh-version 2 writes msh 2.2"
-    else
-        skip "soupmesh --msh-version 2" "the option is not wired yet"
-    fi
+    soupmesh -q $SM --msh-version 2 -o b22.msh "$ROOT/corpus/bunny.obj"
+    sed -n 2p b22.msh | grep -q '^2\.2 0 8$'
+    ok $? "soupmesh --msh-version 2 writes msh 2.2"
+    tetstat --json - < b4.msh > stdin.json && grep -q '"tets": [1-9]' stdin.json
+    ok $? "tetstat reads a .msh on stdin (sniffed)"
 else
     skip "soupmesh writes .msh .node .mesh by -o extension" "soupmesh is not built"
 fi
