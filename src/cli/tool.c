@@ -4,6 +4,7 @@
 #include "souptet/outfile.h"
 
 #include <errno.h>
+#include <getopt.h>
 #include <limits.h>
 #include <math.h>
 #include <signal.h>
@@ -204,6 +205,43 @@ void tool_progress_end(tool_ctx *t)
         fprintf(stderr, "\r\033[K");
         fflush(stderr);
         g_progress_drawn = 0;
+    }
+}
+
+tool_common tool_common_default(void)
+{
+    tool_common co;
+    co.threads = 0;
+    co.max_bytes = tool_default_max_memory();
+    return co;
+}
+
+int tool_common_option(tool_ctx *t, int c, char *const argv[],
+                       void (*usage)(void), tool_common *co)
+{
+    switch (c) {
+    case TOOL_OPT_THREADS:
+        return tool_parse_size(t, "--threads", optarg, 1, 4096, &co->threads)
+                   ? TOOL_EXIT_USAGE : TOOL_CONTINUE;
+    case TOOL_OPT_MAXMEM:
+        return tool_parse_bytes(t, "--max-memory", optarg, &co->max_bytes)
+                   ? TOOL_EXIT_USAGE : TOOL_CONTINUE;
+    case 'q':
+        t->verbosity = 0;
+        return TOOL_CONTINUE;
+    case 'v':
+        t->verbosity = 2;
+        return TOOL_CONTINUE;
+    case TOOL_OPT_HELP:
+        usage();
+        return TOOL_EXIT_OK;
+    case TOOL_OPT_VERSION:
+        tool_print_version(t);
+        return TOOL_EXIT_OK;
+    case ':':
+        return tool_usage_error(t, "option '%s' needs a value", argv[optind - 1]);
+    default:
+        return tool_usage_error(t, "unknown option '%s'", argv[optind - 1]);
     }
 }
 

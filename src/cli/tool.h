@@ -76,4 +76,44 @@ double tool_now(void);
 /* Print the version line "name (souptet) X.Y.Z". */
 void tool_print_version(const tool_ctx *t);
 
+/* ---- options every tool shares ----------------------------------------
+ *
+ * A tool's option table starts with its own long options, then
+ * TOOL_LONG_OPTIONS_BASIC (-q, -v, --help, --version) and, for tools that
+ * compute, TOOL_LONG_OPTIONS_RESOURCES (--threads, --max-memory); its own
+ * option codes start at TOOL_OPT_FIRST. In the getopt_long loop, every
+ * code the tool does not handle itself goes to tool_common_option. */
+enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION,
+       TOOL_OPT_FIRST = 1100 };
+#define TOOL_LONG_OPTIONS_BASIC                              \
+    {"quiet", no_argument, NULL, 'q'},                       \
+    {"verbose", no_argument, NULL, 'v'},                     \
+    {"help", no_argument, NULL, TOOL_OPT_HELP},              \
+    {"version", no_argument, NULL, TOOL_OPT_VERSION}
+#define TOOL_LONG_OPTIONS_RESOURCES                          \
+    {"threads", required_argument, NULL, TOOL_OPT_THREADS},  \
+    {"max-memory", required_argument, NULL, TOOL_OPT_MAXMEM}
+
+/* What the shared options set: threads (0: all cores) and the memory
+ * limit (tool_default_max_memory() unless --max-memory). */
+typedef struct tool_common {
+    size_t threads;
+    size_t max_bytes;
+} tool_common;
+
+/* The shared options' defaults. */
+tool_common tool_common_default(void);
+
+/* When to go on parsing (see tool_common_option). */
+#define TOOL_CONTINUE (-1)
+
+/* Handle getopt_long's code c when it is a shared option (-q, -v,
+ * --threads, --max-memory, --help, --version), a missing value (':') or an
+ * unknown option (anything else): returns TOOL_CONTINUE when parsing goes
+ * on, else the exit status the tool returns at once (TOOL_EXIT_OK after
+ * --help, which calls usage(), and --version; TOOL_EXIT_USAGE after a
+ * usage error, already printed). Uses optarg and optind. */
+int tool_common_option(tool_ctx *t, int c, char *const argv[],
+                       void (*usage)(void), tool_common *co);
+
 #endif

@@ -71,15 +71,15 @@ static void usage(void)
 "Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
 }
 
-enum { OPT_DENSITY = 256, OPT_SCULPT, OPT_SURFACE, OPT_LATTICE, OPT_CELLS,
-       OPT_SEED, OPT_NOREPAIR, OPT_THREADS, OPT_MAXMEM, OPT_HELP,
-       OPT_VERSION };
+enum { OPT_DENSITY = TOOL_OPT_FIRST, OPT_SCULPT, OPT_SURFACE, OPT_LATTICE, OPT_CELLS,
+       OPT_SEED, OPT_NOREPAIR };
 
 int main(int argc, char *argv[])
 {
     tool_ctx t;
     tool_init(&t, "latticetet", argc, argv);
-    size_t max_bytes = tool_default_max_memory(), threads = 0, cells = 0;
+    tool_common co = tool_common_default();
+    size_t cells = 0;
     const char *out = NULL, *in = NULL, *surface = NULL, *lattice = NULL;
     double rho = -1, size = 0;
     int sculpt = 0, repair = 1;
@@ -94,12 +94,8 @@ int main(int argc, char *argv[])
         {"seed", required_argument, NULL, OPT_SEED},
         {"no-repair", no_argument, NULL, OPT_NOREPAIR},
         {"output", required_argument, NULL, 'o'},
-        {"threads", required_argument, NULL, OPT_THREADS},
-        {"max-memory", required_argument, NULL, OPT_MAXMEM},
-        {"quiet", no_argument, NULL, 'q'},
-        {"verbose", no_argument, NULL, 'v'},
-        {"help", no_argument, NULL, OPT_HELP},
-        {"version", no_argument, NULL, OPT_VERSION},
+        TOOL_LONG_OPTIONS_BASIC,
+        TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
@@ -142,30 +138,14 @@ int main(int argc, char *argv[])
         case 'o':
             out = optarg;
             break;
-        case OPT_THREADS:
-            if (tool_parse_size(&t, "--threads", optarg, 1, 4096, &threads))
-                return TOOL_EXIT_USAGE;
+        default: {
+            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
+            if (rc_opt != TOOL_CONTINUE) {
+                tool_finish(&t);
+                return rc_opt;
+            }
             break;
-        case OPT_MAXMEM:
-            if (tool_parse_bytes(&t, "--max-memory", optarg, &max_bytes))
-                return TOOL_EXIT_USAGE;
-            break;
-        case 'q':
-            t.verbosity = 0;
-            break;
-        case 'v':
-            t.verbosity = 2;
-            break;
-        case OPT_HELP:
-            usage();
-            return TOOL_EXIT_OK;
-        case OPT_VERSION:
-            tool_print_version(&t);
-            return TOOL_EXIT_OK;
-        case ':':
-            return tool_usage_error(&t, "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return tool_usage_error(&t, "unknown option '%s'", argv[optind - 1]);
+        }
         }
     }
     if (optind < argc)
@@ -198,7 +178,7 @@ int main(int argc, char *argv[])
     if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
         return tool_usage_error(&t, "cannot tell the format of '%s' (use .vtu, "
                                     ".msh, .node, .ele or .mesh)", out);
-    tool_set_threads(threads);
+    tool_set_threads(co.threads);
 
     st_error err;
     st_error_clear(&err);
@@ -209,7 +189,7 @@ int main(int argc, char *argv[])
     int rc = TOOL_EXIT_FAIL;
     const char *in_name = st_path_is_stdio(in) ? "<stdin>" : in;
     double t0 = tool_now();
-    if (st_grid_read(&g, in, max_bytes, &err)) {
+    if (st_grid_read(&g, in, co.max_bytes, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

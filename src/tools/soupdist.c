@@ -54,29 +54,24 @@ static void usage(void)
         ST_DIST_DEFAULT_CELLS, ST_DIST_MIN_BAND, ST_DIST_DEFAULT_BAND);
 }
 
-enum { OPT_PAD = 256, OPT_BAND, OPT_THREADS, OPT_MAXMEM, OPT_HELP, OPT_VERSION };
+enum { OPT_PAD = TOOL_OPT_FIRST, OPT_BAND };
 
 int main(int argc, char *argv[])
 {
     tool_ctx t;
     tool_init(&t, "soupdist", argc, argv);
+    tool_common co = tool_common_default();
     st_dist_params p = st_dist_params_default();
-    p.max_bytes = tool_default_max_memory();
     const char *out = NULL, *in = NULL;
     int have_cells = 0, have_voxel = 0;
-    size_t threads = 0;
     static const struct option opts[] = {
         {"cells", required_argument, NULL, 'r'},
         {"voxel", required_argument, NULL, 's'},
         {"pad", required_argument, NULL, OPT_PAD},
         {"band", required_argument, NULL, OPT_BAND},
         {"output", required_argument, NULL, 'o'},
-        {"threads", required_argument, NULL, OPT_THREADS},
-        {"max-memory", required_argument, NULL, OPT_MAXMEM},
-        {"quiet", no_argument, NULL, 'q'},
-        {"verbose", no_argument, NULL, 'v'},
-        {"help", no_argument, NULL, OPT_HELP},
-        {"version", no_argument, NULL, OPT_VERSION},
+        TOOL_LONG_OPTIONS_BASIC,
+        TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
@@ -109,32 +104,14 @@ int main(int argc, char *argv[])
         case 'o':
             out = optarg;
             break;
-        case OPT_THREADS:
-            if (tool_parse_size(&t, "--threads", optarg, 1, 4096, &threads))
-                return TOOL_EXIT_USAGE;
+        default: {
+            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
+            if (rc_opt != TOOL_CONTINUE) {
+                tool_finish(&t);
+                return rc_opt;
+            }
             break;
-        case OPT_MAXMEM:
-            if (tool_parse_bytes(&t, "--max-memory", optarg, &p.max_bytes))
-                return TOOL_EXIT_USAGE;
-            break;
-        case 'q':
-            t.verbosity = 0;
-            break;
-        case 'v':
-            t.verbosity = 2;
-            break;
-        case OPT_HELP:
-            usage();
-            return TOOL_EXIT_OK;
-        case OPT_VERSION:
-            tool_print_version(&t);
-            return TOOL_EXIT_OK;
-        case ':':
-            return tool_usage_error(&t, "option '%s' needs a value",
-                                    argv[optind - 1]);
-        default:
-            return tool_usage_error(&t, "unknown option '%s'",
-                                    argv[optind - 1]);
+        }
         }
     }
     if (have_cells && have_voxel)
@@ -153,7 +130,8 @@ int main(int argc, char *argv[])
         st_grid_format_from_path(out) == ST_GRID_FMT_UNKNOWN)
         return tool_usage_error(&t, "cannot tell the format of '%s' "
                                     "(use .vdb or .vti)", out);
-    tool_set_threads(threads);
+    tool_set_threads(co.threads);
+    p.max_bytes = co.max_bytes;
 
     st_error err;
     st_error_clear(&err);

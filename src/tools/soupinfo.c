@@ -155,20 +155,18 @@ static void print_table(FILE *f, const char *name, const st_soupinfo *r)
 
 /* ---- main ------------------------------------------------------------------ */
 
-enum { OPT_JSON = 256, OPT_NOSELF, OPT_HELP, OPT_VERSION };
+enum { OPT_JSON = TOOL_OPT_FIRST, OPT_NOSELF };
 
 int main(int argc, char *argv[])
 {
     tool_ctx t;
     tool_init(&t, "soupinfo", argc, argv);
+    tool_common co = tool_common_default();
     int json = 0, self_check = 1;
     static const struct option opts[] = {
         {"json", no_argument, NULL, OPT_JSON},
         {"no-self-check", no_argument, NULL, OPT_NOSELF},
-        {"quiet", no_argument, NULL, 'q'},
-        {"verbose", no_argument, NULL, 'v'},
-        {"help", no_argument, NULL, OPT_HELP},
-        {"version", no_argument, NULL, OPT_VERSION},
+        TOOL_LONG_OPTIONS_BASIC,
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
@@ -180,28 +178,14 @@ int main(int argc, char *argv[])
         case OPT_NOSELF:
             self_check = 0;
             break;
-        case 'q':
-            t.verbosity = 0;
+        default: {
+            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
+            if (rc_opt != TOOL_CONTINUE) {
+                tool_finish(&t);
+                return rc_opt;
+            }
             break;
-        case 'v':
-            t.verbosity = 2;
-            break;
-        case OPT_HELP:
-            usage();
-            tool_finish(&t);
-            return TOOL_EXIT_OK;
-        case OPT_VERSION:
-            tool_print_version(&t);
-            tool_finish(&t);
-            return TOOL_EXIT_OK;
-        case ':':
-            tool_finish(&t);
-            return tool_usage_error(&t, "option '%s' needs a value",
-                                    argv[optind - 1]);
-        default:
-            tool_finish(&t);
-            return tool_usage_error(&t, "unknown option '%s'",
-                                    argv[optind - 1]);
+        }
         }
     }
     static char *const stdin_only[] = {"-", NULL};

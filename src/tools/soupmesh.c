@@ -72,8 +72,8 @@ static void usage(void)
 "Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
 }
 
-enum { OPT_CELLS = 256, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
-       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED, OPT_THREADS, OPT_MAXMEM, OPT_HELP, OPT_VERSION };
+enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
+       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED };
 
 static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
 {
@@ -104,9 +104,9 @@ int main(int argc, char *argv[])
 {
     tool_ctx t;
     tool_init(&t, "soupmesh", argc, argv);
+    tool_common co = tool_common_default();
     st_pipeline_params p = st_pipeline_params_default();
-    size_t threads = 0, max_iters = 0, seed = 1;
-    p.max_bytes = tool_default_max_memory();
+    size_t max_iters = 0, seed = 1;
     const char *out = NULL, *in = NULL, *embed = NULL;
     st_tetformat_opts fopts = {0, 0};
     static const struct option opts[] = {
@@ -122,12 +122,8 @@ int main(int argc, char *argv[])
         {"msh-binary", no_argument, NULL, OPT_MSH_BINARY},
         {"embed", required_argument, NULL, OPT_EMBED},
         {"output", required_argument, NULL, 'o'},
-        {"threads", required_argument, NULL, OPT_THREADS},
-        {"max-memory", required_argument, NULL, OPT_MAXMEM},
-        {"quiet", no_argument, NULL, 'q'},
-        {"verbose", no_argument, NULL, 'v'},
-        {"help", no_argument, NULL, OPT_HELP},
-        {"version", no_argument, NULL, OPT_VERSION},
+        TOOL_LONG_OPTIONS_BASIC,
+        TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
@@ -185,30 +181,14 @@ int main(int argc, char *argv[])
         case 'o':
             out = optarg;
             break;
-        case OPT_THREADS:
-            if (tool_parse_size(&t, "--threads", optarg, 1, 4096, &threads))
-                return TOOL_EXIT_USAGE;
+        default: {
+            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
+            if (rc_opt != TOOL_CONTINUE) {
+                tool_finish(&t);
+                return rc_opt;
+            }
             break;
-        case OPT_MAXMEM:
-            if (tool_parse_bytes(&t, "--max-memory", optarg, &p.max_bytes))
-                return TOOL_EXIT_USAGE;
-            break;
-        case 'q':
-            t.verbosity = 0;
-            break;
-        case 'v':
-            t.verbosity = 2;
-            break;
-        case OPT_HELP:
-            usage();
-            return TOOL_EXIT_OK;
-        case OPT_VERSION:
-            tool_print_version(&t);
-            return TOOL_EXIT_OK;
-        case ':':
-            return tool_usage_error(&t, "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return tool_usage_error(&t, "unknown option '%s'", argv[optind - 1]);
+        }
         }
     }
     if (optind < argc)
@@ -229,7 +209,8 @@ int main(int argc, char *argv[])
     int embed_text = elen > 4 && strcmp(embed + elen - 4, ".txt") == 0;
     if (embed && !embed_text && !(elen > 4 && strcmp(embed + elen - 4, ".vtu") == 0))
         return tool_usage_error(&t, "--embed writes .txt or .vtu, not '%s'", embed);
-    tool_set_threads(threads);
+    tool_set_threads(co.threads);
+    p.max_bytes = co.max_bytes;
 
     st_error err;
     st_error_clear(&err);

@@ -69,8 +69,7 @@ static void usage(void)
         ST_WRAP_DEFAULT_MIN_VOLUME, ST_DIST_DEFAULT_CELLS);
 }
 
-enum { OPT_ISO = 256, OPT_ADAPT, OPT_SMOOTH, OPT_MINVOL, OPT_CAVITIES, OPT_SURFACE, OPT_THREADS,
-       OPT_MAXMEM, OPT_HELP, OPT_VERSION };
+enum { OPT_ISO = TOOL_OPT_FIRST, OPT_ADAPT, OPT_SMOOTH, OPT_MINVOL, OPT_CAVITIES, OPT_SURFACE };
 
 /* The history lines of the field plus this command line. Caller frees. */
 static char *history(const st_grid *g, const char *source, const char *cmd)
@@ -90,10 +89,10 @@ int main(int argc, char *argv[])
 {
     tool_ctx t;
     tool_init(&t, "soupwrap", argc, argv);
+    tool_common co = tool_common_default();
     st_wrap_params p = st_wrap_params_default();
     st_dist_params dp = st_dist_params_default();
-    dp.max_bytes = tool_default_max_memory();
-    size_t max_bytes = dp.max_bytes, threads = 0, smooth = 0;
+    size_t smooth = 0;
     const char *out = NULL, *in = NULL, *surface = NULL;
     int have_cells = 0;
     static const struct option opts[] = {
@@ -105,12 +104,8 @@ int main(int argc, char *argv[])
         {"surface", required_argument, NULL, OPT_SURFACE},
         {"cells", required_argument, NULL, 'r'},
         {"output", required_argument, NULL, 'o'},
-        {"threads", required_argument, NULL, OPT_THREADS},
-        {"max-memory", required_argument, NULL, OPT_MAXMEM},
-        {"quiet", no_argument, NULL, 'q'},
-        {"verbose", no_argument, NULL, 'v'},
-        {"help", no_argument, NULL, OPT_HELP},
-        {"version", no_argument, NULL, OPT_VERSION},
+        TOOL_LONG_OPTIONS_BASIC,
+        TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
@@ -149,33 +144,14 @@ int main(int argc, char *argv[])
         case 'o':
             out = optarg;
             break;
-        case OPT_THREADS:
-            if (tool_parse_size(&t, "--threads", optarg, 1, 4096, &threads))
-                return TOOL_EXIT_USAGE;
+        default: {
+            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
+            if (rc_opt != TOOL_CONTINUE) {
+                tool_finish(&t);
+                return rc_opt;
+            }
             break;
-        case OPT_MAXMEM:
-            if (tool_parse_bytes(&t, "--max-memory", optarg, &max_bytes))
-                return TOOL_EXIT_USAGE;
-            dp.max_bytes = max_bytes;
-            break;
-        case 'q':
-            t.verbosity = 0;
-            break;
-        case 'v':
-            t.verbosity = 2;
-            break;
-        case OPT_HELP:
-            usage();
-            return TOOL_EXIT_OK;
-        case OPT_VERSION:
-            tool_print_version(&t);
-            return TOOL_EXIT_OK;
-        case ':':
-            return tool_usage_error(&t, "option '%s' needs a value",
-                                    argv[optind - 1]);
-        default:
-            return tool_usage_error(&t, "unknown option '%s'",
-                                    argv[optind - 1]);
+        }
         }
     }
     if (optind < argc)
@@ -203,7 +179,8 @@ int main(int argc, char *argv[])
                                         "(use .obj, .off, .ply or .stl)",
                                     out);
     }
-    tool_set_threads(threads);
+    tool_set_threads(co.threads);
+    dp.max_bytes = co.max_bytes;
 
     st_error err;
     st_error_clear(&err);
@@ -229,7 +206,7 @@ int main(int argc, char *argv[])
             rc = tool_fail(&t, &err);
             goto done;
         }
-    } else if (st_grid_read(&g, in, max_bytes, &err)) {
+    } else if (st_grid_read(&g, in, co.max_bytes, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

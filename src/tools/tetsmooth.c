@@ -69,9 +69,8 @@ static void usage(void)
 "Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
 }
 
-enum { OPT_FAIR = 256, OPT_FIT, OPT_ITERS, OPT_LAMBDA, OPT_MINANGLE, OPT_SURFACE, OPT_OFFSET,
-       OPT_CELL, OPT_STEP, OPT_MAXIT, OPT_QROUNDS, OPT_NOQ, OPT_THREADS, OPT_MAXMEM,
-       OPT_HELP, OPT_VERSION };
+enum { OPT_FAIR = TOOL_OPT_FIRST, OPT_FIT, OPT_ITERS, OPT_LAMBDA, OPT_MINANGLE, OPT_SURFACE, OPT_OFFSET,
+       OPT_CELL, OPT_STEP, OPT_MAXIT, OPT_QROUNDS, OPT_NOQ };
 
 typedef struct iter_ctx {
     tool_ctx *t;
@@ -91,9 +90,10 @@ int main(int argc, char *argv[])
 {
     tool_ctx t;
     tool_init(&t, "tetsmooth", argc, argv);
+    tool_common co = tool_common_default();
     st_fair_params fp = st_fair_params_default();
     st_fit_params gp = st_fit_params_default();
-    size_t max_bytes = tool_default_max_memory(), threads = 0, n;
+    size_t n;
     const char *out = NULL, *in = NULL, *surface = NULL;
     int mode = 0; /* 1 fair, 2 fit */
     int fair_only = 0, fit_only = 0, noq = 0;
@@ -111,12 +111,8 @@ int main(int argc, char *argv[])
         {"quality-rounds", required_argument, NULL, OPT_QROUNDS},
         {"no-quality", no_argument, NULL, OPT_NOQ},
         {"output", required_argument, NULL, 'o'},
-        {"threads", required_argument, NULL, OPT_THREADS},
-        {"max-memory", required_argument, NULL, OPT_MAXMEM},
-        {"quiet", no_argument, NULL, 'q'},
-        {"verbose", no_argument, NULL, 'v'},
-        {"help", no_argument, NULL, OPT_HELP},
-        {"version", no_argument, NULL, OPT_VERSION},
+        TOOL_LONG_OPTIONS_BASIC,
+        TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
@@ -183,30 +179,14 @@ int main(int argc, char *argv[])
         case 'o':
             out = optarg;
             break;
-        case OPT_THREADS:
-            if (tool_parse_size(&t, "--threads", optarg, 1, 4096, &threads))
-                return TOOL_EXIT_USAGE;
+        default: {
+            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
+            if (rc_opt != TOOL_CONTINUE) {
+                tool_finish(&t);
+                return rc_opt;
+            }
             break;
-        case OPT_MAXMEM:
-            if (tool_parse_bytes(&t, "--max-memory", optarg, &max_bytes))
-                return TOOL_EXIT_USAGE;
-            break;
-        case 'q':
-            t.verbosity = 0;
-            break;
-        case 'v':
-            t.verbosity = 2;
-            break;
-        case OPT_HELP:
-            usage();
-            return TOOL_EXIT_OK;
-        case OPT_VERSION:
-            tool_print_version(&t);
-            return TOOL_EXIT_OK;
-        case ':':
-            return tool_usage_error(&t, "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return tool_usage_error(&t, "unknown option '%s'", argv[optind - 1]);
+        }
         }
     }
     if (!mode)
@@ -234,7 +214,7 @@ int main(int argc, char *argv[])
     if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
         return tool_usage_error(&t, "will not write a binary mesh to a terminal: give -o "
                                     "FILE or pipe it");
-    tool_set_threads(threads);
+    tool_set_threads(co.threads);
 
     st_error err;
     st_error_clear(&err);
@@ -244,7 +224,7 @@ int main(int argc, char *argv[])
     int rc = TOOL_EXIT_FAIL;
     const char *inname = st_path_is_stdio(in) ? "<stdin>" : in;
     double t0 = tool_now();
-    if (st_tetmesh_read(&m, in, max_bytes, &err)) {
+    if (st_tetmesh_read(&m, in, co.max_bytes, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

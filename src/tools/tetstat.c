@@ -238,25 +238,21 @@ static void print_table(FILE *f, const char *name, const char *sname,
 
 /* ---- main ------------------------------------------------------------------ */
 
-enum { OPT_JSON = 256, OPT_THREADS, OPT_MAXMEM, OPT_HELP, OPT_VERSION };
+enum { OPT_JSON = TOOL_OPT_FIRST };
 
 int main(int argc, char *argv[])
 {
     tool_ctx t;
     tool_init(&t, "tetstat", argc, argv);
+    tool_common co = tool_common_default();
     int json = 0;
-    size_t threads = 0, max_bytes = tool_default_max_memory();
-    const char *surface = NULL, *field = NULL;
+        const char *surface = NULL, *field = NULL;
     static const struct option opts[] = {
         {"surface", required_argument, NULL, 'S'},
         {"field", required_argument, NULL, 'F'},
         {"json", no_argument, NULL, OPT_JSON},
-        {"threads", required_argument, NULL, OPT_THREADS},
-        {"max-memory", required_argument, NULL, OPT_MAXMEM},
-        {"quiet", no_argument, NULL, 'q'},
-        {"verbose", no_argument, NULL, 'v'},
-        {"help", no_argument, NULL, OPT_HELP},
-        {"version", no_argument, NULL, OPT_VERSION},
+        TOOL_LONG_OPTIONS_BASIC,
+        TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
@@ -271,40 +267,14 @@ int main(int argc, char *argv[])
         case OPT_JSON:
             json = 1;
             break;
-        case OPT_THREADS:
-            if (tool_parse_size(&t, "--threads", optarg, 1, 4096, &threads)) {
+        default: {
+            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
+            if (rc_opt != TOOL_CONTINUE) {
                 tool_finish(&t);
-                return TOOL_EXIT_USAGE;
+                return rc_opt;
             }
             break;
-        case OPT_MAXMEM:
-            if (tool_parse_bytes(&t, "--max-memory", optarg, &max_bytes)) {
-                tool_finish(&t);
-                return TOOL_EXIT_USAGE;
-            }
-            break;
-        case 'q':
-            t.verbosity = 0;
-            break;
-        case 'v':
-            t.verbosity = 2;
-            break;
-        case OPT_HELP:
-            usage();
-            tool_finish(&t);
-            return TOOL_EXIT_OK;
-        case OPT_VERSION:
-            tool_print_version(&t);
-            tool_finish(&t);
-            return TOOL_EXIT_OK;
-        case ':':
-            tool_finish(&t);
-            return tool_usage_error(&t, "option '%s' needs a value",
-                                    argv[optind - 1]);
-        default:
-            tool_finish(&t);
-            return tool_usage_error(&t, "unknown option '%s'",
-                                    argv[optind - 1]);
+        }
         }
     }
     if (argc - optind > 1) {
@@ -321,7 +291,7 @@ int main(int argc, char *argv[])
         return tool_usage_error(&t, "standard input ('-') given %d times",
                                 nstdin);
     }
-    tool_set_threads(threads);
+    tool_set_threads(co.threads);
 
     st_error err;
     st_error_clear(&err);
@@ -332,7 +302,7 @@ int main(int argc, char *argv[])
     int rc = TOOL_EXIT_FAIL;
     double t0 = tool_now();
     /* Read every input first: a bad one gives no half report. */
-    if (st_tetmesh_read(&m, in, max_bytes, &err)) {
+    if (st_tetmesh_read(&m, in, co.max_bytes, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }
@@ -340,7 +310,7 @@ int main(int argc, char *argv[])
         rc = tool_fail(&t, &err);
         goto done;
     }
-    if (field && st_grid_read(&g, field, max_bytes, &err)) {
+    if (field && st_grid_read(&g, field, co.max_bytes, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }
