@@ -12,6 +12,7 @@
 #define SOUPTET_CLI_TOOL_H
 
 #include <stddef.h>
+#include <stdio.h>
 #include "souptet/err.h"
 #include "souptet/meta.h"
 #include "souptet/progress.h"
@@ -75,6 +76,13 @@ double tool_now(void);
 
 /* Print the version line "name (souptet) X.Y.Z". */
 void tool_print_version(const tool_ctx *t);
+
+/* JSON output: s as a quoted, escaped JSON string; x as the shortest of 15,
+ * 16 or 17 significant digits that reads back as exactly x (so 0.1 does not
+ * print as 0.10000000000000001), or "null" for NaN and infinities (JSON has
+ * neither). tool_json_number writes into buf and returns it (or "null"). */
+void tool_json_string(FILE *f, const char *s);
+const char *tool_json_number(char buf[32], double x);
 
 /* ---- options every tool shares ----------------------------------------
  *

@@ -48,39 +48,12 @@ static void usage(void)
 
 /* ---- output ---------------------------------------------------------------- */
 
-static void json_string(FILE *f, const char *s)
-{
-    fputc('"', f);
-    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-        if (*p == '"' || *p == '\\')
-            fprintf(f, "\\%c", *p);
-        else if (*p < 0x20)
-            fprintf(f, "\\u%04x", *p);
-        else
-            fputc(*p, f);
-    }
-    fputc('"', f);
-}
-
-/* The shortest of 15, 16 or 17 significant digits that reads back as
- * exactly x: 17 always does, fewer keep 0.1 from printing as
- * 0.10000000000000001. */
-static const char *num(char buf[32], double x)
-{
-    for (int digits = 15; digits <= 17; digits++) {
-        snprintf(buf, 32, "%.*g", digits, x);
-        if (strtod(buf, NULL) == x)
-            break;
-    }
-    return buf;
-}
-
 /* One JSON object. */
 static void print_json(FILE *f, const char *name, const st_soupinfo *r)
 {
     char b[7][32];
     fprintf(f, "{\"file\": ");
-    json_string(f, name);
+    tool_json_string(f, name);
     fprintf(f,
             ",\n  \"vertices\": %zu, \"triangles\": %zu, "
             "\"unreferenced_vertices\": %zu,\n"
@@ -96,9 +69,9 @@ static void print_json(FILE *f, const char *name, const st_soupinfo *r)
             "\"consistently_oriented\": %s,\n"
             "  \"collinear_triangles\": %zu, ",
             r->vertices, r->triangles, r->unreferenced_vertices,
-            num(b[0], r->lo[0]), num(b[1], r->lo[1]), num(b[2], r->lo[2]),
-            num(b[3], r->hi[0]), num(b[4], r->hi[1]), num(b[5], r->hi[2]),
-            num(b[6], r->diagonal),
+            tool_json_number(b[0], r->lo[0]), tool_json_number(b[1], r->lo[1]), tool_json_number(b[2], r->lo[2]),
+            tool_json_number(b[3], r->hi[0]), tool_json_number(b[4], r->hi[1]), tool_json_number(b[5], r->hi[2]),
+            tool_json_number(b[6], r->diagonal),
             r->welded_vertices, r->degenerate_triangles,
             r->duplicated_triangles, r->edges, r->boundary_edges,
             r->manifold_edges, r->nonmanifold_edges, r->inconsistent_edges,

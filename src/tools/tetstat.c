@@ -59,34 +59,6 @@ static void usage(void)
 
 /* ---- output ---------------------------------------------------------------- */
 
-static void json_string(FILE *f, const char *s)
-{
-    fputc('"', f);
-    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-        if (*p == '"' || *p == '\\')
-            fprintf(f, "\\%c", *p);
-        else if (*p < 0x20)
-            fprintf(f, "\\u%04x", *p);
-        else
-            fputc(*p, f);
-    }
-    fputc('"', f);
-}
-
-/* The shortest of 15..17 significant digits that reads back as x; "null"
- * for NaN and infinities (JSON has neither). */
-static const char *num(char buf[32], double x)
-{
-    if (!isfinite(x))
-        return "null";
-    for (int digits = 15; digits <= 17; digits++) {
-        snprintf(buf, 32, "%.*g", digits, x);
-        if (strtod(buf, NULL) == x)
-            break;
-    }
-    return buf;
-}
-
 static const char *yesno(int b)
 {
     return b ? "true" : "false";
@@ -97,16 +69,16 @@ static void print_json(FILE *f, const char *name, const char *sname,
 {
     char b[12][32];
     fprintf(f, "{\"file\": ");
-    json_string(f, name);
+    tool_json_string(f, name);
     fprintf(f,
             ",\n  \"tets\": %zu, \"points\": %zu, \"unused_points\": %zu,\n"
             "  \"lo\": [%s, %s, %s], \"hi\": [%s, %s, %s],\n"
             "  \"min_dihedral\": %s, \"max_dihedral\": %s,\n"
             "  \"min_dihedral_histogram\": {\"bin_degrees\": %g, \"counts\": [",
-            r->tets, r->points, r->unused_points, num(b[0], r->lo[0]),
-            num(b[1], r->lo[1]), num(b[2], r->lo[2]), num(b[3], r->hi[0]),
-            num(b[4], r->hi[1]), num(b[5], r->hi[2]),
-            num(b[6], r->min_dihedral), num(b[7], r->max_dihedral),
+            r->tets, r->points, r->unused_points, tool_json_number(b[0], r->lo[0]),
+            tool_json_number(b[1], r->lo[1]), tool_json_number(b[2], r->lo[2]), tool_json_number(b[3], r->hi[0]),
+            tool_json_number(b[4], r->hi[1]), tool_json_number(b[5], r->hi[2]),
+            tool_json_number(b[6], r->min_dihedral), tool_json_number(b[7], r->max_dihedral),
             ST_TETSTAT_BIN_DEG);
     for (int i = 0; i < ST_TETSTAT_BINS; i++)
         fprintf(f, "%s%zu", i ? ", " : "", r->hist[i]);
@@ -118,10 +90,10 @@ static void print_json(FILE *f, const char *name, const char *sname,
             "  \"components\": %zu, \"volume\": %s, \"h\": %s",
             r->inverted, r->degenerate, r->boundary_faces, r->interior_faces,
             r->nonmanifold_faces, yesno(r->conforming), r->components,
-            num(b[0], r->volume), r->has_h ? num(b[1], r->h) : "null");
+            tool_json_number(b[0], r->volume), r->has_h ? tool_json_number(b[1], r->h) : "null");
     if (r->has_surface) {
         fprintf(f, ",\n  \"surface\": {\"file\": ");
-        json_string(f, sname);
+        tool_json_string(f, sname);
         fprintf(f,
                 ", \"vertices\": %zu, \"triangles\": %zu,\n"
                 "    \"boundary_vertices\": %zu, \"dist_min\": %s, "
@@ -129,15 +101,15 @@ static void print_json(FILE *f, const char *name, const char *sname,
                 "    \"surface_dist_max\": %s, \"closed\": %s, "
                 "\"surface_volume\": %s, \"volume_ratio\": %s",
                 r->surface_vertices, r->surface_triangles,
-                r->boundary_vertices, num(b[0], r->dist_min),
-                num(b[1], r->dist_max), num(b[2], r->dist_mean),
-                num(b[3], r->surface_dist_max), yesno(r->surface_closed),
-                num(b[4], r->surface_volume), num(b[5], r->volume_ratio));
+                r->boundary_vertices, tool_json_number(b[0], r->dist_min),
+                tool_json_number(b[1], r->dist_max), tool_json_number(b[2], r->dist_mean),
+                tool_json_number(b[3], r->surface_dist_max), yesno(r->surface_closed),
+                tool_json_number(b[4], r->surface_volume), tool_json_number(b[5], r->volume_ratio));
         if (r->has_enclosure)
             fprintf(f,
                     ",\n    \"vertices_inside\": %zu, \"fraction_inside\": "
                     "%s, \"crossing_triangles\": %zu, \"encloses\": %s}",
-                    r->vertices_inside, num(b[6], r->fraction_inside),
+                    r->vertices_inside, tool_json_number(b[6], r->fraction_inside),
                     r->crossing_triangles, yesno(r->encloses));
         else
             fprintf(f, ",\n    \"vertices_inside\": null, "
@@ -146,12 +118,12 @@ static void print_json(FILE *f, const char *name, const char *sname,
     }
     if (r->has_field) {
         fprintf(f, ",\n  \"field\": {\"file\": ");
-        json_string(f, fname);
+        tool_json_string(f, fname);
         fprintf(f,
                 ", \"voxels\": %zu, \"field_inside\": %zu, "
                 "\"mesh_inside\": %zu, \"both\": %zu, \"iou\": %s}",
                 r->field_voxels, r->field_inside, r->mesh_voxels,
-                r->both_voxels, num(b[0], r->iou));
+                r->both_voxels, tool_json_number(b[0], r->iou));
     }
     fprintf(f, "}\n");
 }
