@@ -248,6 +248,16 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     rc = st_sign_field(g, &sg, prog, err);
     if (rc)
         goto done;
+    /* The soup is at hand: re-sign the voxels next to it exactly from
+     * confident neighbours (sign.h, st_sign_refine), which the vote alone
+     * gets wrong within a voxel of the surface and in thin features. */
+    rc = st_bvh_build(&bvh, s, err);
+    if (rc)
+        goto done;
+    st_sign_refine_params rf = st_sign_refine_params_default();
+    rc = st_sign_refine_bvh(g, bvh, &rf, NULL, err);
+    if (rc)
+        goto done;
     double t_cand = now_seconds();
     st->seconds_sign = t_cand - t_sign;
     st->field_dims[0] = g->nx;
@@ -255,9 +265,6 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     st->field_dims[2] = g->nz;
     st->voxel = g->voxel;
 
-    rc = st_bvh_build(&bvh, s, err);
-    if (rc)
-        goto done;
     double lo[3], hi[3];
     rc = st_soup_bounds(s, lo, hi, err);
     if (rc)

@@ -18,6 +18,9 @@
  */
 #include "souptet/sign.h"
 #include "souptet/mem.h"
+#include "souptet/bvh.h"
+#include "souptet/isect.h"
+#include "souptet/pred.h"
 
 #include <limits.h>
 #include <math.h>
@@ -660,6 +663,351 @@ st_status st_sign_field(st_grid *g, const st_sign_params *p,
              p->ignore_odd ? "ignored" : "kept",
              p->nested_union ? "union" : "parity", t);
     if (st_meta_set(&g->meta, "sign_rule", buf))
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    return ST_OK;
+}
+
+/* --- near-surface refinement (sign.h) ---------------------------------- */
+
+st_sign_refine_params st_sign_refine_params_default(void)
+{
+    /* band 1.5 voxels: the answers are only as good as the confident
+     * neighbours' votes, and on thin parts (CGAL's man's fingers) some
+     * votes between 1 and 1.5 voxels from the surface are wrong too: at
+     * 128^3, closed man 0.9972 with band 1, 0.9991 with 1.5; armadillo and
+     * elephant 0.99997 / 1.0000; the damaged classes within 0.002 either
+     * way (issue 4's note has the bench tables for both). Radius 2: a
+     * voxel inside a feature thinner than a voxel still finds neighbours
+     * 1.5 voxels from it (radius 3 changed nothing on man and cheese).
+     * Up to 6 answers, unanimous: a disagreement (a hole, an overlap of
+     * interpenetrating shells, whose inner faces do not separate inside
+     * from outside) leaves the vote. */
+    st_sign_refine_params p = {1.5, 2, 6};
+    return p;
+}
+
+typedef struct refine_tri {
+    double lo[3], hi[3];
+    uint32_t id;
+} refine_tri;
+
+typedef struct refine_buf {
+    refine_tri *t;
+    size_t n, cap;
+    int oom;
+    const st_soup *s;
+} refine_buf;
+
+static int refine_collect(void *ctx, uint32_t tri)
+{
+    refine_buf *b = ctx;
+    if (b->n == b->cap) {
+        size_t cap = b->cap ? 2 * b->cap : 64;
+        refine_tri *t = st_realloc_array(b->t, cap, sizeof *t);
+        if (!t) {
+            b->oom = 1;
+            return 1;
+        }
+        b->t = t;
+        b->cap = cap;
+    }
+    refine_tri *r = &b->t[b->n++];
+    r->id = tri;
+    for (int a = 0; a < 3; a++) {
+        r->lo[a] = INFINITY;
+        r->hi[a] = -INFINITY;
+    }
+    for (int v = 0; v < 3; v++) {
+        const double *x = b->s->xyz + 3 * (size_t)b->s->tris[3 * (size_t)tri + v];
+        for (int a = 0; a < 3; a++) {
+            if (x[a] < r->lo[a])
+                r->lo[a] = x[a];
+            if (x[a] > r->hi[a])
+                r->hi[a] = x[a];
+        }
+    }
+    return 0;
+}
+
+static int sgn(double x) { return (x > 0) - (x < 0); }
+
+/* How the closed segment [p, q] meets triangle (a b c): 0 not at all,
+ * 1 a proper crossing (through the triangle's open interior, the ends off
+ * its plane), -1 any other contact (an end on the triangle, through an
+ * edge or a vertex, in its plane): degenerate, the caller takes another
+ * segment. Exact (orient3d signs; st_segment_tri_intersect for contacts
+ * the signs alone do not settle). */
+static int segment_crossing(const double p[3], const double q[3],
+                            const double a[3], const double b[3],
+                            const double c[3])
+{
+    int sp = sgn(st_orient3d(a, b, c, p)), sq = sgn(st_orient3d(a, b, c, q));
+    if (sp != 0 && sp == sq)
+        return 0;
+    if (sp == 0 || sq == 0)   /* an end in the plane, or the segment in it */
+        return st_segment_tri_intersect(p, q, a, b, c) ? -1 : 0;
+    int e1 = sgn(st_orient3d(p, q, a, b)), e2 = sgn(st_orient3d(p, q, b, c)),
+        e3 = sgn(st_orient3d(p, q, c, a));
+    if ((e1 > 0 || e2 > 0 || e3 > 0) && (e1 < 0 || e2 < 0 || e3 < 0))
+        return 0;             /* the line passes beside the triangle */
+    if (e1 == 0 || e2 == 0 || e3 == 0)
+        return -1;            /* through an edge or a vertex */
+    return 1;
+}
+
+/* Do triangles i and j have the same three vertex positions? */
+static int same_tri(const st_soup *s, uint32_t i, uint32_t j)
+{
+    const uint32_t *ti = s->tris + 3 * (size_t)i, *tj = s->tris + 3 * (size_t)j;
+    int used[3] = {0, 0, 0};
+    for (int u = 0; u < 3; u++) {
+        const double *x = s->xyz + 3 * (size_t)ti[u];
+        int found = 0;
+        for (int v = 0; v < 3 && !found; v++) {
+            const double *y = s->xyz + 3 * (size_t)tj[v];
+            if (!used[v] && x[0] == y[0] && x[1] == y[1] && x[2] == y[2])
+                used[v] = found = 1;
+        }
+        if (!found)
+            return 0;
+    }
+    return 1;
+}
+
+/* Crossings of segment [p, q] with the candidate triangles: the parity of
+ * the distinct triangles crossed, or -1 when a contact is degenerate. */
+#define MAX_CROSSED 64
+static int segment_parity(const st_soup *s, const refine_buf *b,
+                          const uint32_t *sel, size_t nsel,
+                          const double p[3], const double q[3])
+{
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = p[a] < q[a] ? p[a] : q[a];
+        hi[a] = p[a] < q[a] ? q[a] : p[a];
+    }
+    uint32_t crossed[MAX_CROSSED];
+    size_t nc = 0;
+    for (size_t t = 0; t < nsel; t++) {
+        const refine_tri *r = &b->t[sel[t]];
+        if (r->hi[0] < lo[0] || r->lo[0] > hi[0] || r->hi[1] < lo[1] ||
+            r->lo[1] > hi[1] || r->hi[2] < lo[2] || r->lo[2] > hi[2])
+            continue;
+        const uint32_t *v = s->tris + 3 * (size_t)r->id;
+        int x = segment_crossing(p, q, s->xyz + 3 * (size_t)v[0],
+                                 s->xyz + 3 * (size_t)v[1], s->xyz + 3 * (size_t)v[2]);
+        if (x < 0)
+            return -1;
+        if (x == 0)
+            continue;
+        int dup = 0;
+        for (size_t e = 0; e < nc && !dup; e++)
+            dup = same_tri(s, crossed[e], r->id);
+        if (dup)
+            continue;
+        if (nc == MAX_CROSSED)
+            return -1;        /* a pathological pile of faces: not used */
+        crossed[nc++] = r->id;
+    }
+    return (int)(nc & 1u);
+}
+
+typedef struct refine_offset {
+    int d[3];
+    int len2;
+    int cheb;   /* max |d[a]|: the reach its segment needs */
+} refine_offset;
+
+static int offset_cmp(const void *x, const void *y)
+{
+    const refine_offset *a = x, *b = y;
+    if (a->cheb != b->cheb)
+        return a->cheb < b->cheb ? -1 : 1;
+    if (a->len2 != b->len2)
+        return a->len2 < b->len2 ? -1 : 1;
+    for (int k = 2; k >= 0; k--)
+        if (a->d[k] != b->d[k])
+            return a->d[k] < b->d[k] ? -1 : 1;
+    return 0;
+}
+
+st_status st_sign_refine(st_grid *g, const st_soup *soup,
+                         const st_sign_refine_params *p, size_t *changed,
+                         st_error *err)
+{
+    if (changed)
+        *changed = 0;
+    if (!soup || soup->ntris == 0)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "no triangles to refine with");
+    st_bvh *bvh = NULL;
+    st_status st = st_bvh_build(&bvh, soup, err);
+    if (st)
+        return st;
+    st = st_sign_refine_bvh(g, bvh, p, changed, err);
+    st_bvh_free(bvh);
+    return st;
+}
+
+st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
+                             const st_sign_refine_params *p, size_t *changed,
+                             st_error *err)
+{
+    if (changed)
+        *changed = 0;
+    const st_soup *soup = bvh ? bvh->soup : NULL;
+    if (g->kind != ST_GRID_SIGNED)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "refinement needs a signed field");
+    if (!(p->band_voxels > 0 && p->band_voxels <= 8) || p->radius < 1 ||
+        p->radius > 3 || p->answers < 1)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "bad refinement parameters (band %g, radius %d, "
+                            "answers %d)", p->band_voxels, p->radius, p->answers);
+    if (!soup || soup->ntris == 0)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "no triangles to refine with");
+    refine_offset offs[7 * 7 * 7];
+    int noffs = 0;
+    for (int z = -p->radius; z <= p->radius; z++)
+        for (int y = -p->radius; y <= p->radius; y++)
+            for (int x = -p->radius; x <= p->radius; x++)
+                if (x || y || z) {
+                    int ax = abs(x), ay = abs(y), az = abs(z);
+                    int cheb = ax > ay ? (ax > az ? ax : az) : (ay > az ? ay : az);
+                    refine_offset o = {{x, y, z}, x * x + y * y + z * z, cheb};
+                    offs[noffs++] = o;
+                }
+    qsort(offs, (size_t)noffs, sizeof *offs, offset_cmp);
+
+    const float band = (float)(p->band_voxels * g->voxel);
+    const long nx = (long)g->nx, ny = (long)g->ny, nz = (long)g->nz;
+    const double reach = p->radius * g->voxel;
+    /* Tiles of TILE^3 voxels share one BVH query (the query and the
+     * candidates' boxes cost more than the exact tests); each voxel then
+     * keeps the candidates whose boxes meet its own reach. */
+    enum { TILE = 4 };
+    const long tx = (nx + TILE - 1) / TILE, ty = (ny + TILE - 1) / TILE,
+               tz = (nz + TILE - 1) / TILE;
+    const long ntiles = tx * ty * tz;
+    size_t nchanged = 0;
+    int oom = 0;
+    #pragma omp parallel reduction(+ : nchanged)
+    {
+        refine_buf b = {NULL, 0, 0, 0, soup};
+        uint32_t *sel = NULL;   /* the candidates (in b) near the voxel */
+        size_t nsel = 0, selcap = 0;
+        int seloom = 0;
+        #pragma omp for schedule(dynamic, 4)
+        for (long t = 0; t < ntiles; t++) {
+            if (b.oom || seloom)
+                continue;
+            const long i0 = (t % tx) * TILE, j0 = ((t / tx) % ty) * TILE,
+                       k0 = (t / (tx * ty)) * TILE;
+            const long i1 = i0 + TILE < nx ? i0 + TILE : nx,
+                       j1 = j0 + TILE < ny ? j0 + TILE : ny,
+                       k1 = k0 + TILE < nz ? k0 + TILE : nz;
+            int any = 0;
+            for (long k = k0; k < k1 && !any; k++)
+                for (long j = j0; j < j1 && !any; j++)
+                    for (long i = i0; i < i1 && !any; i++)
+                        any = fabsf(g->data[st_grid_index(g, (size_t)i, (size_t)j, (size_t)k)]) < band;
+            if (!any)
+                continue;
+            double lo[3], hi[3], plo[3], phi[3];
+            st_grid_center(g, (size_t)i0, (size_t)j0, (size_t)k0, plo);
+            st_grid_center(g, (size_t)(i1 - 1), (size_t)(j1 - 1), (size_t)(k1 - 1), phi);
+            for (int a = 0; a < 3; a++) {
+                lo[a] = plo[a] - reach;
+                hi[a] = phi[a] + reach;
+            }
+            b.n = 0;
+            st_bvh_query_box(bvh, lo, hi, refine_collect, &b);
+            if (b.oom)
+                continue;
+            if (selcap < b.n) {
+                uint32_t *ns = st_realloc_array(sel, b.n, sizeof *ns);
+                if (!ns) {
+                    seloom = 1;
+                    continue;
+                }
+                sel = ns;
+                selcap = b.n;
+            }
+            for (long k = k0; k < k1; k++)
+                for (long j = j0; j < j1; j++)
+                    for (long i = i0; i < i1; i++) {
+                        size_t idx = st_grid_index(g, (size_t)i, (size_t)j, (size_t)k);
+                        float dv = g->data[idx];
+                        if (!(fabsf(dv) < band))
+                            continue;
+                        double pv[3];
+                        st_grid_center(g, (size_t)i, (size_t)j, (size_t)k, pv);
+                        /* The candidates within the reach of the
+                         * neighbours taken so far: offsets come nearest
+                         * first, so grow the reach only when needed. */
+                        int have = 0;
+                        int nin = 0, nout = 0;
+                        for (int o = 0; o < noffs && nin + nout < p->answers; o++) {
+                            long ui = i + offs[o].d[0], uj = j + offs[o].d[1], uk = k + offs[o].d[2];
+                            if (ui < 0 || ui >= nx || uj < 0 || uj >= ny || uk < 0 || uk >= nz)
+                                continue;
+                            float du = g->data[st_grid_index(g, (size_t)ui, (size_t)uj, (size_t)uk)];
+                            if (fabsf(du) < band)
+                                continue;
+                            if (offs[o].cheb > have) {
+                                have = offs[o].cheb;
+                                const double rr = have * g->voxel;
+                                nsel = 0;
+                                for (size_t q = 0; q < b.n; q++) {
+                                    const refine_tri *r = &b.t[q];
+                                    int out = (r->hi[0] < pv[0] - rr) | (r->lo[0] > pv[0] + rr) |
+                                              (r->hi[1] < pv[1] - rr) | (r->lo[1] > pv[1] + rr) |
+                                              (r->hi[2] < pv[2] - rr) | (r->lo[2] > pv[2] + rr);
+                                    sel[nsel] = (uint32_t)q;
+                                    nsel += !out;
+                                }
+                            }
+                            double pu[3];
+                            st_grid_center(g, (size_t)ui, (size_t)uj, (size_t)uk, pu);
+                            int par = segment_parity(soup, &b, sel, nsel, pv, pu);
+                            if (par < 0)
+                                continue;
+                            if ((du < 0) ^ par)
+                                nin++;
+                            else
+                                nout++;
+                            /* One answer that agrees with the vote settles
+                             * it (only a unanimous answer against the vote
+                             * changes a sign), so stop: the same result,
+                             * one segment for most voxels. */
+                            if ((dv < 0) ? nin : nout)
+                                break;
+                        }
+                        int inside = dv < 0;
+                        if (nin && !nout)
+                            inside = 1;
+                        else if (nout && !nin)
+                            inside = 0;
+                        if (inside != (dv < 0)) {
+                            g->data[idx] = inside ? -fabsf(dv) : fabsf(dv);
+                            nchanged++;
+                        }
+                    }
+        }
+        if (b.oom || seloom) {
+            #pragma omp atomic write
+            oom = 1;
+        }
+        free(b.t);
+        free(sel);
+    }
+    if (oom)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory in the refinement");
+    if (changed)
+        *changed = nchanged;
+    char buf[128];
+    snprintf(buf, sizeof buf, "band=%g radius=%d answers=%d unanimous exact",
+             p->band_voxels, p->radius, p->answers);
+    if (st_meta_set(&g->meta, "sign_refine", buf))
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     return ST_OK;
 }

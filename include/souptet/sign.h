@@ -40,6 +40,7 @@
 #include "souptet/grid.h"
 #include "souptet/progress.h"
 #include "souptet/soup.h"
+#include "souptet/bvh.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -128,6 +129,11 @@ st_sign_refine_params st_sign_refine_params_default(void);
 st_status st_sign_refine(st_grid *g, const st_soup *soup,
                          const st_sign_refine_params *p, size_t *changed,
                          st_error *err);
+/* The same with a BVH already built over the soup (bvh->soup), for a
+ * caller that keeps one (the pipeline's candidate search). */
+st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
+                             const st_sign_refine_params *p, size_t *changed,
+                             st_error *err);
 
 #ifdef __cplusplus
 }

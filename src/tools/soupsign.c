@@ -44,6 +44,12 @@ static void usage(void)
 "      --nested union|parity  union: a voxel hidden from outside along\n"
 "                       every ray is inside whatever the parity (keeps\n"
 "                       interpenetrating parts whole; default); parity: the paper\n"
+"      --surface S      the soup the field was computed from: refine the signs\n"
+"                       within a voxel of it by exact segment crossings\n"
+"                       (not with --rule paper)\n"
+"      --refine-band D  refine voxels nearer than D voxels (default 1.5)\n"
+"      --refine-radius R  neighbours within R voxels per axis (default 2)\n"
+"      --refine-answers A  neighbours' answers combined per voxel (default 6)\n"
 "      --rule NAME      a preset: paper (exactly the paper's rule), parity\n"
 "                       (k = 1), default; options after it adjust it\n"
 "  -o, --output OUT     .vdb or .vti file; '-' or none: OpenVDB stream on stdout\n"
@@ -56,12 +62,13 @@ static void usage(void)
 "\n"
 "Examples:\n"
 "  soupdist bunny.obj | soupsign -o bunny-sdf.vti\n"
+"  soupdist bunny.obj | soupsign --surface bunny.obj -o bunny-sdf.vti\n"
 "  soupdist --band full -r 128 scan.ply | soupsign --rule paper -o scan.vdb\n"
 "\n"
 "Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
 }
 
-enum { OPT_BAND = 256, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RULE, OPT_THREADS,
+enum { OPT_BAND = 256, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS, OPT_THREADS,
        OPT_MAXMEM, OPT_HELP, OPT_VERSION };
 
 int main(int argc, char *argv[])
@@ -70,7 +77,9 @@ int main(int argc, char *argv[])
     tool_init(&t, "soupsign", argc, argv);
     st_sign_params p = st_sign_params_default();
     size_t max_bytes = tool_default_max_memory(), threads = 0;
-    const char *out = NULL, *in = NULL;
+    const char *out = NULL, *in = NULL, *surface = NULL;
+    st_sign_refine_params rp = st_sign_refine_params_default();
+    int paper = 0;
     static const struct option opts[] = {
         {"band", required_argument, NULL, OPT_BAND},
         {"rays", required_argument, NULL, OPT_RAYS},
@@ -78,6 +87,10 @@ int main(int argc, char *argv[])
         {"odd", required_argument, NULL, OPT_ODD},
         {"nested", required_argument, NULL, OPT_NESTED},
         {"rule", required_argument, NULL, OPT_RULE},
+        {"surface", required_argument, NULL, OPT_SURFACE},
+        {"refine-band", required_argument, NULL, OPT_REFINE_BAND},
+        {"refine-radius", required_argument, NULL, OPT_REFINE_RADIUS},
+        {"refine-answers", required_argument, NULL, OPT_REFINE_ANSWERS},
         {"output", required_argument, NULL, 'o'},
         {"threads", required_argument, NULL, OPT_THREADS},
         {"max-memory", required_argument, NULL, OPT_MAXMEM},
@@ -136,6 +149,26 @@ int main(int argc, char *argv[])
         case OPT_RULE:
             if (st_sign_params_named(&p, optarg))
                 return tool_usage_error(&t, "unknown rule '%s' (paper, parity, default)", optarg);
+            paper = strcmp(optarg, "paper") == 0;
+            break;
+        case OPT_SURFACE:
+            surface = optarg;
+            break;
+        case OPT_REFINE_RADIUS:
+        case OPT_REFINE_ANSWERS: {
+            size_t v;
+            if (tool_parse_size(&t, c == OPT_REFINE_RADIUS ? "--refine-radius" : "--refine-answers",
+                                optarg, 1, c == OPT_REFINE_RADIUS ? 3 : 124, &v))
+                return TOOL_EXIT_USAGE;
+            if (c == OPT_REFINE_RADIUS)
+                rp.radius = (int)v;
+            else
+                rp.answers = (int)v;
+            break;
+        }
+        case OPT_REFINE_BAND:
+            if (tool_parse_double(&t, "--refine-band", optarg, 1e-3, 8.0, &rp.band_voxels))
+                return TOOL_EXIT_USAGE;
             break;
         case 'o':
             out = optarg;
@@ -180,11 +213,18 @@ int main(int argc, char *argv[])
                                     "terminal: give -o FILE or pipe it");
     if (!st_path_is_stdio(out) && st_grid_format_from_path(out) == ST_GRID_FMT_UNKNOWN)
         return tool_usage_error(&t, "cannot tell the format of '%s' (use .vdb or .vti)", out);
+    if (surface && paper)
+        return tool_usage_error(&t, "--rule paper is the paper's rule exactly: it takes no --surface");
+    if (surface && st_path_is_stdio(surface) && st_path_is_stdio(in))
+        return tool_usage_error(&t, "the field and the surface cannot both come from stdin");
     tool_set_threads(threads);
 
     st_error err;
     st_error_clear(&err);
     st_grid *g = NULL;
+    st_soup *soup = NULL;
+    size_t changed = 0;
+    double t_refine = 0.0;
     int rc = TOOL_EXIT_FAIL;
     double t0 = tool_now();
     if (st_grid_read(&g, in, max_bytes, &err)) {
@@ -202,6 +242,22 @@ int main(int argc, char *argv[])
         goto done;
     }
     tool_progress_end(&t);
+    if (surface) {
+        double r0 = tool_now();
+        if (st_soup_read(&soup, surface, &err)) {
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        double r1 = tool_now();
+        if (st_sign_refine(g, soup, &rp, &changed, &err)) {
+            if (!err.file[0])
+                snprintf(err.file, sizeof err.file, "%s", surface);
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        t_refine = tool_now() - r1;
+        t1 += r1 - r0;   /* reading the surface is not signing */
+    }
     double t2 = tool_now();
     if (st_meta_history_append(&g->meta, t.command_line ? t.command_line : "soupsign")) {
         st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
@@ -220,10 +276,14 @@ int main(int argc, char *argv[])
              st_meta_get(&g->meta, "sign_rule"));
     tool_say(&t, 2, "event distance %.6g (%.3g voxels); %zu of %zu voxels inside (%.2f%%)",
              event, event / g->voxel, inside, n, 100.0 * (double)inside / (double)n);
-    tool_say(&t, 2, "read %.3f s, signs %.3f s, write %.3f s", t1 - t0, t2 - t1, t3 - t2);
+    if (surface)
+        tool_say(&t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
+                 rp.band_voxels, changed, t_refine);
+    tool_say(&t, 2, "read %.3f s, signs %.3f s, write %.3f s", t1 - t0, t2 - t1 - t_refine, t3 - t2);
     rc = TOOL_EXIT_OK;
 done:
     st_grid_free(g);
+    st_soup_free(soup);
     tool_finish(&t);
     return rc;
 }

@@ -48,7 +48,8 @@ static void usage(void)
 "      --min-volume V   drop outer pieces enclosing less than V cubic voxels\n"
 "                       (default %g; 0 keeps every piece)\n"
 "      --keep-cavities  keep pieces that lie inside others (default: fill)\n"
-"      --surface INPUT  wrap a soup: distance and signs in-process\n"
+"      --surface INPUT  wrap a soup: distance and signs (refined next to the\n"
+"                       surface, as soupsign --surface) in-process\n"
 "  -r, --cells N        with --surface: voxels along the longest side\n"
 "                       (default %d)\n"
 "  -o, --output OUT     .obj .off .ply (binary) .stl (binary); '-' or none:\n"
@@ -199,8 +200,10 @@ int main(int argc, char *argv[])
             goto done;
         }
         st_sign_params sp = st_sign_params_default();
+        st_sign_refine_params rf = st_sign_refine_params_default();
         if (st_dist_field(&g, input, &dp, &prog, &err) ||
-            st_sign_field(g, &sp, &prog, &err)) {
+            st_sign_field(g, &sp, &prog, &err) ||
+            st_sign_refine(g, input, &rf, NULL, &err)) {
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", srcname);
             rc = tool_fail(&t, &err);

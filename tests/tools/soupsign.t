@@ -41,4 +41,17 @@ expect_fail "bad --rays" 2 "rays" soupsign --rays 7 d.vdb
 expect_fail "unknown rule" 2 "unknown rule" soupsign --rule magic d.vdb
 expect_fail "unknown toggle" 2 "--toggle is first, nearest or crossing" soupsign --toggle middle d.vdb
 
+# The near-surface refinement with the soup (--surface).
+check "--surface refines: a .vti" sh -c "soupdist -r 48 '$BUNNY' | soupsign --surface '$BUNNY' -o r.vti"
+check "--surface records the refinement in the history metadata" sh -c "soupsign --surface '$BUNNY' -o r.vdb d.vdb && grep -aq 'sign_refine' r.vdb"
+check "-v reports the refinement" sh -c "soupsign -v --surface '$BUNNY' -o r2.vdb d.vdb 2>&1 | grep -q 'refinement (band 1.5 voxels): [0-9]* signs changed'"
+mkdir r1 r2
+(cd r1 && OMP_NUM_THREADS=1 soupsign --surface "$BUNNY" -o s.vti ../d.vdb)
+(cd r2 && OMP_NUM_THREADS=2 soupsign --surface "$BUNNY" -o s.vti ../d.vdb)
+check "refined: 1 and 2 threads write identical files" cmp r1/s.vti r2/s.vti
+expect_fail "--rule paper takes no --surface" 2 "takes no --surface" soupsign --rule paper --surface "$BUNNY" d.vdb
+expect_fail "a missing surface" 1 "^soupsign: nosuch.obj" soupsign --surface nosuch.obj -o y.vdb d.vdb
+check "no partial output after a refinement failure" test ! -e y.vdb
+expect_fail "bad --refine-band" 2 "refine-band" soupsign --refine-band 0 --surface "$BUNNY" d.vdb
+
 done_testing
