@@ -86,6 +86,8 @@ typedef struct fair_ctx {
     double *tmp;         /* 3 * nv scratch coordinates */
     double *disp;        /* 3 * nv displacements */
     double *nrm;         /* 3 * nv area-weighted normals (boundary) */
+    uint32_t *moved_at;  /* nv: apply_disp phase of the vertex's last move */
+    uint32_t *tried_at;  /* nv: phase it was last blocked in, 0 if not */
     size_t moves, backoffs, stuck;
     double floor;        /* p.min_angle */
 } fair_ctx;
@@ -265,32 +267,61 @@ static void extend_inward(fair_ctx *c)
 }
 
 /* Move v by the fraction of disp that keeps its star positive: 1, 1/2, ...
- * Returns the fraction taken (0 when blocked). */
+ * Returns the fraction taken (0 when blocked). The star's score at p may
+ * not fall below min(floor, its score now); a score at p of at least the
+ * floor passes whatever the score now is, so that one is computed only
+ * when a trial position scores under the floor. */
 static double move_checked(fair_ctx *c, uint32_t v, const double disp[3],
                            size_t *backoffs)
 {
     double *x = c->sm.m->xyz + 3 * (size_t)v;
-    double floor_score = fmin(c->floor, sm_star_score(&c->sm, v, x));
+    double floor_score = c->floor;
+    int have_floor = 0;
     double f = 1.0;
     for (int h = 0; h <= FAIR_HALVINGS; h++, f *= 0.5) {
         double p[3] = {x[0] + f * disp[0], x[1] + f * disp[1], x[2] + f * disp[2]};
-        if (sm_star_positive(&c->sm, v, p) && sm_star_score(&c->sm, v, p) >= floor_score) {
-            memcpy(x, p, sizeof p);
-            return f;
+        if (sm_star_positive(&c->sm, v, p)) {
+            double sp = sm_star_score(&c->sm, v, p);
+            if (!(sp >= c->floor) && !have_floor) {
+                floor_score = fmin(c->floor, sm_star_score(&c->sm, v, x));
+                have_floor = 1;
+            }
+            if (sp >= floor_score) {
+                memcpy(x, p, sizeof p);
+                return f;
+            }
         }
         (*backoffs)++;
     }
     return 0.0;
 }
 
-/* Move every vertex by c->disp, in colour order, in sweeps. */
+/* 1 when no edge neighbour of v has moved since phase t. */
+static int star_unchanged(const fair_ctx *c, uint32_t v, uint32_t t)
+{
+    const sm_mesh *sm = &c->sm;
+    for (size_t k = sm->vv_off[v]; k < sm->vv_off[v + 1]; k++)
+        if (c->moved_at[sm->vv[k]] > t)
+            return 0;
+    return 1;
+}
+
+/* Move every vertex by c->disp, in colour order, in sweeps. A vertex that
+ * was blocked outright keeps its displacement, so while no neighbour has
+ * moved its star and its trials are the same as last time: it is blocked
+ * again without the trials (counted as if they were made). Phases number
+ * the (sweep, colour) steps from 1; a neighbour never shares a phase. */
 static void apply_disp(fair_ctx *c)
 {
     const sm_mesh *sm = &c->sm;
     double *d = c->disp;
+    memset(c->moved_at, 0, sm->nv * sizeof *c->moved_at);
+    memset(c->tried_at, 0, sm->nv * sizeof *c->tried_at);
+    uint32_t phase = 0;
     for (int sweep = 0; sweep < FAIR_SWEEPS; sweep++) {
         size_t pending = 0, moves = 0, backoffs = 0, stuck = 0;
         for (size_t col = 0; col < sm->ncolours; col++) {
+            uint32_t ph = ++phase;
             #pragma omp parallel for schedule(dynamic, 32) reduction(+ : pending, moves, backoffs, stuck) \
                 if (PAR_MOVES(sm->col_off[col + 1] - sm->col_off[col]))
             for (size_t j = sm->col_off[col]; j < sm->col_off[col + 1]; j++) {
@@ -298,7 +329,16 @@ static void apply_disp(fair_ctx *c)
                 double *dv = d + 3 * (size_t)v;
                 if (dv[0] == 0.0 && dv[1] == 0.0 && dv[2] == 0.0)
                     continue;
-                double f = move_checked(c, v, dv, &backoffs);
+                double f;
+                if (c->tried_at[v] && star_unchanged(c, v, c->tried_at[v])) {
+                    backoffs += FAIR_HALVINGS + 1;
+                    f = 0.0;
+                } else {
+                    f = move_checked(c, v, dv, &backoffs);
+                }
+                c->tried_at[v] = f == 0.0 ? ph : 0;
+                if (f > 0.0)
+                    c->moved_at[v] = ph;
                 if (f == 1.0) {
                     dv[0] = dv[1] = dv[2] = 0.0;
                     moves++;
@@ -353,6 +393,8 @@ static void fair_ctx_free(fair_ctx *c)
     free(c->tmp);
     free(c->disp);
     free(c->nrm);
+    free(c->moved_at);
+    free(c->tried_at);
 }
 
 /* Rescale passes from the current positions (uniform weights) until the
@@ -413,9 +455,12 @@ st_status st_fair(st_tetmesh *m, const st_fair_params *pp, st_fair_stats *stats,
     c.tmp = st_malloc_array(3 * nv, sizeof *c.tmp);
     c.disp = st_calloc_array(3 * nv, sizeof *c.disp);
     c.nrm = st_malloc_array(3 * nv, sizeof *c.nrm);
+    c.moved_at = st_malloc_array(nv, sizeof *c.moved_at);
+    c.tried_at = st_malloc_array(nv, sizeof *c.tried_at);
     double *rhs = st_malloc_array(6 * (nb ? nb : 1), sizeof *rhs);
     double *tgt = st_malloc_array(3 * nv, sizeof *tgt);
-    if (!c.bidx || !c.bvert || !c.tmp || !c.disp || !c.nrm || !rhs || !tgt) {
+    if (!c.bidx || !c.bvert || !c.tmp || !c.disp || !c.nrm || !c.moved_at || !c.tried_at ||
+        !rhs || !tgt) {
         s = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory (fairing)");
         goto done;
     }

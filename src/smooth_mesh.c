@@ -243,6 +243,98 @@ int sm_star_positive(const sm_mesh *sm, uint32_t v, const double p[3])
 /* Degrees per radian, as tetqual.c has it, so the angles agree. */
 #define SM_RAD2DEG (180.0 / 3.14159265358979323846)
 
+/* fmax for the non-negative operands of sm_norm3 (fabs values, maybe NaN
+ * or infinite): returns what fmax returns, without the libm call. */
+static inline double sm_fmax(double a, double b)
+{
+    return (a > b || b != b) ? a : b;
+}
+
+/* st_norm3 (geom.c) inline, operation for operation, so the value is the
+ * same bit for bit. */
+static inline double sm_norm3(const double v[3])
+{
+    double m = sm_fmax(fabs(v[0]), sm_fmax(fabs(v[1]), fabs(v[2])));
+    if (!(m > 0.0) || !isfinite(m))
+        return m;
+    double x = v[0] / m, y = v[1] / m, z = v[2] / m;
+    return m * sqrt(x * x + y * y + z * z);
+}
+
+/* The pair (|u x v|, s u . v) of one edge; 0 for a degenerate case. */
+static inline int edge_pair(const double u[3], const double v[3], double s, double *y,
+                            double *x)
+{
+    double w[3];
+    st_cross3(w, u, v);
+    *y = sm_norm3(w);
+    *x = s * st_dot3(u, v);
+    return *y > 0.0 && isfinite(*y) && isfinite(*x);
+}
+
+/* The two extreme dihedrals of a tet as (|u x v|, u . v) pairs: the
+ * smallest at (*ylo, *xlo), the largest at (*yhi, *xhi). Returns 0 for a
+ * degenerate case (see sm_tet_score), which st_tet_dihedral_range must
+ * score. */
+static inline int tet_extremes(const double *a, const double *b, const double *c,
+                               const double *d, double *ylo, double *xlo,
+                               double *yhi, double *xhi)
+{
+    /* sm_tet_score's edge i = (pi, pj), others pk, pl, takes u = e x f,
+     * v = e x g with e = pj - pi, f = pk - pi, g = pl - pi. The edges from
+     * one corner share their differences, and a x b = -(b x a) exactly in
+     * floating point (a1 b2 - a2 b1 = -(a2 b1 - a1 b2)); negating u or v
+     * negates w = u x v and u . v exactly too, so the 18 cross products
+     * come down to 14 with the same |w| and, up to sign, u . v. */
+    double d1[3], d2[3], d3[3], c0[3], c2[3], c3[3], b0[3], b1[3], b3[3];
+    st_sub3(d1, b, a);
+    st_sub3(d2, c, a);
+    st_sub3(d3, d, a);
+    st_sub3(c0, a, b);
+    st_sub3(c2, c, b);
+    st_sub3(c3, d, b);
+    st_sub3(b0, a, c);
+    st_sub3(b1, b, c);
+    st_sub3(b3, d, c);
+    double A[3], B[3], C[3], D[3], E[3], F[3], G[3], H[3];
+    st_cross3(A, d1, d2);   /* edge 0: u = A, v = B */
+    st_cross3(B, d1, d3);   /* edge 1: u = -A, v = C */
+    st_cross3(C, d2, d3);   /* edge 2: u = -B, v = -C */
+    st_cross3(D, c2, c0);   /* edge 3: u = D, v = E */
+    st_cross3(E, c2, c3);   /* edge 4: u = F, v = -E */
+    st_cross3(F, c3, c0);
+    st_cross3(G, b3, b0);   /* edge 5: u = G, v = H */
+    st_cross3(H, b3, b1);
+    /* the sign of u . v: edge 1 has one factor negated, edge 4 one, edge 2
+     * two */
+    double y[6], x[6];
+    if (!edge_pair(A, B, 1.0, y + 0, x + 0) || !edge_pair(A, C, -1.0, y + 1, x + 1) ||
+        !edge_pair(B, C, 1.0, y + 2, x + 2) || !edge_pair(D, E, 1.0, y + 3, x + 3) ||
+        !edge_pair(F, E, -1.0, y + 4, x + 4) || !edge_pair(G, H, 1.0, y + 5, x + 5))
+        return 0;
+    int imin = 0, imax = 0;   /* smallest angle: largest x / y */
+    for (int i = 1; i < 6; i++) {
+        if (x[i] * y[imin] > x[imin] * y[i])
+            imin = i;
+        if (x[i] * y[imax] < x[imax] * y[i])
+            imax = i;
+    }
+    *ylo = y[imin];
+    *xlo = x[imin];
+    *yhi = y[imax];
+    *xhi = x[imax];
+    return 1;
+}
+
+static double degenerate_score(const double *a, const double *b, const double *c,
+                               const double *d)
+{
+    double lo, hi;
+    st_tet_dihedral_range(a, b, c, d, &lo, &hi);
+    double s2 = ST_FIT_MAX_WEIGHT * (180.0 - hi);
+    return lo < s2 ? lo : s2;
+}
+
 /* The score is asked for tens of times per trial move (the quality pass
  * scores ~40 candidate positions of a star of ~20 tets): instead of six
  * atan2 calls (st_tet_dihedral_range), the dihedral at each edge is kept
@@ -254,49 +346,86 @@ int sm_star_positive(const sm_mesh *sm, uint32_t v, const double p[3])
 double sm_tet_score(const double *a, const double *b, const double *c,
                     const double *d)
 {
-    const double *p[4] = {a, b, c, d};
-    static const int ed[6][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2},
-                                 {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};
-    double y[6], x[6];
-    for (int i = 0; i < 6; i++) {
-        const double *pi = p[ed[i][0]], *pj = p[ed[i][1]], *pk = p[ed[i][2]],
-                     *pl = p[ed[i][3]];
-        double e[3], f[3], g[3], u[3], v[3], w[3];
-        st_sub3(e, pj, pi);
-        st_sub3(f, pk, pi);
-        st_sub3(g, pl, pi);
-        st_cross3(u, e, f);
-        st_cross3(v, e, g);
-        st_cross3(w, u, v);
-        y[i] = st_norm3(w);
-        x[i] = st_dot3(u, v);
-        if (!(y[i] > 0.0) || !isfinite(y[i]) || !isfinite(x[i])) {
-            double lo, hi;
-            st_tet_dihedral_range(a, b, c, d, &lo, &hi);
-            double s2 = ST_FIT_MAX_WEIGHT * (180.0 - hi);
-            return lo < s2 ? lo : s2;
-        }
-    }
-    int imin = 0, imax = 0;   /* smallest angle: largest x / y */
-    for (int i = 1; i < 6; i++) {
-        if (x[i] * y[imin] > x[imin] * y[i])
-            imin = i;
-        if (x[i] * y[imax] < x[imax] * y[i])
-            imax = i;
-    }
-    double lo = atan2(y[imin], x[imin]) * SM_RAD2DEG;
-    double hi = atan2(y[imax], x[imax]) * SM_RAD2DEG;
+    double ylo, xlo, yhi, xhi;
+    if (!tet_extremes(a, b, c, d, &ylo, &xlo, &yhi, &xhi))
+        return degenerate_score(a, b, c, d);
+    double lo = atan2(ylo, xlo) * SM_RAD2DEG;
+    double hi = atan2(yhi, xhi) * SM_RAD2DEG;
     double s2 = ST_FIT_MAX_WEIGHT * (180.0 - hi);
     return lo < s2 ? lo : s2;
+}
+
+/* Tets per block of sm_star_score's pruned minimum. */
+#define SM_STAR_BLOCK 64
+/* Ratios r = x / y whose atan2 sm_star_score may skip: a tet is skipped
+ * when its ratio is further than SM_PRUNE_GAP * (1 + |r*|)^2 from the
+ * extreme r*, which parts the angles by more than 2e-7 rad, far beyond
+ * the few ulps of atan2 and of the division; past |r*| > SM_PRUNE_MAX
+ * (angles within 1e-6 rad of 0 or 180 degrees) nothing is skipped. */
+#define SM_PRUNE_GAP 1e-6
+#define SM_PRUNE_MAX 1e6
+
+/* min over tets of min(lo_t, W (180 - hi_t)) is min(min_t lo_t,
+ * W (180 - max_t hi_t)) exactly (the rounded subtraction and product are
+ * monotone), and atan2(y, x) falls as x / y grows: so atan2 is needed only
+ * for the tets whose ratio is near the extreme one. The per-tet choice of
+ * the extreme edge is sm_tet_score's, so the result is sm_tet_score's
+ * minimum bit for bit. */
+static double star_block_score(const sm_mesh *sm, uint32_t v, const double p[3],
+                               size_t j0, size_t j1)
+{
+    double ylo[SM_STAR_BLOCK], xlo[SM_STAR_BLOCK], yhi[SM_STAR_BLOCK], xhi[SM_STAR_BLOCK];
+    double rlo[SM_STAR_BLOCK], rhi[SM_STAR_BLOCK];
+    double s = INFINITY, rlo_max = -INFINITY, rhi_min = INFINITY;
+    size_t n = 0;
+    for (size_t j = j0; j < j1; j++) {
+        const double *q[4];
+        star_corners(sm, sm->vt[j], v, p, q);
+        if (!tet_extremes(q[0], q[1], q[2], q[3], ylo + n, xlo + n, yhi + n, xhi + n)) {
+            double x = degenerate_score(q[0], q[1], q[2], q[3]);
+            if (x < s)
+                s = x;
+            continue;
+        }
+        rlo[n] = xlo[n] / ylo[n];
+        rhi[n] = xhi[n] / yhi[n];
+        if (rlo[n] > rlo_max)
+            rlo_max = rlo[n];
+        if (rhi[n] < rhi_min)
+            rhi_min = rhi[n];
+        n++;
+    }
+    if (n == 0)
+        return s;
+    double cut_lo = -INFINITY, cut_hi = INFINITY;
+    if (fabs(rlo_max) <= SM_PRUNE_MAX)
+        cut_lo = rlo_max - SM_PRUNE_GAP * (1.0 + fabs(rlo_max)) * (1.0 + fabs(rlo_max));
+    if (fabs(rhi_min) <= SM_PRUNE_MAX)
+        cut_hi = rhi_min + SM_PRUNE_GAP * (1.0 + fabs(rhi_min)) * (1.0 + fabs(rhi_min));
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        if (!(rlo[i] < cut_lo)) {
+            double a = atan2(ylo[i], xlo[i]) * SM_RAD2DEG;
+            if (a < lo)
+                lo = a;
+        }
+        if (!(rhi[i] > cut_hi)) {
+            double a = atan2(yhi[i], xhi[i]) * SM_RAD2DEG;
+            if (a > hi)
+                hi = a;
+        }
+    }
+    double s2 = ST_FIT_MAX_WEIGHT * (180.0 - hi);
+    double t = lo < s2 ? lo : s2;
+    return t < s ? t : s;
 }
 
 double sm_star_score(const sm_mesh *sm, uint32_t v, const double p[3])
 {
     double s = INFINITY;
-    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
-        const double *q[4];
-        star_corners(sm, sm->vt[j], v, p, q);
-        double x = sm_tet_score(q[0], q[1], q[2], q[3]);
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j += SM_STAR_BLOCK) {
+        size_t j1 = j + SM_STAR_BLOCK < sm->vt_off[v + 1] ? j + SM_STAR_BLOCK : sm->vt_off[v + 1];
+        double x = star_block_score(sm, v, p, j, j1);
         if (x < s)
             s = x;
     }

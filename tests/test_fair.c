@@ -1,6 +1,7 @@
 /* test_fair.c - st_fair: volume kept, nothing inverted, corners rounded,
  * deterministic for any thread count. Meshes are blocks of 5-tet cubes
  * built here. */
+#include "../src/smooth_internal.h"
 #include "souptet/pred.h"
 #include "souptet/smooth.h"
 #include "souptet/tetmesh.h"
@@ -13,6 +14,15 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+
+static uint64_t rng_state = 88172645463325252ull;
+static double rnd(void)   /* xorshift64, uniform in [0, 1) */
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return (double)(rng_state >> 11) / 9007199254740992.0;
+}
 
 /* A 5-tet cube lattice of n^3 cells of width h from lo, keeping the cells
  * for which keep(center) is nonzero (NULL: all); mirrored splits on
@@ -214,8 +224,101 @@ static void test_refusals(void)
     st_tetmesh_free(e);
 }
 
+/* sm_star_score skips the atan2 of tets that cannot hold the star's
+ * extreme angles and shares cross products between edges: its value must
+ * still be the minimum of sm_tet_score over the star, bit for bit, for
+ * round, sliver, flat and needle tets, and for stars past its block of 64
+ * tets. */
+static void test_star_score_is_min(void)
+{
+    enum { NT = 150, NTRIAL = 40 };
+    st_tetmesh *m = st_tetmesh_new();
+    double o[3] = {0, 0, 0};
+    st_tetmesh_add_point(m, o, NULL);
+    for (int t = 0; t < NT; t++) {
+        double q[3][3];
+        for (int i = 0; i < 3; i++)
+            for (int a = 0; a < 3; a++)
+                q[i][a] = 2.0 * rnd() - 1.0;
+        int kind = t % 5;
+        if (kind == 1)        /* sliver: the third corner near the plane of the others and v */
+            for (int a = 0; a < 3; a++)
+                q[2][a] = 0.5 * q[0][a] + 0.4 * q[1][a] + 1e-7 * rnd();
+        else if (kind == 2)   /* exactly flat: the third corner on a line */
+            for (int a = 0; a < 3; a++)
+                q[2][a] = 2.0 * q[0][a] - q[1][a];
+        else if (kind == 3)   /* needle: two corners nearly together */
+            for (int a = 0; a < 3; a++)
+                q[1][a] = q[0][a] + 1e-9 * rnd();
+        uint32_t c[3];
+        for (int i = 0; i < 3; i++) {
+            c[i] = (uint32_t)m->npoints;
+            st_tetmesh_add_point(m, q[i], NULL);
+        }
+        st_tetmesh_add_tet(m, 0, c[0], c[1], c[2], NULL);
+    }
+    sm_mesh sm;
+    memset(&sm, 0, sizeof sm);
+    size_t off[2] = {0, NT};
+    uint32_t vt[NT];
+    for (uint32_t t = 0; t < NT; t++)
+        vt[t] = t;
+    sm.m = m;
+    sm.nv = m->npoints;
+    sm.nt = m->ntets;
+    sm.vt_off = off;
+    sm.vt = vt;
+    /* windows of the tet list as stars: single tets (each kind alone),
+     * a few, exactly a block, past a block, all */
+    static const int lens[] = {1, 1, 2, 3, 4, 5, 9, 64, 65, 130, NT};
+    int same = 1, tested = 0, finite_lo = 0;
+    for (size_t k = 0; k < sizeof lens / sizeof lens[0]; k++) {
+        for (int trial = 0; trial < NTRIAL; trial++) {
+            int len = lens[k], start = (int)(rnd() * (NT - len + 1));
+            sm.vt = vt + start;
+            off[1] = (size_t)len;
+            double p[3], scale = trial < 5 ? 0.0 : pow(10.0, -3.0 - (double)(trial % 8));
+            for (int a = 0; a < 3; a++)
+                p[a] = scale * (2.0 * rnd() - 1.0);
+            double want = INFINITY;
+            for (int t = start; t < start + len; t++) {
+                const uint32_t *tc = m->tets + 4 * (size_t)t;
+                double sc = sm_tet_score(p, m->xyz + 3 * (size_t)tc[1], m->xyz + 3 * (size_t)tc[2],
+                                         m->xyz + 3 * (size_t)tc[3]);
+                if (sc < want)
+                    want = sc;
+            }
+            double got = sm_star_score(&sm, 0, p);
+            if (memcmp(&got, &want, sizeof got) != 0)
+                same = 0;
+            tested++;
+            finite_lo += want > 0.0 && want < 60.0;
+        }
+    }
+    sm.vt = vt;
+    TAP_CHECK(same && finite_lo > tested / 8,
+              "the star score is the minimum of the tet scores, bit for bit (%d stars, %d "
+              "with a non-zero score)", tested, finite_lo);
+    /* and sm_tet_score is st_tet_dihedral_range's min(min, W (180 - max)) */
+    double worst = 0.0;
+    for (int t = 0; t < NT; t++) {
+        const uint32_t *tc = m->tets + 4 * (size_t)t;
+        const double *q0 = m->xyz + 3 * (size_t)tc[0], *q1 = m->xyz + 3 * (size_t)tc[1],
+                     *q2 = m->xyz + 3 * (size_t)tc[2], *q3 = m->xyz + 3 * (size_t)tc[3];
+        double lo, hi;
+        st_tet_dihedral_range(q0, q1, q2, q3, &lo, &hi);
+        double want = fmin(lo, ST_FIT_MAX_WEIGHT * (180.0 - hi));
+        double d = fabs(sm_tet_score(q0, q1, q2, q3) - want);
+        if (!(d <= worst))
+            worst = d;
+    }
+    TAP_CHECK(worst < 1e-9, "the tet score agrees with the dihedral range (%.3g degrees)", worst);
+    st_tetmesh_free(m);
+}
+
 int main(void)
 {
+    test_star_score_is_min();
     test_block();
     test_ball_many_iters();
     test_thin_slab();
