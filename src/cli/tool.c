@@ -234,6 +234,30 @@ const char *tool_json_number(char buf[32], double x)
     return buf;
 }
 
+int tool_output_unwritable(const tool_ctx *t, const char *path)
+{
+    if (st_path_is_stdio(path))
+        return 0;
+    size_t n = strlen(path);
+    char *dir = malloc(n + 2);
+    if (!dir)
+        return 0;   /* let the real write report it */
+    memcpy(dir, path, n + 1);
+    char *slash = strrchr(dir, '/');
+    if (!slash)
+        strcpy(dir, ".");
+    else if (slash == dir)
+        dir[1] = '\0';   /* "/name": the root */
+    else
+        *slash = '\0';
+    int bad = access(dir, W_OK | X_OK) != 0;
+    if (bad)
+        fprintf(stderr, "%s: %s: cannot write there: %s\n", t->name, path,
+                strerror(errno));
+    free(dir);
+    return bad;
+}
+
 tool_common tool_common_default(void)
 {
     tool_common co;

@@ -62,6 +62,13 @@ int tool_parse_bytes(const tool_ctx *t, const char *opt, const char *arg,
 /* The default memory limit: 80% of physical memory (0 if unknown). */
 size_t tool_default_max_memory(void);
 
+/* Before a long computation: 1 (after printing "name: PATH: cannot write
+ * there: why") when the directory that would hold the output file PATH
+ * does not exist or is not writable, else 0. NULL and "-" (stdout) are
+ * always fine. The real write still checks everything; this only saves
+ * the user a run whose result could not be kept. */
+int tool_output_unwritable(const tool_ctx *t, const char *path);
+
 /* Set the OpenMP thread count (0: leave the default). */
 void tool_set_threads(size_t threads);
 

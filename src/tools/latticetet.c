@@ -178,6 +178,10 @@ int main(int argc, char *argv[])
     if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
         return tool_usage_error(&t, "cannot tell the format of '%s' (use .vtu, "
                                     ".msh, .node, .ele or .mesh)", out);
+    if (tool_output_unwritable(&t, out)) {
+        tool_finish(&t);
+        return TOOL_EXIT_FAIL;
+    }
     tool_set_threads(co.threads);
 
     st_error err;

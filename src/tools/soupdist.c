@@ -130,6 +130,10 @@ int main(int argc, char *argv[])
         st_grid_format_from_path(out) == ST_GRID_FMT_UNKNOWN)
         return tool_usage_error(&t, "cannot tell the format of '%s' "
                                     "(use .vdb or .vti)", out);
+    if (tool_output_unwritable(&t, out)) {
+        tool_finish(&t);
+        return TOOL_EXIT_FAIL;
+    }
     tool_set_threads(co.threads);
     p.max_bytes = co.max_bytes;
 

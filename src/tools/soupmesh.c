@@ -209,6 +209,10 @@ int main(int argc, char *argv[])
     int embed_text = elen > 4 && strcmp(embed + elen - 4, ".txt") == 0;
     if (embed && !embed_text && !(elen > 4 && strcmp(embed + elen - 4, ".vtu") == 0))
         return tool_usage_error(&t, "--embed writes .txt or .vtu, not '%s'", embed);
+    if (tool_output_unwritable(&t, out) || tool_output_unwritable(&t, embed)) {
+        tool_finish(&t);
+        return TOOL_EXIT_FAIL;
+    }
     tool_set_threads(co.threads);
     p.max_bytes = co.max_bytes;
 

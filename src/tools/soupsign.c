@@ -68,15 +68,14 @@ static void usage(void)
 "Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
 }
 
-enum { OPT_BAND = 256, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS, OPT_THREADS,
-       OPT_MAXMEM, OPT_HELP, OPT_VERSION };
+enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
 
 int main(int argc, char *argv[])
 {
     tool_ctx t;
     tool_init(&t, "soupsign", argc, argv);
+    tool_common co = tool_common_default();
     st_sign_params p = st_sign_params_default();
-    size_t max_bytes = tool_default_max_memory(), threads = 0;
     const char *out = NULL, *in = NULL, *surface = NULL;
     st_sign_refine_params rp = st_sign_refine_params_default();
     int paper = 0;
@@ -92,12 +91,8 @@ int main(int argc, char *argv[])
         {"refine-radius", required_argument, NULL, OPT_REFINE_RADIUS},
         {"refine-answers", required_argument, NULL, OPT_REFINE_ANSWERS},
         {"output", required_argument, NULL, 'o'},
-        {"threads", required_argument, NULL, OPT_THREADS},
-        {"max-memory", required_argument, NULL, OPT_MAXMEM},
-        {"quiet", no_argument, NULL, 'q'},
-        {"verbose", no_argument, NULL, 'v'},
-        {"help", no_argument, NULL, OPT_HELP},
-        {"version", no_argument, NULL, OPT_VERSION},
+        TOOL_LONG_OPTIONS_BASIC,
+        TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
@@ -173,30 +168,14 @@ int main(int argc, char *argv[])
         case 'o':
             out = optarg;
             break;
-        case OPT_THREADS:
-            if (tool_parse_size(&t, "--threads", optarg, 1, 4096, &threads))
-                return TOOL_EXIT_USAGE;
+        default: {
+            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
+            if (rc_opt != TOOL_CONTINUE) {
+                tool_finish(&t);
+                return rc_opt;
+            }
             break;
-        case OPT_MAXMEM:
-            if (tool_parse_bytes(&t, "--max-memory", optarg, &max_bytes))
-                return TOOL_EXIT_USAGE;
-            break;
-        case 'q':
-            t.verbosity = 0;
-            break;
-        case 'v':
-            t.verbosity = 2;
-            break;
-        case OPT_HELP:
-            usage();
-            return TOOL_EXIT_OK;
-        case OPT_VERSION:
-            tool_print_version(&t);
-            return TOOL_EXIT_OK;
-        case ':':
-            return tool_usage_error(&t, "option '%s' needs a value", argv[optind - 1]);
-        default:
-            return tool_usage_error(&t, "unknown option '%s'", argv[optind - 1]);
+        }
         }
     }
     if (optind < argc)
@@ -217,7 +196,11 @@ int main(int argc, char *argv[])
         return tool_usage_error(&t, "--rule paper is the paper's rule exactly: it takes no --surface");
     if (surface && st_path_is_stdio(surface) && st_path_is_stdio(in))
         return tool_usage_error(&t, "the field and the surface cannot both come from stdin");
-    tool_set_threads(threads);
+    if (tool_output_unwritable(&t, out)) {
+        tool_finish(&t);
+        return TOOL_EXIT_FAIL;
+    }
+    tool_set_threads(co.threads);
 
     st_error err;
     st_error_clear(&err);
@@ -227,7 +210,7 @@ int main(int argc, char *argv[])
     double t_refine = 0.0;
     int rc = TOOL_EXIT_FAIL;
     double t0 = tool_now();
-    if (st_grid_read(&g, in, max_bytes, &err)) {
+    if (st_grid_read(&g, in, co.max_bytes, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

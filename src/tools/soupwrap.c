@@ -180,6 +180,10 @@ int main(int argc, char *argv[])
                                         "(use .obj, .off, .ply or .stl)",
                                     out);
     }
+    if (tool_output_unwritable(&t, out)) {
+        tool_finish(&t);
+        return TOOL_EXIT_FAIL;
+    }
     tool_set_threads(co.threads);
     dp.max_bytes = co.max_bytes;
 

@@ -214,6 +214,10 @@ int main(int argc, char *argv[])
     if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
         return tool_usage_error(&t, "will not write a binary mesh to a terminal: give -o "
                                     "FILE or pipe it");
+    if (tool_output_unwritable(&t, out)) {
+        tool_finish(&t);
+        return TOOL_EXIT_FAIL;
+    }
     tool_set_threads(co.threads);
 
     st_error err;

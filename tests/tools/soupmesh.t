@@ -50,6 +50,8 @@ expect_fail "a missing file" 1 "^soupmesh: missing.obj" soupmesh -o x.vtu missin
 printf 'v 0 0 0\nv 1 0 0\nf 1 2 9\n' > bad.obj
 expect_fail "an index out of range names the line" 1 "^soupmesh: bad.obj:3: " soupmesh -o x.vtu bad.obj
 check "no partial output" test ! -e x.vtu
+expect_fail "an output directory that does not exist is refused before the work" 1 \
+    "^soupmesh: $WORK/no-such-dir/m.vtu: cannot write there" soupmesh -o "$WORK/no-such-dir/m.vtu" "$BUNNY"
 expect_fail "bad --cells" 2 "cells" soupmesh --cells 0 -o x.vtu "$BUNNY"
 expect_fail "unknown output format" 2 "format" soupmesh -o x.abc "$BUNNY"
 
