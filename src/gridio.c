@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 st_grid_format st_grid_format_from_path(const char *path)
 {
@@ -61,6 +62,24 @@ st_status st_grid_write(const st_grid *g, const char *path, st_error *err)
     }
     return st_error_set(err, ST_EINPUT, path, 0,
                         "unknown field format (use .vdb or .vti)");
+}
+
+st_status st_gridio_check_input_file(const char *path, st_error *err)
+{
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
+                            strerror(errno));
+    if (S_ISDIR(st.st_mode))
+        return st_error_set(err, ST_EIO, path, 0, "is a directory");
+    if (S_ISREG(st.st_mode) && st.st_size == 0)
+        return st_error_set(err, ST_EINPUT, path, 0, "empty file");
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
+                            strerror(errno));
+    fclose(fp);
+    return ST_OK;
 }
 
 st_status st_gridio_read_stdin(unsigned char **data, size_t *size,

@@ -24,6 +24,12 @@ extern "C" {
  * success, even for 0 bytes; caller frees). Stdin has to be read whole
  * anyway: its format is sniffed from the first bytes, and neither reader
  * may seek on a pipe. ST_EIO on a read error. */
+/* Checks by path before a library reads a file by name, so that the usual
+ * failures get the system's words, not the library's: ST_EIO "cannot open:
+ * why" or "is a directory", ST_EINPUT "empty file". Shared by the field
+ * and tet-mesh adapters. */
+st_status st_gridio_check_input_file(const char *path, st_error *err);
+
 st_status st_gridio_read_stdin(unsigned char **data, size_t *size,
                                st_error *err);
 

@@ -191,26 +191,6 @@ std::string escape_key(const std::string &key)
     return key;
 }
 
-/* Pre-checks by path so that the usual failures get the system's words,
- * not VTK's. */
-st_status check_input_file(const char *path, st_error *err)
-{
-    struct stat st;
-    if (stat(path, &st) != 0)
-        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
-                            std::strerror(errno));
-    if (S_ISDIR(st.st_mode))
-        return st_error_set(err, ST_EIO, path, 0, "is a directory");
-    if (S_ISREG(st.st_mode) && st.st_size == 0)
-        return st_error_set(err, ST_EINPUT, path, 0, "empty file");
-    FILE *fp = std::fopen(path, "rb");
-    if (!fp)
-        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
-                            std::strerror(errno));
-    std::fclose(fp);
-    return ST_OK;
-}
-
 st_status vtk_failed(const char *name, const char *what, st_error *err)
 {
     std::string m = vtk_message(t_errors);
@@ -554,7 +534,7 @@ st_status st_grid_read_vti(st_grid **out, const char *path, size_t max_bytes,
         std::free(data);
         return s;
     }
-    if (st_status s = check_input_file(path, err))
+    if (st_status s = st_gridio_check_input_file(path, err))
         return s;
     return guarded(path, "reading", err, [&] {
         vtkNew<vtkXMLImageDataReader> r;

@@ -554,24 +554,6 @@ st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
     return ST_OK;
 }
 
-st_status check_input_file(const char *path, st_error *err)
-{
-    struct stat st;
-    if (stat(path, &st) != 0)
-        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
-                            std::strerror(errno));
-    if (S_ISDIR(st.st_mode))
-        return st_error_set(err, ST_EIO, path, 0, "is a directory");
-    if (S_ISREG(st.st_mode) && st.st_size == 0)
-        return st_error_set(err, ST_EINPUT, path, 0, "empty file");
-    FILE *fp = std::fopen(path, "rb");
-    if (!fp)
-        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
-                            std::strerror(errno));
-    std::fclose(fp);
-    return ST_OK;
-}
-
 } // namespace
 
 extern "C" {
@@ -614,7 +596,7 @@ st_status st_tetio_read_vtu_file(st_tetmesh **out, const char *path,
                                  size_t max_bytes, st_error *err)
 {
     *out = nullptr;
-    if (st_status s = check_input_file(path, err))
+    if (st_status s = st_gridio_check_input_file(path, err))
         return s;
     return guarded(path, "reading", err, [&] {
         vtkNew<vtkXMLUnstructuredGridReader> r;
