@@ -32,6 +32,13 @@
  *     whatever the parity: the union of the parts, as a person sees it.
  *     (Not in the paper, whose rule is parity only.)
  * Results do not depend on the thread count.
+ *
+ * Memory: st_sign_field needs the grid (4 bytes per voxel) plus ONE BYTE PER
+ * VOXEL, for every rule and option: the votes (each of the 13 lines adds
+ * 0..2; a line dropped for odd parity adds 1, neutral), one bit "some ray
+ * sees the voxel from outside" for nested_union, and the two toggle marks
+ * of the direction being swept. Each thread also keeps line states for a
+ * block of lines (O(32 (nx + nz)) bytes), not per voxel.
  */
 #ifndef SOUPTET_SIGN_H
 #define SOUPTET_SIGN_H

@@ -24,6 +24,7 @@ print(frac)
 PY
 check "the bunny's pseudo volume is a plausible fraction of the box" $PYVTK inside.py s.vti
 
+check "-v reports the voting's wall and CPU time" sh -c "soupsign -v -o v.vdb d.vdb 2>&1 | grep -q 'signs [0-9.]* s (CPU [0-9.]* s, all threads)'"
 mkdir t1 t2
 (cd t1 && OMP_NUM_THREADS=1 soupsign -o s.vti ../d.vdb)
 (cd t2 && OMP_NUM_THREADS=2 soupsign -o s.vti ../d.vdb)
