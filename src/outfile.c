@@ -62,6 +62,11 @@ st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
     struct stat st;
     if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
         return st_error_set(err, ST_EIO, path, 0, "is a directory");
+    /* The temporary file is renamed over the target: over a device or a
+     * FIFO (/dev/null, /dev/stdout) that would replace the node itself. */
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode))
+        return st_error_set(err, ST_EIO, path, 0, "not a regular file "
+                            "(write to '-' for standard output)");
     size_t n = strlen(path);
     o->path = st_strdup(path);
     o->tmp = malloc(n + 16);
@@ -77,9 +82,17 @@ st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
     o->tmp[dirlen] = '.';
     strcpy(o->tmp + dirlen + 1, path + dirlen);
     strcat(o->tmp, ".XXXXXX");
+    /* Listed before it exists, so no signal finds it on disk but not in
+     * the list (mkstemp fills in the name in place; until then the handler
+     * unlinks a name that does not exist). Signals are not blocked here:
+     * a blocked main thread would have them delivered to another thread,
+     * while this one goes on writing and could re-create the file. */
+    o->slot = pending_add(o->tmp);
     int fd = mkstemp(o->tmp);
     if (fd < 0) {
         int e = errno;
+        pending_remove(o->slot);
+        o->slot = -1;
         free(o->tmp);
         o->tmp = NULL;
         st_outfile_abort(o);
@@ -90,7 +103,6 @@ st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
     mode_t mask = umask(0);
     umask(mask);
     fchmod(fd, 0666 & ~mask);
-    o->slot = pending_add(o->tmp);
     if (open_stream) {
         o->fp = fdopen(fd, "wb");
         if (!o->fp) {
@@ -109,10 +121,14 @@ st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
 st_status st_outfile_commit(st_outfile *o, st_error *err)
 {
     if (!o->path) {             /* stdout */
-        if (o->fp && fflush(o->fp) != 0) {
+        /* An earlier write may have failed with nothing left to flush. */
+        errno = 0;
+        if (o->fp && (fflush(o->fp) != 0 || ferror(o->fp))) {
             int e = errno;
+            o->fp = NULL;
             return st_error_set(err, ST_EIO, "<stdout>", 0,
-                                "write failed: %s", strerror(e));
+                                "write failed: %s",
+                                e ? strerror(e) : "I/O error");
         }
         o->fp = NULL;
         return ST_OK;
@@ -153,8 +169,8 @@ void st_outfile_abort(st_outfile *o)
         fclose(o->fp);
     o->fp = NULL;
     if (o->tmp) {
-        pending_remove(o->slot);
-        unlink(o->tmp);
+        unlink(o->tmp);          /* then forget it: a signal between the two */
+        pending_remove(o->slot); /* unlinks a name that is already gone */
         free(o->tmp);
     }
     free(o->path);

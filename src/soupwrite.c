@@ -7,6 +7,7 @@
 #include "souptet/soupwrite.h"
 #include "souptet/geom.h"
 
+#include <errno.h>
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -207,6 +208,7 @@ st_status st_soup_write(FILE *f, const st_soup *s, st_soup_format format,
                             ".off, .ply or .stl)");
     }
     if (ferror(f))
-        return st_error_set(err, ST_EIO, name, 0, "write error");
+        return st_error_set(err, ST_EIO, name, 0, "write failed: %s",
+                            errno ? strerror(errno) : "stream error");
     return ST_OK;
 }

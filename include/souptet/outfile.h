@@ -4,7 +4,9 @@
  * st_outfile_begin creates a temporary file beside the target (same
  * directory, so the final rename is atomic); st_outfile_commit checks every
  * write, closes, and renames it over the target; st_outfile_abort removes
- * it. "-" (or NULL) means stdout, where nothing is renamed.
+ * it. "-" (or NULL) means stdout, where nothing is renamed. A target that
+ * exists and is not a regular file (a directory, a device such as
+ * /dev/null, a FIFO) is refused: renaming over it would replace the node.
  *
  * Temporary names in flight are remembered so a tool's signal handler can
  * remove them with st_outfile_unlink_pending(), which is async-signal-safe.
@@ -28,11 +30,14 @@ typedef struct st_outfile {
 
 /* Start an output. With open_stream, o->fp is open for binary writing
  * (stdout for "-"); without, the empty temporary file exists at o->tmp for
- * a library that writes by name (VTK, OpenVDB). Errors name the target. */
+ * a library that writes by name (VTK, OpenVDB). Errors name the target.
+ * The temporary is listed for st_outfile_unlink_pending before it is
+ * created, so a signal never finds one on disk but not in the list. */
 st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
                            st_error *err);
-/* Flush and close (checking for write errors), then rename tmp to path.
- * On failure the temporary file is removed. */
+/* Flush and close (checking for write errors, earlier ones too), then
+ * rename tmp to path. On failure the temporary file is removed. For stdout,
+ * flush it and check its error flag ("<stdout>: write failed: why"). */
 st_status st_outfile_commit(st_outfile *o, st_error *err);
 /* Close and remove the temporary file. Safe after commit and on a zeroed
  * st_outfile. */

@@ -1,9 +1,11 @@
 /* tool.c - shared tool plumbing (see tool.h). */
 #define _GNU_SOURCE
 #include "tool.h"
+#include "souptet/grid.h"
 #include "souptet/outfile.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <getopt.h>
 #include <limits.h>
 #include <math.h>
@@ -12,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 #ifdef _OPENMP
@@ -22,11 +25,21 @@ static const char *g_name = "souptet";
 static char *g_command_line;   /* freed at exit, whatever path main takes */
 static int g_progress_drawn;
 static double g_progress_last;
+static int g_failed;           /* tool_fail has printed an error */
 
+/* Remove the temporary outputs, then die of the signal at once (its
+ * default action, unblocked: the raise does not return). The signal comes
+ * to the main thread, which is the one writing (Linux gives a process's
+ * signal to its main thread unless that blocks it), so nothing re-creates
+ * a temporary by name between the unlink and the end. */
 static void on_signal(int sig)
 {
-    st_outfile_unlink_pending();
     signal(sig, SIG_DFL);
+    st_outfile_unlink_pending();
+    sigset_t s;
+    sigemptyset(&s);
+    sigaddset(&s, sig);
+    pthread_sigmask(SIG_UNBLOCK, &s, NULL);
     raise(sig);
 }
 
@@ -43,21 +56,61 @@ static void free_command_line(void)
     g_command_line = NULL;
 }
 
+/* At exit: whatever is still buffered for stdout goes out now, and a write
+ * that failed at any time (a full disk, a closed descriptor) turns a
+ * successful exit into exit 1 with a message, as the GNU tools do. A
+ * closed pipe never gets here: SIGPIPE ends the tool first. */
+static void close_stdout(void)
+{
+    errno = 0;
+    int bad = fflush(stdout) != 0;
+    int e = errno;
+    bad |= ferror(stdout) != 0;
+    if (!bad)
+        return;
+    if (!g_failed)
+        fprintf(stderr, "%s: <stdout>: write failed: %s\n", g_name,
+                e ? strerror(e) : "I/O error");
+    _exit(TOOL_EXIT_FAIL);
+}
+
+/* A descriptor 0, 1 or 2 the tool was started without would be handed out
+ * by the next open(), and a temporary output file could then receive what
+ * is printed to stdout. Hold its place with one that fails every read and
+ * write (a directory opened read-only: EISDIR, EBADF). */
+static void hold_std_fds(void)
+{
+    for (int fd = 0; fd <= 2; fd++)
+        if (fcntl(fd, F_GETFD) < 0 && errno == EBADF) {
+            int h = open("/", O_RDONLY | O_DIRECTORY);
+            if (h >= 0 && h != fd) {
+                dup2(h, fd);
+                close(h);
+            }
+        }
+}
+
 void tool_init(tool_ctx *t, const char *name, int argc, char *argv[])
 {
+    hold_std_fds();
     t->name = name;
     g_name = name;
     t->verbosity = 1;
     t->command_line = g_command_line = st_command_line(argc, argv);
     atexit(free_command_line);
+    atexit(close_stdout);
     t->t0 = tool_now();
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
-    int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
+    int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT, SIGXCPU};
     for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++)
         sigaction(sigs[i], &sa, NULL);
+    /* Past a file size limit (ulimit -f), write(2) then fails with EFBIG
+     * and the output's own error path reports it and removes the
+     * temporary, instead of a core dump leaving it behind. */
+    signal(SIGXFSZ, SIG_IGN);
 }
 
 void tool_finish(tool_ctx *t)
@@ -69,9 +122,50 @@ void tool_finish(tool_ctx *t)
 int tool_fail(const tool_ctx *t, const st_error *err)
 {
     char buf[1200];
+    g_failed = 1;
     tool_progress_end((tool_ctx *)t);
     fprintf(stderr, "%s: %s\n", t->name, st_error_format(err, buf, sizeof buf));
     return TOOL_EXIT_FAIL;
+}
+
+int tool_flush_stdout(const tool_ctx *t)
+{
+    errno = 0;
+    int bad = fflush(stdout) != 0;
+    int e = errno;
+    bad |= ferror(stdout) != 0;
+    if (!bad)
+        return 0;
+    st_error err;
+    st_error_set(&err, ST_EIO, "<stdout>", 0, "write failed: %s",
+                 e ? strerror(e) : "I/O error");
+    return tool_fail(t, &err);
+}
+
+st_status tool_check_field_finite(const struct st_grid *g, const char *name,
+                                  st_error *err)
+{
+    size_t n = st_grid_count(g), bad = 0;
+    for (size_t i = 0; i < n; i++)
+        bad += !isfinite(g->data[i]);
+    if (!bad)
+        return ST_OK;
+    return st_error_set(err, ST_EINPUT, name, 0,
+                        "the field has %zu values that are not finite", bad);
+}
+
+void tool_limit_hint(st_error *err, const char *hint)
+{
+    if (!err || err->status != ST_ELIMIT || !hint)
+        return;
+    size_t n = strlen(err->msg);
+    /* The library's own advice, "... (lower the resolution)", gives way
+     * to the tool's, which knows its option names. */
+    char *paren = strrchr(err->msg, '(');
+    if (n > 0 && err->msg[n - 1] == ')' && paren && paren > err->msg &&
+        paren[-1] == ' ')
+        n = (size_t)(paren - 1 - err->msg);
+    snprintf(err->msg + n, sizeof err->msg - n, " (%s)", hint);
 }
 
 int tool_usage_error(const tool_ctx *t, const char *fmt, ...)
@@ -165,6 +259,14 @@ size_t tool_default_max_memory(void)
     return (size_t)((double)pages * (double)size * 0.8);
 }
 
+size_t tool_max_lattice_tets(size_t max_bytes)
+{
+    size_t cap = (size_t)1 << 31;
+    if (max_bytes && max_bytes / TOOL_LATTICE_BYTES_PER_TET < cap)
+        cap = max_bytes / TOOL_LATTICE_BYTES_PER_TET;
+    return cap > 0 ? cap : 1;
+}
+
 void tool_set_threads(size_t threads)
 {
 #ifdef _OPENMP
@@ -238,6 +340,14 @@ int tool_output_unwritable(const tool_ctx *t, const char *path)
 {
     if (st_path_is_stdio(path))
         return 0;
+    struct stat st;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        fprintf(stderr, "%s: %s: %s\n", t->name, path,
+                S_ISDIR(st.st_mode) ? "is a directory"
+                                    : "not a regular file (write to '-' for "
+                                      "standard output)");
+        return 1;
+    }
     size_t n = strlen(path);
     char *dir = malloc(n + 2);
     if (!dir)

@@ -29,12 +29,30 @@ typedef struct tool_ctx {
 } tool_ctx;
 
 /* Set up a tool: name, command line, signal handlers that remove
- * temporary outputs (SIGINT, SIGTERM, SIGHUP, SIGPIPE). */
+ * temporary outputs (SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT, SIGXCPU;
+ * SIGXFSZ is ignored, so a write past ulimit -f fails with EFBIG and is
+ * reported like any write error), and a check at exit that everything
+ * written to stdout got there (a failed write makes the exit status 1,
+ * with "name: <stdout>: write failed: why" unless an error was already
+ * printed). */
 void tool_init(tool_ctx *t, const char *name, int argc, char *argv[]);
 void tool_finish(tool_ctx *t);
 
 /* Print "name: FILE:LINE: msg" and return TOOL_EXIT_FAIL. */
 int tool_fail(const tool_ctx *t, const st_error *err);
+/* Flush stdout (a report): 0, or after a write error now or earlier,
+ * print "name: <stdout>: write failed: why" and return TOOL_EXIT_FAIL. */
+int tool_flush_stdout(const tool_ctx *t);
+/* A field read from NAME (a file, or "<stdin>") must hold finite values
+ * only (as soupsign requires of its input): ST_OK, or ST_EINPUT with "the
+ * field has N values that are not finite" naming NAME. */
+struct st_grid;
+st_status tool_check_field_finite(const struct st_grid *g, const char *name,
+                                  st_error *err);
+/* When err is a limit (ST_ELIMIT), end its message with "(hint)" naming
+ * the options to change, in place of the library's own parenthesized
+ * advice if it ends with one. */
+void tool_limit_hint(st_error *err, const char *hint);
 /* Print "name: msg" and "Try 'name --help'." and return TOOL_EXIT_USAGE. */
 int tool_usage_error(const tool_ctx *t, const char *fmt, ...)
 #ifdef __GNUC__
@@ -64,10 +82,20 @@ size_t tool_default_max_memory(void);
 
 /* Before a long computation: 1 (after printing "name: PATH: cannot write
  * there: why") when the directory that would hold the output file PATH
- * does not exist or is not writable, else 0. NULL and "-" (stdout) are
- * always fine. The real write still checks everything; this only saves
+ * does not exist or is not writable, or (after "name: PATH: is a
+ * directory" or "...: not a regular file ...") when PATH exists and is not
+ * a regular file, which st_outfile refuses to replace; else 0. NULL and
+ * "-" (stdout) are always fine. The real write still checks everything; this only saves
  * the user a run whose result could not be kept. */
 int tool_output_unwritable(const tool_ctx *t, const char *path);
+
+/* What one lattice tet costs at least while a lattice is built
+ * (lattice.h: 4 uint32 vertex ids, 4 int64 neighbours, 4 uint32 star
+ * entries), before the mesh made from it: a lattice of more tets than
+ * max_bytes / this cannot fit and is refused before it is allocated. */
+#define TOOL_LATTICE_BYTES_PER_TET 64
+/* The most lattice tets max_bytes allows (no memory limit: 2^31). */
+size_t tool_max_lattice_tets(size_t max_bytes);
 
 /* Set the OpenMP thread count (0: leave the default). */
 void tool_set_threads(size_t threads);

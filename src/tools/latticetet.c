@@ -57,7 +57,8 @@ static void usage(void)
 "  -o, --output OUT     .vtu file (or .msh, .node/.ele, .mesh by extension,\n"
 "                       without the arrays); '-' or none: .vtu on stdout\n"
 "      --threads T      threads to use (default: all cores)\n"
-"      --max-memory SZ  refuse fields larger than SZ (default 80%% of RAM)\n"
+"      --max-memory SZ  refuse fields and lattices larger than SZ\n"
+"                       (default 80%% of RAM)\n"
 "  -q, --quiet          no messages but errors\n"
 "  -v, --verbose        report tets kept, bombs, timings\n"
 "      --help           show this help and exit\n"
@@ -193,7 +194,8 @@ int main(int argc, char *argv[])
     int rc = TOOL_EXIT_FAIL;
     const char *in_name = st_path_is_stdio(in) ? "<stdin>" : in;
     double t0 = tool_now();
-    if (st_grid_read(&g, in, co.max_bytes, &err)) {
+    if (st_grid_read(&g, in, co.max_bytes, &err) ||
+        tool_check_field_finite(g, in_name, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }
@@ -212,9 +214,11 @@ int main(int argc, char *argv[])
     double lo[3], hi[3];
     st_lattice_grid_box(g, lo, hi);
     double h = size > 0 ? size : st_lattice_h_for_cells(lo, hi, cells);
-    /* 2^31 tets is far past what a coarse mesh needs; say so before
-     * running out of memory. */
-    const size_t max_tets = (size_t)1 << 31;
+    /* A lattice that cannot fit in --max-memory (or past 2^31 tets, far
+     * beyond what a coarse mesh needs) is refused before it is built. */
+    const size_t max_tets = tool_max_lattice_tets(co.max_bytes);
+    const char *limit_hint = "use fewer --cells or a larger -h, or raise "
+                             "--max-memory";
     if (!sculpt) {
         st_lattice_params lp = st_lattice_params_default();
         lp.kind = kind;
@@ -223,6 +227,9 @@ int main(int argc, char *argv[])
         lp.max_tets = max_tets;
         st_density_stats ds;
         if (st_lattice_build(&L, lo, hi, &lp, &err)) {
+            if (!err.file[0])
+                snprintf(err.file, sizeof err.file, "%s", in_name);
+            tool_limit_hint(&err, limit_hint);
             rc = tool_fail(&t, &err);
             goto done;
         }
@@ -255,6 +262,7 @@ int main(int argc, char *argv[])
         if (st_sculpt(&m, &ss, g, soup, NULL, &sp, &err)) {
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", in_name);
+            tool_limit_hint(&err, limit_hint);
             rc = tool_fail(&t, &err);
             goto done;
         }

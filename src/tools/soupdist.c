@@ -152,6 +152,8 @@ int main(int argc, char *argv[])
     if (st_dist_field(&g, soup, &p, &prog, &err)) {
         if (!err.file[0])
             snprintf(err.file, sizeof err.file, "%s", in);
+        tool_limit_hint(&err, "use a smaller -r or a larger -s, or raise "
+                              "--max-memory");
         rc = tool_fail(&t, &err);
         goto done;
     }

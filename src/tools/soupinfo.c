@@ -222,11 +222,8 @@ int main(int argc, char *argv[])
     }
     if (json)
         fputs("]\n", stdout);
-    if (fflush(stdout) != 0 || ferror(stdout)) {
-        st_error err;
-        st_error_set(&err, ST_EIO, NULL, 0, "cannot write to standard output");
-        rc = tool_fail(&t, &err);
-    }
+    if (tool_flush_stdout(&t))
+        rc = TOOL_EXIT_FAIL;
     tool_finish(&t);
     return rc;
 }

@@ -11,6 +11,7 @@
 #define _GNU_SOURCE
 #include "../cli/tool.h"
 #include "souptet/embed.h"
+#include "souptet/lattice.h"
 #include "souptet/mem.h"
 #include "souptet/outfile.h"
 #include "souptet/pipeline.h"
@@ -20,10 +21,14 @@
 
 #include <getopt.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 static void usage(void)
 {
@@ -59,7 +64,8 @@ static void usage(void)
 "      --max-iters N    fit iterations at most (default 300)\n"
 "      --no-quality     skip the quality pass after the fit\n"
 "      --threads T      threads to use (default: all cores)\n"
-"      --max-memory SZ  refuse fields larger than SZ (default 80%% of RAM)\n"
+"      --max-memory SZ  refuse fields and lattices larger than SZ\n"
+"                       (default 80%% of RAM)\n"
 "  -q, --quiet          no messages but errors\n"
 "  -v, --verbose        report every candidate and the timings\n"
 "      --help           show this help and exit\n"
@@ -98,6 +104,46 @@ static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
                  density ? "" : ",", c->seconds_sculpt, c->seconds_fit,
                  k == st->best ? "  <- best" : "");
     }
+}
+
+/* The pipeline lays one lattice per candidate (pipeline.h), up to one per
+ * thread at a time, and does not hold them to a memory limit: refuse here,
+ * before any of them is allocated, lattices that cannot fit in max_bytes.
+ * Any rotation of the soup's box spans at most its diagonal d along a
+ * lattice axis, so a lattice of cell width h has at most d/h + 2 cells
+ * along an axis plus the padding; 12 tets a cell (BCC; cubic5 has 5).
+ * Returns 1 (err set) when even that bound is over the limit. */
+static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
+                              size_t max_bytes, st_error *err)
+{
+    double lo[3], hi[3];
+    st_error e;
+    if (!max_bytes || st_soup_bounds(soup, lo, hi, &e))
+        return 0;   /* no limit, or the pipeline reports the soup */
+    double d2 = 0;
+    for (int a = 0; a < 3; a++)
+        d2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    double h = st_lattice_h_for_cells(lo, hi, p->cells);
+    if (!(h > 0) || !isfinite(h))
+        return 0;
+    double n = floor(sqrt(d2) / h) + 3 + 2 * ST_LATTICE_PAD_DEFAULT;
+    double tets = 12.0 * n * n * n;
+    double at_once = 1;
+#ifdef _OPENMP
+    if (p->tries > 1)
+        at_once = (double)((size_t)omp_get_max_threads() < p->tries
+                               ? (size_t)omp_get_max_threads() : p->tries);
+#endif
+    double need = tets * at_once * TOOL_LATTICE_BYTES_PER_TET;
+    if (need <= (double)max_bytes)
+        return 0;
+    st_error_set(err, ST_ELIMIT, NULL, 0,
+                 "--cells %zu lays lattices of up to %.0f tets (%.0f at a "
+                 "time), about %.1f MiB, over the limit of %.1f MiB (use "
+                 "fewer --cells or --tries, or raise --max-memory)",
+                 p->cells, tets, at_once, need / 1048576.0,
+                 (double)max_bytes / 1048576.0);
+    return 1;
 }
 
 int main(int argc, char *argv[])
@@ -232,11 +278,17 @@ int main(int argc, char *argv[])
         goto done;
     }
     tool_say(&t, 2, "%s: %zu vertices, %zu triangles", in, soup->nverts, soup->ntris);
+    if (lattice_over_limit(soup, &p, co.max_bytes, &err)) {
+        snprintf(err.file, sizeof err.file, "%s", st_path_is_stdio(in) ? "<stdin>" : in);
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
     st_progress prog = tool_progress(&t);
     if (st_pipeline_run(&m, &st, soup, &p, &prog, &err)) {
         tool_progress_end(&t);
         if (!err.file[0])
             snprintf(err.file, sizeof err.file, "%s", st_path_is_stdio(in) ? "<stdin>" : in);
+        tool_limit_hint(&err, "use fewer --cells or --field-cells, or raise --max-memory");
         report(&t, &st, p.density_rho > 0);
         rc = tool_fail(&t, &err);
         goto done;
@@ -249,6 +301,25 @@ int main(int argc, char *argv[])
         rc = tool_fail(&t, &err);
         goto done;
     }
+    /* Where the input vertices lie is worked out before anything is
+     * written, so a failure there leaves no mesh behind either. */
+    size_t nout = 0;
+    int64_t first = -1;
+    if (embed) {
+        et = st_malloc_array(soup->nverts ? soup->nverts : 1, sizeof *et);
+        eb = st_malloc_array(soup->nverts ? soup->nverts : 1, 4 * sizeof *eb);
+        if (!et || !eb) {
+            st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        if (st_embed_compute(et, eb, &nout, &first, m, soup, &err) ||
+            (!embed_text &&
+             st_embed_to_tetmesh(&side, soup->xyz, et, eb, soup->nverts, &err))) {
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+    }
     if (st_tetformat_from_path(out) != ST_TETFORMAT_NONE
             ? st_tetformat_save(m, ST_TETFORMAT_NONE, out, &fopts, &err)
             : st_tetmesh_save(m, out, &err)) {
@@ -256,21 +327,10 @@ int main(int argc, char *argv[])
         goto done;
     }
     if (embed) {
-        et = st_malloc_array(soup->nverts ? soup->nverts : 1, sizeof *et);
-        eb = st_malloc_array(soup->nverts ? soup->nverts : 1, 4 * sizeof *eb);
-        size_t nout = 0;
-        int64_t first = -1;
-        if (!et || !eb) {
-            st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
-            rc = tool_fail(&t, &err);
-            goto done;
-        }
-        if (st_embed_compute(et, eb, &nout, &first, m, soup, &err) ||
-            (embed_text
-                 ? st_embed_write_text(embed, et, eb, soup->nverts, m->ntets,
-                                       st_path_is_stdio(out) ? "<stdout>" : out, in, &err)
-                 : (st_embed_to_tetmesh(&side, soup->xyz, et, eb, soup->nverts, &err) ||
-                    st_tetmesh_save(side, embed, &err)))) {
+        if (embed_text
+                ? st_embed_write_text(embed, et, eb, soup->nverts, m->ntets,
+                                      st_path_is_stdio(out) ? "<stdout>" : out, in, &err)
+                : st_tetmesh_save(side, embed, &err)) {
             rc = tool_fail(&t, &err);
             goto done;
         }

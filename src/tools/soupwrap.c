@@ -210,10 +210,12 @@ int main(int argc, char *argv[])
             st_sign_refine(g, input, &rf, NULL, &err)) {
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", srcname);
+            tool_limit_hint(&err, "use a smaller -r or raise --max-memory");
             rc = tool_fail(&t, &err);
             goto done;
         }
-    } else if (st_grid_read(&g, in, co.max_bytes, &err)) {
+    } else if (st_grid_read(&g, in, co.max_bytes, &err) ||
+               tool_check_field_finite(g, srcname, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

@@ -229,6 +229,7 @@ int main(int argc, char *argv[])
     const char *inname = st_path_is_stdio(in) ? "<stdin>" : in;
     double t0 = tool_now();
     if (st_tetmesh_read(&m, in, co.max_bytes, &err)) {
+        tool_limit_hint(&err, "raise --max-memory");
         rc = tool_fail(&t, &err);
         goto done;
     }

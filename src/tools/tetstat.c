@@ -275,6 +275,7 @@ int main(int argc, char *argv[])
     double t0 = tool_now();
     /* Read every input first: a bad one gives no half report. */
     if (st_tetmesh_read(&m, in, co.max_bytes, &err)) {
+        tool_limit_hint(&err, "raise --max-memory");
         rc = tool_fail(&t, &err);
         goto done;
     }
@@ -283,6 +284,21 @@ int main(int argc, char *argv[])
         goto done;
     }
     if (field && st_grid_read(&g, field, co.max_bytes, &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    if (g && tool_check_field_finite(g, strcmp(field, "-") ? field : "<stdin>",
+                                     &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    /* The IoU is with the negative voxels: an unsigned field has none,
+     * and a report of 0 would look like a finding. (A foreign field of
+     * unknown kind is taken as signed.) */
+    if (g && g->kind == ST_GRID_DISTANCE) {
+        st_error_set(&err, ST_EINPUT, strcmp(field, "-") ? field : "<stdin>",
+                     0, "the field is %s, not signed (run soupsign first)",
+                     st_grid_kind_name(g->kind));
         rc = tool_fail(&t, &err);
         goto done;
     }
@@ -305,9 +321,8 @@ int main(int argc, char *argv[])
         print_json(stdout, name, sname, fname, &r);
     else
         print_table(stdout, name, sname, fname, &r);
-    if (fflush(stdout) != 0 || ferror(stdout)) {
-        st_error_set(&err, ST_EIO, NULL, 0, "cannot write to standard output");
-        rc = tool_fail(&t, &err);
+    if (tool_flush_stdout(&t)) {
+        rc = TOOL_EXIT_FAIL;
         goto done;
     }
     /* The report is the result; what is wrong with the mesh is also said
