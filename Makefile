@@ -5,7 +5,7 @@
 #   make demo             the main job on the bundled model
 #   make bench            measurements against peers (bench/results/)
 #   make install PREFIX=/usr/local DESTDIR=
-#   make fuzz [FUZZ_SECONDS=60]  libFuzzer on every reader (build-fuzz/)
+#   make fuzz [FUZZ_SECONDS=60] [FUZZ_RUNS=N]  libFuzzer on every reader (build-fuzz/)
 #   make config=debug|sanitize ...   (objects go to build/ or build-<config>/)
 
 config ?= release
@@ -110,7 +110,8 @@ $(BUILD)/bench/%: bench/%.c $(LIBA)
 	$(CXX) $(LDFLAGS_ALL) $@.o $(LIBA) $(LIBS) -o $@
 
 # libFuzzer harnesses, one per reader (fuzz/fuzz_*.c), built with clang in
-# build-fuzz/ and run by scripts/fuzz for FUZZ_SECONDS each.
+# build-fuzz/ and run by scripts/fuzz for FUZZ_SECONDS each (FUZZ_RUNS=N:
+# N executions each instead, FUZZ_SECONDS still caps the time).
 FUZZ_SECONDS ?= 60
 FUZZ_BIN := $(patsubst fuzz/%.c,$(BUILD)/fuzz/%,$(sort $(wildcard fuzz/fuzz_*.c)))
 $(BUILD)/fuzz/%: fuzz/%.c $(LIBA)
