@@ -32,18 +32,20 @@
  * moved the image but carried the field data along: then the image wins).
  * Without souptet_kind the kind is UNKNOWN and the band INFINITY.
  *
- * VTK reports problems through its logger and its global output window,
- * both of which print to stderr. The library must not print: unless the
- * program installed an output window of its own, a collecting output
- * window replaces VTK's default once and the logger's stderr output is
- * turned off; the text VTK reported during a call goes into that call's
- * st_error. (This is process-wide VTK state: any other VTK user in the
- * library gets the same silence.)
+ * VTK's XML reader trusts the file (fuzzing crashed it with misspelled
+ * attributes and made it allocate from block headers), so every input is
+ * read into memory and passes st_vtkxml_check (src/vtkxml.h) before VTK
+ * sees a byte; files by path take the same in-memory path.
+ *
+ * VTK's messages go into the st_error of the call that caused them, never
+ * to stderr (vtk_capture.h).
  */
 #include "souptet/gridio.h"
 #include "souptet/meta.h"
 #include "souptet/outfile.h"
 #include "gridio_internal.h"
+#include "../vtkxml.h"
+#include "vtk_capture.h"
 
 #include <vtkAbstractArray.h>
 #include <vtkDataArray.h>
@@ -53,10 +55,7 @@
 #include <vtkFloatArray.h>
 #include <vtkImageData.h>
 #include <vtkInformation.h>
-#include <vtkLogger.h>
 #include <vtkNew.h>
-#include <vtkObjectFactory.h>
-#include <vtkOutputWindow.h>
 #include <vtkPointData.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
@@ -77,106 +76,6 @@ namespace {
 
 const char *const kMetaPrefix = "souptet_meta:";
 
-/* What VTK reported on this thread since the last reset. Thread-local so
- * that two threads reading two files do not get each other's messages. */
-thread_local std::string t_errors;
-thread_local std::string t_warnings;
-
-/* VTK's output window replaced by one that collects instead of printing. */
-class CaptureWindow : public vtkOutputWindow {
-public:
-    static CaptureWindow *New();
-    vtkTypeMacro(CaptureWindow, vtkOutputWindow);
-
-    void DisplayText(const char *text) override
-    {
-        if (!text)
-            return;
-        std::string &to = GetCurrentMessageType() == MESSAGE_TYPE_ERROR
-                              ? t_errors
-                              : t_warnings;
-        if (to.size() < 16384)      // a runaway loop must not eat memory
-            to += text;
-    }
-
-protected:
-    CaptureWindow() = default;
-    ~CaptureWindow() override = default;
-};
-vtkStandardNewMacro(CaptureWindow);
-
-void install_capture()
-{
-    static const bool done = [] {
-        // Respect an output window the program chose; replace only VTK's
-        // default one (which writes to stderr).
-        vtkOutputWindow *cur = vtkOutputWindow::GetInstance();
-        if (cur && std::strcmp(cur->GetClassName(), "vtkOutputWindow") == 0) {
-            CaptureWindow *w = CaptureWindow::New();
-            vtkOutputWindow::SetInstance(w);
-            w->Delete();    // SetInstance holds a reference
-            // VTK 9 also hands every error and warning to its logger
-            // (loguru) before the output window, and the logger writes
-            // ERROR and WARNING lines to stderr by default, whole pipeline
-            // dumps included. A program that left VTK's messaging at its
-            // defaults wants none of that from a library: stderr logging
-            // off (file and callback sinks are untouched).
-            vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
-        }
-        return true;
-    }();
-    (void)done;
-}
-
-void reset_capture()
-{
-    t_errors.clear();
-    t_warnings.clear();
-}
-
-/* One VTK message without its "ERROR: In FILE, line N" header and the
- * "ClassName (0x...): " prefix, on one line. */
-std::string clean_message(std::string s)
-{
-    size_t nl = s.find('\n');
-    if (s.compare(0, 3, "ERR") == 0 || s.compare(0, 4, "Warn") == 0 ||
-        s.compare(0, 7, "Generic") == 0)
-        s = nl == std::string::npos ? "" : s.substr(nl + 1);
-    size_t p = s.find("): ");
-    if (p != std::string::npos && p < 80)
-        s = s.substr(p + 3);
-    for (char &c : s)
-        if (c == '\n' || c == '\r')
-            c = ' ';
-    while (!s.empty() && s.back() == ' ')
-        s.pop_back();
-    return s;
-}
-
-/* The messages VTK reported (each ends with a blank line), joined with
- * "; ". The executive's "Algorithm ... returned failure for request"
- * (followed by a dump of the whole request) says nothing new: left out. */
-std::string vtk_message(const std::string &all)
-{
-    std::string out;
-    size_t start = 0;
-    while (start < all.size() && out.size() < 400) {
-        size_t end = all.find("\n\n", start);
-        if (end == std::string::npos)
-            end = all.size();
-        std::string m = clean_message(all.substr(start, end - start));
-        start = end + 2;
-        if (m.empty() || m.find("returned failure for request") !=
-                             std::string::npos ||
-            out.find(m) != std::string::npos)
-            continue;
-        out += (out.empty() ? "" : "; ") + m;
-    }
-    if (out.size() > 400)
-        out = out.substr(0, 400) + "...";
-    return out;
-}
-
 bool is_reserved_name(const std::string &n)
 {
     return n == "souptet_kind" || n == "band" || n == "origin" ||
@@ -189,13 +88,6 @@ std::string escape_key(const std::string &key)
         key.compare(0, std::strlen(kMetaPrefix), kMetaPrefix) == 0)
         return kMetaPrefix + key;
     return key;
-}
-
-st_status vtk_failed(const char *name, const char *what, st_error *err)
-{
-    std::string m = vtk_message(t_errors);
-    return st_error_set(err, ST_EINPUT, name, 0, "%s%s%s", what,
-                        m.empty() ? "" : ": ", m.c_str());
 }
 
 /* The point array holding the field, or null. */
@@ -238,13 +130,13 @@ bool close_to(double a, double b, double scale)
 st_status read_with(vtkXMLImageDataReader *r, const char *name,
                     size_t max_bytes, st_grid **out, st_error *err)
 {
-    reset_capture();
+    st_vtk::Capture cap;
     r->UpdateInformation();
     vtkInformation *info = r->GetOutputInformation(0);
     int ext[6];
-    if (!t_errors.empty() || r->GetErrorCode() != vtkErrorCode::NoError ||
+    if (st_vtk::failed() || r->GetErrorCode() != vtkErrorCode::NoError ||
         !info || !info->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
-        return vtk_failed(name, "not a readable VTK ImageData (.vti) file",
+        return st_vtk::fail(name, "not a readable VTK ImageData (.vti) file",
                           err);
     info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), ext);
     long long d[3];
@@ -276,9 +168,9 @@ st_status read_with(vtkXMLImageDataReader *r, const char *name,
 
     r->Update();
     vtkImageData *img = r->GetOutput();
-    if (!t_errors.empty() || r->GetErrorCode() != vtkErrorCode::NoError ||
+    if (st_vtk::failed() || r->GetErrorCode() != vtkErrorCode::NoError ||
         !img)
-        return vtk_failed(name,
+        return st_vtk::fail(name,
                           "cannot read the image data (truncated or "
                           "corrupt file?)",
                           err);
@@ -388,23 +280,38 @@ st_status read_with(vtkXMLImageDataReader *r, const char *name,
     return ST_OK;
 }
 
-/* Every exception into an st_error naming the file. */
-template <class F>
-st_status guarded(const char *name, const char *what, st_error *err, F &&f)
+/* Check a document in memory, then read it with VTK. owned, if not null,
+ * is data's malloc'd buffer: it is freed (on every way out) as soon as VTK
+ * holds its own copy, so that a file read by path peaks at the two copies
+ * VTK makes (its input string and the stream it parses), as a read from
+ * memory always did. */
+st_status read_mem(st_grid **out, const unsigned char *data, size_t size,
+                   const char *name, size_t max_bytes, unsigned char *owned,
+                   st_error *err)
 {
-    try {
-        install_capture();
-        return f();
-    } catch (const std::bad_alloc &) {
-        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory %s",
-                            what);
-    } catch (const std::exception &e) {
-        return st_error_set(err, ST_EINPUT, name, 0, "error %s: %s", what,
-                            e.what());
-    } catch (...) {
-        return st_error_set(err, ST_EINTERNAL, name, 0,
-                            "unknown exception %s", what);
-    }
+    struct Owned {
+        unsigned char *p;
+        ~Owned() { std::free(p); }
+    } own{owned};
+    *out = nullptr;
+    if (size == 0)
+        return st_error_set(err, ST_EINPUT, name, 0, "empty input");
+    return st_vtk::guarded(name, "reading", err, [&] {
+        // VTK trusts the file's structure and sizes; it sees only a
+        // document the pre-flight check has passed.
+        if (st_status s = st_vtkxml_check(data, size, name, "ImageData",
+                                          st_vtkxml_budget(max_bytes),
+                                          st_vtkxml_inflate_vtk, nullptr,
+                                          err))
+            return s;
+        vtkNew<vtkXMLImageDataReader> r;
+        r->ReadFromInputStringOn();
+        r->SetInputString(
+            std::string(reinterpret_cast<const char *>(data), size));
+        std::free(own.p);
+        own.p = nullptr;
+        return read_with(r, name, max_bytes, out, err);
+    });
 }
 
 st_status write_vti(const st_grid *g, const char *path, st_error *err)
@@ -473,13 +380,13 @@ st_status write_vti(const st_grid *g, const char *path, st_error *err)
     w->EncodeAppendedDataOff();     // raw binary, not base64
     w->SetCompressorTypeToZLib();
     w->SetHeaderTypeToUInt64();
-    reset_capture();
+    st_vtk::Capture cap;
     errno = 0;
     const int ok = w->Write();
     const int e = errno;
-    if (!ok || !t_errors.empty() ||
+    if (!ok || st_vtk::failed() ||
         w->GetErrorCode() != vtkErrorCode::NoError) {
-        std::string m = vtk_message(t_errors);
+        std::string m = st_vtk::message();
         if (m.empty() && e)
             m = std::strerror(e);
         return st_error_set(err, ST_EIO, path, 0, "write failed%s%s",
@@ -499,7 +406,7 @@ st_status st_grid_write_vti(const st_grid *g, const char *path, st_error *err)
         return st_error_set(err, ST_EINPUT, ST_GRIDIO_STDOUT_NAME, 0,
                             "standard output carries OpenVDB streams only; "
                             "write .vti to a file");
-    return guarded(path, "writing", err,
+    return st_vtk::guarded(path, "writing", err,
                    [&] { return write_vti(g, path, err); });
 }
 
@@ -507,40 +414,27 @@ st_status st_gridio_read_vti_mem(st_grid **out, const unsigned char *data,
                                  size_t size, const char *name,
                                  size_t max_bytes, st_error *err)
 {
-    *out = nullptr;
-    if (size == 0)
-        return st_error_set(err, ST_EINPUT, name, 0, "empty input");
-    return guarded(name, "reading", err, [&] {
-        vtkNew<vtkXMLImageDataReader> r;
-        r->ReadFromInputStringOn();
-        r->SetInputString(
-            std::string(reinterpret_cast<const char *>(data), size));
-        return read_with(r, name, max_bytes, out, err);
-    });
+    return read_mem(out, data, size, name, max_bytes, nullptr, err);
 }
 
 st_status st_grid_read_vti(st_grid **out, const char *path, size_t max_bytes,
                            st_error *err)
 {
     *out = nullptr;
+    unsigned char *data;
+    size_t size;
     if (st_path_is_stdio(path)) {
-        unsigned char *data;
-        size_t size;
         if (st_status s = st_gridio_read_stdin(&data, &size, err))
             return s;
-        st_status s = st_gridio_read_vti_mem(out, data, size,
-                                             ST_GRIDIO_STDIN_NAME, max_bytes,
-                                             err);
-        std::free(data);
-        return s;
+        return read_mem(out, data, size, ST_GRIDIO_STDIN_NAME, max_bytes,
+                        data, err);
     }
     if (st_status s = st_gridio_check_input_file(path, err))
         return s;
-    return guarded(path, "reading", err, [&] {
-        vtkNew<vtkXMLImageDataReader> r;
-        r->SetFileName(path);
-        return read_with(r, path, max_bytes, out, err);
-    });
+    // Through memory, so that the bytes checked are the bytes VTK reads.
+    if (st_status s = st_vtkxml_read_file(path, &data, &size, err))
+        return s;
+    return read_mem(out, data, size, path, max_bytes, data, err);
 }
 
 } // extern "C"

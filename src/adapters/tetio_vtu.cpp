@@ -26,16 +26,12 @@
  * tool may have moved). Refused, with a message naming the file: input VTK
  * cannot parse, cells that are not tetrahedra, point indices out of range,
  * non-finite coordinates, arrays whose length does not match, more than
- * max_bytes of mesh.
+ * max_bytes of mesh. Before VTK sees a byte, every input (files by path
+ * are read into memory first) passes st_vtkxml_check (src/vtkxml.h): VTK's
+ * reader trusts the file's structure and the sizes in it.
  *
- * VTK reports problems through its global output window (and its logger),
- * which print to stderr. The field adapter (gridio_vti.cpp) replaces VTK's
- * default window by one that collects, and silences the logger's stderr
- * output; this file makes sure that has happened (by one call into the
- * field adapter) and then wraps whatever window is installed in one that
- * collects the messages of this adapter's own calls (thread-locally) and
- * passes every other message on to the window it wraps. So each adapter
- * sees only its own messages, whichever is used first.
+ * VTK's messages go into the st_error of the call that caused them, never
+ * to stderr (vtk_capture.h).
  */
 #include "souptet/tetio.h"
 #include "souptet/mem.h"
@@ -43,6 +39,8 @@
 #include "souptet/tetmesh.h"
 #include "gridio_internal.h"
 #include "tetio_internal.h"
+#include "../vtkxml.h"
+#include "vtk_capture.h"
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -52,10 +50,7 @@
 #include <vtkErrorCode.h>
 #include <vtkFieldData.h>
 #include <vtkIdTypeArray.h>
-#include <vtkLogger.h>
 #include <vtkNew.h>
-#include <vtkObjectFactory.h>
-#include <vtkOutputWindow.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkStringArray.h>
@@ -73,157 +68,6 @@
 #include <sys/stat.h>
 
 namespace {
-
-/* ---- VTK's messages ---------------------------------------------------- */
-
-thread_local std::string t_errors;
-thread_local int t_capturing = 0;
-
-class TetioCaptureWindow : public vtkOutputWindow {
-public:
-    static TetioCaptureWindow *New();
-    vtkTypeMacro(TetioCaptureWindow, vtkOutputWindow);
-
-    void SetPrevious(vtkOutputWindow *w)
-    {
-        if (w)
-            w->Register(this);
-        prev_ = w;
-    }
-
-    void DisplayText(const char *text) override
-    {
-        if (!text)
-            return;
-        if (t_capturing) {
-            if (GetCurrentMessageType() == MESSAGE_TYPE_ERROR &&
-                t_errors.size() < 16384)   // a runaway loop must not eat memory
-                t_errors += text;
-            return;
-        }
-        if (!prev_)
-            return;
-        switch (GetCurrentMessageType()) {
-        case MESSAGE_TYPE_ERROR: prev_->DisplayErrorText(text); break;
-        case MESSAGE_TYPE_WARNING: prev_->DisplayWarningText(text); break;
-        case MESSAGE_TYPE_GENERIC_WARNING:
-            prev_->DisplayGenericWarningText(text);
-            break;
-        case MESSAGE_TYPE_DEBUG: prev_->DisplayDebugText(text); break;
-        default: prev_->DisplayText(text); break;
-        }
-    }
-
-protected:
-    TetioCaptureWindow() = default;
-    ~TetioCaptureWindow() override
-    {
-        if (prev_)
-            prev_->UnRegister(this);
-    }
-
-private:
-    vtkOutputWindow *prev_ = nullptr;
-};
-vtkStandardNewMacro(TetioCaptureWindow);
-
-void install_capture()
-{
-    static const bool done = [] {
-        // Let the field adapter install its collector first: it replaces
-        // only VTK's default window, so it must see that window.
-        st_grid *g = nullptr;
-        st_error e;
-        const unsigned char probe[1] = {'x'};
-        st_gridio_read_vti_mem(&g, probe, 1, "<probe>", 0, &e);
-        st_grid_free(g);
-        vtkOutputWindow *cur = vtkOutputWindow::GetInstance();
-        const bool is_default =
-            cur && std::strcmp(cur->GetClassName(), "vtkOutputWindow") == 0;
-        TetioCaptureWindow *w = TetioCaptureWindow::New();
-        // VTK's default window would print: wrap it only when it is not
-        // the default (the field adapter's, or one the program chose).
-        if (cur && !is_default)
-            w->SetPrevious(cur);
-        if (is_default)
-            vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
-        vtkOutputWindow::SetInstance(w);
-        w->Delete();
-        return true;
-    }();
-    (void)done;
-}
-
-/* Collects VTK's errors for the lifetime of one call on this thread. */
-struct Capture {
-    Capture()
-    {
-        t_errors.clear();
-        t_capturing++;
-    }
-    ~Capture() { t_capturing--; }
-};
-
-/* VTK's message without its "ERROR: In FILE, line N" header and the
- * "ClassName (0x...): " prefix, messages joined by "; ". */
-std::string vtk_message()
-{
-    std::string out;
-    size_t start = 0;
-    const std::string &all = t_errors;
-    while (start < all.size() && out.size() < 400) {
-        size_t end = all.find("\n\n", start);
-        if (end == std::string::npos)
-            end = all.size();
-        std::string s = all.substr(start, end - start);
-        start = end + 2;
-        if (s.compare(0, 3, "ERR") == 0) {
-            size_t nl = s.find('\n');
-            s = nl == std::string::npos ? "" : s.substr(nl + 1);
-        }
-        size_t p = s.find("): ");
-        if (p != std::string::npos && p < 80)
-            s = s.substr(p + 3);
-        for (char &c : s)
-            if (c == '\n' || c == '\r')
-                c = ' ';
-        while (!s.empty() && s.back() == ' ')
-            s.pop_back();
-        if (s.empty() ||
-            s.find("returned failure for request") != std::string::npos ||
-            out.find(s) != std::string::npos)
-            continue;
-        out += (out.empty() ? "" : "; ") + s;
-    }
-    if (out.size() > 400)
-        out = out.substr(0, 400) + "...";
-    return out;
-}
-
-st_status vtk_failed(const char *name, const char *what, st_error *err)
-{
-    std::string m = vtk_message();
-    return st_error_set(err, ST_EINPUT, name, 0, "%s%s%s", what,
-                        m.empty() ? "" : ": ", m.c_str());
-}
-
-template <class F>
-st_status guarded(const char *name, const char *what, st_error *err, F &&f)
-{
-    try {
-        install_capture();
-        return f();
-    } catch (const std::bad_alloc &) {
-        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory %s",
-                            what);
-    } catch (const std::exception &e) {
-        return st_error_set(err, ST_EINPUT, name, 0, "error %s: %s", what,
-                            e.what());
-    } catch (...) {
-        return st_error_set(err, ST_EINTERNAL, name, 0,
-                            "unknown exception %s", what);
-    }
-}
 
 bool is_quality_name(const char *n)
 {
@@ -337,13 +181,13 @@ st_status write_file(const st_tetmesh *m, const char *path, st_error *err)
     w->SetInputData(ug);
     w->SetFileName(path);
     configure(w);
-    Capture cap;
+    st_vtk::Capture cap;
     errno = 0;
     const int ok = w->Write();
     const int e = errno;
-    if (!ok || !t_errors.empty() ||
+    if (!ok || st_vtk::failed() ||
         w->GetErrorCode() != vtkErrorCode::NoError) {
-        std::string msg = vtk_message();
+        std::string msg = st_vtk::message();
         if (msg.empty() && e)
             msg = std::strerror(e);
         return st_error_set(err, ST_EIO, path, 0, "write failed%s%s",
@@ -365,11 +209,11 @@ st_status write_mem(unsigned char **data, size_t *size, const st_tetmesh *m,
     w->SetInputData(ug);
     w->WriteToOutputStringOn();
     configure(w);
-    Capture cap;
+    st_vtk::Capture cap;
     const int ok = w->Write();
-    if (!ok || !t_errors.empty() ||
+    if (!ok || st_vtk::failed() ||
         w->GetErrorCode() != vtkErrorCode::NoError) {
-        std::string msg = vtk_message();
+        std::string msg = st_vtk::message();
         return st_error_set(err, ST_EIO, name, 0, "write failed%s%s",
                             msg.empty() ? "" : ": ", msg.c_str());
     }
@@ -441,10 +285,10 @@ st_status read_arrays(st_tetmesh *m, vtkFieldData *src, st_tet_assoc assoc,
 st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
                     size_t max_bytes, st_tetmesh **out, st_error *err)
 {
-    Capture cap;
+    st_vtk::Capture cap;
     r->UpdateInformation();
-    if (!t_errors.empty() || r->GetErrorCode() != vtkErrorCode::NoError)
-        return vtk_failed(name,
+    if (st_vtk::failed() || r->GetErrorCode() != vtkErrorCode::NoError)
+        return st_vtk::fail(name,
                           "not a readable VTK UnstructuredGrid (.vtu) file",
                           err);
     r->SetupUpdateExtent(0, 1, 0);
@@ -468,9 +312,9 @@ st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
 
     r->Update();
     vtkUnstructuredGrid *ug = r->GetOutput();
-    if (!t_errors.empty() || r->GetErrorCode() != vtkErrorCode::NoError ||
+    if (st_vtk::failed() || r->GetErrorCode() != vtkErrorCode::NoError ||
         !ug)
-        return vtk_failed(name,
+        return st_vtk::fail(name,
                           "cannot read the mesh data (truncated or corrupt "
                           "file?)",
                           err);
@@ -554,6 +398,42 @@ st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
     return ST_OK;
 }
 
+/* Check a document in memory, then read it with VTK. owned, if not null,
+ * is data's malloc'd buffer: it is freed (on every way out) as soon as VTK
+ * holds its own copy, so that a file read by path peaks at the two copies
+ * VTK makes (its input string and the stream it parses). */
+st_status read_mem(st_tetmesh **out, const unsigned char *data, size_t size,
+                   const char *name, size_t max_bytes, unsigned char *owned,
+                   st_error *err)
+{
+    struct Owned {
+        unsigned char *p;
+        ~Owned() { std::free(p); }
+    } own{owned};
+    *out = nullptr;
+    if (!name)
+        name = ST_TETIO_STDIN_NAME;
+    if (size == 0)
+        return st_error_set(err, ST_EINPUT, name, 0, "empty input");
+    return st_vtk::guarded(name, "reading", err, [&] {
+        // VTK trusts the file's structure and sizes; it sees only a
+        // document the pre-flight check has passed.
+        if (st_status s = st_vtkxml_check(data, size, name,
+                                          "UnstructuredGrid",
+                                          st_vtkxml_budget(max_bytes),
+                                          st_vtkxml_inflate_vtk, nullptr,
+                                          err))
+            return s;
+        vtkNew<vtkXMLUnstructuredGridReader> r;
+        r->ReadFromInputStringOn();
+        r->SetInputString(
+            std::string(reinterpret_cast<const char *>(data), size));
+        std::free(own.p);
+        own.p = nullptr;
+        return read_with(r, name, max_bytes, out, err);
+    });
+}
+
 } // namespace
 
 extern "C" {
@@ -561,7 +441,7 @@ extern "C" {
 st_status st_tetio_write_vtu_file(const st_tetmesh *m, const char *path,
                                   st_error *err)
 {
-    return guarded(path, "writing", err,
+    return st_vtk::guarded(path, "writing", err,
                    [&] { return write_file(m, path, err); });
 }
 
@@ -570,7 +450,7 @@ st_status st_tetio_write_vtu_mem(unsigned char **data, size_t *size,
 {
     *data = nullptr;
     *size = 0;
-    return guarded(ST_TETIO_STDOUT_NAME, "writing", err,
+    return st_vtk::guarded(ST_TETIO_STDOUT_NAME, "writing", err,
                    [&] { return write_mem(data, size, m, err); });
 }
 
@@ -578,18 +458,7 @@ st_status st_tetio_read_vtu_mem(st_tetmesh **out, const unsigned char *data,
                                 size_t size, const char *name,
                                 size_t max_bytes, st_error *err)
 {
-    *out = nullptr;
-    if (!name)
-        name = ST_TETIO_STDIN_NAME;
-    if (size == 0)
-        return st_error_set(err, ST_EINPUT, name, 0, "empty input");
-    return guarded(name, "reading", err, [&] {
-        vtkNew<vtkXMLUnstructuredGridReader> r;
-        r->ReadFromInputStringOn();
-        r->SetInputString(
-            std::string(reinterpret_cast<const char *>(data), size));
-        return read_with(r, name, max_bytes, out, err);
-    });
+    return read_mem(out, data, size, name, max_bytes, nullptr, err);
 }
 
 st_status st_tetio_read_vtu_file(st_tetmesh **out, const char *path,
@@ -598,11 +467,12 @@ st_status st_tetio_read_vtu_file(st_tetmesh **out, const char *path,
     *out = nullptr;
     if (st_status s = st_gridio_check_input_file(path, err))
         return s;
-    return guarded(path, "reading", err, [&] {
-        vtkNew<vtkXMLUnstructuredGridReader> r;
-        r->SetFileName(path);
-        return read_with(r, path, max_bytes, out, err);
-    });
+    // Through memory, so that the bytes checked are the bytes VTK reads.
+    unsigned char *data;
+    size_t size;
+    if (st_status s = st_vtkxml_read_file(path, &data, &size, err))
+        return s;
+    return read_mem(out, data, size, path, max_bytes, data, err);
 }
 
 } // extern "C"
