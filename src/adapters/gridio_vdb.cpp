@@ -478,8 +478,11 @@ st_status guarded(const char *name, const char *what, st_error *err,
     try {
         return f();
     } catch (const std::bad_alloc &) {
-        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory %s",
-                            what);
+        /* Reading, OpenVDB sizes some buffers by counts in the file before
+         * it reads them: an absurd count lands here, not a real shortage. */
+        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory %s%s",
+                            what, is ? " (the file asks for more memory "
+                            "than there is: is it corrupt?)" : "");
     } catch (const std::ios_base::failure &e) {
         if (is && is->eof())
             return st_error_set(err, ST_EINPUT, name, 0,
