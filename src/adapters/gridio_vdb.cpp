@@ -79,6 +79,8 @@
 #include <openvdb/tools/Prune.h>
 
 #include <cerrno>
+#include <cstdarg>
+#include <cstdint>
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
@@ -94,6 +96,9 @@
 #include <streambuf>
 #include <string>
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
 #include <sys/stat.h>
 #include <vector>
 
@@ -440,6 +445,123 @@ st_status grid_to_st(st_grid **out, const FloatGrid &grid, const char *name,
     return ST_OK;
 }
 
+/* Before OpenVDB reads a byte: its reader sizes std::strings by 32-bit
+ * lengths in the file and zero-fills them before reading (MetaMap::
+ * readMeta, readString), so a 3 KB file could make it touch 4 GiB per
+ * string. Walk the parts of the format laid out by length prefixes — the
+ * header, the file's metadata, and each grid's descriptor and metadata
+ * (the next grid found by its end offset when the file has offsets) —
+ * and refuse a length or count that the bytes after it cannot hold. The
+ * tree itself is OpenVDB's to read: its sizes are fixed by the node
+ * types, and its compressed blocks are allocated but only filled from the
+ * bytes present. Only file versions 221..224 are walked (what OpenVDB 10
+ * reads); anything else goes straight to OpenVDB, which refuses it. */
+class VdbWalk {
+public:
+    VdbWalk(const unsigned char *data, uint64_t size, const char *name,
+            st_error *err)
+        : data_(data), size_(size), name_(name), err_(err) {}
+
+    st_status run()
+    {
+        int64_t magic;
+        uint32_t version;
+        if (!get(&magic, 8) || !get(&version, 4))
+            return ST_OK;   /* OpenVDB says what is wrong */
+        if (magic != 0x56444220 || version < 221 || version > 224)
+            return ST_OK;
+        unsigned char offsets = 0;
+        if (!skip(8) || !get(&offsets, 1) || !skip(36))
+            return ST_OK;
+        if (st_status st = meta_map("the file's metadata"))
+            return st;
+        int32_t ngrids;
+        if (!get(&ngrids, 4))
+            return ST_OK;
+        if (ngrids < 0 || uint64_t(ngrids) > left() / 8)
+            return fail("the header says %ld grids, more than the %llu bytes "
+                        "left can hold", long(ngrids),
+                        (unsigned long long)left());
+        for (int32_t g = 0; g < ngrids; g++) {
+            for (int k = 0; k < 3; k++)   /* name, type, instance parent */
+                if (st_status st = block("a grid descriptor's name"))
+                    return st;
+            int64_t grid_pos, block_pos, end_pos;
+            if (!get(&grid_pos, 8) || !get(&block_pos, 8) || !get(&end_pos, 8)
+                || !skip(4))   /* the grid's compression flags */
+                return ST_OK;
+            if (st_status st = meta_map("a grid's metadata"))
+                return st;
+            if (!offsets || end_pos <= int64_t(pos_) || uint64_t(end_pos) > size_)
+                break;   /* the tree follows: OpenVDB's to read */
+            pos_ = uint64_t(end_pos);
+        }
+        return ST_OK;
+    }
+
+private:
+    const unsigned char *data_;
+    uint64_t size_, pos_ = 0;
+    const char *name_;
+    st_error *err_;
+
+    uint64_t left() const { return size_ - pos_; }
+    bool get(void *dst, size_t n)
+    {
+        if (left() < n)
+            return false;
+        std::memcpy(dst, data_ + pos_, n);
+        pos_ += n;
+        return true;
+    }
+    bool skip(uint64_t n)
+    {
+        if (left() < n)
+            return false;
+        pos_ += n;
+        return true;
+    }
+    __attribute__((format(printf, 2, 3)))
+    st_status fail(const char *fmt, ...)
+    {
+        char what[256];
+        va_list ap;
+        va_start(ap, fmt);
+        std::vsnprintf(what, sizeof what, fmt, ap);
+        va_end(ap);
+        return st_error_set_offset(err_, ST_EINPUT, name_, pos_,
+                                   "not a valid OpenVDB file: %s", what);
+    }
+    /* One length-prefixed block (a string or a metadata value). */
+    st_status block(const char *what)
+    {
+        uint32_t n;
+        if (!get(&n, 4))
+            return ST_OK;
+        if (n > left())
+            return fail("%s claims %lu bytes but %llu remain", what,
+                        (unsigned long)n, (unsigned long long)left());
+        pos_ += n;
+        return ST_OK;
+    }
+    /* A MetaMap: a count, then name, type name and value, each a block. */
+    st_status meta_map(const char *what)
+    {
+        int32_t count;
+        if (!get(&count, 4))
+            return ST_OK;
+        if (count < 0 || uint64_t(count) > left() / 12)
+            return fail("%s claims %ld entries, more than the %llu bytes "
+                        "left can hold", what, long(count),
+                        (unsigned long long)left());
+        for (int32_t i = 0; i < count; i++)
+            for (int k = 0; k < 3; k++)
+                if (st_status st = block(what))
+                    return st;
+        return ST_OK;
+    }
+};
+
 /* Read the first usable FloatGrid from a stream (file or memory). */
 st_status read_stream(st_grid **out, std::istream &is, const char *name,
                       size_t max_bytes, st_error *err)
@@ -695,6 +817,8 @@ st_status st_gridio_read_vdb_mem(st_grid **out, const unsigned char *data,
     *out = nullptr;
     try {
         init_openvdb();
+        if (st_status st = VdbWalk(data, size, name, err).run())
+            return st;
         MemBuf buf(data, size);
         std::istream is(&buf);
         return guarded(name, "reading", err, &is, [&] {
@@ -729,6 +853,25 @@ st_status st_grid_read_vdb(st_grid **out, const char *path, size_t max_bytes,
         return st_error_set(err, ST_EIO, path, 0, "is a directory");
     if (S_ISREG(st.st_mode) && st.st_size == 0)
         return st_error_set(err, ST_EINPUT, path, 0, "empty file");
+    if (S_ISREG(st.st_mode)) {
+        /* Walk the length-prefixed parts first (see VdbWalk), mapped, not
+         * copied; a FIFO is read by OpenVDB as it comes. */
+        int fd = open(path, O_RDONLY);
+        if (fd < 0)
+            return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
+                                std::strerror(errno));
+        void *map = mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_PRIVATE,
+                         fd, 0);
+        close(fd);
+        if (map == MAP_FAILED)
+            return st_error_set(err, ST_EIO, path, 0, "cannot map: %s",
+                                std::strerror(errno));
+        st_status ws = VdbWalk(static_cast<const unsigned char *>(map),
+                               uint64_t(st.st_size), path, err).run();
+        munmap(map, size_t(st.st_size));
+        if (ws)
+            return ws;
+    }
     try {
         init_openvdb();
         // Read straight from the file (no copy in memory): io::Stream

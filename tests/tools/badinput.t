@@ -256,4 +256,14 @@ for n in 0 -1 abc; do
     expect_fail "--threads '$n'" 2 "^soupmesh: --threads wants" soupmesh --threads "$n" -o x.vtu "$BUNNY"
 done
 
+# A 3 KB .vdb whose grid metadata claims a 4 GB string: OpenVDB would
+# zero-fill it before reading (4 GB touched, seconds); the walk of the
+# length-prefixed parts refuses it first, fast and small.
+V="$ROOT/tests/data/fuzz/vdb/timeout-d8fabcd9cee97d9b5231c03d9e917109de94238a"
+expect_fail "a .vdb claiming a 4 GB metadata string: refused by the walk, naming the byte" 1 \
+    "^soupsign: .*timeout-d8fabcd9[0-9a-f]*: byte [0-9]+: not a valid OpenVDB file: a grid's metadata claims [0-9]+ bytes but [0-9]+ remain" \
+    soupsign -o x.vdb "$V"
+expect_fail "the same on stdin" 1 "^soupsign: <stdin>: byte [0-9]+: not a valid OpenVDB file" \
+    sh -c "soupsign -o x.vdb < '$V'"
+
 done_testing
