@@ -530,7 +530,8 @@ private:
         std::vsnprintf(what, sizeof what, fmt, ap);
         va_end(ap);
         return st_error_set_offset(err_, ST_EINPUT, name_, pos_,
-                                   "not a valid OpenVDB file: %s", what);
+                                   "not a valid OpenVDB file (truncated or corrupt): %s",
+                                   what);
     }
     /* One length-prefixed block (a string or a metadata value). */
     st_status block(const char *what)
