@@ -33,6 +33,7 @@
 #include "souptet/bvh.h"
 #include "souptet/isect.h"
 #include "souptet/pred.h"
+#include "souptet/mincut.h"
 
 #include <float.h>
 #include <limits.h>
@@ -56,7 +57,7 @@ static const int DIRS[13][3] = {
 
 st_sign_params st_sign_params_paper(void)
 {
-    st_sign_params p = {0.8, 0.0, 26, ST_TOGGLE_FIRST, 0, 0};
+    st_sign_params p = {0.8, 0.0, 26, ST_TOGGLE_FIRST, 0, 0, 0, 0};
     return p;
 }
 
@@ -77,10 +78,18 @@ st_sign_params st_sign_params_default(void)
      *     voxels, and a missed crossing breaks the union below (bunny,
      *     interpenetrating: 0.925 at k = 0.8, 0.989 at k = 1);
      *   - the union of hidden parts, for interpenetrating shells (0.57
-     *     without it).
+     *     without it);
+     *   - split event runs: two crossings closer than the event distance
+     *     (where interpenetrating shells meet, across thin walls and
+     *     tunnels) are two events, not one (cheese, interpenetrating, with
+     *     the cut: 0.916 whole runs, 0.938 split; torus: 0.878, 0.996);
+     *   - the cut of the undecided voxels (mincut.h): the votes as
+     *     evidence, the surface as a cheap place to cut (cheese, closed:
+     *     0.951 without, 0.995 with; deleted50: 0.672, 0.898; bunny,
+     *     holes: 0.932, 0.952; man, interpenetrating: 0.907, 0.976).
      * Nothing here depends on how far the grid reaches (c is not used at
      * k = 1), so a narrow-band field suffices. */
-    st_sign_params p = {1.0, 0.0, 26, ST_TOGGLE_CROSSING, 0, 1};
+    st_sign_params p = {1.0, 0.0, 26, ST_TOGGLE_CROSSING, 0, 1, 1, 1};
     return p;
 }
 
@@ -169,6 +178,10 @@ static inline int vote_inside(unsigned u) { return u > 13; }
 
 #define NO_MARK SIZE_MAX
 
+/* Split event runs: a rise of this fraction of the event distance between
+ * two dips of the distance separates two crossings. */
+#define SPLIT_RISE 0.2f
+
 typedef struct sweep {
     const float *data;
     uint8_t *v;           /* the byte per voxel (above) */
@@ -176,6 +189,8 @@ typedef struct sweep {
     st_sign_toggle toggle;
     float t_axis;         /* event distance for an axis direction */
     int k1;               /* k = 1: the event distance scales with the step */
+    int split;            /* split event runs at a rise between two dips */
+    unsigned *count;      /* st_sign_line: counts the events (else NULL) */
     uint8_t tab[256];     /* P_STATE bits -> the full line state */
 } sweep;
 
@@ -285,6 +300,40 @@ static inline long steps_back(long c, int dc, long n)
 }
 static inline long lmin(long a, long b) { return a < b ? a : b; }
 
+/* The crossing toggle's marks for an event whose nearest voxel is om
+ * steps past idx (see walk_run). Along a line through a locally flat
+ * surface the unsigned distance of the samples is |s - s0| sin(angle): a V
+ * with its tip at the crossing s0, which lies within half a step of the
+ * nearest sample m. The crossing is before m exactly when the previous
+ * sample is nearer than the next (ties: before, so a voxel center on the
+ * surface is past it both ways). The forward ray changes parity at the
+ * first voxel past the crossing, the backward ray at the last voxel before
+ * it: S at m and R at m - 1 when the crossing is before m, S at m + 1 and
+ * R at m when it is after. Where m - 1 or m + 1 is off the line (the
+ * surface touches the grid's border), the mark stays on m. */
+static void place_marks(const sweep *w, ptrdiff_t stride, size_t idx, long bk, long fw,
+                        long om, uint8_t *pl, size_t *lastr)
+{
+    const float *data = w->data + idx;
+    const int has_prev = bk + om > 0, has_next = fw - om > 0;
+    const ptrdiff_t m = om * stride;
+    const float dp = has_prev ? data[m - stride] : INFINITY;
+    const float dn = has_next ? data[m + stride] : INFINITY;
+    ptrdiff_t s_at = m, r_at = m;
+    if (dp <= dn) {
+        if (has_prev)
+            r_at = m - stride;
+    } else if (has_next) {
+        s_at = m + stride;
+    }
+    w->v[(ptrdiff_t)idx + s_at] |= MARK_S;
+    w->v[(ptrdiff_t)idx + r_at] |= MARK_R;
+    *pl ^= P_E_ODD;
+    if (w->count)
+        (*w->count)++;
+    *lastr = (size_t)((ptrdiff_t)idx + r_at);
+}
+
 /* Pass 1. Voxel idx is an event and the voxel before it on the line is
  * not (or is off the grid): an event run starts here. The line has bk
  * voxels before idx and fw after it. Walk the run to its end (the voxels
@@ -298,6 +347,40 @@ static void walk_run(const sweep *w, ptrdiff_t stride, float t, size_t idx,
     const float *data = w->data + idx;
     long o = 0, om = 0;             /* offsets of the run's end and nearest */
     float mn = data[0];
+    if (w->split) {
+        /* Dips: a sample at least delta above the run's last minimum and
+         * then one at least delta below that rise's maximum close an event
+         * at the minimum and start another. */
+        const float delta = SPLIT_RISE * t;
+        float mx = mn;
+        int rising = 0;
+        while (o < fw) {
+            const float a = data[(o + 1) * stride];
+            if (!(a < t))
+                break;
+            o++;
+            if (rising && a < mx - delta) {
+                place_marks(w, stride, idx, bk, fw, om, pl, lastr);
+                mn = mx = a;
+                om = o;
+                rising = 0;
+                continue;
+            }
+            if (a < mn && !rising) {
+                mn = a;
+                om = o;
+            }
+            if (a > mn + delta)
+                rising = 1;
+            if (rising) {
+                if (a > mx)
+                    mx = a;
+            } else
+                mx = a;
+        }
+        place_marks(w, stride, idx, bk, fw, om, pl, lastr);
+        return;
+    }
     while (o < fw) {
         const float a = data[(o + 1) * stride];
         if (!(a < t))
@@ -308,31 +391,12 @@ static void walk_run(const sweep *w, ptrdiff_t stride, float t, size_t idx,
             om = o;
         }
     }
-    ptrdiff_t s_at, r_at;           /* offsets from idx */
     if (w->toggle == ST_TOGGLE_CROSSING) {
-        /* Along a line through a locally flat surface the unsigned distance
-         * of the samples is |s - s0| sin(angle): a V with its tip at the
-         * crossing s0, which lies within half a step of the nearest sample
-         * m. The crossing is before m exactly when the previous sample is
-         * nearer than the next (ties: before, so a voxel center on the
-         * surface is past it both ways). The forward ray changes parity at
-         * the first voxel past the crossing, the backward ray at the last
-         * voxel before it: S at m and R at m - 1 when the crossing is
-         * before m, S at m + 1 and R at m when it is after. Where m - 1 or
-         * m + 1 is off the line (the surface touches the grid's border),
-         * the mark stays on m. */
-        const int has_prev = bk + om > 0, has_next = fw - om > 0;
-        const ptrdiff_t m = om * stride;
-        const float dp = has_prev ? data[m - stride] : INFINITY;
-        const float dn = has_next ? data[m + stride] : INFINITY;
-        s_at = r_at = m;
-        if (dp <= dn) {
-            if (has_prev)
-                r_at = m - stride;
-        } else if (has_next) {
-            s_at = m + stride;
-        }
-    } else if (w->toggle == ST_TOGGLE_NEAREST) {
+        place_marks(w, stride, idx, bk, fw, om, pl, lastr);
+        return;
+    }
+    ptrdiff_t s_at, r_at;           /* offsets from idx */
+    if (w->toggle == ST_TOGGLE_NEAREST) {
         s_at = r_at = om * stride;
     } else {
         s_at = 0;
@@ -341,6 +405,8 @@ static void walk_run(const sweep *w, ptrdiff_t stride, float t, size_t idx,
     w->v[(ptrdiff_t)idx + s_at] |= MARK_S;
     w->v[(ptrdiff_t)idx + r_at] |= MARK_R;
     *pl ^= P_E_ODD;
+    if (w->count)
+        (*w->count)++;
     *lastr = (size_t)((ptrdiff_t)idx + r_at);
 }
 
@@ -654,6 +720,8 @@ static void sweep_init(sweep *w, const st_grid *g, const st_sign_params *p,
     w->toggle = p->toggle;
     w->t_axis = t_axis;
     w->k1 = p->k >= 1.0;
+    w->split = p->split_runs && p->toggle == ST_TOGGLE_CROSSING;
+    w->count = NULL;
     sweep_table(w, p);
 }
 
@@ -692,12 +760,41 @@ static void write_signs(float *out, const uint8_t *v, size_t n, int nested)
     }
 }
 
+/* The undecided voxels by a minimum cut (mincut.h), the votes as its
+ * evidence: a majority inside is evidence for inside (U - 13, 1..13); a
+ * minority is evidence for outside (U - 13) only where some ray sees the
+ * voxel from outside, since a voxel hidden along every ray (inside
+ * interpenetrating shells, or in a tunnel) is where parity is not to be
+ * trusted: it has none, and the cut joins it to the side that encloses it
+ * (the union rule's intent, decided by area rather than by straight
+ * rays; without nested_union, parity is trusted there too). Each voxel's byte becomes its evidence, then its label; the
+ * signs are written from the labels. */
+static st_status cut_undecided(st_grid *g, uint8_t *v, int nested, st_error *err)
+{
+    const size_t n = st_grid_count(g);
+    int8_t *e = (int8_t *)v;
+    #pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        const int u = v[i] & V_COUNT, vis = (v[i] & V_VISIBLE) != 0;
+        e[i] = (int8_t)(u > 13 || vis || !nested ? u - 13 : 0);
+    }
+    const st_mincut_params cp = st_mincut_params_default();
+    st_status st = st_mincut_label(g, e, &cp, NULL, err);
+    if (st)
+        return st;
+    float *out = g->data;
+    #pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++)
+        out[i] = e[i] ? -fabsf(out[i]) : fabsf(out[i]);
+    return ST_OK;
+}
+
 unsigned st_sign_line(const float *d, size_t n, float t,
                       const st_sign_params *p, unsigned char *votes,
                       unsigned char *valid)
 {
     /* A n x 1 x 1 grid of the samples, swept like an x row. */
-    float *a = malloc((n ? n : 1) * sizeof *a);
+    float *a = calloc(n ? n : 1, sizeof *a);
     uint8_t *v = calloc(n ? n : 1, 1);
     if (!a || !v) {
         free(a);
@@ -705,10 +802,8 @@ unsigned st_sign_line(const float *d, size_t n, float t,
         return 0;
     }
     unsigned events = 0;
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n; i++)
         a[i] = fabsf(d[i]);
-        events += a[i] < t && (i == 0 || !(a[i - 1] < t));
-    }
     st_grid g;
     memset(&g, 0, sizeof g);
     g.nx = n;
@@ -716,6 +811,7 @@ unsigned st_sign_line(const float *d, size_t n, float t,
     g.data = a;
     sweep w;
     sweep_init(&w, &g, p, a, v, t);
+    w.count = &events;
     if (n)
         x_row(&w, 0, t);            /* t is the line's own */
     const int counted = !(p->ignore_odd && (events & 1u));
@@ -806,25 +902,36 @@ st_status st_sign_field(st_grid *g, const st_sign_params *p,
         free(v);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     }
-    /* Majority; ties (and voxels no counted ray reached) are outside. With
+    /* With the cut, the votes are its evidence (cut_undecided). Without:
+     * majority; ties (and voxels no counted ray reached) are outside; with
      * nested_union, a voxel no ray reaches from outside without meeting
      * the surface is inside whatever the parity. */
     float *out = g->data;
-    #pragma omp parallel for schedule(static)
-    for (size_t b0 = 0; b0 < n; b0 += SIGN_BLOCK)
-        write_signs(out + b0, v + b0, n - b0 < SIGN_BLOCK ? n - b0 : SIGN_BLOCK,
-                    p->nested_union);
+    if (p->cut) {
+        st_status cs = cut_undecided(g, v, p->nested_union, err);
+        if (cs) {
+            free(v);
+            return cs;
+        }
+    } else {
+        #pragma omp parallel for schedule(static)
+        for (size_t b0 = 0; b0 < n; b0 += SIGN_BLOCK)
+            write_signs(out + b0, v + b0, n - b0 < SIGN_BLOCK ? n - b0 : SIGN_BLOCK,
+                        p->nested_union);
+    }
     free(v);
     g->kind = ST_GRID_SIGNED;
     char buf[160];
     snprintf(buf, sizeof buf,
-             "k=%g c=%s rays=%d toggle=%s odd=%s nested=%s "
-             "event_distance=%.9g",
+             "k=%g c=%s rays=%d toggle=%s odd=%s nested=%s runs=%s "
+             "undecided=%s event_distance=%.9g",
              p->k, p->band_voxels > 0 ? "band" : "1/max|d|", p->rays,
              p->toggle == ST_TOGGLE_CROSSING ? "crossing"
                  : p->toggle == ST_TOGGLE_NEAREST ? "nearest" : "first",
              p->ignore_odd ? "ignored" : "kept",
-             p->nested_union ? "union" : "parity", t);
+             p->nested_union ? "union" : "parity",
+             p->split_runs && p->toggle == ST_TOGGLE_CROSSING ? "split" : "whole",
+             p->cut ? "cut" : "vote", t);
     if (st_meta_set(&g->meta, "sign_rule", buf))
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     return ST_OK;

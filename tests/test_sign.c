@@ -110,6 +110,25 @@ static void test_rays(void)
     const float c[] = {3, 0.1f, 0.4f, 0.1f, 3, 3};
     memset(v, 0, sizeof v);
     TAP_CHECK(st_sign_line(c, N(c), 0.5f, &p, v, NULL) == 1, "no second event without leaving the band");
+    /* ... unless the run holds two crossings (split runs, the default):
+     * the distance dips twice, rising by more than a fifth of t between
+     * (two surfaces closer than t: a thin wall). Each dip is a crossing:
+     * only voxel 2, between them, is inside, from both directions. */
+    st_sign_params dflt = st_sign_params_default();
+    const unsigned char wc_split[] = {0, 0, 2, 0, 0, 0};
+    memset(v, 0, sizeof v);
+    e = st_sign_line(c, N(c), 0.5f, &dflt, v, NULL);
+    TAP_CHECK(e == 2 && votes_are(v, wc_split, N(c)), "split runs: two dips in one run are two crossings");
+    if (!votes_are(v, wc_split, N(c)))
+        print_votes(v, N(c));
+    dflt.split_runs = 0;
+    memset(v, 0, sizeof v);
+    TAP_CHECK(st_sign_line(c, N(c), 0.5f, &dflt, v, NULL) == 1, "whole runs: the same run is one event");
+    /* A rise of less than a fifth of t is not a second crossing. */
+    const float c2[] = {3, 0.1f, 0.19f, 0.1f, 3, 3};
+    dflt.split_runs = 1;
+    memset(v, 0, sizeof v);
+    TAP_CHECK(st_sign_line(c2, N(c2), 0.5f, &dflt, v, NULL) == 1, "split runs: a small rise is one event");
 
     /* An odd line (a ray through a hole): kept by the paper, dropped on
      * request, both directions. */
@@ -395,6 +414,7 @@ static void test_sweep_matches_lines(void)
     st_sign_params_named(&rules[1], "parity");
     rules[2] = st_sign_params_default();
     rules[2].nested_union = 0;
+    rules[2].cut = 0;   /* the per-line rule: the cut is a step after it */
     rules[3] = rules[2];
     rules[3].rays = 13;
     rules[3].ignore_odd = 1;

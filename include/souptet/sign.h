@@ -31,10 +31,26 @@
  *     outside without meeting an event (hidden along all rays) is inside
  *     whatever the parity: the union of the parts, as a person sees it.
  *     (Not in the paper, whose rule is parity only.)
+ *   - two crossings in one event run: where two surfaces come closer than
+ *     the event distance (interpenetrating shells meeting, thin walls and
+ *     tunnels), the samples' distance dips twice without leaving the run.
+ *     With split_runs (crossing toggle only), a rise of a fifth of the
+ *     event distance between two dips ends one event and starts the next,
+ *     each with its own crossing toggle; the paper counts one.
+ *   - the cut (not in the paper): the votes decide a voxel only as
+ *     evidence (a majority inside, or outside where a ray sees it from
+ *     outside; hidden voxels have none under nested_union) for a minimum
+ *     cut of the grid (mincut.h) in which cutting next to the surface is
+ *     cheap and cutting free space costs a voxel face. So holes and
+ *     deleted faces are spanned by the least area, ties and hidden voxels
+ *     join the side that encloses them, and stray votes in the open are
+ *     outvoted by their neighbours. Voxels whose votes are nearly
+ *     unanimous are decided by them and cost the cut nothing.
  * Results do not depend on the thread count.
  *
  * Memory: st_sign_field needs the grid (4 bytes per voxel) plus ONE BYTE PER
- * VOXEL, for every rule and option: the votes (each of the 13 lines adds
+ * VOXEL for the votes, for every rule and option (the cut adds about 70
+ * bytes per undecided voxel, nothing on a closed surface's far voxels): the votes (each of the 13 lines adds
  * 0..2; a line dropped for odd parity adds 1, neutral), one bit "some ray
  * sees the voxel from outside" for nested_union, and the two toggle marks
  * of the direction being swept. Each thread also keeps line states for a
@@ -68,6 +84,9 @@ typedef struct st_sign_params {
     st_sign_toggle toggle;
     int ignore_odd;         /* drop lines with an odd number of events */
     int nested_union;       /* hidden from all rays = inside (see above) */
+    int split_runs;         /* crossing toggle: an event run with two dips
+                             * is two events (see above) */
+    int cut;                /* the sides by a minimum cut (see above) */
 } st_sign_params;
 
 /* The paper's rule exactly: k 0.8, c = 1/max|d|, 26 rays, toggle on the

@@ -55,6 +55,13 @@ static void usage(void)
 "      --nested union|parity  union: a voxel hidden from outside along\n"
 "                       every ray is inside whatever the parity (keeps\n"
 "                       interpenetrating parts whole; default); parity: the paper\n"
+"      --runs split|whole  split: an event run whose distance dips twice\n"
+"                       holds two crossings (two surfaces closer than the\n"
+"                       event distance; default, crossing toggle only);\n"
+"                       whole: one event per run (the paper)\n"
+"      --cut on|off     on: the votes are evidence for a minimum cut that\n"
+"                       follows the surface and spans its holes by the least\n"
+"                       area (default); off: the majority decides (the paper)\n"
 "      --surface S      the soup the field was computed from: refine the signs\n"
 "                       within a voxel of it by exact segment crossings\n"
 "                       (not with --rule paper)\n"
@@ -79,7 +86,7 @@ static void usage(void)
 "Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
 }
 
-enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
+enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
 
 int main(int argc, char *argv[])
 {
@@ -96,6 +103,8 @@ int main(int argc, char *argv[])
         {"toggle", required_argument, NULL, OPT_TOGGLE},
         {"odd", required_argument, NULL, OPT_ODD},
         {"nested", required_argument, NULL, OPT_NESTED},
+        {"runs", required_argument, NULL, OPT_RUNS},
+        {"cut", required_argument, NULL, OPT_CUT},
         {"rule", required_argument, NULL, OPT_RULE},
         {"surface", required_argument, NULL, OPT_SURFACE},
         {"refine-band", required_argument, NULL, OPT_REFINE_BAND},
@@ -151,6 +160,22 @@ int main(int argc, char *argv[])
                 p.nested_union = 0;
             else
                 return tool_usage_error(&t, "--nested is union or parity, not '%s'", optarg);
+            break;
+        case OPT_RUNS:
+            if (strcmp(optarg, "split") == 0)
+                p.split_runs = 1;
+            else if (strcmp(optarg, "whole") == 0)
+                p.split_runs = 0;
+            else
+                return tool_usage_error(&t, "--runs is split or whole, not '%s'", optarg);
+            break;
+        case OPT_CUT:
+            if (strcmp(optarg, "on") == 0)
+                p.cut = 1;
+            else if (strcmp(optarg, "off") == 0)
+                p.cut = 0;
+            else
+                return tool_usage_error(&t, "--cut is on or off, not '%s'", optarg);
             break;
         case OPT_RULE:
             if (st_sign_params_named(&p, optarg))
