@@ -1,0 +1,27 @@
+/*
+ * weld.h - exact welding: vertices at the same position (bit for bit, with
+ * -0 equal to 0) become one. The topology of a soup (its edges, holes and
+ * pieces) is read on welded vertices, so an exact soup (every triangle
+ * with its own three vertices) has the topology of the mesh it came from.
+ */
+#ifndef SOUPTET_WELD_H
+#define SOUPTET_WELD_H
+
+#include <stdint.h>
+#include "souptet/soup.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define ST_WELD_NONE UINT32_MAX
+
+/* weld[v] (s->nverts entries) = the welded id of referenced vertex v, ids
+ * 0.. in order of first appearance; ST_WELD_NONE for a vertex no triangle
+ * uses. Returns the number of welded ids, or -1 when out of memory. */
+long long st_weld_vertices(uint32_t *weld, const st_soup *s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
