@@ -681,3 +681,52 @@ st_status st_dist_field(st_grid **out, const st_soup *s,
     *out = g;
     return ST_OK;
 }
+
+st_status st_dist_lower(st_grid *g, const st_soup *s, double reach,
+                        st_error *err)
+{
+    if (!(reach > 0) || !s->ntris)
+        return ST_OK;
+    const size_t nx = g->nx, ny = g->ny, nz = g->nz;
+    const double h = g->voxel;
+    (void)err;
+    /* A z layer per iteration: every voxel's minimum over the triangles
+     * within reach of it, in any order (a minimum), so the threads never
+     * share a voxel. */
+    #pragma omp parallel for schedule(dynamic, 1)
+    for (size_t k = 0; k < nz; k++) {
+        const double z = g->origin[2] + h * (double)k;
+        for (size_t t = 0; t < s->ntris; t++) {
+            const double *a = s->xyz + 3 * (size_t)s->tris[3 * t],
+                         *b = s->xyz + 3 * (size_t)s->tris[3 * t + 1],
+                         *c = s->xyz + 3 * (size_t)s->tris[3 * t + 2];
+            double lo[3], hi[3];
+            for (int q = 0; q < 3; q++) {
+                lo[q] = fmin(a[q], fmin(b[q], c[q])) - reach;
+                hi[q] = fmax(a[q], fmax(b[q], c[q])) + reach;
+            }
+            if (z < lo[2] || z > hi[2])
+                continue;
+            double fi0 = ceil((lo[0] - g->origin[0]) / h), fi1 = floor((hi[0] - g->origin[0]) / h);
+            double fj0 = ceil((lo[1] - g->origin[1]) / h), fj1 = floor((hi[1] - g->origin[1]) / h);
+            if (fi1 < 0 || fj1 < 0 || fi0 > (double)(nx - 1) || fj0 > (double)(ny - 1))
+                continue;
+            const size_t i0 = fi0 < 0 ? 0 : (size_t)fi0, j0 = fj0 < 0 ? 0 : (size_t)fj0;
+            const size_t i1 = fi1 > (double)(nx - 1) ? nx - 1 : (size_t)fi1;
+            const size_t j1 = fj1 > (double)(ny - 1) ? ny - 1 : (size_t)fj1;
+            for (size_t j = j0; j <= j1; j++)
+                for (size_t i = i0; i <= i1; i++) {
+                    const double p[3] = {g->origin[0] + h * (double)i,
+                                         g->origin[1] + h * (double)j, z};
+                    const double d2 = st_point_triangle_dist2(p, a, b, c, NULL);
+                    if (!(d2 < reach * reach))
+                        continue;
+                    float *v = g->data + st_grid_index(g, i, j, k);
+                    const float d = (float)sqrt(d2);
+                    if (d < *v)
+                        *v = d;
+                }
+        }
+    }
+    return ST_OK;
+}

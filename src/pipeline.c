@@ -4,6 +4,7 @@
 #include "souptet/pipeline.h"
 
 #include "souptet/bvh.h"
+#include "souptet/holes.h"
 #include "souptet/dist.h"
 #include "souptet/grid.h"
 #include "souptet/lattice.h"
@@ -33,6 +34,7 @@ st_pipeline_params st_pipeline_params_default(void)
     p.fit_max_iters = 0;
     p.density_rho = 0.0;
     p.max_bytes = 0;
+    p.fill_holes = 1;
     return p;
 }
 
@@ -237,9 +239,30 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                               : (p->cells * 8 > 128 ? p->cells * 8 : 128);
     dp.max_bytes = p->max_bytes;
     st_grid *g = NULL;
-    st_bvh *bvh = NULL;
+    st_bvh *bvh = NULL, *bvh_field = NULL;
     st_tetmesh **meshes = NULL;
-    st_status rc = st_dist_field(&g, s, &dp, prog, err);
+    st_soup *caps = NULL, *capped = NULL;
+    /* The pseudo volume of the soup with its holes capped (holes.h): the
+     * field and its refinement see the caps; the mesh is fitted to, and
+     * must enclose, the soup itself. */
+    const st_soup *field_soup = s;
+    st_status rc = ST_OK;
+    if (p->fill_holes) {
+        st_holes_params hp = st_holes_params_default();
+        rc = st_soup_hole_caps(&caps, s, &hp, NULL, err);
+        if (rc)
+            goto done;
+        if (caps->ntris) {
+            rc = (capped = st_soup_new()) ? ST_OK
+                 : st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+            rc = rc ? rc : st_soup_append(capped, s, err);
+            rc = rc ? rc : st_soup_append(capped, caps, err);
+            if (rc)
+                goto done;
+            field_soup = capped;
+        }
+    }
+    rc = st_dist_field(&g, field_soup, &dp, prog, err);
     if (rc)
         goto done;
     double t_sign = now_seconds();
@@ -254,8 +277,12 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     rc = st_bvh_build(&bvh, s, err);
     if (rc)
         goto done;
+    if (field_soup != s && (rc = st_bvh_build(&bvh_field, field_soup, err)))
+        goto done;
     st_sign_refine_params rf = st_sign_refine_params_default();
-    rc = st_sign_refine_bvh(g, bvh, &rf, NULL, err);
+    rc = st_sign_refine_bvh(g, bvh_field ? bvh_field : bvh, &rf, NULL, err);
+    st_bvh_free(bvh_field);
+    bvh_field = NULL;
     if (rc)
         goto done;
     double t_cand = now_seconds();
@@ -343,6 +370,9 @@ done:
         free(local.candidates);
     }
     st_bvh_free(bvh);
+    st_bvh_free(bvh_field);
+    st_soup_free(caps);
+    st_soup_free(capped);
     st_grid_free(g);
     return rc;
 }

@@ -536,3 +536,22 @@ st_status st_soup_read(st_soup **out, const char *path, st_error *err)
     free(data);
     return st;
 }
+
+st_status st_soup_append(st_soup *dst, const st_soup *src, st_error *err)
+{
+    const size_t base = dst->nverts;
+    for (size_t v = 0; v < src->nverts; v++) {
+        const double *q = src->xyz + 3 * v;
+        st_status st = st_soup_add_vertex(dst, q[0], q[1], q[2], err);
+        if (st)
+            return st;
+    }
+    for (size_t t = 0; t < src->ntris; t++) {
+        const uint32_t *c = src->tris + 3 * t;
+        st_status st = st_soup_add_triangle(dst, (uint32_t)(base + c[0]), (uint32_t)(base + c[1]),
+                                            (uint32_t)(base + c[2]), err);
+        if (st)
+            return st;
+    }
+    return ST_OK;
+}

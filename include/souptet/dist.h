@@ -71,6 +71,13 @@ st_status st_dist_field(st_grid **out, const st_soup *s,
                         const st_dist_params *p, const st_progress *progress,
                         st_error *err);
 
+/* Lower g's values to the distance to s's triangles where that is below
+ * `reach` (model units): the field of the union of g's soup and s, as far
+ * as reach (hole caps added to a field from a file). Exact point-triangle
+ * distances; identical for any number of threads. */
+st_status st_dist_lower(st_grid *g, const st_soup *s, double reach,
+                        st_error *err);
+
 #ifdef __cplusplus
 }
 #endif

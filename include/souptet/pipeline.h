@@ -57,6 +57,8 @@ typedef struct st_pipeline_params {
     int fit_max_iters;     /* 0: smooth.h's default */
     double density_rho;    /* > 0: the Spillmann mesher with this rho_min */
     size_t max_bytes;      /* limit for the distance field (0: none) */
+    int fill_holes;        /* the field of the soup with its holes capped
+                              (holes.h) (1) */
 } st_pipeline_params;
 
 st_pipeline_params st_pipeline_params_default(void);

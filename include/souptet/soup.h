@@ -86,6 +86,10 @@ st_status st_soup_read(st_soup **out, const char *path, st_error *err);
 st_status st_soup_bounds(const st_soup *s, double lo[3], double hi[3],
                          st_error *err);
 
+/* Append src's vertices and triangles to dst (src's indices shifted).
+ * ST_ENOMEM or ST_ELIMIT; dst keeps what it had on failure only in part. */
+st_status st_soup_append(st_soup *dst, const st_soup *src, st_error *err);
+
 #ifdef __cplusplus
 }
 #endif

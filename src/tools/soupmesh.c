@@ -62,6 +62,9 @@ static void usage(void)
 "      --field-cells N  voxels along the longest side of the distance field\n"
 "                       (default max(128, 8 * cells))\n"
 "      --max-iters N    fit iterations at most (default 300)\n"
+"      --fill-holes on|off  cap the soup's holes for its pseudo volume\n"
+"                       (holes.h: loops of boundary edges, when small beside\n"
+"                       the surface around them; default on)\n"
 "      --no-quality     skip the quality pass after the fit\n"
 "      --threads T      threads to use (default: all cores)\n"
 "      --max-memory SZ  refuse fields and lattices larger than SZ\n"
@@ -79,7 +82,7 @@ static void usage(void)
 }
 
 enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
-       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED };
+       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED, OPT_FILL_HOLES };
 
 static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
 {
@@ -164,6 +167,7 @@ int main(int argc, char *argv[])
         {"field-cells", required_argument, NULL, OPT_FIELD_CELLS},
         {"max-iters", required_argument, NULL, OPT_MAX_ITERS},
         {"no-quality", no_argument, NULL, OPT_NO_QUALITY},
+        {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
         {"msh-version", required_argument, NULL, OPT_MSH_VERSION},
         {"msh-binary", no_argument, NULL, OPT_MSH_BINARY},
         {"embed", required_argument, NULL, OPT_EMBED},
@@ -207,6 +211,14 @@ int main(int argc, char *argv[])
             break;
         case OPT_NO_QUALITY:
             p.quality = 0;
+            break;
+        case OPT_FILL_HOLES:
+            if (strcmp(optarg, "on") == 0)
+                p.fill_holes = 1;
+            else if (strcmp(optarg, "off") == 0)
+                p.fill_holes = 0;
+            else
+                return tool_usage_error(&t, "--fill-holes is on or off, not '%s'", optarg);
             break;
         case OPT_MSH_VERSION: {
             size_t v;

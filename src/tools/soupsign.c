@@ -12,6 +12,8 @@
 #include "souptet/gridio.h"
 #include "souptet/outfile.h"
 #include "souptet/sign.h"
+#include "souptet/dist.h"
+#include "souptet/holes.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -65,6 +67,10 @@ static void usage(void)
 "      --surface S      the soup the field was computed from: refine the signs\n"
 "                       within a voxel of it by exact segment crossings\n"
 "                       (not with --rule paper)\n"
+"      --fill-holes on|off  with --surface: cap the surface's holes (loops of\n"
+"                       boundary edges, by the triangulation of least area,\n"
+"                       when small beside the surface around them) before\n"
+"                       voting (default on)\n"
 "      --refine-band D  refine voxels nearer than D voxels (default 1.5)\n"
 "      --refine-radius R  neighbours within R voxels per axis (default 2)\n"
 "      --refine-answers A  neighbours' answers combined per voxel (default 6)\n"
@@ -86,7 +92,7 @@ static void usage(void)
 "Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
 }
 
-enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
+enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_FILL_HOLES, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
 
 int main(int argc, char *argv[])
 {
@@ -96,7 +102,7 @@ int main(int argc, char *argv[])
     st_sign_params p = st_sign_params_default();
     const char *out = NULL, *in = NULL, *surface = NULL;
     st_sign_refine_params rp = st_sign_refine_params_default();
-    int paper = 0;
+    int paper = 0, fill_holes = 1;
     static const struct option opts[] = {
         {"band", required_argument, NULL, OPT_BAND},
         {"rays", required_argument, NULL, OPT_RAYS},
@@ -105,6 +111,7 @@ int main(int argc, char *argv[])
         {"nested", required_argument, NULL, OPT_NESTED},
         {"runs", required_argument, NULL, OPT_RUNS},
         {"cut", required_argument, NULL, OPT_CUT},
+        {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
         {"rule", required_argument, NULL, OPT_RULE},
         {"surface", required_argument, NULL, OPT_SURFACE},
         {"refine-band", required_argument, NULL, OPT_REFINE_BAND},
@@ -176,6 +183,14 @@ int main(int argc, char *argv[])
                 p.cut = 0;
             else
                 return tool_usage_error(&t, "--cut is on or off, not '%s'", optarg);
+            break;
+        case OPT_FILL_HOLES:
+            if (strcmp(optarg, "on") == 0)
+                fill_holes = 1;
+            else if (strcmp(optarg, "off") == 0)
+                fill_holes = 0;
+            else
+                return tool_usage_error(&t, "--fill-holes is on or off, not '%s'", optarg);
             break;
         case OPT_RULE:
             if (st_sign_params_named(&p, optarg))
@@ -251,6 +266,46 @@ int main(int argc, char *argv[])
         goto done;
     }
     double t1 = tool_now();
+    /* With the surface: cap its holes (holes.h) and add the caps to the
+     * field before voting, so rays meet them; refine against the soup and
+     * its caps. */
+    st_holes_stats hs;
+    memset(&hs, 0, sizeof hs);
+    double t_holes = 0.0;
+    if (surface) {
+        double r0 = tool_now();
+        if (st_soup_read(&soup, surface, &err)) {
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        double r1 = tool_now();
+        t1 += r1 - r0;   /* reading the surface is not signing */
+        if (fill_holes) {
+            st_soup *caps = NULL;
+            st_holes_params hp = st_holes_params_default();
+            double reach = 3.0 * g->voxel;
+            if (g->band < reach)
+                reach = g->band;
+            if (st_soup_hole_caps(&caps, soup, &hp, &hs, &err) ||
+                st_dist_lower(g, caps, reach, &err) || st_soup_append(soup, caps, &err)) {
+                st_soup_free(caps);
+                if (!err.file[0])
+                    snprintf(err.file, sizeof err.file, "%s", surface);
+                rc = tool_fail(&t, &err);
+                goto done;
+            }
+            char buf[96];
+            snprintf(buf, sizeof buf, "%zu of %zu loops capped, %zu triangles", hs.filled,
+                     hs.loops, caps->ntris);
+            st_soup_free(caps);
+            if (st_meta_set(&g->meta, "hole_caps", buf)) {
+                st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
+                rc = tool_fail(&t, &err);
+                goto done;
+            }
+            t_holes = tool_now() - r1;
+        }
+    }
     st_progress prog = tool_progress(&t);
     const double c0 = cpu_now();
     double event = st_sign_event_distance(&p, g);
@@ -264,11 +319,6 @@ int main(int argc, char *argv[])
     const double cpu_sign = cpu_now() - c0;
     tool_progress_end(&t);
     if (surface) {
-        double r0 = tool_now();
-        if (st_soup_read(&soup, surface, &err)) {
-            rc = tool_fail(&t, &err);
-            goto done;
-        }
         double r1 = tool_now();
         if (st_sign_refine(g, soup, &rp, &changed, &err)) {
             if (!err.file[0])
@@ -277,7 +327,6 @@ int main(int argc, char *argv[])
             goto done;
         }
         t_refine = tool_now() - r1;
-        t1 += r1 - r0;   /* reading the surface is not signing */
     }
     double t2 = tool_now();
     if (st_meta_history_append(&g->meta, t.command_line ? t.command_line : "soupsign")) {
@@ -297,11 +346,15 @@ int main(int argc, char *argv[])
              st_meta_get(&g->meta, "sign_rule"));
     tool_say(&t, 2, "event distance %.6g (%.3g voxels); %zu of %zu voxels inside (%.2f%%)",
              event, event / g->voxel, inside, n, 100.0 * (double)inside / (double)n);
+    if (surface && fill_holes)
+        tool_say(&t, 2, "holes: %zu of %zu boundary loops capped (%zu too large, %zu too long, "
+                 "%zu edges by pinched vertices left open), %.3f s",
+                 hs.filled, hs.loops, hs.too_large, hs.too_long, hs.pinched, t_holes);
     if (surface)
         tool_say(&t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
                  rp.band_voxels, changed, t_refine);
     tool_say(&t, 2, "read %.3f s, signs %.3f s (CPU %.3f s, all threads), write %.3f s",
-             t1 - t0, t2 - t1 - t_refine, cpu_sign, t3 - t2);
+             t1 - t0, t2 - t1 - t_refine - t_holes, cpu_sign, t3 - t2);
     rc = TOOL_EXIT_OK;
 done:
     st_grid_free(g);

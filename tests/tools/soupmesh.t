@@ -55,4 +55,11 @@ expect_fail "an output directory that does not exist is refused before the work"
 expect_fail "bad --cells" 2 "cells" soupmesh --cells 0 -o x.vtu "$BUNNY"
 expect_fail "unknown output format" 2 "format" soupmesh -o x.abc "$BUNNY"
 
+# Hole caps for the pseudo volume (default on): a holed bunny meshes with
+# and without them, and both enclose it.
+awk '/^v /{print; next} /^f /{if ($2+0 == 1 || $3+0 == 1 || $4+0 == 1) next} {print}' "$BUNNY" > holed.obj
+check "a holed bunny meshes with its hole capped" sh -c "soupmesh -v -o hc.vtu holed.obj 2>&1 | grep -q 'encloses the input'"
+check "--fill-holes off meshes it too" sh -c "soupmesh -v --fill-holes off -o ho.vtu holed.obj 2>&1 | grep -q 'encloses the input'"
+expect_fail "bad --fill-holes" 2 "--fill-holes is on or off" soupmesh --fill-holes 2 holed.obj
+
 done_testing

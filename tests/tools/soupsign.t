@@ -55,4 +55,19 @@ expect_fail "a missing surface" 1 "^soupsign: nosuch.obj" soupsign --surface nos
 check "no partial output after a refinement failure" test ! -e y.vdb
 expect_fail "bad --refine-band" 2 "refine-band" soupsign --refine-band 0 --surface "$BUNNY" d.vdb
 
+# The steps after the per-line rule: split runs, the cut, hole caps.
+check "--runs whole and --cut off run" sh -c "soupsign --runs whole -o w.vdb d.vdb && soupsign --cut off -o c.vdb d.vdb"
+check "the rule metadata names the runs and the cut" sh -c "soupsign -v -o m.vdb d.vdb 2>&1 | grep -q 'runs=split undecided=cut'"
+expect_fail "bad --runs" 2 "--runs is split or whole" soupsign --runs some d.vdb
+expect_fail "bad --cut" 2 "--cut is on or off" soupsign --cut maybe d.vdb
+expect_fail "bad --fill-holes" 2 "--fill-holes is on or off" soupsign --fill-holes yes d.vdb
+# The bunny without the faces that touch one vertex: one hole, capped.
+awk '/^v /{print; next} /^f /{n++; if ($2+0 == 1 || $3+0 == 1 || $4+0 == 1) next} {print}' "$BUNNY" > holed.obj
+check "the holed bunny has fewer faces" sh -c "test \$(grep -c '^f ' holed.obj) -lt \$(grep -c '^f ' '$BUNNY')"
+soupdist -r 48 -o h.vdb holed.obj
+check "-v reports the hole capped" sh -c "soupsign -v --surface holed.obj -o h1.vdb h.vdb 2>&1 | grep -q 'holes: 1 of 1 boundary loops capped'"
+check "the caps are in the metadata" sh -c "grep -aq 'hole_caps' h1.vdb"
+soupsign -v --fill-holes off --surface holed.obj -o h2.vdb h.vdb 2> h2.log
+check "--fill-holes off: no caps" sh -c "test -s h2.vdb && ! grep -q 'holes:' h2.log && ! grep -aq 'hole_caps' h2.vdb"
+
 done_testing

@@ -1,0 +1,63 @@
+/*
+ * holes.h - caps for the holes of a soup.
+ *
+ * A hole is a loop of boundary edges (edges of exactly one triangle, on
+ * exactly welded vertices, degenerate and duplicated triangles left out)
+ * through vertices that have exactly two boundary edges. Its cap is the
+ * triangulation of the loop of least area (dynamic programming over the
+ * loop's vertices, Barequet and Sharir's minimal-area polygon
+ * triangulation): a flat hole gets a flat cap, a hole across a tube the
+ * chord across it.
+ *
+ * Not every loop is a hole: an open patch (a panel of a CAD part, one of a
+ * teapot's patches, a sheet) has a loop around itself, and capping it would
+ * add a second surface beside or across the patch. A loop is capped only
+ * when its cap is small beside the surface around it: at most
+ * max_cap_ratio times the area of the pieces (edge-connected triangles)
+ * its edges belong to. Loops through a vertex with more than two boundary
+ * edges (where holes touch, and everywhere in a soup with half its faces
+ * deleted at random) are not traced: how their edges pair up is not
+ * known, and a wrong pairing spans a cap across the surface.
+ *
+ * Orientation is not read; the result does not depend on how the soup's
+ * vertices are shared, only on their positions.
+ */
+#ifndef SOUPTET_HOLES_H
+#define SOUPTET_HOLES_H
+
+#include <stddef.h>
+#include "souptet/err.h"
+#include "souptet/soup.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct st_holes_params {
+    double max_cap_ratio;   /* cap area / area of the pieces around it */
+    size_t max_loop;        /* loops with more edges are left open */
+} st_holes_params;
+
+typedef struct st_holes_stats {
+    size_t boundary_edges;
+    size_t loops;           /* loops traced */
+    size_t filled;          /* loops capped */
+    size_t too_large;       /* cap above max_cap_ratio (or of no area) */
+    size_t too_long;        /* more than max_loop edges */
+    size_t pinched;         /* boundary edges on paths that meet a vertex
+                             * with more than two boundary edges: left open */
+} st_holes_stats;
+
+st_holes_params st_holes_params_default(void);
+
+/* *caps gets a new soup of the caps' triangles (possibly none; its
+ * vertices are copies of the loops' positions). stats may be NULL.
+ * ST_ENOMEM, ST_ELIMIT (more than 2^31 triangles). */
+st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
+                            const st_holes_params *p, st_holes_stats *stats,
+                            st_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

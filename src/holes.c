@@ -1,0 +1,365 @@
+/*
+ * holes.c - caps for the holes of a soup (see holes.h).
+ *
+ *   1. weld the vertices exactly; drop degenerate triangles and all but
+ *      the first of each set of duplicates;
+ *   2. sort the half-edges by their unordered welded ends: an edge of one
+ *      triangle is a boundary edge; every edge joins its triangles into
+ *      pieces (union-find), whose areas are summed;
+ *   3. walk the boundary edges through vertices with two of them into
+ *      loops;
+ *   4. triangulate each loop by least area (O(n^3) in its n vertices) and
+ *      keep the cap if it is small beside the pieces around the loop.
+ */
+#include "souptet/holes.h"
+#include "souptet/geom.h"
+#include "souptet/mem.h"
+#include "souptet/weld.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NONE UINT32_MAX
+
+st_holes_params st_holes_params_default(void)
+{
+    /* 0.25: a hole's cap is at most a quarter of the surface around it (on
+     * the corpus, holes of 3 rings of faces on models of 3 000 faces and
+     * up: under 0.15); an open patch's own loop spans about its area. */
+    st_holes_params p = {0.25, 256};
+    return p;
+}
+
+typedef struct tri_key {
+    uint32_t k[3];      /* sorted welded corners */
+    uint32_t t;
+} tri_key;
+
+static int cmp_tri_key(const void *pa, const void *pb)
+{
+    const tri_key *a = pa, *b = pb;
+    for (int i = 0; i < 3; i++)
+        if (a->k[i] != b->k[i])
+            return a->k[i] < b->k[i] ? -1 : 1;
+    return (a->t > b->t) - (a->t < b->t);
+}
+
+typedef struct half {
+    uint64_t key;       /* lower welded end << 32 | higher */
+    uint32_t t;
+} half;
+
+static int cmp_half(const void *pa, const void *pb)
+{
+    const half *a = pa, *b = pb;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->t > b->t) - (a->t < b->t);
+}
+
+static uint32_t uf_find(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+static double tri_area(const double *a, const double *b, const double *c)
+{
+    double u[3], v[3], n[3];
+    st_sub3(u, b, a);
+    st_sub3(v, c, a);
+    st_cross3(n, u, v);
+    return 0.5 * st_norm3(n);
+}
+
+/* The least-area triangulation of the polygon pts[0..n) (n >= 3): fills
+ * tri[3 (n - 2)] with local indices and returns its area; -1 when out of
+ * memory. */
+static double least_area(const double *const *pts, size_t n, uint32_t *tri)
+{
+    double *w = malloc(n * n * sizeof *w);
+    uint16_t *best = malloc(n * n * sizeof *best);
+    size_t *stack = malloc(2 * n * sizeof *stack);
+    if (!w || !best || !stack) {
+        free(w);
+        free(best);
+        free(stack);
+        return -1.0;
+    }
+    for (size_t i = 0; i + 1 < n; i++)
+        w[i * n + i + 1] = 0.0;
+    for (size_t len = 2; len < n; len++)
+        for (size_t i = 0; i + len < n; i++) {
+            const size_t j = i + len;
+            double m = INFINITY;
+            size_t mk = i + 1;
+            for (size_t k = i + 1; k < j; k++) {
+                double c = w[i * n + k] + w[k * n + j] + tri_area(pts[i], pts[k], pts[j]);
+                if (c < m) {        /* ties keep the first k */
+                    m = c;
+                    mk = k;
+                }
+            }
+            w[i * n + j] = m;
+            best[i * n + j] = (uint16_t)mk;
+        }
+    const double area = w[n - 1];
+    size_t top = 0, nt = 0;
+    stack[top++] = 0;
+    stack[top++] = n - 1;
+    while (top) {
+        const size_t j = stack[--top], i = stack[--top];
+        if (j - i < 2)
+            continue;
+        const size_t k = best[i * n + j];
+        tri[3 * nt] = (uint32_t)i;
+        tri[3 * nt + 1] = (uint32_t)k;
+        tri[3 * nt + 2] = (uint32_t)j;
+        nt++;
+        stack[top++] = i;
+        stack[top++] = k;
+        stack[top++] = k;
+        stack[top++] = j;
+    }
+    free(w);
+    free(best);
+    free(stack);
+    return area;
+}
+
+st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
+                            const st_holes_params *p, st_holes_stats *stats,
+                            st_error *err)
+{
+    st_holes_stats st0;
+    memset(&st0, 0, sizeof st0);
+    *caps = NULL;
+    if (s->ntris > (size_t)INT32_MAX)
+        return st_error_set(err, ST_ELIMIT, NULL, 0,
+                            "%zu triangles: hole filling handles at most 2^31", s->ntris);
+    if (p->max_loop > 4096 || !(p->max_cap_ratio >= 0))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "hole filling: loops of at most 4096 edges, a cap ratio >= 0");
+    const size_t nt = s->ntris;
+    st_status rc = ST_ENOMEM;
+    st_soup *out = st_soup_new();
+    uint32_t *weld = st_malloc_array(s->nverts ? s->nverts : 1, sizeof *weld);
+    tri_key *keys = st_malloc_array(nt ? nt : 1, sizeof *keys);
+    half *he = st_malloc_array(3 * nt + 1, sizeof *he);
+    uint32_t *parent = st_malloc_array(nt ? nt : 1, sizeof *parent);
+    double *piece_area = st_calloc_array(nt ? nt : 1, sizeof *piece_area);
+    uint32_t *stamp = NULL, *be_a = NULL, *be_b = NULL, *be_t = NULL, *vedge = NULL,
+             *loop_v = NULL, *loop_e = NULL, *tri = NULL;
+    uint8_t *deg = NULL, *used = NULL;
+    const double **pts = NULL;
+    long long nw = 0;
+    if (!out || !weld || !keys || !he || !parent || !piece_area ||
+        (nw = st_weld_vertices(weld, s)) < 0)
+        goto done;
+
+    /* 1. welded, non-degenerate, first of its duplicates */
+    size_t nk = 0;
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t a = weld[s->tris[3 * t]], b = weld[s->tris[3 * t + 1]],
+                 c = weld[s->tris[3 * t + 2]], x;
+        if (a == b || b == c || a == c)
+            continue;
+        if (a > b) { x = a; a = b; b = x; }
+        if (b > c) { x = b; b = c; c = x; }
+        if (a > b) { x = a; a = b; b = x; }
+        keys[nk].k[0] = a;
+        keys[nk].k[1] = b;
+        keys[nk].k[2] = c;
+        keys[nk].t = (uint32_t)t;
+        nk++;
+    }
+    qsort(keys, nk, sizeof *keys, cmp_tri_key);
+    size_t nh = 0;
+    for (size_t i = 0; i < nk; i++) {
+        if (i > 0 && memcmp(keys[i].k, keys[i - 1].k, sizeof keys[i].k) == 0)
+            continue;
+        const uint32_t *k = keys[i].k, t = keys[i].t;
+        const uint64_t e[3] = {(uint64_t)k[0] << 32 | k[1], (uint64_t)k[1] << 32 | k[2],
+                               (uint64_t)k[0] << 32 | k[2]};
+        for (int j = 0; j < 3; j++) {
+            he[nh].key = e[j];
+            he[nh].t = t;
+            nh++;
+        }
+        const uint32_t *v = s->tris + 3 * (size_t)t;
+        piece_area[t] = tri_area(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
+                                 s->xyz + 3 * (size_t)v[2]);
+    }
+    free(keys);
+    keys = NULL;
+    qsort(he, nh, sizeof *he, cmp_half);
+
+    /* 2. boundary edges and pieces */
+    for (size_t t = 0; t < nt; t++)
+        parent[t] = (uint32_t)t;
+    size_t nb = 0;
+    for (size_t i = 0, j; i < nh; i = j) {
+        for (j = i + 1; j < nh && he[j].key == he[i].key; j++) {
+            uint32_t a = uf_find(parent, he[i].t), b = uf_find(parent, he[j].t);
+            if (a != b)
+                parent[a > b ? a : b] = a < b ? a : b;
+        }
+        nb += j - i == 1;
+    }
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t r = uf_find(parent, (uint32_t)t);
+        if (r != t) {
+            piece_area[r] += piece_area[t];
+            piece_area[t] = 0.0;
+        }
+    }
+    st0.boundary_edges = nb;
+    be_a = st_malloc_array(nb ? nb : 1, sizeof *be_a);
+    be_b = st_malloc_array(nb ? nb : 1, sizeof *be_b);
+    be_t = st_malloc_array(nb ? nb : 1, sizeof *be_t);
+    deg = st_calloc_array((size_t)nw ? (size_t)nw : 1, 1);
+    vedge = st_malloc_array(2 * (size_t)nw + 1, sizeof *vedge);
+    used = st_calloc_array(nb ? nb : 1, 1);
+    stamp = st_malloc_array(nt ? nt : 1, sizeof *stamp);
+    loop_v = st_malloc_array(nb + 1, sizeof *loop_v);
+    loop_e = st_malloc_array(nb + 1, sizeof *loop_e);
+    tri = st_malloc_array(3 * (p->max_loop + 1), sizeof *tri);
+    pts = st_malloc_array(p->max_loop + 1, sizeof *pts);
+    if (!be_a || !be_b || !be_t || !deg || !vedge || !used || !stamp || !loop_v ||
+        !loop_e || !tri || !pts)
+        goto done;
+    for (size_t v = 0; v < 2 * (size_t)nw; v++)
+        vedge[v] = NONE;
+    for (size_t t = 0; t < nt; t++)
+        stamp[t] = NONE;
+    size_t e = 0;
+    for (size_t i = 0, j; i < nh; i = j) {
+        for (j = i + 1; j < nh && he[j].key == he[i].key; j++)
+            ;
+        if (j - i != 1)
+            continue;
+        const uint32_t a = (uint32_t)(he[i].key >> 32), b = (uint32_t)he[i].key;
+        be_a[e] = a;
+        be_b[e] = b;
+        be_t[e] = he[i].t;
+        for (int q = 0; q < 2; q++) {
+            const uint32_t v = q ? b : a;
+            if (deg[v] < 2)
+                vedge[2 * (size_t)v + deg[v]] = (uint32_t)e;
+            if (deg[v] < 3)
+                deg[v]++;
+        }
+        e++;
+    }
+    free(he);
+    he = NULL;
+    /* 3, 4. loops and caps */
+    for (size_t e0 = 0; e0 < nb; e0++) {
+        if (used[e0])
+            continue;
+        size_t n = 0;
+        int pinched = deg[be_a[e0]] != 2;
+        uint32_t start = be_a[e0], v = be_b[e0], cur = (uint32_t)e0;
+        used[e0] = 1;
+        loop_v[n] = start;
+        loop_e[n++] = cur;
+        while (!pinched && v != start) {
+            if (deg[v] != 2) {
+                pinched = 1;
+                break;
+            }
+            const uint32_t next = vedge[2 * (size_t)v] == cur ? vedge[2 * (size_t)v + 1]
+                                                              : vedge[2 * (size_t)v];
+            if (used[next]) {       /* cannot happen on degree-2 paths */
+                pinched = 1;
+                break;
+            }
+            used[next] = 1;
+            loop_v[n] = v;
+            loop_e[n++] = next;
+            cur = next;
+            v = be_a[cur] == v ? be_b[cur] : be_a[cur];
+        }
+        if (pinched) {
+            st0.pinched += n;
+            continue;
+        }
+        st0.loops++;
+        if (n < 3)
+            continue;
+        if (n > p->max_loop) {
+            st0.too_long++;
+            continue;
+        }
+        /* The loop's positions: a vertex of the soup welded to each. */
+        for (size_t i = 0; i < n; i++) {
+            const uint32_t *tv = s->tris + 3 * (size_t)be_t[loop_e[i]];
+            const double *q = NULL;
+            for (int c = 0; c < 3; c++)
+                if (weld[tv[c]] == loop_v[i])
+                    q = s->xyz + 3 * (size_t)tv[c];
+            pts[i] = q;
+        }
+        const double cap = least_area(pts, n, tri);
+        if (cap < 0) {
+            rc = ST_ENOMEM;
+            goto done;
+        }
+        double around = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            const uint32_t r = uf_find(parent, be_t[loop_e[i]]);
+            if ((size_t)stamp[r] != e0) {
+                stamp[r] = (uint32_t)e0;
+                around += piece_area[r];
+            }
+        }
+        if (!(cap > 0.0) || cap > p->max_cap_ratio * around) {
+            st0.too_large++;
+            continue;
+        }
+        const size_t base = out->nverts;
+        for (size_t i = 0; i < n; i++)
+            if ((rc = st_soup_add_vertex(out, pts[i][0], pts[i][1], pts[i][2], err)))
+                goto fail;
+        for (size_t i = 0; i + 2 < n; i++)
+            if ((rc = st_soup_add_triangle(out, (uint32_t)(base + tri[3 * i]),
+                                           (uint32_t)(base + tri[3 * i + 1]),
+                                           (uint32_t)(base + tri[3 * i + 2]), err)))
+                goto fail;
+        st0.filled++;
+    }
+    rc = ST_OK;
+done:
+    if (rc == ST_ENOMEM)
+        st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
+fail:
+    free(weld);
+    free(keys);
+    free(he);
+    free(parent);
+    free(piece_area);
+    free(stamp);
+    free(be_a);
+    free(be_b);
+    free(be_t);
+    free(deg);
+    free(vedge);
+    free(used);
+    free(loop_v);
+    free(loop_e);
+    free(tri);
+    free(pts);
+    if (rc) {
+        st_soup_free(out);
+        return rc;
+    }
+    if (stats)
+        *stats = st0;
+    *caps = out;
+    return ST_OK;
+}
