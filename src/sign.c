@@ -81,12 +81,14 @@ st_sign_params st_sign_params_default(void)
      *     without it);
      *   - split event runs: two crossings closer than the event distance
      *     (where interpenetrating shells meet, across thin walls and
-     *     tunnels) are two events, not one (cheese, interpenetrating, with
-     *     the cut: 0.916 whole runs, 0.938 split; torus: 0.878, 0.996);
+     *     tunnels) are two events, not one (with the cut, votes only, no
+     *     refinement: torus, interpenetrating, 0.878 whole runs, 0.993
+     *     split; cheese, interpenetrating, 0.916, 0.922);
      *   - the cut of the undecided voxels (mincut.h): the votes as
-     *     evidence, the surface as a cheap place to cut (cheese, closed:
-     *     0.951 without, 0.995 with; deleted50: 0.672, 0.898; bunny,
-     *     holes: 0.932, 0.952; man, interpenetrating: 0.907, 0.976).
+     *     evidence, the surface as a cheap place to cut (split runs, no
+     *     refinement, votes alone / cut: cheese, closed, 0.948 / 0.995;
+     *     cheese, deleted50, 0.672 / 0.883; bunny, holes, 0.932 / 0.950;
+     *     man, interpenetrating, 0.935 / 0.946).
      * Nothing here depends on how far the grid reaches (c is not used at
      * k = 1), so a narrow-band field suffices. */
     st_sign_params p = {1.0, 0.0, 26, ST_TOGGLE_CROSSING, 0, 1, 1, 1};
