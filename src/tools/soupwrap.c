@@ -14,6 +14,7 @@
 #include "../cli/tool.h"
 #include "souptet/dist.h"
 #include "souptet/gridio.h"
+#include "souptet/holes.h"
 #include "souptet/outfile.h"
 #include "souptet/sign.h"
 #include "souptet/soup.h"
@@ -48,8 +49,10 @@ static void usage(void)
 "      --min-volume V   drop outer pieces enclosing less than V cubic voxels\n"
 "                       (default %g; 0 keeps every piece)\n"
 "      --keep-cavities  keep pieces that lie inside others (default: fill)\n"
-"      --surface INPUT  wrap a soup: distance and signs (refined next to the\n"
-"                       surface, as soupsign --surface) in-process\n"
+"      --surface INPUT  wrap a soup: distance and signs (its holes capped and\n"
+"                       the signs refined next to it, as soupsign --surface)\n"
+"                       in-process\n"
+"      --fill-holes on|off  with --surface: cap the soup's holes (default on)\n"
 "  -r, --cells N        with --surface: voxels along the longest side\n"
 "                       (default %d)\n"
 "  -o, --output OUT     .obj .off .ply (binary) .stl (binary); '-' or none:\n"
@@ -70,7 +73,8 @@ static void usage(void)
         ST_WRAP_DEFAULT_MIN_VOLUME, ST_DIST_DEFAULT_CELLS);
 }
 
-enum { OPT_ISO = TOOL_OPT_FIRST, OPT_ADAPT, OPT_SMOOTH, OPT_MINVOL, OPT_CAVITIES, OPT_SURFACE };
+enum { OPT_ISO = TOOL_OPT_FIRST, OPT_ADAPT, OPT_SMOOTH, OPT_MINVOL, OPT_CAVITIES, OPT_SURFACE,
+       OPT_FILL_HOLES };
 
 /* The history lines of the field plus this command line. Caller frees. */
 static char *history(const st_grid *g, const char *source, const char *cmd)
@@ -95,7 +99,7 @@ int main(int argc, char *argv[])
     st_dist_params dp = st_dist_params_default();
     size_t smooth = 0;
     const char *out = NULL, *in = NULL, *surface = NULL;
-    int have_cells = 0;
+    int have_cells = 0, fill_holes = 1;
     static const struct option opts[] = {
         {"iso", required_argument, NULL, OPT_ISO},
         {"adaptivity", required_argument, NULL, OPT_ADAPT},
@@ -103,6 +107,7 @@ int main(int argc, char *argv[])
         {"min-volume", required_argument, NULL, OPT_MINVOL},
         {"keep-cavities", no_argument, NULL, OPT_CAVITIES},
         {"surface", required_argument, NULL, OPT_SURFACE},
+        {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
         {"cells", required_argument, NULL, 'r'},
         {"output", required_argument, NULL, 'o'},
         TOOL_LONG_OPTIONS_BASIC,
@@ -136,6 +141,14 @@ int main(int argc, char *argv[])
             break;
         case OPT_SURFACE:
             surface = optarg;
+            break;
+        case OPT_FILL_HOLES:
+            if (strcmp(optarg, "on") == 0)
+                fill_holes = 1;
+            else if (strcmp(optarg, "off") == 0)
+                fill_holes = 0;
+            else
+                return tool_usage_error(&t, "--fill-holes is on or off, not '%s'", optarg);
             break;
         case 'r':
             if (tool_parse_size(&t, "-r", optarg, 1, 65536, &dp.cells))
@@ -202,6 +215,21 @@ int main(int argc, char *argv[])
         if (st_soup_read(&input, surface, &err)) {
             rc = tool_fail(&t, &err);
             goto done;
+        }
+        /* As soupsign --surface: the field of the soup with its holes
+         * capped (holes.h), refined against both. */
+        if (fill_holes) {
+            st_soup *caps = NULL;
+            st_holes_params hp = st_holes_params_default();
+            if (st_soup_hole_caps(&caps, input, &hp, NULL, &err) ||
+                st_soup_append(input, caps, &err)) {
+                st_soup_free(caps);
+                if (!err.file[0])
+                    snprintf(err.file, sizeof err.file, "%s", srcname);
+                rc = tool_fail(&t, &err);
+                goto done;
+            }
+            st_soup_free(caps);
         }
         st_sign_params sp = st_sign_params_default();
         st_sign_refine_params rf = st_sign_refine_params_default();

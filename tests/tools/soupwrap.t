@@ -94,6 +94,13 @@ OFF
 END
 check "--surface: a flipped cube soup becomes one closed shell" sh -c \
     "soupwrap --surface cube.off -r 24 -o c.ply && soupinfo --json c.ply > c.json && python3 good.py c.json 1"
+# The same cube without its last face: its hole is capped (default) or not.
+awk 'NR == 2 { print "36 10 0"; next } NR <= 2 + 36 + 10 { print }' cube.off > holed.off
+check "--surface: a cube with a face missing becomes one closed shell (hole capped)" sh -c \
+    "soupwrap --surface holed.off -r 24 -o h1.ply && soupinfo --json h1.ply > h1.json && python3 good.py h1.json 1"
+check "--fill-holes off: one closed shell too" sh -c \
+    "soupwrap --surface holed.off --fill-holes off -r 24 -o h2.ply && soupinfo --json h2.ply > h2.json && python3 good.py h2.json 1"
+expect_fail "bad --fill-holes" 2 "--fill-holes is on or off" soupwrap --surface holed.off --fill-holes 1
 check "--smooth 2 and --adaptivity 0.5 stay valid" sh -c \
     "soupwrap --smooth 2 -o sm.obj s.vdb && soupwrap --adaptivity 0.5 -o ad.obj s.vdb && soupinfo --json sm.obj ad.obj > sa.json && python3 good.py sa.json 1"
 check "adaptivity makes fewer faces" sh -c \
