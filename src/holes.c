@@ -6,8 +6,8 @@
  *   2. sort the half-edges by their unordered welded ends: an edge of one
  *      triangle is a boundary edge; every edge joins its triangles into
  *      pieces (union-find), whose areas are summed;
- *   3. walk the boundary edges through vertices with two of them into
- *      loops;
+ *   3. pair the boundary edges at each vertex (by angle where holes
+ *      touch) and walk them into loops;
  *   4. triangulate each loop by least area (O(n^3) in its n vertices) and
  *      keep the cap if it is small beside the pieces around the loop.
  */
@@ -22,6 +22,9 @@
 #include <string.h>
 
 #define NONE UINT32_MAX
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 
 st_holes_params st_holes_params_default(void)
 {
@@ -132,6 +135,130 @@ static double least_area(const double *const *pts, size_t n, uint32_t *tri)
     return area;
 }
 
+/* Edge e's partner at its end v is `other`. */
+static void set_partner(const uint32_t *be_a, uint32_t *pa, uint32_t *pb, uint32_t e,
+                        uint32_t v, uint32_t other)
+{
+    if (be_a[e] == v)
+        pa[e] = other;
+    else
+        pb[e] = other;
+}
+
+/* Is angle a (radians) strictly inside one of the sectors [lo, hi]? */
+static int covered(const double *lo, const double *hi, size_t n, double a)
+{
+    for (size_t i = 0; i < n; i++)
+        for (int w = -1; w <= 1; w++) {
+            const double b = a + 2.0 * M_PI * w;
+            if (b > lo[i] && b < hi[i])
+                return 1;
+        }
+    return 0;
+}
+
+/* The k (even, > 2) boundary edges ev at welded vertex v, where holes
+ * touch: seen along the mean normal of the triangles around v (their
+ * normals' signs aligned with the first: orientation is not read), the
+ * triangles cover sectors of directions; a hole passes through v in each
+ * gap between two consecutive boundary edges that no triangle covers, and
+ * pairs those two edges. Pairs only when the gaps account for every edge
+ * exactly once (else the edges stay unpaired and their loops open: a
+ * vertex on a sharp crease, where one plane does not order the fans).
+ * Returns -1 when out of memory. */
+static int pair_by_angle(const st_soup *s, const uint32_t *weld, const uint32_t *wpos,
+                         const uint32_t *be_a, const uint32_t *be_b, uint32_t *pa, uint32_t *pb,
+                         uint32_t v, const uint32_t *ev, size_t k, const uint32_t *tv, size_t nt)
+{
+    const double *o = s->xyz + 3 * (size_t)wpos[v];
+    double nsum[3] = {0, 0, 0}, first[3] = {0, 0, 0};
+    for (size_t i = 0; i < nt; i++) {
+        const uint32_t *c = s->tris + 3 * (size_t)tv[i];
+        double u[3], w[3], n[3];
+        st_sub3(u, s->xyz + 3 * (size_t)c[1], s->xyz + 3 * (size_t)c[0]);
+        st_sub3(w, s->xyz + 3 * (size_t)c[2], s->xyz + 3 * (size_t)c[0]);
+        st_cross3(n, u, w);
+        if (i == 0)
+            memcpy(first, n, sizeof n);
+        const double sg = st_dot3(n, first) >= 0 ? 1.0 : -1.0;
+        for (int q = 0; q < 3; q++)
+            nsum[q] += sg * n[q];
+    }
+    const double len = st_norm3(nsum);
+    if (!(len > 0))
+        return 0;
+    double nn[3] = {nsum[0] / len, nsum[1] / len, nsum[2] / len}, ax[3] = {1, 0, 0}, U[3], W[3];
+    if (fabs(nn[0]) > 0.9)
+        ax[0] = 0, ax[1] = 1;
+    st_cross3(U, nn, ax);
+    const double lu = st_norm3(U);
+    for (int q = 0; q < 3; q++)
+        U[q] /= lu;
+    st_cross3(W, nn, U);
+    double *lo = malloc((nt + 1) * sizeof *lo), *hi = malloc((nt + 1) * sizeof *hi);
+    double *ang = malloc(k * sizeof *ang);
+    uint32_t *ord = malloc(k * sizeof *ord);
+    uint8_t *hit = calloc(k, 1);
+    if (!lo || !hi || !ang || !ord || !hit) {
+        free(lo), free(hi), free(ang), free(ord), free(hit);
+        return -1;
+    }
+#define ANGLE(p) atan2(((p)[0] - o[0]) * W[0] + ((p)[1] - o[1]) * W[1] + ((p)[2] - o[2]) * W[2], \
+                       ((p)[0] - o[0]) * U[0] + ((p)[1] - o[1]) * U[1] + ((p)[2] - o[2]) * U[2])
+    for (size_t i = 0; i < nt; i++) {
+        const uint32_t *c = s->tris + 3 * (size_t)tv[i];
+        double a[2];
+        int m = 0;
+        for (int q = 0; q < 3 && m < 2; q++)
+            if (weld[c[q]] != v)
+                a[m++] = ANGLE(s->xyz + 3 * (size_t)c[q]);
+        double l = fmin(a[0], a[1]), h = fmax(a[0], a[1]);
+        if (h - l > M_PI) {     /* the short way round passes +-pi */
+            const double t = l + 2.0 * M_PI;
+            l = h;
+            h = t;
+        }
+        lo[i] = l;
+        hi[i] = h;
+    }
+    for (size_t i = 0; i < k; i++) {
+        const uint32_t e = ev[i], w = be_a[e] == v ? be_b[e] : be_a[e];
+        ang[i] = ANGLE(s->xyz + 3 * (size_t)wpos[w]);
+        ord[i] = (uint32_t)i;
+    }
+#undef ANGLE
+    for (size_t i = 1; i < k; i++)      /* insertion sort by angle, k small */
+        for (size_t j = i; j > 0 && ang[ord[j]] < ang[ord[j - 1]]; j--) {
+            uint32_t x = ord[j];
+            ord[j] = ord[j - 1];
+            ord[j - 1] = x;
+        }
+    size_t gaps = 0;
+    int ok = 1;
+    for (size_t i = 0; i < k && ok; i++) {
+        const size_t j = (i + 1) % k;
+        const double a = ang[ord[i]], b = ang[ord[j]] + (j == 0 ? 2.0 * M_PI : 0.0);
+        if (covered(lo, hi, nt, 0.5 * (a + b)))
+            continue;
+        if (hit[ord[i]] || hit[ord[j]])
+            ok = 0;
+        hit[ord[i]] = hit[ord[j]] = 1;
+        gaps++;
+    }
+    if (ok && 2 * gaps == k)
+        for (size_t i = 0; i < k; i++) {
+            const size_t j = (i + 1) % k;
+            const double a = ang[ord[i]], b = ang[ord[j]] + (j == 0 ? 2.0 * M_PI : 0.0);
+            if (!covered(lo, hi, nt, 0.5 * (a + b))) {
+                set_partner(be_a, pa, pb, ev[ord[i]], v, ev[ord[j]]);
+                set_partner(be_a, pa, pb, ev[ord[j]], v, ev[ord[i]]);
+            }
+        }
+    (void)be_b;
+    free(lo), free(hi), free(ang), free(ord), free(hit);
+    return 0;
+}
+
 st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
                             const st_holes_params *p, st_holes_stats *stats,
                             st_error *err)
@@ -153,12 +280,15 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
     half *he = st_malloc_array(3 * nt + 1, sizeof *he);
     uint32_t *parent = st_malloc_array(nt ? nt : 1, sizeof *parent);
     double *piece_area = st_calloc_array(nt ? nt : 1, sizeof *piece_area);
-    uint32_t *stamp = NULL, *be_a = NULL, *be_b = NULL, *be_t = NULL, *vedge = NULL,
+    uint32_t *stamp = NULL, *be_a = NULL, *be_b = NULL, *be_t = NULL,
              *loop_v = NULL, *loop_e = NULL, *tri = NULL;
-    uint8_t *deg = NULL, *used = NULL;
+    uint8_t *used = NULL, *kept = NULL;
+    uint32_t *pa = NULL, *pb = NULL, *bdeg = NULL, *vstart = NULL, *vlist = NULL,
+             *tstart = NULL, *tlist = NULL, *wpos = NULL;
     const double **pts = NULL;
     long long nw = 0;
-    if (!out || !weld || !keys || !he || !parent || !piece_area ||
+    kept = st_calloc_array(nt ? nt : 1, 1);
+    if (!out || !weld || !keys || !he || !parent || !piece_area || !kept ||
         (nw = st_weld_vertices(weld, s)) < 0)
         goto done;
 
@@ -192,6 +322,7 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
             nh++;
         }
         const uint32_t *v = s->tris + 3 * (size_t)t;
+        kept[t] = 1;
         piece_area[t] = tri_area(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
                                  s->xyz + 3 * (size_t)v[2]);
     }
@@ -222,19 +353,22 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
     be_a = st_malloc_array(nb ? nb : 1, sizeof *be_a);
     be_b = st_malloc_array(nb ? nb : 1, sizeof *be_b);
     be_t = st_malloc_array(nb ? nb : 1, sizeof *be_t);
-    deg = st_calloc_array((size_t)nw ? (size_t)nw : 1, 1);
-    vedge = st_malloc_array(2 * (size_t)nw + 1, sizeof *vedge);
     used = st_calloc_array(nb ? nb : 1, 1);
     stamp = st_malloc_array(nt ? nt : 1, sizeof *stamp);
     loop_v = st_malloc_array(nb + 1, sizeof *loop_v);
     loop_e = st_malloc_array(nb + 1, sizeof *loop_e);
     tri = st_malloc_array(3 * (p->max_loop + 1), sizeof *tri);
     pts = st_malloc_array(p->max_loop + 1, sizeof *pts);
-    if (!be_a || !be_b || !be_t || !deg || !vedge || !used || !stamp || !loop_v ||
-        !loop_e || !tri || !pts)
+    pa = st_malloc_array(nb ? nb : 1, sizeof *pa);
+    pb = st_malloc_array(nb ? nb : 1, sizeof *pb);
+    bdeg = st_calloc_array((size_t)nw + 1, sizeof *bdeg);
+    vstart = st_calloc_array((size_t)nw + 2, sizeof *vstart);
+    vlist = st_malloc_array(2 * nb + 1, sizeof *vlist);
+    tstart = st_calloc_array((size_t)nw + 2, sizeof *tstart);
+    wpos = st_malloc_array((size_t)nw + 1, sizeof *wpos);
+    if (!be_a || !be_b || !be_t || !used || !stamp || !loop_v || !loop_e || !tri || !pts ||
+        !pa || !pb || !bdeg || !vstart || !vlist || !tstart || !wpos)
         goto done;
-    for (size_t v = 0; v < 2 * (size_t)nw; v++)
-        vedge[v] = NONE;
     for (size_t t = 0; t < nt; t++)
         stamp[t] = NONE;
     size_t e = 0;
@@ -247,35 +381,86 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
         be_a[e] = a;
         be_b[e] = b;
         be_t[e] = he[i].t;
-        for (int q = 0; q < 2; q++) {
-            const uint32_t v = q ? b : a;
-            if (deg[v] < 2)
-                vedge[2 * (size_t)v + deg[v]] = (uint32_t)e;
-            if (deg[v] < 3)
-                deg[v]++;
-        }
+        pa[e] = pb[e] = NONE;
+        bdeg[a]++;
+        bdeg[b]++;
         e++;
     }
     free(he);
     he = NULL;
+    /* The boundary edges at each vertex, and a position for each welded
+     * vertex (the first soup vertex welded to it). */
+    for (size_t v = 0; v < (size_t)nw; v++)
+        vstart[v + 1] = vstart[v] + bdeg[v];
+    for (size_t v = 0; v < (size_t)nw; v++)
+        bdeg[v] = 0;
+    for (size_t i = 0; i < nb; i++) {
+        vlist[vstart[be_a[i]] + bdeg[be_a[i]]++] = (uint32_t)i;
+        vlist[vstart[be_b[i]] + bdeg[be_b[i]]++] = (uint32_t)i;
+    }
+    for (size_t v = s->nverts; v-- > 0;)
+        if (weld[v] != ST_WELD_NONE)
+            wpos[weld[v]] = (uint32_t)v;
+    /* The kept triangles at each vertex where holes touch. */
+    for (size_t t = 0; t < nt; t++)
+        if (kept[t])
+            for (int c = 0; c < 3; c++) {
+                const uint32_t w = weld[s->tris[3 * t + c]];
+                if (bdeg[w] > 2)
+                    tstart[w + 1]++;
+            }
+    for (size_t v = 0; v < (size_t)nw; v++)
+        tstart[v + 1] += tstart[v];
+    tlist = st_malloc_array(tstart[nw] + 1, sizeof *tlist);
+    if (!tlist)
+        goto done;
+    size_t *tfill = st_calloc_array((size_t)nw + 1, sizeof *tfill);
+    if (!tfill)
+        goto done;
+    for (size_t t = 0; t < nt; t++)
+        if (kept[t])
+            for (int c = 0; c < 3; c++) {
+                const uint32_t w = weld[s->tris[3 * t + c]];
+                if (vstart[w + 1] - vstart[w] > 2)
+                    tlist[tstart[w] + tfill[w]++] = (uint32_t)t;
+            }
+    free(tfill);
+    /* Pair the boundary edges at every vertex: the two of a vertex with
+     * two; where holes touch, by the angular gaps between the triangles
+     * around it (pair_by_angle). */
+    for (size_t v = 0; v < (size_t)nw; v++) {
+        const size_t k = vstart[v + 1] - vstart[v];
+        const uint32_t *ev = vlist + vstart[v];
+        if (k == 2) {
+            set_partner(be_a, pa, pb, ev[0], (uint32_t)v, ev[1]);
+            set_partner(be_a, pa, pb, ev[1], (uint32_t)v, ev[0]);
+        } else if (k > 2 && !(k & 1)) {
+            int r = pair_by_angle(s, weld, wpos, be_a, be_b, pa, pb, (uint32_t)v, ev, k,
+                                  tlist + tstart[v], tstart[v + 1] - tstart[v]);
+            if (r < 0)
+                goto done;
+        }
+    }
     /* 3, 4. loops and caps */
     for (size_t e0 = 0; e0 < nb; e0++) {
         if (used[e0])
             continue;
         size_t n = 0;
-        int pinched = deg[be_a[e0]] != 2;
-        uint32_t start = be_a[e0], v = be_b[e0], cur = (uint32_t)e0;
+        int pinched = 0;
+        const uint32_t start = be_a[e0];
+        uint32_t v = be_b[e0], cur = (uint32_t)e0;
         used[e0] = 1;
         loop_v[n] = start;
         loop_e[n++] = cur;
-        while (!pinched && v != start) {
-            if (deg[v] != 2) {
+        for (;;) {
+            const uint32_t next = be_a[cur] == v ? pa[cur] : pb[cur];
+            if (next == NONE) {     /* an odd vertex, or one not paired */
                 pinched = 1;
                 break;
             }
-            const uint32_t next = vedge[2 * (size_t)v] == cur ? vedge[2 * (size_t)v + 1]
-                                                              : vedge[2 * (size_t)v];
-            if (used[next]) {       /* cannot happen on degree-2 paths */
+            if (next == e0 && v == start)
+                break;
+            if (used[next] || n > nb) {
                 pinched = 1;
                 break;
             }
@@ -347,8 +532,15 @@ fail:
     free(be_a);
     free(be_b);
     free(be_t);
-    free(deg);
-    free(vedge);
+    free(kept);
+    free(pa);
+    free(pb);
+    free(bdeg);
+    free(vstart);
+    free(vlist);
+    free(tstart);
+    free(tlist);
+    free(wpos);
     free(used);
     free(loop_v);
     free(loop_e);

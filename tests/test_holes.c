@@ -120,8 +120,9 @@ static void test_which_loops(void)
         TAP_NEAR(soup_area(caps), 1 * 2, 1e-12, "the box's cap is the missing face");
     st_soup_free(caps);
 
-    /* Two holes meeting at a corner (a pinched vertex with four boundary
-     * edges): how the edges pair up is not known, so neither is capped.
+    /* Two holes meeting at a box's corner (four boundary edges): on a
+     * crease one plane does not order the triangles around the vertex, so
+     * the edges are not paired and neither hole is capped.
      * add_box writes the x = 0 face's triangles first, {o, (0,2,0),
      * (0,2,3)} and {o, (0,2,3), (0,0,3)}, then x = 1's, then y = 0's,
      * {o, (0,0,3), (1,0,3)} and {o, (1,0,3), (1,0,0)}: triangles 0 and 5
@@ -137,7 +138,7 @@ static void test_which_loops(void)
     box->ntris += 2;
     ok = !st_soup_hole_caps(&caps, pinch, &p, &hs, &err);
     TAP_CHECK(ok && pinch->ntris == box->ntris - 2 && hs.filled == 0 && hs.pinched == 6,
-              "two holes touching at a vertex: left open (%zu of %zu triangles kept, %zu edges pinched)",
+              "two holes touching at a box corner: left open (%zu of %zu triangles kept, %zu edges unpaired)",
               pinch->ntris, box->ntris, hs.pinched);
     st_soup_free(caps);
     st_soup_free(pinch);
@@ -146,8 +147,9 @@ static void test_which_loops(void)
 
 /* The box [0,4] x [0,1] x [0,1] as an exact soup on a grid of spacing
  * 1/10 on every face (so the faces' edges meet), every other triangle
- * flipped; with `slot`, the top face (z = 1) has a slot 3 long and 0.8
- * wide cut out of it: a gutter. */
+ * flipped; with slot 1, the top face (z = 1) has a slot 3 long and 0.8
+ * wide cut out of it: a gutter; with slot 2, two of its triangles that
+ * share only a vertex are missing: two holes touching there. */
 static st_soup *slotted_box(int slot)
 {
     st_soup *s = st_soup_new();
@@ -166,10 +168,16 @@ static st_soup *slotted_box(int slot)
                         q[c][w] = hi[w] * (b + db) / n[w];
                     }
                     const double cx = (q[0][0] + q[2][0]) / 2, cy = (q[0][1] + q[2][1]) / 2;
-                    if (slot && axis == 2 && side && cx > 0.5 && cx < 3.5 && cy > 0.1 && cy < 0.9)
+                    if (slot == 1 && axis == 2 && side && cx > 0.5 && cx < 3.5 && cy > 0.1 &&
+                        cy < 0.9)
                         continue;
-                    add_tri(s, q[0], q[1], q[2], (a + b) & 1);
-                    add_tri(s, q[0], q[2], q[3], 0);
+                    /* slot 2: two triangles of the top face that share
+                     * one vertex and no edge */
+                    const int top = slot == 2 && axis == 2 && side;
+                    if (!(top && a == 10 && b == 5))
+                        add_tri(s, q[0], q[1], q[2], (a + b) & 1);
+                    if (!(top && a == 9 && b == 4))
+                        add_tri(s, q[0], q[2], q[3], 0);
                 }
         }
     return s;
@@ -220,8 +228,24 @@ static void test_pseudo_volume(void)
     TAP_CHECK(nt > 0 && capped >= 0.99 && capped > open + 0.02,
               "box with a slot: IoU %.4f with its cap (%zu triangles), %.4f without", capped, nt,
               open);
-    st_soup_free(box);
     st_soup_free(slotted);
+
+    /* Two holes touching at a vertex of a flat face: the triangles around
+     * it leave two gaps, which pair its four boundary edges; each hole is
+     * capped by the triangle that was there. */
+    st_soup *pinched = slotted_box(2), *caps = NULL;
+    st_holes_params hp = st_holes_params_default();
+    st_holes_stats hs;
+    st_error err;
+    int ok = !st_soup_hole_caps(&caps, pinched, &hp, &hs, &err);
+    TAP_CHECK(ok && hs.loops == 2 && hs.filled == 2 && hs.pinched == 0 && caps->ntris == 2,
+              "two holes touching on a flat face: paired by angle, both capped (%zu loops, %zu capped)",
+              hs.loops, hs.filled);
+    if (ok)
+        TAP_NEAR(soup_area(caps), 2 * 0.5 * 0.1 * 0.1, 1e-12, "the caps are the two missing triangles");
+    st_soup_free(caps);
+    st_soup_free(pinched);
+    st_soup_free(box);
 }
 
 int main(void)

@@ -2,8 +2,13 @@
  * holes.h - caps for the holes of a soup.
  *
  * A hole is a loop of boundary edges (edges of exactly one triangle, on
- * exactly welded vertices, degenerate and duplicated triangles left out)
- * through vertices that have exactly two boundary edges. Its cap is the
+ * exactly welded vertices, degenerate and duplicated triangles left out).
+ * At a vertex with two boundary edges the loop goes on along the other;
+ * where holes touch (a vertex with 2m boundary edges) the edges are paired
+ * by angle: seen along the mean normal of the triangles around the vertex
+ * (their normals' signs aligned, orientation not read), each gap between
+ * two consecutive boundary edges that no triangle covers is a hole
+ * passing through, and pairs them. Its cap is the
  * triangulation of the loop of least area (dynamic programming over the
  * loop's vertices, Barequet and Sharir's minimal-area polygon
  * triangulation): a flat hole gets a flat cap, a hole across a tube the
@@ -14,10 +19,10 @@
  * add a second surface beside or across the patch. A loop is capped only
  * when its cap is small beside the surface around it: at most
  * max_cap_ratio times the area of the pieces (edge-connected triangles)
- * its edges belong to. Loops through a vertex with more than two boundary
- * edges (where holes touch, and everywhere in a soup with half its faces
- * deleted at random) are not traced: how their edges pair up is not
- * known, and a wrong pairing spans a cap across the surface.
+ * its edges belong to. Where the gaps do not pair every edge exactly once
+ * (an odd count, or a vertex on a sharp crease, where one plane does not
+ * order the triangles around it) the edges stay unpaired and their loops
+ * open: a wrong pairing would span a cap across the surface.
  *
  * Orientation is not read; the result does not depend on how the soup's
  * vertices are shared, only on their positions.
@@ -44,8 +49,8 @@ typedef struct st_holes_stats {
     size_t filled;          /* loops capped */
     size_t too_large;       /* cap above max_cap_ratio (or of no area) */
     size_t too_long;        /* more than max_loop edges */
-    size_t pinched;         /* boundary edges on paths that meet a vertex
-                             * with more than two boundary edges: left open */
+    size_t pinched;         /* boundary edges on paths through a vertex
+                             * whose edges could not be paired: left open */
 } st_holes_stats;
 
 st_holes_params st_holes_params_default(void);

@@ -348,7 +348,7 @@ int main(int argc, char *argv[])
              event, event / g->voxel, inside, n, 100.0 * (double)inside / (double)n);
     if (surface && fill_holes)
         tool_say(&t, 2, "holes: %zu of %zu boundary loops capped (%zu too large, %zu too long, "
-                 "%zu edges by pinched vertices left open), %.3f s",
+                 "%zu edges left open where holes touch unpaired), %.3f s",
                  hs.filled, hs.loops, hs.too_large, hs.too_long, hs.pinched, t_holes);
     if (surface)
         tool_say(&t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
