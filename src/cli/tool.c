@@ -225,6 +225,19 @@ int tool_parse_double(const tool_ctx *t, const char *opt, const char *arg,
     return 0;
 }
 
+int tool_parse_switch(const tool_ctx *t, const char *opt, const char *arg, int *out)
+{
+    if (strcmp(arg, "on") == 0)
+        *out = 1;
+    else if (strcmp(arg, "off") == 0)
+        *out = 0;
+    else {
+        tool_usage_error(t, "%s is on or off, not '%s'", opt, arg);
+        return -1;
+    }
+    return 0;
+}
+
 int tool_parse_bytes(const tool_ctx *t, const char *opt, const char *arg,
                      size_t *out)
 {

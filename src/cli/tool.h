@@ -73,6 +73,9 @@ int tool_parse_size(const tool_ctx *t, const char *opt, const char *arg,
                     size_t min, size_t max, size_t *out);
 int tool_parse_double(const tool_ctx *t, const char *opt, const char *arg,
                       double min, double max, double *out);
+/* "on" (1) or "off" (0) into *out; anything else prints "OPT is on or
+ * off, not 'ARG'" as a usage error and returns -1. */
+int tool_parse_switch(const tool_ctx *t, const char *opt, const char *arg, int *out);
 /* A byte count with an optional K, M, G or T suffix (powers of 1024). */
 int tool_parse_bytes(const tool_ctx *t, const char *opt, const char *arg,
                      size_t *out);

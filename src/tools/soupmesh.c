@@ -213,12 +213,8 @@ int main(int argc, char *argv[])
             p.quality = 0;
             break;
         case OPT_FILL_HOLES:
-            if (strcmp(optarg, "on") == 0)
-                p.fill_holes = 1;
-            else if (strcmp(optarg, "off") == 0)
-                p.fill_holes = 0;
-            else
-                return tool_usage_error(&t, "--fill-holes is on or off, not '%s'", optarg);
+            if (tool_parse_switch(&t, "--fill-holes", optarg, &p.fill_holes))
+                return TOOL_EXIT_USAGE;
             break;
         case OPT_MSH_VERSION: {
             size_t v;

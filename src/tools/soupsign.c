@@ -177,20 +177,12 @@ int main(int argc, char *argv[])
                 return tool_usage_error(&t, "--runs is split or whole, not '%s'", optarg);
             break;
         case OPT_CUT:
-            if (strcmp(optarg, "on") == 0)
-                p.cut = 1;
-            else if (strcmp(optarg, "off") == 0)
-                p.cut = 0;
-            else
-                return tool_usage_error(&t, "--cut is on or off, not '%s'", optarg);
+            if (tool_parse_switch(&t, "--cut", optarg, &p.cut))
+                return TOOL_EXIT_USAGE;
             break;
         case OPT_FILL_HOLES:
-            if (strcmp(optarg, "on") == 0)
-                fill_holes = 1;
-            else if (strcmp(optarg, "off") == 0)
-                fill_holes = 0;
-            else
-                return tool_usage_error(&t, "--fill-holes is on or off, not '%s'", optarg);
+            if (tool_parse_switch(&t, "--fill-holes", optarg, &fill_holes))
+                return TOOL_EXIT_USAGE;
             break;
         case OPT_RULE:
             if (st_sign_params_named(&p, optarg))

@@ -143,12 +143,8 @@ int main(int argc, char *argv[])
             surface = optarg;
             break;
         case OPT_FILL_HOLES:
-            if (strcmp(optarg, "on") == 0)
-                fill_holes = 1;
-            else if (strcmp(optarg, "off") == 0)
-                fill_holes = 0;
-            else
-                return tool_usage_error(&t, "--fill-holes is on or off, not '%s'", optarg);
+            if (tool_parse_switch(&t, "--fill-holes", optarg, &fill_holes))
+                return TOOL_EXIT_USAGE;
             break;
         case 'r':
             if (tool_parse_size(&t, "-r", optarg, 1, 65536, &dp.cells))
