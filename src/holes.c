@@ -1,11 +1,10 @@
 /*
  * holes.c - caps for the holes of a soup (see holes.h).
  *
- *   1. weld the vertices exactly; drop degenerate triangles and all but
- *      the first of each set of duplicates;
- *   2. sort the half-edges by their unordered welded ends: an edge of one
- *      triangle is a boundary edge; every edge joins its triangles into
- *      pieces (union-find), whose areas are summed;
+ *   1. the soup's edges and pieces on welded vertices (edges.h:
+ *      degenerate and duplicated triangles left out);
+ *   2. an edge of one triangle is a boundary edge; the pieces' areas are
+ *      summed;
  *   3. pair the boundary edges at each vertex (by angle where holes
  *      touch) and walk them into loops;
  *   4. triangulate each loop by least area (O(n^3) in its n vertices) and
@@ -14,6 +13,7 @@
 #include "souptet/holes.h"
 #include "souptet/geom.h"
 #include "souptet/mem.h"
+#include "souptet/edges.h"
 #include "souptet/weld.h"
 
 #include <math.h>
@@ -33,42 +33,6 @@ st_holes_params st_holes_params_default(void)
      * up: under 0.15); an open patch's own loop spans about its area. */
     st_holes_params p = {0.25, 256};
     return p;
-}
-
-typedef struct tri_key {
-    uint32_t k[3];      /* sorted welded corners */
-    uint32_t t;
-} tri_key;
-
-static int cmp_tri_key(const void *pa, const void *pb)
-{
-    const tri_key *a = pa, *b = pb;
-    for (int i = 0; i < 3; i++)
-        if (a->k[i] != b->k[i])
-            return a->k[i] < b->k[i] ? -1 : 1;
-    return (a->t > b->t) - (a->t < b->t);
-}
-
-typedef struct half {
-    uint64_t key;       /* lower welded end << 32 | higher */
-    uint32_t t;
-} half;
-
-static int cmp_half(const void *pa, const void *pb)
-{
-    const half *a = pa, *b = pb;
-    if (a->key != b->key)
-        return a->key < b->key ? -1 : 1;
-    return (a->t > b->t) - (a->t < b->t);
-}
-
-static uint32_t uf_find(uint32_t *parent, uint32_t x)
-{
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
 }
 
 static double tri_area(const double *a, const double *b, const double *c)
@@ -274,80 +238,38 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
                             "hole filling: loops of at most 4096 edges, a cap ratio >= 0");
     const size_t nt = s->ntris;
     st_status rc = ST_ENOMEM;
+    st_soup_edges E;
+    if ((rc = st_soup_edges_build(&E, s, err)))
+        return rc;
+    rc = ST_ENOMEM;
+    const uint32_t *weld = E.weld, *piece = E.piece;
+    const uint8_t *kept = E.kept;
+    const st_half_edge *he = E.he;
+    const size_t nh = E.nhalf, nw = E.nweld;
     st_soup *out = st_soup_new();
-    uint32_t *weld = st_malloc_array(s->nverts ? s->nverts : 1, sizeof *weld);
-    tri_key *keys = st_malloc_array(nt ? nt : 1, sizeof *keys);
-    half *he = st_malloc_array(3 * nt + 1, sizeof *he);
-    uint32_t *parent = st_malloc_array(nt ? nt : 1, sizeof *parent);
     double *piece_area = st_calloc_array(nt ? nt : 1, sizeof *piece_area);
     uint32_t *stamp = NULL, *be_a = NULL, *be_b = NULL, *be_t = NULL,
              *loop_v = NULL, *loop_e = NULL, *tri = NULL;
-    uint8_t *used = NULL, *kept = NULL;
+    uint8_t *used = NULL;
     uint32_t *pa = NULL, *pb = NULL, *bdeg = NULL, *vstart = NULL, *vlist = NULL,
              *tstart = NULL, *tlist = NULL, *wpos = NULL;
     const double **pts = NULL;
-    long long nw = 0;
-    kept = st_calloc_array(nt ? nt : 1, 1);
-    if (!out || !weld || !keys || !he || !parent || !piece_area || !kept ||
-        (nw = st_weld_vertices(weld, s)) < 0)
+    if (!out || !piece_area)
         goto done;
 
-    /* 1. welded, non-degenerate, first of its duplicates */
-    size_t nk = 0;
-    for (size_t t = 0; t < nt; t++) {
-        uint32_t a = weld[s->tris[3 * t]], b = weld[s->tris[3 * t + 1]],
-                 c = weld[s->tris[3 * t + 2]], x;
-        if (a == b || b == c || a == c)
-            continue;
-        if (a > b) { x = a; a = b; b = x; }
-        if (b > c) { x = b; b = c; c = x; }
-        if (a > b) { x = a; a = b; b = x; }
-        keys[nk].k[0] = a;
-        keys[nk].k[1] = b;
-        keys[nk].k[2] = c;
-        keys[nk].t = (uint32_t)t;
-        nk++;
-    }
-    qsort(keys, nk, sizeof *keys, cmp_tri_key);
-    size_t nh = 0;
-    for (size_t i = 0; i < nk; i++) {
-        if (i > 0 && memcmp(keys[i].k, keys[i - 1].k, sizeof keys[i].k) == 0)
-            continue;
-        const uint32_t *k = keys[i].k, t = keys[i].t;
-        const uint64_t e[3] = {(uint64_t)k[0] << 32 | k[1], (uint64_t)k[1] << 32 | k[2],
-                               (uint64_t)k[0] << 32 | k[2]};
-        for (int j = 0; j < 3; j++) {
-            he[nh].key = e[j];
-            he[nh].t = t;
-            nh++;
-        }
-        const uint32_t *v = s->tris + 3 * (size_t)t;
-        kept[t] = 1;
-        piece_area[t] = tri_area(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
-                                 s->xyz + 3 * (size_t)v[2]);
-    }
-    free(keys);
-    keys = NULL;
-    qsort(he, nh, sizeof *he, cmp_half);
-
-    /* 2. boundary edges and pieces */
+    /* the pieces' areas and the boundary edges */
     for (size_t t = 0; t < nt; t++)
-        parent[t] = (uint32_t)t;
+        if (kept[t]) {
+            const uint32_t *v = s->tris + 3 * t;
+            piece_area[piece[t]] += tri_area(s->xyz + 3 * (size_t)v[0],
+                                             s->xyz + 3 * (size_t)v[1],
+                                             s->xyz + 3 * (size_t)v[2]);
+        }
     size_t nb = 0;
     for (size_t i = 0, j; i < nh; i = j) {
-        for (j = i + 1; j < nh && he[j].key == he[i].key; j++) {
-            uint32_t a = uf_find(parent, he[i].t), b = uf_find(parent, he[j].t);
-            if (a != b)
-                parent[a > b ? a : b] = a < b ? a : b;
-        }
+        for (j = i + 1; j < nh && he[j].key == he[i].key; j++)
+            ;
         nb += j - i == 1;
-    }
-    for (size_t t = 0; t < nt; t++) {
-        uint32_t r = uf_find(parent, (uint32_t)t);
-        if (r != t) {
-            piece_area[r] += piece_area[t];
-            piece_area[t] = 0.0;
-        }
     }
     st0.boundary_edges = nb;
     be_a = st_malloc_array(nb ? nb : 1, sizeof *be_a);
@@ -386,8 +308,6 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
         bdeg[b]++;
         e++;
     }
-    free(he);
-    he = NULL;
     /* The boundary edges at each vertex, and a position for each welded
      * vertex (the first soup vertex welded to it). */
     for (size_t v = 0; v < (size_t)nw; v++)
@@ -497,7 +417,7 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
         }
         double around = 0.0;
         for (size_t i = 0; i < n; i++) {
-            const uint32_t r = uf_find(parent, be_t[loop_e[i]]);
+            const uint32_t r = piece[be_t[loop_e[i]]];
             if ((size_t)stamp[r] != e0) {
                 stamp[r] = (uint32_t)e0;
                 around += piece_area[r];
@@ -523,16 +443,12 @@ done:
     if (rc == ST_ENOMEM)
         st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
 fail:
-    free(weld);
-    free(keys);
-    free(he);
-    free(parent);
+    st_soup_edges_free(&E);
     free(piece_area);
     free(stamp);
     free(be_a);
     free(be_b);
     free(be_t);
-    free(kept);
     free(pa);
     free(pb);
     free(bdeg);

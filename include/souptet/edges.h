@@ -1,0 +1,55 @@
+/*
+ * edges.h - the edges and pieces of a soup, read on exactly welded
+ * vertices (weld.h) with degenerate triangles (two corners welded
+ * together) and all but the first of each set of duplicated triangles
+ * (the same three welded corners, in any order) left out.
+ *
+ * An edge is a run of half-edges with the same unordered welded ends; its
+ * length is the number of kept triangles that use it (1: a boundary edge,
+ * 2: a manifold edge). Pieces are the classes of kept triangles joined by
+ * shared edges, each named by its smallest triangle index, so nothing
+ * depends on hashing or sorting details. The hole caps (holes.h) and the
+ * closed shells (shells.h) read the soup's topology from here.
+ */
+#ifndef SOUPTET_EDGES_H
+#define SOUPTET_EDGES_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "souptet/err.h"
+#include "souptet/soup.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct st_half_edge {
+    uint64_t key;       /* lower welded end << 32 | higher */
+    uint32_t t;         /* its triangle */
+} st_half_edge;
+
+typedef struct st_soup_edges {
+    uint32_t *weld;     /* nverts: welded id of each vertex (weld.h) */
+    size_t nweld;       /* number of welded ids */
+    uint8_t *kept;      /* ntris: 1 for a kept triangle */
+    st_half_edge *he;   /* the kept triangles' half-edges, sorted by key,
+                         * ties by triangle */
+    size_t nhalf;
+    uint32_t *piece;    /* ntris: smallest triangle of t's piece (t itself
+                         * for a triangle left out) */
+} st_soup_edges;
+
+/* ST_ENOMEM, ST_ELIMIT (more than 2^31 triangles). On failure *e is
+ * zeroed and holds nothing to free. */
+st_status st_soup_edges_build(st_soup_edges *e, const st_soup *s, st_error *err);
+void st_soup_edges_free(st_soup_edges *e);
+
+/* 1 when triangle t of s runs along its edge from welded end a to welded
+ * end b (a -> b as consecutive corners), 0 when b -> a. */
+int st_soup_edges_forward(const st_soup_edges *e, const st_soup *s, uint32_t t,
+                          uint32_t a, uint32_t b);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

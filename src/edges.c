@@ -1,0 +1,142 @@
+/*
+ * edges.c - edges and pieces of a soup on welded vertices (see edges.h).
+ *
+ *   1. weld the vertices exactly; sort the non-degenerate triangles by
+ *      their sorted welded corners (ties by index) and keep the first of
+ *      each run of equal corners;
+ *   2. sort the kept triangles' half-edges by their unordered welded ends
+ *      (ties by triangle: the order is total);
+ *   3. join the triangles of every edge (union-find toward the smaller
+ *      index, so every root is its piece's smallest triangle).
+ */
+#include "souptet/edges.h"
+#include "souptet/mem.h"
+#include "souptet/weld.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct tri_key {
+    uint32_t k[3];      /* sorted welded corners */
+    uint32_t t;
+} tri_key;
+
+static int cmp_tri_key(const void *pa, const void *pb)
+{
+    const tri_key *a = pa, *b = pb;
+    for (int i = 0; i < 3; i++)
+        if (a->k[i] != b->k[i])
+            return a->k[i] < b->k[i] ? -1 : 1;
+    return (a->t > b->t) - (a->t < b->t);
+}
+
+static int cmp_half(const void *pa, const void *pb)
+{
+    const st_half_edge *a = pa, *b = pb;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->t > b->t) - (a->t < b->t);
+}
+
+static uint32_t uf_find(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+void st_soup_edges_free(st_soup_edges *e)
+{
+    if (!e)
+        return;
+    free(e->weld);
+    free(e->kept);
+    free(e->he);
+    free(e->piece);
+    memset(e, 0, sizeof *e);
+}
+
+st_status st_soup_edges_build(st_soup_edges *e, const st_soup *s, st_error *err)
+{
+    memset(e, 0, sizeof *e);
+    if (s->ntris > (size_t)INT32_MAX)
+        return st_error_set(err, ST_ELIMIT, NULL, 0,
+                            "%zu triangles: the soup's edges are read for at most 2^31",
+                            s->ntris);
+    const size_t nt = s->ntris;
+    tri_key *keys = st_malloc_array(nt ? nt : 1, sizeof *keys);
+    e->weld = st_malloc_array(s->nverts ? s->nverts : 1, sizeof *e->weld);
+    e->kept = st_calloc_array(nt ? nt : 1, 1);
+    e->he = st_malloc_array(3 * nt + 1, sizeof *e->he);
+    e->piece = st_malloc_array(nt ? nt : 1, sizeof *e->piece);
+    long long nw = -1;
+    if (!keys || !e->weld || !e->kept || !e->he || !e->piece ||
+        (nw = st_weld_vertices(e->weld, s)) < 0) {
+        free(keys);
+        st_soup_edges_free(e);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
+    }
+    e->nweld = (size_t)nw;
+
+    /* 1. welded, non-degenerate, first of its duplicates */
+    size_t nk = 0;
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t a = e->weld[s->tris[3 * t]], b = e->weld[s->tris[3 * t + 1]],
+                 c = e->weld[s->tris[3 * t + 2]], x;
+        if (a == b || b == c || a == c)
+            continue;
+        if (a > b) { x = a; a = b; b = x; }
+        if (b > c) { x = b; b = c; c = x; }
+        if (a > b) { x = a; a = b; b = x; }
+        keys[nk].k[0] = a;
+        keys[nk].k[1] = b;
+        keys[nk].k[2] = c;
+        keys[nk].t = (uint32_t)t;
+        nk++;
+    }
+    qsort(keys, nk, sizeof *keys, cmp_tri_key);
+
+    /* 2. half-edges of the kept triangles */
+    size_t nh = 0;
+    for (size_t i = 0; i < nk; i++) {
+        if (i > 0 && memcmp(keys[i].k, keys[i - 1].k, sizeof keys[i].k) == 0)
+            continue;
+        const uint32_t *k = keys[i].k, t = keys[i].t;
+        const uint64_t ends[3] = {(uint64_t)k[0] << 32 | k[1], (uint64_t)k[1] << 32 | k[2],
+                                  (uint64_t)k[0] << 32 | k[2]};
+        for (int j = 0; j < 3; j++) {
+            e->he[nh].key = ends[j];
+            e->he[nh].t = t;
+            nh++;
+        }
+        e->kept[t] = 1;
+    }
+    free(keys);
+    qsort(e->he, nh, sizeof *e->he, cmp_half);
+    e->nhalf = nh;
+
+    /* 3. pieces */
+    for (size_t t = 0; t < nt; t++)
+        e->piece[t] = (uint32_t)t;
+    for (size_t i = 0, j; i < nh; i = j)
+        for (j = i + 1; j < nh && e->he[j].key == e->he[i].key; j++) {
+            uint32_t a = uf_find(e->piece, e->he[i].t), b = uf_find(e->piece, e->he[j].t);
+            if (a != b)
+                e->piece[a > b ? a : b] = a < b ? a : b;
+        }
+    for (size_t t = 0; t < nt; t++)
+        e->piece[t] = uf_find(e->piece, (uint32_t)t);
+    return ST_OK;
+}
+
+int st_soup_edges_forward(const st_soup_edges *e, const st_soup *s, uint32_t t,
+                          uint32_t a, uint32_t b)
+{
+    const uint32_t *v = s->tris + 3 * (size_t)t;
+    for (int c = 0; c < 3; c++)
+        if (e->weld[v[c]] == a)
+            return e->weld[v[(c + 1) % 3]] == b;
+    return 0;
+}
