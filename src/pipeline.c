@@ -10,6 +10,7 @@
 #include "souptet/lattice.h"
 #include "souptet/mem.h"
 #include "souptet/sculpt.h"
+#include "souptet/shells.h"
 #include "souptet/sign.h"
 #include "souptet/smooth.h"
 #include "souptet/tetqual.h"
@@ -35,6 +36,7 @@ st_pipeline_params st_pipeline_params_default(void)
     p.density_rho = 0.0;
     p.max_bytes = 0;
     p.fill_holes = 1;
+    p.closed_shells = 1;
     return p;
 }
 
@@ -285,6 +287,16 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     bvh_field = NULL;
     if (rc)
         goto done;
+    /* The soup's closed pieces (without the caps) bound their solid
+     * exactly (shells.h): overlapping parts stay whole. */
+    if (p->closed_shells) {
+        st_shells sh;
+        rc = st_soup_closed_shells(&sh, s, err);
+        rc = rc ? rc : st_shells_sign(g, &sh, NULL, err);
+        st_shells_free(&sh);
+        if (rc)
+            goto done;
+    }
     double t_cand = now_seconds();
     st->seconds_sign = t_cand - t_sign;
     st->field_dims[0] = g->nx;

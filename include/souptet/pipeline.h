@@ -59,6 +59,8 @@ typedef struct st_pipeline_params {
     size_t max_bytes;      /* limit for the distance field (0: none) */
     int fill_holes;        /* the field of the soup with its holes capped
                               (holes.h) (1) */
+    int closed_shells;     /* the soup's closed pieces sign their solid
+                              exactly (shells.h) (1) */
 } st_pipeline_params;
 
 st_pipeline_params st_pipeline_params_default(void);

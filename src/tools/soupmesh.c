@@ -65,6 +65,8 @@ static void usage(void)
 "      --fill-holes on|off  cap the soup's holes for its pseudo volume\n"
 "                       (holes.h: loops of boundary edges, when small beside\n"
 "                       the surface around them; default on)\n"
+"      --shells on|off  the soup's closed pieces (every edge shared by two\n"
+"                       faces) bound their solid exactly (default on)\n"
 "      --no-quality     skip the quality pass after the fit\n"
 "      --threads T      threads to use (default: all cores)\n"
 "      --max-memory SZ  refuse fields and lattices larger than SZ\n"
@@ -82,7 +84,7 @@ static void usage(void)
 }
 
 enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
-       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED, OPT_FILL_HOLES };
+       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED, OPT_FILL_HOLES, OPT_SHELLS };
 
 static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
 {
@@ -168,6 +170,7 @@ int main(int argc, char *argv[])
         {"max-iters", required_argument, NULL, OPT_MAX_ITERS},
         {"no-quality", no_argument, NULL, OPT_NO_QUALITY},
         {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
+        {"shells", required_argument, NULL, OPT_SHELLS},
         {"msh-version", required_argument, NULL, OPT_MSH_VERSION},
         {"msh-binary", no_argument, NULL, OPT_MSH_BINARY},
         {"embed", required_argument, NULL, OPT_EMBED},
@@ -214,6 +217,10 @@ int main(int argc, char *argv[])
             break;
         case OPT_FILL_HOLES:
             if (tool_parse_switch(&t, "--fill-holes", optarg, &p.fill_holes))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_SHELLS:
+            if (tool_parse_switch(&t, "--shells", optarg, &p.closed_shells))
                 return TOOL_EXIT_USAGE;
             break;
         case OPT_MSH_VERSION: {

@@ -14,6 +14,7 @@
 #include "souptet/sign.h"
 #include "souptet/dist.h"
 #include "souptet/holes.h"
+#include "souptet/shells.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -71,6 +72,10 @@ static void usage(void)
 "                       boundary edges, by the triangulation of least area,\n"
 "                       when small beside the surface around them) before\n"
 "                       voting (default on)\n"
+"      --shells on|off  with --surface: the surface's closed pieces (every edge\n"
+"                       shared by two faces) bound their solid exactly: inside\n"
+"                       them is inside, and when the surface is nothing else\n"
+"                       the signs are exactly their solid (default on)\n"
 "      --refine-band D  refine voxels nearer than D voxels (default 1.5)\n"
 "      --refine-radius R  neighbours within R voxels per axis (default 2)\n"
 "      --refine-answers A  neighbours' answers combined per voxel (default 6)\n"
@@ -92,7 +97,7 @@ static void usage(void)
 "Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
 }
 
-enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_FILL_HOLES, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
+enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_FILL_HOLES, OPT_SHELLS, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
 
 int main(int argc, char *argv[])
 {
@@ -102,7 +107,7 @@ int main(int argc, char *argv[])
     st_sign_params p = st_sign_params_default();
     const char *out = NULL, *in = NULL, *surface = NULL;
     st_sign_refine_params rp = st_sign_refine_params_default();
-    int paper = 0, fill_holes = 1;
+    int paper = 0, fill_holes = 1, use_shells = 1;
     static const struct option opts[] = {
         {"band", required_argument, NULL, OPT_BAND},
         {"rays", required_argument, NULL, OPT_RAYS},
@@ -112,6 +117,7 @@ int main(int argc, char *argv[])
         {"runs", required_argument, NULL, OPT_RUNS},
         {"cut", required_argument, NULL, OPT_CUT},
         {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
+        {"shells", required_argument, NULL, OPT_SHELLS},
         {"rule", required_argument, NULL, OPT_RULE},
         {"surface", required_argument, NULL, OPT_SURFACE},
         {"refine-band", required_argument, NULL, OPT_REFINE_BAND},
@@ -184,6 +190,10 @@ int main(int argc, char *argv[])
             if (tool_parse_switch(&t, "--fill-holes", optarg, &fill_holes))
                 return TOOL_EXIT_USAGE;
             break;
+        case OPT_SHELLS:
+            if (tool_parse_switch(&t, "--shells", optarg, &use_shells))
+                return TOOL_EXIT_USAGE;
+            break;
         case OPT_RULE:
             if (st_sign_params_named(&p, optarg))
                 return tool_usage_error(&t, "unknown rule '%s' (paper, parity, default)", optarg);
@@ -249,8 +259,10 @@ int main(int argc, char *argv[])
     st_error_clear(&err);
     st_grid *g = NULL;
     st_soup *soup = NULL;
-    size_t changed = 0;
-    double t_refine = 0.0;
+    st_shells shells;
+    memset(&shells, 0, sizeof shells);
+    size_t changed = 0, shell_changed = 0;
+    double t_refine = 0.0, t_shells = 0.0;
     int rc = TOOL_EXIT_FAIL;
     double t0 = tool_now();
     if (st_grid_read(&g, in, co.max_bytes, &err)) {
@@ -272,6 +284,16 @@ int main(int argc, char *argv[])
         }
         double r1 = tool_now();
         t1 += r1 - r0;   /* reading the surface is not signing */
+        /* The closed pieces of the surface as given, before any cap joins
+         * an open piece to them. */
+        if (use_shells && st_soup_closed_shells(&shells, soup, &err)) {
+            if (!err.file[0])
+                snprintf(err.file, sizeof err.file, "%s", surface);
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        t_shells = tool_now() - r1;
+        r1 = tool_now();
         if (fill_holes) {
             st_soup *caps = NULL;
             st_holes_params hp = st_holes_params_default();
@@ -319,6 +341,12 @@ int main(int argc, char *argv[])
             goto done;
         }
         t_refine = tool_now() - r1;
+        r1 = tool_now();
+        if (use_shells && st_shells_sign(g, &shells, &shell_changed, &err)) {
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        t_shells += tool_now() - r1;
     }
     double t2 = tool_now();
     if (st_meta_history_append(&g->meta, t.command_line ? t.command_line : "soupsign")) {
@@ -345,12 +373,18 @@ int main(int argc, char *argv[])
     if (surface)
         tool_say(&t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
                  rp.band_voxels, changed, t_refine);
+    if (surface && use_shells)
+        tool_say(&t, 2, "closed shells: %zu (%zu triangles in none%s), %zu signs changed, "
+                 "%.3f s", shells.count, shells.open_triangles,
+                 shells.count && !shells.open_triangles ? ": the signs are their solid" : "",
+                 shell_changed, t_shells);
     tool_say(&t, 2, "read %.3f s, signs %.3f s (CPU %.3f s, all threads), write %.3f s",
-             t1 - t0, t2 - t1 - t_refine - t_holes, cpu_sign, t3 - t2);
+             t1 - t0, t2 - t1 - t_refine - t_holes - t_shells, cpu_sign, t3 - t2);
     rc = TOOL_EXIT_OK;
 done:
     st_grid_free(g);
     st_soup_free(soup);
+    st_shells_free(&shells);
     tool_finish(&t);
     return rc;
 }

@@ -15,6 +15,7 @@
 #include "souptet/dist.h"
 #include "souptet/gridio.h"
 #include "souptet/holes.h"
+#include "souptet/shells.h"
 #include "souptet/outfile.h"
 #include "souptet/sign.h"
 #include "souptet/soup.h"
@@ -53,6 +54,8 @@ static void usage(void)
 "                       the signs refined next to it, as soupsign --surface)\n"
 "                       in-process\n"
 "      --fill-holes on|off  with --surface: cap the soup's holes (default on)\n"
+"      --shells on|off  with --surface: the soup's closed pieces bound their\n"
+"                       solid exactly, as soupsign --shells (default on)\n"
 "  -r, --cells N        with --surface: voxels along the longest side\n"
 "                       (default %d)\n"
 "  -o, --output OUT     .obj .off .ply (binary) .stl (binary); '-' or none:\n"
@@ -74,7 +77,7 @@ static void usage(void)
 }
 
 enum { OPT_ISO = TOOL_OPT_FIRST, OPT_ADAPT, OPT_SMOOTH, OPT_MINVOL, OPT_CAVITIES, OPT_SURFACE,
-       OPT_FILL_HOLES };
+       OPT_FILL_HOLES, OPT_SHELLS };
 
 /* The history lines of the field plus this command line. Caller frees. */
 static char *history(const st_grid *g, const char *source, const char *cmd)
@@ -99,7 +102,7 @@ int main(int argc, char *argv[])
     st_dist_params dp = st_dist_params_default();
     size_t smooth = 0;
     const char *out = NULL, *in = NULL, *surface = NULL;
-    int have_cells = 0, fill_holes = 1;
+    int have_cells = 0, fill_holes = 1, use_shells = 1;
     static const struct option opts[] = {
         {"iso", required_argument, NULL, OPT_ISO},
         {"adaptivity", required_argument, NULL, OPT_ADAPT},
@@ -108,6 +111,7 @@ int main(int argc, char *argv[])
         {"keep-cavities", no_argument, NULL, OPT_CAVITIES},
         {"surface", required_argument, NULL, OPT_SURFACE},
         {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
+        {"shells", required_argument, NULL, OPT_SHELLS},
         {"cells", required_argument, NULL, 'r'},
         {"output", required_argument, NULL, 'o'},
         TOOL_LONG_OPTIONS_BASIC,
@@ -144,6 +148,10 @@ int main(int argc, char *argv[])
             break;
         case OPT_FILL_HOLES:
             if (tool_parse_switch(&t, "--fill-holes", optarg, &fill_holes))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_SHELLS:
+            if (tool_parse_switch(&t, "--shells", optarg, &use_shells))
                 return TOOL_EXIT_USAGE;
             break;
         case 'r':
@@ -200,6 +208,8 @@ int main(int argc, char *argv[])
     st_error_clear(&err);
     st_grid *g = NULL;
     st_soup *input = NULL, *res = NULL;
+    st_shells shells;
+    memset(&shells, 0, sizeof shells);
     char *comment = NULL;
     st_outfile of = {0};
     int rc = TOOL_EXIT_FAIL;
@@ -212,8 +222,15 @@ int main(int argc, char *argv[])
             rc = tool_fail(&t, &err);
             goto done;
         }
-        /* As soupsign --surface: the field of the soup with its holes
-         * capped (holes.h), refined against both. */
+        /* As soupsign --surface: the closed pieces of the soup as given,
+         * the field of the soup with its holes capped (holes.h), refined
+         * against both, then the closed pieces' solid (shells.h). */
+        if (use_shells && st_soup_closed_shells(&shells, input, &err)) {
+            if (!err.file[0])
+                snprintf(err.file, sizeof err.file, "%s", srcname);
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
         if (fill_holes) {
             st_soup *caps = NULL;
             st_holes_params hp = st_holes_params_default();
@@ -231,7 +248,8 @@ int main(int argc, char *argv[])
         st_sign_refine_params rf = st_sign_refine_params_default();
         if (st_dist_field(&g, input, &dp, &prog, &err) ||
             st_sign_field(g, &sp, &prog, &err) ||
-            st_sign_refine(g, input, &rf, NULL, &err)) {
+            st_sign_refine(g, input, &rf, NULL, &err) ||
+            (use_shells && st_shells_sign(g, &shells, NULL, &err))) {
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", srcname);
             tool_limit_hint(&err, "use a smaller -r or raise --max-memory");
@@ -295,6 +313,7 @@ done:
     free(comment);
     st_soup_free(res);
     st_soup_free(input);
+    st_shells_free(&shells);
     st_grid_free(g);
     tool_finish(&t);
     return rc;

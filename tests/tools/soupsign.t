@@ -70,4 +70,72 @@ check "the caps are in the metadata" sh -c "grep -aq 'hole_caps' h1.vdb"
 soupsign -v --fill-holes off --surface holed.obj -o h2.vdb h.vdb 2> h2.log
 check "--fill-holes off: no caps" sh -c "test -s h2.vdb && ! grep -q 'holes:' h2.log && ! grep -aq 'hole_caps' h2.vdb"
 
+# Closed shells (--shells): two interpenetrating cubes, each closed.
+cat > cubes.obj <<'OBJ'
+v 0 0 0
+v 2 0 0
+v 2 2 0
+v 0 2 0
+v 0 0 2
+v 2 0 2
+v 2 2 2
+v 0 2 2
+v 1.3 1.3 1.3
+v 3.3 1.3 1.3
+v 3.3 3.3 1.3
+v 1.3 3.3 1.3
+v 1.3 1.3 3.3
+v 3.3 1.3 3.3
+v 3.3 3.3 3.3
+v 1.3 3.3 3.3
+f 1 3 2
+f 1 4 3
+f 5 6 7
+f 5 7 8
+f 1 2 6
+f 1 6 5
+f 2 3 7
+f 2 7 6
+f 3 4 8
+f 3 8 7
+f 4 1 5
+f 4 5 8
+f 9 10 11
+f 9 12 11
+f 13 14 15
+f 13 15 16
+f 9 10 14
+f 9 14 13
+f 10 11 15
+f 10 15 14
+f 11 12 16
+f 11 16 15
+f 12 9 13
+f 12 13 16
+OBJ
+soupdist -r 40 -o cubes.vdb cubes.obj
+check "-v reports two closed shells, the signs exactly theirs" sh -c \
+    "soupsign -v --surface cubes.obj -o cs.vti cubes.vdb 2>&1 | grep -q 'closed shells: 2 (0 triangles in none: the signs are their solid)'"
+cat > union.py <<'PY'
+import sys, vtk
+from vtk.util.numpy_support import vtk_to_numpy
+r = vtk.vtkXMLImageDataReader(); r.SetFileName(sys.argv[1]); r.Update()
+im = r.GetOutput(); nx, ny, nz = im.GetDimensions()
+a = vtk_to_numpy(im.GetPointData().GetScalars()).reshape(nz, ny, nx)
+bad = 0
+for k in range(nz):
+    for j in range(ny):
+        for i in range(nx):
+            x, y, z = im.GetPoint(i + nx * (j + ny * k))
+            inside = all(0 < c < 2 for c in (x, y, z)) or all(1.3 < c < 3.3 for c in (x, y, z))
+            bad += inside != (a[k, j, i] < 0)
+assert bad == 0, bad
+PY
+check "the signs are the cubes' union exactly, overlap included" $PYVTK union.py cs.vti
+check "--shells off: no shells reported" sh -c \
+    "soupsign -v --shells off --surface cubes.obj -o co.vdb cubes.vdb 2>&1 | (! grep -q 'closed shells') && ! grep -aq closed_shells co.vdb"
+check "the bunny is one closed shell" sh -c "soupsign -v --surface '$BUNNY' -o b1.vdb d.vdb 2>&1 | grep -q 'closed shells: 1 (0 triangles'"
+check "the holed bunny has none" sh -c "soupsign -v --surface holed.obj -o h3.vdb h.vdb 2>&1 | grep -q 'closed shells: 0 ('"
+expect_fail "bad --shells" 2 "--shells is on or off" soupsign --shells 1 d.vdb
+
 done_testing
