@@ -97,7 +97,7 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA)
 
 # Peers for make bench (not installed).
 BENCH_BIN := $(BUILD)/bench/vdb_udf $(BUILD)/bench/stream26 $(BUILD)/bench/iou \
-             $(BUILD)/bench/alpha_wrap $(BUILD)/bench/cgal_mesh3
+             $(BUILD)/bench/alpha_wrap $(BUILD)/bench/cgal_mesh3 $(BUILD)/bench/gwn
 # CGAL's exact kernels need GMP and MPFR; its headers want -frounding-math.
 $(BUILD)/bench/alpha_wrap $(BUILD)/bench/cgal_mesh3: LIBS += -lgmp -lmpfr
 $(BUILD)/bench/alpha_wrap $(BUILD)/bench/cgal_mesh3: CXXFLAGS_ALL += -frounding-math -DNDEBUG
