@@ -5,14 +5,17 @@
  *      degenerate and duplicated triangles left out);
  *   2. an edge of one triangle is a boundary edge; the pieces' areas are
  *      summed;
- *   3. pair the boundary edges at each vertex (by angle where holes
- *      touch) and walk them into loops;
+ *   3. pair the boundary edges at each vertex (where holes touch: by the
+ *      angular gaps around it, or on a crease by the edges' hole sides)
+ *      and walk them into loops;
  *   4. triangulate each loop by least area (O(n^3) in its n vertices) and
- *      keep the cap if it is small beside the pieces around the loop.
+ *      keep the cap if it is small beside the pieces near the loop (a
+ *      bounding volume hierarchy finds them).
  */
 #include "souptet/holes.h"
 #include "souptet/geom.h"
 #include "souptet/mem.h"
+#include "souptet/bvh.h"
 #include "souptet/edges.h"
 #include "souptet/weld.h"
 
@@ -99,6 +102,28 @@ static double least_area(const double *const *pts, size_t n, uint32_t *tri)
     return area;
 }
 
+typedef struct around_ctx {
+    const uint8_t *kept;
+    const uint32_t *piece;
+    uint32_t *stamp;
+    uint32_t mark;
+    const double *piece_area;
+    double around;
+} around_ctx;
+
+static int add_piece(void *vc, uint32_t t)
+{
+    around_ctx *c = vc;
+    if (!c->kept[t])
+        return 0;
+    const uint32_t r = c->piece[t];
+    if (c->stamp[r] != c->mark) {
+        c->stamp[r] = c->mark;
+        c->around += c->piece_area[r];
+    }
+    return 0;
+}
+
 /* Edge e's partner at its end v is `other`. */
 static void set_partner(const uint32_t *be_a, uint32_t *pa, uint32_t *pb, uint32_t e,
                         uint32_t v, uint32_t other)
@@ -121,18 +146,88 @@ static int covered(const double *lo, const double *hi, size_t n, double a)
     return 0;
 }
 
+/* Where one plane does not order the triangles around v (a crease): each
+ * boundary edge e at v has a direction d (from v along it) and a hole side
+ * h (in the plane of e's triangle, perpendicular to e, away from the
+ * triangle: where the missing triangles were). Two edges bound the same
+ * gap when each lies on the other's hole side: the score dot(h1, d2) +
+ * dot(h2, d1) is high (2 for two edges of a flat gap of 90 degrees, 0 for a
+ * gap folded by a right-angled crease, -2 for two edges of one fan's ends
+ * seen from inside it). Pairs are taken best score first (ties by position
+ * in ev), never two edges of one triangle nor a pair scoring -1 or less
+ * (each edge then lies more in the other's triangle than in its hole);
+ * only a matching that pairs every edge is kept, else the edges stay
+ * unpaired and their loops open. hit[] (k bytes) is scratch. */
+static void pair_by_sides(const st_soup *s, const uint32_t *weld, const uint32_t *wpos,
+                          const uint32_t *be_a, const uint32_t *be_b, const uint32_t *be_t,
+                          uint32_t *pa, uint32_t *pb, uint32_t v, const uint32_t *ev, size_t k,
+                          uint8_t *hit)
+{
+    enum { MAXK = 32 };
+    if (k > MAXK)
+        return;
+    const double *o = s->xyz + 3 * (size_t)wpos[v];
+    double d[MAXK][3], h[MAXK][3];
+    for (size_t i = 0; i < k; i++) {
+        const uint32_t e = ev[i], w = be_a[e] == v ? be_b[e] : be_a[e];
+        const uint32_t *c = s->tris + 3 * (size_t)be_t[e];
+        const double *third = NULL;
+        for (int q = 0; q < 3; q++)
+            if (weld[c[q]] != v && weld[c[q]] != w)
+                third = s->xyz + 3 * (size_t)c[q];
+        double t[3];
+        st_sub3(d[i], s->xyz + 3 * (size_t)wpos[w], o);
+        st_sub3(t, third, o);
+        const double dd = st_dot3(d[i], d[i]), td = st_dot3(t, d[i]);
+        for (int q = 0; q < 3; q++)     /* minus t's part across e, away from it */
+            h[i][q] = -(t[q] - td / dd * d[i][q]);
+        const double ld = sqrt(dd), lh = st_norm3(h[i]);
+        if (!(ld > 0) || !(lh > 0))
+            return;
+        for (int q = 0; q < 3; q++) {
+            d[i][q] /= ld;
+            h[i][q] /= lh;
+        }
+    }
+    uint32_t mate[MAXK];
+    memset(hit, 0, k);
+    for (size_t round = 0; round < k / 2; round++) {
+        double best = -1.0;
+        size_t bi = k, bj = k;
+        for (size_t i = 0; i < k; i++)
+            for (size_t j = i + 1; j < k; j++) {
+                if (hit[i] || hit[j] || be_t[ev[i]] == be_t[ev[j]])
+                    continue;
+                const double sc = st_dot3(h[i], d[j]) + st_dot3(h[j], d[i]);
+                if (sc > best) {
+                    best = sc;
+                    bi = i;
+                    bj = j;
+                }
+            }
+        if (bi == k)
+            return;             /* an edge without a partner: all stay open */
+        hit[bi] = hit[bj] = 1;
+        mate[bi] = (uint32_t)bj;
+        mate[bj] = (uint32_t)bi;
+    }
+    for (size_t i = 0; i < k; i++)
+        set_partner(be_a, pa, pb, ev[i], v, ev[mate[i]]);
+}
+
 /* The k (even, > 2) boundary edges ev at welded vertex v, where holes
  * touch: seen along the mean normal of the triangles around v (their
  * normals' signs aligned with the first: orientation is not read), the
  * triangles cover sectors of directions; a hole passes through v in each
  * gap between two consecutive boundary edges that no triangle covers, and
  * pairs those two edges. Pairs only when the gaps account for every edge
- * exactly once (else the edges stay unpaired and their loops open: a
- * vertex on a sharp crease, where one plane does not order the fans).
- * Returns -1 when out of memory. */
+ * exactly once; otherwise (a vertex on a sharp crease, where one plane
+ * does not order the fans) the edges are paired by their hole sides
+ * (pair_by_sides) or stay unpaired. Returns -1 when out of memory. */
 static int pair_by_angle(const st_soup *s, const uint32_t *weld, const uint32_t *wpos,
                          const uint32_t *be_a, const uint32_t *be_b, uint32_t *pa, uint32_t *pb,
-                         uint32_t v, const uint32_t *ev, size_t k, const uint32_t *tv, size_t nt)
+                         uint32_t v, const uint32_t *ev, size_t k, const uint32_t *tv, size_t nt,
+                         const uint32_t *be_t)
 {
     const double *o = s->xyz + 3 * (size_t)wpos[v];
     double nsum[3] = {0, 0, 0}, first[3] = {0, 0, 0};
@@ -218,6 +313,8 @@ static int pair_by_angle(const st_soup *s, const uint32_t *weld, const uint32_t 
                 set_partner(be_a, pa, pb, ev[ord[j]], v, ev[ord[i]]);
             }
         }
+    else
+        pair_by_sides(s, weld, wpos, be_a, be_b, be_t, pa, pb, v, ev, k, hit);
     (void)be_b;
     free(lo), free(hi), free(ang), free(ord), free(hit);
     return 0;
@@ -254,8 +351,12 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
     uint32_t *pa = NULL, *pb = NULL, *bdeg = NULL, *vstart = NULL, *vlist = NULL,
              *tstart = NULL, *tlist = NULL, *wpos = NULL;
     const double **pts = NULL;
+    st_bvh *bvh = NULL;
     if (!out || !piece_area)
         goto done;
+    if ((rc = st_bvh_build(&bvh, s, err)))
+        goto fail;
+    rc = ST_ENOMEM;
 
     /* the pieces' areas and the boundary edges */
     for (size_t t = 0; t < nt; t++)
@@ -347,7 +448,8 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
     free(tfill);
     /* Pair the boundary edges at every vertex: the two of a vertex with
      * two; where holes touch, by the angular gaps between the triangles
-     * around it (pair_by_angle). */
+     * around it (pair_by_angle), or on a crease by their hole sides
+     * (pair_by_sides). */
     for (size_t v = 0; v < (size_t)nw; v++) {
         const size_t k = vstart[v + 1] - vstart[v];
         const uint32_t *ev = vlist + vstart[v];
@@ -356,7 +458,7 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
             set_partner(be_a, pa, pb, ev[1], (uint32_t)v, ev[0]);
         } else if (k > 2 && !(k & 1)) {
             int r = pair_by_angle(s, weld, wpos, be_a, be_b, pa, pb, (uint32_t)v, ev, k,
-                                  tlist + tstart[v], tstart[v + 1] - tstart[v]);
+                                  tlist + tstart[v], tstart[v + 1] - tstart[v], be_t);
             if (r < 0)
                 goto done;
         }
@@ -415,14 +517,26 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
             rc = ST_ENOMEM;
             goto done;
         }
-        double around = 0.0;
-        for (size_t i = 0; i < n; i++) {
-            const uint32_t r = piece[be_t[loop_e[i]]];
-            if ((size_t)stamp[r] != e0) {
-                stamp[r] = (uint32_t)e0;
-                around += piece_area[r];
+        /* The surface around the loop: the pieces with a triangle whose box
+         * meets the loop's box grown by a quarter of its extent each way
+         * (the loop's own pieces among them). */
+        double blo[3], bhi[3], ext = 0.0;
+        for (int q = 0; q < 3; q++)
+            blo[q] = bhi[q] = pts[0][q];
+        for (size_t i = 1; i < n; i++)
+            for (int q = 0; q < 3; q++) {
+                blo[q] = fmin(blo[q], pts[i][q]);
+                bhi[q] = fmax(bhi[q], pts[i][q]);
             }
+        for (int q = 0; q < 3; q++)
+            ext = fmax(ext, bhi[q] - blo[q]);
+        for (int q = 0; q < 3; q++) {
+            blo[q] -= 0.25 * ext;
+            bhi[q] += 0.25 * ext;
         }
+        around_ctx ac = {kept, piece, stamp, (uint32_t)e0, piece_area, 0.0};
+        st_bvh_query_box(bvh, blo, bhi, add_piece, &ac);
+        const double around = ac.around;
         if (!(cap > 0.0) || cap > p->max_cap_ratio * around) {
             st0.too_large++;
             continue;
@@ -444,6 +558,7 @@ done:
         st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
 fail:
     st_soup_edges_free(&E);
+    st_bvh_free(bvh);
     free(piece_area);
     free(stamp);
     free(be_a);

@@ -19,10 +19,16 @@
  * add a second surface beside or across the patch. A loop is capped only
  * when its cap is small beside the surface around it: at most
  * max_cap_ratio times the area of the pieces (edge-connected triangles)
- * its edges belong to. Where the gaps do not pair every edge exactly once
- * (an odd count, or a vertex on a sharp crease, where one plane does not
- * order the triangles around it) the edges stay unpaired and their loops
- * open: a wrong pairing would span a cap across the surface.
+ * near it, those with a triangle whose bounding box meets the loop's box
+ * grown by a quarter of its extent each way (its own pieces among them;
+ * where faces were deleted at random, the fragments beside the hole).
+ * Where the gaps do not pair every edge exactly once (a vertex on a sharp
+ * crease, where one plane does not order the triangles around it), each
+ * boundary edge's hole side (in its triangle's plane, away from the
+ * triangle) pairs it with an edge lying on that side whose own hole side
+ * holds it, best pairs first; where that does not pair every edge (an odd
+ * count, no such partner) the edges stay unpaired and their loops open: a
+ * wrong pairing would span a cap across the surface.
  *
  * Orientation is not read; the result does not depend on how the soup's
  * vertices are shared, only on their positions.
