@@ -183,7 +183,7 @@ st_status st_shells_sign(st_grid *g, const st_shells *sh, size_t *changed, st_er
             const int was = d[i] < 0.0f;
             const int in = inside[i] || (!exact && was);
             n += (size_t)(in != was);
-            d[i] = in ? -fabsf(d[i]) : fabsf(d[i]);
+            d[i] = st_grid_signed_value(d[i], in);
         }
         free(inside);
     }

@@ -727,7 +727,7 @@ static void sweep_init(sweep *w, const st_grid *g, const st_sign_params *p,
     sweep_table(w, p);
 }
 
-/* The decision: -|d| where the voxel is inside (majority, or with the
+/* The decision: -|d| (st_grid_signed_value) where the voxel is inside (majority, or with the
  * union rule hidden along every ray), |d| elsewhere; n voxels from out and
  * their bytes v. Branch-free, 16 voxels at a time. */
 #define SIGN_BLOCK ((size_t)1 << 16)
@@ -738,6 +738,7 @@ static void write_signs(float *out, const uint8_t *v, size_t n, int nested)
     const __m128i count = _mm_set1_epi8((char)V_COUNT), vis = _mm_set1_epi8((char)V_VISIBLE),
                   half = _mm_set1_epi8(13), zero = _mm_setzero_si128(),
                   sign = _mm_set1_epi32((int)0x80000000u), mag = _mm_set1_epi32(0x7FFFFFFF),
+                  fmin = _mm_set1_epi32(0x00800000), /* FLT_MIN's bits */
                   use_vis = nested ? _mm_set1_epi8(-1) : zero;
     for (; i + 16 <= n; i += 16) {
         const __m128i b = _mm_loadu_si128((const __m128i *)(v + i));
@@ -750,15 +751,18 @@ static void write_signs(float *out, const uint8_t *v, size_t n, int nested)
                               _mm_unpacklo_epi16(hi, hi), _mm_unpackhi_epi16(hi, hi)};
         for (int q = 0; q < 4; q++) {
             __m128i *o = (__m128i *)(out + i + 4 * q);
-            const __m128i d = _mm_loadu_si128(o);
-            _mm_storeu_si128(o, _mm_or_si128(_mm_and_si128(d, mag), _mm_and_si128(m[q], sign)));
+            /* st_grid_signed_value: |d|, negative inside, -FLT_MIN
+             * for an inside voxel at distance 0 */
+            const __m128i a = _mm_and_si128(_mm_loadu_si128(o), mag);
+            const __m128i tiny = _mm_and_si128(_mm_and_si128(m[q], _mm_cmpeq_epi32(a, zero)), fmin);
+            _mm_storeu_si128(o, _mm_or_si128(_mm_or_si128(a, tiny), _mm_and_si128(m[q], sign)));
         }
     }
 #endif
     for (; i < n; i++) {
         const unsigned b = v[i];
         const int inside = vote_inside(b & V_COUNT) || (nested && !(b & V_VISIBLE));
-        out[i] = inside ? -fabsf(out[i]) : fabsf(out[i]);
+        out[i] = st_grid_signed_value(out[i], inside);
     }
 }
 
@@ -787,7 +791,7 @@ static st_status cut_undecided(st_grid *g, uint8_t *v, int nested, st_error *err
     float *out = g->data;
     #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++)
-        out[i] = e[i] ? -fabsf(out[i]) : fabsf(out[i]);
+        out[i] = st_grid_signed_value(out[i], e[i]);
     return ST_OK;
 }
 
@@ -1260,7 +1264,7 @@ st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
                         else if (nout && !nin)
                             inside = 0;
                         if (inside != (dv < 0)) {
-                            g->data[idx] = inside ? -fabsf(dv) : fabsf(dv);
+                            g->data[idx] = st_grid_signed_value(dv, inside);
                             nchanged++;
                         }
                     }

@@ -10,6 +10,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -700,6 +701,53 @@ static void report_variants(void)
     st_soup_free(cross);
 }
 
+/* Voxel centers exactly on the surface (distance 0) that the vote puts
+ * inside must read as inside (value < 0): -0.0 would not. The box
+ * [3, 12]^3 on a grid of unit voxels centered on integers has whole
+ * planes of centers on its faces. */
+static void test_zero_distance(void)
+{
+    st_grid *g;
+    st_error err;
+    const double org[3] = {0, 0, 0};
+    const double lo = 3, hi = 12;
+    for (int variant = 0; variant < 2; variant++) {
+        st_grid_new(&g, 16, 16, 16, org, 1.0, 0.0f, 0, &err);
+        g->kind = ST_GRID_DISTANCE;
+        for (size_t k = 0; k < 16; k++)
+            for (size_t j = 0; j < 16; j++)
+                for (size_t i = 0; i < 16; i++) {
+                    const double c[3] = {(double)i, (double)j, (double)k};
+                    double out = 0, in = 1e9;
+                    for (int a = 0; a < 3; a++) {
+                        const double e = c[a] < lo ? lo - c[a] : c[a] > hi ? c[a] - hi : 0;
+                        out += e * e;
+                        in = fmin(in, fmin(c[a] - lo, hi - c[a]));
+                    }
+                    g->data[st_grid_index(g, i, j, k)] = (float)(out > 0 ? sqrt(out) : in);
+                }
+        st_sign_params p = st_sign_params_default();
+        p.cut = variant;
+        int ok = !st_sign_field(g, &p, NULL, &err);
+        size_t negzero = 0, zero_in = 0, zero = 0, wrong = 0;
+        for (size_t k = 0; k < 16; k++)
+            for (size_t j = 0; j < 16; j++)
+                for (size_t i = 0; i < 16; i++) {
+                    const float v = g->data[st_grid_index(g, i, j, k)];
+                    const int strictly = i > lo && i < hi && j > lo && j < hi && k > lo && k < hi;
+                    negzero += v == 0.0f && signbit(v);
+                    zero += fabsf(v) <= FLT_MIN;
+                    zero_in += v < 0.0f && fabsf(v) <= FLT_MIN;
+                    wrong += strictly && !(v < 0.0f);
+                }
+        TAP_CHECK(ok && negzero == 0 && zero_in > 0 && wrong == 0,
+                  "%s: %zu of %zu centers on the surface inside, all < 0 (%zu -0.0), the box's "
+                  "inside inside (%zu wrong)", variant ? "cut" : "votes", zero_in, zero, negzero,
+                  wrong);
+        st_grid_free(g);
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "--variants") == 0) {
@@ -711,5 +759,6 @@ int main(int argc, char **argv)
     test_shapes();
     test_sweep_matches_lines();
     test_refine();
+    test_zero_distance();
     return tap_done();
 }

@@ -13,6 +13,7 @@
 #ifndef SOUPTET_GRID_H
 #define SOUPTET_GRID_H
 
+#include <float.h>
 #include <stddef.h>
 #include "souptet/err.h"
 #include "souptet/meta.h"
@@ -58,6 +59,15 @@ static inline size_t st_grid_index(const st_grid *g, size_t i, size_t j,
                                    size_t k)
 {
     return i + g->nx * (j + g->ny * k);
+}
+/* The value of a signed field for distance d on the given side: |d|,
+ * negative inside. A voxel inside at distance 0 (its center on the
+ * surface) gets -FLT_MIN, not -0.0, so that value < 0 holds for exactly
+ * the inside voxels, as every reader of a signed field tests. */
+static inline float st_grid_signed_value(float d, int inside)
+{
+    const float a = d < 0.0f ? -d : d;
+    return inside ? (a > 0.0f ? -a : -FLT_MIN) : a;
 }
 /* World position of the center of voxel (i, j, k). */
 void st_grid_center(const st_grid *g, size_t i, size_t j, size_t k,
