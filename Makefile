@@ -49,7 +49,7 @@ CXXFLAGS_ALL := -std=c++17 $(OPT) -Wall -Wextra -ffp-contract=off -fopenmp -Iinc
 LIBS := -lopenvdb -ltbb -lImath-3_1 \
         -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
         -lvtkCommonDataModel-9.1 -lvtkCommonMath-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1 \
-        $(OMPLIB) -lpthread -lm
+        -lxxhash $(OMPLIB) -lpthread -lm
 LDFLAGS_ALL := $(OPT) -fopenmp $(LDFLAGS)
 
 LIB_C   := $(sort $(wildcard src/*.c))

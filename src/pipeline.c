@@ -4,14 +4,12 @@
 #include "souptet/pipeline.h"
 
 #include "souptet/bvh.h"
-#include "souptet/holes.h"
+#include "souptet/pseudo.h"
 #include "souptet/dist.h"
 #include "souptet/grid.h"
 #include "souptet/lattice.h"
 #include "souptet/mem.h"
 #include "souptet/sculpt.h"
-#include "souptet/shells.h"
-#include "souptet/sign.h"
 #include "souptet/smooth.h"
 #include "souptet/tetqual.h"
 
@@ -241,62 +239,24 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                               : (p->cells * 8 > 128 ? p->cells * 8 : 128);
     dp.max_bytes = p->max_bytes;
     st_grid *g = NULL;
-    st_bvh *bvh = NULL, *bvh_field = NULL;
+    st_bvh *bvh = NULL;
     st_tetmesh **meshes = NULL;
-    st_soup *caps = NULL, *capped = NULL;
-    /* The pseudo volume of the soup with its holes capped (holes.h): the
-     * field and its refinement see the caps; the mesh is fitted to, and
-     * must enclose, the soup itself. */
-    const st_soup *field_soup = s;
-    st_status rc = ST_OK;
-    if (p->fill_holes) {
-        st_holes_params hp = st_holes_params_default();
-        rc = st_soup_hole_caps(&caps, s, &hp, NULL, err);
-        if (rc)
-            goto done;
-        if (caps->ntris) {
-            rc = (capped = st_soup_new()) ? ST_OK
-                 : st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
-            rc = rc ? rc : st_soup_append(capped, s, err);
-            rc = rc ? rc : st_soup_append(capped, caps, err);
-            if (rc)
-                goto done;
-            field_soup = capped;
-        }
-    }
-    rc = st_dist_field(&g, field_soup, &dp, prog, err);
+    /* The pseudo volume (pseudo.h), as soupsign --surface gives it: the
+     * field and its refinement see the hole caps; the mesh is fitted to,
+     * and must enclose, the soup itself. */
+    st_pseudo_params pp = st_pseudo_params_default();
+    pp.fill_holes = p->fill_holes;
+    pp.closed_shells = p->closed_shells;
+    st_pseudo_stats ps;
+    st_status rc = st_pseudo_volume(&g, s, &dp, &pp, &ps, prog, err);
     if (rc)
         goto done;
-    double t_sign = now_seconds();
+    double t_sign = t_start + (now_seconds() - t_start) -
+                    (ps.seconds_shells + ps.seconds_holes + ps.seconds_vote + ps.seconds_refine);
     st->seconds_dist = t_sign - t_start;
-    st_sign_params sg = st_sign_params_default();
-    rc = st_sign_field(g, &sg, prog, err);
-    if (rc)
-        goto done;
-    /* The soup is at hand: re-sign the voxels next to it exactly from
-     * confident neighbours (sign.h, st_sign_refine), which the vote alone
-     * gets wrong within a voxel of the surface and in thin features. */
     rc = st_bvh_build(&bvh, s, err);
     if (rc)
         goto done;
-    if (field_soup != s && (rc = st_bvh_build(&bvh_field, field_soup, err)))
-        goto done;
-    st_sign_refine_params rf = st_sign_refine_params_default();
-    rc = st_sign_refine_bvh(g, bvh_field ? bvh_field : bvh, &rf, NULL, err);
-    st_bvh_free(bvh_field);
-    bvh_field = NULL;
-    if (rc)
-        goto done;
-    /* The soup's closed pieces (without the caps) bound their solid
-     * exactly (shells.h): overlapping parts stay whole. */
-    if (p->closed_shells) {
-        st_shells sh;
-        rc = st_soup_closed_shells(&sh, s, err);
-        rc = rc ? rc : st_shells_sign(g, &sh, NULL, err);
-        st_shells_free(&sh);
-        if (rc)
-            goto done;
-    }
     double t_cand = now_seconds();
     st->seconds_sign = t_cand - t_sign;
     st->field_dims[0] = g->nx;
@@ -382,9 +342,6 @@ done:
         free(local.candidates);
     }
     st_bvh_free(bvh);
-    st_bvh_free(bvh_field);
-    st_soup_free(caps);
-    st_soup_free(capped);
     st_grid_free(g);
     return rc;
 }

@@ -14,9 +14,11 @@
 #include <limits.h>
 #include <math.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <xxhash.h>
 
 /* ---- building ---------------------------------------------------------- */
 
@@ -482,8 +484,24 @@ static st_status read_all(int fd, size_t hint, unsigned char **data,
     return ST_OK;
 }
 
+void st_soup_source_of(st_soup_source *src, const void *data, size_t size)
+{
+    XXH128_hash_t h = XXH3_128bits(data, size);
+    src->size = (unsigned long long)size;
+    snprintf(src->hash, sizeof src->hash, "xxh3-128:%016llx%016llx",
+             (unsigned long long)h.high64, (unsigned long long)h.low64);
+}
+
 st_status st_soup_read(st_soup **out, const char *path, st_error *err)
 {
+    return st_soup_read_source(out, path, NULL, err);
+}
+
+st_status st_soup_read_source(st_soup **out, const char *path, st_soup_source *src,
+                              st_error *err)
+{
+    if (src)
+        memset(src, 0, sizeof *src);
     if (out)
         *out = NULL;
     if (!out || !path)
@@ -528,6 +546,8 @@ st_status st_soup_read(st_soup **out, const char *path, st_error *err)
         is_stdin ? ST_SOUP_UNKNOWN : st_soup_format_from_path(path);
     if (fmt == ST_SOUP_UNKNOWN)
         fmt = st_soup_format_sniff(data, size);
+    if (src)
+        st_soup_source_of(src, data, size);
     if (fmt == ST_SOUP_UNKNOWN)
         st = st_error_set(err, ST_EINPUT, name, 0,
                           "unknown format (not OBJ, OFF, PLY or STL)");

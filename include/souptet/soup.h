@@ -81,6 +81,25 @@ const char *st_soup_format_name(st_soup_format format);
  * unreadable files, empty files and files without triangles are errors. */
 st_status st_soup_read(st_soup **out, const char *path, st_error *err);
 
+/* What a file's bytes were, so a later reader can tell the same file from
+ * a changed one: its size and a 128-bit content hash (XXH3-128, as
+ * "xxh3-128:" and 32 hex digits). Not a cryptographic hash: it tells
+ * accidental changes, not a forgery. */
+#define ST_SOUP_HASH_LEN 48
+typedef struct st_soup_source {
+    unsigned long long size;
+    char hash[ST_SOUP_HASH_LEN];
+} st_soup_source;
+
+/* st_soup_read that also gives the source's size and hash (src may be
+ * NULL). *src is filled whenever the file's bytes were read, even when
+ * they do not parse (so a changed file is told from a broken one), and
+ * zeroed otherwise. */
+st_status st_soup_read_source(st_soup **out, const char *path, st_soup_source *src,
+                              st_error *err);
+/* The size and hash of bytes held in memory. */
+void st_soup_source_of(st_soup_source *src, const void *data, size_t size);
+
 /* Axis-aligned bounds of the referenced vertices: lo[3], hi[3].
  * Returns ST_EINPUT when the soup has no triangles. */
 st_status st_soup_bounds(const st_soup *s, double lo[3], double hi[3],

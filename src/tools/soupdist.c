@@ -56,6 +56,25 @@ static void usage(void)
 
 enum { OPT_PAD = TOOL_OPT_FIRST, OPT_BAND };
 
+/* Which soup the field came from, so soupsign can use it as --surface
+ * (pseudo.h): its absolute path, size and content hash. Nothing for stdin,
+ * or where the path cannot be made absolute. */
+static int record_source(st_grid *g, const char *in, const st_soup_source *src)
+{
+    if (strcmp(in, "-") == 0)
+        return 0;
+    char *abs = realpath(in, NULL);
+    if (!abs)
+        return 0;
+    char size[32];
+    snprintf(size, sizeof size, "%llu", src->size);
+    int rc = st_meta_set(&g->meta, "source_path", abs) ||
+             st_meta_set(&g->meta, "source_size", size) ||
+             st_meta_set(&g->meta, "source_hash", src->hash);
+    free(abs);
+    return rc;
+}
+
 int main(int argc, char *argv[])
 {
     tool_ctx t;
@@ -143,7 +162,8 @@ int main(int argc, char *argv[])
     st_grid *g = NULL;
     int rc = TOOL_EXIT_FAIL;
     double t_read = tool_now();
-    if (st_soup_read(&soup, in, &err)) {
+    st_soup_source src;
+    if (st_soup_read_source(&soup, in, &src, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }
@@ -161,6 +181,7 @@ int main(int argc, char *argv[])
     double t_write = tool_now();
     if (st_meta_set(&g->meta, "source",
                     strcmp(in, "-") == 0 ? "<stdin>" : in) ||
+        record_source(g, in, &src) ||
         st_meta_history_append(&g->meta, t.command_line ? t.command_line
                                                         : "soupdist")) {
         st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");

@@ -11,10 +11,7 @@
 #include "../cli/tool.h"
 #include "souptet/gridio.h"
 #include "souptet/outfile.h"
-#include "souptet/sign.h"
-#include "souptet/dist.h"
-#include "souptet/holes.h"
-#include "souptet/shells.h"
+#include "souptet/pseudo.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -44,8 +41,8 @@ static void usage(void)
 "FIELD is a distance field from soupdist (.vdb or .vti); '-' or none reads\n"
 "an OpenVDB stream from stdin.\n"
 "\n"
-"  -k K                 event threshold on P = 1 - c|d|, in (0, 1] (default 0.8);\n"
-"                       1 counts surface crossings (Nooruddin-Turk parity)\n"
+"  -k K                 event threshold on P = 1 - c|d|, in (0, 1] (default 1:\n"
+"                       surface crossings, Nooruddin-Turk parity; the paper 0.8)\n"
 "      --band D         c = 1/(D voxels) instead of 1/max|d| (a narrow band suffices)\n"
 "      --rays 13|26     one or both directions along the 13 lines (default 26)\n"
 "      --toggle first|nearest|crossing  where in an event run the parity\n"
@@ -65,9 +62,13 @@ static void usage(void)
 "      --cut on|off     on: the votes are evidence for a minimum cut that\n"
 "                       follows the surface and spans its holes by the least\n"
 "                       area (default); off: the majority decides (the paper)\n"
-"      --surface S      the soup the field was computed from: refine the signs\n"
-"                       within a voxel of it by exact segment crossings\n"
-"                       (not with --rule paper)\n"
+"      --surface S|none the soup the field was computed from: its closed pieces,\n"
+"                       its holes capped and the signs within a voxel of it\n"
+"                       refined by exact segment crossings (pseudo.h). Default:\n"
+"                       the soup soupdist recorded in the field, when that file\n"
+"                       is still there with the same bytes (size and content\n"
+"                       hash); else the vote alone, with a note. none: the vote\n"
+"                       alone (as is --rule paper)\n"
 "      --fill-holes on|off  with --surface: cap the surface's holes (loops of\n"
 "                       boundary edges, by the triangulation of least area,\n"
 "                       when small beside the surface around them) before\n"
@@ -90,11 +91,57 @@ static void usage(void)
 "      --version        show the version and exit\n"
 "\n"
 "Examples:\n"
-"  soupdist bunny.obj | soupsign -o bunny-sdf.vti\n"
-"  soupdist bunny.obj | soupsign --surface bunny.obj -o bunny-sdf.vti\n"
+"  soupdist bunny.obj | soupsign -o bunny-sdf.vti   (uses bunny.obj, recorded)\n"
+"  soupdist bunny.obj | soupsign --surface none -o votes-only.vti\n"
 "  soupdist --band full -r 128 scan.ply | soupsign --rule paper -o scan.vdb\n"
 "\n"
 "Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
+}
+
+/* The soup soupdist recorded in the field (source_path, source_size,
+ * source_hash): *soup gets it when the file is there with the same bytes.
+ * A missing, unreadable or changed file is a note, and *soup stays NULL
+ * (the vote alone); never is a file with other bytes used. Fails only
+ * when the very bytes soupdist read no longer parse. */
+static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_error *err)
+{
+    const char *path = st_meta_get(&g->meta, "source_path");
+    const char *size = st_meta_get(&g->meta, "source_size");
+    const char *hash = st_meta_get(&g->meta, "source_hash");
+    *soup = NULL;
+    if (!size || !hash) {
+        tool_say(t, 1, "note: the field names its soup %s but not its size and hash: "
+                       "signs by the vote alone (give --surface FILE)", path);
+        return 0;
+    }
+    st_soup_source src;
+    st_error e;
+    st_error_clear(&e);
+    st_status rc = st_soup_read_source(soup, path, &src, &e);
+    char got[32];
+    snprintf(got, sizeof got, "%llu", src.size);
+    const int same = src.hash[0] && strcmp(got, size) == 0 && strcmp(src.hash, hash) == 0;
+    if (rc && same) {
+        *err = e;
+        return 1;
+    }
+    if (rc || !same) {
+        st_soup_free(*soup);
+        *soup = NULL;
+        if (src.hash[0] && !same)
+            tool_say(t, 1, "note: %s has changed since soupdist read it (%s bytes, %s; now %s "
+                           "bytes, %s): signs by the vote alone (give --surface FILE)",
+                     path, size, hash, got, src.hash);
+        else {
+            char msg[512];
+            st_error_format(&e, msg, sizeof msg);
+            tool_say(t, 1, "note: the field's soup cannot be read (%s): signs by the vote "
+                           "alone (give --surface FILE)", msg);
+        }
+        return 0;
+    }
+    tool_say(t, 2, "surface: %s, as soupdist read it (%s bytes, %s)", path, size, hash);
+    return 0;
 }
 
 enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_FILL_HOLES, OPT_SHELLS, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
@@ -107,7 +154,7 @@ int main(int argc, char *argv[])
     st_sign_params p = st_sign_params_default();
     const char *out = NULL, *in = NULL, *surface = NULL;
     st_sign_refine_params rp = st_sign_refine_params_default();
-    int paper = 0, fill_holes = 1, use_shells = 1;
+    int paper = 0, fill_holes = 1, use_shells = 1, no_surface = 0;
     static const struct option opts[] = {
         {"band", required_argument, NULL, OPT_BAND},
         {"rays", required_argument, NULL, OPT_RAYS},
@@ -200,7 +247,8 @@ int main(int argc, char *argv[])
             paper = strcmp(optarg, "paper") == 0;
             break;
         case OPT_SURFACE:
-            surface = optarg;
+            no_surface = strcmp(optarg, "none") == 0;
+            surface = no_surface ? NULL : optarg;
             break;
         case OPT_REFINE_RADIUS:
         case OPT_REFINE_ANSWERS: {
@@ -259,10 +307,8 @@ int main(int argc, char *argv[])
     st_error_clear(&err);
     st_grid *g = NULL;
     st_soup *soup = NULL;
-    st_shells shells;
-    memset(&shells, 0, sizeof shells);
-    size_t changed = 0, shell_changed = 0;
-    double t_refine = 0.0, t_shells = 0.0;
+    st_pseudo_stats ps;
+    memset(&ps, 0, sizeof ps);
     int rc = TOOL_EXIT_FAIL;
     double t0 = tool_now();
     if (st_grid_read(&g, in, co.max_bytes, &err)) {
@@ -270,84 +316,39 @@ int main(int argc, char *argv[])
         goto done;
     }
     double t1 = tool_now();
-    /* With the surface: cap its holes (holes.h) and add the caps to the
-     * field before voting, so rays meet them; refine against the soup and
-     * its caps. */
-    st_holes_stats hs;
-    memset(&hs, 0, sizeof hs);
-    double t_holes = 0.0;
     if (surface) {
-        double r0 = tool_now();
         if (st_soup_read(&soup, surface, &err)) {
             rc = tool_fail(&t, &err);
             goto done;
         }
-        double r1 = tool_now();
-        t1 += r1 - r0;   /* reading the surface is not signing */
-        /* The closed pieces of the surface as given, before any cap joins
-         * an open piece to them. */
-        if (use_shells && st_soup_closed_shells(&shells, soup, &err)) {
-            if (!err.file[0])
-                snprintf(err.file, sizeof err.file, "%s", surface);
+        t1 = tool_now();   /* reading the surface is not signing */
+    } else if (!no_surface && !paper && st_meta_get(&g->meta, "source_path")) {
+        if (recorded_surface(&t, g, &soup, &err)) {
             rc = tool_fail(&t, &err);
             goto done;
         }
-        t_shells = tool_now() - r1;
-        r1 = tool_now();
-        if (fill_holes) {
-            st_soup *caps = NULL;
-            st_holes_params hp = st_holes_params_default();
-            double reach = 3.0 * g->voxel;
-            if (g->band < reach)
-                reach = g->band;
-            if (st_soup_hole_caps(&caps, soup, &hp, &hs, &err) ||
-                st_dist_lower(g, caps, reach, &err) || st_soup_append(soup, caps, &err)) {
-                st_soup_free(caps);
-                if (!err.file[0])
-                    snprintf(err.file, sizeof err.file, "%s", surface);
-                rc = tool_fail(&t, &err);
-                goto done;
-            }
-            char buf[96];
-            snprintf(buf, sizeof buf, "%zu of %zu loops capped, %zu triangles", hs.filled,
-                     hs.loops, caps->ntris);
-            st_soup_free(caps);
-            if (st_meta_set(&g->meta, "hole_caps", buf)) {
-                st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
-                rc = tool_fail(&t, &err);
-                goto done;
-            }
-            t_holes = tool_now() - r1;
-        }
+        if (soup)
+            surface = st_meta_get(&g->meta, "source_path");
+        t1 = tool_now();
     }
+    st_pseudo_params pp = st_pseudo_params_default();
+    pp.sign = p;
+    pp.refine = rp;
+    pp.fill_holes = fill_holes;
+    pp.closed_shells = use_shells;
     st_progress prog = tool_progress(&t);
     const double c0 = cpu_now();
-    double event = st_sign_event_distance(&p, g);
-    if (st_sign_field(g, &p, &prog, &err)) {
+    if (st_pseudo_sign(g, soup, &pp, &ps, &prog, &err)) {
+        tool_progress_end(&t);
         if (!err.file[0])
             snprintf(err.file, sizeof err.file, "%s",
-                     st_path_is_stdio(in) ? "<stdin>" : in);
+                     surface && ps.failed_step && strcmp(ps.failed_step, "vote") != 0 ? surface
+                     : st_path_is_stdio(in) ? "<stdin>" : in);
         rc = tool_fail(&t, &err);
         goto done;
     }
     const double cpu_sign = cpu_now() - c0;
     tool_progress_end(&t);
-    if (surface) {
-        double r1 = tool_now();
-        if (st_sign_refine(g, soup, &rp, &changed, &err)) {
-            if (!err.file[0])
-                snprintf(err.file, sizeof err.file, "%s", surface);
-            rc = tool_fail(&t, &err);
-            goto done;
-        }
-        t_refine = tool_now() - r1;
-        r1 = tool_now();
-        if (use_shells && st_shells_sign(g, &shells, &shell_changed, &err)) {
-            rc = tool_fail(&t, &err);
-            goto done;
-        }
-        t_shells += tool_now() - r1;
-    }
     double t2 = tool_now();
     if (st_meta_history_append(&g->meta, t.command_line ? t.command_line : "soupsign")) {
         st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
@@ -359,32 +360,31 @@ int main(int argc, char *argv[])
         goto done;
     }
     double t3 = tool_now();
-    size_t inside = 0, n = st_grid_count(g);
-    for (size_t i = 0; i < n; i++)
-        inside += g->data[i] < 0.0f;
+    size_t n = st_grid_count(g);
     tool_say(&t, 2, "grid %zux%zux%zu, rule: %s", g->nx, g->ny, g->nz,
              st_meta_get(&g->meta, "sign_rule"));
     tool_say(&t, 2, "event distance %.6g (%.3g voxels); %zu of %zu voxels inside (%.2f%%)",
-             event, event / g->voxel, inside, n, 100.0 * (double)inside / (double)n);
+             ps.event_distance, ps.event_distance / g->voxel, ps.inside, n,
+             100.0 * (double)ps.inside / (double)n);
     if (surface && fill_holes)
         tool_say(&t, 2, "holes: %zu of %zu boundary loops capped (%zu too large, %zu too long, "
                  "%zu edges left open where holes touch unpaired), %.3f s",
-                 hs.filled, hs.loops, hs.too_large, hs.too_long, hs.pinched, t_holes);
+                 ps.holes.filled, ps.holes.loops, ps.holes.too_large, ps.holes.too_long,
+                 ps.holes.pinched, ps.seconds_holes);
     if (surface)
         tool_say(&t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
-                 rp.band_voxels, changed, t_refine);
+                 rp.band_voxels, ps.refined, ps.seconds_refine);
     if (surface && use_shells)
         tool_say(&t, 2, "closed shells: %zu (%zu triangles in none%s), %zu signs changed, "
-                 "%.3f s", shells.count, shells.open_triangles,
-                 shells.count && !shells.open_triangles ? ": the signs are their solid" : "",
-                 shell_changed, t_shells);
+                 "%.3f s", ps.shells, ps.shell_open_triangles,
+                 ps.shells && !ps.shell_open_triangles ? ": the signs are their solid" : "",
+                 ps.shell_changed, ps.seconds_shells);
     tool_say(&t, 2, "read %.3f s, signs %.3f s (CPU %.3f s, all threads), write %.3f s",
-             t1 - t0, t2 - t1 - t_refine - t_holes - t_shells, cpu_sign, t3 - t2);
+             t1 - t0, ps.seconds_vote, cpu_sign, t3 - t2);
     rc = TOOL_EXIT_OK;
 done:
     st_grid_free(g);
     st_soup_free(soup);
-    st_shells_free(&shells);
     tool_finish(&t);
     return rc;
 }

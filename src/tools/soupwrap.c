@@ -14,10 +14,8 @@
 #include "../cli/tool.h"
 #include "souptet/dist.h"
 #include "souptet/gridio.h"
-#include "souptet/holes.h"
-#include "souptet/shells.h"
 #include "souptet/outfile.h"
-#include "souptet/sign.h"
+#include "souptet/pseudo.h"
 #include "souptet/soup.h"
 #include "souptet/soupwrite.h"
 #include "souptet/wrap.h"
@@ -208,8 +206,6 @@ int main(int argc, char *argv[])
     st_error_clear(&err);
     st_grid *g = NULL;
     st_soup *input = NULL, *res = NULL;
-    st_shells shells;
-    memset(&shells, 0, sizeof shells);
     char *comment = NULL;
     st_outfile of = {0};
     int rc = TOOL_EXIT_FAIL;
@@ -222,34 +218,11 @@ int main(int argc, char *argv[])
             rc = tool_fail(&t, &err);
             goto done;
         }
-        /* As soupsign --surface: the closed pieces of the soup as given,
-         * the field of the soup with its holes capped (holes.h), refined
-         * against both, then the closed pieces' solid (shells.h). */
-        if (use_shells && st_soup_closed_shells(&shells, input, &err)) {
-            if (!err.file[0])
-                snprintf(err.file, sizeof err.file, "%s", srcname);
-            rc = tool_fail(&t, &err);
-            goto done;
-        }
-        if (fill_holes) {
-            st_soup *caps = NULL;
-            st_holes_params hp = st_holes_params_default();
-            if (st_soup_hole_caps(&caps, input, &hp, NULL, &err) ||
-                st_soup_append(input, caps, &err)) {
-                st_soup_free(caps);
-                if (!err.file[0])
-                    snprintf(err.file, sizeof err.file, "%s", srcname);
-                rc = tool_fail(&t, &err);
-                goto done;
-            }
-            st_soup_free(caps);
-        }
-        st_sign_params sp = st_sign_params_default();
-        st_sign_refine_params rf = st_sign_refine_params_default();
-        if (st_dist_field(&g, input, &dp, &prog, &err) ||
-            st_sign_field(g, &sp, &prog, &err) ||
-            st_sign_refine(g, input, &rf, NULL, &err) ||
-            (use_shells && st_shells_sign(g, &shells, NULL, &err))) {
+        /* As soupsign --surface (pseudo.h). */
+        st_pseudo_params pp = st_pseudo_params_default();
+        pp.fill_holes = fill_holes;
+        pp.closed_shells = use_shells;
+        if (st_pseudo_volume(&g, input, &dp, &pp, NULL, &prog, &err)) {
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", srcname);
             tool_limit_hint(&err, "use a smaller -r or raise --max-memory");
@@ -313,7 +286,6 @@ done:
     free(comment);
     st_soup_free(res);
     st_soup_free(input);
-    st_shells_free(&shells);
     st_grid_free(g);
     tool_finish(&t);
     return rc;

@@ -1,0 +1,90 @@
+/*
+ * pseudo.h - the pseudo volume of a soup: the one entry point that
+ * soupsign, soupwrap and the pipeline (soupmesh) call.
+ *
+ * Given the unsigned distance field g of soup s (dist.h), in this order:
+ *   1. the closed shells of s as given (shells.h), before any cap joins an
+ *      open piece to them;
+ *   2. caps for the holes of s (holes.h); g is lowered to the caps'
+ *      distance within `cap_reach` voxels (st_dist_lower), so the rays
+ *      meet them: every later step reads only distances below 1.5 voxels,
+ *      so a reach of 3 voxels gives the same signs as a field computed
+ *      from the soup and its caps together;
+ *   3. the vote (sign.h, st_sign_field, the rule in p->sign);
+ *   4. the near-surface refinement against s and its caps (sign.h,
+ *      st_sign_refine);
+ *   5. the shells' solid (st_shells_sign).
+ * Without the soup (s NULL) only step 3 runs: the vote of Spillmann et al.
+ * 2006, section 3, and whatever the rule adds. Steps 1, 2 and 4 are not
+ * in the paper; each can be turned off (fill_holes, closed_shells,
+ * refine). The field need not come from this process: soupsign reads it
+ * from soupdist, and the same call on the same field and soup gives the
+ * same bytes, whoever calls it.
+ *
+ * Module order: ... dist -> sign -> edges -> holes -> shells -> pseudo
+ *   -> lattice ...
+ */
+#ifndef SOUPTET_PSEUDO_H
+#define SOUPTET_PSEUDO_H
+
+#include <stddef.h>
+
+#include "souptet/dist.h"
+#include "souptet/err.h"
+#include "souptet/grid.h"
+#include "souptet/holes.h"
+#include "souptet/progress.h"
+#include "souptet/sign.h"
+#include "souptet/soup.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct st_pseudo_params {
+    st_sign_params sign;            /* the vote (st_sign_params_default) */
+    st_sign_refine_params refine;   /* step 4 (st_sign_refine_params_default) */
+    st_holes_params holes;          /* step 2 (st_holes_params_default) */
+    int fill_holes;                 /* step 2 (1) */
+    int closed_shells;              /* steps 1 and 5 (1) */
+    int refine_signs;               /* step 4 (1) */
+    double cap_reach;               /* voxels (3; the field's band if less) */
+} st_pseudo_params;
+
+/* Every step on, the project's default rule. */
+st_pseudo_params st_pseudo_params_default(void);
+
+/* What each step did, and how long it took (wall seconds). */
+typedef struct st_pseudo_stats {
+    int surface;                    /* the soup was given */
+    double event_distance;          /* the vote's, model units */
+    st_holes_stats holes;
+    size_t cap_triangles;
+    size_t refined;                 /* signs the refinement changed */
+    size_t shells;                  /* closed shells */
+    size_t shell_open_triangles;    /* triangles in none */
+    size_t shell_changed;           /* signs the shells changed */
+    size_t inside;                  /* voxels inside at the end */
+    double seconds_shells, seconds_holes, seconds_vote, seconds_refine;
+    const char *failed_step;        /* on failure: "shells", "holes", "vote",
+                                       "refine" (whose input to blame) */
+} st_pseudo_stats;
+
+/* Sign the unsigned distance field g of soup s in place (negative inside
+ * the pseudo volume); s may be NULL (the vote alone). stats may be NULL.
+ * Records what ran in g->meta ("sign_rule", "hole_caps", "sign_refine",
+ * "closed_shells"). Errors as st_sign_field's, ST_ENOMEM. */
+st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+                         st_pseudo_stats *stats, const st_progress *progress,
+                         st_error *err);
+
+/* The distance field of s (dp) and its signs (st_pseudo_sign): what
+ * `soupdist | soupsign --surface` computes, in one call. */
+st_status st_pseudo_volume(st_grid **out, const st_soup *s, const st_dist_params *dp,
+                           const st_pseudo_params *p, st_pseudo_stats *stats,
+                           const st_progress *progress, st_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,144 @@
+/*
+ * pseudo.c - the pseudo volume of a soup, step by step (pseudo.h).
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "souptet/pseudo.h"
+
+#include "souptet/shells.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+st_pseudo_params st_pseudo_params_default(void)
+{
+    st_pseudo_params p;
+    memset(&p, 0, sizeof p);
+    p.sign = st_sign_params_default();
+    p.refine = st_sign_refine_params_default();
+    p.holes = st_holes_params_default();
+    p.fill_holes = 1;
+    p.closed_shells = 1;
+    p.refine_signs = 1;
+    p.cap_reach = 3.0;
+    return p;
+}
+
+/* Step 2: the caps of s's holes, lowered into g; *with_caps gets s and its
+ * caps as one soup (NULL when there are none). */
+static st_status add_caps(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+                          st_pseudo_stats *st, st_soup **with_caps, st_error *err)
+{
+    *with_caps = NULL;
+    st_soup *caps = NULL;
+    st_status rc = st_soup_hole_caps(&caps, s, &p->holes, &st->holes, err);
+    if (rc)
+        return rc;
+    st->cap_triangles = caps->ntris;
+    double reach = p->cap_reach * g->voxel;
+    if (g->band < reach)
+        reach = g->band;
+    char buf[96];
+    snprintf(buf, sizeof buf, "%zu of %zu loops capped, %zu triangles", st->holes.filled,
+             st->holes.loops, caps->ntris);
+    rc = st_meta_set(&g->meta, "hole_caps", buf)
+             ? st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory") : ST_OK;
+    if (!rc && caps->ntris) {
+        st_soup *all = st_soup_new();
+        rc = all ? ST_OK : st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        rc = rc ? rc : st_dist_lower(g, caps, reach, err);
+        rc = rc ? rc : st_soup_append(all, s, err);
+        rc = rc ? rc : st_soup_append(all, caps, err);
+        if (rc)
+            st_soup_free(all);
+        else
+            *with_caps = all;
+    }
+    st_soup_free(caps);
+    return rc;
+}
+
+st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+                         st_pseudo_stats *stats, const st_progress *progress,
+                         st_error *err)
+{
+    st_pseudo_stats local;
+    st_pseudo_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    if (!g || !p)
+        return st_error_set(err, ST_EINTERNAL, NULL, 0, "st_pseudo_sign: bad arguments");
+    st->surface = s != NULL;
+    st->event_distance = st_sign_event_distance(&p->sign, g);
+    st_shells shells;
+    memset(&shells, 0, sizeof shells);
+    st_soup *with_caps = NULL;
+    st_status rc = ST_OK;
+    double t0 = now_seconds();
+    if (s && p->closed_shells) {
+        st->failed_step = "shells";
+        rc = st_soup_closed_shells(&shells, s, err);
+        if (rc)
+            goto done;
+        st->shells = shells.count;
+        st->shell_open_triangles = shells.open_triangles;
+    }
+    double t1 = now_seconds();
+    st->seconds_shells = t1 - t0;
+    st->failed_step = "holes";
+    if (s && p->fill_holes && (rc = add_caps(g, s, p, st, &with_caps, err)))
+        goto done;
+    double t2 = now_seconds();
+    st->seconds_holes = t2 - t1;
+    st->failed_step = "vote";
+    if ((rc = st_sign_field(g, &p->sign, progress, err)))
+        goto done;
+    double t3 = now_seconds();
+    st->seconds_vote = t3 - t2;
+    st->failed_step = "refine";
+    if (s && p->refine_signs &&
+        (rc = st_sign_refine(g, with_caps ? with_caps : s, &p->refine, &st->refined, err)))
+        goto done;
+    double t4 = now_seconds();
+    st->seconds_refine = t4 - t3;
+    st->failed_step = "shells";
+    if (s && p->closed_shells && (rc = st_shells_sign(g, &shells, &st->shell_changed, err)))
+        goto done;
+    st->seconds_shells += now_seconds() - t4;
+    size_t inside = 0;
+    const size_t n = st_grid_count(g);
+    for (size_t i = 0; i < n; i++)
+        inside += g->data[i] < 0.0f;
+    st->inside = inside;
+    st->failed_step = NULL;
+done:
+    st_soup_free(with_caps);
+    st_shells_free(&shells);
+    return rc;
+}
+
+st_status st_pseudo_volume(st_grid **out, const st_soup *s, const st_dist_params *dp,
+                           const st_pseudo_params *p, st_pseudo_stats *stats,
+                           const st_progress *progress, st_error *err)
+{
+    if (out)
+        *out = NULL;
+    if (!out || !s || !dp || !p)
+        return st_error_set(err, ST_EINTERNAL, NULL, 0, "st_pseudo_volume: bad arguments");
+    st_grid *g = NULL;
+    st_status rc = st_dist_field(&g, s, dp, progress, err);
+    rc = rc ? rc : st_pseudo_sign(g, s, p, stats, progress, err);
+    if (rc) {
+        st_grid_free(g);
+        return rc;
+    }
+    *out = g;
+    return ST_OK;
+}
