@@ -13,7 +13,10 @@
  * field (soupsign's output) on the same grid; the truth is evaluated once at
  * its voxel centers with exact inside tests (solid.h) and each field's
  * inside (value < 0) is compared: one JSON object per field on stdout with
- * IoU, precision and recall.
+ * IoU, precision and recall, and the core IoU: the same over the voxels
+ * whose six neighbours all have the voxel's own true side (the voxels
+ * within a voxel of the true boundary left out, where a field of this
+ * resolution cannot be held to either side).
  */
 #include "souptet/gridio.h"
 #include "souptet/soup.h"
@@ -23,6 +26,32 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* IoU over the voxels away from the true boundary (see above). */
+static double core_iou(const uint8_t *truth, const st_grid *g)
+{
+    const size_t nx = g->nx, ny = g->ny, nz = g->nz;
+    size_t both = 0, either = 0;
+    for (size_t z = 0; z < nz; z++)
+        for (size_t y = 0; y < ny; y++)
+            for (size_t x = 0; x < nx; x++) {
+                const size_t i = x + nx * (y + ny * z);
+                const uint8_t t = truth[i] != 0;
+                int edge = 0;
+                if (x > 0) edge |= (truth[i - 1] != 0) != t;
+                if (x + 1 < nx) edge |= (truth[i + 1] != 0) != t;
+                if (y > 0) edge |= (truth[i - nx] != 0) != t;
+                if (y + 1 < ny) edge |= (truth[i + nx] != 0) != t;
+                if (z > 0) edge |= (truth[i - nx * ny] != 0) != t;
+                if (z + 1 < nz) edge |= (truth[i + nx * ny] != 0) != t;
+                if (edge)
+                    continue;
+                const int f = g->data[i] < 0.0f;
+                both += t && f;
+                either += t || f;
+            }
+    return either ? (double)both / (double)either : 1.0;
+}
 
 int main(int argc, char **argv)
 {
@@ -85,8 +114,9 @@ int main(int argc, char **argv)
             fprintf(stderr, "iou: %s: %s\n", argv[f], err.msg);
             rc = 1;
         } else {
-            printf("{\"field\": \"%s\", \"iou\": %.6f, \"precision\": %.6f, \"recall\": %.6f}\n",
-                   argv[f], iou, precision, recall);
+            printf("{\"field\": \"%s\", \"iou\": %.6f, \"precision\": %.6f, \"recall\": %.6f, "
+                   "\"core_iou\": %.6f}\n",
+                   argv[f], iou, precision, recall, core_iou(truth, field));
         }
         st_grid_free(g);
     }

@@ -140,3 +140,34 @@ int st_soup_edges_forward(const st_soup_edges *e, const st_soup *s, uint32_t t,
             return e->weld[v[(c + 1) % 3]] == b;
     return 0;
 }
+
+void st_soup_edges_neighbours(const st_soup_edges *e, const st_soup *s, uint32_t *nbr,
+                              uint8_t *same, uint8_t *open)
+{
+    for (size_t i = 0; i < 3 * s->ntris; i++) {
+        nbr[i] = ST_EDGES_NONE;
+        same[i] = 0;
+    }
+    for (size_t i = 0, j; i < e->nhalf; i = j) {
+        for (j = i + 1; j < e->nhalf && e->he[j].key == e->he[i].key; j++)
+            ;
+        const uint32_t t1 = e->he[i].t;
+        if (j - i != 2) {
+            if (open)
+                open[e->piece[t1]] = 1;
+            continue;
+        }
+        const uint32_t t2 = e->he[i + 1].t;
+        const uint32_t a = (uint32_t)(e->he[i].key >> 32), b = (uint32_t)e->he[i].key;
+        const uint8_t sd = st_soup_edges_forward(e, s, t1, a, b) ==
+                           st_soup_edges_forward(e, s, t2, a, b);
+        for (int k = 0; k < 2; k++) {
+            const uint32_t t = k ? t2 : t1, o = k ? t1 : t2;
+            size_t slot = 3 * (size_t)t;
+            while (nbr[slot] != ST_EDGES_NONE)
+                slot++;          /* at most 3: one per edge of t */
+            nbr[slot] = o;
+            same[slot] = sd;
+        }
+    }
+}

@@ -4,9 +4,11 @@
 #define _POSIX_C_SOURCE 200809L
 #include "souptet/pseudo.h"
 
+#include "souptet/mem.h"
 #include "souptet/shells.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -29,6 +31,8 @@ st_pseudo_params st_pseudo_params_default(void)
     p.closed_shells = 1;
     p.refine_signs = 1;
     p.cap_reach = 3.0;
+    p.sides = 1;
+    p.sides_params = st_sides_params_default();
     return p;
 }
 
@@ -66,6 +70,27 @@ static st_status add_caps(st_grid *g, const st_soup *s, const st_pseudo_params *
     return rc;
 }
 
+/* Step 3 with the sides (sides.h): the plain majority turns each
+ * orientable region, the regions' local winding numbers join the votes as
+ * the cut's evidence. */
+static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+                                 st_pseudo_stats *st, const st_progress *progress,
+                                 st_error *err)
+{
+    const size_t n = st_grid_count(g);
+    uint8_t *majority = st_malloc_array(n ? n : 1, 1);
+    int8_t *evidence = st_malloc_array(n ? n : 1, 1);
+    st_status rc = majority && evidence ? ST_OK
+                 : st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the sides");
+    const st_sides_params sp = p->sides_params;
+    rc = rc ? rc : st_sign_majority(g, &p->sign, majority, err);
+    rc = rc ? rc : st_sides_evidence(evidence, g, majority, NULL, s, &sp, &st->sides, err);
+    free(majority);
+    rc = rc ? rc : st_sign_field_evidence(g, &p->sign, evidence, progress, err);
+    free(evidence);
+    return rc;
+}
+
 st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p,
                          st_pseudo_stats *stats, const st_progress *progress,
                          st_error *err)
@@ -98,7 +123,10 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
     double t2 = now_seconds();
     st->seconds_holes = t2 - t1;
     st->failed_step = "vote";
-    if ((rc = st_sign_field(g, &p->sign, progress, err)))
+    if (s && p->sides && p->sign.cut) {
+        if ((rc = vote_with_sides(g, with_caps ? with_caps : s, p, st, progress, err)))
+            goto done;
+    } else if ((rc = st_sign_field(g, &p->sign, progress, err)))
         goto done;
     double t3 = now_seconds();
     st->seconds_vote = t3 - t2;

@@ -23,7 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define NONE UINT32_MAX
+#define NONE ST_EDGES_NONE
 
 void st_shells_free(st_shells *sh)
 {
@@ -62,29 +62,7 @@ st_status st_soup_closed_shells(st_shells *out, const st_soup *s, st_error *err)
         goto done;
 
     /* 2. manifold neighbours */
-    for (size_t i = 0; i < 3 * nt; i++)
-        nbr[i] = NONE;
-    for (size_t i = 0, j; i < E.nhalf; i = j) {
-        for (j = i + 1; j < E.nhalf && E.he[j].key == E.he[i].key; j++)
-            ;
-        const uint32_t t1 = E.he[i].t;
-        if (j - i != 2) {
-            open[E.piece[t1]] = 1;
-            continue;
-        }
-        const uint32_t t2 = E.he[i + 1].t;
-        const uint32_t a = (uint32_t)(E.he[i].key >> 32), b = (uint32_t)E.he[i].key;
-        const uint8_t sd = st_soup_edges_forward(&E, s, t1, a, b) ==
-                           st_soup_edges_forward(&E, s, t2, a, b);
-        for (int k = 0; k < 2; k++) {
-            const uint32_t t = k ? t2 : t1, o = k ? t1 : t2;
-            size_t slot = 3 * (size_t)t;
-            while (nbr[slot] != NONE)
-                slot++;          /* at most 3: one per edge of t */
-            nbr[slot] = o;
-            same[slot] = sd;
-        }
-    }
+    st_soup_edges_neighbours(&E, s, nbr, same, open);
 
     /* 3. orientation by propagation; 4. signed volumes */
     memset(flip, 2, nt);        /* 2: not reached yet */

@@ -775,14 +775,20 @@ static void write_signs(float *out, const uint8_t *v, size_t n, int nested)
  * (the union rule's intent, decided by area rather than by straight
  * rays; without nested_union, parity is trusted there too). Each voxel's byte becomes its evidence, then its label; the
  * signs are written from the labels. */
-static st_status cut_undecided(st_grid *g, uint8_t *v, int nested, st_error *err)
+static st_status cut_undecided(st_grid *g, uint8_t *v, int nested, const int8_t *extra,
+                               st_error *err)
 {
     const size_t n = st_grid_count(g);
     int8_t *e = (int8_t *)v;
     #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         const int u = v[i] & V_COUNT, vis = (v[i] & V_VISIBLE) != 0;
-        e[i] = (int8_t)(u > 13 || vis || !nested ? u - 13 : 0);
+        int ev = u > 13 || vis || !nested ? u - 13 : 0;
+        if (extra) {
+            ev += extra[i];
+            ev = ev < -127 ? -127 : ev > 127 ? 127 : ev;
+        }
+        e[i] = (int8_t)ev;
     }
     const st_mincut_params cp = st_mincut_params_default();
     st_status st = st_mincut_label(g, e, &cp, NULL, err);
@@ -832,8 +838,10 @@ unsigned st_sign_line(const float *d, size_t n, float t,
     return events;
 }
 
-st_status st_sign_field(st_grid *g, const st_sign_params *p,
-                        const st_progress *progress, st_error *err)
+/* The checks and the 13 sweeps: v (n bytes, zeroed) gets every voxel's
+ * votes (see above). */
+static st_status vote_all(const st_grid *g, const st_sign_params *p, uint8_t *v,
+                          const st_progress *progress, st_error *err)
 {
     if (g->kind == ST_GRID_SIGNED)
         return st_error_set(err, ST_EINPUT, NULL, 0,
@@ -862,10 +870,10 @@ st_status st_sign_field(st_grid *g, const st_sign_params *p,
         uint32_t neg = 0, nonf = 0, diff = 0;
         #pragma omp simd reduction(+ : neg, nonf, diff)
         for (size_t i = b0; i < b1; i++) {
-            const float v = data[i];
-            nonf += !(fabsf(v) <= FLT_MAX);
-            neg += v < 0.0f;
-            diff += v != first;
+            const float x = data[i];
+            nonf += !(fabsf(x) <= FLT_MAX);
+            neg += x < 0.0f;
+            diff += x != first;
         }
         negative += neg;
         nonfinite += nonf;
@@ -885,12 +893,8 @@ st_status st_sign_field(st_grid *g, const st_sign_params *p,
                             (double)first);
 
     const double t = st_sign_event_distance(p, g);
-    uint8_t *v = st_calloc_big(n);
-    if (!v)
-        return st_error_set(err, ST_ENOMEM, NULL, 0,
-                            "out of memory for the votes");
     sweep w;
-    sweep_init(&w, g, p, g->data, v, (float)t);
+    sweep_init(&w, (st_grid *)g, p, g->data, v, (float)t);
     st_status st = ST_OK;
     for (int d = 0; d < 13 && !st; d++) {
         /* Every direction is walked forward in memory (see DIRS). */
@@ -904,17 +908,55 @@ st_status st_sign_field(st_grid *g, const st_sign_params *p,
             st = sweep_across(&w, DIRS[d], stride);
         st_progress_report(progress, "signs", (d + 1) / 13.0);
     }
+    if (st)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    return ST_OK;
+}
+
+st_status st_sign_majority(const st_grid *g, const st_sign_params *p, uint8_t *inside,
+                           st_error *err)
+{
+    const size_t n = st_grid_count(g);
+    memset(inside, 0, n);
+    st_status st = vote_all(g, p, inside, NULL, err);
+    if (st)
+        return st;
+    #pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        const unsigned b = inside[i];
+        inside[i] = (uint8_t)(vote_inside(b & V_COUNT) ||
+                              (p->nested_union && !(b & V_VISIBLE)));
+    }
+    return ST_OK;
+}
+
+st_status st_sign_field(st_grid *g, const st_sign_params *p,
+                        const st_progress *progress, st_error *err)
+{
+    return st_sign_field_evidence(g, p, NULL, progress, err);
+}
+
+st_status st_sign_field_evidence(st_grid *g, const st_sign_params *p, const int8_t *extra,
+                                 const st_progress *progress, st_error *err)
+{
+    const size_t n = st_grid_count(g);
+    uint8_t *v = st_calloc_big(n ? n : 1);
+    if (!v)
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory for the votes");
+    st_status st = vote_all(g, p, v, progress, err);
     if (st) {
         free(v);
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        return st;
     }
+    const double t = st_sign_event_distance(p, g);
     /* With the cut, the votes are its evidence (cut_undecided). Without:
      * majority; ties (and voxels no counted ray reached) are outside; with
      * nested_union, a voxel no ray reaches from outside without meeting
      * the surface is inside whatever the parity. */
     float *out = g->data;
     if (p->cut) {
-        st_status cs = cut_undecided(g, v, p->nested_union, err);
+        st_status cs = cut_undecided(g, v, p->nested_union, extra, err);
         if (cs) {
             free(v);
             return cs;

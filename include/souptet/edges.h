@@ -49,6 +49,16 @@ void st_soup_edges_free(st_soup_edges *e);
 int st_soup_edges_forward(const st_soup_edges *e, const st_soup *s, uint32_t t,
                           uint32_t a, uint32_t b);
 
+/* Each kept triangle's manifold neighbours: nbr[3t..3t+3) gets the
+ * triangles across t's edges of exactly two triangles (ST_EDGES_NONE in
+ * the unused slots), same[] 1 where the two run along that edge the same
+ * way (one must be flipped to agree). open[piece] (if not NULL, indexed
+ * by piece root, zeroed by the caller) is set for a piece with an edge of
+ * one, or of three or more, triangles. nbr and same hold 3 ntris. */
+#define ST_EDGES_NONE UINT32_MAX
+void st_soup_edges_neighbours(const st_soup_edges *e, const st_soup *s, uint32_t *nbr,
+                              uint8_t *same, uint8_t *open);
+
 #ifdef __cplusplus
 }
 #endif

@@ -10,7 +10,10 @@
  *      meet them: every later step reads only distances below 1.5 voxels,
  *      so a reach of 3 voxels gives the same signs as a field computed
  *      from the soup and its caps together;
- *   3. the vote (sign.h, st_sign_field, the rule in p->sign);
+ *   3. the vote (sign.h, st_sign_field, the rule in p->sign), its cut
+ *      also given the side of the soup's oriented walls that each voxel
+ *      near them is on (sides.h: the soup and its caps, each orientable
+ *      region turned the way the plain majority of the votes reads it);
  *   4. the near-surface refinement against s and its caps (sign.h,
  *      st_sign_refine);
  *   5. the shells' solid (st_shells_sign).
@@ -33,6 +36,7 @@
 #include "souptet/err.h"
 #include "souptet/grid.h"
 #include "souptet/holes.h"
+#include "souptet/sides.h"
 #include "souptet/progress.h"
 #include "souptet/sign.h"
 #include "souptet/soup.h"
@@ -48,6 +52,8 @@ typedef struct st_pseudo_params {
     int fill_holes;                 /* step 2 (1) */
     int closed_shells;              /* steps 1 and 5 (1) */
     int refine_signs;               /* step 4 (1) */
+    int sides;                      /* step 3 with the sides' evidence (1) */
+    st_sides_params sides_params;   /* (st_sides_params_default) */
     double cap_reach;               /* voxels (3; the field's band if less) */
 } st_pseudo_params;
 
@@ -60,6 +66,7 @@ typedef struct st_pseudo_stats {
     double event_distance;          /* the vote's, model units */
     st_holes_stats holes;
     size_t cap_triangles;
+    st_sides_stats sides;
     size_t refined;                 /* signs the refinement changed */
     size_t shells;                  /* closed shells */
     size_t shell_open_triangles;    /* triangles in none */

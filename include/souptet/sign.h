@@ -112,6 +112,20 @@ double st_sign_event_distance(const st_sign_params *p, const st_grid *g);
 st_status st_sign_field(st_grid *g, const st_sign_params *p,
                         const st_progress *progress, st_error *err);
 
+/* st_sign_field with more evidence for the cut (p->cut only): extra[i]
+ * (NULL: none) is added to voxel i's evidence from the votes (a margin of
+ * U - 13 votes; see mincut.h for its weight), for what the votes cannot
+ * see: the side of an oriented surface (sides.h). */
+st_status st_sign_field_evidence(st_grid *g, const st_sign_params *p, const int8_t *extra,
+                                 const st_progress *progress, st_error *err);
+
+/* The majority of the votes alone, without touching g: inside[i] (n
+ * bytes) gets 1 where voxel i's votes say inside (ties outside; hidden
+ * voxels inside under nested_union), else 0. Same checks as
+ * st_sign_field. */
+st_status st_sign_majority(const st_grid *g, const st_sign_params *p, uint8_t *inside,
+                           st_error *err);
+
 /* The rule on one line of samples (for tests and for reading the rule):
  * d[0..n) are the distances along the line, t the event distance; adds the
  * line's inside votes to votes[] (one per ray: up to 2 with 26 rays) and,

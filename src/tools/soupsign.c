@@ -77,6 +77,10 @@ static void usage(void)
 "                       shared by two faces) bound their solid exactly: inside\n"
 "                       them is inside, and when the surface is nothing else\n"
 "                       the signs are exactly their solid (default on)\n"
+"      --sides on|off   with --surface: the side of the surface's oriented walls\n"
+"                       each voxel near them is on (its pieces oriented by\n"
+"                       propagation, each turned the way the votes read it)\n"
+"                       joins the votes as evidence for the cut (default on)\n"
 "      --refine-band D  refine voxels nearer than D voxels (default 1.5)\n"
 "      --refine-radius R  neighbours within R voxels per axis (default 2)\n"
 "      --refine-answers A  neighbours' answers combined per voxel (default 6)\n"
@@ -144,7 +148,7 @@ static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_er
     return 0;
 }
 
-enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_FILL_HOLES, OPT_SHELLS, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
+enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_FILL_HOLES, OPT_SHELLS, OPT_SIDES, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
 
 int main(int argc, char *argv[])
 {
@@ -154,7 +158,7 @@ int main(int argc, char *argv[])
     st_sign_params p = st_sign_params_default();
     const char *out = NULL, *in = NULL, *surface = NULL;
     st_sign_refine_params rp = st_sign_refine_params_default();
-    int paper = 0, fill_holes = 1, use_shells = 1, no_surface = 0;
+    int paper = 0, fill_holes = 1, use_shells = 1, use_sides = 1, no_surface = 0;
     static const struct option opts[] = {
         {"band", required_argument, NULL, OPT_BAND},
         {"rays", required_argument, NULL, OPT_RAYS},
@@ -165,6 +169,7 @@ int main(int argc, char *argv[])
         {"cut", required_argument, NULL, OPT_CUT},
         {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
         {"shells", required_argument, NULL, OPT_SHELLS},
+        {"sides", required_argument, NULL, OPT_SIDES},
         {"rule", required_argument, NULL, OPT_RULE},
         {"surface", required_argument, NULL, OPT_SURFACE},
         {"refine-band", required_argument, NULL, OPT_REFINE_BAND},
@@ -239,6 +244,10 @@ int main(int argc, char *argv[])
             break;
         case OPT_SHELLS:
             if (tool_parse_switch(&t, "--shells", optarg, &use_shells))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_SIDES:
+            if (tool_parse_switch(&t, "--sides", optarg, &use_sides))
                 return TOOL_EXIT_USAGE;
             break;
         case OPT_RULE:
@@ -336,6 +345,7 @@ int main(int argc, char *argv[])
     pp.refine = rp;
     pp.fill_holes = fill_holes;
     pp.closed_shells = use_shells;
+    pp.sides = use_sides;
     st_progress prog = tool_progress(&t);
     const double c0 = cpu_now();
     if (st_pseudo_sign(g, soup, &pp, &ps, &prog, &err)) {
@@ -371,6 +381,10 @@ int main(int argc, char *argv[])
                  "%zu edges left open where holes touch unpaired), %.3f s",
                  ps.holes.filled, ps.holes.loops, ps.holes.too_large, ps.holes.too_long,
                  ps.holes.pinched, ps.seconds_holes);
+    if (surface && use_sides && p.cut)
+        tool_say(&t, 2, "sides: %zu orientable regions (%zu turned to the votes, %zu edges "
+                 "disagreeing), %zu voxels given their side", ps.sides.regions, ps.sides.turned,
+                 ps.sides.conflicts, ps.sides.voxels);
     if (surface)
         tool_say(&t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
                  rp.band_voxels, ps.refined, ps.seconds_refine);

@@ -1,0 +1,225 @@
+/*
+ * sides.c - the side of an oriented soup near each voxel (see sides.h).
+ */
+#include "souptet/sides.h"
+
+#include "souptet/bvh.h"
+#include "souptet/edges.h"
+#include "souptet/mem.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+st_sides_params st_sides_params_default(void)
+{
+    /* band 2.5 voxels: the voxels the cut reads either side of a wall;
+     * cube radius 3 voxels: a wall's solid angle from 1 voxel away is
+     * two thirds of a hemisphere (w about 1/3); weight 24 turns that into
+     * 8 votes of margin, below the 10 that decide a voxel alone
+     * (mincut.h), so the votes and the cut's area still have a say. */
+    st_sides_params p = {2.5, 3.0, 24.0, 9};
+    return p;
+}
+
+/* Signed solid angle of triangle (a, b, c) seen from the origin, positive
+ * when the origin is behind it (the triangle counter-clockwise seen from
+ * its front). Van Oosterom and Strackee 1983. */
+static double solid_angle(const double a[3], const double b[3], const double c[3])
+{
+    const double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    const double lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    const double lc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                       a[2] * (b[0] * c[1] - b[1] * c[0]);
+    const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    const double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
+    const double ca = c[0] * a[0] + c[1] * a[1] + c[2] * a[2];
+    const double den = la * lb * lc + ab * lc + bc * la + ca * lb;
+    return 2.0 * atan2(det, den);
+}
+
+/* The voxel nearest point q, or SIZE_MAX outside the grid. */
+static size_t voxel_at(const st_grid *g, const double q[3])
+{
+    const size_t dims[3] = {g->nx, g->ny, g->nz};
+    size_t ijk[3];
+    for (int k = 0; k < 3; k++) {
+        const double f = floor((q[k] - g->origin[k]) / g->voxel + 0.5);
+        if (!(f >= 0.0 && f < (double)dims[k]))
+            return SIZE_MAX;
+        ijk[k] = (size_t)f;
+    }
+    return st_grid_index(g, ijk[0], ijk[1], ijk[2]);
+}
+
+typedef struct wsum {
+    const st_soup *o;
+    const double *p;
+    double sum;
+} wsum;
+
+static int add_angle(void *ctx, uint32_t t)
+{
+    wsum *w = ctx;
+    const uint32_t *v = w->o->tris + 3 * (size_t)t;
+    double a[3], b[3], c[3];
+    for (int k = 0; k < 3; k++) {
+        a[k] = w->o->xyz[3 * (size_t)v[0] + k] - w->p[k];
+        b[k] = w->o->xyz[3 * (size_t)v[1] + k] - w->p[k];
+        c[k] = w->o->xyz[3 * (size_t)v[2] + k] - w->p[k];
+    }
+    w->sum += solid_angle(a, b, c);
+    return 0;
+}
+
+st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *majority,
+                            const uint8_t *need, const st_soup *s,
+                            const st_sides_params *p, st_sides_stats *stats,
+                            st_error *err)
+{
+    st_sides_stats local;
+    st_sides_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    const size_t n = st_grid_count(g);
+    memset(evidence, 0, n);
+    st_soup_edges E;
+    st_status rc = st_soup_edges_build(&E, s, err);
+    if (rc)
+        return rc;
+    const size_t nt = s->ntris;
+    uint32_t *nbr = st_malloc_array(3 * nt + 1, sizeof *nbr);
+    uint8_t *same = st_malloc_array(3 * nt + 1, 1);
+    uint8_t *flip = st_malloc_array(nt + 1, 1);
+    uint32_t *region = st_malloc_array(nt + 1, sizeof *region);
+    uint32_t *queue = st_malloc_array(nt + 1, sizeof *queue);
+    double *score = st_calloc_array(nt + 1, sizeof *score);
+    st_soup *o = st_soup_new();
+    st_bvh *bvh = NULL;
+    if (!nbr || !same || !flip || !region || !queue || !score || !o) {
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's sides");
+        goto done;
+    }
+    st_soup_edges_neighbours(&E, s, nbr, same, NULL);
+
+    /* 1. orientable regions, by propagation */
+    memset(flip, 2, nt);
+    for (size_t t0 = 0; t0 < nt; t0++) {
+        if (!E.kept[t0] || flip[t0] != 2)
+            continue;
+        size_t qh = 0, qt = 0;
+        flip[t0] = 0;
+        region[t0] = (uint32_t)t0;
+        queue[qt++] = (uint32_t)t0;
+        st->regions++;
+        while (qh < qt) {
+            const uint32_t t = queue[qh++];
+            for (size_t slot = 3 * (size_t)t; slot < 3 * (size_t)t + 3; slot++) {
+                const uint32_t q = nbr[slot];
+                if (q == ST_EDGES_NONE)
+                    continue;
+                const uint8_t want = (uint8_t)(flip[t] ^ same[slot]);
+                if (flip[q] == 2) {
+                    flip[q] = want;
+                    region[q] = (uint32_t)t0;
+                    queue[qt++] = q;
+                } else if (flip[q] != want) {
+                    st->conflicts++;
+                }
+            }
+        }
+    }
+
+    /* 2. each region turned to the votes' reading */
+    const double off = 1.5 * g->voxel;
+    for (size_t t = 0; t < nt; t++) {
+        if (!E.kept[t])
+            continue;
+        const uint32_t *v = s->tris + 3 * t;
+        const double *A = s->xyz + 3 * (size_t)v[0], *B = s->xyz + 3 * (size_t)v[1],
+                     *C = s->xyz + 3 * (size_t)v[2];
+        double u[3], w[3], nrm[3], c[3];
+        for (int k = 0; k < 3; k++) {
+            u[k] = B[k] - A[k];
+            w[k] = C[k] - A[k];
+            c[k] = (A[k] + B[k] + C[k]) / 3.0;
+        }
+        nrm[0] = u[1] * w[2] - u[2] * w[1];
+        nrm[1] = u[2] * w[0] - u[0] * w[2];
+        nrm[2] = u[0] * w[1] - u[1] * w[0];
+        const double len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+        if (!(len > 0.0))
+            continue;
+        const double sgn = flip[t] ? -1.0 : 1.0;
+        double front[3], back[3];
+        for (int k = 0; k < 3; k++) {
+            front[k] = c[k] + sgn * off * nrm[k] / len;
+            back[k] = c[k] - sgn * off * nrm[k] / len;
+        }
+        const size_t fi = voxel_at(g, front), bi = voxel_at(g, back);
+        const int fin = fi != SIZE_MAX && majority[fi];
+        const int bin = bi != SIZE_MAX && majority[bi];
+        if (fin != bin)   /* front outside, back inside: agrees */
+            score[region[t]] += bin ? 0.5 * len : -0.5 * len;
+    }
+    for (size_t v = 0; v < s->nverts; v++)
+        if ((rc = st_soup_add_vertex(o, s->xyz[3 * v], s->xyz[3 * v + 1], s->xyz[3 * v + 2],
+                                     err)))
+            goto done;
+    for (size_t t = 0; t < nt; t++) {
+        if (!E.kept[t])
+            continue;
+        if (region[t] == t && score[t] < 0.0)
+            st->turned++;
+        const int back = flip[t] ^ (score[region[t]] < 0.0);
+        const uint32_t *v = s->tris + 3 * t;
+        if ((rc = st_soup_add_triangle(o, v[0], back ? v[2] : v[1], back ? v[1] : v[2], err)))
+            goto done;
+    }
+    if (o->ntris == 0)
+        goto done;
+    if ((rc = st_bvh_build(&bvh, o, err)))
+        goto done;
+
+    /* 3. the local winding number near the soup */
+    const float band = (float)(p->band_voxels * g->voxel);
+    const double r = p->radius_voxels * g->voxel;
+    const double scale = p->weight / (4.0 * M_PI);
+    const double cap = (double)p->max_evidence;
+    size_t count = 0;
+    #pragma omp parallel for schedule(dynamic, 1) reduction(+ : count)
+    for (size_t z = 0; z < g->nz; z++)
+        for (size_t y = 0; y < g->ny; y++)
+            for (size_t x = 0; x < g->nx; x++) {
+                const size_t i = st_grid_index(g, x, y, z);
+                if (!(fabsf(g->data[i]) < band) || (need && !need[i]))
+                    continue;
+                const double q[3] = {g->origin[0] + g->voxel * (double)x,
+                                     g->origin[1] + g->voxel * (double)y,
+                                     g->origin[2] + g->voxel * (double)z};
+                const double lo[3] = {q[0] - r, q[1] - r, q[2] - r};
+                const double hi[3] = {q[0] + r, q[1] + r, q[2] + r};
+                wsum w = {o, q, 0.0};
+                st_bvh_query_box(bvh, lo, hi, add_angle, &w);
+                double e = scale * w.sum;
+                e = e > cap ? cap : e < -cap ? -cap : e;
+                evidence[i] = (int8_t)lround(e);
+                count++;
+            }
+    st->voxels = count;
+done:
+    st_bvh_free(bvh);
+    st_soup_free(o);
+    st_soup_edges_free(&E);
+    free(nbr);
+    free(same);
+    free(flip);
+    free(region);
+    free(queue);
+    free(score);
+    return rc;
+}
