@@ -34,7 +34,7 @@ st_holes_params st_holes_params_default(void)
     /* 0.25: a hole's cap is at most a quarter of the surface around it (on
      * the corpus, holes of 3 rings of faces on models of 3 000 faces and
      * up: under 0.15); an open patch's own loop spans about its area. */
-    st_holes_params p = {0.25, 256};
+    st_holes_params p = {0.25, 256, 0.01};
     return p;
 }
 
@@ -110,6 +110,78 @@ typedef struct around_ctx {
     const double *piece_area;
     double around;
 } around_ctx;
+
+/* A flat hole (any size): the loop lies within flat times its extent of
+ * the plane of its Newell normal, and the triangles along it that lie in
+ * that plane (normals within about 8 degrees of it) are mostly outside the
+ * loop, as around a face that is missing, not inside it, as along the rim
+ * of a flat sheet. A CAD part that lost a face: its cap is the face. */
+static int flat_hole(const st_soup *s, const double *const *pts, size_t n, const uint32_t *be_t,
+                     const uint32_t *loop_e, double flat)
+{
+    if (!(flat > 0.0))
+        return 0;
+    double nn[3] = {0, 0, 0}, c[3] = {0, 0, 0}, lo[3], hi[3];
+    for (int q = 0; q < 3; q++)
+        lo[q] = hi[q] = pts[0][q];
+    for (size_t i = 0; i < n; i++) {
+        const double *a = pts[i], *b = pts[(i + 1) % n];
+        nn[0] += (a[1] - b[1]) * (a[2] + b[2]);
+        nn[1] += (a[2] - b[2]) * (a[0] + b[0]);
+        nn[2] += (a[0] - b[0]) * (a[1] + b[1]);
+        for (int q = 0; q < 3; q++) {
+            c[q] += a[q] / (double)n;
+            lo[q] = fmin(lo[q], a[q]);
+            hi[q] = fmax(hi[q], a[q]);
+        }
+    }
+    const double len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+    double ext = 0.0;
+    for (int q = 0; q < 3; q++)
+        ext = fmax(ext, hi[q] - lo[q]);
+    if (!(len > 0.0) || !(ext > 0.0))
+        return 0;
+    for (int q = 0; q < 3; q++)
+        nn[q] /= len;
+    for (size_t i = 0; i < n; i++) {
+        const double d = (pts[i][0] - c[0]) * nn[0] + (pts[i][1] - c[1]) * nn[1] +
+                         (pts[i][2] - c[2]) * nn[2];
+        if (fabs(d) > flat * ext)
+            return 0;
+    }
+    size_t inner = 0, outer = 0;
+    for (size_t i = 0; i < n; i++) {
+        const double *a = pts[i], *b = pts[(i + 1) % n];
+        const uint32_t *tv = s->tris + 3 * (size_t)be_t[loop_e[i]];
+        const double *P = s->xyz + 3 * (size_t)tv[0], *Q = s->xyz + 3 * (size_t)tv[1],
+                     *R = s->xyz + 3 * (size_t)tv[2];
+        double u[3], w[3], tn[3];
+        for (int q = 0; q < 3; q++) {
+            u[q] = Q[q] - P[q];
+            w[q] = R[q] - P[q];
+        }
+        tn[0] = u[1] * w[2] - u[2] * w[1];
+        tn[1] = u[2] * w[0] - u[0] * w[2];
+        tn[2] = u[0] * w[1] - u[1] * w[0];
+        const double tl = sqrt(tn[0] * tn[0] + tn[1] * tn[1] + tn[2] * tn[2]);
+        if (!(tl > 0.0) || fabs(tn[0] * nn[0] + tn[1] * nn[1] + tn[2] * nn[2]) < 0.99 * tl)
+            continue;
+        /* the triangle's centroid: left of a -> b is inside the loop */
+        double e[3], m[3], x[3];
+        for (int q = 0; q < 3; q++) {
+            e[q] = b[q] - a[q];
+            m[q] = (P[q] + Q[q] + R[q]) / 3.0 - a[q];
+        }
+        x[0] = e[1] * m[2] - e[2] * m[1];
+        x[1] = e[2] * m[0] - e[0] * m[2];
+        x[2] = e[0] * m[1] - e[1] * m[0];
+        if (x[0] * nn[0] + x[1] * nn[1] + x[2] * nn[2] > 0.0)
+            inner++;
+        else
+            outer++;
+    }
+    return inner * 2 <= outer;
+}
 
 static int add_piece(void *vc, uint32_t t)
 {
@@ -537,7 +609,8 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
         around_ctx ac = {kept, piece, stamp, (uint32_t)e0, piece_area, 0.0};
         st_bvh_query_box(bvh, blo, bhi, add_piece, &ac);
         const double around = ac.around;
-        if (!(cap > 0.0) || cap > p->max_cap_ratio * around) {
+        if (!(cap > 0.0) || (cap > p->max_cap_ratio * around &&
+                             !flat_hole(s, pts, n, be_t, loop_e, p->flat))) {
             st0.too_large++;
             continue;
         }

@@ -99,13 +99,35 @@ static void test_which_loops(void)
     st_soup_free(twice);
     st_soup_free(holed);
 
-    /* A bowl (the lower hemisphere) is an open patch: its rim's cap is
-     * half the bowl's area, so it is left open. */
+    /* A bowl (the lower hemisphere, a one-sided scan of a ball): its rim
+     * is flat, so it is capped whatever the cap's size (issue 17: a
+     * one-sided hemisphere closes); without the flat rule its cap is half
+     * the bowl's area, too large. */
     st_soup *bowl = sphere(1e-9);
     ok = !st_soup_hole_caps(&caps, bowl, &p, &hs, &err);
-    TAP_CHECK(ok && hs.loops == 1 && hs.filled == 0 && hs.too_large == 1 && caps->ntris == 0,
-              "a bowl: its rim is not a hole (cap too large beside it)");
+    TAP_CHECK(ok && hs.loops == 1 && hs.filled == 1 && caps->ntris == 30,
+              "a bowl: its flat rim is capped (%zu triangles)", ok ? caps->ntris : 0);
     st_soup_free(caps);
+    st_holes_params nf = p;
+    nf.flat = 0.0;
+    ok = !st_soup_hole_caps(&caps, bowl, &nf, &hs, &err);
+    TAP_CHECK(ok && hs.loops == 1 && hs.filled == 0 && hs.too_large == 1 && caps->ntris == 0,
+              "without the flat rule its cap is too large beside it");
+    st_soup_free(caps);
+    /* A flat sheet's rim is no hole: its cap would lie on the sheet. */
+    st_soup *sheet = st_soup_new();
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            const double a[3] = {i, j, 0}, b[3] = {i + 1, j, 0}, c[3] = {i + 1, j + 1, 0},
+                         d[3] = {i, j + 1, 0};
+            add_tri(sheet, a, b, c, 0);
+            add_tri(sheet, a, c, d, 0);
+        }
+    ok = !st_soup_hole_caps(&caps, sheet, &p, &hs, &err);
+    TAP_CHECK(ok && hs.loops == 1 && hs.filled == 0 && caps->ntris == 0,
+              "a flat sheet's rim is left open");
+    st_soup_free(caps);
+    st_soup_free(sheet);
     st_soup_free(bowl);
 
     /* A box without one face: its loop is capped by two triangles of the

@@ -22,6 +22,9 @@
  * near it, those with a triangle whose bounding box meets the loop's box
  * grown by a quarter of its extent each way (its own pieces among them;
  * where faces were deleted at random, the fragments beside the hole).
+ * A flat loop is capped whatever its size (a CAD part that lost a face:
+ * its cap is the face) unless the triangles along it that lie in its plane
+ * are mostly inside it (the rim of a flat sheet, which is no hole).
  * Where the gaps do not pair every edge exactly once (a vertex on a sharp
  * crease, where one plane does not order the triangles around it), each
  * boundary edge's hole side (in its triangle's plane, away from the
@@ -47,6 +50,9 @@ extern "C" {
 typedef struct st_holes_params {
     double max_cap_ratio;   /* cap area / area of the pieces around it */
     size_t max_loop;        /* loops with more edges are left open */
+    double flat;            /* a loop within flat times its extent of a
+                             * plane, not along a flat sheet's rim, is
+                             * capped whatever its size (0: never) */
 } st_holes_params;
 
 typedef struct st_holes_stats {

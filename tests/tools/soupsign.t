@@ -138,4 +138,38 @@ check "the bunny is one closed shell" sh -c "soupsign -v --surface '$BUNNY' -o b
 check "the holed bunny has none" sh -c "soupsign -v --surface holed.obj -o h3.vdb h.vdb 2>&1 | grep -q 'closed shells: 0 ('"
 expect_fail "bad --shells" 2 "--shells is on or off" soupsign --shells 1 d.vdb
 
+# The pipe carries its surface (issue 17): soupdist records the soup (path,
+# size, content hash) and soupsign uses it as --surface when it is unchanged.
+cp "$BUNNY" pipe.obj
+soupdist -r 40 -o pd.vdb pipe.obj
+cat > same.py <<'PY'
+import sys, vtk
+from vtk.util.numpy_support import vtk_to_numpy
+def signs(f):
+    r = vtk.vtkXMLImageDataReader(); r.SetFileName(f); r.Update()
+    return vtk_to_numpy(r.GetOutput().GetPointData().GetScalars())
+a, b = signs(sys.argv[1]), signs(sys.argv[2])
+same = a.shape == b.shape and (a.view('u4') == b.view('u4')).all()
+assert same == (sys.argv[3] == 'same'), (sys.argv, int((a.view('u4') != b.view('u4')).sum()))
+PY
+check "the field records its soup" sh -c "grep -aq source_hash pd.vdb && grep -aq xxh3-128: pd.vdb"
+check "soupdist | soupsign uses the recorded soup (-v says so)" sh -c \
+    "soupdist -r 40 pipe.obj | soupsign -v -o pipe.vti 2>&1 | grep -q 'surface: .*pipe.obj, as soupdist read it'"
+soupsign --surface pipe.obj -o surf.vti pd.vdb
+soupsign --surface none -o none.vti pd.vdb
+check "the pipe's signs are byte-identical to --surface" $PYVTK same.py pipe.vti surf.vti same
+check "--surface none is the vote alone, and differs" $PYVTK same.py none.vti surf.vti differ
+check "the pipe names its rule with the surface's steps" sh -c \
+    "soupsign -o pr.vdb pd.vdb && grep -aq sign_refine pr.vdb && grep -aq hole_caps pr.vdb"
+echo "# changed" >> pipe.obj
+check "a changed soup: a one-line note, the vote alone" sh -c \
+    "soupsign -o ch.vti pd.vdb 2>&1 | grep -q 'note: .*pipe.obj has changed since soupdist read it' && $PYVTK same.py ch.vti none.vti same"
+check "-q hides the note" sh -c "soupsign -q -o chq.vdb pd.vdb 2>&1 | (! grep -q .)"
+mv pipe.obj moved.obj
+check "a moved soup: a note, the vote alone" sh -c \
+    "soupsign -o mv.vti pd.vdb 2>&1 | grep -q 'note: the field.s soup cannot be read' && $PYVTK same.py mv.vti none.vti same"
+check "--surface FILE still works on such a field" soupsign --surface moved.obj -o mf.vdb pd.vdb
+check "a field from stdin records no soup" sh -c "soupdist -r 24 - < moved.obj | soupsign -v -o st.vdb 2>&1 | (! grep -q 'surface:')"
+check "--rule paper ignores the recorded soup" sh -c "cp moved.obj pipe.obj && soupsign --rule paper -o pp.vdb pd.vdb && ! grep -aq sign_refine pp.vdb"
+
 done_testing

@@ -1,0 +1,252 @@
+/*
+ * test_pseudo.c - the pseudo volume's entry point (pseudo.h) and the
+ * sides of an oriented soup (sides.h): one call gives what the steps give
+ * one by one, and large holes close: a box with a whole face missing (of
+ * any size), a thin plate with half of one face gone, a one-sided
+ * hemisphere shell; an unoriented soup gives what an oriented one gives.
+ */
+#include "souptet/pseudo.h"
+#include "souptet/solid.h"
+#include "shapes.h"
+#include "tap.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* An axis-aligned box's faces as an oriented soup, leaving out the faces
+ * `skip` says (axis, side, the face's center), each face split into n x n
+ * quads so that part of one can go. */
+typedef int (*skip_fn)(int axis, int side, const double c[3]);
+
+static void add_box_faces(st_soup *s, const double lo[3], const double hi[3], int n, skip_fn skip,
+                          int flip_some)
+{
+    for (int axis = 0; axis < 3; axis++)
+        for (int side = 0; side < 2; side++) {
+            const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+            for (int a = 0; a < n; a++)
+                for (int b = 0; b < n; b++) {
+                    double q[4][3], c[3] = {0, 0, 0};
+                    for (int k = 0; k < 4; k++) {
+                        const int ia = a + (k == 1 || k == 2), ib = b + (k >= 2);
+                        q[k][axis] = side ? hi[axis] : lo[axis];
+                        q[k][u] = lo[u] + (hi[u] - lo[u]) * ia / n;
+                        q[k][w] = lo[w] + (hi[w] - lo[w]) * ib / n;
+                        for (int d = 0; d < 3; d++)
+                            c[d] += 0.25 * q[k][d];
+                    }
+                    if (skip && skip(axis, side, c))
+                        continue;
+                    const int f = flip_some && ((a + b) & 1);
+                    add_tri(s, q[0], q[1], q[2], !side ^ f);
+                    add_tri(s, q[0], q[2], q[3], !side ^ f);
+                }
+        }
+}
+
+/* IoU of the pseudo volume of `s` (a field of `cells` voxels along the
+ * longest side) with the solid of the closed `truth`. */
+static double iou_of(const st_soup *s, const st_soup *truth, size_t cells,
+                     const st_pseudo_params *pp)
+{
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = cells;
+    st_grid *g = NULL;
+    st_error err;
+    double iou = -1, prec, rec;
+    if (st_pseudo_volume(&g, s, &dp, pp, NULL, NULL, &err))
+        return -1;
+    uint8_t *in = malloc(st_grid_count(g));
+    const st_soup *shells[1] = {truth};
+    if (in && !st_solid_inside(in, g, shells, 1, ST_SOLID_NONZERO, &err))
+        st_solid_iou(&iou, &prec, &rec, in, g, &err);
+    free(in);
+    st_grid_free(g);
+    return iou;
+}
+
+static int top_face(int axis, int side, const double c[3])
+{
+    (void)c;
+    return axis == 2 && side == 1;
+}
+static int big_side_face(int axis, int side, const double c[3])
+{
+    (void)c;
+    return axis == 1 && side == 0;
+}
+static int half_top(int axis, int side, const double c[3])
+{
+    return axis == 2 && side == 1 && c[0] < 1.0;
+}
+
+static void test_entry_point(void)
+{
+    /* st_pseudo_volume is the field and then st_pseudo_sign: the same bytes */
+    st_soup *s = st_soup_new();
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 0.7, 0.5};
+    add_box_faces(s, lo, hi, 3, top_face, 1);
+    st_pseudo_params pp = st_pseudo_params_default();
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = 40;
+    st_grid *a = NULL, *b = NULL;
+    st_error err;
+    st_pseudo_stats st;
+    int ok = !st_pseudo_volume(&a, s, &dp, &pp, &st, NULL, &err) &&
+             !st_dist_field(&b, s, &dp, NULL, &err) &&
+             !st_pseudo_sign(b, s, &pp, NULL, NULL, &err);
+    TAP_CHECK(ok, "st_pseudo_volume and st_dist_field + st_pseudo_sign both run");
+    TAP_CHECK(ok && st_grid_count(a) == st_grid_count(b) &&
+              memcmp(a->data, b->data, st_grid_count(a) * sizeof(float)) == 0,
+              "they give identical signs and distances");
+    TAP_CHECK(ok && st.holes.filled == 1 && st.sides.regions >= 1 && st.inside > 0,
+              "the stats say what ran (%zu loops capped, %zu regions, %zu inside)",
+              st.holes.filled, st.sides.regions, st.inside);
+    TAP_CHECK(ok && st_meta_get(&a->meta, "hole_caps") && st_meta_get(&a->meta, "sign_rule") &&
+              st_meta_get(&a->meta, "closed_shells"), "and record it in the metadata");
+    st_grid_free(a);
+    st_grid_free(b);
+    /* without the soup: the vote alone, nothing else */
+    b = NULL;
+    ok = !st_dist_field(&b, s, &dp, NULL, &err) && !st_pseudo_sign(b, NULL, &pp, &st, NULL, &err);
+    TAP_CHECK(ok && !st.surface && st.holes.loops == 0 && !st_meta_get(&b->meta, "hole_caps"),
+              "no soup: the vote alone");
+    st_grid_free(b);
+    st_soup_free(s);
+}
+
+static void test_large_holes(void)
+{
+    const st_pseudo_params pp = st_pseudo_params_default();
+    /* a box without one whole face, of three sizes and shapes */
+    const double his[3][3] = {{1, 1, 1}, {4, 1, 1}, {3, 2, 0.3}};
+    for (int k = 0; k < 3; k++) {
+        const double lo[3] = {0, 0, 0};
+        st_soup *s = st_soup_new(), *t = st_soup_new();
+        add_box_faces(s, lo, his[k], 2, k == 2 ? top_face : big_side_face, 0);
+        add_box_oriented(t, lo, his[k]);
+        const double iou = iou_of(s, t, 64, &pp);
+        TAP_CHECK(iou >= 0.999, "a %gx%gx%g box without its %s face signs as the full box "
+                  "(IoU %.4f)", his[k][0], his[k][1], his[k][2], k == 2 ? "largest" : "y = 0",
+                  iou);
+        st_soup_free(s);
+        st_soup_free(t);
+    }
+    /* a thin plate with half of its top face gone, faces turned at random */
+    {
+        const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 0.1};
+        st_soup *s = st_soup_new(), *t = st_soup_new();
+        add_box_faces(s, lo, hi, 8, half_top, 1);
+        add_box_oriented(t, lo, hi);
+        const double iou = iou_of(s, t, 96, &pp);
+        TAP_CHECK(iou >= 0.99, "a thin plate with half of one face missing (IoU %.4f)", iou);
+        st_soup_free(s);
+        st_soup_free(t);
+    }
+}
+
+static void test_hemisphere(void)
+{
+    /* the lower half of a UV sphere, open at its equator: closes there */
+    st_soup *s = st_soup_new(), *t = st_soup_new();
+    add_sphere(s, 1.0, 1e-9);
+    add_sphere(t, 1.0, 1e-9);
+    /* the truth: the same shell and the disc across its rim (its faces
+     * turned at random, so compared by parity) */
+    const int nu = 32;
+    for (int j = 0; j < nu; j++) {
+        const double p0 = 2 * M_PI * j / nu, p1 = 2 * M_PI * (j + 1) / nu;
+        const double a[3] = {cos(p0), sin(p0), cos(M_PI / 2)};
+        const double b[3] = {cos(p1), sin(p1), cos(M_PI / 2)};
+        const double c[3] = {0, 0, cos(M_PI / 2)};
+        add_tri(t, a, b, c, 0);
+    }
+    const st_pseudo_params pp = st_pseudo_params_default();
+    /* t is closed but not consistently oriented: compare by parity */
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = 64;
+    st_grid *g = NULL;
+    st_error err;
+    double iou = -1, prec = 0, rec = 0;
+    if (!st_pseudo_volume(&g, s, &dp, &pp, NULL, NULL, &err)) {
+        uint8_t *in = malloc(st_grid_count(g));
+        const st_soup *shells[1] = {t};
+        if (in && !st_solid_inside(in, g, shells, 1, ST_SOLID_PARITY, &err))
+            st_solid_iou(&iou, &prec, &rec, in, g, &err);
+        free(in);
+        st_grid_free(g);
+    }
+    TAP_CHECK(iou >= 0.98, "a one-sided hemisphere shell closes across its rim (IoU %.4f, "
+              "recall %.4f)", iou, rec);
+    st_soup_free(s);
+    st_soup_free(t);
+}
+
+static void test_sides_orientation(void)
+{
+    /* The sides' evidence does not read the file's orientation: a box
+     * without its top, faces turned at random or all the right way, gives
+     * the same evidence; and it is positive inside, negative outside. */
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    st_soup *a = st_soup_new(), *b = st_soup_new();
+    add_box_faces(a, lo, hi, 4, top_face, 0);
+    add_box_faces(b, lo, hi, 4, top_face, 1);
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = 32;
+    st_grid *g = NULL;
+    st_error err;
+    int ok = !st_dist_field(&g, a, &dp, NULL, &err);
+    const size_t n = ok ? st_grid_count(g) : 1;
+    uint8_t *maj = malloc(n);
+    int8_t *ea = malloc(n), *eb = malloc(n);
+    const st_sides_params sp = st_sides_params_default();
+    const st_sign_params sgp = st_sign_params_default();
+    st_sides_stats sa, sb;
+    ok = ok && maj && ea && eb && !st_sign_majority(g, &sgp, maj, &err) &&
+         !st_sides_evidence(ea, g, maj, NULL, a, &sp, &sa, &err) &&
+         !st_sides_evidence(eb, g, maj, NULL, b, &sp, &sb, &err);
+    TAP_CHECK(ok && memcmp(ea, eb, n) == 0, "the same evidence for faces turned at random");
+    TAP_CHECK(ok && sa.regions == 1 && sb.regions == 1,
+              "one orientable region each (%zu, %zu)", ok ? sa.regions : 0, ok ? sb.regions : 0);
+    if (ok) {
+        /* a voxel a voxel and a half inside the bottom wall, one outside it */
+        const double vx = g->voxel;
+        size_t in_i = 0, out_i = 0;
+        double best_in = 1e9, best_out = 1e9;
+        for (size_t k = 0; k < g->nz; k++)
+            for (size_t j = 0; j < g->ny; j++)
+                for (size_t i = 0; i < g->nx; i++) {
+                    const double x = g->origin[0] + vx * i, y = g->origin[1] + vx * j,
+                                 z = g->origin[2] + vx * k;
+                    const double dx = fabs(x - 0.5) + fabs(y - 0.5);
+                    const double din = dx + fabs(z - 1.5 * vx), dout = dx + fabs(z + 1.5 * vx);
+                    if (din < best_in) {
+                        best_in = din;
+                        in_i = st_grid_index(g, i, j, k);
+                    }
+                    if (dout < best_out) {
+                        best_out = dout;
+                        out_i = st_grid_index(g, i, j, k);
+                    }
+                }
+        TAP_CHECK(ea[in_i] > 0 && ea[out_i] < 0, "inside the floor positive (%d), under it "
+                  "negative (%d)", ea[in_i], ea[out_i]);
+    } else
+        TAP_CHECK(0, "inside the floor positive, under it negative");
+    free(maj);
+    free(ea);
+    free(eb);
+    st_grid_free(g);
+    st_soup_free(a);
+    st_soup_free(b);
+}
+
+int main(void)
+{
+    test_entry_point();
+    test_large_holes();
+    test_hemisphere();
+    test_sides_orientation();
+    return tap_done();
+}
