@@ -5,6 +5,7 @@
 #include "souptet/pseudo.h"
 
 #include "souptet/mem.h"
+#include "souptet/mincut.h"
 #include "souptet/shells.h"
 
 #include <math.h>
@@ -78,15 +79,17 @@ static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_pseudo_p
                                  st_error *err)
 {
     const size_t n = st_grid_count(g);
-    uint8_t *majority = st_malloc_array(n ? n : 1, 1);
+    uint8_t *votes = st_malloc_array(n ? n : 1, 1);
     int8_t *evidence = st_malloc_array(n ? n : 1, 1);
-    st_status rc = majority && evidence ? ST_OK
+    st_status rc = votes && evidence ? ST_OK
                  : st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the sides");
     const st_sides_params sp = p->sides_params;
-    rc = rc ? rc : st_sign_majority(g, &p->sign, majority, err);
-    rc = rc ? rc : st_sides_evidence(evidence, g, majority, NULL, s, &sp, &st->sides, err);
-    free(majority);
-    rc = rc ? rc : st_sign_field_evidence(g, &p->sign, evidence, progress, err);
+    /* voxels the cut takes as the votes say get no evidence (mincut.h) */
+    const int decided = st_mincut_params_default().fixed_evidence;
+    rc = rc ? rc : st_sign_votes(g, &p->sign, votes, err);
+    rc = rc ? rc : st_sides_evidence(evidence, g, votes, decided, s, &sp, &st->sides, err);
+    rc = rc ? rc : st_sign_field_evidence(g, &p->sign, evidence, votes, progress, err);
+    free(votes);
     free(evidence);
     return rc;
 }

@@ -6,6 +6,7 @@
 #include "souptet/bvh.h"
 #include "souptet/edges.h"
 #include "souptet/mem.h"
+#include "souptet/sign.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -77,8 +78,8 @@ static int add_angle(void *ctx, uint32_t t)
     return 0;
 }
 
-st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *majority,
-                            const uint8_t *need, const st_soup *s,
+st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
+                            int decided, const st_soup *s,
                             const st_sides_params *p, st_sides_stats *stats,
                             st_error *err)
 {
@@ -161,8 +162,8 @@ st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *m
             back[k] = c[k] - sgn * off * nrm[k] / len;
         }
         const size_t fi = voxel_at(g, front), bi = voxel_at(g, back);
-        const int fin = fi != SIZE_MAX && majority[fi];
-        const int bin = bi != SIZE_MAX && majority[bi];
+        const int fin = fi != SIZE_MAX && (votes[fi] & ST_SIGN_VOTES_INSIDE);
+        const int bin = bi != SIZE_MAX && (votes[bi] & ST_SIGN_VOTES_INSIDE);
         if (fin != bin)   /* front outside, back inside: agrees */
             score[region[t]] += bin ? 0.5 * len : -0.5 * len;
     }
@@ -196,7 +197,8 @@ st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *m
         for (size_t y = 0; y < g->ny; y++)
             for (size_t x = 0; x < g->nx; x++) {
                 const size_t i = st_grid_index(g, x, y, z);
-                if (!(fabsf(g->data[i]) < band) || (need && !need[i]))
+                const int margin = (int)(votes[i] & ST_SIGN_VOTES_COUNT) - 13;
+                if (!(fabsf(g->data[i]) < band) || (decided > 0 && abs(margin) >= decided))
                     continue;
                 const double q[3] = {g->origin[0] + g->voxel * (double)x,
                                      g->origin[1] + g->voxel * (double)y,

@@ -913,19 +913,20 @@ static st_status vote_all(const st_grid *g, const st_sign_params *p, uint8_t *v,
     return ST_OK;
 }
 
-st_status st_sign_majority(const st_grid *g, const st_sign_params *p, uint8_t *inside,
-                           st_error *err)
+st_status st_sign_votes(const st_grid *g, const st_sign_params *p, uint8_t *votes,
+                        st_error *err)
 {
     const size_t n = st_grid_count(g);
-    memset(inside, 0, n);
-    st_status st = vote_all(g, p, inside, NULL, err);
+    memset(votes, 0, n);
+    st_status st = vote_all(g, p, votes, NULL, err);
     if (st)
         return st;
     #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
-        const unsigned b = inside[i];
-        inside[i] = (uint8_t)(vote_inside(b & V_COUNT) ||
-                              (p->nested_union && !(b & V_VISIBLE)));
+        const unsigned b = votes[i];
+        votes[i] = (uint8_t)((b & (V_COUNT | V_VISIBLE)) |
+                             (vote_inside(b & V_COUNT) || (p->nested_union && !(b & V_VISIBLE))
+                                  ? ST_SIGN_VOTES_INSIDE : 0u));
     }
     return ST_OK;
 }
@@ -933,21 +934,28 @@ st_status st_sign_majority(const st_grid *g, const st_sign_params *p, uint8_t *i
 st_status st_sign_field(st_grid *g, const st_sign_params *p,
                         const st_progress *progress, st_error *err)
 {
-    return st_sign_field_evidence(g, p, NULL, progress, err);
+    return st_sign_field_evidence(g, p, NULL, NULL, progress, err);
 }
 
 st_status st_sign_field_evidence(st_grid *g, const st_sign_params *p, const int8_t *extra,
-                                 const st_progress *progress, st_error *err)
+                                 uint8_t *votes, const st_progress *progress, st_error *err)
 {
     const size_t n = st_grid_count(g);
-    uint8_t *v = st_calloc_big(n ? n : 1);
-    if (!v)
-        return st_error_set(err, ST_ENOMEM, NULL, 0,
-                            "out of memory for the votes");
-    st_status st = vote_all(g, p, v, progress, err);
-    if (st) {
-        free(v);
-        return st;
+    uint8_t *v = votes;
+    if (v) {
+        /* st_sign_votes' bytes: the count and the seen bit are ours */
+        #pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++)
+            v[i] &= (uint8_t)(V_COUNT | V_VISIBLE);
+    } else {
+        v = st_calloc_big(n ? n : 1);
+        if (!v)
+            return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the votes");
+        st_status st = vote_all(g, p, v, progress, err);
+        if (st) {
+            free(v);
+            return st;
+        }
     }
     const double t = st_sign_event_distance(p, g);
     /* With the cut, the votes are its evidence (cut_undecided). Without:
@@ -958,7 +966,8 @@ st_status st_sign_field_evidence(st_grid *g, const st_sign_params *p, const int8
     if (p->cut) {
         st_status cs = cut_undecided(g, v, p->nested_union, extra, err);
         if (cs) {
-            free(v);
+            if (!votes)
+                free(v);
             return cs;
         }
     } else {
@@ -967,7 +976,8 @@ st_status st_sign_field_evidence(st_grid *g, const st_sign_params *p, const int8
             write_signs(out + b0, v + b0, n - b0 < SIGN_BLOCK ? n - b0 : SIGN_BLOCK,
                         p->nested_union);
     }
-    free(v);
+    if (!votes)
+        free(v);
     g->kind = ST_GRID_SIGNED;
     char buf[160];
     snprintf(buf, sizeof buf,

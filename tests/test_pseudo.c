@@ -203,9 +203,9 @@ static void test_sides_orientation(void)
     const st_sides_params sp = st_sides_params_default();
     const st_sign_params sgp = st_sign_params_default();
     st_sides_stats sa, sb;
-    ok = ok && maj && ea && eb && !st_sign_majority(g, &sgp, maj, &err) &&
-         !st_sides_evidence(ea, g, maj, NULL, a, &sp, &sa, &err) &&
-         !st_sides_evidence(eb, g, maj, NULL, b, &sp, &sb, &err);
+    ok = ok && maj && ea && eb && !st_sign_votes(g, &sgp, maj, &err) &&
+         !st_sides_evidence(ea, g, maj, 0, a, &sp, &sa, &err) &&
+         !st_sides_evidence(eb, g, maj, 0, b, &sp, &sb, &err);
     TAP_CHECK(ok && memcmp(ea, eb, n) == 0, "the same evidence for faces turned at random");
     TAP_CHECK(ok && sa.regions == 1 && sb.regions == 1,
               "one orientable region each (%zu, %zu)", ok ? sa.regions : 0, ok ? sb.regions : 0);

@@ -11,10 +11,11 @@
  *      exactly two triangles (breadth-first, as shells.h does; a conflict
  *      is left where it is found), giving orientable regions;
  *   2. each region is turned, as a whole, to the way the votes read it
- *      (the majority of the votes, st_sign_majority): for each triangle,
+ *      (the majority of the votes, st_sign_votes): for each triangle,
  *      the voxels a voxel and a half in front of and behind its centroid,
  *      weighted by area, where they disagree; a tie keeps it;
- *   3. every voxel within band_voxels of the soup (and where `need` is set)
+ *   3. every voxel within band_voxels of the soup whose votes leave it to
+ *      the cut
  *      gets the local generalized winding number of the oriented soup
  *      (Jacobson et al. 2013): the signed solid angles (Van Oosterom and
  *      Strackee 1983) of the triangles in the cube of radius_voxels
@@ -61,11 +62,12 @@ typedef struct st_sides_stats {
 } st_sides_stats;
 
 /* evidence (n bytes) gets each voxel's evidence (0 where none). g: the
- * soup's unsigned distance field; majority: the votes' inside flags for
- * it (st_sign_majority); need: NULL, or 1 where evidence is wanted.
- * stats may be NULL. ST_ENOMEM, ST_ELIMIT. */
-st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *majority,
-                            const uint8_t *need, const st_soup *s,
+ * soup's unsigned distance field; votes: its votes (st_sign_votes);
+ * decided > 0: voxels whose votes' margin is at least that (the cut takes
+ * them as they are, mincut.h) get none. stats may be NULL. ST_ENOMEM,
+ * ST_ELIMIT. */
+st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
+                            int decided, const st_soup *s,
                             const st_sides_params *p, st_sides_stats *stats,
                             st_error *err);
 

@@ -115,16 +115,20 @@ st_status st_sign_field(st_grid *g, const st_sign_params *p,
 /* st_sign_field with more evidence for the cut (p->cut only): extra[i]
  * (NULL: none) is added to voxel i's evidence from the votes (a margin of
  * U - 13 votes; see mincut.h for its weight), for what the votes cannot
- * see: the side of an oriented surface (sides.h). */
+ * see: the side of an oriented surface (sides.h). votes: NULL, or what
+ * st_sign_votes gave for this g and p (not voted again; overwritten). */
 st_status st_sign_field_evidence(st_grid *g, const st_sign_params *p, const int8_t *extra,
-                                 const st_progress *progress, st_error *err);
+                                 uint8_t *votes, const st_progress *progress, st_error *err);
 
-/* The majority of the votes alone, without touching g: inside[i] (n
- * bytes) gets 1 where voxel i's votes say inside (ties outside; hidden
- * voxels inside under nested_union), else 0. Same checks as
- * st_sign_field. */
-st_status st_sign_majority(const st_grid *g, const st_sign_params *p, uint8_t *inside,
-                           st_error *err);
+/* The votes alone, without touching g: votes[i] (n bytes) gets voxel i's
+ * inside votes U (0..26, 13 neutral; ST_SIGN_VOTES_COUNT) and
+ * ST_SIGN_VOTES_INSIDE where the majority says inside (ties outside;
+ * hidden voxels inside under nested_union). Same checks as st_sign_field. */
+#define ST_SIGN_VOTES_COUNT 0x1fu
+#define ST_SIGN_VOTES_SEEN 0x20u     /* some ray sees the voxel from outside */
+#define ST_SIGN_VOTES_INSIDE 0x80u
+st_status st_sign_votes(const st_grid *g, const st_sign_params *p, uint8_t *votes,
+                        st_error *err);
 
 /* The rule on one line of samples (for tests and for reading the rule):
  * d[0..n) are the distances along the line, t the event distance; adds the
