@@ -10,7 +10,8 @@ TAP lines without a plan (sim.t numbers them); exits 0.
   linear     sim.stiffness against a hand-made one-tet matrix; CG+Jacobi
              reaches the direct solution; eigsh's extreme eigenvalues agree
              with a dense solver's
-  sfepy      (with --sfepy) the Neo-Hookean sag converges, keeps the base
+  sfepy      (with --sfepy) SfePy reads the cage file as meshio does; the
+             Neo-Hookean sag converges, keeps the base
              fixed, goes down; under a small load it matches linear
              elasticity (sim.stiffness) to 1%
 """
@@ -95,6 +96,13 @@ def main():
 
     if not with_sfepy:
         return 0
+    from sfepy.base.base import output
+    from sfepy.discrete.fem import Mesh
+    output.set_output(quiet=True)
+    m = Mesh.from_file(cage)
+    ok(np.array_equal(m.coors, points) and np.array_equal(m.get_conn("3_4"), tets),
+       "SfePy reads the Medit cage as meshio does: the same points and tets, in order"
+       " (so the embedding's tet numbers hold there)")
     height = np.ptp(points[:, 1])
     base = sim.base_nodes(points)
     load = 0.015
