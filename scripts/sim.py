@@ -88,13 +88,16 @@ def carry(points, tets, tet_of, bary):
     return np.einsum("ni,nij->nj", bary, corners)
 
 
-def locate(points, tets, xyz, k=24):
+def locate(points, tets, xyz, k=24, slack=1e-12):
     """Barycentric embedding of xyz in a tet mesh that was not made with
-    --embed (the bench's peers): for each point the tet, among the k whose
-    centroids are nearest, whose smallest coordinate is largest (>= 0 for a
-    tet that contains it; a point a rounding error outside keeps its
-    nearest tet with a coordinate slightly below 0). Floating point, for
-    measuring only: souptet's own embedding (embed.h) is exact."""
+    --embed (the bench's peers): for each point the tet whose smallest
+    coordinate is largest (>= 0 for a tet that contains it; a point a
+    rounding error outside keeps its nearest tet with a coordinate slightly
+    below 0), first among the k tets whose centroids are nearest, then,
+    for the points none of those contains (a long sliver's centroid can be
+    far from the points inside it), among all tets. Floating point, for
+    measuring only: souptet's own embedding (embed.h) is exact. Returns
+    (tet, coordinates, smallest coordinate) per point."""
     from scipy.spatial import cKDTree
     cent = points[tets].mean(axis=1)
     k = min(k, len(tets))
@@ -109,6 +112,22 @@ def locate(points, tets, xyz, k=24):
         mn = b.min(axis=1)
         better = mn > best_min
         best_t[better], best_b[better], best_min[better] = t[better], b[better], mn[better]
+    lost = np.nonzero(best_min < -slack)[0]
+    if len(lost):
+        p = points[tets]
+        a = p[:, 0]
+        inv = np.linalg.inv(np.stack([p[:, 1] - a, p[:, 2] - a, p[:, 3] - a], axis=2))
+        for c in range(0, len(lost), 16):
+            idx = lost[c:c + 16]
+            l123 = np.einsum("mij,nmj->nmi", inv, xyz[idx][:, None, :] - a[None])
+            b = np.concatenate([1 - l123.sum(axis=2, keepdims=True), l123], axis=2)
+            mn = b.min(axis=2)
+            j = mn.argmax(axis=1)
+            r = np.arange(len(idx))
+            better = mn[r, j] > best_min[idx]
+            best_t[idx[better]] = j[better]
+            best_b[idx[better]] = b[r, j][better]
+            best_min[idx[better]] = mn[r, j][better]
     return best_t, best_b, best_min
 
 

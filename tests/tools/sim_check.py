@@ -7,6 +7,7 @@ TAP lines without a plan (sim.t numbers them); exits 0.
              and the rest cage carries the surface onto itself (rounding)
   rigid      a rotated and shifted cage carries the surface to the rotated
              and shifted surface, to rounding (<= 1e-14 of its size)
+  locate     the bench's floating-point point location finds every point
   linear     sim.stiffness against a hand-made one-tet matrix; CG+Jacobi
              reaches the direct solution; eigsh's extreme eigenvalues agree
              with a dense solver's
@@ -60,6 +61,18 @@ def main():
     emax, _ = sim.smooth_error(points, tets, tet_of, bary, surf)
     ok(1e-8 < emax < 0.05, "a smooth bend and twist is interpolated with an error above rounding"
        " and below 5%% of the size (%.1e)" % emax)
+
+    # locate (the bench's embedding of peers' meshes) with too few
+    # candidates (k = 2) must still find every point's tet by its fallback.
+    from scipy.spatial import Delaunay
+    rng = np.random.default_rng(20)
+    dp = rng.random((300, 3))
+    dt = Delaunay(dp).simplices.astype(np.int64)
+    q = 0.2 + 0.6 * rng.random((500, 3))
+    lt, lb, lmin = sim.locate(dp, dt, q, k=2)
+    back = np.abs(sim.carry(dp, dt, lt, lb) - q).max()
+    ok(lmin.min() >= 0 and back < 1e-14, "locate finds a containing tet for every point"
+       " (smallest coordinate %.1e, back %.1e)" % (lmin.min(), back))
 
     # One tet, by hand: the unit corner tet under a uniaxial strain
     # eps_xx = 0.01 has stress diag(lam + 2 mu, lam, lam) 0.01, and corner a
