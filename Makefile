@@ -3,6 +3,7 @@
 #   make                  library and tools into build/ (build/bin/<tool>)
 #   make check            install missing Debian packages, build, run all tests
 #   make demo             the main job on the bundled model
+#   make demo-sim         the bundled model's cage in a FEM solve (SfePy)
 #   make bench            measurements against peers (bench/results/)
 #   make install PREFIX=/usr/local DESTDIR=
 #   make fuzz [FUZZ_SECONDS=60] [FUZZ_RUNS=N]  libFuzzer on every reader (build-fuzz/)
@@ -63,7 +64,7 @@ LIBA    := $(BUILD)/libsouptet.a
 TOOL_BIN := $(TOOLS:%=$(BUILD)/bin/%)
 TEST_BIN := $(TESTS_C:%=$(BUILD)/tests/%)
 
-.PHONY: all check test demo bench setup install uninstall clean fuzz
+.PHONY: all check test demo demo-sim bench setup install uninstall clean fuzz
 all: $(LIBA) $(TOOL_BIN) $(TEST_BIN)
 
 $(BUILD)/obj/%.o: src/%.c
@@ -145,6 +146,10 @@ test: check
 demo: setup
 	$(MAKE) --no-print-directory all
 	scripts/demo $(BUILD)/bin
+
+demo-sim: setup
+	$(MAKE) --no-print-directory all
+	scripts/simulate $(BUILD)/bin demo
 
 bench: setup
 	@scripts/setup --bench
