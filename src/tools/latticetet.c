@@ -53,7 +53,9 @@ static void usage(void)
 "  -h, --size SIZE      cell width in model units (instead of --cells)\n"
 "      --seed S         random rotation and offset of the lattice (default 0:\n"
 "                       axis-aligned at the box's corner)\n"
-"      --no-repair      sculpt without bomb and manifold repair\n"
+"      --no-repair      sculpt without bomb and manifold repair; with\n"
+"                       --density, the paper's rule alone: no cleanup of\n"
+"                       hanging tets, islands and pinched boundaries\n"
 "  -o, --output OUT     .vtu file (or .msh, .node/.ele, .mesh by extension,\n"
 "                       without the arrays); '-' or none: .vtu on stdout\n"
 "      --threads T      threads to use (default: all cores)\n"
@@ -234,7 +236,10 @@ int main(int argc, char *argv[])
             goto done;
         }
         double t2 = tool_now();
-        if (st_lattice_density_filter(&m, &ds, L, g, rho, &err)) {
+        st_density_clean_stats cs;
+        memset(&cs, 0, sizeof cs);
+        if (st_lattice_density_filter_clean(&m, &ds, &cs, L, g, rho, repair,
+                                            &err)) {
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", in_name);
             rc = tool_fail(&t, &err);
@@ -250,6 +255,30 @@ int main(int argc, char *argv[])
                  ds.kept, ds.lattice_tets, rho, ds.centroid_rule, ds.point_tests);
         tool_say(&t, 2, "read %.3f s, lattice %.3f s, density %.3f s",
                  t1 - t0, t2 - t1, t3 - t2);
+        if (repair) {
+            tool_say(&t, 2, "cleanup: %zu pieces of pseudo volume, %zu of "
+                     "tets; %zu tets filled and %zu dropped at pinched "
+                     "vertices; %zu pieces joined (%zu tets), %zu islands "
+                     "dropped (%zu tets)", cs.pieces, cs.tet_pieces,
+                     cs.filled, cs.dropped, cs.joins, cs.join_tets,
+                     cs.islands, cs.island_tets);
+            if (cs.bad_vertices_left)
+                tool_say(&t, 1, "warning: the boundary is not manifold at "
+                         "%zu vertices", cs.bad_vertices_left);
+            for (size_t q = 0; q < cs.nthin && q < ST_CLEAN_MAX_THIN; q++) {
+                const st_thin_part *p = &cs.thin[q];
+                tool_say(&t, 1, "%s: warning: a part of the pseudo volume is "
+                         "too thin for this lattice (h %.4g): %zu voxels in "
+                         "(%.4g %.4g %.4g)-(%.4g %.4g %.4g), %.4g thick, "
+                         "%.0f%% of it meshed; --cells %zu would hold it",
+                         in_name, h, p->voxels, p->lo[0], p->lo[1], p->lo[2],
+                         p->hi[0], p->hi[1], p->hi[2], p->thickness,
+                         100.0 * p->held, p->cells);
+            }
+            if (cs.nthin > ST_CLEAN_MAX_THIN)
+                tool_say(&t, 1, "%s: warning: %zu more parts too thin",
+                         in_name, cs.nthin - ST_CLEAN_MAX_THIN);
+        }
     } else {
         st_sculpt_params sp = st_sculpt_params_default();
         sp.kind = kind;
