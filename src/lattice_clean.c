@@ -55,7 +55,10 @@ typedef struct cleaner {
     uint32_t *tlabel;         /* voxel piece of each tet, 0: none */
     uint32_t *vlabel;         /* voxel piece of each voxel, 0: outside */
     size_t npieces;
-    size_t *par;              /* scratch: star-sized union-find */
+    size_t *par;              /* scratch: 2 star-sized union-finds */
+    unsigned char *scratch_keep;  /* 2 stars of keep flags */
+    size_t *groot;            /* a star's groups and their costs */
+    double *gcost;
     st_density_clean_stats *st;
 } cleaner;
 
@@ -198,69 +201,123 @@ static int vertex_bad(const cleaner *c, uint32_t v)
     return star_groups(c, v, 1) > 1 || star_groups(c, v, 0) > 1;
 }
 
-/* Mend v the cheaper way; returns 1 when it changed something. */
+/* The groups of v's star with keep == want (after star_groups): their
+ * roots (positions in the star) into root[] and rho-weighted costs into
+ * cost[] (kept: rho vol, what dropping costs; unkept: (1 - rho) vol, what
+ * filling costs), sorted by ascending cost (ties: star order). */
+static size_t group_costs(const cleaner *c, uint32_t v, int want,
+                          size_t *root, double *cost)
+{
+    const st_lattice *L = c->L;
+    size_t a0 = L->star_off[v], k = L->star_off[v + 1] - a0;
+    const uint32_t *S = L->star + a0;
+    star_groups(c, v, want);
+    size_t n = 0;
+    for (size_t q = 0; q < k; q++) {
+        if ((c->keep[S[q]] != 0) != want || uf_find(c->par, q) != q)
+            continue;
+        double w = 0;
+        for (size_t r = 0; r < k; r++)
+            if ((c->keep[S[r]] != 0) == want && uf_find(c->par, r) == q)
+                w += (want ? c->rho[S[r]] : 1.0 - c->rho[S[r]]) * c->vol[S[r]];
+        size_t i = n++;
+        while (i > 0 && cost[i - 1] > w) {
+            cost[i] = cost[i - 1];
+            root[i] = root[i - 1];
+            i--;
+        }
+        cost[i] = w;
+        root[i] = q;
+    }
+    return n;
+}
+
+/* Mend v the cheaper way; returns 1 when it changed something. Fill adds
+ * the unkept groups of the star cheapest first, drop removes the kept
+ * groups cheapest first, each until v is manifold (at most all groups but
+ * the costliest); both are tried and the cheaper is kept. */
 static int mend_vertex(cleaner *c, uint32_t v)
 {
     const st_lattice *L = c->L;
     size_t a0 = L->star_off[v], k = L->star_off[v + 1] - a0;
     const uint32_t *S = L->star + a0;
+    unsigned char *save = c->scratch_keep;
+    for (size_t q = 0; q < k; q++)
+        save[q] = c->keep[S[q]];
     /* Fill: allowed with a complete star and one voxel piece among the
      * kept tets. */
     int can_fill = star_complete(L, v);
     uint32_t lab = 0;
-    double fill_cost = 0;
     for (size_t q = 0; q < k; q++) {
         size_t t = S[q];
-        if (c->keep[t]) {
-            if (c->tlabel[t] && lab && c->tlabel[t] != lab)
+        if (c->keep[t] && c->tlabel[t]) {
+            if (lab && c->tlabel[t] != lab)
                 can_fill = 0;
-            if (c->tlabel[t])
-                lab = c->tlabel[t];
-        } else
-            fill_cost += (1.0 - c->rho[t]) * c->vol[t];
-    }
-    /* Drop: every kept group but the heaviest. */
-    star_groups(c, v, 1);
-    double best = -1, drop_cost = 0;
-    size_t best_root = k;
-    int can_drop = 1;
-    for (size_t q = 0; q < k; q++) {
-        if (!c->keep[S[q]] || uf_find(c->par, q) != q)
-            continue;
-        double w = 0;
-        for (size_t r = 0; r < k; r++)
-            if (c->keep[S[r]] && uf_find(c->par, r) == q)
-                w += c->rho[S[r]] * c->vol[S[r]];
-        drop_cost += w;
-        if (w > best) {
-            best = w;
-            best_root = q;
+            lab = c->tlabel[t];
         }
     }
-    drop_cost -= best;
-    size_t ngroups = 0;
-    for (size_t q = 0; q < k; q++)
-        if (c->keep[S[q]] && uf_find(c->par, q) == q)
-            ngroups++;
-    if (ngroups < 2)
-        can_drop = 0;   /* one kept group, pinched holes: only a fill helps */
-    for (size_t q = 0; q < k && can_drop; q++)
-        if (c->keep[S[q]] && uf_find(c->par, q) != best_root && c->fixed[S[q]])
-            can_drop = 0;
-    if (can_fill && (!can_drop || fill_cost <= drop_cost)) {
+    double fill_cost = INFINITY, drop_cost = INFINITY;
+    size_t *root = c->groot;
+    double *cost = c->gcost;
+    unsigned char *fill_keep = c->scratch_keep + k;
+    if (can_fill) {
+        size_t n = group_costs(c, v, 0, root, cost);
+        /* keep a copy of the group ids: star_groups is rerun below */
+        size_t *gid = c->par + k;
         for (size_t q = 0; q < k; q++)
-            if (!c->keep[S[q]]) {
-                c->keep[S[q]] = 1;
-                c->st->filled++;
-            }
+            gid[q] = uf_find(c->par, q);
+        double sum = 0;
+        for (size_t i = 0; i + 1 < n || (i < n && n == 1); i++) {
+            for (size_t q = 0; q < k; q++)
+                if (!save[q] && gid[q] == root[i])
+                    c->keep[S[q]] = 1;
+            sum += cost[i];
+            if (!vertex_bad(c, v))
+                break;
+        }
+        if (!vertex_bad(c, v)) {
+            fill_cost = sum;
+            for (size_t q = 0; q < k; q++)
+                fill_keep[q] = c->keep[S[q]];
+        }
+        for (size_t q = 0; q < k; q++)
+            c->keep[S[q]] = save[q];
+    }
+    /* Drop: never tets a join added. */
+    {
+        size_t n = group_costs(c, v, 1, root, cost);
+        size_t *gid = c->par + k;
+        for (size_t q = 0; q < k; q++)
+            gid[q] = uf_find(c->par, q);
+        double sum = 0;
+        int ok = n >= 2;
+        for (size_t i = 0; ok && i + 1 < n; i++) {
+            for (size_t q = 0; q < k; q++)
+                if (save[q] && gid[q] == root[i]) {
+                    if (c->fixed[S[q]])
+                        ok = 0;
+                    c->keep[S[q]] = 0;
+                }
+            sum += cost[i];
+            if (!vertex_bad(c, v))
+                break;
+        }
+        if (ok && !vertex_bad(c, v))
+            drop_cost = sum;
+        if (!(drop_cost < fill_cost))
+            for (size_t q = 0; q < k; q++)
+                c->keep[S[q]] = save[q];
+    }
+    if (fill_cost <= drop_cost && isfinite(fill_cost)) {
+        for (size_t q = 0; q < k; q++) {
+            c->keep[S[q]] = fill_keep[q];
+            c->st->filled += fill_keep[q] && !save[q];
+        }
         return 1;
     }
-    if (can_drop) {
+    if (isfinite(drop_cost)) {
         for (size_t q = 0; q < k; q++)
-            if (c->keep[S[q]] && uf_find(c->par, q) != best_root) {
-                c->keep[S[q]] = 0;
-                c->st->dropped++;
-            }
+            c->st->dropped += save[q] && !c->keep[S[q]];
         return 1;
     }
     return 0;
@@ -607,9 +664,13 @@ st_status st_lattice_density_clean(unsigned char *keep,
     c.fixed = st_calloc_array(L->ntets + 1, 1);
     c.vol = st_malloc_array(L->ntets + 1, sizeof *c.vol);
     c.tlabel = st_calloc_array(L->ntets + 1, sizeof *c.tlabel);
-    c.par = st_malloc_array(maxk + 1, sizeof *c.par);
+    c.par = st_malloc_array(2 * maxk + 1, sizeof *c.par);
+    c.scratch_keep = st_malloc_array(2 * maxk + 1, 1);
+    c.groot = st_malloc_array(maxk + 1, sizeof *c.groot);
+    c.gcost = st_malloc_array(maxk + 1, sizeof *c.gcost);
     st_status s = ST_OK;
-    if (!c.fixed || !c.vol || !c.tlabel || !c.par)
+    if (!c.fixed || !c.vol || !c.tlabel || !c.par || !c.scratch_keep ||
+        !c.groot || !c.gcost)
         s = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     if (!s)
         s = label_voxels(&c, err);
@@ -640,6 +701,9 @@ st_status st_lattice_density_clean(unsigned char *keep,
     free(c.tlabel);
     free(c.vlabel);
     free(c.par);
+    free(c.scratch_keep);
+    free(c.groot);
+    free(c.gcost);
     if (!s && stats)
         *stats = local;
     return s;
