@@ -37,7 +37,7 @@ static void usage(void)
 "      --iters N        fairing steps (default 3)\n"
 "      --lambda L       lambda*dt of each step, umbrella weights (default 1)\n"
 "      --min-angle A    no move makes a tet's angles worse than A degrees\n"
-"                       (min A, max 180 - A/0.75; default 20)\n"
+"                       (min A, max 180 - A/0.75; default 30)\n"
 "  --fit                pull the boundary onto the surface while the mesh keeps\n"
 "                       enclosing it (Stuart et al. 2013, section 3.3), then\n"
 "                       raise the worst dihedral angles\n"
