@@ -619,10 +619,16 @@ static st_status thin_parts(cleaner *c, double longest, st_error *err)
         if (c->keep[t] && c->tlabel[t])
             held[c->tlabel[t]] += c->vol[t];
     double vv = g->voxel * g->voxel * g->voxel;
+    double hh = c->L->h;
     for (size_t l = 1; l <= np; l++) {
         double frac = held[l] / ((double)count[l] * vv);
         if (frac >= ST_CLEAN_HELD)
             continue;
+        if ((double)count[l] * vv < ST_CLEAN_SPECK * hh * hh * hh) {
+            c->st->specks++;
+            c->st->speck_voxels += count[l];
+            continue;
+        }
         size_t q = c->st->nthin++;
         if (q >= ST_CLEAN_MAX_THIN)
             continue;

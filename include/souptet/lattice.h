@@ -215,11 +215,16 @@ st_status st_lattice_density_filter(st_tetmesh **out, st_density_stats *stats,
  * of each). Deterministic (serial, in vertex and tet order).
  *
  * A voxel piece whose tets hold less than ST_CLEAN_HELD of its volume is
- * "too thin" for the lattice: it is listed in stats (up to
+ * "too thin" for the lattice (unless it is a speck, see below): it is
+ * listed in stats (up to
  * ST_CLEAN_MAX_THIN of them) with its box, its thickness (twice its
  * deepest voxel's distance to the surface, plus a voxel: that centre is
  * within half a voxel of the middle) and the --cells along the box's
  * longest side at which h is half that thickness. */
+/* A piece of the pseudo volume smaller than this many h^3 (a cubic5
+ * corner tet is h^3 / 6) is a speck no lattice tet can hold: counted, not
+ * listed as too thin (damaged soups leave a few voxels here and there). */
+#define ST_CLEAN_SPECK (1.0 / 6.0)
 #define ST_CLEAN_ROUNDS 32
 #define ST_CLEAN_HELD 0.5
 #define ST_CLEAN_MAX_THIN 8
@@ -240,6 +245,7 @@ typedef struct st_density_clean_stats {
     size_t islands, island_tets;  /* pieces dropped and their tets */
     size_t bad_vertices_left;     /* non-manifold vertices at the end */
     size_t nthin;            /* voxel pieces too thin (all of them) */
+    size_t specks, speck_voxels;  /* pieces under ST_CLEAN_SPECK h^3 */
     st_thin_part thin[ST_CLEAN_MAX_THIN];   /* the first of them */
 } st_density_clean_stats;
 

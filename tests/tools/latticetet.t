@@ -126,5 +126,11 @@ cells=$(sed -n 's/.*--cells \([0-9]*\) would hold it.*/\1/p' plate6.log | head -
 check "the plate at the suggested --cells ($cells): no warning, one piece" \
     sh -c "latticetet --density 0.5 --cells '$cells' -o platek.vtu plate.vdb 2> platek.log &&
            ! grep -q warning platek.log && tetstat --json platek.vtu | $PYVTK pieces.py 1"
+check "--cells auto on the plate: the first size that holds it, said, no warning" \
+    sh -c "latticetet --density 0.5 --cells auto -o platea.vtu plate.vdb 2> platea.log &&
+           grep -q '^latticetet: --cells auto: [0-9]* cells' platea.log &&
+           ! grep -q warning platea.log && tetstat --json platea.vtu | $PYVTK pieces.py 1"
+expect_fail "--cells auto is for --density" 2 "auto" \
+    latticetet --sculpt --surface plate.obj --cells auto plate.vdb
 
 done_testing
