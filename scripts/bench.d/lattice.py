@@ -28,7 +28,8 @@ import time
 # SOUPTET_BENCH_MODELS="bunny man cheese ..." picks others (any corpus model
 # that damage-corpus damages).
 MODELS = ("bunny", "armadillo", "fandisk", "torus")
-DAMAGES = ("closed", "soup", "deleted50", "flipped", "interpenetrating", "holes")
+DAMAGES = tuple(os.environ.get("SOUPTET_BENCH_DAMAGES",
+                               "closed soup deleted50 flipped interpenetrating holes").split())
 # Issue 24: 8..40 cells; SOUPTET_BENCH_CELLS="8 12 ..." picks others.
 CELLS = tuple(int(c) for c in os.environ.get("SOUPTET_BENCH_CELLS", "8 16 24 40").split())
 PIPE_INPUTS = ("closed", "soup", "deleted50")   # issue 6: "soups and 50%-deleted included"
