@@ -63,6 +63,10 @@
 #define FAIR_VOLUME_AIM 1e-4
 /* Rescale passes after the back-offs. */
 #define FAIR_VOLUME_PASSES 6
+/* The quality pass works on the tets scoring below this (smooth.h: a
+ * score of 35 is angles in [35, 133.3]), above the default floor so that
+ * the floor is not where the angles end. */
+#define FAIR_QUALITY_GOAL 40.0
 /* Conjugate gradients: relative residual and iteration cap. */
 #define FAIR_CG_TOL 1e-12
 #define FAIR_CG_MAX 1000
@@ -75,7 +79,8 @@ st_fair_params st_fair_params_default(void)
     p.relax_iters = 3;
     p.volume_tol = 0.005;
     p.quality_rounds = 40;
-    p.min_angle = 20.0;
+    p.min_angle = 30.0;
+    p.boundary_quality = 1;
     return p;
 }
 
@@ -529,7 +534,13 @@ st_status st_fair(st_tetmesh *m, const st_fair_params *pp, st_fair_stats *stats,
             ne++;
         }
         double h = ne ? len / (double)ne : 1.0;
-        st.quality_moves = sm_quality_interior(sm, h, p.quality_rounds, 35.0);
+        st.quality_moves = p.boundary_quality
+            ? sm_quality_fair(sm, h, p.quality_rounds, FAIR_QUALITY_GOAL)
+            : sm_quality_interior(sm, h, p.quality_rounds, FAIR_QUALITY_GOAL);
+        /* tangent moves keep the volume to first order: what the curvature
+         * costs goes back by the rescale (its moves keep the floor) */
+        if (p.boundary_quality)
+            correct_volume(&c, v0);
     }
     st_progress_report(prog, "fair", 1.0);
     st.volume_after = sm_boundary_volume(sm, m->xyz);

@@ -258,6 +258,8 @@ typedef struct fit_ctx {
                             move (a point grid index), or UINT32_MAX */
     double h, d_offset;
     int full_check;   /* non-conforming faces: test S vertices everywhere */
+    int fair_boundary;   /* no S (after fairing): boundary vertices move in
+                            their tangent plane only (sm_quality_fair) */
 } fit_ctx;
 
 /* Which vertices can be skipped: a vertex move is a deterministic function
@@ -657,11 +659,37 @@ static int cmp_cand(const void *a, const void *b)
 }
 
 /* Try to raise the lowest score of v's star; 1 when v moved. */
+/* The sum of the area-weighted outward normals of v's boundary faces. */
+static void fair_normal(const sm_mesh *sm, uint32_t v, double n[3])
+{
+    n[0] = n[1] = n[2] = 0.0;
+    for (size_t j = sm->vf_off[v]; j < sm->vf_off[v + 1]; j++) {
+        const uint32_t *f = sm->bf + 3 * (size_t)sm->vf[j];
+        const double *a = sm->m->xyz + 3 * (size_t)f[0];
+        const double *b = sm->m->xyz + 3 * (size_t)f[1];
+        const double *d = sm->m->xyz + 3 * (size_t)f[2];
+        double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+        n[0] += u[1] * w[2] - u[2] * w[1];
+        n[1] += u[2] * w[0] - u[0] * w[2];
+        n[2] += u[0] * w[1] - u[1] * w[0];
+    }
+    double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (l > 0.0 && isfinite(l))
+        for (int a = 0; a < 3; a++)
+            n[a] /= l;
+    else
+        n[0] = n[1] = n[2] = 0.0;
+}
+
 static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *rejected)
 {
     const sm_mesh *sm = &c->sm;
-    if (!c->s && sm->onb[v])
-        return 0;   /* no surface (after fairing): the boundary stays */
+    /* no surface (after fairing): the boundary stays, or with
+     * fair_boundary moves only within its tangent plane */
+    const int tangent_only = !c->s && sm->onb[v];
+    if (tangent_only && !c->fair_boundary)
+        return 0;
     double *x = sm->m->xyz + 3 * (size_t)v;
     double s0 = sm_star_score(sm, v, x);
     /* candidates: {score, x, y, z, order} */
@@ -742,6 +770,14 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
             for (int a = 0; a < 3; a++)
                 nrm[a] = (x[a] - cp[a]) / dx;
     }
+    if (tangent_only) {
+        /* the boundary's area-weighted normal: the gradient of the volume
+         * in v, so steps across it keep the volume to first order; only
+         * those candidates are kept */
+        nc = 0;
+        fair_normal(sm, v, nrm);
+        dx = nrm[0] != 0.0 || nrm[1] != 0.0 || nrm[2] != 0.0 ? 1.0 : 0.0;
+    }
     if (dx > 0.0)
         for (int d = 0; d < 2; d++) {
             const double *g = dirs[d];
@@ -750,7 +786,7 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
             double gl = sqrt(gt[0] * gt[0] + gt[1] * gt[1] + gt[2] * gt[2]);
             if (!(gl > 0.0) || !isfinite(gl))
                 continue;
-            for (int b = 0; b < QUAL_NTANGENT; b++)
+            for (int b = 0; b < (tangent_only ? 1 : QUAL_NTANGENT); b++)
                 for (size_t k2 = 0; k2 < QUAL_NSTEPS; k2++, nc++) {
                     double st = qual_steps[k2] * c->h;
                     for (int a = 0; a < 3; a++)
@@ -759,9 +795,11 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
         }
     /* the six axis directions, a small step: a way out where the
      * gradients point into the invariant */
-    for (int a = 0; a < 6; a++, nc++)
+    for (int a = 0; a < 6 && !tangent_only; a++, nc++)
         for (int b2 = 0; b2 < 3; b2++)
             cand[nc][1 + b2] = x[b2] + (b2 == a / 2 ? (a & 1 ? -1.0 : 1.0) * QUAL_AXIS_STEP * c->h : 0.0);
+    if (nc == 0)
+        return 0;
     for (int i = 0; i < nc; i++) {
         cand[i][0] = sm_star_score(sm, v, cand[i] + 1);
         cand[i][4] = i;
@@ -775,7 +813,7 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
         if (!(cand[i][0] > s0 + QUAL_MIN_GAIN))
             break;
         const double *p = cand[i] + 1;
-        if (sm->onb[v]) {
+        if (sm->onb[v] && c->s) {
             int64_t tri;
             double d2 = st_bvh_nearest(c->bvh, p, dmax * dmax, &tri, NULL);
             if (tri < 0 || sqrt(d2) > dmax)
@@ -856,6 +894,22 @@ size_t sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal)
     memset(&c, 0, sizeof c);
     c.sm = *sm;   /* borrowed: not freed here */
     c.h = h;
+    st_fit_params p = st_fit_params_default();
+    p.quality_rounds = rounds;
+    p.quality_goal = goal;
+    st_fit_stats st;
+    memset(&st, 0, sizeof st);
+    quality_pass(&c, &p, NULL, &st, 0.0);
+    return st.quality_moves;
+}
+
+size_t sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal)
+{
+    fit_ctx c;
+    memset(&c, 0, sizeof c);
+    c.sm = *sm;   /* borrowed: not freed here */
+    c.h = h;
+    c.fair_boundary = 1;
     st_fit_params p = st_fit_params_default();
     p.quality_rounds = rounds;
     p.quality_goal = goal;

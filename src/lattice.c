@@ -844,6 +844,17 @@ st_status st_lattice_density_filter(st_tetmesh **out, st_density_stats *stats,
                                     const st_lattice *L, const st_grid *g,
                                     double rho_min, st_error *err)
 {
+    return st_lattice_density_filter_clean(out, stats, NULL, L, g, rho_min,
+                                           0, err);
+}
+
+st_status st_lattice_density_filter_clean(st_tetmesh **out,
+                                          st_density_stats *stats,
+                                          st_density_clean_stats *cs,
+                                          const st_lattice *L,
+                                          const st_grid *g, double rho_min,
+                                          int clean, st_error *err)
+{
     *out = NULL;
     if (!(rho_min >= 0.0 && rho_min <= 1.0))
         return st_error_set(err, ST_EINPUT, NULL, 0,
@@ -859,10 +870,21 @@ st_status st_lattice_density_filter(st_tetmesh **out, st_density_stats *stats,
     st_status st = st_lattice_density(rho, &s, L, g, err);
     st_tetmesh *m = NULL;
     if (!st) {
-        for (size_t t = 0; t < L->ntets; t++) {
+        for (size_t t = 0; t < L->ntets; t++)
             keep[t] = rho[t] >= rho_min;
-            s.kept += keep[t];
+        if (clean) {
+            double lo[3], hi[3];
+            st_lattice_grid_box(g, lo, hi);
+            double longest = 0;
+            for (int a = 0; a < 3; a++)
+                if (hi[a] - lo[a] > longest)
+                    longest = hi[a] - lo[a];
+            st = st_lattice_density_clean(keep, cs, L, g, rho, longest, err);
         }
+        for (size_t t = 0; t < L->ntets; t++)
+            s.kept += keep[t];
+    }
+    if (!st) {
         st = st_lattice_to_tetmesh(&m, L, keep, err);
     }
     if (!st) {

@@ -75,6 +75,10 @@ double sm_boundary_volume(const sm_mesh *sm, const double *xyz);
  * vertices move, so the volume stays exactly as it is; h scales the trial
  * steps. Returns the number of moves. */
 size_t sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal);
+/* The same pass with the boundary vertices too, each only in the plane
+ * across its boundary faces' area-weighted normal (the volume's gradient
+ * in it: first-order volume kept). Returns the number of moves. */
+size_t sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal);
 
 /* Monotonic seconds. */
 double sm_now(void);

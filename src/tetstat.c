@@ -34,6 +34,210 @@ static size_t uf_find(size_t *parent, size_t x)
     return x;
 }
 
+/* ---- contacts and the boundary's manifoldness ---------------------------- */
+
+/* Ascending CSR of the tets around each point (tets listed in index order,
+ * so each list is sorted). */
+static st_status point_stars(const st_tetmesh *m, size_t **off_out,
+                             uint32_t **star_out, st_error *err)
+{
+    size_t np = m->npoints, nt = m->ntets;
+    size_t *off = st_calloc_array(np + 1, sizeof *off);
+    uint32_t *star = st_malloc_array(4 * nt + 1, sizeof *star);
+    size_t *fill = st_malloc_array(np + 1, sizeof *fill);
+    if (!off || !star || !fill) {
+        free(off); free(star); free(fill);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    for (size_t i = 0; i < 4 * nt; i++)
+        off[m->tets[i] + 1]++;
+    for (size_t v = 0; v < np; v++)
+        off[v + 1] += off[v];
+    memcpy(fill, off, (np + 1) * sizeof *fill);
+    for (size_t t = 0; t < nt; t++)
+        for (int c = 0; c < 4; c++)
+            star[fill[m->tets[4 * t + (size_t)c]]++] = (uint32_t)t;
+    free(fill);
+    *off_out = off;
+    *star_out = star;
+    return ST_OK;
+}
+
+static size_t find_sorted(const uint32_t *a, size_t n, uint32_t x)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (a[mid] < x)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* Groups, through the faces holding both a and b (b == UINT32_MAX: the
+ * faces holding a), of the tets sel[0..k) (ascending, each holding a and
+ * b). par is scratch of k slots. */
+static size_t face_groups(const st_tetmesh *m, const int64_t *nbr,
+                          const uint32_t *sel, size_t k, uint32_t a,
+                          uint32_t b, size_t *par)
+{
+    for (size_t q = 0; q < k; q++)
+        par[q] = q;
+    for (size_t q = 0; q < k; q++) {
+        size_t t = sel[q];
+        for (int i = 0; i < 4; i++) {
+            uint32_t opp = m->tets[4 * t + (size_t)i];
+            if (opp == a || opp == b)
+                continue;   /* that face misses a or b */
+            int64_t u = nbr[4 * t + (size_t)i];
+            if (u < 0)
+                continue;
+            size_t r = find_sorted(sel, k, (uint32_t)u);
+            if (r == k || sel[r] != (uint32_t)u)
+                continue;
+            size_t x = uf_find(par, q), y = uf_find(par, r);
+            if (x != y)
+                par[x > y ? x : y] = x > y ? y : x;
+        }
+    }
+    size_t n = 0;
+    for (size_t q = 0; q < k; q++)
+        n += uf_find(par, q) == q;
+    return n;
+}
+
+/* Pinched points and edges (tets around them in more than one group
+ * through faces), and the boundary faces' non-manifold edges (in other
+ * than two boundary faces) and points (whose boundary faces do not make
+ * one closed fan). */
+static st_status contacts(st_tetstat *out, const st_tetmesh *m,
+                          const int64_t *nbr, const uint32_t *bf, size_t nbf,
+                          st_error *err)
+{
+    size_t *off = NULL;
+    uint32_t *star = NULL;
+    st_status s = point_stars(m, &off, &star, err);
+    if (s)
+        return s;
+    const size_t np = m->npoints;
+    size_t maxk = 0;
+    for (size_t v = 0; v < np; v++)
+        if (off[v + 1] - off[v] > maxk)
+            maxk = off[v + 1] - off[v];
+    /* Boundary faces around each point, as the pairs of their other
+     * corners. */
+    size_t *boff = st_calloc_array(np + 1, sizeof *boff);
+    if (!boff) {
+        free(off); free(star);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    for (size_t f = 0; f < nbf; f++)
+        for (int c = 0; c < 3; c++)
+            boff[bf[3 * f + (size_t)c] + 1]++;
+    /* Scratch: the star's tets, or the link points (two per face). */
+    for (size_t v = 0; v < np; v++)
+        if (2 * boff[v + 1] > maxk)
+            maxk = 2 * boff[v + 1];
+    size_t *bfill = st_malloc_array(np + 1, sizeof *bfill);
+    uint32_t *link = st_malloc_array(3 * nbf + 1, 2 * sizeof *link);
+    size_t *par = st_malloc_array(maxk + 1, 2 * sizeof *par);
+    uint32_t *sel = st_malloc_array(maxk + 1, 2 * sizeof *sel);
+    if (!bfill || !link || !par || !sel) {
+        free(off); free(star); free(boff); free(bfill); free(link);
+        free(par); free(sel);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    for (size_t v = 0; v < np; v++)
+        boff[v + 1] += boff[v];
+    memcpy(bfill, boff, (np + 1) * sizeof *bfill);
+    for (size_t f = 0; f < nbf; f++)
+        for (int c = 0; c < 3; c++) {
+            size_t q = bfill[bf[3 * f + (size_t)c]]++;
+            link[2 * q] = bf[3 * f + (size_t)(c + 1) % 3];
+            link[2 * q + 1] = bf[3 * f + (size_t)(c + 2) % 3];
+        }
+    free(bfill);
+    uint32_t *lv = sel + maxk + 1;   /* link points (second half) */
+    for (size_t v = 0; v < np; v++) {
+        const uint32_t *st = star + off[v];
+        size_t k = off[v + 1] - off[v];
+        if (k == 0)
+            continue;
+        if (face_groups(m, nbr, st, k, (uint32_t)v, UINT32_MAX, par) > 1)
+            out->pinched_points++;
+        /* Edges (v, w), w > v: the tets of v's star holding w. */
+        for (size_t a = 0; a < k; a++)
+            for (int c = 0; c < 4; c++) {
+                uint32_t w = m->tets[4 * (size_t)st[a] + (size_t)c];
+                if (w <= v)
+                    continue;
+                /* Count each edge once: at the first tet holding it. */
+                int first = 1;
+                for (size_t b = 0; b < a && first; b++)
+                    for (int d = 0; d < 4; d++)
+                        if (m->tets[4 * (size_t)st[b] + (size_t)d] == w)
+                            first = 0;
+                if (!first)
+                    continue;
+                size_t ks = 0;
+                for (size_t b = a; b < k; b++)
+                    for (int d = 0; d < 4; d++)
+                        if (m->tets[4 * (size_t)st[b] + (size_t)d] == w)
+                            sel[ks++] = st[b];
+                if (face_groups(m, nbr, sel, ks, (uint32_t)v, w, par) > 1)
+                    out->pinched_edges++;
+            }
+        /* The boundary fan of v: every link point of degree 2 and the
+         * link connected. */
+        size_t b0 = boff[v], nb = boff[v + 1] - b0;
+        if (nb == 0)
+            continue;
+        size_t nl = 0;
+        size_t *deg = par + maxk + 1;
+        int bad = 0;
+        {
+            for (size_t q = 0; q < 2 * nb; q++) {
+                uint32_t w = link[2 * b0 + q];
+                size_t r = 0;
+                while (r < nl && lv[r] != w)
+                    r++;
+                if (r == nl) {
+                    lv[nl] = w;
+                    deg[nl] = 0;
+                    par[nl] = nl;
+                    nl++;
+                }
+                deg[r]++;
+            }
+            for (size_t q = 0; q < nb; q++) {
+                size_t x = 0, y = 0;
+                while (lv[x] != link[2 * (b0 + q)])
+                    x++;
+                while (lv[y] != link[2 * (b0 + q) + 1])
+                    y++;
+                x = uf_find(par, x);
+                y = uf_find(par, y);
+                if (x != y)
+                    par[x > y ? x : y] = x > y ? y : x;
+            }
+            for (size_t r = 0; r < nl; r++) {
+                if (deg[r] != 2) {
+                    bad = 1;
+                    if (v < lv[r])
+                        out->nonmanifold_boundary_edges++;
+                }
+                if (uf_find(par, r) != 0)
+                    bad = 1;
+            }
+        }
+        out->nonmanifold_boundary_points += bad;
+    }
+    free(off); free(star); free(boff); free(link); free(par); free(sel);
+    return ST_OK;
+}
+
 static void reset(st_tetstat *out)
 {
     memset(out, 0, sizeof *out);
@@ -149,16 +353,23 @@ st_status st_tetstat_mesh(st_tetstat *out, const st_tetmesh *m,
     for (size_t t = 0; t < nt; t++)
         out->components += uf_find(parent, t) == t;
     free(parent);
-    free(nbr);
     out->nonmanifold_faces = nm;
     out->interior_faces = shared / 2;
     /* Not the faces without a neighbour: the sides of non-manifold faces
      * have none either. */
     uint32_t *bf;
     size_t nbf;
-    if ((s = st_tetmesh_boundary(m, &bf, NULL, &nbf, err)))
+    if ((s = st_tetmesh_boundary(m, &bf, NULL, &nbf, err))) {
+        free(nbr);
         return s;
+    }
+    s = contacts(out, m, nbr, bf, nbf, err);
     free(bf);
+    free(nbr);
+    if (s)
+        return s;
+    out->boundary_manifold = out->nonmanifold_boundary_edges == 0 &&
+                             out->nonmanifold_boundary_points == 0;
     out->boundary_faces = nbf;
     out->conforming = nm == 0;
 

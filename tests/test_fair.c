@@ -184,6 +184,32 @@ static void test_thin_slab(void)
     st_tetmesh_free(m);
 }
 
+static void test_keeps_30(void)
+{
+    /* The default fairing of a blocky ball ends with every dihedral angle
+     * in [30, 140] (the simulator's bounds) and the volume within 1%; the
+     * quality pass, boundary vertices included (tangent moves), leaves the
+     * worst tet above where the fairing's floor stopped it. */
+    double lo[3] = {-4, -4, -4}, r = 3.3;
+    st_tetmesh *m = lattice5(8, 1.0, lo, in_ball, &r);
+    double v0 = mesh_volume(m);
+    st_fair_stats st;
+    st_error err;
+    st_status s = st_fair(m, NULL, &st, NULL, &err);
+    TAP_CHECK(s == ST_OK && nonpositive(m) == 0, "default fairing of a ball of %zu tets",
+              m->ntets);
+    TAP_CHECK(st.min_dihedral_after >= 30.0 && st.max_dihedral_after <= 140.0,
+              "angles after fairing in [30, 140]: %.2f..%.2f", st.min_dihedral_after,
+              st.max_dihedral_after);
+    TAP_NEAR(mesh_volume(m) / v0, 1.0, 0.01, "volume within 1%% (%.5f)", mesh_volume(m) / v0);
+    TAP_CHECK(st.quality_moves > 0 && st.min_dihedral_after >= st.min_dihedral_fair &&
+                  st.max_dihedral_after <= st.max_dihedral_fair,
+              "the quality pass moved (%zu) and did not worsen %.2f..%.2f -> %.2f..%.2f",
+              st.quality_moves, st.min_dihedral_fair, st.max_dihedral_fair,
+              st.min_dihedral_after, st.max_dihedral_after);
+    st_tetmesh_free(m);
+}
+
 static void test_threads(void)
 {
 #ifdef _OPENMP
@@ -321,6 +347,7 @@ int main(void)
     test_star_score_is_min();
     test_block();
     test_ball_many_iters();
+    test_keeps_30();
     test_thin_slab();
     test_threads();
     test_refusals();

@@ -295,6 +295,74 @@ static void test_field(void)
     st_tetmesh_free(m);
 }
 
+/* The cubes `pick` (indices i + nx (j + ny k)) of an nx x ny x nz block,
+ * sharing its points. */
+static st_tetmesh *some_cubes(int nx, int ny, int nz, const int *pick,
+                              int npick)
+{
+    const double o[3] = {0, 0, 0};
+    st_tetmesh *all = cubes(o, 1, nx, ny, nz);
+    st_tetmesh *m = st_tetmesh_new();
+    for (size_t i = 0; i < all->npoints; i++)
+        add_pt(m, all->xyz[3 * i], all->xyz[3 * i + 1], all->xyz[3 * i + 2]);
+    for (int q = 0; q < npick; q++)
+        for (int t = 5 * pick[q]; t < 5 * pick[q] + 5; t++) {
+            const uint32_t *v = all->tets + 4 * (size_t)t;
+            st_tetmesh_add_tet(m, v[0], v[1], v[2], v[3], NULL);
+        }
+    st_tetmesh_free(all);
+    return m;
+}
+
+static void test_contacts(void)
+{
+    st_tetstat r;
+    st_error err;
+    const int block[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+    st_tetmesh *m = some_cubes(2, 2, 2, block, 8);
+    TAP_CHECK(st_tetstat_mesh(&r, m, &err) == ST_OK && r.components == 1 &&
+                  r.pinched_edges == 0 && r.pinched_points == 0 &&
+                  r.nonmanifold_boundary_edges == 0 &&
+                  r.nonmanifold_boundary_points == 0 && r.boundary_manifold,
+              "2x2x2 cubes: no contacts, manifold boundary");
+    st_tetmesh_free(m);
+
+    const int edge[2] = {0, 3};   /* (0,0,0) and (1,1,0): the edge x=y=1 */
+    m = some_cubes(2, 2, 1, edge, 2);
+    TAP_CHECK(st_tetstat_mesh(&r, m, &err) == ST_OK && r.components == 2 &&
+                  r.pinched_edges == 1 && r.pinched_points == 2 &&
+                  r.nonmanifold_boundary_edges == 1 &&
+                  r.nonmanifold_boundary_points == 2 && !r.boundary_manifold,
+              "two cubes on an edge: 2 components, 1 pinched edge, its 2 "
+              "points, 1 non-manifold boundary edge (%zu %zu %zu %zu %zu)",
+              r.components, r.pinched_edges, r.pinched_points,
+              r.nonmanifold_boundary_edges, r.nonmanifold_boundary_points);
+    st_tetmesh_free(m);
+
+    const int corner[2] = {0, 7};   /* share the point (1,1,1) */
+    m = some_cubes(2, 2, 2, corner, 2);
+    TAP_CHECK(st_tetstat_mesh(&r, m, &err) == ST_OK && r.components == 2 &&
+                  r.pinched_edges == 0 && r.pinched_points == 1 &&
+                  r.nonmanifold_boundary_edges == 0 &&
+                  r.nonmanifold_boundary_points == 1 && !r.boundary_manifold,
+              "two cubes on a point: 1 pinched point, 1 non-manifold "
+              "boundary point, no edge (%zu %zu %zu %zu %zu)",
+              r.components, r.pinched_edges, r.pinched_points,
+              r.nonmanifold_boundary_edges, r.nonmanifold_boundary_points);
+    st_tetmesh_free(m);
+
+    /* An L of three cubes with a fourth on the corner of the L's notch
+     * would be face-joined; a cube hanging by an edge on an L is one
+     * component but pinched. */
+    const int hang[4] = {0, 1, 2, 7};   /* L in z=0, cube 7 at (1,1,1) */
+    m = some_cubes(2, 2, 2, hang, 4);
+    TAP_CHECK(st_tetstat_mesh(&r, m, &err) == ST_OK && r.components == 2 &&
+                  r.pinched_edges == 2 && !r.boundary_manifold,
+              "a cube on an L's two edges: 2 pinched edges (%zu)",
+              r.pinched_edges);
+    st_tetmesh_free(m);
+}
+
 int main(void)
 {
     test_regular();
@@ -302,5 +370,6 @@ int main(void)
     test_bad_tets();
     test_surface();
     test_field();
+    test_contacts();
     return tap_done();
 }

@@ -187,6 +187,87 @@ st_status st_lattice_density_filter(st_tetmesh **out, st_density_stats *stats,
                                     const st_lattice *L, const st_grid *g,
                                     double rho_min, st_error *err);
 
+/* ---- one piece per piece: the density filter's cleanup ----
+ *
+ * rho alone keeps tets that hang on the rest by an edge or a point, islands
+ * the pseudo volume does not have, and breaks a part where it is about one
+ * cell thin. st_lattice_density_clean edits keep (1: kept) so that
+ *
+ *   the boundary is 2-manifold: at every lattice vertex the kept tets of
+ *   its star make one group through the faces at the vertex and so do the
+ *   others (on the link sphere, a connected set with a connected complement
+ *   is a disc: no pinched point, no edge in four boundary faces). A bad
+ *   vertex is mended the cheaper way: fill (keep its whole star; cost the
+ *   sum of (1 - rho) vol over the tets added), allowed only when the kept
+ *   tets there do not belong to two pieces of the pseudo volume; or drop
+ *   (every kept group of the star but the heaviest in rho vol; cost the
+ *   sum of rho vol dropped), not allowed on tets a join added;
+ *
+ *   every face-connected piece is the main piece of a piece of the pseudo
+ *   volume (its 6-connected inside voxels; a tet belongs to the piece of
+ *   the voxel of its centroid, else of an inside voxel at a corner): each
+ *   voxel piece's main tet piece is the one holding most of its rho vol.
+ *   Any other tet piece is joined to the main piece of its voxel piece
+ *   along the cheapest face path (Dijkstra, cost (1 - rho) vol + tiny) when
+ *   that costs less than its own rho vol, and dropped otherwise.
+ *
+ * The two alternate until nothing changes (at most ST_CLEAN_ROUNDS rounds
+ * of each). Deterministic (serial, in vertex and tet order).
+ *
+ * A voxel piece whose tets hold less than ST_CLEAN_HELD of its volume is
+ * "too thin" for the lattice (unless it is a speck, see below): it is
+ * listed in stats (up to
+ * ST_CLEAN_MAX_THIN of them) with its box, its thickness (twice its
+ * deepest voxel's distance to the surface, plus a voxel: that centre is
+ * within half a voxel of the middle) and the --cells along the box's
+ * longest side at which h is half that thickness. */
+/* A piece of the pseudo volume smaller than this many h^3 (a cubic5
+ * corner tet is h^3 / 6) is a speck no lattice tet can hold: counted, not
+ * listed as too thin (damaged soups leave a few voxels here and there). */
+#define ST_CLEAN_SPECK (1.0 / 6.0)
+#define ST_CLEAN_ROUNDS 32
+#define ST_CLEAN_HELD 0.5
+#define ST_CLEAN_MAX_THIN 8
+
+typedef struct st_thin_part {
+    size_t voxels;           /* inside voxels of the piece */
+    double lo[3], hi[3];     /* its box (voxel extents), model units */
+    double thickness;        /* 2 x max depth inside + 1 voxel */
+    double held;             /* volume of its tets / its voxels' volume */
+    size_t cells;            /* --cells at which h = thickness / 2 */
+} st_thin_part;
+
+typedef struct st_density_clean_stats {
+    size_t pieces;           /* 6-connected pieces of the pseudo volume */
+    size_t tet_pieces;       /* face-connected pieces of the kept tets */
+    size_t filled, dropped;  /* tets added / removed at bad vertices */
+    size_t joins, join_tets; /* pieces joined and the tets the paths add */
+    size_t islands, island_tets;  /* pieces dropped and their tets */
+    size_t bad_vertices_left;     /* non-manifold vertices at the end */
+    size_t nthin;            /* voxel pieces too thin (all of them) */
+    size_t specks, speck_voxels;  /* pieces under ST_CLEAN_SPECK h^3 */
+    st_thin_part thin[ST_CLEAN_MAX_THIN];   /* the first of them */
+} st_density_clean_stats;
+
+/* Clean keep (L->ntets slots, 0/1) as above; rho the densities of
+ * st_lattice_density, g the signed field they came from, longest the
+ * longest side of the box the lattice was laid over (for thin[].cells).
+ * stats may be NULL. ST_ENOMEM only. */
+st_status st_lattice_density_clean(unsigned char *keep,
+                                   st_density_clean_stats *stats,
+                                   const st_lattice *L, const st_grid *g,
+                                   const double *rho, double longest,
+                                   st_error *err);
+
+/* st_lattice_density_filter with the cleanup when clean is nonzero (cs
+ * may be NULL). */
+st_status st_lattice_density_filter_clean(st_tetmesh **out,
+                                          st_density_stats *stats,
+                                          st_density_clean_stats *cs,
+                                          const st_lattice *L,
+                                          const st_grid *g, double rho_min,
+                                          int clean, st_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -55,10 +55,14 @@ typedef struct st_fair_params {
                              the rescale aims much closer than this */
     double min_angle;     /* degrees: no move brings the score of its star
                              (ST_FIT_MAX_WEIGHT below) under this, or under
-                             what it already was (default 20) */
+                             what it already was (default 30: angles in
+                             [30, 140]) */
     int quality_rounds;   /* then rounds of st_fit's quality pass on the
                              interior vertices (the volume does not change);
                              0: none (default 40) */
+    int boundary_quality; /* 1: the quality pass moves boundary vertices
+                             too, within their tangent plane, and the
+                             volume is rescaled after it (default 1) */
 } st_fair_params;
 
 typedef struct st_fair_stats {

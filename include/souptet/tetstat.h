@@ -11,6 +11,12 @@
  *   conformity: faces shared by more than two tets (non-manifold faces),
  *   interior faces (shared by exactly two), boundary faces (one tet);
  *   connected components (tets joined through interior faces);
+ *   contacts: pinched points and edges, around which the tets fall in
+ *   more than one group joined through faces (a tet hanging on the rest by
+ *   an edge pinches that edge and its two points; by a point, that point);
+ *   the boundary faces' non-manifold edges (in other than two boundary
+ *   faces) and non-manifold points (whose boundary faces do not make one
+ *   closed fan: pinched, or on a non-manifold edge);
  *   total signed volume; the lattice cell width h from meta "h".
  * Against a surface S (st_tetstat_surface):
  *   min/max/mean distance from the boundary vertices of the mesh to S
@@ -66,6 +72,9 @@ typedef struct st_tetstat {
     size_t nonmanifold_faces, interior_faces, boundary_faces;
     int conforming;               /* no non-manifold face */
     size_t components;
+    size_t pinched_points, pinched_edges;  /* tets meet only through them */
+    size_t nonmanifold_boundary_edges, nonmanifold_boundary_points;
+    int boundary_manifold;        /* both counts above are 0 */
     double volume;                /* sum of signed tet volumes */
     int has_h;
     double h;                     /* meta "h" when it is a number */

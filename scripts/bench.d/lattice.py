@@ -28,8 +28,10 @@ import time
 # SOUPTET_BENCH_MODELS="bunny man cheese ..." picks others (any corpus model
 # that damage-corpus damages).
 MODELS = ("bunny", "armadillo", "fandisk", "torus")
-DAMAGES = ("closed", "soup", "deleted50", "flipped", "interpenetrating", "holes")
-CELLS = (8, 16, 24)
+DAMAGES = tuple(os.environ.get("SOUPTET_BENCH_DAMAGES",
+                               "closed soup deleted50 flipped interpenetrating holes").split())
+# Issue 24: 8..40 cells; SOUPTET_BENCH_CELLS="8 12 ..." picks others.
+CELLS = tuple(int(c) for c in os.environ.get("SOUPTET_BENCH_CELLS", "8 16 24 40").split())
 PIPE_INPUTS = ("closed", "soup", "deleted50")   # issue 6: "soups and 50%-deleted included"
 RHO = 0.5
 FIELD_CELLS = 128           # soupdist's default grid
@@ -110,6 +112,10 @@ def mesh_stats(bench, build, pm, vtu, field=None):
                 return {"tets": d.get("tets"), "min_dihedral": d.get("min_dihedral"),
                         "max_dihedral": d.get("max_dihedral"), "volume": d.get("volume"),
                         "inverted": d.get("inverted"), "conforming": d.get("conforming"),
+                        "components": d.get("components"),
+                        "pinched_edges": d.get("pinched_edges"),
+                        "pinched_points": d.get("pinched_points"),
+                        "boundary_manifold": d.get("boundary_manifold"),
                         "iou": (d.get("field") or {}).get("iou"), "measured_by": "tetstat"}
             except ValueError:
                 pass
@@ -170,8 +176,22 @@ def stage(build, bench):
             row["latticetet_s"] = t_lat
             row["latticetet_timings"] = timings(r.stderr)
             row["latticetet_work_s"] = work_seconds(row["latticetet_timings"])
+            row["thin_warnings"] = len(re.findall(r"too thin", r.stderr or ""))
+            row["latticetet_stderr"] = r.stderr or ""
             ml = mesh_stats(bench, build, pm, lat, signed)
             row["lattice"] = ml
+            # today's figures (issue 24): the paper's rule alone, and the
+            # fairing as it was (floor 20, interior quality moves only)
+            r0, _ = pm.timed([tool["latticetet"], "--threads", th, "--density", str(RHO),
+                              "--no-repair", "--cells", str(n), "-o", one, signed], 300)
+            if r0 is not None and r0.returncode == 0:
+                row["raw"] = mesh_stats(bench, build, pm, one, signed)
+                if row["raw"].get("tets") and have["tetsmooth"]:
+                    r0, _ = pm.timed([tool["tetsmooth"], "--threads", th, "--fair",
+                                      "--min-angle", "20", "--interior-quality", "-o", one,
+                                      one], 300)
+                    if r0 is not None and r0.returncode == 0:
+                        row["raw_faired"] = mesh_stats(bench, build, pm, one, signed)
             if ml.get("tets", 0) == 0:
                 row["status"] = "empty: no tet reaches density %.1f" % RHO
                 rows.append(row)
@@ -254,34 +274,44 @@ def markdown(rows, have, missing, secs, bench):
     if missing:
         md += ["Inputs missing (run `scripts/bench BUILD corpus` first): " + ", ".join(missing) + ".",
                ""]
-    md += ["| model | input | N | tets | min ° | max ° | faired min ° | faired max ° | vol ratio |"
-           " faired vol ratio | IoU | soupdist s | soupsign s | latticetet s (work) | tetsmooth s |"
-           " 1 pass s | speed-up lattice / pass |",
-           "|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|---|"]
+    md += ["Issue 24: *today* is the paper's rule alone (`latticetet --no-repair`) faired as"
+           " before (`tetsmooth --fair --min-angle 20 --interior-quality`); *now* is the"
+           " default (cleanup; floor 30 and the boundary's tangent quality moves). *pieces*:"
+           " face-connected components (tetstat); *pinch*: pinched points (tets meeting only"
+           " at a point or an edge; tetstat); *mfd*: boundary 2-manifold; *pv pieces*: the"
+           " pseudo volume's 6-connected pieces (latticetet -v; specks smaller than a tet"
+           " included); *thin*: latticetet's too-thin warnings.",
+           "",
+           "| model | input | N | tets today / now | pieces today / now (pv) | pinch today / now |"
+           " mfd today / now | vol ratio today / now | IoU today / now | faired ° today |"
+           " faired ° now | faired vol ratio now | faired IoU today / now | thin | latticetet s |",
+           "|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
     for r in rows:
         if r.get("pipe"):
             continue
         if "lattice" not in r:
-            md.append("| %s | %s | %s | %s |||||||||||||" % (r["model"], r["damage"],
-                                                              r.get("cells", "-"), r["status"]))
+            md.append("| %s | %s | %s | %s |||||||||||" % (r["model"], r["damage"],
+                                                           r.get("cells", "-"), r["status"]))
             continue
         L, F = r["lattice"], r.get("faired") or {}
+        R, RF = r.get("raw") or {}, r.get("raw_faired") or {}
         pv = r.get("pseudo_volume") or 0
-        sp_l = PAPER_GEN_S / lat_s(r) if lat_s(r) else None
-        sp_p = PAPER_PASS_S / r["one_pass_s"] if r.get("one_pass_s") else None
-        md.append("| %s | %s | %d | %s | %s | %s | %s | %s | %s | %s | %s | %.2f | %.2f | %.3f (%s) |"
-                  " %s | %s | %s |" % (
-                      r["model"], r["damage"], r["cells"], _f(L.get("tets"), "%d"),
-                      _f(L.get("min_dihedral")), _f(L.get("max_dihedral")),
-                      _f(F.get("min_dihedral")), _f(F.get("max_dihedral")),
-                      "%.3f" % (L["volume"] / pv) if pv and L.get("volume") else "-",
-                      "%.3f" % (F["volume"] / pv) if pv and F.get("volume") else "-",
-                      _f(F.get("iou") if F else L.get("iou"), "%.3f"),
-                      r["soupdist_s"], r["soupsign_s"], r["latticetet_s"],
-                      _f(r.get("latticetet_work_s"), "%.3f"),
-                      _f(r.get("tetsmooth_s"), "%.3f"), _f(r.get("one_pass_s"), "%.3f"),
-                      "%s / %s" % (_f(sp_l, "%.0f×"), _f(sp_p, "%.0f×")) +
-                      ("" if r["status"] == "ok" else " (%s)" % r["status"])))
+        vr = lambda m: "%.3f" % (m["volume"] / pv) if pv and m.get("volume") else "-"
+        yn = lambda v: "-" if v is None else ("yes" if v else "**no**")
+        ang = lambda m: "%s–%s" % (_f(m.get("min_dihedral")), _f(m.get("max_dihedral")))
+        pvp = re.search(r"cleanup: (\d+) pieces of pseudo volume", r.get("latticetet_stderr", ""))
+        md.append("| %s | %s | %d | %s / %s | %s / %s (%s) | %s / %s | %s / %s | %s / %s |"
+                  " %s / %s | %s | %s | %s | %s | %s | %.3f |" % (
+                      r["model"], r["damage"], r["cells"], _f(R.get("tets"), "%d"),
+                      _f(L.get("tets"), "%d"), _f(R.get("components"), "%d"),
+                      _f(L.get("components"), "%d"), pvp.group(1) if pvp else "-",
+                      _f(R.get("pinched_points"), "%d"), _f(L.get("pinched_points"), "%d"),
+                      yn(R.get("boundary_manifold")), yn(L.get("boundary_manifold")),
+                      vr(R), vr(L), _f(R.get("iou"), "%.3f"), _f(L.get("iou"), "%.3f"),
+                      ang(RF) if RF else "-", ang(F) if F else "-", vr(F) if F else "-",
+                      "%s / %s" % (_f(RF.get("iou"), "%.3f"), _f(F.get("iou"), "%.3f")),
+                      r.get("thin_warnings", 0), r["latticetet_s"])
+                  + ("" if r["status"] == "ok" else " (%s)" % r["status"]))
     # the paper's sizes: rows with about 3K tets
     near = [r for r in rows if r.get("status") == "ok" and not r.get("pipe") and 1500 <= r["lattice"].get("tets", 0) <= 6000]
     if near:

@@ -49,11 +49,15 @@ static void usage(void)
 "      --lattice KIND   cubic5 (5 tets per cube) or bcc (default: cubic5 for\n"
 "                       --density, bcc for --sculpt)\n"
 "      --cells N        cells along the longest side of the field's box\n"
-"                       (default 16 for --density, 10 for --sculpt)\n"
+"                       (default 16 for --density, 10 for --sculpt); with\n"
+"                       --density, 'auto': the coarsest of 8, 10, 12, 14,\n"
+"                       16, 20, ..., 128 at which no part is too thin\n"
 "  -h, --size SIZE      cell width in model units (instead of --cells)\n"
 "      --seed S         random rotation and offset of the lattice (default 0:\n"
 "                       axis-aligned at the box's corner)\n"
-"      --no-repair      sculpt without bomb and manifold repair\n"
+"      --no-repair      sculpt without bomb and manifold repair; with\n"
+"                       --density, the paper's rule alone: no cleanup of\n"
+"                       hanging tets, islands and pinched boundaries\n"
 "  -o, --output OUT     .vtu file (or .msh, .node/.ele, .mesh by extension,\n"
 "                       without the arrays); '-' or none: .vtu on stdout\n"
 "      --threads T      threads to use (default: all cores)\n"
@@ -81,6 +85,7 @@ int main(int argc, char *argv[])
     tool_init(&t, "latticetet", argc, argv);
     tool_common co = tool_common_default();
     size_t cells = 0;
+    int auto_cells = 0;
     const char *out = NULL, *in = NULL, *surface = NULL, *lattice = NULL;
     double rho = -1, size = 0;
     int sculpt = 0, repair = 1;
@@ -116,8 +121,13 @@ int main(int argc, char *argv[])
             lattice = optarg;
             break;
         case OPT_CELLS:
+            if (!strcmp(optarg, "auto")) {
+                auto_cells = 1;
+                break;
+            }
             if (tool_parse_size(&t, "--cells", optarg, 1, 100000, &cells))
                 return TOOL_EXIT_USAGE;
+            auto_cells = 0;
             break;
         case 'h':
             if (tool_parse_double(&t, "-h", optarg, 1e-300, 1e300, &size))
@@ -161,8 +171,11 @@ int main(int argc, char *argv[])
         return tool_usage_error(&t, "--sculpt needs --surface S (the input surface)");
     if (!sculpt && surface)
         return tool_usage_error(&t, "--surface goes with --sculpt");
-    if (cells && size > 0)
+    if ((cells || auto_cells) && size > 0)
         return tool_usage_error(&t, "--cells and -h exclude each other");
+    if (auto_cells && (sculpt || !repair))
+        return tool_usage_error(&t, "--cells auto goes with --density (and its "
+                                    "cleanup: not with --no-repair)");
     st_lattice_kind kind = sculpt ? ST_LATTICE_BCC : ST_LATTICE_CUBIC5;
     if (lattice && st_lattice_kind_from_name(lattice, &kind))
         return tool_usage_error(&t, "--lattice is cubic5 or bcc, not '%s'", lattice);
@@ -220,6 +233,20 @@ int main(int argc, char *argv[])
     const char *limit_hint = "use fewer --cells or a larger -h, or raise "
                              "--max-memory";
     if (!sculpt) {
+      /* --cells auto: the first size of AUTO_CELLS (coarse to fine) at
+       * which no part of the pseudo volume is too thin. */
+      static const size_t auto_seq[] = {8, 10, 12, 14, 16, 20, 24, 28, 32, 40,
+                                        48, 56, 64, 80, 96, 112, 128};
+      const size_t n_auto = sizeof auto_seq / sizeof auto_seq[0];
+      for (size_t try_i = 0;; try_i++) {
+        if (auto_cells) {
+            st_lattice_free(L);
+            st_tetmesh_free(m);
+            L = NULL;
+            m = NULL;
+            cells = auto_seq[try_i];
+            h = st_lattice_h_for_cells(lo, hi, cells);
+        }
         st_lattice_params lp = st_lattice_params_default();
         lp.kind = kind;
         lp.h = h;
@@ -234,7 +261,10 @@ int main(int argc, char *argv[])
             goto done;
         }
         double t2 = tool_now();
-        if (st_lattice_density_filter(&m, &ds, L, g, rho, &err)) {
+        st_density_clean_stats cs;
+        memset(&cs, 0, sizeof cs);
+        if (st_lattice_density_filter_clean(&m, &ds, &cs, L, g, rho, repair,
+                                            &err)) {
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", in_name);
             rc = tool_fail(&t, &err);
@@ -250,6 +280,48 @@ int main(int argc, char *argv[])
                  ds.kept, ds.lattice_tets, rho, ds.centroid_rule, ds.point_tests);
         tool_say(&t, 2, "read %.3f s, lattice %.3f s, density %.3f s",
                  t1 - t0, t2 - t1, t3 - t2);
+        if (repair) {
+            tool_say(&t, 2, "cleanup: %zu pieces of pseudo volume, %zu of "
+                     "tets; %zu tets filled and %zu dropped at pinched "
+                     "vertices; %zu pieces joined (%zu tets), %zu islands "
+                     "dropped (%zu tets)", cs.pieces, cs.tet_pieces,
+                     cs.filled, cs.dropped, cs.joins, cs.join_tets,
+                     cs.islands, cs.island_tets);
+            if (cs.specks)
+                tool_say(&t, 2, "%zu specks of the pseudo volume smaller than "
+                         "a tet (%zu voxels) not meshed", cs.specks,
+                         cs.speck_voxels);
+            if (cs.bad_vertices_left)
+                tool_say(&t, 1, "warning: the boundary is not manifold at "
+                         "%zu vertices", cs.bad_vertices_left);
+            /* with --cells auto, only the last try's parts are news */
+            const int final = !auto_cells || cs.nthin == 0 || try_i + 1 == n_auto;
+            for (size_t q = 0; q < cs.nthin && q < ST_CLEAN_MAX_THIN; q++) {
+                const st_thin_part *p = &cs.thin[q];
+                tool_say(&t, final ? 1 : 2, "%s: warning: a part of the pseudo volume is "
+                         "too thin for this lattice (h %.4g): %zu voxels in "
+                         "(%.4g %.4g %.4g)-(%.4g %.4g %.4g), %.4g thick, "
+                         "%.0f%% of it meshed; --cells %zu would hold it",
+                         in_name, h, p->voxels, p->lo[0], p->lo[1], p->lo[2],
+                         p->hi[0], p->hi[1], p->hi[2], p->thickness,
+                         100.0 * p->held, p->cells);
+            }
+            if (cs.nthin > ST_CLEAN_MAX_THIN)
+                tool_say(&t, final ? 1 : 2, "%s: warning: %zu more parts too thin",
+                         in_name, cs.nthin - ST_CLEAN_MAX_THIN);
+        }
+        if (!auto_cells)
+            break;
+        if (cs.nthin == 0) {
+            tool_say(&t, 1, "--cells auto: %zu cells (h %.6g)", cells, h);
+            break;
+        }
+        if (try_i + 1 == n_auto) {
+            tool_say(&t, 1, "%s: warning: --cells auto: parts still too thin at "
+                     "%zu cells, the finest it tries", in_name, cells);
+            break;
+        }
+      }
     } else {
         st_sculpt_params sp = st_sculpt_params_default();
         sp.kind = kind;

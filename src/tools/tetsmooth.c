@@ -37,7 +37,10 @@ static void usage(void)
 "      --iters N        fairing steps (default 3)\n"
 "      --lambda L       lambda*dt of each step, umbrella weights (default 1)\n"
 "      --min-angle A    no move makes a tet's angles worse than A degrees\n"
-"                       (min A, max 180 - A/0.75; default 20)\n"
+"                       (min A, max 180 - A/0.75; default 30)\n"
+"      --interior-quality  the quality pass moves interior vertices only\n"
+"                       (default: boundary vertices too, in their tangent\n"
+"                       plane, then the volume is rescaled)\n"
 "  --fit                pull the boundary onto the surface while the mesh keeps\n"
 "                       enclosing it (Stuart et al. 2013, section 3.3), then\n"
 "                       raise the worst dihedral angles\n"
@@ -70,7 +73,7 @@ static void usage(void)
 }
 
 enum { OPT_FAIR = TOOL_OPT_FIRST, OPT_FIT, OPT_ITERS, OPT_LAMBDA, OPT_MINANGLE, OPT_SURFACE, OPT_OFFSET,
-       OPT_CELL, OPT_STEP, OPT_MAXIT, OPT_QROUNDS, OPT_NOQ };
+       OPT_CELL, OPT_STEP, OPT_MAXIT, OPT_QROUNDS, OPT_NOQ, OPT_INTQ };
 
 typedef struct iter_ctx {
     tool_ctx *t;
@@ -103,6 +106,7 @@ int main(int argc, char *argv[])
         {"iters", required_argument, NULL, OPT_ITERS},
         {"lambda", required_argument, NULL, OPT_LAMBDA},
         {"min-angle", required_argument, NULL, OPT_MINANGLE},
+        {"interior-quality", no_argument, NULL, OPT_INTQ},
         {"surface", required_argument, NULL, OPT_SURFACE},
         {"offset", required_argument, NULL, OPT_OFFSET},
         {"cell-width", required_argument, NULL, OPT_CELL},
@@ -171,6 +175,10 @@ int main(int argc, char *argv[])
             gp.quality_rounds = (int)n;
             fp.quality_rounds = (int)n;
             break;
+        case OPT_INTQ:
+            fp.boundary_quality = 0;
+            fair_only = 1;
+            break;
         case OPT_NOQ:
             gp.quality = 0;
             fp.quality_rounds = 0;
@@ -195,7 +203,7 @@ int main(int argc, char *argv[])
         return tool_usage_error(&t, "--surface, --offset, --cell-width, --step and --max-iters "
                                     "go with --fit");
     if (mode == 2 && fair_only)
-        return tool_usage_error(&t, "--iters, --lambda and --min-angle go with --fair");
+        return tool_usage_error(&t, "--iters, --lambda, --min-angle and --interior-quality go with --fair");
     if (noq)
         fp.quality_rounds = 0;   /* whatever the order of the options */
     if (mode == 2 && !surface)

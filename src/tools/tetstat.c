@@ -87,9 +87,15 @@ static void print_json(FILE *f, const char *name, const char *sname,
             "  \"inverted\": %zu, \"degenerate\": %zu,\n"
             "  \"boundary_faces\": %zu, \"interior_faces\": %zu, "
             "\"nonmanifold_faces\": %zu, \"conforming\": %s,\n"
-            "  \"components\": %zu, \"volume\": %s, \"h\": %s",
+            "  \"components\": %zu, \"pinched_edges\": %zu, "
+            "\"pinched_points\": %zu,\n"
+            "  \"nonmanifold_boundary_edges\": %zu, "
+            "\"nonmanifold_boundary_points\": %zu, \"boundary_manifold\": %s,\n"
+            "  \"volume\": %s, \"h\": %s",
             r->inverted, r->degenerate, r->boundary_faces, r->interior_faces,
             r->nonmanifold_faces, yesno(r->conforming), r->components,
+            r->pinched_edges, r->pinched_points, r->nonmanifold_boundary_edges,
+            r->nonmanifold_boundary_points, yesno(r->boundary_manifold),
             tool_json_number(b[0], r->volume), r->has_h ? tool_json_number(b[1], r->h) : "null");
     if (r->has_surface) {
         fprintf(f, ",\n  \"surface\": {\"file\": ");
@@ -167,6 +173,13 @@ static void print_table(FILE *f, const char *name, const char *sname,
     ROW("non-manifold faces", "%zu", r->nonmanifold_faces);
     ROW("conforming", "%s", r->conforming ? "yes" : "no   <- NOT CONFORMING");
     ROW("components", "%zu", r->components);
+    ROW("pinched edges", "%zu%s", r->pinched_edges,
+        r->pinched_edges ? "   <- TETS MEET ONLY ALONG AN EDGE" : "");
+    ROW("pinched points", "%zu%s", r->pinched_points,
+        r->pinched_points ? "   <- TETS MEET ONLY AT A POINT OR EDGE" : "");
+    ROW("non-manifold boundary edges", "%zu", r->nonmanifold_boundary_edges);
+    ROW("non-manifold boundary points", "%zu", r->nonmanifold_boundary_points);
+    ROW("boundary manifold", "%s", r->boundary_manifold ? "yes" : "no   <- NOT MANIFOLD");
     ROW("volume", "%.9g", r->volume);
     if (r->has_h)
         ROW("lattice h", "%.9g", r->h);

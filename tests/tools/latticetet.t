@@ -67,4 +67,70 @@ expect_fail "--cells and -h together" 2 "exclude" latticetet --density 0.5 --cel
 expect_fail "a bad --seed" 2 "seed" latticetet --density 0.5 --seed -3 s.vdb
 expect_fail "an output format it cannot write" 2 "format" latticetet --density 0.5 -o m.xyz s.vdb
 
+# Issue 24: one face-connected piece, no pinch, a manifold boundary, at
+# every size; the fairing keeps the angles in [30, 140] and the volume.
+cat > pieces.py <<'PY'
+import json, sys
+r = json.load(sys.stdin)
+want = int(sys.argv[1])
+assert r["components"] == want, r["components"]
+assert r["pinched_edges"] == 0 and r["pinched_points"] == 0, r
+assert r["boundary_manifold"], r
+if len(sys.argv) > 2:
+    assert r["min_dihedral"] >= 30 and r["max_dihedral"] <= 140, r
+    v0 = float(sys.argv[2])
+    assert abs(r["volume"] / v0 - 1) < 0.01, (r["volume"], v0)
+print(r["tets"], r["components"])
+PY
+for n in 8 13 21 34 40; do
+    latticetet --density 0.5 --cells $n -o p$n.vtu s.vdb
+    check "density at $n cells: one piece, no pinch, manifold boundary" \
+        sh -c "tetstat --json p$n.vtu | $PYVTK pieces.py 1"
+done
+v0=$(tetstat --json p21.vtu | $PYVTK -c 'import json,sys; print(json.load(sys.stdin)["volume"])')
+check "tetsmooth --fair at 21 cells: angles in [30, 140], volume within 1%" \
+    sh -c "tetsmooth --fair p21.vtu | tetstat --json - | $PYVTK pieces.py 1 $v0"
+check "--no-repair is the paper's rule alone: the bunny at 34 cells pinches" \
+    sh -c "latticetet --density 0.5 --no-repair --cells 34 s.vdb | tetstat --json - |
+           $PYVTK -c 'import json,sys; r=json.load(sys.stdin); assert r[\"pinched_points\"] or r[\"components\"] > 1 or not r[\"boundary_manifold\"], r'"
+
+# A plate 0.12 thick in a 3 x 3 box: too thin at 6 cells, said with the
+# --cells that holds it; held there.
+cat > plate.obj <<'OBJ'
+v 0 0 0
+v 3 0 0
+v 3 3 0
+v 0 3 0
+v 0 0 0.12
+v 3 0 0.12
+v 3 3 0.12
+v 0 3 0.12
+f 1 3 2
+f 1 4 3
+f 5 6 7
+f 5 7 8
+f 1 2 6
+f 1 6 5
+f 2 3 7
+f 2 7 6
+f 3 4 8
+f 3 8 7
+f 4 1 5
+f 4 5 8
+OBJ
+soupdist -r 96 plate.obj 2>/dev/null | soupsign -o plate.vdb
+check "a thin plate at 6 cells: the warning says where, how thin, which --cells" \
+    sh -c "latticetet --density 0.5 --cells 6 -o plate6.vtu plate.vdb 2> plate6.log &&
+           grep -q '^latticetet: plate.vdb: warning: a part of the pseudo volume is too thin.* thick, .*--cells [0-9]* would hold it' plate6.log"
+cells=$(sed -n 's/.*--cells \([0-9]*\) would hold it.*/\1/p' plate6.log | head -1)
+check "the plate at the suggested --cells ($cells): no warning, one piece" \
+    sh -c "latticetet --density 0.5 --cells '$cells' -o platek.vtu plate.vdb 2> platek.log &&
+           ! grep -q warning platek.log && tetstat --json platek.vtu | $PYVTK pieces.py 1"
+check "--cells auto on the plate: the first size that holds it, said, no warning" \
+    sh -c "latticetet --density 0.5 --cells auto -o platea.vtu plate.vdb 2> platea.log &&
+           grep -q '^latticetet: --cells auto: [0-9]* cells' platea.log &&
+           ! grep -q warning platea.log && tetstat --json platea.vtu | $PYVTK pieces.py 1"
+expect_fail "--cells auto is for --density" 2 "auto" \
+    latticetet --sculpt --surface plate.obj --cells auto plate.vdb
+
 done_testing
