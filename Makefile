@@ -38,14 +38,21 @@ endif
 CC ?= cc
 CXX ?= c++
 OMPLIB ?= -lgomp
-# -ffp-contract=off: fused multiply-adds would change rounding behind the
-# back of the error bounds in the predicates and the exact distances.
+# IEEE double as the predicates' error bounds assume, whatever the user's
+# CFLAGS say (so these come after them: the last flag wins). -ffp-contract=off:
+# fused multiply-adds would change rounding behind the back of the error
+# bounds in the predicates and the exact distances; the rest undo
+# -ffast-math, -Ofast and their parts (src/fpenv.h refuses to compile under
+# the ones a macro shows, for builds that do not go through this file).
+FP_EXACT := -fno-fast-math -fno-unsafe-math-optimizations -fno-associative-math \
+            -fno-reciprocal-math -fno-finite-math-only -fsigned-zeros -ffp-contract=off
 WARN := -Wall -Wextra -Wshadow -Wpointer-arith -Wformat=2 -Wundef
 CFLAGS_ALL := -std=c11 -D_POSIX_C_SOURCE=200809L $(OPT) $(WARN) -Wstrict-prototypes \
-              -ffp-contract=off -fno-fast-math -fopenmp -Iinclude -MMD -MP \
-              -DSOUPTET_VERSION='"$(VERSION)"' $(CFLAGS)
-CXXFLAGS_ALL := -std=c++17 $(OPT) -Wall -Wextra -ffp-contract=off -fopenmp -Iinclude \
-                -I/usr/include/vtk-9.1 -MMD -MP -DSOUPTET_VERSION='"$(VERSION)"' $(CXXFLAGS)
+              -fopenmp -Iinclude -MMD -MP \
+              -DSOUPTET_VERSION='"$(VERSION)"' $(CFLAGS) $(FP_EXACT)
+CXXFLAGS_ALL := -std=c++17 $(OPT) -Wall -Wextra -fopenmp -Iinclude \
+                -I/usr/include/vtk-9.1 -MMD -MP -DSOUPTET_VERSION='"$(VERSION)"' $(CXXFLAGS) \
+                $(FP_EXACT)
 LIBS := -lopenvdb -ltbb -lImath-3_1 \
         -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
         -lvtkCommonDataModel-9.1 -lvtkCommonMath-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1 \

@@ -42,6 +42,7 @@
  * 0.01% (8, 12 and 16 cells), so 20 is the default.
  */
 #include "smooth_internal.h"
+#include "fpenv.h"
 
 #include "souptet/mem.h"
 #include "souptet/smooth.h"

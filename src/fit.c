@@ -67,6 +67,7 @@
  * depend on the thread count.
  */
 #include "smooth_internal.h"
+#include "fpenv.h"
 
 #include "souptet/isect.h"
 #include "souptet/mem.h"

@@ -29,6 +29,7 @@
  * different line).
  */
 #include "souptet/sign.h"
+#include "fpenv.h"
 #include "souptet/mem.h"
 #include "souptet/bvh.h"
 #include "souptet/isect.h"

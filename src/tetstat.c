@@ -10,6 +10,7 @@
  * thread count.
  */
 #include "souptet/tetstat.h"
+#include "fpenv.h"
 #include "souptet/bvh.h"
 #include "souptet/enclose.h"
 #include "souptet/geom.h"
