@@ -530,7 +530,9 @@ st_status st_fair(st_tetmesh *m, const st_fair_params *pp, st_fair_stats *stats,
             ne++;
         }
         double h = ne ? len / (double)ne : 1.0;
-        st.quality_moves = sm_quality_interior(sm, h, p.quality_rounds, 35.0);
+        s = sm_quality_interior(sm, h, p.quality_rounds, 35.0, &st.quality_moves, err);
+        if (s)
+            goto done;
     }
     st_progress_report(prog, "fair", 1.0);
     st.volume_after = sm_boundary_volume(sm, m->xyz);
