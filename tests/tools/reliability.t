@@ -297,4 +297,24 @@ else
     skip "limits checked before allocating (ulimit -v)" "ulimit -v $VLIM does not leave room to run (a sanitizer build?)"
 fi
 
+# ---- durable output ----------------------------------------------------
+# The temporary is fsync'ed before the rename and the directory after it
+# (a power cut then leaves the old file or the whole new one), for a
+# stream writer (soupwrap -> .obj) and a library that writes by name (VTK
+# -> .vtu). strace shows the order of the calls.
+durable() {
+    name=$1 target=$2
+    shift 2
+    strace -f -e trace=fsync,fdatasync,rename,renameat,renameat2 -o "$WORK/trace" "$@" \
+        >/dev/null 2>"$WORK/.err"
+    awk -v t="\"$target\"" '
+        /fsync\(|fdatasync\(/ && /= 0/ { if (state == 0) state = 1; else if (state == 2) state = 3 }
+        /rename/ && index($0, t) && /= 0/ { if (state == 1) state = 2 }
+        END { exit state == 3 ? 0 : 1 }' "$WORK/trace"
+    ok $? "$name: fsync, rename into place, fsync of the directory"
+}
+durable "soupwrap -o .obj" w.obj soupwrap -q -o w.obj s.vdb
+durable "tetsmooth -o .vtu (written by VTK)" f.vtu sh -c \
+    "latticetet -q --density 0.5 --cells 6 -o d6.vtu s.vdb && exec tetsmooth -q --fair -o f.vtu d6.vtu"
+
 done_testing
