@@ -7,6 +7,7 @@
 #   make install PREFIX=/usr/local DESTDIR=
 #   make fuzz [FUZZ_SECONDS=60] [FUZZ_RUNS=N]  libFuzzer on every reader (build-fuzz/)
 #   make config=debug|sanitize ...   (objects go to build/ or build-<config>/)
+#   make config=tsan check   the threaded tests under ThreadSanitizer (clang)
 
 config ?= release
 PREFIX ?= /usr/local
@@ -31,8 +32,17 @@ else ifeq ($(config),fuzz)
   OMPLIB := -lomp
   OPT := -O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer \
          -fno-sanitize-recover=undefined
+else ifeq ($(config),tsan)
+  # ThreadSanitizer over the threaded code (make config=tsan check): clang
+  # and LLVM's OpenMP runtime, whose Archer tool tells TSan about OpenMP's
+  # barriers and reductions (GCC's libgomp would give false reports).
+  BUILD := build-tsan
+  CC := clang
+  CXX := clang++
+  OMPLIB := -lomp
+  OPT := -O1 -g -fsanitize=thread -fno-omit-frame-pointer
 else
-  $(error config must be release, debug, sanitize or fuzz)
+  $(error config must be release, debug, sanitize, fuzz or tsan)
 endif
 
 CC ?= cc
@@ -141,11 +151,25 @@ setup:
 
 # The README's test command. Unit tests are TAP programs; tool tests are
 # TAP shell scripts; prove runs them all and prints the count.
+# The unit tests of the modules with OpenMP loops, run under TSan with 3
+# threads (more than the 2 cores, so threads interleave), Archer loaded.
+TSAN_TESTS := test_dist test_sign test_holes test_shells test_mincut test_lattice \
+              test_sculpt test_fair test_fit test_enclose test_embed test_tetstat \
+              test_tetmesh test_solid test_soupinfo test_wrap
+ifeq ($(config),tsan)
+check:
+	@scripts/setup --fuzz
+	$(MAKE) --no-print-directory $(TSAN_TESTS:%=$(BUILD)/tests/%)
+	OMP_NUM_THREADS=3 OMP_TOOL_LIBRARIES=$$(clang -print-resource-dir)/../../libarcher.so \
+	  TSAN_OPTIONS="halt_on_error=1 ignore_noninstrumented_modules=1 suppressions=$(CURDIR)/tests/tsan.supp" \
+	  prove --exec '' --timer $(TSAN_TESTS:%=$(BUILD)/tests/%)
+else
 check: setup
 	$(MAKE) --no-print-directory all
 	SOUPTET_BIN=$(CURDIR)/$(BUILD)/bin SOUPTET_TESTBIN=$(CURDIR)/$(BUILD)/tests \
 	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
 	  prove --exec '' --timer $(TEST_BIN) $(sort $(wildcard tests/tools/*.t))
+endif
 
 test: check
 
@@ -177,6 +201,6 @@ uninstall:
 	rm -f $(TOOLS:%=$(DESTDIR)$(PREFIX)/share/man/man1/%.1) $(DESTDIR)$(PREFIX)/share/man/man7/souptet.7
 
 clean:
-	rm -rf build build-debug build-sanitize build-fuzz
+	rm -rf build build-debug build-sanitize build-fuzz build-tsan
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
