@@ -8,6 +8,7 @@
 #   make install PREFIX=/usr/local DESTDIR=
 #   make fuzz [FUZZ_SECONDS=60] [FUZZ_RUNS=N]  libFuzzer on every reader (build-fuzz/)
 #   make config=debug|sanitize ...   (objects go to build/ or build-<config>/)
+#   make config=tsan check   the threaded tests under ThreadSanitizer (clang)
 
 config ?= release
 PREFIX ?= /usr/local
@@ -32,21 +33,37 @@ else ifeq ($(config),fuzz)
   OMPLIB := -lomp
   OPT := -O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer \
          -fno-sanitize-recover=undefined
+else ifeq ($(config),tsan)
+  # ThreadSanitizer over the threaded code (make config=tsan check): clang
+  # and LLVM's OpenMP runtime, whose Archer tool tells TSan about OpenMP's
+  # barriers and reductions (GCC's libgomp would give false reports).
+  BUILD := build-tsan
+  CC := clang
+  CXX := clang++
+  OMPLIB := -lomp
+  OPT := -O1 -g -fsanitize=thread -fno-omit-frame-pointer
 else
-  $(error config must be release, debug, sanitize or fuzz)
+  $(error config must be release, debug, sanitize, fuzz or tsan)
 endif
 
 CC ?= cc
 CXX ?= c++
 OMPLIB ?= -lgomp
-# -ffp-contract=off: fused multiply-adds would change rounding behind the
-# back of the error bounds in the predicates and the exact distances.
+# IEEE double as the predicates' error bounds assume, whatever the user's
+# CFLAGS say (so these come after them: the last flag wins). -ffp-contract=off:
+# fused multiply-adds would change rounding behind the back of the error
+# bounds in the predicates and the exact distances; the rest undo
+# -ffast-math, -Ofast and their parts (src/fpenv.h refuses to compile under
+# the ones a macro shows, for builds that do not go through this file).
+FP_EXACT := -fno-fast-math -fno-unsafe-math-optimizations -fno-associative-math \
+            -fno-reciprocal-math -fno-finite-math-only -fsigned-zeros -ffp-contract=off
 WARN := -Wall -Wextra -Wshadow -Wpointer-arith -Wformat=2 -Wundef
 CFLAGS_ALL := -std=c11 -D_POSIX_C_SOURCE=200809L $(OPT) $(WARN) -Wstrict-prototypes \
-              -ffp-contract=off -fno-fast-math -fopenmp -Iinclude -MMD -MP \
-              -DSOUPTET_VERSION='"$(VERSION)"' $(CFLAGS)
-CXXFLAGS_ALL := -std=c++17 $(OPT) -Wall -Wextra -ffp-contract=off -fopenmp -Iinclude \
-                -I/usr/include/vtk-9.1 -MMD -MP -DSOUPTET_VERSION='"$(VERSION)"' $(CXXFLAGS)
+              -fopenmp -Iinclude -MMD -MP \
+              -DSOUPTET_VERSION='"$(VERSION)"' $(CFLAGS) $(FP_EXACT)
+CXXFLAGS_ALL := -std=c++17 $(OPT) -Wall -Wextra -fopenmp -Iinclude \
+                -I/usr/include/vtk-9.1 -MMD -MP -DSOUPTET_VERSION='"$(VERSION)"' $(CXXFLAGS) \
+                $(FP_EXACT)
 LIBS := -lopenvdb -ltbb -lImath-3_1 \
         -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
         -lvtkCommonDataModel-9.1 -lvtkCommonMath-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1 \
@@ -135,11 +152,25 @@ setup:
 
 # The README's test command. Unit tests are TAP programs; tool tests are
 # TAP shell scripts; prove runs them all and prints the count.
+# The unit tests of the modules with OpenMP loops, run under TSan with 3
+# threads (more than the 2 cores, so threads interleave), Archer loaded.
+TSAN_TESTS := test_dist test_sign test_holes test_shells test_mincut test_lattice \
+              test_sculpt test_fair test_fit test_enclose test_embed test_tetstat \
+              test_tetmesh test_solid test_soupinfo test_wrap
+ifeq ($(config),tsan)
+check:
+	@scripts/setup --fuzz
+	$(MAKE) --no-print-directory $(TSAN_TESTS:%=$(BUILD)/tests/%)
+	OMP_NUM_THREADS=3 OMP_TOOL_LIBRARIES=$$(clang -print-resource-dir)/../../libarcher.so \
+	  TSAN_OPTIONS="halt_on_error=1 ignore_noninstrumented_modules=1 suppressions=$(CURDIR)/tests/tsan.supp" \
+	  prove --exec '' --timer $(TSAN_TESTS:%=$(BUILD)/tests/%)
+else
 check: setup
 	$(MAKE) --no-print-directory all
 	SOUPTET_BIN=$(CURDIR)/$(BUILD)/bin SOUPTET_TESTBIN=$(CURDIR)/$(BUILD)/tests \
 	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
 	  prove --exec '' --timer $(TEST_BIN) $(sort $(wildcard tests/tools/*.t))
+endif
 
 test: check
 
@@ -175,6 +206,6 @@ uninstall:
 	rm -f $(TOOLS:%=$(DESTDIR)$(PREFIX)/share/man/man1/%.1) $(DESTDIR)$(PREFIX)/share/man/man7/souptet.7
 
 clean:
-	rm -rf build build-debug build-sanitize build-fuzz
+	rm -rf build build-debug build-sanitize build-fuzz build-tsan
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -16,6 +16,7 @@
  * leaf scans of the queries recompute it from the soup.
  */
 #include "souptet/bvh.h"
+#include "fpenv.h"
 #include "souptet/geom.h"
 #include "souptet/isect.h"
 #include "souptet/mem.h"

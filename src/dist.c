@@ -20,6 +20,7 @@
  * on one thread, in one fixed order.
  */
 #include "souptet/dist.h"
+#include "fpenv.h"
 #include "souptet/geom.h"
 #include "souptet/mem.h"
 

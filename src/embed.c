@@ -11,6 +11,7 @@
  * holds a point is always in that point's bin: no tolerance is needed.
  */
 #include "souptet/embed.h"
+#include "fpenv.h"
 #include "souptet/isect.h"
 #include "souptet/mem.h"
 #include "souptet/outfile.h"

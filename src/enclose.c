@@ -17,6 +17,7 @@
  * reductions only, so the results do not depend on the thread count.
  */
 #include "souptet/enclose.h"
+#include "fpenv.h"
 #include "souptet/mem.h"
 
 #include <math.h>

@@ -42,6 +42,7 @@
  * 0.01% (8, 12 and 16 cells), so 20 is the default.
  */
 #include "smooth_internal.h"
+#include "fpenv.h"
 
 #include "souptet/mem.h"
 #include "souptet/smooth.h"
@@ -534,9 +535,12 @@ st_status st_fair(st_tetmesh *m, const st_fair_params *pp, st_fair_stats *stats,
             ne++;
         }
         double h = ne ? len / (double)ne : 1.0;
-        st.quality_moves = p.boundary_quality
-            ? sm_quality_fair(sm, h, p.quality_rounds, FAIR_QUALITY_GOAL)
-            : sm_quality_interior(sm, h, p.quality_rounds, FAIR_QUALITY_GOAL);
+        s = p.boundary_quality
+            ? sm_quality_fair(sm, h, p.quality_rounds, FAIR_QUALITY_GOAL, &st.quality_moves, err)
+            : sm_quality_interior(sm, h, p.quality_rounds, FAIR_QUALITY_GOAL, &st.quality_moves,
+                                  err);
+        if (s)
+            goto done;
         /* tangent moves keep the volume to first order: what the curvature
          * costs goes back by the rescale (its moves keep the floor) */
         if (p.boundary_quality)

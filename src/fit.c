@@ -67,6 +67,7 @@
  * depend on the thread count.
  */
 #include "smooth_internal.h"
+#include "fpenv.h"
 
 #include "souptet/isect.h"
 #include "souptet/mem.h"
@@ -828,8 +829,9 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
     return 0;
 }
 
-static void quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
-                         st_fit_stats *st, double t0)
+/* ST_OK, or ST_ENOMEM (err set) before any vertex moved. */
+static st_status quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
+                              st_fit_stats *st, double t0, st_error *err)
 {
     sm_mesh *sm = &c->sm;
     st_tetmesh *m = sm->m;
@@ -838,7 +840,8 @@ static void quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
     if (!mark || dirty_init(&dy, sm->nv)) {
         free(mark);
         dirty_free(&dy);
-        return;
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory for the quality pass (%zu vertices)", sm->nv);
     }
     for (int round = 0; round < p->quality_rounds; round++) {
         memset(mark, 0, sm->nv);
@@ -886,9 +889,11 @@ static void quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
     }
     free(mark);
     dirty_free(&dy);
+    return ST_OK;
 }
 
-size_t sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal)
+st_status sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal,
+                              size_t *moves, st_error *err)
 {
     fit_ctx c;
     memset(&c, 0, sizeof c);
@@ -899,11 +904,13 @@ size_t sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal)
     p.quality_goal = goal;
     st_fit_stats st;
     memset(&st, 0, sizeof st);
-    quality_pass(&c, &p, NULL, &st, 0.0);
-    return st.quality_moves;
+    st_status rc = quality_pass(&c, &p, NULL, &st, 0.0, err);
+    *moves = st.quality_moves;
+    return rc;
 }
 
-size_t sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal)
+st_status sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal, size_t *moves,
+                          st_error *err)
 {
     fit_ctx c;
     memset(&c, 0, sizeof c);
@@ -915,8 +922,9 @@ size_t sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal)
     p.quality_goal = goal;
     st_fit_stats st;
     memset(&st, 0, sizeof st);
-    quality_pass(&c, &p, NULL, &st, 0.0);
-    return st.quality_moves;
+    st_status rc = quality_pass(&c, &p, NULL, &st, 0.0, err);
+    *moves = st.quality_moves;
+    return rc;
 }
 
 /* ---- entry points ----------------------------------------------------- */
@@ -1062,7 +1070,8 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
     st.seconds_fit = sm_now() - t0;
     if (p.quality) {
         st_progress_report(prog, "quality", 0.0);
-        quality_pass(&c, &p, dist, &st, t0);
+        if ((rc = quality_pass(&c, &p, dist, &st, t0, err)))
+            goto done;
         ds = boundary_distances(&c, dist);
     }
     st.within_offset = ds.within;
@@ -1096,9 +1105,10 @@ st_status st_enclosure_count(const st_tetmesh *m, const st_soup *s,
 {
     st_enclosure e;
     st_status rc = st_enclosure_compute(&e, m, s, bvh, NULL, NULL, err);
+    /* On error SIZE_MAX, which no caller can read as "encloses". */
     if (verts_outside)
-        *verts_outside = rc ? 0 : e.vertices_outside;
+        *verts_outside = rc ? SIZE_MAX : e.vertices_outside;
     if (tris_crossing)
-        *tris_crossing = rc ? 0 : e.crossing_triangles;
+        *tris_crossing = rc ? SIZE_MAX : e.crossing_triangles;
     return rc;
 }

@@ -9,6 +9,7 @@
  * vertices: a vertex is the clamped end of an edge).
  */
 #include "souptet/geom.h"
+#include "fpenv.h"
 
 #include <math.h>
 

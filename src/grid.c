@@ -1,5 +1,6 @@
 /* grid.c - dense voxel grids (see grid.h). */
 #include "souptet/grid.h"
+#include "fpenv.h"
 #include "souptet/mem.h"
 
 #include <math.h>

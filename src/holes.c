@@ -13,6 +13,7 @@
  *      bounding volume hierarchy finds them).
  */
 #include "souptet/holes.h"
+#include "fpenv.h"
 #include "souptet/geom.h"
 #include "souptet/mem.h"
 #include "souptet/bvh.h"

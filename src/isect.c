@@ -18,6 +18,7 @@
  * all of them orders them along the line.
  */
 #include "souptet/isect.h"
+#include "fpenv.h"
 #include "souptet/pred.h"
 
 #include <math.h>

@@ -14,6 +14,7 @@
  * vertex id (linear time, no hashing, deterministic).
  */
 #include "souptet/lattice.h"
+#include "fpenv.h"
 #include "souptet/isect.h"
 #include "souptet/mem.h"
 

@@ -21,6 +21,7 @@
  * (nbr(v, a), a ^ 1).
  */
 #include "souptet/mincut.h"
+#include "fpenv.h"
 #include "souptet/mem.h"
 
 #include <limits.h>

@@ -3,12 +3,17 @@
  *
  * The temporary file is created with mkstemp in the target's directory, so
  * rename(2) replaces the target in one step and a crash or a signal never
- * leaves a half-written file under the target's name.
+ * leaves a half-written file under the target's name. Durability: the
+ * temporary is fsync'ed before the rename (else after a power cut the
+ * rename may be on disk and the data not: an empty or partial file under
+ * the target's name) and the directory after it (else the rename itself
+ * may be lost).
  */
 #include "souptet/outfile.h"
 #include "souptet/mem.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -118,6 +123,57 @@ st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
     return ST_OK;
 }
 
+/* The errno of a stream whose error flag is set: earlier writes may have
+ * failed and errno been overwritten since (it then said "write failed:
+ * Success"), and glibc does not retry a failed buffer on fflush. So ask
+ * the file again: fsync reports errors of writes the kernel accepted, and
+ * one more byte at the end fails as the lost write did (ENOSPC, EFBIG,
+ * EDQUOT; the temporary is removed afterwards anyway). 0 when the stream
+ * is fine. */
+static int stream_errno(FILE *fp)
+{
+    errno = 0;
+    if (fflush(fp) != 0 && errno)
+        return errno;
+    if (!ferror(fp))
+        return 0;
+    int fd = fileno(fp);
+    errno = 0;
+    if (fsync(fd) != 0 && errno)
+        return errno;
+    off_t end = lseek(fd, 0, SEEK_END);
+    errno = 0;
+    if (end >= 0 && pwrite(fd, "", 1, end) < 0 && errno)
+        return errno;
+    return EIO;   /* the cause is gone; say "Input/output error" */
+}
+
+/* fsync a file by name (written by a library that closed it). */
+static int sync_path(const char *path, int dir)
+{
+    int fd = open(path, O_RDONLY | (dir ? O_DIRECTORY : 0));
+    if (fd < 0)
+        return errno;
+    int e = fsync(fd) != 0 ? errno : 0;
+    close(fd);
+    /* Some file systems cannot sync a directory: nothing more to do. */
+    if (dir && (e == EINVAL || e == EBADF))
+        e = 0;
+    return e;
+}
+
+/* The directory of path ("." when it has none), into buf. */
+static void dir_of(char *buf, size_t n, const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(buf, n, ".");
+    else if (slash == path)
+        snprintf(buf, n, "/");
+    else
+        snprintf(buf, n, "%.*s", (int)(slash - path), path);
+}
+
 st_status st_outfile_commit(st_outfile *o, st_error *err)
 {
     if (!o->path) {             /* stdout */
@@ -130,18 +186,27 @@ st_status st_outfile_commit(st_outfile *o, st_error *err)
                                 "write failed: %s",
                                 e ? strerror(e) : "I/O error");
         }
+        /* A pipe or terminal cannot be synced (EINVAL); a redirected
+         * file is not ours to sync either: the shell made it. */
         o->fp = NULL;
         return ST_OK;
     }
     if (o->fp) {
-        int bad = ferror(o->fp);
-        int e = errno;
-        if (fclose(o->fp) != 0 && !bad) {
-            bad = 1;
+        int e = stream_errno(o->fp);
+        if (!e && fsync(fileno(o->fp)) != 0)
             e = errno;
-        }
+        if (fclose(o->fp) != 0 && !e)
+            e = errno ? errno : EIO;
         o->fp = NULL;
-        if (bad) {
+        if (e) {
+            st_error_set(err, ST_EIO, o->path, 0, "write failed: %s",
+                         strerror(e));
+            st_outfile_abort(o);
+            return ST_EIO;
+        }
+    } else {
+        int e = sync_path(o->tmp, 0);
+        if (e) {
             st_error_set(err, ST_EIO, o->path, 0, "write failed: %s",
                          strerror(e));
             st_outfile_abort(o);
@@ -157,10 +222,18 @@ st_status st_outfile_commit(st_outfile *o, st_error *err)
     }
     pending_remove(o->slot);
     free(o->tmp);
-    free(o->path);
-    o->tmp = o->path = NULL;
+    o->tmp = NULL;
     o->slot = -1;
-    return ST_OK;
+    char dir[4096];
+    dir_of(dir, sizeof dir, o->path);
+    int e = sync_path(dir, 1);
+    st_status rc = ST_OK;
+    if (e)   /* the file is whole, but its name may not survive a crash */
+        rc = st_error_set(err, ST_EIO, o->path, 0, "cannot sync its directory: %s",
+                          strerror(e));
+    free(o->path);
+    o->path = NULL;
+    return rc;
 }
 
 void st_outfile_abort(st_outfile *o)

@@ -2,6 +2,7 @@
  * pipeline.c - distance, signs, candidates, the best one (see pipeline.h).
  */
 #include "souptet/pipeline.h"
+#include "fpenv.h"
 
 #include "souptet/bvh.h"
 #include "souptet/pseudo.h"

@@ -110,6 +110,7 @@
  * a relative 2^-52 of it.
  */
 #include "souptet/pred.h"
+#include "fpenv.h"
 
 #include <float.h>
 #include <math.h>

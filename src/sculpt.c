@@ -51,6 +51,7 @@
  * greedy) and is counted in clusters_greedy.
  */
 #include "souptet/sculpt.h"
+#include "fpenv.h"
 #include "souptet/isect.h"
 #include "souptet/mem.h"
 

@@ -12,6 +12,7 @@
  *      whether the whole piece is flipped once more, to positive volume.
  */
 #include "souptet/shells.h"
+#include "fpenv.h"
 #include "souptet/edges.h"
 #include "souptet/mem.h"
 #include "souptet/meta.h"

@@ -29,6 +29,7 @@
  * different line).
  */
 #include "souptet/sign.h"
+#include "fpenv.h"
 #include "souptet/mem.h"
 #include "souptet/bvh.h"
 #include "souptet/isect.h"
@@ -1218,12 +1219,18 @@ st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
     const long ntiles = tx * ty * tz;
     size_t nchanged = 0;
     int oom = 0;
+    /* The voxels read as neighbours may lie in another thread's tile, so
+     * no voxel is rewritten while the tiles are decided: each thread lists
+     * the sign flips it found and applies them after the loop's barrier.
+     * (A flipped voxel is in the band, which no neighbour test uses, so
+     * the answers are the same; this removes the data race.) */
     #pragma omp parallel reduction(+ : nchanged)
     {
         refine_buf b = {NULL, 0, 0, 0, soup};
         uint32_t *sel = NULL;   /* the candidates (in b) near the voxel */
         size_t nsel = 0, selcap = 0;
         int seloom = 0;
+        size_t *flip = NULL, nflip = 0, flipcap = 0;
         #pragma omp for schedule(dynamic, 4)
         for (long t = 0; t < ntiles; t++) {
             if (b.oom || seloom)
@@ -1316,11 +1323,27 @@ st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
                         else if (nout && !nin)
                             inside = 0;
                         if (inside != (dv < 0)) {
-                            g->data[idx] = st_grid_signed_value(dv, inside);
-                            nchanged++;
+                            if (nflip == flipcap) {
+                                size_t cap = flipcap ? 2 * flipcap : 256;
+                                size_t *nf = st_realloc_array(flip, cap, sizeof *nf);
+                                if (!nf) {
+                                    seloom = 1;
+                                    continue;
+                                }
+                                flip = nf;
+                                flipcap = cap;
+                            }
+                            flip[nflip++] = idx;
                         }
                     }
         }
+        /* (the implicit barrier of the loop above: every read is done) */
+        for (size_t f = 0; f < nflip; f++) {
+            float dv = g->data[flip[f]];
+            g->data[flip[f]] = st_grid_signed_value(dv, !(dv < 0));
+        }
+        nchanged += nflip;
+        free(flip);
         if (b.oom || seloom) {
             #pragma omp atomic write
             oom = 1;

@@ -73,12 +73,15 @@ double sm_boundary_volume(const sm_mesh *sm, const double *xyz);
 
 /* The quality pass of st_fit (fit.c) without a surface: only interior
  * vertices move, so the volume stays exactly as it is; h scales the trial
- * steps. Returns the number of moves. */
-size_t sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal);
+ * steps. *moves gets the number of moves. ST_OK, or ST_ENOMEM (nothing
+ * moved). */
+st_status sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal,
+                              size_t *moves, st_error *err);
 /* The same pass with the boundary vertices too, each only in the plane
  * across its boundary faces' area-weighted normal (the volume's gradient
- * in it: first-order volume kept). Returns the number of moves. */
-size_t sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal);
+ * in it: first-order volume kept). As sm_quality_interior otherwise. */
+st_status sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal, size_t *moves,
+                          st_error *err);
 
 /* Monotonic seconds. */
 double sm_now(void);

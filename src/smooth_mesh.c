@@ -8,6 +8,7 @@
  * gives the same result as moving them one by one, in any thread order.
  */
 #include "smooth_internal.h"
+#include "fpenv.h"
 
 #include "souptet/geom.h"
 #include "souptet/mem.h"

@@ -1,6 +1,7 @@
 /* solid.c - exact ray parity and winding numbers at voxel centers (see
  * solid.h). */
 #include "souptet/solid.h"
+#include "fpenv.h"
 
 #include "souptet/mem.h"
 #include "souptet/pred.h"

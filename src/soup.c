@@ -6,6 +6,7 @@
  * the unchecked appends.
  */
 #include "souptet/soup.h"
+#include "fpenv.h"
 #include "souptet/mem.h"
 #include "soup_parse.h"
 

@@ -9,6 +9,7 @@
  * cursor.
  */
 #include "soup_parse.h"
+#include "fpenv.h"
 
 #include <math.h>
 

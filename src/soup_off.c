@@ -11,6 +11,7 @@
  * allocated from them (the soup grows with the records actually read).
  */
 #include "soup_parse.h"
+#include "fpenv.h"
 
 #include <math.h>
 

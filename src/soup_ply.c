@@ -11,6 +11,7 @@
  * problems at a byte offset, ascii body problems at a line.
  */
 #include "soup_parse.h"
+#include "fpenv.h"
 #include "souptet/mem.h"
 
 #include <math.h>

@@ -14,6 +14,7 @@
  * count must match the file size exactly.
  */
 #include "soup_parse.h"
+#include "fpenv.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -32,6 +32,7 @@
  * member of its set: pieces are numbered by their first triangle.
  */
 #include "souptet/soupinfo.h"
+#include "fpenv.h"
 #include "souptet/bvh.h"
 #include "souptet/geom.h"
 #include "souptet/isect.h"

@@ -5,6 +5,7 @@
  * assembled explicitly), as PLY's binary_little_endian and STL require.
  */
 #include "souptet/soupwrite.h"
+#include "fpenv.h"
 #include "souptet/geom.h"
 
 #include <errno.h>

@@ -16,6 +16,7 @@
  * cursor over the same buffer that stops at its end.
  */
 #include "souptet/tetformat.h"
+#include "fpenv.h"
 #include "souptet/mem.h"
 #include "souptet/outfile.h"
 #include "soup_parse.h"

@@ -20,6 +20,7 @@
  * same column swaps). This is combinatorial: no predicate is evaluated.
  */
 #include "souptet/tetmesh.h"
+#include "fpenv.h"
 #include "souptet/mem.h"
 #include "souptet/tetqual.h"
 

@@ -17,6 +17,7 @@
  * lose digits, and the only division is by the (doubled, sixfold) volume.
  */
 #include "souptet/tetqual.h"
+#include "fpenv.h"
 #include "souptet/geom.h"
 
 #include <math.h>

@@ -10,6 +10,7 @@
  * thread count.
  */
 #include "souptet/tetstat.h"
+#include "fpenv.h"
 #include "souptet/bvh.h"
 #include "souptet/enclose.h"
 #include "souptet/geom.h"
@@ -504,7 +505,7 @@ st_status st_tetstat_surface(st_tetstat *out, const st_tetmesh *m,
     out->surface_dist_max = NAN;
     out->surface_closed = 0;
     out->surface_volume = out->volume_ratio = NAN;
-    out->has_enclosure = out->encloses = 0;
+    out->has_enclosure = out->encloses = out->enclosure_verified = 0;
     out->vertices_inside = out->crossing_triangles = 0;
     out->fraction_inside = NAN;
     st_status st;
@@ -587,7 +588,11 @@ st_status st_tetstat_surface(st_tetstat *out, const st_tetmesh *m,
         out->vertices_inside = enc.vertices_inside;
         out->fraction_inside = enc.fraction_inside;
         out->crossing_triangles = enc.crossing_triangles;
-        out->encloses = enc.encloses;
+        /* The counts prove enclosure only for a conforming mesh of
+         * positively oriented tets (enclose.h). */
+        out->enclosure_verified = out->inverted == 0 && out->degenerate == 0 &&
+                                  out->nonmanifold_faces == 0;
+        out->encloses = enc.encloses && out->enclosure_verified;
     }
 
     /* Volume of S, when it has one. */

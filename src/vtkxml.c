@@ -37,6 +37,7 @@
  * present.
  */
 #include "vtkxml.h"
+#include "fpenv.h"
 
 #include "souptet/mem.h"
 

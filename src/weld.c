@@ -3,6 +3,7 @@
  * addressing on a hash of the coordinates' bits, compared exactly.
  */
 #include "souptet/weld.h"
+#include "fpenv.h"
 #include "souptet/mem.h"
 
 #include <stdint.h>

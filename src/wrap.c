@@ -14,6 +14,7 @@
  * triangles folded onto each other at an angle share only their edge).
  */
 #include "souptet/wrap.h"
+#include "fpenv.h"
 #include "souptet/bvh.h"
 #include "souptet/geom.h"
 #include "souptet/isect.h"

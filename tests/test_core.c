@@ -6,11 +6,15 @@
 #include "souptet/outfile.h"
 #include "tap.h"
 
+#include <errno.h>
 #include <limits.h>
+#include <signal.h>
+#include <stdio.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -131,6 +135,26 @@ static void test_outfile(void)
     st_outfile_unlink_pending();
     TAP_CHECK(stat(tmp, &st) != 0, "the signal-safe cleanup removes temporaries in flight");
     st_outfile_abort(&o);
+
+    /* A write that failed long before the commit, errno overwritten since
+     * (any library call may): the message still says why, not "Success". */
+    struct rlimit rl0, rl;
+    getrlimit(RLIMIT_FSIZE, &rl0);
+    rl = rl0;
+    rl.rlim_cur = 4096;
+    void (*old_xfsz)(int) = signal(SIGXFSZ, SIG_IGN);
+    TAP_CHECK(setrlimit(RLIMIT_FSIZE, &rl) == 0 && st_outfile_begin(&o, path, 1, &e) == ST_OK,
+              "begin under a 4 KiB file size limit");
+    static char big[65536];
+    memset(big, 'x', sizeof big);
+    size_t nw = fwrite(big, 1, sizeof big, o.fp);
+    errno = 0;
+    st_status cs = st_outfile_commit(&o, &e);
+    setrlimit(RLIMIT_FSIZE, &rl0);
+    signal(SIGXFSZ, old_xfsz);
+    TAP_CHECK(nw < sizeof big && cs == ST_EIO && strstr(e.msg, strerror(EFBIG)) &&
+                  stat(path, &st) == 0 && st.st_size == 6,
+              "an earlier failed write is reported with its errno: %s", e.msg);
     unlink(path);
     rmdir(dir);
 }

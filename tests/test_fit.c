@@ -14,8 +14,10 @@
 #include "souptet/tetqual.h"
 #include "shapes.h"
 #include "tap.h"
+#include "../src/smooth_internal.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #ifdef _OPENMP
@@ -226,21 +228,46 @@ static void test_sphere(void)
     st_soup_free(s);
 }
 
+/* The largest colour set of m: the fit and quality loops run a colour in
+ * parallel only when PAR_CHECKED(its size). */
+static size_t largest_colour(st_tetmesh *m)
+{
+    sm_mesh sm;
+    st_error err;
+    size_t big = 0;
+    if (sm_mesh_build(&sm, m, &err))
+        return 0;
+    for (size_t c = 0; c < sm.ncolours; c++)
+        if (sm.col_off[c + 1] - sm.col_off[c] > big)
+            big = sm.col_off[c + 1] - sm.col_off[c];
+    sm_mesh_free(&sm);
+    return big;
+}
+
 static void test_threads(void)
 {
 #ifdef _OPENMP
     st_soup *s = st_soup_new();
     add_sphere(s, 1.0, 2.0);
-    st_tetmesh *a = ball_mesh(0.5, 0.9), *b = ball_mesh(0.5, 0.9);
+    /* h = 0.25: colour sets of several hundred vertices, so the fit and
+     * quality loops really run on several threads (at h = 0.5 the largest
+     * had 48-81 and every loop ran serially). */
+    st_tetmesh *a = ball_mesh(0.25, 0.9), *b = ball_mesh(0.25, 0.9);
+    size_t big = largest_colour(a);
+    TAP_CHECK(PAR_CHECKED(big), "the largest colour set (%zu vertices) takes the parallel path",
+              big);
     int nt = omp_get_max_threads();
     st_error err;
     st_fit_params p = st_fit_params_default();
     p.quality_rounds = 10;
+    st_fit_stats sa, sb;
     omp_set_num_threads(1);
-    st_status r1 = st_fit(a, s, NULL, &p, NULL, NULL, &err);
+    st_status r1 = st_fit(a, s, NULL, &p, &sa, NULL, &err);
     omp_set_num_threads(3);
-    st_status r2 = st_fit(b, s, NULL, &p, NULL, NULL, &err);
+    st_status r2 = st_fit(b, s, NULL, &p, &sb, NULL, &err);
     omp_set_num_threads(nt);
+    TAP_CHECK(r1 == ST_OK && r2 == ST_OK && sa.moves > 0 && sa.quality_moves > 0,
+              "both fits ran: %zu fit moves, %zu quality moves", sa.moves, sa.quality_moves);
     TAP_CHECK(r1 == ST_OK && r2 == ST_OK && a->npoints == b->npoints &&
                   memcmp(a->xyz, b->xyz, 3 * a->npoints * sizeof(double)) == 0,
               "1 and 3 threads give bit-identical points");
@@ -248,7 +275,7 @@ static void test_threads(void)
     st_tetmesh_free(b);
     st_soup_free(s);
 #else
-    TAP_CHECK(1, "no OpenMP: one thread only");
+    TAP_CHECK(1, "1 and 3 threads give bit-identical points # SKIP no OpenMP");
 #endif
 }
 
@@ -299,6 +326,17 @@ static void test_refusals(void)
     m->tets[1] = t;
     rc = st_fit(m, s, NULL, &p, NULL, NULL, &err);
     TAP_CHECK(rc == ST_EINPUT && strstr(err.msg, "inverted"), "an inverted tet is refused");
+    /* A failed enclosure count cannot read as "encloses" (0 and 0). */
+    st_soup *other = st_soup_new();
+    add_sphere(other, 0.5, 2.0);
+    st_bvh *ob = NULL;
+    size_t vo = 0, tc = 0;
+    rc = st_bvh_build(&ob, other, &err) ? ST_ENOMEM
+                                        : st_enclosure_count(m, s, ob, &vo, &tc, &err);
+    TAP_CHECK(rc != ST_OK && vo == SIZE_MAX && tc == SIZE_MAX,
+              "st_enclosure_count on error: SIZE_MAX vertices out and triangles crossing");
+    st_bvh_free(ob);
+    st_soup_free(other);
     st_tetmesh_free(m);
     st_soup_free(s);
 }

@@ -226,11 +226,26 @@ static void test_surface(void)
     TAP_CHECK(r.surface_closed, "inner box: closed and oriented");
     TAP_NEAR(r.surface_volume, 1, 1e-15, "inner box: volume 1");
     TAP_NEAR(r.volume_ratio, 8, 1e-14, "inner box: volume ratio 8");
-    if (r.has_enclosure) {
-        TAP_CHECK(r.vertices_inside == 8 && r.fraction_inside == 1 &&
-                      r.crossing_triangles == 0 && r.encloses,
-                  "inner box: enclosed, every vertex inside, no crossing");
-    }
+    TAP_CHECK(r.has_enclosure && r.vertices_inside == 8 && r.fraction_inside == 1 &&
+                  r.crossing_triangles == 0 && r.encloses && r.enclosure_verified,
+              "inner box: enclosed, every vertex inside, no crossing");
+
+    /* One tet turned inside out (two corners swapped): it covers the same
+     * points and the counts stay clean, but they no longer prove
+     * enclosure (enclose.h), so it is not reported as enclosing. */
+    uint32_t sw = m->tets[1];
+    m->tets[1] = m->tets[2];
+    m->tets[2] = sw;
+    st_tetstat_mesh(&r, m, &err);
+    TAP_CHECK(r.inverted == 1, "one tet inverted");
+    TAP_CHECK(st_tetstat_surface(&r, m, s, &err) == ST_OK && r.has_enclosure &&
+                  r.vertices_inside == 8 && r.crossing_triangles == 0 &&
+                  !r.enclosure_verified && !r.encloses,
+              "inner box, an inverted tet: clean counts, unverified, not 'encloses'");
+    m->tets[2] = m->tets[1];
+    m->tets[1] = sw;
+    st_tetstat_mesh(&r, m, &err);
+    st_tetstat_surface(&r, m, s, &err);
     st_soup_free(s);
 
     /* A box sticking out of the mesh by 0.25 on +x. */
@@ -241,13 +256,11 @@ static void test_surface(void)
      * boundary (and a triangle centroid there samples it). */
     TAP_NEAR(r.surface_dist_max, 0.75, 1e-15,
              "box sticking out: S -> boundary max 0.75");
-    if (r.has_enclosure) {
-        TAP_CHECK(r.vertices_inside == 4 && r.crossing_triangles > 0 &&
-                      !r.encloses,
-                  "box sticking out: 4 of 8 vertices inside, triangles "
-                  "crossing, does not enclose (%zu, %zu)",
-                  r.vertices_inside, r.crossing_triangles);
-    }
+    TAP_CHECK(r.has_enclosure && r.vertices_inside == 4 && r.crossing_triangles > 0 &&
+                  !r.encloses,
+              "box sticking out: 4 of 8 vertices inside, triangles "
+              "crossing, does not enclose (%zu, %zu)",
+              r.vertices_inside, r.crossing_triangles);
     st_soup_free(s);
 
     /* add_box flips every other triangle: closed but not oriented, so no

@@ -35,8 +35,11 @@ typedef struct st_outfile {
  * created, so a signal never finds one on disk but not in the list. */
 st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
                            st_error *err);
-/* Flush and close (checking for write errors, earlier ones too), then
- * rename tmp to path. On failure the temporary file is removed. For stdout,
+/* Flush, fsync and close (checking for write errors, earlier ones too,
+ * with their errno), then rename tmp to path and fsync path's directory,
+ * so the new file survives a power cut once this returns. On failure
+ * before the rename the temporary file is removed; a failed directory
+ * sync after it is reported (ST_EIO) with the file in place. For stdout,
  * flush it and check its error flag ("<stdout>: write failed: why"). */
 st_status st_outfile_commit(st_outfile *o, st_error *err);
 /* Close and remove the temporary file. Safe after commit and on a zeroed

@@ -154,8 +154,9 @@ st_fit_params st_fit_params_default(void);
  * (each S vertex inside, each boundary face clear of S) keeps holding,
  * and stats report the global counts before and after. Fails with
  * ST_EINPUT on inverted or flat tets, a mesh without tets, or no cell
- * width (neither p->cell_width nor a meta "h" > 0). Not converging is not
- * an error: stats->converged says it. stats and prog may be NULL. */
+ * width (neither p->cell_width nor a meta "h" > 0); ST_ENOMEM when out of
+ * memory, the quality pass's memory included (never a silently skipped
+ * pass). Not converging is not an error: stats->converged says it. stats and prog may be NULL. */
 st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
                  const st_fit_params *p, st_fit_stats *stats,
                  const st_progress *prog, st_error *err);
@@ -163,6 +164,8 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
 /* Count, exactly, the vertices of s (those its triangles use) not in the
  * closed union of m's tets, and the triangles of s that meet a boundary
  * face of m (closed sets: touching counts). Enclosing means both are 0.
+ * On error (ST_ENOMEM, those of st_enclosure_compute) both are SIZE_MAX,
+ * so a caller that ignores the status never reads "encloses".
  * bvh over s may be NULL. Thread-safe. */
 st_status st_enclosure_count(const st_tetmesh *m, const st_soup *s,
                              const st_bvh *bvh, size_t *verts_outside,

@@ -92,7 +92,13 @@ typedef struct st_tetstat {
     size_t vertices_inside;       /* S vertices in the closed mesh */
     double fraction_inside;       /* vertices_inside / surface_vertices */
     size_t crossing_triangles;    /* S triangles meeting the boundary */
-    int encloses;                 /* all inside and none crossing */
+    int encloses;                 /* all inside and none crossing, and
+                                     enclosure_verified */
+    int enclosure_verified;       /* no inverted or flat tet and conforming:
+                                     only then do the two counts prove
+                                     enclosure (enclose.h); with clean
+                                     counts and 0 here the answer is
+                                     "unverified", not "encloses" */
 
     /* against a signed field (has_field) */
     int has_field;
@@ -104,7 +110,9 @@ typedef struct st_tetstat {
 st_status st_tetstat_mesh(st_tetstat *out, const st_tetmesh *m,
                           st_error *err);
 
-/* Fill the surface part of *out for surface s (at least one triangle). */
+/* Fill the surface part of *out for surface s (at least one triangle).
+ * Call st_tetstat_mesh on *out first: encloses needs its inverted,
+ * degenerate and nonmanifold_faces counts. */
 st_status st_tetstat_surface(st_tetstat *out, const st_tetmesh *m,
                              const st_soup *s, st_error *err);
 

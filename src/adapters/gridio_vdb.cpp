@@ -68,6 +68,7 @@
  * init_openvdb).
  */
 #include "souptet/gridio.h"
+#include "../fpenv.h"
 #include "souptet/meta.h"
 #include "souptet/outfile.h"
 #include "gridio_internal.h"

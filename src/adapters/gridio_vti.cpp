@@ -41,6 +41,7 @@
  * to stderr (vtk_capture.h).
  */
 #include "souptet/gridio.h"
+#include "../fpenv.h"
 #include "souptet/meta.h"
 #include "souptet/outfile.h"
 #include "gridio_internal.h"

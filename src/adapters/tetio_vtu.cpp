@@ -34,6 +34,7 @@
  * to stderr (vtk_capture.h).
  */
 #include "souptet/tetio.h"
+#include "../fpenv.h"
 #include "souptet/mem.h"
 #include "souptet/meta.h"
 #include "souptet/tetmesh.h"

@@ -1,6 +1,7 @@
 /* tool.c - shared tool plumbing (see tool.h). */
 #define _GNU_SOURCE
 #include "tool.h"
+#include "../fpenv.h"
 #include "souptet/grid.h"
 #include "souptet/outfile.h"
 

@@ -5,7 +5,8 @@
  * Shape of a tool (after Netpbm): parse options into a settings struct,
  * open input ("-" = stdin), one library call per stage, write output
  * through st_outfile (temporary name, renamed at the end), exit 0 ok,
- * 1 bad input or failure, 2 usage. Messages go to stderr as
+ * 1 bad input or failure, 2 usage, 3 a mesh written that does not
+ * enclose its surface (soupmesh, tetsmooth --fit). Messages go to stderr as
  * "tool: file:line: what".
  */
 #ifndef SOUPTET_CLI_TOOL_H
@@ -20,6 +21,10 @@
 #define TOOL_EXIT_OK 0
 #define TOOL_EXIT_FAIL 1
 #define TOOL_EXIT_USAGE 2
+/* The output was written, complete, but the mesh does not enclose the
+ * surface (or that cannot be verified): a failure of the tool's promise,
+ * never only a warning, and always printed (even with -q). */
+#define TOOL_EXIT_NOT_ENCLOSING 3
 
 typedef struct tool_ctx {
     const char *name;      /* program name for messages */

@@ -359,14 +359,19 @@ int main(int argc, char *argv[])
              b->tets, b->points, b->min_dihedral, b->max_dihedral,
              st.encloses ? "encloses the input" : "DOES NOT enclose the input",
              b->verts_outside, b->tris_crossing, tool_now() - t0);
-    if (!st.encloses && p.density_rho <= 0)
-        tool_say(&t, 1, "warning: the best of %zu candidates does not enclose the input; "
-                 "try more --cells or --tries", st.ncandidates);
-    else if (p.density_rho <= 0 && !b->converged)
+    rc = TOOL_EXIT_OK;
+    if (!st.encloses && p.density_rho <= 0) {
+        /* Level 0: printed even with -q, and the exit status says it. */
+        tool_say(&t, 0, "%s: error: the mesh written to %s does not enclose the input "
+                 "(%zu vertices outside, %zu triangles crossing; best of %zu candidates); "
+                 "try more --cells or --tries", st_path_is_stdio(in) ? "<stdin>" : in, st_path_is_stdio(out) ? "<stdout>" : out,
+                 b->verts_outside, b->tris_crossing, st.ncandidates);
+        rc = TOOL_EXIT_NOT_ENCLOSING;
+    } else if (p.density_rho <= 0 && !b->converged) {
         tool_say(&t, 2, "%zu boundary vertices stayed farther than %.3g * h from the "
                  "surface (thin gaps), up to %.4g", b->beyond_offset, p.offset_ratio,
                  b->max_distance);
-    rc = TOOL_EXIT_OK;
+    }
 done:
     free(et);
     free(eb);

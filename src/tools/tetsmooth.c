@@ -234,6 +234,9 @@ int main(int argc, char *argv[])
     st_soup *s = NULL;
     st_bvh *bvh = NULL;
     int rc = TOOL_EXIT_FAIL;
+    int not_enclosing = 0;
+    st_fit_stats fst;
+    memset(&fst, 0, sizeof fst);
     const char *inname = st_path_is_stdio(in) ? "<stdin>" : in;
     double t0 = tool_now();
     if (st_tetmesh_read(&m, in, co.max_bytes, &err)) {
@@ -305,11 +308,8 @@ int main(int argc, char *argv[])
             tool_say(&t, 1, "%zu of %zu boundary vertices could not get within %.4g of the "
                             "surface (up to %.4g away: thin gaps or blocked moves)",
                      st.beyond_offset, st.boundary_vertices, st.d_offset, st.max_distance);
-        if (st.outside_after || st.crossing_after)
-            tool_say(&t, 1, "warning: the mesh does not enclose %s: %zu of its vertices "
-                            "outside, %zu triangles crossing the boundary (as on input: %zu, %zu)",
-                     surface, st.outside_after, st.crossing_after, st.outside_before,
-                     st.crossing_before);
+        not_enclosing = st.outside_after || st.crossing_after;
+        fst = st;
         snprintf(param, sizeof param, "fit offset=%.6g h=%.6g step=%.6g quality=%d "
                  "converged=%d beyond_offset=%zu",
                  gp.offset_ratio, st.h, gp.step, gp.quality, st.converged, st.beyond_offset);
@@ -326,6 +326,15 @@ int main(int argc, char *argv[])
     }
     tool_say(&t, 2, "total %.3f s", tool_now() - t0);
     rc = TOOL_EXIT_OK;
+    if (not_enclosing) {
+        /* Level 0: printed even with -q, and the exit status says it. */
+        tool_say(&t, 0, "%s: error: the mesh written to %s does not enclose %s: %zu of its "
+                        "vertices outside, %zu triangles crossing the boundary (as on input: "
+                        "%zu, %zu)",
+                 inname, st_path_is_stdio(out) ? "<stdout>" : out, surface, fst.outside_after,
+                 fst.crossing_after, fst.outside_before, fst.crossing_before);
+        rc = TOOL_EXIT_NOT_ENCLOSING;
+    }
 done:
     st_bvh_free(bvh);
     st_soup_free(s);

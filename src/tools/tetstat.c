@@ -64,6 +64,18 @@ static const char *yesno(int b)
     return b ? "true" : "false";
 }
 
+/* "yes", "no", or "unverified": the counts are clean but the mesh has
+ * inverted or flat tets or is not conforming, where they prove nothing
+ * (enclose.h). */
+static const char *enclosure_word(const st_tetstat *r)
+{
+    if (r->encloses)
+        return "yes";
+    if (r->vertices_inside == r->surface_vertices && r->crossing_triangles == 0)
+        return "unverified";
+    return "no";
+}
+
 static void print_json(FILE *f, const char *name, const char *sname,
                        const char *fname, const st_tetstat *r)
 {
@@ -114,13 +126,14 @@ static void print_json(FILE *f, const char *name, const char *sname,
         if (r->has_enclosure)
             fprintf(f,
                     ",\n    \"vertices_inside\": %zu, \"fraction_inside\": "
-                    "%s, \"crossing_triangles\": %zu, \"encloses\": %s}",
+                    "%s, \"crossing_triangles\": %zu, \"encloses\": %s, "
+                    "\"enclosure\": \"%s\"}",
                     r->vertices_inside, tool_json_number(b[6], r->fraction_inside),
-                    r->crossing_triangles, yesno(r->encloses));
+                    r->crossing_triangles, yesno(r->encloses), enclosure_word(r));
         else
             fprintf(f, ",\n    \"vertices_inside\": null, "
                        "\"fraction_inside\": null, \"crossing_triangles\": "
-                       "null, \"encloses\": null}");
+                       "null, \"encloses\": null, \"enclosure\": null}");
     }
     if (r->has_field) {
         fprintf(f, ",\n  \"field\": {\"file\": ");
@@ -204,8 +217,13 @@ static void print_table(FILE *f, const char *name, const char *sname,
                 r->vertices_inside, r->surface_vertices,
                 100.0 * r->fraction_inside);
             ROW("S triangles crossing", "%zu", r->crossing_triangles);
-            ROW("encloses S", "%s",
-                r->encloses ? "yes" : "no   <- DOES NOT ENCLOSE");
+            if (r->encloses)
+                ROW("encloses S", "yes");
+            else if (!strcmp(enclosure_word(r), "unverified"))
+                ROW("encloses S", "unverified (the counts are clean, but they prove "
+                    "enclosure only without inverted or flat tets, conforming)");
+            else
+                ROW("encloses S", "no   <- DOES NOT ENCLOSE");
         } else {
             ROW("encloses S", "n/a (enclosure test not available)");
         }
@@ -349,7 +367,12 @@ int main(int argc, char *argv[])
     if (r.nonmanifold_faces)
         tool_say(&t, 1, "%s: warning: not conforming: %zu faces shared by "
                  "more than two tets", name, r.nonmanifold_faces);
-    if (r.has_surface && r.has_enclosure && !r.encloses)
+    if (r.has_surface && r.has_enclosure && !r.encloses &&
+        !strcmp(enclosure_word(&r), "unverified"))
+        tool_say(&t, 1, "%s: warning: enclosure of %s unverified: no vertex outside and "
+                 "no triangle crossing, but the mesh has inverted or flat tets or is not "
+                 "conforming", name, sname);
+    else if (r.has_surface && r.has_enclosure && !r.encloses)
         tool_say(&t, 1,
                  "%s: warning: does not enclose %s: %zu of %zu vertices "
                  "outside, %zu triangles crossing the boundary",

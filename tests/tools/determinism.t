@@ -64,11 +64,16 @@ soupdist -q -r 32 -o d.vdb "$BUNNY"
 soupsign -q -o s.vdb d.vdb
 latticetet -q --density 0.5 --cells 8 -o l.vtu s.vdb
 latticetet -q --sculpt --surface "$BUNNY" --cells 6 -o b6.vtu s.vdb
+# The fit and quality loops run a colour set in parallel only past 64
+# vertices (PAR_CHECKED, src/smooth_internal.h): b6's largest has 48, so
+# with it those loops always ran on one thread; b12's largest has 182.
+latticetet -q --sculpt --surface "$BUNNY" --cells 12 -o b12.vtu s.vdb
 # The bunny as an exact soup (every triangle its own vertices).
 awk '/^v /{v[++n]=$0} /^f /{split($2,a,"/");split($3,b,"/");split($4,c,"/");
      print v[a[1]]; print v[b[1]]; print v[c[1]]; m+=3; f[++k]="f " m-2 " " m-1 " " m}
      END{for(i=1;i<=k;i++) print f[i]}' "$BUNNY" > soup.obj
-check "the inputs are made" test -s d.vdb -a -s s.vdb -a -s l.vtu -a -s b6.vtu -a -s soup.obj
+check "the inputs are made" test -s d.vdb -a -s s.vdb -a -s l.vtu -a -s b6.vtu -a -s b12.vtu \
+    -a -s soup.obj
 
 # The control: the comparison sees a difference where there is one.
 mkdir c1 c2
@@ -96,12 +101,19 @@ same "latticetet --density, bcc, seeded -> .msh" "t.msh" \
 same "tetsmooth --fair" "f.vtu" "tetsmooth -q --fair -o f.vtu ../l.vtu"
 same "tetsmooth --fit (with the quality pass)" "f.vtu" \
     "tetsmooth -q --fit --surface '$BUNNY' -o f.vtu ../b6.vtu"
+same "tetsmooth --fit on 12 cells (colour sets large enough to run in parallel)" "f.vtu" \
+    "tetsmooth -q --fit --surface '$BUNNY' -o f.vtu ../b12.vtu"
 same "tetstat --json --surface --field" "r.json" \
     "tetstat -q --json --surface '$BUNNY' --field ../s.vdb ../l.vtu > r.json"
 same "soupinfo --json (with the self-intersection test)" "r.json" \
     "soupinfo --json '$BUNNY' ../soup.obj > r.json"
 same "soupmesh, 3 candidates -> .node/.ele with --embed" "m.node m.ele e.txt" \
     "soupmesh -q --cells 4 --field-cells 32 --tries 3 --embed e.txt -o m.node '$BUNNY'"
+
+# --tries 1: one candidate gets every thread (with more, each candidate
+# runs on one), at 12 cells its fit and quality loops run in parallel.
+same "soupmesh, 1 candidate at 12 cells -> .vtu" "m.vtu" \
+    "soupmesh -q --cells 12 --field-cells 32 --tries 1 -o m.vtu '$BUNNY'"
 
 # tetstat's report holds no command line: there --threads itself can vary.
 for n in 1 2 3; do

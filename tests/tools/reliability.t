@@ -59,32 +59,45 @@ whole_or_none() {
     soupsign -q "$1/big.vti" > /dev/null 2>&1
 }
 
+# Under load the tool may finish between the poll that saw its temporary
+# and the kill: then it exits 0 with the whole field, which is as correct
+# as dying by the signal with no output. sig_ok SIG CODE DIR: either.
+sig_ok() {
+    if [ "$irc" = "$2" ]; then
+        return 0
+    elif [ "$irc" = 0 ] && soupsign -q "$3/big.vti" > /dev/null 2>&1; then
+        echo "#   (SIG$1 came after the tool finished: exit 0, $3/big.vti complete)"
+        return 0
+    fi
+    echo "#   exit $irc"
+    return 1
+}
+
 mkdir int term over
 interrupt INT int
-[ "$irc" = 130 ]
-ok $? "SIGINT while writing: the tool dies by SIGINT (exit 130)"
-[ "$irc" = 130 ] || echo "#   exit $irc"
+sig_ok INT 130 int
+ok $? "SIGINT while writing: the tool dies by SIGINT (exit 130), or had finished"
 whole_or_none int
-ok $? "SIGINT: no output file"
+ok $? "SIGINT: no output file (or the whole one)"
 no_temps int
 ok $? "SIGINT: the temporary file is removed"
 
 interrupt TERM term
-[ "$irc" = 143 ]
-ok $? "SIGTERM while writing: the tool dies by SIGTERM (exit 143)"
-[ "$irc" = 143 ] || echo "#   exit $irc"
+sig_ok TERM 143 term
+ok $? "SIGTERM while writing: the tool dies by SIGTERM (exit 143), or had finished"
 whole_or_none term
-ok $? "SIGTERM: no output file"
+ok $? "SIGTERM: no output file (or the whole one)"
 no_temps term
 ok $? "SIGTERM: the temporary file is removed"
 
 printf 'the previous result\n' > over/big.vti
 cp over/big.vti before.vti
 interrupt TERM over
-[ "$irc" = 143 ]
-ok $? "SIGTERM while overwriting: exit 143"
-cmp -s before.vti over/big.vti || { test -s over/big.vti && whole_or_none over; }
-ok $? "SIGTERM while overwriting: the old file is left as it was"
+sig_ok TERM 143 over
+ok $? "SIGTERM while overwriting: exit 143, or had finished"
+# (killed just after the rename, or finished: the whole new field)
+cmp -s before.vti over/big.vti || soupsign -q over/big.vti > /dev/null 2>&1
+ok $? "SIGTERM while overwriting: the old file is left as it was (or the whole new one)"
 no_temps over
 ok $? "SIGTERM while overwriting: the temporary file is removed"
 
@@ -283,5 +296,27 @@ EOF
 else
     skip "limits checked before allocating (ulimit -v)" "ulimit -v $VLIM does not leave room to run (a sanitizer build?)"
 fi
+
+# ---- durable output ----------------------------------------------------
+# The temporary is fsync'ed before the rename and the directory after it
+# (a power cut then leaves the old file or the whole new one), for a
+# stream writer (soupwrap -> .obj) and a library that writes by name (VTK
+# -> .vtu). strace shows the order of the calls.
+durable() {
+    name=$1 target=$2
+    shift 2
+    # (LeakSanitizer cannot run under ptrace: off here, for the sanitize build)
+    ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 \
+        strace -f -e trace=fsync,fdatasync,rename,renameat,renameat2 -o "$WORK/trace" "$@" \
+        >/dev/null 2>"$WORK/.err"
+    awk -v t="\"$target\"" '
+        /fsync\(|fdatasync\(/ && /= 0/ { if (state == 0) state = 1; else if (state == 2) state = 3 }
+        /rename/ && index($0, t) && /= 0/ { if (state == 1) state = 2 }
+        END { exit state == 3 ? 0 : 1 }' "$WORK/trace"
+    ok $? "$name: fsync, rename into place, fsync of the directory"
+}
+durable "soupwrap -o .obj" w.obj soupwrap -q -o w.obj s.vdb
+latticetet -q --density 0.5 --cells 6 -o d6.vtu s.vdb
+durable "tetsmooth -o .vtu (written by VTK)" f.vtu tetsmooth -q --fair -o f.vtu d6.vtu
 
 done_testing

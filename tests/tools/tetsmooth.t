@@ -29,12 +29,21 @@ assert r["min_dihedral"] >= 30.0 and r["max_dihedral"] <= 140.0, (r["min_dihedra
 s = r["surface"]
 # boundary vertices within 0.4 h, all but a few held back at thin gaps
 assert s["dist_max"] <= 0.6 * r["h"], (s["dist_max"], r["h"])
-if s.get("encloses") is not None:
-    assert s["encloses"], s
+assert s["encloses"] is True and s["enclosure"] == "yes", s
 print(r["min_dihedral"], r["max_dihedral"])
 PY
 check "fit: no inverted tets, angles in [30, 140], boundary near the surface (tetstat)" \
     /usr/bin/python3 q.py f6.json
+
+# A surface 1.4 times the bunny's size sticks out of the 6-cell lattice:
+# the fit cannot enclose it. The mesh is written, the exit status is 3 and
+# the error is on stderr even with -q.
+awk '/^v /{printf "v %.9g %.9g %.9g\n", $2 * 1.4, $3 * 1.4, $4 * 1.4; next} {print}' \
+    "$BUNNY" > big.obj
+expect_fail "fit to a surface it cannot enclose: exit 3, said even with -q" 3 \
+    '^tetsmooth: b6\.vtu: error: the mesh written to nb\.vtu does not enclose big\.obj: [0-9]+ of its vertices outside' \
+    tetsmooth -q --fit --surface big.obj -o nb.vtu b6.vtu
+check "... and the mesh was written whole" sh -c "tetstat --json nb.vtu > nb.json"
 
 check "fit through pipes" sh -c "tetsmooth --fit --surface '$BUNNY' < b6.vtu | cat > p6.vtu && test -s p6.vtu"
 mkdir t1 t2

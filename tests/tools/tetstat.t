@@ -84,6 +84,9 @@ tets[2][2], tets[2][3] = tets[2][3], tets[2][2]
 write_vtu("inverted.vtu", pts, tets)
 write_vtu("twocubes.vtu", *lattice((2, 1, 1)))
 write_vtu("big.vtu", *lattice((2, 2, 2)))
+pts, tets = lattice((2, 2, 2))
+tets[0][2], tets[0][3] = tets[0][3], tets[0][2]
+write_vtu("big-inverted.vtu", pts, tets)
 write_vtu("hex.vtu", [(i & 1, i >> 1 & 1, i >> 2 & 1) for i in range(8)],
           [[0, 1, 3, 2, 4, 5, 7, 6]], celltype=vtk.VTK_HEXAHEDRON)
 write_box_off("inner.off", (0.5, 0.5, 0.5), (1.5, 1.5, 1.5))
@@ -159,16 +162,17 @@ check "'-' is stdin" sh -c "cat cube.vtu | tetstat --json - | python3 -c 'import
 # Against surfaces: the inner box [0.5,1.5]^3 of the mesh [0,2]^3.
 check "inner box: distances, volume ratio 8" \
     sh -c "tetstat --json --surface inner.off big.vtu > inner.json && python3 want.py inner.json surface/vertices=8 surface/triangles=12 surface/boundary_vertices=26 surface/dist_min=0.5 surface/dist_max=0.8660254 surface/surface_dist_max=0.5 surface/closed=true surface/surface_volume=1 surface/volume_ratio=8"
-if python3 -c "import json,sys; sys.exit(json.load(open('inner.json'))['surface']['encloses'] is None)"; then
-    check "inner box: enclosed (every vertex inside, nothing crossing)" \
-        python3 want.py inner.json surface/encloses=true surface/vertices_inside=8 surface/fraction_inside=1 surface/crossing_triangles=0
-    check "box sticking out: not enclosed, said on stderr" \
-        sh -c "tetstat --json --surface out.off big.vtu > out.json 2> out.err && python3 want.py out.json surface/encloses=false surface/vertices_inside=4 surface/fraction_inside=0.5 && grep -q 'does not enclose out.off' out.err"
-    check "box sticking out: the table says so" sh -c "tetstat --surface out.off big.vtu 2>/dev/null | grep -q 'DOES NOT ENCLOSE'"
-else
-    ok 0 "inner box: enclosed # SKIP enclosure test not built"
-    ok 0 "box sticking out: not enclosed # SKIP enclosure test not built"
-fi
+# The enclosure test is always built: a null "encloses" is a failure here.
+check "inner box: enclosed (every vertex inside, nothing crossing)" \
+    python3 want.py inner.json surface/encloses=true surface/enclosure=yes surface/vertices_inside=8 surface/fraction_inside=1 surface/crossing_triangles=0
+check "box sticking out: not enclosed, said on stderr" \
+    sh -c "tetstat --json --surface out.off big.vtu > out.json 2> out.err && python3 want.py out.json surface/encloses=false surface/enclosure=no surface/vertices_inside=4 surface/fraction_inside=0.5 && grep -q 'does not enclose out.off' out.err"
+check "box sticking out: the table says so" sh -c "tetstat --surface out.off big.vtu 2>/dev/null | grep -q 'DOES NOT ENCLOSE'"
+# One inverted tet: the counts are clean but prove nothing (enclose.h).
+check "an inverted tet: clean counts, enclosure unverified, not 'encloses'" \
+    sh -c "tetstat --json --surface inner.off big-inverted.vtu > inv.json 2> inv.err && python3 want.py inv.json surface/encloses=false surface/enclosure=unverified surface/vertices_inside=8 surface/crossing_triangles=0 && grep -q 'enclosure of inner.off unverified' inv.err"
+check "an inverted tet: the table says unverified" \
+    sh -c "tetstat --surface inner.off big-inverted.vtu 2>/dev/null | grep -Eq '^  encloses S +unverified'"
 check "box sticking out: S -> boundary max 0.75" \
     sh -c "tetstat --json --surface out.off big.vtu 2>/dev/null > out2.json && python3 want.py out2.json surface/surface_dist_max=0.75"
 check "a soup that is not oriented: volume n/a in the table" \
