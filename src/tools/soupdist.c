@@ -28,7 +28,7 @@ static void usage(void)
 "Usage: soupdist [OPTION]... [INPUT]\n"
 "Compute the unsigned distance field of a triangle soup.\n"
 "\n"
-"INPUT is a surface (.obj .off .ply .stl); '-' or none reads stdin.\n"
+"INPUT is a surface (.obj .off .ply .stl .gltf .glb); '-' or none reads stdin.\n"
 "The grid covers the bounding box padded by P voxels; values within the band\n"
 "are exact distances, values beyond it are clamped to the band.\n"
 "\n"
@@ -143,7 +143,7 @@ int main(int argc, char *argv[])
     st_grid *g = NULL;
     int rc = TOOL_EXIT_FAIL;
     double t_read = tool_now();
-    if (st_soup_read(&soup, in, &err)) {
+    if (tool_soup_read(&t, &soup, in, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

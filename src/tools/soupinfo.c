@@ -28,7 +28,7 @@ static void usage(void)
 "edges, holes, pieces, Euler characteristic, genus, and self-intersecting\n"
 "triangles (exact).\n"
 "\n"
-"INPUT is a surface (.obj .off .ply .stl); '-' or none reads stdin.\n"
+"INPUT is a surface (.obj .off .ply .stl .gltf .glb); '-' or none reads stdin.\n"
 "Vertices are welded where their coordinates are exactly equal (no\n"
 "tolerance) before edges and pieces are counted.\n"
 "\n"
@@ -186,7 +186,7 @@ int main(int argc, char *argv[])
         st_soup *soup = NULL;
         st_soupinfo r;
         double t_read = tool_now();
-        if (st_soup_read(&soup, in, &err)) {
+        if (tool_soup_read(&t, &soup, in, &err)) {
             rc = tool_fail(&t, &err);
             continue;
         }

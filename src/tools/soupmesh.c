@@ -38,7 +38,7 @@ static void usage(void)
 "coarse tetrahedral mesh that encloses it, with dihedral angles far from 0 and\n"
 "180 degrees (Stuart et al. 2013 on the pseudo volume of Spillmann et al. 2006).\n"
 "\n"
-"INPUT is a surface: .obj .off .ply .stl; '-' reads stdin (format sniffed).\n"
+"INPUT is a surface: .obj .off .ply .stl .gltf .glb; '-' reads stdin (format sniffed).\n"
 "\n"
 "  -o, --output OUT     the mesh, by extension: .vtu (VTK), .msh (Gmsh), .node/.ele\n"
 "                       (TetGen), .mesh (Medit); '-' or none: .vtu on stdout\n"

@@ -39,7 +39,7 @@ static void usage(void)
 "self-intersecting triangles (each checked exactly before it is written).\n"
 "\n"
 "FIELD is a signed field from soupsign (.vdb or .vti); '-' or none reads an\n"
-"OpenVDB stream from stdin. With --surface, INPUT (.obj .off .ply .stl) is\n"
+"OpenVDB stream from stdin. With --surface, INPUT (.obj .off .ply .stl .gltf .glb) is\n"
 "run through soupdist and soupsign with their defaults first.\n"
 "\n"
 "      --iso V          isovalue in model units (default %g; negative shrinks)\n"

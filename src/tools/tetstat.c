@@ -35,7 +35,7 @@ static void usage(void)
 "\n"
 "MESH is a .vtu tet mesh; '-' or none reads stdin.\n"
 "\n"
-"  -S, --surface S      also measure against surface S (.obj .off .ply .stl):\n"
+"  -S, --surface S      also measure against surface S (.obj .off .ply .stl .gltf .glb):\n"
 "                       distances boundary <-> S, volume ratio (when S is\n"
 "                       closed and oriented), enclosure of S by the mesh\n"
 "  -F, --field F        also give the IoU of the mesh with the pseudo volume\n"
@@ -279,7 +279,7 @@ int main(int argc, char *argv[])
         rc = tool_fail(&t, &err);
         goto done;
     }
-    if (surface && st_soup_read(&s, surface, &err)) {
+    if (surface && tool_soup_read(&t, &s, surface, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }
