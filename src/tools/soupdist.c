@@ -123,6 +123,9 @@ int main(int argc, char *argv[])
                                 argv[optind]);
     if (!in)
         in = "-";
+    if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
+        return tool_usage_error(&t, "will not read a surface from a terminal: "
+                                    "give a file or pipe one");
     if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
         return tool_usage_error(&t, "will not write a binary VDB stream to a "
                                     "terminal: give -o FILE or pipe it");

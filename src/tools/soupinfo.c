@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static void usage(void)
 {
@@ -171,6 +172,11 @@ int main(int argc, char *argv[])
         tool_finish(&t);
         return tool_usage_error(&t, "standard input ('-') given %d times",
                                 nstdin);
+    }
+    if (nstdin && isatty(STDIN_FILENO)) {
+        tool_finish(&t);
+        return tool_usage_error(&t, "will not read a surface from a terminal: "
+                                    "give a file or pipe one");
     }
 
     /* A bad input is reported and skipped: the others are still worth a

@@ -44,7 +44,7 @@ static void usage(void)
 "FIELD is a distance field from soupdist (.vdb or .vti); '-' or none reads\n"
 "an OpenVDB stream from stdin.\n"
 "\n"
-"  -k K                 event threshold on P = 1 - c|d|, in (0, 1] (default 0.8);\n"
+"  -k K                 event threshold on P = 1 - c|d|, in (0, 1] (default 1; paper: 0.8);\n"
 "                       1 counts surface crossings (Nooruddin-Turk parity)\n"
 "      --band D         c = 1/(D voxels) instead of 1/max|d| (a narrow band suffices)\n"
 "      --rays 13|26     one or both directions along the 13 lines (default 26)\n"

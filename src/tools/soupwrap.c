@@ -258,6 +258,7 @@ int main(int argc, char *argv[])
         }
     } else if (st_grid_read(&g, in, co.max_bytes, &err) ||
                tool_check_field_finite(g, srcname, &err)) {
+        if (st_soup_format_from_path(in) != ST_SOUP_UNKNOWN) snprintf(err.msg + strlen(err.msg), sizeof err.msg - strlen(err.msg), "; a surface? soupwrap --surface %s", in);
         rc = tool_fail(&t, &err);
         goto done;
     }
