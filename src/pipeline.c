@@ -236,9 +236,28 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         return st_error_set(err, ST_EINPUT, NULL, 0, "the soup has no triangles");
 
     double t_start = now_seconds();
+    /* With an absolute cell width, the cells it makes along the longest
+     * side stand for p->cells (the field's resolution follows them). */
+    size_t cells = p->cells;
+    if (p->h != 0) {
+        double blo[3], bhi[3];
+        st_status bs = st_soup_bounds(s, blo, bhi, err);
+        if (bs)
+            return bs;
+        double n = ceil(st_lattice_h_for_cells(blo, bhi, 1) / p->h);
+        if (!(p->h > 0) || !isfinite(p->h))
+            return st_error_set(err, ST_EINPUT, NULL, 0,
+                                "the cell width must be > 0 and finite");
+        if (!(n <= ST_PIPELINE_MAX_CELLS))
+            return st_error_set(err, ST_ELIMIT, NULL, 0,
+                                "a cell width of %g makes %.0f cells along "
+                                "the longest side, more than %d",
+                                p->h, n, ST_PIPELINE_MAX_CELLS);
+        cells = n < 1 ? 1 : (size_t)n;
+    }
     st_dist_params dp = st_dist_params_default();
     dp.cells = p->field_cells ? p->field_cells
-                              : (p->cells * 8 > 128 ? p->cells * 8 : 128);
+                              : (cells * 8 > 128 ? cells * 8 : 128);
     dp.max_bytes = p->max_bytes;
     st_grid *g = NULL;
     st_bvh *bvh = NULL, *bvh_field = NULL;
@@ -308,7 +327,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     rc = st_soup_bounds(s, lo, hi, err);
     if (rc)
         goto done;
-    double h = st_lattice_h_for_cells(lo, hi, p->cells);
+    double h = p->h > 0 ? p->h : st_lattice_h_for_cells(lo, hi, p->cells);
     st->h = h;
 
     size_t K = p->tries;

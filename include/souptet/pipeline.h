@@ -45,9 +45,15 @@ extern "C" {
 
 /* Most candidates one call runs. */
 #define ST_PIPELINE_MAX_TRIES 1024
+/* Most lattice cells along the longest side (as soupmesh --cells). */
+#define ST_PIPELINE_MAX_CELLS 4096
 
 typedef struct st_pipeline_params {
     size_t cells;          /* lattice cells along the longest side (10) */
+    double h;              /* > 0: the lattice cell width in model units,
+                              instead of cells (0); the field's default
+                              resolution then counts ceil(longest side / h)
+                              cells */
     size_t field_cells;    /* voxels along the longest side of the field;
                               0: max(128, 8 * cells) */
     double offset_ratio;   /* d_offset = offset_ratio * h (0.4) */

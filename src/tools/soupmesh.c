@@ -49,6 +49,8 @@ static void usage(void)
 "                       point arrays embed_tet, embed_bary)\n"
 "      --cells N        BCC lattice cells along the longest side of the\n"
 "                       model's box (default 10; more cells, more tets)\n"
+"  -h, --size H         the lattice cell width in model units, instead of\n"
+"                       --cells (as latticetet -h)\n"
 "      --offset R       stop fitting when every boundary vertex is within\n"
 "                       R * h of the surface (h = cell width; default 0.4)\n"
 "      --tries K        candidates with randomly rotated and offset lattices,\n"
@@ -128,7 +130,7 @@ static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
     double d2 = 0;
     for (int a = 0; a < 3; a++)
         d2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
-    double h = st_lattice_h_for_cells(lo, hi, p->cells);
+    double h = p->h > 0 ? p->h : st_lattice_h_for_cells(lo, hi, p->cells);
     if (!(h > 0) || !isfinite(h))
         return 0;
     double n = floor(sqrt(d2) / h) + 3 + 2 * ST_LATTICE_PAD_DEFAULT;
@@ -143,10 +145,11 @@ static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
     if (need <= (double)max_bytes)
         return 0;
     st_error_set(err, ST_ELIMIT, NULL, 0,
-                 "--cells %zu lays lattices of up to %.0f tets (%.0f at a "
-                 "time), about %.1f MiB, over the limit of %.1f MiB (use "
-                 "fewer --cells or --tries, or raise --max-memory)",
-                 p->cells, tets, at_once, need / 1048576.0,
+                 "cells of width %g make lattices of up to %.0f tets (%.0f "
+                 "at a time), about %.1f MiB, over the limit of %.1f MiB "
+                 "(use fewer --cells, a larger --size, fewer --tries, or "
+                 "raise --max-memory)",
+                 h, tets, at_once, need / 1048576.0,
                  (double)max_bytes / 1048576.0);
     return 1;
 }
@@ -158,10 +161,12 @@ int main(int argc, char *argv[])
     tool_common co = tool_common_default();
     st_pipeline_params p = st_pipeline_params_default();
     size_t max_iters = 0, seed = 1;
+    int have_cells = 0;
     const char *out = NULL, *in = NULL, *embed = NULL;
     st_tetformat_opts fopts = {0, 0};
     static const struct option opts[] = {
         {"cells", required_argument, NULL, OPT_CELLS},
+        {"size", required_argument, NULL, 'h'},
         {"offset", required_argument, NULL, OPT_OFFSET},
         {"tries", required_argument, NULL, OPT_TRIES},
         {"seed", required_argument, NULL, OPT_SEED},
@@ -180,10 +185,15 @@ int main(int argc, char *argv[])
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, ":o:qv", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, ":o:h:qv", opts, NULL)) != -1) {
         switch (c) {
         case OPT_CELLS:
-            if (tool_parse_size(&t, "--cells", optarg, 1, 4096, &p.cells))
+            if (tool_parse_size(&t, "--cells", optarg, 1, ST_PIPELINE_MAX_CELLS, &p.cells))
+                return TOOL_EXIT_USAGE;
+            have_cells = 1;
+            break;
+        case 'h':
+            if (tool_parse_double(&t, "--size", optarg, 1e-300, 1e300, &p.h))
                 return TOOL_EXIT_USAGE;
             break;
         case OPT_OFFSET:
@@ -252,6 +262,8 @@ int main(int argc, char *argv[])
         }
         }
     }
+    if (have_cells && p.h > 0)
+        return tool_usage_error(&t, "--cells and --size exclude each other");
     if (optind < argc)
         in = argv[optind++];
     if (optind < argc)
