@@ -1410,6 +1410,10 @@ st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
                                        "GLB length %lu, the file has %zu "
                                        "bytes (truncated?)",
                                        (unsigned long)length, size);
+        if (length < 20)
+            return st_error_set_offset(err, ST_EINPUT, name, 8,
+                                       "GLB length %lu, shorter than its "
+                                       "headers", (unsigned long)length);
         size_t pos = 12;
         uint32_t clen = le32(data + pos), ctype = le32(data + pos + 4);
         if (ctype != GLB_JSON)
