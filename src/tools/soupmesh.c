@@ -150,13 +150,21 @@ static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
     double need = tets * at_once * TOOL_LATTICE_BYTES_PER_TET;
     if (need <= (double)max_bytes)
         return 0;
-    st_error_set(err, ST_ELIMIT, NULL, 0,
-                 "cells of width %g make lattices of up to %.0f tets (%.0f "
-                 "at a time), about %.1f MiB, over the limit of %.1f MiB "
-                 "(use fewer --cells, a larger --size, fewer --tries, or "
-                 "raise --max-memory)",
-                 h, tets, at_once, need / 1048576.0,
-                 (double)max_bytes / 1048576.0);
+    if (p->h > 0)
+        st_error_set(err, ST_ELIMIT, NULL, 0,
+                     "--size %g lays lattices of up to %.0f tets (%.0f at a "
+                     "time), about %.1f MiB, over the limit of %.1f MiB (use "
+                     "a larger --size or fewer --tries, or raise "
+                     "--max-memory)",
+                     h, tets, at_once, need / 1048576.0,
+                     (double)max_bytes / 1048576.0);
+    else
+        st_error_set(err, ST_ELIMIT, NULL, 0,
+                     "--cells %zu lays lattices of up to %.0f tets (%.0f at a "
+                     "time), about %.1f MiB, over the limit of %.1f MiB (use "
+                     "fewer --cells or --tries, or raise --max-memory)",
+                     p->cells, tets, at_once, need / 1048576.0,
+                     (double)max_bytes / 1048576.0);
     return 1;
 }
 
