@@ -171,9 +171,10 @@ static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
 /* soupmesh --dry-run: what a run would lay, on stdout, one "key value"
  * a line. Memory: the field (floats and a sign byte per voxel, twice for
  * the sweeps) and the lattices laid at once (the bound of
- * lattice_over_limit). The time class counts tets per candidate fitted;
- * measured on the corpus at 2 threads: ~4 000 tets take about a second,
- * ~30 000 about ten, ~250 000 minutes. */
+ * lattice_over_limit). The time class counts tets times candidates: on
+ * this project's 2-core machine a bunny of ~1 000 to ~4 000 tets takes 2-5
+ * s in all; the 20 000 and 200 000 boundaries are a rough extrapolation
+ * (the fit is about linear in tets), not a measurement. */
 static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_params *p,
                           const st_pipeline_stats *st)
 {
