@@ -231,6 +231,9 @@ def vtu_field_data(path):
             continue
         if a.IsA("vtkStringArray") and a.GetNumberOfValues() > 0:
             out[a.GetName()] = a.GetValue(0)
+        elif a.IsA("vtkUnsignedCharArray"):   # souptet's text meta
+            out[a.GetName()] = bytes(int(a.GetValue(i)) for i in
+                                     range(a.GetNumberOfTuples())).decode()
         elif a.IsA("vtkDataArray") and a.GetNumberOfTuples() > 0:
             out[a.GetName()] = a.GetTuple1(0)
     return out

@@ -126,6 +126,73 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
     return ST_OK;
 }
 
+/* Choose h for about p->target_tets tets (pipeline.h): sculpt the first
+ * candidate's lattice (the fit moves vertices, never adds or removes a
+ * tet, so its count is the mesh's) and step h in log-log space. The
+ * slope starts at -3 (a solid: tets ~ 1/h^3) and is then measured from
+ * the last two sculpts, kept within [-4, -1.5] (thin parts count like a
+ * surface, ~ 1/h^2); a step changes h by a factor within [1/2, 2] so one
+ * bad slope cannot ask for a lattice 8^k times too large. A lattice that
+ * could not fit in max_bytes (the bound soupmesh checks) ends the search
+ * with ST_ELIMIT. On return *h is the width whose count was closest. */
+static st_status choose_h(double *h, st_pipeline_stats *st, const st_grid *g,
+                          const st_soup *s, const st_bvh *bvh,
+                          const st_pipeline_params *p, const double lo[3],
+                          const double hi[3], st_error *err)
+{
+    const double target = p->target_tets ? (double)p->target_tets : 0;
+    double d2 = 0;
+    for (int a = 0; a < 3; a++)
+        d2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    double hk = *h, hprev = 0, nprev = 0, slope = -3;
+    double best_h = hk, best_err = INFINITY;
+    size_t best_n = 0;
+    for (int it = 0; it < ST_PIPELINE_SIZE_STEPS; it++) {
+        double cells = floor(sqrt(d2) / hk) + 3 + 2 * ST_LATTICE_PAD_DEFAULT;
+        if (p->max_bytes &&
+            12.0 * cells * cells * cells * 64.0 > (double)p->max_bytes)
+            return st_error_set(err, ST_ELIMIT, NULL, 0,
+                                "about %.0f tets need cells of width %g, "
+                                "whose lattice is over the memory limit",
+                                target, hk);
+        st_sculpt_params sp = st_sculpt_params_default();
+        sp.kind = ST_LATTICE_BCC;
+        sp.h = hk;
+        sp.seed = st_pipeline_candidate_seed(p->seed, 0);
+        st_sculpt_stats ss;
+        memset(&ss, 0, sizeof ss);
+        st_tetmesh *m = NULL;
+        st_status rc = st_sculpt(&m, &ss, g, s, bvh, &sp, err);
+        if (rc)
+            return rc;
+        double n = (double)m->ntets;
+        st_tetmesh_free(m);
+        st->sculpts++;
+        double e = target > 0 && n > 0 ? fabs(log(n / target)) : 0;
+        if (e < best_err) {
+            best_err = e;
+            best_h = hk;
+            best_n = (size_t)n;
+        }
+        if (target <= 0 || (n > 0 && fabs(n / target - 1) <= 0.1))
+            break;
+        if (hprev > 0 && n > 0 && nprev > 0 && n != nprev)
+            slope = log(n / nprev) / log(hk / hprev);
+        if (!(slope <= -1.5))
+            slope = -1.5;
+        if (slope < -4)
+            slope = -4;
+        double step = n > 0 ? exp(log(target / n) / slope) : 0.5;
+        step = step < 0.5 ? 0.5 : step > 2 ? 2 : step;
+        hprev = hk;
+        nprev = n;
+        hk *= step;
+    }
+    *h = best_h;
+    st->estimated_tets = best_n;
+    return ST_OK;
+}
+
 /* The Spillmann candidate: cubic5 lattice, density filter, fairing. */
 static st_status run_density_candidate(st_tetmesh **out,
                                        st_pipeline_candidate *c,
@@ -235,9 +302,28 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         return st_error_set(err, ST_EINPUT, NULL, 0, "the soup has no triangles");
 
     double t_start = now_seconds();
+    /* With an absolute cell width, the cells it makes along the longest
+     * side stand for p->cells (the field's resolution follows them). */
+    size_t cells = p->cells;
+    if (p->h != 0) {
+        double blo[3], bhi[3];
+        st_status bs = st_soup_bounds(s, blo, bhi, err);
+        if (bs)
+            return bs;
+        double n = ceil(st_lattice_h_for_cells(blo, bhi, 1) / p->h);
+        if (!(p->h > 0) || !isfinite(p->h))
+            return st_error_set(err, ST_EINPUT, NULL, 0,
+                                "the cell width must be > 0 and finite");
+        if (!(n <= ST_PIPELINE_MAX_CELLS))
+            return st_error_set(err, ST_ELIMIT, NULL, 0,
+                                "a cell width of %g makes %.0f cells along "
+                                "the longest side, more than %d",
+                                p->h, n, ST_PIPELINE_MAX_CELLS);
+        cells = n < 1 ? 1 : (size_t)n;
+    }
     st_dist_params dp = st_dist_params_default();
     dp.cells = p->field_cells ? p->field_cells
-                              : (p->cells * 8 > 128 ? p->cells * 8 : 128);
+                              : (cells * 8 > 128 ? cells * 8 : 128);
     dp.max_bytes = p->max_bytes;
     st_grid *g = NULL;
     st_bvh *bvh = NULL;
@@ -269,8 +355,19 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     rc = st_soup_bounds(s, lo, hi, err);
     if (rc)
         goto done;
-    double h = st_lattice_h_for_cells(lo, hi, p->cells);
+    double h = p->h > 0 ? p->h : st_lattice_h_for_cells(lo, hi, p->cells);
+    if (p->density_rho <= 0 && (p->target_tets || p->dry_run)) {
+        double t_size = now_seconds();
+        rc = choose_h(&h, st, g, s, bvh, p, lo, hi, err);
+        st->seconds_size = now_seconds() - t_size;
+        if (rc)
+            goto done;
+    }
     st->h = h;
+    if (p->dry_run) {
+        st->seconds_total = now_seconds() - t_start;
+        goto done;
+    }
 
     size_t K = p->tries;
     st->candidates = calloc(K, sizeof *st->candidates);

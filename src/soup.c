@@ -14,6 +14,8 @@
 #include <fcntl.h>
 #include <limits.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
@@ -326,6 +328,8 @@ st_soup_format st_soup_format_from_path(const char *path)
         return ST_SOUP_PLY;
     if (ieq(dot, "stl"))
         return ST_SOUP_STL;
+    if (ieq(dot, "gltf") || ieq(dot, "glb"))
+        return ST_SOUP_GLTF;
     return ST_SOUP_UNKNOWN;
 }
 
@@ -336,6 +340,7 @@ const char *st_soup_format_name(st_soup_format format)
     case ST_SOUP_OFF: return "off";
     case ST_SOUP_PLY: return "ply";
     case ST_SOUP_STL: return "stl";
+    case ST_SOUP_GLTF: return "gltf";
     case ST_SOUP_UNKNOWN: break;
     }
     return "unknown";
@@ -369,6 +374,20 @@ st_soup_format st_soup_format_sniff(const unsigned char *data, size_t size)
         return ST_SOUP_UNKNOWN;
     if (has_prefix(data, size, "ply\n") || has_prefix(data, size, "ply\r\n"))
         return ST_SOUP_PLY;
+    /* glTF: the GLB magic, or a JSON object (no other format starts with
+     * '{' after blanks). */
+    if (has_prefix(data, size, "glTF"))
+        return ST_SOUP_GLTF;
+    {
+        size_t i = 0;
+        if (has_prefix(data, size, "\xEF\xBB\xBF"))
+            i = 3;
+        while (i < size && (data[i] == ' ' || data[i] == '\t' ||
+                            data[i] == '\n' || data[i] == '\r'))
+            i++;
+        if (i < size && data[i] == '{')
+            return ST_SOUP_GLTF;
+    }
 
     /* OFF: the first token, after blank and comment lines. */
     st_text t;
@@ -407,10 +426,59 @@ st_soup_format st_soup_format_sniff(const unsigned char *data, size_t size)
 
 /* ---- parsing and reading ------------------------------------------------ */
 
+void st_soup__warn(st_soup_warnings *warn, const char *name, long long line,
+                   long long offset, const char *fmt, ...)
+{
+    if (!warn)
+        return;
+    if (warn->count++ > 0)
+        return;
+    char msg[sizeof warn->first.msg];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (offset >= 0)
+        st_error_set_offset(&warn->first, ST_OK, name, offset, "%s", msg);
+    else
+        st_error_set(&warn->first, ST_OK, name, line, "%s", msg);
+}
+
+static void warnings_clear(st_soup_warnings *warn)
+{
+    if (warn) {
+        st_error_clear(&warn->first);
+        warn->count = 0;
+    }
+}
+
 st_status st_soup_parse(st_soup **out, st_soup_format format,
                         const unsigned char *data, size_t size,
                         const char *name, st_error *err)
 {
+    return st_soup_parse_warn(out, format, data, size, name, NULL, err);
+}
+
+static st_status parse_at(st_soup **out, st_soup_format format,
+                          const unsigned char *data, size_t size,
+                          const char *name, const char *path,
+                          st_soup_warnings *warn, st_error *err);
+
+st_status st_soup_parse_warn(st_soup **out, st_soup_format format,
+                             const unsigned char *data, size_t size,
+                             const char *name, st_soup_warnings *warn,
+                             st_error *err)
+{
+    return parse_at(out, format, data, size, name, NULL, warn, err);
+}
+
+/* st_soup_parse_warn, with the file's path for glTF's external buffers. */
+static st_status parse_at(st_soup **out, st_soup_format format,
+                          const unsigned char *data, size_t size,
+                          const char *name, const char *path,
+                          st_soup_warnings *warn, st_error *err)
+{
+    warnings_clear(warn);
     if (out)
         *out = NULL;
     if (!name)
@@ -427,11 +495,14 @@ st_status st_soup_parse(st_soup **out, st_soup_format format,
     switch (format) {
     case ST_SOUP_OBJ: st = st_soup__parse_obj(s, data, size, name, err); break;
     case ST_SOUP_OFF: st = st_soup__parse_off(s, data, size, name, err); break;
-    case ST_SOUP_PLY: st = st_soup__parse_ply(s, data, size, name, err); break;
+    case ST_SOUP_PLY: st = st_soup__parse_ply(s, data, size, name, warn, err); break;
     case ST_SOUP_STL: st = st_soup__parse_stl(s, data, size, name, err); break;
+    case ST_SOUP_GLTF:
+        st = st_soup__parse_gltf(s, data, size, name, path, warn, err);
+        break;
     default:
         st = st_error_set(err, ST_EINPUT, name, 0,
-                          "unknown format (not OBJ, OFF, PLY or STL)");
+                          "unknown format (not OBJ, OFF, PLY, STL or glTF)");
         break;
     }
     if (st == ST_OK && s->ntris == 0)
@@ -495,14 +566,21 @@ void st_soup_source_of(st_soup_source *src, const void *data, size_t size)
 
 st_status st_soup_read(st_soup **out, const char *path, st_error *err)
 {
-    return st_soup_read_source(out, path, NULL, err);
+    return st_soup_read_source(out, path, NULL, NULL, err);
+}
+
+st_status st_soup_read_warn(st_soup **out, const char *path,
+                            st_soup_warnings *warn, st_error *err)
+{
+    return st_soup_read_source(out, path, NULL, warn, err);
 }
 
 st_status st_soup_read_source(st_soup **out, const char *path, st_soup_source *src,
-                              st_error *err)
+                              st_soup_warnings *warn, st_error *err)
 {
     if (src)
         memset(src, 0, sizeof *src);
+    warnings_clear(warn);
     if (out)
         *out = NULL;
     if (!out || !path)
@@ -551,9 +629,10 @@ st_status st_soup_read_source(st_soup **out, const char *path, st_soup_source *s
         st_soup_source_of(src, data, size);
     if (fmt == ST_SOUP_UNKNOWN)
         st = st_error_set(err, ST_EINPUT, name, 0,
-                          "unknown format (not OBJ, OFF, PLY or STL)");
+                          "unknown format (not OBJ, OFF, PLY, STL or glTF)");
     else
-        st = st_soup_parse(out, fmt, data, size, name, err);
+        st = parse_at(out, fmt, data, size, name, is_stdin ? NULL : path,
+                      warn, err);
     free(data);
     return st;
 }

@@ -191,9 +191,25 @@ st_status st_soup__parse_obj(st_soup *s, const unsigned char *data,
 st_status st_soup__parse_off(st_soup *s, const unsigned char *data,
                              size_t size, const char *name, st_error *err);
 st_status st_soup__parse_ply(st_soup *s, const unsigned char *data,
-                             size_t size, const char *name, st_error *err);
+                             size_t size, const char *name,
+                             st_soup_warnings *warn, st_error *err);
 st_status st_soup__parse_stl(st_soup *s, const unsigned char *data,
                              size_t size, const char *name, st_error *err);
+
+/* glTF: path is the .gltf's own path, for buffers in files beside it
+ * (NULL: such buffers are an error). */
+st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
+                              size_t size, const char *name, const char *path,
+                              st_soup_warnings *warn, st_error *err);
+
+/* Record a warning at a text line (offset < 0) or a byte offset: the first
+ * is kept whole, the others counted. warn may be NULL. */
+void st_soup__warn(st_soup_warnings *warn, const char *name, long long line,
+                   long long offset, const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
 
 /* STL kind from the content: 1 ASCII, 0 binary (see soup_stl.c). */
 int st_soup__stl_is_ascii(const unsigned char *data, size_t size);

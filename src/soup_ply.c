@@ -48,6 +48,7 @@ typedef struct ply {
     size_t nelems;
     elem *vertex, *face;
     const char *name;
+    st_soup_warnings *warn;
     st_error *err;
 } ply;
 
@@ -275,8 +276,19 @@ static st_status read_header(ply *p, st_text *t)
             st = hdr_property(p, t);
         else if (st_tok_eq(tok, n, "end_header"))
             break;
-        else
-            st = hdr_error(p, t->line, "unknown header line", tok, n);
+        else {
+            /* Exporters put free text there (Blender 2.4x: "Created by
+             * Blender3D 247 - www.blender.org, source file: ..."); assimp
+             * and VTK skip it, so do we, saying so. */
+            char q[ST_QUOTE_SIZE];
+            size_t len = n;
+            while (tok + len < t->end && tok[len] != '\n' &&
+                   tok[len] != '\r')
+                len++;
+            st_soup__warn(p->warn, p->name, t->line, -1,
+                          "header line without a keyword skipped: '%s'",
+                          st_soup__quote(q, sizeof q, tok, len));
+        }
         if (st)
             return st;
         st_text_next_line(t);
@@ -574,11 +586,13 @@ static st_status read_ascii(ply *p, st_soup *s, st_text *t)
 }
 
 st_status st_soup__parse_ply(st_soup *s, const unsigned char *data,
-                             size_t size, const char *name, st_error *err)
+                             size_t size, const char *name,
+                             st_soup_warnings *warn, st_error *err)
 {
     ply p;
     memset(&p, 0, sizeof p);
     p.name = name;
+    p.warn = warn;
     p.err = err;
     st_text t;
     st_text_init(&t, data, size, 0);

@@ -127,6 +127,7 @@ static const reader k_readers[] = {
     {"off", K_SOUP, ST_SOUP_OFF, NULL, NULL},
     {"ply", K_SOUP, ST_SOUP_PLY, NULL, NULL},
     {"stl", K_SOUP, ST_SOUP_STL, NULL, NULL},
+    {"gltf", K_SOUP, ST_SOUP_GLTF, NULL, NULL},
     /* A surface on stdin: the format sniffed (fuzz/fuzz_soupsniff.c). */
     {"soupsniff", K_SOUP, ST_SOUP_UNKNOWN, NULL, NULL},
     {"vdb", K_GRID, 0, st_gridio_read_vdb_mem, NULL},

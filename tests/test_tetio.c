@@ -50,6 +50,16 @@ static st_tetmesh *sample(void)
     st_meta_set(&m->meta, "lattice", "cubic5");
     st_meta_set(&m->meta, "history",
                 "soupdist -r 64 bunny.obj\nlatticetet --density 0.5");
+    /* Numbers in the .vtu are Float64 only when %.17g gives them back
+     * exactly; everything else stays text (bytes). */
+    st_meta_set(&m->meta, "offset_ratio", "0.40000000000000002");
+    st_meta_set(&m->meta, "seed", "1");
+    st_meta_set(&m->meta, "not_shortest", "1e5");
+    st_meta_set(&m->meta, "padded", " 2");
+    st_meta_set(&m->meta, "nan", "nan");
+    st_meta_set(&m->meta, "big", "18446744073709551615");
+    st_meta_set(&m->meta, "empty", "");
+    st_meta_set(&m->meta, "utf8", "caf\xc3\xa9 \xe2\x9c\x93");
     return m;
 }
 
@@ -178,6 +188,38 @@ static void test_other_formats(void)
                   st_tet_format_from_path("x.obj") == ST_TET_FMT_UNKNOWN &&
                   st_tet_format_from_path(".vtu") == ST_TET_FMT_UNKNOWN,
               "formats from paths");
+    st_tetmesh_free(m);
+}
+
+/* A points-only mesh (soupmesh --embed F.vtu) is written with one vertex
+ * cell per point and no cell arrays, and reads back as points only. */
+static void test_points_only(void)
+{
+    st_tetmesh *m = st_tetmesh_new(), *r = NULL;
+    add_pt(m, 0.1, 0.2, 0.3);
+    add_pt(m, 1, 2, 3);
+    add_pt(m, -1, 0.5, 1e-7);
+    double *v;
+    st_tetmesh_add_array(m, "embed_tet", ST_ON_POINTS, 1, &v, NULL);
+    v[0] = 3; v[1] = -1; v[2] = 7;
+    st_meta_set(&m->meta, "source", "x.obj");
+    st_error err;
+    char p[256];
+    path_in(p, sizeof p, "pts.vtu");
+    TAP_CHECK(st_tetmesh_write(m, p, &err) == ST_OK, "write a points-only .vtu");
+    FILE *f = fopen(p, "rb");
+    char buf[4096] = {0};
+    size_t n = f ? fread(buf, 1, sizeof buf - 1, f) : 0;
+    if (f)
+        fclose(f);
+    buf[n] = '\0';
+    TAP_CHECK(strstr(buf, "NumberOfCells=\"3\"") != NULL &&
+                  strstr(buf, "min_dihedral") == NULL,
+              "points-only: 3 cells for 3 points, no empty quality arrays");
+    TAP_CHECK(st_tetmesh_read(&r, p, 0, &err) == ST_OK && same_mesh(m, r) &&
+                  r->ntets == 0,
+              "points-only: reads back as the same points, arrays, no tets");
+    st_tetmesh_free(r);
     st_tetmesh_free(m);
 }
 
@@ -441,6 +483,7 @@ int main(int argc, char **argv)
     }
     test_file_roundtrip();
     test_mem_roundtrip();
+    test_points_only();
     test_other_formats();
     test_pipe();
     test_bad_input();

@@ -45,11 +45,29 @@ extern "C" {
 
 /* Most candidates one call runs. */
 #define ST_PIPELINE_MAX_TRIES 1024
+/* Most lattice cells along the longest side (as soupmesh --cells). */
+#define ST_PIPELINE_MAX_CELLS 4096
+/* Sculpts at most when choosing h for target_tets. */
+#define ST_PIPELINE_SIZE_STEPS 10
 
 typedef struct st_pipeline_params {
     size_t cells;          /* lattice cells along the longest side (10) */
+    double h;              /* > 0: the lattice cell width in model units,
+                              instead of cells (0); the field's default
+                              resolution then counts ceil(longest side / h)
+                              cells */
     size_t field_cells;    /* voxels along the longest side of the field;
                               0: max(128, 8 * cells) */
+    size_t target_tets;    /* > 0: choose h for about this many tets: the
+                              first candidate's lattice is sculpted at the
+                              h of cells (or h) and then at widths stepped
+                              in log-log space (tets ~ h^slope, the slope
+                              measured) until its count is within 10% of
+                              this, ST_PIPELINE_SIZE_STEPS sculpts at most;
+                              the closest one wins (0) */
+    int dry_run;           /* 1: stop once h is chosen (and, without
+                              target_tets, the first candidate sculpted):
+                              no mesh; stats give h and estimated_tets (0) */
     double offset_ratio;   /* d_offset = offset_ratio * h (0.4) */
     size_t tries;          /* candidates (1) */
     uint64_t seed;         /* seed of candidate 0 (1) */
@@ -92,6 +110,11 @@ typedef struct st_pipeline_stats {
                                             frees with free() */
     size_t best;                         /* index of the chosen one */
     int encloses;                        /* the chosen one encloses */
+    size_t estimated_tets;               /* the first candidate's sculpted
+                                            tets at h (target_tets or
+                                            dry_run; the fit keeps them) */
+    size_t sculpts;                      /* sculpts spent choosing h */
+    double seconds_size;                 /* and their time */
 } st_pipeline_stats;
 
 /* Mesh soup s. *out gets the chosen candidate's mesh, with meta "h",
@@ -100,7 +123,7 @@ typedef struct st_pipeline_stats {
  * on failure (it is NULL when nothing was allocated). Fails when the
  * soup is empty or every candidate failed (the first candidate's message
  * is reported). Not enclosing is not a failure: stats say it, and meta
- * "encloses" is "no". */
+ * "encloses" is "no". With p->dry_run, *out stays NULL on success. */
 st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                           const st_soup *s, const st_pipeline_params *p,
                           const st_progress *prog, st_error *err);

@@ -9,7 +9,9 @@
  * Formats: OBJ (v/f, negative indices), OFF (also COFF/NOFF/...), PLY (ascii,
  * binary_little_endian, binary_big_endian; any scalar property type; the
  * face list may be named vertex_indices or vertex_index), STL (ASCII and
- * binary).
+ * binary), glTF 2.0 (.gltf with external or data-URI buffers, .glb: the
+ * triangle, strip and fan primitives of the default scene's node trees,
+ * in world space; see soup_gltf.c).
  *
  * Readers parse a memory buffer (so fuzzers and pipes use the same code) and
  * never trust a count from the file for an allocation: arrays grow with the
@@ -33,7 +35,8 @@ typedef enum st_soup_format {
     ST_SOUP_OBJ,
     ST_SOUP_OFF,
     ST_SOUP_PLY,
-    ST_SOUP_STL
+    ST_SOUP_STL,
+    ST_SOUP_GLTF        /* .gltf (JSON) and .glb (binary), told apart by content */
 } st_soup_format;
 
 /* A zero-initialised st_soup is a valid empty soup. Grow xyz and tris only
@@ -59,8 +62,18 @@ st_status st_soup_add_vertex(st_soup *s, double x, double y, double z,
 st_status st_soup_add_triangle(st_soup *s, uint32_t a, uint32_t b, uint32_t c,
                                st_error *err);
 
+/* What a reader accepted but did not expect (a PLY header line without a
+ * keyword, ...): the first such note with its place (first.status is
+ * ST_OK, first.msg "" when there was none) and how many there were. The
+ * library never prints them; a tool does (tool_soup_read). */
+typedef struct st_soup_warnings {
+    st_error first;
+    size_t count;
+} st_soup_warnings;
+
 /* Parse a whole file held in memory (format must be known: ST_SOUP_UNKNOWN
- * is an error). name is used in messages only. Numbers with more than 19
+ * is an error). A glTF document parsed from memory can only use data-URI
+ * and GLB buffers (st_soup_read also finds the files beside it). name is used in messages only. Numbers with more than 19
  * significant digits or unusual exponents go through strtod, which follows
  * the C locale's decimal point: tools run in the "C" locale.
  * On success *out owns a soup with at least one triangle. On failure *out
@@ -69,11 +82,20 @@ st_status st_soup_parse(st_soup **out, st_soup_format format,
                         const unsigned char *data, size_t size,
                         const char *name, st_error *err);
 
+/* As st_soup_parse / st_soup_read, and the warnings into *warn (cleared
+ * first; may be NULL), also when parsing fails. */
+st_status st_soup_parse_warn(st_soup **out, st_soup_format format,
+                             const unsigned char *data, size_t size,
+                             const char *name, st_soup_warnings *warn,
+                             st_error *err);
+st_status st_soup_read_warn(st_soup **out, const char *path,
+                            st_soup_warnings *warn, st_error *err);
+
 /* The format named by a path's extension (case-insensitive), or UNKNOWN. */
 st_soup_format st_soup_format_from_path(const char *path);
 /* The format recognised from a file's first bytes (for stdin), or UNKNOWN. */
 st_soup_format st_soup_format_sniff(const unsigned char *data, size_t size);
-/* "obj", "off", "ply", "stl" or "unknown". */
+/* "obj", "off", "ply", "stl", "gltf" or "unknown". */
 const char *st_soup_format_name(st_soup_format format);
 
 /* Read a surface file; "-" reads stdin (format sniffed). The format comes
@@ -92,11 +114,12 @@ typedef struct st_soup_source {
 } st_soup_source;
 
 /* st_soup_read that also gives the source's size and hash (src may be
- * NULL). *src is filled whenever the file's bytes were read, even when
+ * NULL) and the reader's warnings (warn may be NULL; st_soup_read_warn).
+ * For a .gltf the hash covers the JSON file, not its external buffers. *src is filled whenever the file's bytes were read, even when
  * they do not parse (so a changed file is told from a broken one), and
  * zeroed otherwise. */
 st_status st_soup_read_source(st_soup **out, const char *path, st_soup_source *src,
-                              st_error *err);
+                              st_soup_warnings *warn, st_error *err);
 /* The size and hash of bytes held in memory. */
 void st_soup_source_of(st_soup_source *src, const void *data, size_t size);
 

@@ -14,14 +14,21 @@
  *              then the mesh's own per-cell arrays; point data: the mesh's
  *              per-point arrays. All vtkDoubleArray.
  *   field data every st_meta entry (source, h, lattice, parameters,
- *              history, ...) as a one-value vtkStringArray named by its key,
- *              in st_meta order.
+ *              history, ...) named by its key, in st_meta order: a value
+ *              that is a number exactly as %.17g prints it as a one-value
+ *              vtkDoubleArray, any other as a vtkUnsignedCharArray of its
+ *              bytes (meshio cannot read VTK's String arrays; see
+ *              meta_number).
+ *   no tets    a points-only mesh (soupmesh --embed F.vtu) gets one
+ *              VTK_VERTEX cell per point and no cell arrays, so ParaView
+ *              draws it and meshio reads it.
  *   encoding   appended raw binary, zlib compression, UInt64 block headers
  *              and Int64 ids (meshes beyond 2^31 entries stay readable).
  *
  * Reading accepts foreign files: float or double points, any numeric
- * point/cell arrays of 1..9 components (converted to double), string
- * field data as meta. The three quality arrays are derived data: they are
+ * point/cell arrays of 1..9 components (converted to double), string,
+ * char and one-value numeric field data as meta, vertex cells i = point i
+ * as a points-only mesh. The three quality arrays are derived data: they are
  * not read back (every write recomputes them from the geometry, which a
  * tool may have moved). Refused, with a message naming the file: input VTK
  * cannot parse, cells that are not tetrahedra, point indices out of range,
@@ -55,6 +62,7 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkStringArray.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridReader.h>
 #include <vtkXMLUnstructuredGridWriter.h>
@@ -77,6 +85,32 @@ bool is_quality_name(const char *n)
                  std::strcmp(n, "volume") == 0);
 }
 
+/* ---- metadata ---------------------------------------------------------- */
+
+/* A meta value VTK, ParaView and meshio all read (meshio 5-7 refuses VTK's
+ * String arrays: its vtu reader has no "String" type and asserts on their
+ * appended blocks). A value that is exactly the %.17g form of a finite
+ * double (h, seed, offset_ratio, candidates, ...) becomes a one-value
+ * Float64 array, so ParaView can compute with it; anything else (source,
+ * history, lattice, ...) a UInt8 array of its bytes. Reading formats a
+ * number with %.17g again, so the meta round-trips exactly. */
+bool meta_number(const char *v, double *x)
+{
+    if (!v[0] || v[0] == ' ' || v[0] == '\t' || v[0] == '\n')
+        return false;
+    char *end;
+    errno = 0;
+    const double d = std::strtod(v, &end);
+    if (*end || errno || !std::isfinite(d))
+        return false;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.17g", d);
+    if (std::strcmp(buf, v) != 0)
+        return false;
+    *x = d;
+    return true;
+}
+
 /* ---- writing ----------------------------------------------------------- */
 
 /* The grid for m. Points and the mesh's arrays are borrowed (the writer
@@ -92,6 +126,22 @@ st_status build_grid(vtkUnstructuredGrid *ug, const st_tetmesh *m,
     pts->SetData(xyz);
     ug->SetPoints(pts);
 
+    if (m->ntets == 0) {
+        // A points-only mesh (soupmesh --embed F.vtu): one VTK_VERTEX per
+        // point, so ParaView draws the points and meshio finds cells; no
+        // cell arrays (they would be empty).
+        const vtkIdType np = vtkIdType(m->npoints);
+        vtkNew<vtkIdTypeArray> offsets, conn;
+        offsets->SetNumberOfValues(np + 1);
+        conn->SetNumberOfValues(np);
+        for (vtkIdType i = 0; i <= np; i++)
+            offsets->SetValue(i, i);
+        for (vtkIdType i = 0; i < np; i++)
+            conn->SetValue(i, i);
+        vtkNew<vtkCellArray> cells;
+        cells->SetData(offsets, conn);
+        ug->SetCells(VTK_VERTEX, cells);
+    }
     const vtkIdType nt = vtkIdType(m->ntets);
     vtkNew<vtkIdTypeArray> offsets, conn;
     offsets->SetNumberOfValues(nt + 1);
@@ -101,22 +151,25 @@ st_status build_grid(vtkUnstructuredGrid *ug, const st_tetmesh *m,
         o[t] = 4 * t;
     for (vtkIdType i = 0; i < 4 * nt; i++)
         c[i] = vtkIdType(m->tets[i]);
-    vtkNew<vtkCellArray> cells;
-    cells->SetData(offsets, conn);
-    ug->SetCells(VTK_TETRA, cells);
-
     vtkCellData *cd = ug->GetCellData();
-    const char *qn[3] = {"min_dihedral", "max_dihedral", "volume"};
-    double *q[3];
-    for (int k = 0; k < 3; k++) {
-        vtkNew<vtkDoubleArray> a;
-        a->SetName(qn[k]);
-        a->SetNumberOfValues(nt);
-        q[k] = a->GetPointer(0);
-        cd->AddArray(a);
+    if (nt > 0 || m->npoints == 0) {
+        vtkNew<vtkCellArray> cells;
+        cells->SetData(offsets, conn);
+        ug->SetCells(VTK_TETRA, cells);
     }
-    st_tetmesh_quality(m, q[0], q[1], q[2]);
-    cd->SetActiveScalars("min_dihedral");
+    if (nt > 0) {
+        const char *qn[3] = {"min_dihedral", "max_dihedral", "volume"};
+        double *q[3];
+        for (int k = 0; k < 3; k++) {
+            vtkNew<vtkDoubleArray> a;
+            a->SetName(qn[k]);
+            a->SetNumberOfValues(nt);
+            q[k] = a->GetPointer(0);
+            cd->AddArray(a);
+        }
+        st_tetmesh_quality(m, q[0], q[1], q[2]);
+        cd->SetActiveScalars("min_dihedral");
+    }
 
     for (size_t i = 0; i < m->narrays; i++) {
         const st_tet_array *arr = &m->arrays[i];
@@ -124,6 +177,8 @@ st_status build_grid(vtkUnstructuredGrid *ug, const st_tetmesh *m,
         if (on_cells && is_quality_name(arr->name))
             continue;   // recomputed above
         const size_t n = on_cells ? m->ntets : m->npoints;
+        if (on_cells && n == 0)
+            continue;   // no tets: vertex cells, no empty tet arrays
         if (arr->ncomp < 1 || arr->ncomp > 9)
             return st_error_set(err, ST_EINTERNAL, name, 0,
                                 "mesh array '%s' has %d components",
@@ -141,11 +196,24 @@ st_status build_grid(vtkUnstructuredGrid *ug, const st_tetmesh *m,
 
     vtkFieldData *fd = ug->GetFieldData();
     for (size_t i = 0; i < m->meta.count; i++) {
-        vtkNew<vtkStringArray> s;
-        s->SetName(m->meta.entries[i].key);
-        s->InsertNextValue(m->meta.entries[i].value ? m->meta.entries[i].value
-                                                    : "");
-        fd->AddArray(s);
+        const char *key = m->meta.entries[i].key;
+        const char *val = m->meta.entries[i].value ? m->meta.entries[i].value
+                                                   : "";
+        double x;
+        if (meta_number(val, &x)) {
+            vtkNew<vtkDoubleArray> d;
+            d->SetName(key);
+            d->InsertNextValue(x);
+            fd->AddArray(d);
+        } else {
+            vtkNew<vtkUnsignedCharArray> b;
+            b->SetName(key);
+            const size_t len = std::strlen(val);
+            b->SetNumberOfValues(vtkIdType(len));
+            if (len)
+                std::memcpy(b->GetPointer(0), val, len);
+            fd->AddArray(b);
+        }
     }
     return ST_OK;
 }
@@ -350,7 +418,19 @@ st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
         std::memcpy(m->xyz + 3 * size_t(i), p, sizeof p);
     }
     m->npoints = size_t(npts);
-    for (vtkIdType c = 0; c < ncells; c++) {
+    // A points-only mesh as this file writes it: cell i is VTK_VERTEX i.
+    bool points_only = ncells == npts && ncells > 0;
+    for (vtkIdType c = 0; points_only && c < ncells; c++) {
+        vtkIdType n;
+        const vtkIdType *ids;
+        if (ug->GetCellType(c) != VTK_VERTEX) {
+            points_only = false;
+            break;
+        }
+        ug->GetCellPoints(c, n, ids);
+        points_only = n == 1 && ids[0] == c;
+    }
+    for (vtkIdType c = 0; !points_only && c < ncells; c++) {
         const int type = ug->GetCellType(c);
         vtkIdType n;
         const vtkIdType *ids;
@@ -376,22 +456,52 @@ st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
             t[k] = uint32_t(ids[k]);
         }
     }
-    m->ntets = size_t(ncells);
+    m->ntets = points_only ? 0 : size_t(ncells);
 
-    if (st_status s = read_arrays(m, ug->GetCellData(), ST_ON_CELLS, name,
-                                  &bytes, max_bytes, err))
-        return s;
+    if (!points_only)
+        if (st_status s = read_arrays(m, ug->GetCellData(), ST_ON_CELLS,
+                                      name, &bytes, max_bytes, err))
+            return s;
     if (st_status s = read_arrays(m, ug->GetPointData(), ST_ON_POINTS, name,
                                   &bytes, max_bytes, err))
         return s;
     vtkFieldData *fd = ug->GetFieldData();
     for (int i = 0; fd && i < fd->GetNumberOfArrays(); i++) {
-        vtkStringArray *s =
-            vtkStringArray::SafeDownCast(fd->GetAbstractArray(i));
-        if (!s || !s->GetName() || !s->GetName()[0] ||
-            s->GetNumberOfValues() < 1)
+        vtkAbstractArray *a = fd->GetAbstractArray(i);
+        if (!a || !a->GetName() || !a->GetName()[0])
             continue;
-        if (st_meta_set(&m->meta, s->GetName(), s->GetValue(0).c_str()))
+        std::string v;
+        const int type = a->GetDataType();
+        vtkDataArray *d = vtkDataArray::SafeDownCast(a);
+        if (vtkStringArray *sa = vtkStringArray::SafeDownCast(a)) {
+            if (sa->GetNumberOfValues() < 1)
+                continue;
+            v = sa->GetValue(0);   // files before numbers were numbers
+        } else if (d && d->GetNumberOfComponents() == 1 &&
+                   (type == VTK_UNSIGNED_CHAR || type == VTK_SIGNED_CHAR ||
+                    type == VTK_CHAR)) {
+            const vtkIdType n = d->GetNumberOfTuples();
+            if (st_size_add(&bytes, bytes, size_t(n)) != 0 ||
+                (max_bytes && bytes > max_bytes))
+                return st_error_set(err, ST_ELIMIT, name, 0,
+                                    "mesh needs more than the memory limit "
+                                    "of %zu bytes", max_bytes);
+            v.reserve(size_t(n));
+            for (vtkIdType k = 0; k < n; k++) {
+                const int c = int(d->GetComponent(k, 0)) & 0xff;
+                if (c == 0)
+                    break;   // a C string ends there
+                v.push_back(char(c));
+            }
+        } else if (d && d->GetNumberOfComponents() == 1 &&
+                   d->GetNumberOfTuples() == 1) {
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%.17g", d->GetComponent(0, 0));
+            v = buf;
+        } else {
+            continue;   // not metadata souptet knows how to keep
+        }
+        if (st_meta_set(&m->meta, a->GetName(), v.c_str()))
             return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
     }
     guard.m = nullptr;

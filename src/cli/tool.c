@@ -4,6 +4,7 @@
 #include "../fpenv.h"
 #include "souptet/grid.h"
 #include "souptet/outfile.h"
+#include "souptet/soup.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -127,6 +128,29 @@ int tool_fail(const tool_ctx *t, const st_error *err)
     tool_progress_end((tool_ctx *)t);
     fprintf(stderr, "%s: %s\n", t->name, st_error_format(err, buf, sizeof buf));
     return TOOL_EXIT_FAIL;
+}
+
+st_status tool_soup_read(const tool_ctx *t, struct st_soup **out,
+                         const char *path, st_error *err)
+{
+    return tool_soup_read_source(t, out, path, NULL, err);
+}
+
+st_status tool_soup_read_source(const tool_ctx *t, struct st_soup **out, const char *path,
+                                struct st_soup_source *src, st_error *err)
+{
+    st_soup_warnings w;
+    st_status st = st_soup_read_source(out, path, src, &w, err);
+    if (w.count > 0 && t->verbosity >= 1) {
+        char buf[1200];
+        tool_progress_end((tool_ctx *)t);
+        fprintf(stderr, "%s: warning: %s\n", t->name,
+                st_error_format(&w.first, buf, sizeof buf));
+        if (w.count > 1)
+            fprintf(stderr, "%s: warning: %s: %zu more like it\n", t->name,
+                    w.first.file, w.count - 1);
+    }
+    return st;
 }
 
 int tool_flush_stdout(const tool_ctx *t)

@@ -45,6 +45,16 @@ void tool_finish(tool_ctx *t);
 
 /* Print "name: FILE:LINE: msg" and return TOOL_EXIT_FAIL. */
 int tool_fail(const tool_ctx *t, const st_error *err);
+/* st_soup_read, printing the reader's warnings (unless -q) as
+ * "name: warning: FILE:LINE: what" and "name: warning: FILE: N more like
+ * it", before any error. */
+struct st_soup;
+struct st_soup_source;
+st_status tool_soup_read(const tool_ctx *t, struct st_soup **out,
+                         const char *path, st_error *err);
+/* The same, with the file's size and content hash (soup.h). */
+st_status tool_soup_read_source(const tool_ctx *t, struct st_soup **out, const char *path,
+                                struct st_soup_source *src, st_error *err);
 /* Flush stdout (a report): 0, or after a write error now or earlier,
  * print "name: <stdout>: write failed: why" and return TOOL_EXIT_FAIL. */
 int tool_flush_stdout(const tool_ctx *t);

@@ -219,7 +219,7 @@ int main(int argc, char *argv[])
         rc = tool_fail(&t, &err);
         goto done;
     }
-    if (sculpt && st_soup_read(&soup, surface, &err)) {
+    if (sculpt && tool_soup_read(&t, &soup, surface, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

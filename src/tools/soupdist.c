@@ -28,7 +28,7 @@ static void usage(void)
 "Usage: soupdist [OPTION]... [INPUT]\n"
 "Compute the unsigned distance field of a triangle soup.\n"
 "\n"
-"INPUT is a surface (.obj .off .ply .stl); '-' or none reads stdin.\n"
+"INPUT is a surface (.obj .off .ply .stl .gltf .glb); '-' or none reads stdin.\n"
 "The grid covers the bounding box padded by P voxels; values within the band\n"
 "are exact distances, values beyond it are clamped to the band.\n"
 "\n"
@@ -142,6 +142,9 @@ int main(int argc, char *argv[])
                                 argv[optind]);
     if (!in)
         in = "-";
+    if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
+        return tool_usage_error(&t, "will not read a surface from a terminal: "
+                                    "give a file or pipe one");
     if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
         return tool_usage_error(&t, "will not write a binary VDB stream to a "
                                     "terminal: give -o FILE or pipe it");
@@ -163,7 +166,7 @@ int main(int argc, char *argv[])
     int rc = TOOL_EXIT_FAIL;
     double t_read = tool_now();
     st_soup_source src;
-    if (st_soup_read_source(&soup, in, &src, &err)) {
+    if (tool_soup_read_source(&t, &soup, in, &src, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static void usage(void)
 {
@@ -28,7 +29,7 @@ static void usage(void)
 "edges, holes, pieces, Euler characteristic, genus, and self-intersecting\n"
 "triangles (exact).\n"
 "\n"
-"INPUT is a surface (.obj .off .ply .stl); '-' or none reads stdin.\n"
+"INPUT is a surface (.obj .off .ply .stl .gltf .glb); '-' or none reads stdin.\n"
 "Vertices are welded where their coordinates are exactly equal (no\n"
 "tolerance) before edges and pieces are counted.\n"
 "\n"
@@ -172,6 +173,11 @@ int main(int argc, char *argv[])
         return tool_usage_error(&t, "standard input ('-') given %d times",
                                 nstdin);
     }
+    if (nstdin && isatty(STDIN_FILENO)) {
+        tool_finish(&t);
+        return tool_usage_error(&t, "will not read a surface from a terminal: "
+                                    "give a file or pipe one");
+    }
 
     /* A bad input is reported and skipped: the others are still worth a
      * report (as wc does), and the exit status says something failed. */
@@ -186,7 +192,7 @@ int main(int argc, char *argv[])
         st_soup *soup = NULL;
         st_soupinfo r;
         double t_read = tool_now();
-        if (st_soup_read(&soup, in, &err)) {
+        if (tool_soup_read(&t, &soup, in, &err)) {
             rc = tool_fail(&t, &err);
             continue;
         }

@@ -38,7 +38,7 @@ static void usage(void)
 "coarse tetrahedral mesh that encloses it, with dihedral angles far from 0 and\n"
 "180 degrees (Stuart et al. 2013 on the pseudo volume of Spillmann et al. 2006).\n"
 "\n"
-"INPUT is a surface: .obj .off .ply .stl; '-' reads stdin (format sniffed).\n"
+"INPUT is a surface: .obj .off .ply .stl .gltf .glb; '-' reads stdin (format sniffed).\n"
 "\n"
 "  -o, --output OUT     the mesh, by extension: .vtu (VTK), .msh (Gmsh), .node/.ele\n"
 "                       (TetGen), .mesh (Medit); '-' or none: .vtu on stdout\n"
@@ -49,6 +49,13 @@ static void usage(void)
 "                       point arrays embed_tet, embed_bary)\n"
 "      --cells N        BCC lattice cells along the longest side of the\n"
 "                       model's box (default 10; more cells, more tets)\n"
+"  -h, --size H         the lattice cell width in model units, instead of\n"
+"                       --cells (as latticetet -h)\n"
+"      --tets N         choose the cell width for about N tets (within 20%%;\n"
+"                       --cells or --size give the first guess)\n"
+"      --dry-run        print the cell width h, the estimated tets, memory\n"
+"                       and a time class, then exit (the field and signs are\n"
+"                       computed, the fit is not)\n"
 "      --offset R       stop fitting when every boundary vertex is within\n"
 "                       R * h of the surface (h = cell width; default 0.4)\n"
 "      --tries K        candidates with randomly rotated and offset lattices,\n"
@@ -63,8 +70,8 @@ static void usage(void)
 "                       (default max(128, 8 * cells))\n"
 "      --max-iters N    fit iterations at most (default 300)\n"
 "      --fill-holes on|off  cap the soup's holes for its pseudo volume\n"
-"                       (holes.h: loops of boundary edges, when small beside\n"
-"                       the surface around them; default on)\n"
+"                       (loops of boundary edges, when small beside the\n"
+"                       surface around them; default on)\n"
 "      --shells on|off  the soup's closed pieces (every edge shared by two\n"
 "                       faces) bound their solid exactly (default on)\n"
 "      --no-quality     skip the quality pass after the fit\n"
@@ -84,7 +91,8 @@ static void usage(void)
 }
 
 enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
-       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED, OPT_FILL_HOLES, OPT_SHELLS };
+       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED, OPT_FILL_HOLES, OPT_SHELLS,
+       OPT_TETS, OPT_DRY_RUN };
 
 static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
 {
@@ -128,7 +136,7 @@ static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
     double d2 = 0;
     for (int a = 0; a < 3; a++)
         d2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
-    double h = st_lattice_h_for_cells(lo, hi, p->cells);
+    double h = p->h > 0 ? p->h : st_lattice_h_for_cells(lo, hi, p->cells);
     if (!(h > 0) || !isfinite(h))
         return 0;
     double n = floor(sqrt(d2) / h) + 3 + 2 * ST_LATTICE_PAD_DEFAULT;
@@ -142,13 +150,56 @@ static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
     double need = tets * at_once * TOOL_LATTICE_BYTES_PER_TET;
     if (need <= (double)max_bytes)
         return 0;
-    st_error_set(err, ST_ELIMIT, NULL, 0,
-                 "--cells %zu lays lattices of up to %.0f tets (%.0f at a "
-                 "time), about %.1f MiB, over the limit of %.1f MiB (use "
-                 "fewer --cells or --tries, or raise --max-memory)",
-                 p->cells, tets, at_once, need / 1048576.0,
-                 (double)max_bytes / 1048576.0);
+    if (p->h > 0)
+        st_error_set(err, ST_ELIMIT, NULL, 0,
+                     "--size %g lays lattices of up to %.0f tets (%.0f at a "
+                     "time), about %.1f MiB, over the limit of %.1f MiB (use "
+                     "a larger --size or fewer --tries, or raise "
+                     "--max-memory)",
+                     h, tets, at_once, need / 1048576.0,
+                     (double)max_bytes / 1048576.0);
+    else
+        st_error_set(err, ST_ELIMIT, NULL, 0,
+                     "--cells %zu lays lattices of up to %.0f tets (%.0f at a "
+                     "time), about %.1f MiB, over the limit of %.1f MiB (use "
+                     "fewer --cells or --tries, or raise --max-memory)",
+                     p->cells, tets, at_once, need / 1048576.0,
+                     (double)max_bytes / 1048576.0);
     return 1;
+}
+
+/* soupmesh --dry-run: what a run would lay, on stdout, one "key value"
+ * a line. Memory: the field (floats and a sign byte per voxel, twice for
+ * the sweeps) and the lattices laid at once (the bound of
+ * lattice_over_limit). The time class counts tets times candidates: on
+ * this project's 2-core machine a bunny of ~1 000 to ~4 000 tets takes 2-5
+ * s in all; the 20 000 and 200 000 boundaries are a rough extrapolation
+ * (the fit is about linear in tets), not a measurement. */
+static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_params *p,
+                          const st_pipeline_stats *st)
+{
+    double lo[3], hi[3], d2 = 0;
+    st_error e;
+    if (st_soup_bounds(soup, lo, hi, &e) == ST_OK)
+        for (int a = 0; a < 3; a++)
+            d2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    double n = floor(sqrt(d2) / st->h) + 3 + 2 * ST_LATTICE_PAD_DEFAULT;
+    double at_once = 1;
+#ifdef _OPENMP
+    if (p->tries > 1)
+        at_once = (double)((size_t)omp_get_max_threads() < p->tries
+                               ? (size_t)omp_get_max_threads() : p->tries);
+#endif
+    double lattice = 12.0 * n * n * n * at_once * TOOL_LATTICE_BYTES_PER_TET;
+    double field = (double)st->field_dims[0] * (double)st->field_dims[1] *
+                   (double)st->field_dims[2] * 2.0 * (sizeof(float) + 1);
+    double work = (double)st->estimated_tets * (double)p->tries;
+    const char *cls = work < 20000 ? "seconds" : work < 200000 ? "minutes"
+                                                               : "tens of minutes or more";
+    printf("h %.17g\ncells %.0f\nestimated_tets %zu\nmemory_mib %.1f\ntime %s\n",
+           st->h, ceil(st_lattice_h_for_cells(lo, hi, 1) / st->h), st->estimated_tets,
+           (lattice + field) / 1048576.0, cls);
+    return tool_flush_stdout(t) ? TOOL_EXIT_FAIL : TOOL_EXIT_OK;
 }
 
 int main(int argc, char *argv[])
@@ -158,10 +209,14 @@ int main(int argc, char *argv[])
     tool_common co = tool_common_default();
     st_pipeline_params p = st_pipeline_params_default();
     size_t max_iters = 0, seed = 1;
+    int have_cells = 0;
     const char *out = NULL, *in = NULL, *embed = NULL;
     st_tetformat_opts fopts = {0, 0};
     static const struct option opts[] = {
         {"cells", required_argument, NULL, OPT_CELLS},
+        {"size", required_argument, NULL, 'h'},
+        {"tets", required_argument, NULL, OPT_TETS},
+        {"dry-run", no_argument, NULL, OPT_DRY_RUN},
         {"offset", required_argument, NULL, OPT_OFFSET},
         {"tries", required_argument, NULL, OPT_TRIES},
         {"seed", required_argument, NULL, OPT_SEED},
@@ -180,11 +235,23 @@ int main(int argc, char *argv[])
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, ":o:qv", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, ":o:h:qv", opts, NULL)) != -1) {
         switch (c) {
         case OPT_CELLS:
-            if (tool_parse_size(&t, "--cells", optarg, 1, 4096, &p.cells))
+            if (tool_parse_size(&t, "--cells", optarg, 1, ST_PIPELINE_MAX_CELLS, &p.cells))
                 return TOOL_EXIT_USAGE;
+            have_cells = 1;
+            break;
+        case 'h':
+            if (tool_parse_double(&t, "--size", optarg, 1e-300, 1e300, &p.h))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_TETS:
+            if (tool_parse_size(&t, "--tets", optarg, 10, 100000000, &p.target_tets))
+                return TOOL_EXIT_USAGE;
+            break;
+        case OPT_DRY_RUN:
+            p.dry_run = 1;
             break;
         case OPT_OFFSET:
             if (tool_parse_double(&t, "--offset", optarg, 1e-3, 10.0, &p.offset_ratio))
@@ -252,6 +319,11 @@ int main(int argc, char *argv[])
         }
         }
     }
+    if (have_cells && p.h > 0)
+        return tool_usage_error(&t, "--cells and --size exclude each other");
+    if (p.density_rho > 0 && (p.target_tets || p.dry_run))
+        return tool_usage_error(&t, "--tets and --dry-run size the sculpted mesh, "
+                                    "not --density's");
     if (optind < argc)
         in = argv[optind++];
     if (optind < argc)
@@ -260,7 +332,7 @@ int main(int argc, char *argv[])
         return tool_usage_error(&t, "no input surface (soupmesh -o out.vtu model.obj)");
     if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
         return tool_usage_error(&t, "will not read a surface from a terminal: give a file");
-    if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
+    if (st_path_is_stdio(out) && isatty(STDOUT_FILENO) && !p.dry_run)
         return tool_usage_error(&t, "will not write a .vtu document to a terminal: "
                                     "give -o FILE or pipe it");
     if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
@@ -309,6 +381,13 @@ int main(int argc, char *argv[])
         goto done;
     }
     tool_progress_end(&t);
+    if (p.dry_run) {
+        rc = dry_run_report(&t, soup, &p, &st);
+        goto done;
+    }
+    if (p.target_tets)
+        tool_say(&t, 2, "h %.6g for about %zu tets: %zu sculpts, %.2f s", st.h,
+                 p.target_tets, st.sculpts, st.seconds_size);
     report(&t, &st, p.density_rho > 0);
     if (st_meta_set(&m->meta, "source", st_path_is_stdio(in) ? "<stdin>" : in) ||
         st_meta_history_append(&m->meta, t.command_line ? t.command_line : "soupmesh")) {

@@ -41,8 +41,8 @@ static void usage(void)
 "FIELD is a distance field from soupdist (.vdb or .vti); '-' or none reads\n"
 "an OpenVDB stream from stdin.\n"
 "\n"
-"  -k K                 event threshold on P = 1 - c|d|, in (0, 1] (default 1:\n"
-"                       surface crossings, Nooruddin-Turk parity; the paper 0.8)\n"
+"  -k K                 event threshold on P = 1 - c|d|, in (0, 1] (default 1; paper: 0.8);\n"
+"                       1 counts surface crossings (Nooruddin-Turk parity)\n"
 "      --band D         c = 1/(D voxels) instead of 1/max|d| (a narrow band suffices)\n"
 "      --rays 13|26     one or both directions along the 13 lines (default 26)\n"
 "      --toggle first|nearest|crossing  where in an event run the parity\n"
@@ -121,7 +121,7 @@ static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_er
     st_soup_source src;
     st_error e;
     st_error_clear(&e);
-    st_status rc = st_soup_read_source(soup, path, &src, &e);
+    st_status rc = st_soup_read_source(soup, path, &src, NULL, &e);
     char got[32];
     snprintf(got, sizeof got, "%llu", src.size);
     const int same = src.hash[0] && strcmp(got, size) == 0 && strcmp(src.hash, hash) == 0;
@@ -326,7 +326,7 @@ int main(int argc, char *argv[])
     }
     double t1 = tool_now();
     if (surface) {
-        if (st_soup_read(&soup, surface, &err)) {
+        if (tool_soup_read(&t, &soup, surface, &err)) {
             rc = tool_fail(&t, &err);
             goto done;
         }

@@ -37,7 +37,7 @@ static void usage(void)
 "self-intersecting triangles (each checked exactly before it is written).\n"
 "\n"
 "FIELD is a signed field from soupsign (.vdb or .vti); '-' or none reads an\n"
-"OpenVDB stream from stdin. With --surface, INPUT (.obj .off .ply .stl) is\n"
+"OpenVDB stream from stdin. With --surface, INPUT (.obj .off .ply .stl .gltf .glb) is\n"
 "run through soupdist and soupsign with their defaults first.\n"
 "\n"
 "      --iso V          isovalue in model units (default %g; negative shrinks)\n"
@@ -231,6 +231,7 @@ int main(int argc, char *argv[])
         }
     } else if (st_grid_read(&g, in, co.max_bytes, &err) ||
                tool_check_field_finite(g, srcname, &err)) {
+        if (st_soup_format_from_path(in) != ST_SOUP_UNKNOWN) snprintf(err.msg + strlen(err.msg), sizeof err.msg - strlen(err.msg), "; a surface? soupwrap --surface %s", in);
         rc = tool_fail(&t, &err);
         goto done;
     }

@@ -44,7 +44,7 @@ static void usage(void)
 "  --fit                pull the boundary onto the surface while the mesh keeps\n"
 "                       enclosing it (Stuart et al. 2013, section 3.3), then\n"
 "                       raise the worst dihedral angles\n"
-"      --surface S      the surface to enclose (.obj .off .ply .stl); required\n"
+"      --surface S      the surface to enclose (.obj .off .ply .stl .gltf .glb); required\n"
 "      --offset R       stop when every boundary vertex is within R*h of S\n"
 "                       (default 0.4)\n"
 "      --cell-width H   the lattice cell width h when the mesh does not record\n"
@@ -271,7 +271,7 @@ int main(int argc, char *argv[])
         snprintf(param, sizeof param, "fair iters=%d lambda_dt=%.6g min_angle=%.6g quality_rounds=%d",
                  fp.iters, fp.lambda_dt, fp.min_angle, fp.quality_rounds);
     } else {
-        if (st_soup_read(&s, surface, &err) || st_bvh_build(&bvh, s, &err)) {
+        if (tool_soup_read(&t, &s, surface, &err) || st_bvh_build(&bvh, s, &err)) {
             rc = tool_fail(&t, &err);
             goto done;
         }

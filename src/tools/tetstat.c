@@ -22,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static void usage(void)
 {
@@ -33,9 +34,10 @@ static void usage(void)
 "two tets), connected components, boundary faces, volume, the lattice cell\n"
 "width h when the mesh records it.\n"
 "\n"
-"MESH is a .vtu tet mesh; '-' or none reads stdin.\n"
+"MESH is a tet mesh (.vtu .msh .mesh .node/.ele, by extension; sniffed on\n"
+"stdin); '-' or none reads stdin.\n"
 "\n"
-"  -S, --surface S      also measure against surface S (.obj .off .ply .stl):\n"
+"  -S, --surface S      also measure against surface S (.obj .off .ply .stl .gltf .glb):\n"
 "                       distances boundary <-> S, volume ratio (when S is\n"
 "                       closed and oriented), enclosure of S by the mesh\n"
 "  -F, --field F        also give the IoU of the mesh with the pseudo volume\n"
@@ -294,6 +296,11 @@ int main(int argc, char *argv[])
         return tool_usage_error(&t, "standard input ('-') given %d times",
                                 nstdin);
     }
+    if (nstdin && isatty(STDIN_FILENO)) {
+        tool_finish(&t);
+        return tool_usage_error(&t, "will not read from a terminal: give a "
+                                    "file or pipe one");
+    }
     tool_set_threads(co.threads);
 
     st_error err;
@@ -310,7 +317,7 @@ int main(int argc, char *argv[])
         rc = tool_fail(&t, &err);
         goto done;
     }
-    if (surface && st_soup_read(&s, surface, &err)) {
+    if (surface && tool_soup_read(&t, &s, surface, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

@@ -29,7 +29,9 @@ fd = m.GetFieldData()
 names = [fd.GetAbstractArray(i).GetName() for i in range(fd.GetNumberOfArrays())]
 for key in ("h", "lattice", "seed", "history"):
     assert key in names, (key, names)
-hist = fd.GetAbstractArray("history").GetValue(0)
+# Text meta is a UInt8 array of its bytes (tetio_vtu.cpp: meshio reads it).
+ha = fd.GetAbstractArray("history")
+hist = bytes(int(ha.GetValue(i)) for i in range(ha.GetNumberOfTuples())).decode()
 assert "latticetet" in hist and "soupsign" in hist, hist
 print(n)
 PY

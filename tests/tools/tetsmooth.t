@@ -70,7 +70,7 @@ import vtk, sys
 r = vtk.vtkXMLUnstructuredGridReader(); r.SetFileName('fd8.vtu'); r.Update()
 fd = r.GetOutput().GetFieldData()
 h = [fd.GetAbstractArray(i) for i in range(fd.GetNumberOfArrays()) if fd.GetArrayName(i) == 'history']
-v = h[0].GetValue(0) if h else ''
+v = bytes(int(h[0].GetValue(i)) for i in range(h[0].GetNumberOfTuples())).decode() if h else ''
 sys.exit(0 if 'tetsmooth -v --fair' in v and 'latticetet' in v else 1)
 \""
 

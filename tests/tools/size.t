@@ -1,0 +1,58 @@
+#!/bin/sh
+# tests/tools/size.t - size control in soupmesh: -h/--size H (an absolute
+# lattice cell width, as latticetet's -h), --tets N (a mesh within 20% of
+# N tets) and --dry-run (h, estimated tets, memory, time class; no mesh).
+. "$(dirname "$0")/lib.sh"
+TB=${SOUPTET_TESTBIN:-$ROOT/build/tests}
+cd "$WORK" || exit 1
+# A tetrahedron whose longest box side is 2: --cells 4 is h = 0.5 exactly.
+printf 'OFF\n4 4 0\n0 0 0\n2 0 0\n0 2 0\n0 0 2\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n' >tet.off
+
+check "soupmesh --cells 4" soupmesh -q --cells 4 -o c.vtu tet.off
+check "soupmesh --size 0.5" soupmesh -q --size 0.5 -o s.vtu tet.off
+check "--size 0.5 is --cells 4 on a box of longest side 2: the same mesh" \
+    "$TB/test_tetformat" --compare c.vtu s.vtu
+check "-h 0.5 is --size 0.5" sh -c "soupmesh -q -h 0.5 -o h.vtu tet.off && '$TB/test_tetformat' --compare s.vtu h.vtu"
+tetstat -q --json s.vtu >s.json && grep -q '"h": 0.5[,}]' s.json
+ok $? "the mesh records h = 0.5"
+soupmesh -q --size 0.3 --field-cells 32 -o t.vtu tet.off && tetstat -q --json t.vtu >t.json &&
+    grep -q '"h": 0.29999999999999999[,}]\|"h": 0.3[,}]' t.json
+ok $? "--size 0.3 (not a divisor of the box) keeps h = 0.3"
+expect_fail "--cells and --size together are a usage error" 2 \
+    "--cells and --size exclude each other" soupmesh --cells 4 --size 1 tet.off
+expect_fail "--size 0 is a usage error" 2 "--size wants a number" soupmesh --size 0 tet.off
+expect_fail "a width making more than 4096 cells is refused before any work" 1 \
+    "tet.off: .*(more than 4096|over the limit)" soupmesh --size 1e-4 -o x.vtu tet.off
+[ ! -e x.vtu ]
+ok $? "and leaves no output"
+
+# --tets on the bundled bunny: --cells 10 gives about 3 800 tets; ask for
+# 1 000, with one candidate and with four (other rotations).
+BUNNY=$ROOT/corpus/bunny.obj
+for tries in 1 4; do
+    soupmesh -q --tets 1000 --tries $tries -o b$tries.vtu "$BUNNY" &&
+        tetstat -q --json b$tries.vtu >b$tries.json
+    n=$(sed -n 's/.*"tets": \([0-9]*\).*/\1/p' b$tries.json | head -1)
+    [ -n "$n" ] && [ "$n" -ge 800 ] && [ "$n" -le 1200 ]
+    ok $? "soupmesh --tets 1000 --tries $tries: $n tets, within 20%"
+done
+soupmesh --dry-run --tets 1000 "$BUNNY" >dry.txt 2>dry.err
+rc=$?
+[ $rc -eq 0 ] && grep -q '^h [0-9.e+-]*$' dry.txt && grep -q '^estimated_tets [0-9]*$' dry.txt &&
+    grep -q '^memory_mib [0-9.]*$' dry.txt && grep -q '^time seconds$' dry.txt && [ ! -s dry.err ]
+ok $? "--dry-run prints h, estimated_tets, memory_mib and time, and nothing else"
+est=$(sed -n 's/^estimated_tets //p' dry.txt)
+n=$(sed -n 's/.*"tets": \([0-9]*\).*/\1/p' b1.json | head -1)
+[ -n "$est" ] && [ "$est" = "$n" ]
+ok $? "the estimate ($est) is the count the run with one candidate made ($n): the fit keeps every tet"
+h=$(sed -n 's/^h //p' dry.txt)
+soupmesh -q --dry-run --size "$h" "$BUNNY" >dry2.txt
+[ "$(sed -n 's/^estimated_tets //p' dry2.txt)" = "$est" ]
+ok $? "--dry-run --size with that h estimates the same count"
+mkdir -p nothing && (cd nothing && soupmesh -q --dry-run -o x.vtu "$BUNNY" >/dev/null) && [ -z "$(ls nothing)" ]
+ok $? "--dry-run writes no mesh"
+expect_fail "--tets with --density is a usage error" 2 "--tets and --dry-run size the sculpted mesh" \
+    soupmesh --density 0.5 --tets 100 tet.off
+expect_fail "--tets 3 is a usage error" 2 "--tets wants" soupmesh --tets 3 tet.off
+
+done_testing
