@@ -589,7 +589,8 @@ def fill_markdown(rows, previous):
         mark = lambda b: "met" if b else "**missed**"
         md.append("| %s | %d%s | %s | %s | %s | %s | %s | %s | %d / %d | %s | %s / %s (%s / %s) | %s |" % (
             dmg, len(sub), " (%d failed)" % failed if failed else "",
-            "%s (%s)" % (_pct(worst[0]), worst[1]) if worst else "-", "%g%%" % (100 * want),
+            ("%s (%s)" % (_pct(worst[0]), worst[1] if worst[0] < 1.0 else "all")) if worst else "-",
+            "%g%%" % (100 * want),
             mark(inside_met),
             "%.3f-%.3f" % (min(kr), max(kr)) if kr else "-",
             "%.2f-%.2f" % FILL_VOLUME if not vol_na else "n/a (union)",
