@@ -55,7 +55,7 @@ def _log(msg):
 
 def inputs(bench):
     """[(model, damage, path or None)]."""
-    damaged = os.path.join(bench.ROOT, "corpus", "cache", "damaged")
+    damaged = bench.DAMAGED
     out = []
     for name in (ONLY or MODELS):
         for dmg in DAMAGES:

@@ -86,7 +86,7 @@ def _tetgen(bench, src, tmp):
 
 def stage(build, bench):
     root = bench.ROOT
-    damaged = os.path.join(root, "corpus", "cache", "damaged")
+    damaged = bench.DAMAGED
     tmp = os.path.join(bench.RESULTS, "tmp", "wrap")
     os.makedirs(tmp, exist_ok=True)
     peer = os.path.join(build, "bench", "alpha_wrap")
