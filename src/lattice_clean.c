@@ -16,6 +16,7 @@
  * Everything is serial and in index order: the result depends only on the
  * input.
  */
+#include "fpenv.h"
 #include "souptet/lattice.h"
 #include "souptet/mem.h"
 

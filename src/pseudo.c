@@ -2,6 +2,7 @@
  * pseudo.c - the pseudo volume of a soup, step by step (pseudo.h).
  */
 #define _POSIX_C_SOURCE 200809L
+#include "fpenv.h"
 #include "souptet/pseudo.h"
 
 #include "souptet/mem.h"

@@ -1,6 +1,7 @@
 /*
  * sides.c - the side of an oriented soup near each voxel (see sides.h).
  */
+#include "fpenv.h"
 #include "souptet/sides.h"
 
 #include "souptet/bvh.h"

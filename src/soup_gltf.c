@@ -41,6 +41,7 @@
  * offsets, limits nesting (64 levels; glTF needs under 10) and allocates
  * only in proportion to the bytes it has read.
  */
+#include "fpenv.h"
 #include "soup_parse.h"
 #include "souptet/mem.h"
 
