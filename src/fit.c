@@ -892,13 +892,16 @@ static st_status quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
     return ST_OK;
 }
 
-st_status sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal,
-                              size_t *moves, st_error *err)
+/* The quality pass on a borrowed mesh (fairing's), with or without the
+ * boundary's tangent moves. */
+static st_status quality_on(sm_mesh *sm, double h, int rounds, double goal, int boundary,
+                            size_t *moves, st_error *err)
 {
     fit_ctx c;
     memset(&c, 0, sizeof c);
     c.sm = *sm;   /* borrowed: not freed here */
     c.h = h;
+    c.fair_boundary = boundary;
     st_fit_params p = st_fit_params_default();
     p.quality_rounds = rounds;
     p.quality_goal = goal;
@@ -909,22 +912,16 @@ st_status sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal,
     return rc;
 }
 
+st_status sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal,
+                              size_t *moves, st_error *err)
+{
+    return quality_on(sm, h, rounds, goal, 0, moves, err);
+}
+
 st_status sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal, size_t *moves,
                           st_error *err)
 {
-    fit_ctx c;
-    memset(&c, 0, sizeof c);
-    c.sm = *sm;   /* borrowed: not freed here */
-    c.h = h;
-    c.fair_boundary = 1;
-    st_fit_params p = st_fit_params_default();
-    p.quality_rounds = rounds;
-    p.quality_goal = goal;
-    st_fit_stats st;
-    memset(&st, 0, sizeof st);
-    st_status rc = quality_pass(&c, &p, NULL, &st, 0.0, err);
-    *moves = st.quality_moves;
-    return rc;
+    return quality_on(sm, h, rounds, goal, 1, moves, err);
 }
 
 /* ---- entry points ----------------------------------------------------- */

@@ -18,6 +18,7 @@
  */
 #include "fpenv.h"
 #include "souptet/lattice.h"
+#include "unionfind.h"
 #include "souptet/mem.h"
 
 #include <math.h>
@@ -28,23 +29,6 @@
 /* Join path cost per tet on top of (1 - rho) vol, in units of the tet's
  * volume: so that among paths of full-density tets the shortest wins. */
 #define JOIN_STEP 1e-3
-
-static size_t uf_find(size_t *parent, size_t x)
-{
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
-}
-
-static void uf_join(size_t *parent, size_t a, size_t b)
-{
-    a = uf_find(parent, a);
-    b = uf_find(parent, b);
-    if (a != b)
-        parent[a > b ? a : b] = a > b ? b : a;
-}
 
 typedef struct cleaner {
     const st_lattice *L;

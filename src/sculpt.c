@@ -51,6 +51,7 @@
  * greedy) and is counted in clusters_greedy.
  */
 #include "souptet/sculpt.h"
+#include "unionfind.h"
 #include "fpenv.h"
 #include "souptet/isect.h"
 #include "souptet/mem.h"
@@ -216,25 +217,6 @@ static size_t add_star(const st_lattice *L, unsigned char *keep, uint32_t v,
 
 /* ---- bomb repair ---- */
 
-static size_t uf_find(size_t *parent, size_t x)
-{
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
-}
-
-static void uf_union(size_t *parent, size_t a, size_t b)
-{
-    a = uf_find(parent, a);
-    b = uf_find(parent, b);
-    if (a < b)
-        parent[b] = a;
-    else if (b < a)
-        parent[a] = b;
-}
-
 /* One cluster's search state. Option o of bomb i adds the local tets
  * opt_tets[opt_off[4i+o] .. opt_off[4i+o+1]). */
 typedef struct search {
@@ -371,7 +353,7 @@ st_status st_sculpt_repair_bombs(unsigned char *keep, st_sculpt_stats *stats,
                     if (claim[t] < 0)
                         claim[t] = (int64_t)b;
                     else
-                        uf_union(parent, b, (size_t)claim[t]);
+                        uf_join(parent, b, (size_t)claim[t]);
                 }
             }
         /* Group bombs by cluster root (roots are the smallest members, so
@@ -607,7 +589,7 @@ static st_status nonmanifold(const st_lattice *L, const unsigned char *keep,
                     qa++;
                 while (lv[qb] != link[2 * a + 1])
                     qb++;
-                uf_union(par, qa, qb);
+                uf_join(par, qa, qb);
             }
             for (size_t q = 0; q < nl; q++) {
                 if (deg[q] != 2)

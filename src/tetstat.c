@@ -10,6 +10,7 @@
  * thread count.
  */
 #include "souptet/tetstat.h"
+#include "unionfind.h"
 #include "fpenv.h"
 #include "souptet/bvh.h"
 #include "souptet/enclose.h"
@@ -25,15 +26,6 @@
 #include <string.h>
 
 /* ---- the mesh alone ------------------------------------------------------ */
-
-static size_t uf_find(size_t *parent, size_t x)
-{
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
-}
 
 /* ---- contacts and the boundary's manifoldness ---------------------------- */
 
