@@ -22,6 +22,8 @@
 #include "souptet/tetmesh.h"
 #include "fpenv.h"
 #include "souptet/mem.h"
+#include "souptet/pred.h"
+#include "souptet/soup.h"
 #include "souptet/tetqual.h"
 
 #include <math.h>
@@ -486,6 +488,57 @@ st_status st_tetmesh_boundary(const st_tetmesh *m, uint32_t **faces,
         *face_tet = ft;
     *nfaces = n;
     return ST_OK;
+}
+
+st_status st_tetmesh_boundary_soup(struct st_soup **out, const st_tetmesh *m,
+                                   st_error *err)
+{
+    *out = NULL;
+    uint32_t *f = NULL, *ft = NULL, *map = NULL;
+    size_t nf = 0;
+    st_status rc = st_tetmesh_boundary(m, &f, &ft, &nf, err);
+    if (rc)
+        return rc;
+    st_soup *s = st_soup_new();
+    map = st_malloc_array(m->npoints ? m->npoints : 1, sizeof *map);
+    if (!s || !map) {
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < m->npoints; i++)
+        map[i] = UINT32_MAX;
+    for (size_t k = 0; k < nf; k++) {
+        uint32_t *v = f + 3 * k;
+        const uint32_t *q = m->tets + 4 * (size_t)ft[k];
+        uint32_t opp = q[0] ^ q[1] ^ q[2] ^ q[3] ^ v[0] ^ v[1] ^ v[2];
+        /* The fourth point behind the face: orient3d > 0 (pred.h). */
+        if (st_orient3d(m->xyz + 3 * (size_t)v[0], m->xyz + 3 * (size_t)v[1],
+                        m->xyz + 3 * (size_t)v[2], m->xyz + 3 * (size_t)opp) < 0) {
+            uint32_t tmp = v[1];
+            v[1] = v[2];
+            v[2] = tmp;
+        }
+        uint32_t w[3];
+        for (int c = 0; c < 3; c++) {
+            if (map[v[c]] == UINT32_MAX) {
+                const double *p = m->xyz + 3 * (size_t)v[c];
+                if ((rc = st_soup_add_vertex(s, p[0], p[1], p[2], err)))
+                    goto done;
+                map[v[c]] = (uint32_t)(s->nverts - 1);
+            }
+            w[c] = map[v[c]];
+        }
+        if ((rc = st_soup_add_triangle(s, w[0], w[1], w[2], err)))
+            goto done;
+    }
+    *out = s;
+    s = NULL;
+done:
+    st_soup_free(s);
+    free(map);
+    free(f);
+    free(ft);
+    return rc;
 }
 
 /* ---- quality ------------------------------------------------------------- */

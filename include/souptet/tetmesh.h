@@ -99,6 +99,20 @@ st_status st_tetmesh_boundary(const st_tetmesh *m, uint32_t **faces,
                               uint32_t **face_tet, size_t *nfaces,
                               st_error *err);
 
+/* The boundary surface of m as a soup (the collision proxy soupmesh
+ * --boundary writes): the boundary faces of st_tetmesh_boundary, in its
+ * order, each turned by the exact orientation test (pred.h) so that the
+ * tet's fourth point lies behind it, i.e. its normal (b-a)x(c-a) points
+ * out of the mesh whatever the tets' own orientation (a face of a flat
+ * tet keeps st_tetmesh_boundary's order); only the points the faces use,
+ * numbered in order of first use, with their coordinates copied bit for
+ * bit. For a conforming mesh the surface is closed (every edge on an even
+ * number of faces) and consistently oriented. *out is a new soup (empty
+ * for a mesh without tets); ST_ENOMEM, ST_ELIMIT. */
+struct st_soup;
+st_status st_tetmesh_boundary_soup(struct st_soup **out, const st_tetmesh *m,
+                                   st_error *err);
+
 /* A deep copy of src (geometry, arrays, meta) into a new mesh *out. */
 st_status st_tetmesh_copy(st_tetmesh **out, const st_tetmesh *src,
                           st_error *err);
