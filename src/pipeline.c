@@ -79,9 +79,34 @@ static void dihedral_range(const st_tetmesh *m, double *lo, double *hi)
     *hi = m->ntets ? mx : 0.0;
 }
 
+/* Tell the caller (pipeline.h): one call at a time, whichever thread. */
+static void emit(const st_pipeline_params *p, st_pipeline_event *ev)
+{
+    if (!p->on_event)
+        return;
+    #pragma omp critical(st_pipeline_event)
+    p->on_event(p->on_event_ctx, ev);
+}
+
+typedef struct iter_relay {
+    const st_pipeline_params *p;
+    size_t k;
+} iter_relay;
+
+static void relay_iter(void *ctx, const st_fit_iter *it)
+{
+    const iter_relay *r = ctx;
+    st_pipeline_event ev;
+    memset(&ev, 0, sizeof ev);
+    ev.what = "iteration";
+    ev.k = r->k;
+    ev.fit = it;
+    emit(r->p, &ev);
+}
+
 /* The Cetra candidate: sculpt, fit, quality pass. */
 static st_status run_sculpt_candidate(st_tetmesh **out,
-                                      st_pipeline_candidate *c,
+                                      st_pipeline_candidate *c, size_t k,
                                       const st_grid *g, const st_soup *s,
                                       const st_bvh *bvh, double h,
                                       const st_pipeline_params *p,
@@ -102,8 +127,21 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
     c->bombs_left = ss.bombs_left;
     double t1 = now_seconds();
     c->seconds_sculpt = t1 - t0;
+    st_pipeline_event ev;
+    memset(&ev, 0, sizeof ev);
+    ev.what = "sculpted";
+    ev.k = k;
+    ev.h = h;
+    ev.tets = m->ntets;
+    ev.seconds = c->seconds_sculpt;
+    emit(p, &ev);
 
+    iter_relay relay = {p, k};
     st_fit_params fp = st_fit_params_default();
+    if (p->on_event) {
+        fp.on_iter = relay_iter;
+        fp.on_iter_ctx = &relay;
+    }
     fp.offset_ratio = p->offset_ratio;
     fp.cell_width = h;
     fp.quality = p->quality;
@@ -168,6 +206,12 @@ static st_status choose_h(double *h, st_pipeline_stats *st, const st_grid *g,
         double n = (double)m->ntets;
         st_tetmesh_free(m);
         st->sculpts++;
+        st_pipeline_event ev;
+        memset(&ev, 0, sizeof ev);
+        ev.what = "size";
+        ev.h = hk;
+        ev.tets = (size_t)n;
+        emit(p, &ev);
         double e = target > 0 && n > 0 ? fabs(log(n / target)) : 0;
         if (e < best_err) {
             best_err = e;
@@ -350,6 +394,15 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     st->field_dims[1] = g->ny;
     st->field_dims[2] = g->nz;
     st->voxel = g->voxel;
+    {
+        st_pipeline_event ev;
+        memset(&ev, 0, sizeof ev);
+        ev.what = "field";
+        memcpy(ev.field_dims, st->field_dims, sizeof ev.field_dims);
+        ev.voxel = g->voxel;
+        ev.seconds = t_cand - t_start;
+        emit(p, &ev);
+    }
 
     double lo[3], hi[3];
     rc = st_soup_bounds(s, lo, hi, err);
@@ -395,7 +448,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         st_error_clear(&e);
         st_status r = p->density_rho > 0
             ? run_density_candidate(&meshes[k], c, g, s, bvh, h, p, &e)
-            : run_sculpt_candidate(&meshes[k], c, g, s, bvh, h, p,
+            : run_sculpt_candidate(&meshes[k], c, k, g, s, bvh, h, p,
                                    K == 1 ? prog : NULL, &e);
         if (r) {
             c->failed = 1;
@@ -405,6 +458,14 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
             c->points = meshes[k]->npoints;
             dihedral_range(meshes[k], &c->min_dihedral, &c->max_dihedral);
         }
+        st_pipeline_event ev;
+        memset(&ev, 0, sizeof ev);
+        ev.what = "candidate";
+        ev.k = k;
+        ev.h = h;
+        ev.tets = c->tets;
+        ev.candidate = c;
+        emit(p, &ev);
         #pragma omp critical(st_pipeline_progress)
         {
             finished++;

@@ -36,6 +36,7 @@
 
 #include "souptet/err.h"
 #include "souptet/progress.h"
+#include "souptet/smooth.h"
 #include "souptet/soup.h"
 #include "souptet/tetmesh.h"
 
@@ -49,6 +50,35 @@ extern "C" {
 #define ST_PIPELINE_MAX_CELLS 4096
 /* Sculpts at most when choosing h for target_tets. */
 #define ST_PIPELINE_SIZE_STEPS 10
+
+struct st_pipeline_candidate;
+
+/* What a long run tells its caller as it goes (st_pipeline_params.on_event),
+ * for progress lines: the library never prints. */
+typedef struct st_pipeline_event {
+    const char *what;      /* "field": the distance field and signs are
+                              done (field_dims, voxel);
+                              "size": a sculpt while choosing h for
+                              target_tets or dry_run (h, tets);
+                              "sculpted": candidate k's lattice is
+                              sculpted (h, tets, seconds);
+                              "iteration": one fit or quality iteration of
+                              candidate k (fit);
+                              "candidate": candidate k is done (candidate) */
+    size_t k;              /* the candidate (0 for "field" and "size") */
+    size_t field_dims[3];
+    double voxel, h;
+    size_t tets;
+    double seconds;        /* the stage's time */
+    const st_fit_iter *fit;
+    const struct st_pipeline_candidate *candidate;
+} st_pipeline_event;
+
+/* Called with ctx and the event; calls never overlap (they may come from
+ * different threads, one at a time, when candidates run in parallel),
+ * and the order of the candidates' events depends on which runs first;
+ * nothing about the result does. */
+typedef void (*st_pipeline_event_fn)(void *ctx, const st_pipeline_event *ev);
 
 typedef struct st_pipeline_params {
     size_t cells;          /* lattice cells along the longest side (10) */
@@ -79,6 +109,8 @@ typedef struct st_pipeline_params {
                               (holes.h) (1) */
     int closed_shells;     /* the soup's closed pieces sign their solid
                               exactly (shells.h) (1) */
+    st_pipeline_event_fn on_event;   /* may be NULL (NULL) */
+    void *on_event_ctx;
 } st_pipeline_params;
 
 st_pipeline_params st_pipeline_params_default(void);

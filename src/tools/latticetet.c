@@ -48,13 +48,15 @@ static void usage(void)
 "      --surface S      the surface the field was made from (with --sculpt)\n"
 "      --lattice KIND   cubic5 (5 tets per cube) or bcc (default: cubic5 for\n"
 "                       --density, bcc for --sculpt)\n"
-"      --cells N        cells along the longest side of the field's box\n"
-"                       (default 16 for --density, 10 for --sculpt); with\n"
+"      --cells N        cells along the longest side of the field's box with\n"
+"                       --density, of the surface's box with --sculpt (as\n"
+"                       soupmesh) (default 16 for --density, 10 for --sculpt); with\n"
 "                       --density, 'auto': the coarsest of 8, 10, 12, 14,\n"
 "                       16, 20, ..., 128 at which no part is too thin\n"
 "  -h, --size SIZE      cell width in model units (instead of --cells)\n"
-"      --seed S         random rotation and offset of the lattice (default 0:\n"
-"                       axis-aligned at the box's corner)\n"
+"      --seed S         random rotation and offset of the lattice (0: axis-aligned\n"
+"                       at the box's corner; default 0 for --density, 1 for\n"
+"                       --sculpt, as soupmesh)\n"
 "      --no-repair      sculpt without bomb and manifold repair; with\n"
 "                       --density, the paper's rule alone: no cleanup of\n"
 "                       hanging tets, islands and pinched boundaries\n"
@@ -90,6 +92,7 @@ int main(int argc, char *argv[])
     double rho = -1, size = 0;
     int sculpt = 0, repair = 1;
     uint64_t seed = 0;
+    int have_seed = 0;
     static const struct option opts[] = {
         {"density", required_argument, NULL, OPT_DENSITY},
         {"sculpt", no_argument, NULL, OPT_SCULPT},
@@ -141,6 +144,7 @@ int main(int argc, char *argv[])
                 return tool_usage_error(&t, "--seed wants a non-negative "
                                             "integer, not '%s'", optarg);
             seed = (uint64_t)v;
+            have_seed = 1;
             break;
         }
         case OPT_NOREPAIR:
@@ -181,11 +185,17 @@ int main(int argc, char *argv[])
         return tool_usage_error(&t, "--lattice is cubic5 or bcc, not '%s'", lattice);
     if (!cells)   /* sculpting keeps a layer more: coarser by default */
         cells = sculpt ? 10 : 16;
+    /* Sculpting: soupmesh's defaults, so the pipe makes soupmesh's mesh. */
+    if (!have_seed && sculpt)
+        seed = 1;
     if (!in)
         in = "-";
     if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
         return tool_usage_error(&t, "no input: give a field or pipe one in "
                                     "(soupdist m.obj | soupsign | latticetet ...)");
+    if (surface && st_path_is_stdio(surface) && isatty(STDIN_FILENO))
+        return tool_usage_error(&t, "will not read a surface from a terminal: give a "
+                                    "file or pipe one");
     if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
         return tool_usage_error(&t, "will not write a .vtu document to a "
                                     "terminal: give -o FILE or pipe it");
@@ -227,6 +237,15 @@ int main(int argc, char *argv[])
     double lo[3], hi[3];
     st_lattice_grid_box(g, lo, hi);
     double h = size > 0 ? size : st_lattice_h_for_cells(lo, hi, cells);
+    if (sculpt && !(size > 0)) {
+        /* --cells over the surface's box, as soupmesh counts them. */
+        double slo[3], shi[3];
+        if (st_soup_bounds(soup, slo, shi, &err)) {
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        h = st_lattice_h_for_cells(slo, shi, cells);
+    }
     /* A lattice that cannot fit in --max-memory (or past 2^31 tets, far
      * beyond what a coarse mesh needs) is refused before it is built. */
     const size_t max_tets = tool_max_lattice_tets(co.max_bytes);

@@ -16,6 +16,7 @@
 #include "souptet/outfile.h"
 #include "souptet/pipeline.h"
 #include "souptet/soup.h"
+#include "souptet/soupwrite.h"
 #include "souptet/tetformat.h"
 #include "souptet/tetio.h"
 
@@ -47,6 +48,8 @@ static void usage(void)
 "      --embed FILE     where each input vertex lies: its tet and barycentric\n"
 "                       coordinates, as text (.txt) or a point cloud (.vtu with\n"
 "                       point arrays embed_tet, embed_bary)\n"
+"      --boundary FILE  also write the mesh's boundary surface (closed, normals\n"
+"                       outward; a collision proxy) as .obj, .off, .ply or .stl\n"
 "      --cells N        BCC lattice cells along the longest side of the\n"
 "                       model's box (default 10; more cells, more tets)\n"
 "  -h, --size H         the lattice cell width in model units, instead of\n"
@@ -92,7 +95,33 @@ static void usage(void)
 
 enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
        OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED, OPT_FILL_HOLES, OPT_SHELLS,
-       OPT_TETS, OPT_DRY_RUN };
+       OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY };
+
+/* -v: a line as each stage, sculpt, fit iteration and candidate ends, so a
+ * long run is never silent (pipeline.h, st_pipeline_event). */
+static void on_event(void *ctx, const st_pipeline_event *ev)
+{
+    const tool_ctx *t = ctx;
+    if (strcmp(ev->what, "field") == 0)
+        tool_say(t, 2, "field %zux%zux%zu, voxel %.6g: distance and signs %.3f s",
+                 ev->field_dims[0], ev->field_dims[1], ev->field_dims[2], ev->voxel,
+                 ev->seconds);
+    else if (strcmp(ev->what, "size") == 0)
+        tool_say(t, 2, "size: h %.6g sculpts %zu tets", ev->h, ev->tets);
+    else if (strcmp(ev->what, "sculpted") == 0)
+        tool_say(t, 2, "candidate %zu: %zu tets sculpted at h %.6g, %.2f s", ev->k,
+                 ev->tets, ev->h, ev->seconds);
+    else if (strcmp(ev->what, "iteration") == 0)
+        tool_say(t, 2, "candidate %zu: %s %3d: %zu/%zu boundary vertices within offset "
+                 "(max distance %.4g), dihedral %.2f..%.2f, %zu moved, %zu rejected, %.2f s",
+                 ev->k, ev->fit->phase, ev->fit->iter, ev->fit->within_offset,
+                 ev->fit->boundary_vertices, ev->fit->max_distance, ev->fit->min_dihedral,
+                 ev->fit->max_dihedral, ev->fit->moved, ev->fit->rejected,
+                 ev->fit->seconds);
+    else if (strcmp(ev->what, "candidate") == 0)
+        tool_say(t, 2, "candidate %zu: done%s", ev->k,
+                 ev->candidate->failed ? " (failed)" : "");
+}
 
 static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
 {
@@ -210,7 +239,7 @@ int main(int argc, char *argv[])
     st_pipeline_params p = st_pipeline_params_default();
     size_t max_iters = 0, seed = 1;
     int have_cells = 0;
-    const char *out = NULL, *in = NULL, *embed = NULL;
+    const char *out = NULL, *in = NULL, *embed = NULL, *boundary = NULL;
     st_tetformat_opts fopts = {0, 0};
     static const struct option opts[] = {
         {"cells", required_argument, NULL, OPT_CELLS},
@@ -229,6 +258,7 @@ int main(int argc, char *argv[])
         {"msh-version", required_argument, NULL, OPT_MSH_VERSION},
         {"msh-binary", no_argument, NULL, OPT_MSH_BINARY},
         {"embed", required_argument, NULL, OPT_EMBED},
+        {"boundary", required_argument, NULL, OPT_BOUNDARY},
         {"output", required_argument, NULL, 'o'},
         TOOL_LONG_OPTIONS_BASIC,
         TOOL_LONG_OPTIONS_RESOURCES,
@@ -306,6 +336,9 @@ int main(int argc, char *argv[])
         case OPT_EMBED:
             embed = optarg;
             break;
+        case OPT_BOUNDARY:
+            boundary = optarg;
+            break;
         case 'o':
             out = optarg;
             break;
@@ -342,12 +375,24 @@ int main(int argc, char *argv[])
     int embed_text = elen > 4 && strcmp(embed + elen - 4, ".txt") == 0;
     if (embed && !embed_text && !(elen > 4 && strcmp(embed + elen - 4, ".vtu") == 0))
         return tool_usage_error(&t, "--embed writes .txt or .vtu, not '%s'", embed);
-    if (tool_output_unwritable(&t, out) || tool_output_unwritable(&t, embed)) {
+    st_soup_format bfmt = boundary ? st_soup_format_from_path(boundary) : ST_SOUP_UNKNOWN;
+    if (boundary && (st_path_is_stdio(boundary) || bfmt == ST_SOUP_UNKNOWN ||
+                     bfmt == ST_SOUP_GLTF))
+        return tool_usage_error(&t, "--boundary writes .obj, .off, .ply or .stl, not '%s'",
+                                boundary);
+    if (boundary && p.density_rho > 0)
+        return tool_usage_error(&t, "--boundary goes with the enclosing mesh, not --density");
+    if (tool_output_unwritable(&t, out) || tool_output_unwritable(&t, embed) ||
+        tool_output_unwritable(&t, boundary)) {
         tool_finish(&t);
         return TOOL_EXIT_FAIL;
     }
     tool_set_threads(co.threads);
     p.max_bytes = co.max_bytes;
+    if (t.verbosity >= 2) {
+        p.on_event = on_event;
+        p.on_event_ctx = &t;
+    }
 
     st_error err;
     st_error_clear(&err);
@@ -358,6 +403,10 @@ int main(int argc, char *argv[])
     int64_t *et = NULL;
     double *eb = NULL;
     st_tetmesh *side = NULL;
+    st_soup *bsoup = NULL;
+    st_outfile bof;
+    memset(&bof, 0, sizeof bof);
+    bof.slot = -1;
     int rc = TOOL_EXIT_FAIL;
     double t0 = tool_now();
     if (st_soup_read(&soup, in, &err)) {
@@ -414,9 +463,36 @@ int main(int argc, char *argv[])
             goto done;
         }
     }
+    /* The boundary surface is written to its temporary file before the
+     * mesh is saved and renamed into place after it, so a failure on
+     * either side leaves neither half-done. */
+    if (boundary) {
+        const char *cmd = t.command_line ? t.command_line : "soupmesh";
+        size_t n = strlen(cmd) + strlen(in) + 64;
+        char *comment = malloc(n);
+        if (!comment) {
+            st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        snprintf(comment, n, "souptet soupmesh: the boundary of the mesh; source: %s\n%s",
+                 st_path_is_stdio(in) ? "<stdin>" : in, cmd);
+        st_status bs = st_tetmesh_boundary_soup(&bsoup, m, &err);
+        if (!bs && !(bs = st_outfile_begin(&bof, boundary, 1, &err)))
+            bs = st_soup_write(bof.fp, bsoup, bfmt, comment, boundary, &err);
+        free(comment);
+        if (bs) {
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+    }
     if (st_tetformat_from_path(out) != ST_TETFORMAT_NONE
             ? st_tetformat_save(m, ST_TETFORMAT_NONE, out, &fopts, &err)
             : st_tetmesh_save(m, out, &err)) {
+        rc = tool_fail(&t, &err);
+        goto done;
+    }
+    if (boundary && st_outfile_commit(&bof, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }
@@ -452,6 +528,8 @@ int main(int argc, char *argv[])
                  b->max_distance);
     }
 done:
+    st_outfile_abort(&bof);
+    st_soup_free(bsoup);
     free(et);
     free(eb);
     st_tetmesh_free(side);

@@ -297,6 +297,9 @@ int main(int argc, char *argv[])
     if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
         return tool_usage_error(&t, "no input: give a field or pipe one in "
                                     "(soupdist mesh.obj | soupsign)");
+    if (surface && st_path_is_stdio(surface) && isatty(STDIN_FILENO))
+        return tool_usage_error(&t, "will not read a surface from a terminal: give a "
+                                    "file or pipe one");
     if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
         return tool_usage_error(&t, "will not write a binary VDB stream to a "
                                     "terminal: give -o FILE or pipe it");

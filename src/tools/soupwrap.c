@@ -187,6 +187,9 @@ int main(int argc, char *argv[])
         return tool_usage_error(&t, "no input: give a field or pipe one in "
                                     "(soupdist mesh.obj | soupsign | "
                                     "soupwrap), or --surface INPUT");
+    if (surface && st_path_is_stdio(surface) && isatty(STDIN_FILENO))
+        return tool_usage_error(&t, "will not read a surface from a terminal: give a "
+                                    "file or pipe one");
     st_soup_format fmt = ST_SOUP_OBJ;
     if (!st_path_is_stdio(out)) {
         fmt = st_soup_format_from_path(out);

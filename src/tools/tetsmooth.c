@@ -217,6 +217,9 @@ int main(int argc, char *argv[])
     if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
         return tool_usage_error(&t, "no input: give a mesh or pipe one in "
                                     "(latticetet ... | tetsmooth ...)");
+    if (surface && st_path_is_stdio(surface) && isatty(STDIN_FILENO))
+        return tool_usage_error(&t, "will not read a surface from a terminal: give a "
+                                    "file or pipe one");
     if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
         return tool_usage_error(&t, "cannot tell the format of '%s' (use .vtu)", out);
     if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
