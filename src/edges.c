@@ -1,17 +1,20 @@
 /*
  * edges.c - edges and pieces of a soup on welded vertices (see edges.h).
  *
- *   1. weld the vertices exactly; sort the non-degenerate triangles by
- *      their sorted welded corners (ties by index) and keep the first of
- *      each run of equal corners;
- *   2. sort the kept triangles' half-edges by their unordered welded ends
+ *   1. weld the vertices exactly; sort the triangles by their sorted
+ *      welded corners (ties by index): a run of equal corners is one
+ *      triangle and its duplicates; keep the first of each run that is
+ *      not degenerate;
+ *   2. sort the kept triangles' half-edges (with ST_EDGES_DUPLICATES,
+ *      every non-degenerate triangle's) by their unordered welded ends
  *      (ties by triangle: the order is total);
- *   3. join the triangles of every edge (union-find toward the smaller
+ *   3. join the triangles of every edge (unionfind.h: toward the smaller
  *      index, so every root is its piece's smallest triangle).
  */
 #include "souptet/edges.h"
 #include "souptet/mem.h"
 #include "souptet/weld.h"
+#include "unionfind.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -38,15 +41,6 @@ static int cmp_half(const void *pa, const void *pb)
     return (a->t > b->t) - (a->t < b->t);
 }
 
-static uint32_t uf_find(uint32_t *parent, uint32_t x)
-{
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
-}
-
 void st_soup_edges_free(st_soup_edges *e)
 {
     if (!e)
@@ -60,6 +54,28 @@ void st_soup_edges_free(st_soup_edges *e)
 
 st_status st_soup_edges_build(st_soup_edges *e, const st_soup *s, st_error *err)
 {
+    return st_soup_edges_build_opts(e, s, 0, err);
+}
+
+size_t st_soup_edges_run_end(const st_soup_edges *e, size_t i)
+{
+    size_t j = i + 1;
+    while (j < e->nhalf && e->he[j].key == e->he[i].key)
+        j++;
+    return j;
+}
+
+int st_soup_edges_corner(const st_soup_edges *e, const st_soup *s, uint32_t t, uint32_t w)
+{
+    for (int c = 0; c < 3; c++)
+        if (e->weld[s->tris[3 * (size_t)t + (size_t)c]] == w)
+            return c;
+    return -1;
+}
+
+st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned flags,
+                                   st_error *err)
+{
     memset(e, 0, sizeof *e);
     if (s->ntris > (size_t)INT32_MAX)
         return st_error_set(err, ST_ELIMIT, NULL, 0,
@@ -71,10 +87,12 @@ st_status st_soup_edges_build(st_soup_edges *e, const st_soup *s, st_error *err)
     e->kept = st_calloc_array(nt ? nt : 1, 1);
     e->he = st_malloc_array(3 * nt + 1, sizeof *e->he);
     e->piece = st_malloc_array(nt ? nt : 1, sizeof *e->piece);
+    size_t *uf = st_malloc_array(nt ? nt : 1, sizeof *uf);
     long long nw = -1;
-    if (!keys || !e->weld || !e->kept || !e->he || !e->piece ||
+    if (!keys || !e->weld || !e->kept || !e->he || !e->piece || !uf ||
         (nw = st_weld_vertices(e->weld, s)) < 0) {
         free(keys);
+        free(uf);
         st_soup_edges_free(e);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
     }
@@ -85,8 +103,7 @@ st_status st_soup_edges_build(st_soup_edges *e, const st_soup *s, st_error *err)
     for (size_t t = 0; t < nt; t++) {
         uint32_t a = e->weld[s->tris[3 * t]], b = e->weld[s->tris[3 * t + 1]],
                  c = e->weld[s->tris[3 * t + 2]], x;
-        if (a == b || b == c || a == c)
-            continue;
+        e->degenerate += a == b || b == c || a == c;
         if (a > b) { x = a; a = b; b = x; }
         if (b > c) { x = b; b = c; c = x; }
         if (a > b) { x = a; a = b; b = x; }
@@ -101,9 +118,11 @@ st_status st_soup_edges_build(st_soup_edges *e, const st_soup *s, st_error *err)
     /* 2. half-edges of the kept triangles */
     size_t nh = 0;
     for (size_t i = 0; i < nk; i++) {
-        if (i > 0 && memcmp(keys[i].k, keys[i - 1].k, sizeof keys[i].k) == 0)
-            continue;
         const uint32_t *k = keys[i].k, t = keys[i].t;
+        const int dup = i > 0 && memcmp(k, keys[i - 1].k, sizeof keys[i].k) == 0;
+        e->duplicates += dup;
+        if (k[0] == k[1] || k[1] == k[2] || (dup && !(flags & ST_EDGES_DUPLICATES)))
+            continue;
         const uint64_t ends[3] = {(uint64_t)k[0] << 32 | k[1], (uint64_t)k[1] << 32 | k[2],
                                   (uint64_t)k[0] << 32 | k[2]};
         for (int j = 0; j < 3; j++) {
@@ -111,7 +130,7 @@ st_status st_soup_edges_build(st_soup_edges *e, const st_soup *s, st_error *err)
             e->he[nh].t = t;
             nh++;
         }
-        e->kept[t] = 1;
+        e->kept[t] = (uint8_t)!dup;
     }
     free(keys);
     qsort(e->he, nh, sizeof *e->he, cmp_half);
@@ -119,15 +138,13 @@ st_status st_soup_edges_build(st_soup_edges *e, const st_soup *s, st_error *err)
 
     /* 3. pieces */
     for (size_t t = 0; t < nt; t++)
-        e->piece[t] = (uint32_t)t;
+        uf[t] = t;
     for (size_t i = 0, j; i < nh; i = j)
-        for (j = i + 1; j < nh && e->he[j].key == e->he[i].key; j++) {
-            uint32_t a = uf_find(e->piece, e->he[i].t), b = uf_find(e->piece, e->he[j].t);
-            if (a != b)
-                e->piece[a > b ? a : b] = a < b ? a : b;
-        }
+        for (j = i + 1; j < nh && e->he[j].key == e->he[i].key; j++)
+            uf_join(uf, e->he[i].t, e->he[j].t);
     for (size_t t = 0; t < nt; t++)
-        e->piece[t] = uf_find(e->piece, (uint32_t)t);
+        e->piece[t] = (uint32_t)uf_find(uf, t);
+    free(uf);
     return ST_OK;
 }
 

@@ -4,18 +4,16 @@
  *
  * Algorithm, in passes over the soup:
  *
- *   1. Weld: an open-addressing hash table keyed on the bit patterns of the
- *      three coordinates (-0.0 folded onto 0.0) maps every referenced
- *      vertex to a welded id; ids are handed out in vertex order, so the
- *      result does not depend on hashing details.
- *   2. Per triangle: its three welded corners; degenerate when two agree.
- *   3. Duplicates: sort the triangles' sorted corner triples; equal
- *      neighbours are copies.
- *   4. Edges: sort the half-edges of non-degenerate triangles by their
- *      unordered welded endpoints (ties by half-edge index, so the order is
- *      total and the result deterministic). Each run of equal keys is one
- *      edge; its length and the directions of its half-edges classify it.
- *      The same pass joins triangles into pieces (union-find), joins the
+ *   1-3. The soup's topology as edges.h gives it (the one definition the
+ *      hole caps and shells read too), duplicates kept in the edges:
+ *      exact welding (weld.h: vertex ids in order of first use), degenerate
+ *      triangles (two corners welded together), duplicates (equal sorted
+ *      corner triples), the half-edges of every non-degenerate triangle
+ *      sorted by their unordered welded ends (ties by triangle, so the
+ *      order is total and the result deterministic), and the pieces
+ *      (union-find toward the smallest triangle).
+ *   4. Edges: each run of equal keys is one edge; its length and the
+ *      directions of its half-edges classify it. The same pass joins the
  *      boundary edges' endpoints (for the cycle rank), joins the corners
  *      on both sides of a manifold edge (for fans) and records manifold
  *      neighbours (for orientation propagation).
@@ -28,93 +26,31 @@
  *      decided once, exactly, by the rule for the corners it shares (see
  *      soupinfo.h).
  *
- * Union-find joins toward the smaller index, so every root is the smallest
- * member of its set: pieces are numbered by their first triangle.
+ * Union-find (unionfind.h) joins toward the smaller index, so every root is
+ * the smallest member of its set: pieces are numbered by their first
+ * triangle.
  */
 #include "souptet/soupinfo.h"
 #include "fpenv.h"
 #include "souptet/bvh.h"
+#include "souptet/edges.h"
 #include "souptet/geom.h"
 #include "souptet/isect.h"
 #include "souptet/mem.h"
 #include "souptet/pred.h"
 #include "souptet/weld.h"
+#include "unionfind.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define NONE UINT32_MAX
-
-/* ---- union-find ---------------------------------------------------------- */
-
-static uint32_t uf_find(uint32_t *parent, uint32_t x)
-{
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]]; /* path halving */
-        x = parent[x];
-    }
-    return x;
-}
-
-static void uf_union(uint32_t *parent, uint32_t a, uint32_t b)
-{
-    a = uf_find(parent, a);
-    b = uf_find(parent, b);
-    if (a < b)
-        parent[b] = a;
-    else if (b < a)
-        parent[a] = b;
-}
-
-static uint32_t *uf_new(size_t n)
-{
-    uint32_t *p = st_malloc_array(n, sizeof *p);
-    if (p)
-        for (size_t i = 0; i < n; i++)
-            p[i] = (uint32_t)i;
-    return p;
-}
-
-/* ---- sorting ------------------------------------------------------------- */
-
-typedef struct triple {
-    uint32_t k[3]; /* sorted welded corners */
-    uint32_t t;
-} triple;
-
-static int cmp_triple(const void *pa, const void *pb)
-{
-    const triple *a = pa, *b = pb;
-    for (int i = 0; i < 3; i++)
-        if (a->k[i] != b->k[i])
-            return a->k[i] < b->k[i] ? -1 : 1;
-    return (a->t > b->t) - (a->t < b->t);
-}
-
-typedef struct halfedge {
-    uint64_t key; /* min endpoint << 32 | max endpoint */
-    uint32_t h;   /* 3 * triangle + slot of its start corner */
-} halfedge;
-
-static int cmp_halfedge(const void *pa, const void *pb)
-{
-    const halfedge *a = pa, *b = pb;
-    if (a->key != b->key)
-        return a->key < b->key ? -1 : 1;
-    return (a->h > b->h) - (a->h < b->h);
-}
 
 static int cmp_u64(const void *pa, const void *pb)
 {
     uint64_t a = *(const uint64_t *)pa, b = *(const uint64_t *)pb;
     return (a > b) - (a < b);
-}
-
-static uint32_t next_corner(uint32_t h)
-{
-    return h % 3 == 2 ? h - 2 : h + 1;
 }
 
 /* Three distinct points on one line: every projection of the triangle onto
@@ -126,6 +62,15 @@ static int collinear(const double *a, const double *b, const double *c)
            st_orient2d_drop(a, b, c, 2) == 0.0;
 }
 
+static size_t *uf_new(size_t n)
+{
+    size_t *p = st_malloc_array(n ? n : 1, sizeof *p);
+    if (p)
+        for (size_t i = 0; i < n; i++)
+            p[i] = i;
+    return p;
+}
+
 /* ---- the report ---------------------------------------------------------- */
 
 st_status st_soupinfo_compute(st_soupinfo *out, const st_soup *s,
@@ -134,7 +79,7 @@ st_status st_soupinfo_compute(st_soupinfo *out, const st_soup *s,
     memset(out, 0, sizeof *out);
     if (!s || s->ntris == 0)
         return st_error_set(err, ST_EINPUT, NULL, 0, "no triangles");
-    /* Corners and half-edges are indexed in 32 bits. */
+    /* Corners are indexed in 32 bits. */
     if (s->ntris > (size_t)(UINT32_MAX - 3) / 3)
         return st_error_set(err, ST_ELIMIT, NULL, 0,
                             "%zu triangles: soupinfo handles at most %lu",
@@ -148,140 +93,99 @@ st_status st_soupinfo_compute(st_soupinfo *out, const st_soup *s,
     out->vertices = s->nverts;
     out->triangles = s->ntris;
 
-    const size_t nt = s->ntris, nc = 3 * nt;
-    uint32_t *weld = NULL, *W = NULL, *tri_uf = NULL, *corner_uf = NULL,
-             *vert_uf = NULL, *nbr = NULL, *piece = NULL, *queue = NULL,
-             *fans = NULL;
+    /* 1-3. weld, degenerate and duplicated triangles, the half-edges of
+     * every non-degenerate triangle (duplicates too: they make their edges
+     * non-manifold) sorted, pieces (edges.h) */
+    st_soup_edges e;
+    st = st_soup_edges_build_opts(&e, s, ST_EDGES_DUPLICATES, err);
+    if (st)
+        return st;
+    const size_t nt = s->ntris, nc = 3 * nt, nw = e.nweld, nh = e.nhalf;
+    const uint32_t *weld = e.weld;
+    size_t *corner_uf = NULL, *vert_uf = NULL, *fans = NULL;
+    uint32_t *nbr = NULL, *queue = NULL, *pidx = NULL;
     uint8_t *deg = NULL, *mark = NULL, *same = NULL, *flip = NULL;
-    triple *trip = NULL;
-    halfedge *he = NULL;
     uint64_t *pv = NULL;
     size_t *pF = NULL, *pE = NULL, *pBad = NULL, *pFans = NULL, *pV = NULL;
     uint8_t *pNonori = NULL;
     st = ST_ENOMEM;
 
-    /* 1. weld */
-    weld = st_malloc_array(s->nverts, sizeof *weld);
-    if (!weld)
-        goto done;
-    long long nw = st_weld_vertices(weld, s);
-    if (nw < 0)
-        goto done;
-    out->welded_vertices = (size_t)nw;
-    out->unreferenced_vertices = 0;
+    out->welded_vertices = nw;
     for (size_t v = 0; v < s->nverts; v++)
-        if (weld[v] == NONE)
-            out->unreferenced_vertices++;
+        out->unreferenced_vertices += weld[v] == ST_WELD_NONE;
+    out->degenerate_triangles = e.degenerate;
+    out->duplicated_triangles = e.duplicates;
 
-    /* 2. welded corners, degenerate triangles */
-    W = st_malloc_array(nc, sizeof *W);
     deg = st_calloc_array(nt, 1);
-    if (!W || !deg)
+    if (!deg)
         goto done;
     size_t nnd = 0; /* non-degenerate triangles */
-    for (size_t i = 0; i < nc; i++)
-        W[i] = weld[s->tris[i]];
     for (size_t t = 0; t < nt; t++) {
-        const uint32_t *c = W + 3 * t;
-        if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
+        const uint32_t *v = s->tris + 3 * t;
+        if (weld[v[0]] == weld[v[1]] || weld[v[1]] == weld[v[2]] ||
+            weld[v[0]] == weld[v[2]]) {
             deg[t] = 1;
-            out->degenerate_triangles++;
-        } else {
-            nnd++;
-            const uint32_t *v = s->tris + 3 * t;
-            if (collinear(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
-                          s->xyz + 3 * (size_t)v[2]))
-                out->collinear_triangles++;
+            continue;
         }
+        nnd++;
+        if (collinear(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
+                      s->xyz + 3 * (size_t)v[2]))
+            out->collinear_triangles++;
     }
-    free(weld);
-    weld = NULL;
 
-    /* 3. duplicated triangles */
-    trip = st_malloc_array(nt, sizeof *trip);
-    if (!trip)
-        goto done;
-    for (size_t t = 0; t < nt; t++) {
-        uint32_t a = W[3 * t], b = W[3 * t + 1], c = W[3 * t + 2], x;
-        if (a > b) { x = a; a = b; b = x; }
-        if (b > c) { x = b; b = c; c = x; }
-        if (a > b) { x = a; a = b; b = x; }
-        trip[t].k[0] = a;
-        trip[t].k[1] = b;
-        trip[t].k[2] = c;
-        trip[t].t = (uint32_t)t;
-    }
-    qsort(trip, nt, sizeof *trip, cmp_triple);
-    for (size_t t = 1; t < nt; t++)
-        if (memcmp(trip[t].k, trip[t - 1].k, sizeof trip[t].k) == 0)
-            out->duplicated_triangles++;
-    free(trip);
-    trip = NULL;
-
-    /* 4. edges */
-    size_t nh = 3 * nnd;
-    he = st_malloc_array(nh, sizeof *he);
-    tri_uf = uf_new(nt);
+    /* 4. edges: each run of equal keys; the corners on both sides of a
+     * manifold edge joined (fans), the boundary edges' ends joined (the
+     * cycle rank) */
     corner_uf = uf_new(nc);
-    vert_uf = uf_new((size_t)nw);
-    mark = st_calloc_array((size_t)nw, 1);
+    vert_uf = uf_new(nw);
+    mark = st_calloc_array(nw ? nw : 1, 1);
     nbr = st_malloc_array(nc, sizeof *nbr);
     same = st_calloc_array(nc, 1);
-    if (!he || !tri_uf || !corner_uf || !vert_uf || !mark || !nbr || !same)
+    if (!corner_uf || !vert_uf || !mark || !nbr || !same)
         goto done;
-    size_t k = 0;
-    for (uint32_t h = 0; h < nc; h++) {
-        nbr[h] = NONE;
-        if (deg[h / 3])
-            continue;
-        uint64_t a = W[h], b = W[next_corner(h)];
-        he[k].key = a < b ? (a << 32 | b) : (b << 32 | a);
-        he[k].h = h;
-        k++;
-    }
-    qsort(he, nh, sizeof *he, cmp_halfedge);
+    /* nbr[3t + c]: the manifold neighbour across t's edge that starts at
+     * corner c (ST_EDGES_NONE: none), same[] 1 when both run along it the
+     * same way. */
+    for (size_t h = 0; h < nc; h++)
+        nbr[h] = ST_EDGES_NONE;
     size_t bverts = 0, bcomps = 0;
     for (size_t i = 0, j; i < nh; i = j) {
-        for (j = i + 1; j < nh && he[j].key == he[i].key; j++)
-            uf_union(tri_uf, he[i].h / 3, he[j].h / 3);
-        size_t n = j - i;
+        j = st_soup_edges_run_end(&e, i);
+        const uint32_t u = (uint32_t)(e.he[i].key >> 32),
+                       v = (uint32_t)(e.he[i].key & 0xffffffffu);
         out->edges++;
-        if (n == 1) {
-            uint32_t u = (uint32_t)(he[i].key >> 32),
-                     v = (uint32_t)(he[i].key & 0xffffffffu);
+        if (j - i == 1) {
             out->boundary_edges++;
             mark[u] = mark[v] = 1;
-            uf_union(vert_uf, u, v);
-        } else if (n == 2) {
-            uint32_t h1 = he[i].h, h2 = he[i + 1].h;
+            uf_join(vert_uf, u, v);
+        } else if (j - i == 2) {
+            const uint32_t t1 = e.he[i].t, t2 = e.he[i + 1].t;
             out->manifold_edges++;
-            /* Same start corner: both traverse the edge the same way. */
-            int samedir = W[h1] == W[h2];
-            if (samedir)
-                out->inconsistent_edges++;
-            nbr[h1] = h2 / 3;
-            nbr[h2] = h1 / 3;
-            same[h1] = same[h2] = (uint8_t)samedir;
-            /* Join the corners at each endpoint across the edge: the
-             * corner of h1 at its start meets the corner of h2 at the same
-             * point, which is h2's start or end. */
-            uint32_t e1 = next_corner(h1), e2 = next_corner(h2);
-            if (samedir) {
-                uf_union(corner_uf, h1, h2);
-                uf_union(corner_uf, e1, e2);
-            } else {
-                uf_union(corner_uf, h1, e2);
-                uf_union(corner_uf, e1, h2);
-            }
+            const int f1 = st_soup_edges_forward(&e, s, t1, u, v),
+                      f2 = st_soup_edges_forward(&e, s, t2, u, v);
+            const uint8_t samedir = f1 == f2;
+            out->inconsistent_edges += samedir;
+            const size_t cu1 = 3 * (size_t)t1 + (size_t)st_soup_edges_corner(&e, s, t1, u),
+                         cv1 = 3 * (size_t)t1 + (size_t)st_soup_edges_corner(&e, s, t1, v),
+                         cu2 = 3 * (size_t)t2 + (size_t)st_soup_edges_corner(&e, s, t2, u),
+                         cv2 = 3 * (size_t)t2 + (size_t)st_soup_edges_corner(&e, s, t2, v);
+            /* The edge starts at u in a triangle that runs u -> v. */
+            const size_t h1 = f1 ? cu1 : cv1, h2 = f2 ? cu2 : cv2;
+            nbr[h1] = t2;
+            nbr[h2] = t1;
+            same[h1] = same[h2] = samedir;
+            /* The corners at the same point, across the edge. */
+            uf_join(corner_uf, cu1, cu2);
+            uf_join(corner_uf, cv1, cv2);
         } else {
             out->nonmanifold_edges++;
         }
     }
-    for (size_t v = 0; v < (size_t)nw; v++) {
+    for (size_t v = 0; v < nw; v++) {
         if (!mark[v])
             continue;
         bverts++;
-        if (uf_find(vert_uf, (uint32_t)v) == v)
+        if (uf_find(vert_uf, v) == v)
             bcomps++;
     }
     /* Cycle rank of the boundary graph; never negative (a forest has
@@ -292,22 +196,23 @@ st_status st_soupinfo_compute(st_soupinfo *out, const st_soup *s,
 
     /* non-manifold vertices: more than one fan (root corner) per point;
      * Euler characteristic of the non-degenerate part */
-    fans = st_calloc_array((size_t)nw, sizeof *fans);
+    fans = st_calloc_array(nw ? nw : 1, sizeof *fans);
     if (!fans)
         goto done;
-    memset(mark, 0, (size_t)nw);
+    memset(mark, 0, nw);
     size_t nv_nd = 0;
-    for (uint32_t c = 0; c < nc; c++) {
+    for (size_t c = 0; c < nc; c++) {
         if (deg[c / 3])
             continue;
+        const uint32_t w = weld[s->tris[c]];
         if (uf_find(corner_uf, c) == c)
-            fans[W[c]]++;
-        if (!mark[W[c]]) {
-            mark[W[c]] = 1;
+            fans[w]++;
+        if (!mark[w]) {
+            mark[w] = 1;
             nv_nd++;
         }
     }
-    for (size_t v = 0; v < (size_t)nw; v++)
+    for (size_t v = 0; v < nw; v++)
         if (fans[v] > 1)
             out->nonmanifold_vertices++;
     out->euler = (long long)nv_nd - (long long)out->edges + (long long)nnd;
@@ -315,56 +220,51 @@ st_status st_soupinfo_compute(st_soupinfo *out, const st_soup *s,
                   out->nonmanifold_edges == 0;
     out->consistently_oriented = out->inconsistent_edges == 0;
 
-    /* 5. pieces, numbered by their first triangle */
-    piece = st_malloc_array(nt, sizeof *piece);
-    if (!piece)
+    /* 5. pieces (edges.h names each by its smallest triangle), numbered
+     * in that order */
+    pidx = st_malloc_array(nt, sizeof *pidx);
+    if (!pidx)
         goto done;
     size_t np = 0;
-    for (size_t t = 0; t < nt; t++) {
-        piece[t] = NONE;
-        if (!deg[t] && uf_find(tri_uf, (uint32_t)t) == t)
-            piece[t] = (uint32_t)np++;
-    }
+    for (size_t t = 0; t < nt; t++)
+        pidx[t] = !deg[t] && e.piece[t] == t ? (uint32_t)np++ : ST_EDGES_NONE;
     for (size_t t = 0; t < nt; t++)
         if (!deg[t])
-            piece[t] = piece[uf_find(tri_uf, (uint32_t)t)];
+            pidx[t] = pidx[e.piece[t]];
     out->pieces = np;
-    pF = st_calloc_array(np, sizeof *pF);
-    pE = st_calloc_array(np, sizeof *pE);
-    pBad = st_calloc_array(np, sizeof *pBad);
-    pFans = st_calloc_array(np, sizeof *pFans);
-    pV = st_calloc_array(np, sizeof *pV);
-    pNonori = st_calloc_array(np, 1);
+    pF = st_calloc_array(np ? np : 1, sizeof *pF);
+    pE = st_calloc_array(np ? np : 1, sizeof *pE);
+    pBad = st_calloc_array(np ? np : 1, sizeof *pBad);
+    pFans = st_calloc_array(np ? np : 1, sizeof *pFans);
+    pV = st_calloc_array(np ? np : 1, sizeof *pV);
+    pNonori = st_calloc_array(np ? np : 1, 1);
     if (!pF || !pE || !pBad || !pFans || !pV || !pNonori)
         goto done;
     for (size_t t = 0; t < nt; t++)
         if (!deg[t])
-            pF[piece[t]]++;
+            pF[pidx[t]]++;
     for (size_t i = 0, j; i < nh; i = j) {
-        for (j = i + 1; j < nh && he[j].key == he[i].key; j++)
-            ;
-        uint32_t p = piece[he[i].h / 3];
+        j = st_soup_edges_run_end(&e, i);
+        const uint32_t p = pidx[e.he[i].t];
         pE[p]++;
         if (j - i != 2)
             pBad[p]++;
     }
-    free(he);
-    he = NULL;
 
     /* distinct (piece, point) pairs among the fans */
     size_t nfans = 0;
-    for (uint32_t c = 0; c < nc; c++)
+    for (size_t c = 0; c < nc; c++)
         if (!deg[c / 3] && uf_find(corner_uf, c) == c)
             nfans++;
-    pv = st_malloc_array(nfans, sizeof *pv);
+    pv = st_malloc_array(nfans ? nfans : 1, sizeof *pv);
     if (!pv)
         goto done;
-    k = 0;
-    for (uint32_t c = 0; c < nc; c++) {
+    size_t k = 0;
+    for (size_t c = 0; c < nc; c++) {
         if (!deg[c / 3] && uf_find(corner_uf, c) == c) {
-            uint32_t p = piece[c / 3];
+            const uint32_t p = pidx[c / 3];
             pFans[p]++;
-            pv[k++] = (uint64_t)p << 32 | W[c];
+            pv[k++] = (uint64_t)p << 32 | weld[s->tris[c]];
         }
     }
     qsort(pv, nfans, sizeof *pv, cmp_u64);
@@ -387,19 +287,19 @@ st_status st_soupinfo_compute(st_soupinfo *out, const st_soup *s,
         flip[t0] = 0;
         queue[qt++] = (uint32_t)t0;
         while (qh < qt) {
-            uint32_t t = queue[qh++];
-            for (uint32_t h = 3 * t; h < 3 * t + 3; h++) {
-                uint32_t o = nbr[h];
-                if (o == NONE)
+            const uint32_t t = queue[qh++];
+            for (size_t h = 3 * (size_t)t; h < 3 * (size_t)t + 3; h++) {
+                const uint32_t o = nbr[h];
+                if (o == ST_EDGES_NONE)
                     continue;
                 /* Traversing the shared edge the same way means one of the
                  * two must flip to agree with the other. */
-                uint8_t want = (uint8_t)(flip[t] ^ same[h]);
+                const uint8_t want = (uint8_t)(flip[t] ^ same[h]);
                 if (flip[o] == 2) {
                     flip[o] = want;
                     queue[qt++] = o;
                 } else if (flip[o] != want) {
-                    pNonori[piece[t]] = 1;
+                    pNonori[pidx[t]] = 1;
                 }
             }
         }
@@ -422,19 +322,15 @@ done:
     if (st == ST_ENOMEM)
         st_error_set(err, ST_ENOMEM, NULL, 0,
                      "out of memory analysing %zu triangles", nt);
-    free(weld);
-    free(W);
+    st_soup_edges_free(&e);
     free(deg);
-    free(trip);
-    free(he);
-    free(tri_uf);
     free(corner_uf);
     free(vert_uf);
     free(mark);
     free(nbr);
     free(same);
     free(fans);
-    free(piece);
+    free(pidx);
     free(pF);
     free(pE);
     free(pBad);

@@ -8,8 +8,15 @@
  * length is the number of kept triangles that use it (1: a boundary edge,
  * 2: a manifold edge). Pieces are the classes of kept triangles joined by
  * shared edges, each named by its smallest triangle index, so nothing
- * depends on hashing or sorting details. The hole caps (holes.h) and the
- * closed shells (shells.h) read the soup's topology from here.
+ * depends on hashing or sorting details. The hole caps (holes.h), the
+ * closed shells (shells.h) and the damage report (soupinfo.h) read the
+ * soup's topology from here: it is the one place that welds, finds
+ * degenerate and duplicated triangles, sorts half-edges and joins pieces.
+ *
+ * With ST_EDGES_DUPLICATES the duplicates are not left out of the edges:
+ * every non-degenerate triangle gives its half-edges and joins its piece,
+ * so a duplicated face makes its edges non-manifold (as it does for a
+ * mesher, and as soupinfo counts it).
  */
 #ifndef SOUPTET_EDGES_H
 #define SOUPTET_EDGES_H
@@ -31,17 +38,36 @@ typedef struct st_half_edge {
 typedef struct st_soup_edges {
     uint32_t *weld;     /* nverts: welded id of each vertex (weld.h) */
     size_t nweld;       /* number of welded ids */
-    uint8_t *kept;      /* ntris: 1 for a kept triangle */
-    st_half_edge *he;   /* the kept triangles' half-edges, sorted by key,
-                         * ties by triangle */
+    uint8_t *kept;      /* ntris: 1 for a kept triangle: non-degenerate
+                         * and the first (smallest index) of its copies */
+    size_t degenerate;  /* triangles with two corners welded together */
+    size_t duplicates;  /* triangles whose welded corners (a multiset, in
+                         * any order) equal an earlier triangle's,
+                         * degenerate ones included: the extra copies */
+    st_half_edge *he;   /* the kept triangles' half-edges (with
+                         * ST_EDGES_DUPLICATES: every non-degenerate
+                         * triangle's), sorted by key, ties by triangle */
     size_t nhalf;
     uint32_t *piece;    /* ntris: smallest triangle of t's piece (t itself
                          * for a triangle left out) */
 } st_soup_edges;
 
+/* Options of st_soup_edges_build_opts. */
+#define ST_EDGES_DUPLICATES 1u   /* duplicates keep their half-edges */
+
 /* ST_ENOMEM, ST_ELIMIT (more than 2^31 triangles). On failure *e is
  * zeroed and holds nothing to free. */
 st_status st_soup_edges_build(st_soup_edges *e, const st_soup *s, st_error *err);
+/* The same with options (flags: 0 or ST_EDGES_DUPLICATES). */
+st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned flags,
+                                   st_error *err);
+
+/* The edges are the runs of e->he with equal keys: the run starting at
+ * half-edge i ends before st_soup_edges_run_end(e, i). */
+size_t st_soup_edges_run_end(const st_soup_edges *e, size_t i);
+
+/* The corner of triangle t (0, 1 or 2) at welded point w, or -1. */
+int st_soup_edges_corner(const st_soup_edges *e, const st_soup *s, uint32_t t, uint32_t w);
 void st_soup_edges_free(st_soup_edges *e);
 
 /* 1 when triangle t of s runs along its edge from welded end a to welded

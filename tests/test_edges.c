@@ -1,0 +1,190 @@
+/*
+ * test_edges.c - the one definition of a soup's topology: exact welding
+ * (weld.h) and edges, duplicates and pieces (edges.h), on tiny inline
+ * shapes with known answers.
+ */
+#include "souptet/edges.h"
+#include "souptet/weld.h"
+#include "shapes.h"
+#include "tap.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static st_soup *new_soup(void)
+{
+    st_soup *s = st_soup_new();
+    if (!s)
+        abort();
+    return s;
+}
+
+static uint32_t vert(st_soup *s, double x, double y, double z)
+{
+    st_soup_add_vertex(s, x, y, z, NULL);
+    return (uint32_t)(s->nverts - 1);
+}
+
+/* Edges of e with exactly n half-edges. */
+static size_t edges_of(const st_soup_edges *e, size_t n)
+{
+    size_t c = 0;
+    for (size_t i = 0, j; i < e->nhalf; i = j) {
+        j = st_soup_edges_run_end(e, i);
+        c += j - i == n;
+    }
+    return c;
+}
+
+static size_t pieces(const st_soup_edges *e, const st_soup *s)
+{
+    size_t c = 0;
+    for (size_t t = 0; t < s->ntris; t++)
+        c += e->kept[t] && e->piece[t] == t;
+    return c;
+}
+
+static void test_weld(void)
+{
+    st_soup *s = new_soup();
+    uint32_t a = vert(s, 0, 0, 0), b = vert(s, 1, 0, 0), c = vert(s, 0, 1, 0);
+    uint32_t a2 = vert(s, -0.0, 0, -0.0);                 /* a, signed zeros */
+    uint32_t b2 = vert(s, 1 + 0x1p-52, 0, 0);             /* one ulp from b */
+    vert(s, 5, 5, 5);                                     /* used by none */
+    st_soup_add_triangle(s, a, b, c, NULL);
+    st_soup_add_triangle(s, a2, c, b2, NULL);
+    uint32_t w[6];
+    long long n = st_weld_vertices(w, s);
+    TAP_CHECK(n == 4, "weld: 4 distinct points among 5 used vertices (%lld)", n);
+    TAP_CHECK(w[a] == 0 && w[b] == 1 && w[c] == 2, "weld: ids in order of first use");
+    TAP_CHECK(w[a2] == w[a], "weld: -0 is 0");
+    TAP_CHECK(w[b2] != w[b], "weld: one ulp apart stays apart (no epsilon)");
+    TAP_CHECK(w[5] == ST_WELD_NONE, "weld: an unused vertex has no id");
+    st_soup_free(s);
+}
+
+static void test_closed_box(void)
+{
+    st_soup *s = new_soup();
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 2, 3};
+    add_box(s, lo, hi);   /* an exact soup, every other triangle flipped */
+    st_soup_edges e;
+    st_error err;
+    TAP_CHECK(st_soup_edges_build(&e, s, &err) == ST_OK, "box: edges built");
+    TAP_CHECK(e.nweld == 8, "box: 36 vertices weld to 8 (%zu)", e.nweld);
+    TAP_CHECK(e.nhalf == 36 && edges_of(&e, 2) == 18 && edges_of(&e, 1) == 0,
+              "box: 18 edges of two triangles, none open");
+    TAP_CHECK(pieces(&e, s) == 1 && e.piece[11] == 0, "box: one piece, named 0");
+    TAP_CHECK(e.degenerate == 0 && e.duplicates == 0, "box: nothing degenerate or duplicated");
+    uint32_t *nbr = malloc(3 * s->ntris * sizeof *nbr);
+    uint8_t *same = malloc(3 * s->ntris), open[12] = {0};
+    st_soup_edges_neighbours(&e, s, nbr, same, open);
+    size_t nsame = 0, nnone = 0;
+    for (size_t i = 0; i < 3 * s->ntris; i++) {
+        nsame += same[i];
+        nnone += nbr[i] == ST_EDGES_NONE;
+    }
+    /* add_box flips every other triangle: inside a face the two halves
+     * disagree (6 edges), across faces some do: the count is even (both
+     * sides of an edge count) and not zero. */
+    TAP_CHECK(nnone == 0 && nsame > 0 && nsame % 2 == 0,
+              "box: every triangle has 3 neighbours, %zu slots run the same way", nsame);
+    TAP_CHECK(open[0] == 0, "box: the piece is not open");
+    free(nbr);
+    free(same);
+    st_soup_edges_free(&e);
+
+    st_soup *o = new_soup();
+    add_box_oriented(o, lo, hi);
+    TAP_CHECK(st_soup_edges_build(&e, o, &err) == ST_OK, "oriented box: edges built");
+    int agree = 1;
+    for (size_t i = 0, j; i < e.nhalf; i = j) {
+        j = st_soup_edges_run_end(&e, i);
+        uint32_t u = (uint32_t)(e.he[i].key >> 32), v = (uint32_t)e.he[i].key;
+        agree &= st_soup_edges_forward(&e, o, e.he[i].t, u, v) !=
+                 st_soup_edges_forward(&e, o, e.he[i + 1].t, u, v);
+    }
+    TAP_CHECK(agree, "oriented box: the two triangles of every edge run along it opposite ways");
+    uint32_t t0w = e.weld[o->tris[1]];
+    TAP_CHECK(st_soup_edges_corner(&e, o, 0, t0w) == 1 &&
+              st_soup_edges_corner(&e, o, 0, 1000) == -1, "corner: found by welded point");
+    st_soup_edges_free(&e);
+    st_soup_free(o);
+    st_soup_free(s);
+}
+
+static void test_damage(void)
+{
+    /* Two triangles sharing an edge, a copy of the first in the other
+     * order, a degenerate one (repeated index) twice, and a triangle apart. */
+    st_soup *s = new_soup();
+    uint32_t a = vert(s, 0, 0, 0), b = vert(s, 1, 0, 0), c = vert(s, 0, 1, 0),
+             d = vert(s, 1, 1, 0), f = vert(s, 5, 0, 0), g = vert(s, 6, 0, 0),
+             h = vert(s, 5, 1, 0);
+    st_soup_add_triangle(s, a, b, c, NULL);   /* 0 */
+    st_soup_add_triangle(s, b, d, c, NULL);   /* 1 */
+    st_soup_add_triangle(s, c, b, a, NULL);   /* 2: copy of 0, flipped */
+    st_soup_add_triangle(s, a, a, b, NULL);   /* 3: degenerate */
+    st_soup_add_triangle(s, a, b, a, NULL);   /* 4: degenerate, a copy of 3 */
+    st_soup_add_triangle(s, f, g, h, NULL);   /* 5: apart */
+    st_soup_edges e;
+    st_error err;
+    TAP_CHECK(st_soup_edges_build(&e, s, &err) == ST_OK, "damage: edges built");
+    TAP_CHECK(e.degenerate == 2 && e.duplicates == 2,
+              "damage: 2 degenerate, 2 extra copies (one of them degenerate) (%zu, %zu)",
+              e.degenerate, e.duplicates);
+    TAP_CHECK(e.kept[0] && e.kept[1] && !e.kept[2] && !e.kept[3] && !e.kept[4] && e.kept[5],
+              "damage: the first copy kept, the copy and the degenerate left out");
+    TAP_CHECK(e.nhalf == 9 && edges_of(&e, 2) == 1 && edges_of(&e, 1) == 7,
+              "damage: without the copy, one shared edge and 7 open ones");
+    TAP_CHECK(pieces(&e, s) == 2 && e.piece[1] == 0 && e.piece[5] == 5 && e.piece[2] == 2,
+              "damage: pieces {0, 1} and {5}; the copy left out is its own");
+    st_soup_edges_free(&e);
+
+    TAP_CHECK(st_soup_edges_build_opts(&e, s, ST_EDGES_DUPLICATES, &err) == ST_OK,
+              "damage, duplicates kept: edges built");
+    TAP_CHECK(e.nhalf == 12 && edges_of(&e, 3) == 1 && edges_of(&e, 2) == 2,
+              "damage, duplicates kept: the copy makes edge bc of three triangles, ab and ca of two");
+    TAP_CHECK(!e.kept[2] && e.piece[2] == 0, "damage, duplicates kept: the copy is in piece 0, still not kept");
+    TAP_CHECK(e.degenerate == 2 && e.duplicates == 2, "damage, duplicates kept: the same counts");
+    st_soup_edges_free(&e);
+    st_soup_free(s);
+}
+
+/* Reversing the order of the triangles renames pieces by their smallest
+ * triangle, nothing else: the same number of edges of each length. */
+static void test_order(void)
+{
+    st_soup *s = new_soup(), *r = new_soup();
+    add_sphere(s, 1.0, 0.5);   /* open at the top */
+    for (size_t v = 0; v < s->nverts; v++)
+        st_soup_add_vertex(r, s->xyz[3 * v], s->xyz[3 * v + 1], s->xyz[3 * v + 2], NULL);
+    for (size_t t = s->ntris; t-- > 0;)
+        st_soup_add_triangle(r, s->tris[3 * t], s->tris[3 * t + 1], s->tris[3 * t + 2], NULL);
+    st_soup_edges e, f;
+    st_error err;
+    st_soup_edges_build(&e, s, &err);
+    st_soup_edges_build(&f, r, &err);
+    int same = e.nhalf == f.nhalf && e.nweld == f.nweld;
+    for (size_t n = 1; n <= 3; n++)
+        same &= edges_of(&e, n) == edges_of(&f, n);
+    TAP_CHECK(same && edges_of(&e, 1) > 0, "order: reversed triangles, the same edges (%zu open)",
+              edges_of(&e, 1));
+    TAP_CHECK(pieces(&e, s) == 1 && pieces(&f, r) == 1 && f.piece[0] == 0,
+              "order: one piece either way, named by its smallest triangle");
+    st_soup_edges_free(&e);
+    st_soup_edges_free(&f);
+    st_soup_free(s);
+    st_soup_free(r);
+}
+
+int main(void)
+{
+    test_weld();
+    test_closed_box();
+    test_damage();
+    test_order();
+    return tap_done();
+}

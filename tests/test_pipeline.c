@@ -1,0 +1,130 @@
+/*
+ * test_pipeline.c - the whole job in one call (pipeline.h) on a small
+ * sphere: the mesh encloses it, the candidates' seeds and the winner's
+ * order, the result does not depend on the thread count or on the events
+ * being reported, the events come as documented, dry runs and bad
+ * parameters.
+ */
+#include "souptet/pipeline.h"
+#include "shapes.h"
+#include "tap.h"
+
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct counts {
+    size_t field, size, sculpted, iteration, candidate;
+    size_t last_k;
+    int bad;
+} counts;
+
+static void on_event(void *ctx, const st_pipeline_event *ev)
+{
+    counts *c = ctx;
+    if (strcmp(ev->what, "field") == 0)
+        c->field++, c->bad |= !(ev->field_dims[0] > 0 && ev->voxel > 0);
+    else if (strcmp(ev->what, "size") == 0)
+        c->size++, c->bad |= !(ev->h > 0);
+    else if (strcmp(ev->what, "sculpted") == 0)
+        c->sculpted++, c->bad |= !(ev->tets > 0 && ev->h > 0);
+    else if (strcmp(ev->what, "iteration") == 0)
+        c->iteration++, c->bad |= !(ev->fit && ev->fit->iter >= 1);
+    else if (strcmp(ev->what, "candidate") == 0)
+        c->candidate++, c->bad |= !(ev->candidate && ev->candidate->seed != 0);
+    else
+        c->bad = 1;
+}
+
+static int same_mesh(const st_tetmesh *a, const st_tetmesh *b)
+{
+    return a && b && a->npoints == b->npoints && a->ntets == b->ntets &&
+           memcmp(a->xyz, b->xyz, 3 * a->npoints * sizeof *a->xyz) == 0 &&
+           memcmp(a->tets, b->tets, 4 * a->ntets * sizeof *a->tets) == 0;
+}
+
+int main(void)
+{
+    st_soup *s = st_soup_new();
+    add_sphere(s, 1.0, 2.0);   /* closed, half its triangles flipped */
+    st_pipeline_params p = st_pipeline_params_default();
+    p.cells = 4;
+    p.field_cells = 40;
+    p.tries = 3;
+    st_error err;
+
+    TAP_CHECK(st_pipeline_candidate_seed(7, 0) == 7, "candidate 0 takes the seed itself");
+    TAP_CHECK(st_pipeline_candidate_seed(0, 1) != 0 && st_pipeline_candidate_seed(7, 1) !=
+              st_pipeline_candidate_seed(7, 2), "later candidates: random, distinct, never 0");
+
+    st_tetmesh *m1 = NULL, *m2 = NULL;
+    st_pipeline_stats st1, st2;
+    omp_set_num_threads(1);
+    st_status r1 = st_pipeline_run(&m1, &st1, s, &p, NULL, &err);
+    TAP_CHECK(r1 == ST_OK && m1 && m1->ntets > 0, "the sphere meshes (%zu tets)",
+              m1 ? m1->ntets : 0);
+    TAP_CHECK(st1.encloses && st1.candidates[st1.best].verts_outside == 0 &&
+              st1.candidates[st1.best].tris_crossing == 0, "the mesh encloses the soup");
+    TAP_CHECK(st1.ncandidates == 3 && st1.candidates[0].seed == p.seed,
+              "three candidates, the first with the seed");
+    int best_ok = 1;
+    for (size_t k = 0; k < st1.ncandidates; k++) {
+        const st_pipeline_candidate *c = &st1.candidates[k], *b = &st1.candidates[st1.best];
+        int ce = c->verts_outside == 0 && c->tris_crossing == 0;
+        if (ce && !c->failed && k != st1.best)
+            best_ok &= b->min_dihedral > c->min_dihedral ||
+                       (b->min_dihedral == c->min_dihedral && (b->max_dihedral < c->max_dihedral ||
+                        (b->max_dihedral == c->max_dihedral && st1.best < k)));
+    }
+    TAP_CHECK(best_ok, "the best has the largest minimum angle among the enclosing (%zu)", st1.best);
+    TAP_CHECK(m1 && st_meta_get(&m1->meta, "h") && st_meta_get(&m1->meta, "encloses") &&
+              strcmp(st_meta_get(&m1->meta, "candidates"), "3") == 0,
+              "meta: h, encloses, candidates");
+
+    counts c;
+    memset(&c, 0, sizeof c);
+    p.on_event = on_event;
+    p.on_event_ctx = &c;
+    omp_set_num_threads(2);
+    st_status r2 = st_pipeline_run(&m2, &st2, s, &p, NULL, &err);
+    TAP_CHECK(r2 == ST_OK && same_mesh(m1, m2),
+              "2 threads and events reported: the same mesh as 1 thread without");
+    TAP_CHECK(c.field == 1 && c.sculpted == 3 && c.candidate == 3 && c.size == 0,
+              "events: the field once, each candidate sculpted and done (%zu %zu %zu)",
+              c.field, c.sculpted, c.candidate);
+    TAP_CHECK(c.iteration >= 3 && !c.bad, "events: the fit's iterations, well formed (%zu)",
+              c.iteration);
+    free(st1.candidates);
+    free(st2.candidates);
+    st_tetmesh_free(m2);
+    m2 = NULL;
+
+    /* A dry run: h and the sculpted count, no mesh. */
+    memset(&c, 0, sizeof c);
+    p.dry_run = 1;
+    p.tries = 1;
+    st_status r3 = st_pipeline_run(&m2, &st2, s, &p, NULL, &err);
+    TAP_CHECK(r3 == ST_OK && m2 == NULL && st2.estimated_tets > 0 && st2.h > 0,
+              "dry run: no mesh, h %g and %zu tets estimated", st2.h, st2.estimated_tets);
+    TAP_CHECK(c.size == 1 && c.sculpted == 0, "dry run: one sizing sculpt, no candidate");
+    free(st2.candidates);
+    p.dry_run = 0;
+    p.on_event = NULL;
+
+    p.tries = 0;
+    TAP_CHECK(st_pipeline_run(&m2, NULL, s, &p, NULL, &err) == ST_EINPUT && !m2,
+              "tries 0: refused");
+    p.tries = 1;
+    p.offset_ratio = 0;
+    TAP_CHECK(st_pipeline_run(&m2, NULL, s, &p, NULL, &err) == ST_EINPUT,
+              "offset 0: refused");
+    p.offset_ratio = 0.4;
+    st_soup *empty = st_soup_new();
+    TAP_CHECK(st_pipeline_run(&m2, NULL, empty, &p, NULL, &err) == ST_EINPUT,
+              "an empty soup: refused (%s)", err.msg);
+    st_soup_free(empty);
+    st_tetmesh_free(m1);
+    st_soup_free(s);
+    return tap_done();
+}
