@@ -95,6 +95,21 @@ st_status st_meta_copy(st_meta *dst, const st_meta *src)
     return ST_OK;
 }
 
+st_status st_meta_inherit(st_meta *m, const st_meta *from)
+{
+    st_meta tmp = {0};
+    if (st_meta_copy(&tmp, from))
+        return ST_ENOMEM;
+    for (size_t i = 0; i < m->count; i++)
+        if (st_meta_set(&tmp, m->entries[i].key, m->entries[i].value)) {
+            st_meta_clear(&tmp);
+            return ST_ENOMEM;
+        }
+    st_meta_clear(m);
+    *m = tmp;
+    return ST_OK;
+}
+
 /* Characters that make an argument need quoting in a POSIX shell. */
 static int needs_quotes(const char *s)
 {

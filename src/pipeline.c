@@ -39,6 +39,48 @@ st_pipeline_params st_pipeline_params_default(void)
     return p;
 }
 
+double st_pipeline_cell_width(const st_soup *s, const st_pipeline_params *p)
+{
+    double lo[3], hi[3];
+    st_error e;
+    if (st_soup_bounds(s, lo, hi, &e))
+        return 0;
+    return p->h > 0 ? p->h : st_lattice_h_for_cells(lo, hi, p->cells);
+}
+
+/* Cells along a lattice axis at most, at width h, for a box of diagonal
+ * squared d2 (pipeline.h). */
+static double lattice_cells_bound(double d2, double h)
+{
+    return floor(sqrt(d2) / h) + 3 + 2 * ST_LATTICE_PAD_DEFAULT;
+}
+
+double st_pipeline_lattice_bytes(const st_soup *s, double h, size_t tries,
+                                 double *tets, double *at_once)
+{
+    double lo[3], hi[3], d2 = 0;
+    st_error e;
+    if (tets)
+        *tets = 0;
+    if (at_once)
+        *at_once = 0;
+    if (st_soup_bounds(s, lo, hi, &e) || !(h > 0) || !isfinite(h))
+        return 0;
+    for (int a = 0; a < 3; a++)
+        d2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    double n = lattice_cells_bound(d2, h);
+    double t = 12.0 * n * n * n;
+    double k = 1;
+    if (tries > 1)
+        k = (double)((size_t)omp_get_max_threads() < tries ? (size_t)omp_get_max_threads()
+                                                            : tries);
+    if (tets)
+        *tets = t;
+    if (at_once)
+        *at_once = k;
+    return t * k * ST_LATTICE_BYTES_PER_TET;
+}
+
 /* splitmix64's finaliser: a bijection of 64-bit words that mixes well. */
 static uint64_t mix64(uint64_t z)
 {
@@ -186,9 +228,9 @@ static st_status choose_h(double *h, st_pipeline_stats *st, const st_grid *g,
     double best_h = hk, best_err = INFINITY;
     size_t best_n = 0;
     for (int it = 0; it < ST_PIPELINE_SIZE_STEPS; it++) {
-        double cells = floor(sqrt(d2) / hk) + 3 + 2 * ST_LATTICE_PAD_DEFAULT;
+        double cells = lattice_cells_bound(d2, hk);
         if (p->max_bytes &&
-            12.0 * cells * cells * cells * 64.0 > (double)p->max_bytes)
+            12.0 * cells * cells * cells * ST_LATTICE_BYTES_PER_TET > (double)p->max_bytes)
             return st_error_set(err, ST_ELIMIT, NULL, 0,
                                 "about %.0f tets need cells of width %g, "
                                 "whose lattice is over the memory limit",

@@ -69,6 +69,17 @@ static void test_meta(void)
     TAP_CHECK(c.count == 2 && strcmp(st_meta_get(&c, "source"), "b.obj") == 0,
               "a copy outlives its original");
     TAP_CHECK(st_meta_get(&c, "missing") == NULL, "a missing key is NULL");
+    /* A tool's output inherits its input's keys; its own win. */
+    st_meta own = {0};
+    st_meta_set(&own, "h", "0.5");
+    st_meta_set(&own, "source", "mine.obj");
+    st_meta_inherit(&own, &c);
+    TAP_CHECK(own.count == 3 && strcmp(own.entries[0].key, "source") == 0 &&
+              strcmp(own.entries[0].value, "mine.obj") == 0 &&
+              strcmp(own.entries[1].key, "history") == 0 &&
+              strcmp(own.entries[2].key, "h") == 0 && strcmp(own.entries[2].value, "0.5") == 0,
+              "inherit: the input's keys in its order, the output's values win, its new keys last");
+    st_meta_clear(&own);
     st_meta_clear(&c);
     char *argv[] = {"soupdist", "-o", "my file.vdb", "it's", "x\ny"};
     char *cl = st_command_line(5, argv);

@@ -5,6 +5,7 @@
  * being reported, the events come as documented, dry runs and bad
  * parameters.
  */
+#include "souptet/lattice.h"
 #include "souptet/pipeline.h"
 #include "shapes.h"
 #include "tap.h"
@@ -120,6 +121,21 @@ int main(void)
     TAP_CHECK(st_pipeline_run(&m2, NULL, s, &p, NULL, &err) == ST_EINPUT,
               "offset 0: refused");
     p.offset_ratio = 0.4;
+    /* The lattice bound: the sphere's box has diagonal 2 sqrt(3); at
+     * h 0.5, floor(6.93) + 3 + 2 * 2 = 13 cells an axis, 12 tets a cell. */
+    double tets, at_once;
+    double bytes = st_pipeline_lattice_bytes(s, 0.5, 1, &tets, &at_once);
+    TAP_CHECK(tets == 12.0 * 13 * 13 * 13 && at_once == 1 &&
+              bytes == tets * ST_LATTICE_BYTES_PER_TET,
+              "lattice bound at h 0.5: %.0f tets, %.0f at once, %.0f bytes", tets, at_once, bytes);
+    omp_set_num_threads(2);
+    st_pipeline_lattice_bytes(s, 0.5, 8, NULL, &at_once);
+    TAP_CHECK(at_once == 2, "8 tries on 2 threads: 2 lattices at once");
+    TAP_CHECK(st_pipeline_lattice_bytes(s, 0, 1, &tets, NULL) == 0 && tets == 0,
+              "no bound for a width of 0");
+    p.cells = 4;
+    TAP_CHECK(st_pipeline_cell_width(s, &p) == 0.5, "4 cells over a box of side 2: h 0.5 (%g)",
+              st_pipeline_cell_width(s, &p));
     st_soup *empty = st_soup_new();
     TAP_CHECK(st_pipeline_run(&m2, NULL, empty, &p, NULL, &err) == ST_EINPUT,
               "an empty soup: refused (%s)", err.msg);

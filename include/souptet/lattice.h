@@ -66,6 +66,11 @@ int st_lattice_kind_from_name(const char *name, st_lattice_kind *kind);
 
 /* Default padding in cells (see Placement above). */
 #define ST_LATTICE_PAD_DEFAULT 2
+/* What one lattice tet costs at least while a lattice is built (4 uint32
+ * vertex ids, 4 int64 neighbours, 4 uint32 star entries), before the mesh
+ * made from it: a lattice of more tets than a memory limit over this cannot
+ * fit and is refused before it is allocated. */
+#define ST_LATTICE_BYTES_PER_TET 64
 
 typedef struct st_lattice_params {
     st_lattice_kind kind;

@@ -36,6 +36,12 @@ const char *st_meta_get(const st_meta *m, const char *key);
 st_status st_meta_history_append(st_meta *m, const char *line);
 /* Deep copy of src into dst (dst's old contents are freed). */
 st_status st_meta_copy(st_meta *dst, const st_meta *src);
+/* m inherits from's entries: afterwards it holds from's entries in from's
+ * order, each replaced by m's own value where m has the key, then m's
+ * other keys in m's order (what a tool's output keeps of its input's
+ * source and history while its own keys win). On ST_ENOMEM m is
+ * unchanged. */
+st_status st_meta_inherit(st_meta *m, const st_meta *from);
 
 /* A command line as one string, arguments with spaces or quotes shell-quoted.
  * Caller frees. NULL on allocation failure. */

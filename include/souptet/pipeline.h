@@ -149,6 +149,23 @@ typedef struct st_pipeline_stats {
     double seconds_size;                 /* and their time */
 } st_pipeline_stats;
 
+/* The lattice cell width p gives for s: p->h, or the width of p->cells
+ * cells along the longest side of s's box. 0 when s has no bounds. */
+double st_pipeline_cell_width(const st_soup *s, const st_pipeline_params *p);
+
+/* A bound on the memory the candidates' lattices take at cell width h
+ * (what a run is refused on before any lattice is allocated, and what
+ * a dry run reports): any rotation of s's box spans at most its diagonal
+ * d along a lattice axis, so a lattice has at most floor(d / h) + 3 +
+ * 2 ST_LATTICE_PAD_DEFAULT cells along an axis, 12 tets a cell (BCC),
+ * ST_LATTICE_BYTES_PER_TET bytes a tet, and min(tries, threads) lattices
+ * are laid at once (one when tries is 1). *tets and *at_once (may be
+ * NULL) get the tets of one lattice and the lattices at once. Returns the
+ * bytes, or 0 (and 0s) when s has no bounds or h is not positive and
+ * finite. */
+double st_pipeline_lattice_bytes(const st_soup *s, double h, size_t tries,
+                                 double *tets, double *at_once);
+
 /* Mesh soup s. *out gets the chosen candidate's mesh, with meta "h",
  * "lattice", "seed", "offset_ratio", "candidates", "encloses". stats may
  * be NULL; when given, stats->candidates must be freed by the caller even

@@ -15,6 +15,7 @@
 #include <stddef.h>
 #include <stdio.h>
 #include "souptet/err.h"
+#include "souptet/lattice.h"
 #include "souptet/meta.h"
 #include "souptet/progress.h"
 
@@ -108,10 +109,9 @@ size_t tool_default_max_memory(void);
 int tool_output_unwritable(const tool_ctx *t, const char *path);
 
 /* What one lattice tet costs at least while a lattice is built
- * (lattice.h: 4 uint32 vertex ids, 4 int64 neighbours, 4 uint32 star
- * entries), before the mesh made from it: a lattice of more tets than
+ * (lattice.h, ST_LATTICE_BYTES_PER_TET): a lattice of more tets than
  * max_bytes / this cannot fit and is refused before it is allocated. */
-#define TOOL_LATTICE_BYTES_PER_TET 64
+#define TOOL_LATTICE_BYTES_PER_TET ST_LATTICE_BYTES_PER_TET
 /* The most lattice tets max_bytes allows (no memory limit: 2^31). */
 size_t tool_max_lattice_tets(size_t max_bytes);
 

@@ -392,15 +392,9 @@ int main(int argc, char *argv[])
     /* The field's metadata (source, history) carries over; the lattice's
      * own keys win. */
     {
-        st_meta keep_meta = {0};
-        int bad = st_meta_copy(&keep_meta, &m->meta) != ST_OK;
-        bad |= st_meta_copy(&m->meta, &g->meta) != ST_OK;
-        for (size_t k = 0; !bad && k < keep_meta.count; k++)
-            bad |= st_meta_set(&m->meta, keep_meta.entries[k].key,
-                               keep_meta.entries[k].value) != ST_OK;
-        st_meta_clear(&keep_meta);
-        bad |= st_meta_history_append(&m->meta, t.command_line ? t.command_line
-                                                               : "latticetet") != ST_OK;
+        int bad = st_meta_inherit(&m->meta, &g->meta) != ST_OK;
+        bad = bad || st_meta_history_append(&m->meta, t.command_line ? t.command_line
+                                                                     : "latticetet") != ST_OK;
         if (bad) {
             st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
             rc = tool_fail(&t, &err);

@@ -150,33 +150,16 @@ static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
 
 /* The pipeline lays one lattice per candidate (pipeline.h), up to one per
  * thread at a time, and does not hold them to a memory limit: refuse here,
- * before any of them is allocated, lattices that cannot fit in max_bytes.
- * Any rotation of the soup's box spans at most its diagonal d along a
- * lattice axis, so a lattice of cell width h has at most d/h + 2 cells
- * along an axis plus the padding; 12 tets a cell (BCC; cubic5 has 5).
- * Returns 1 (err set) when even that bound is over the limit. */
+ * before any of them is allocated, lattices whose bound
+ * (st_pipeline_lattice_bytes) is over max_bytes. Returns 1 (err set) then;
+ * 0 without a limit or when the pipeline will report the soup. */
 static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
                               size_t max_bytes, st_error *err)
 {
-    double lo[3], hi[3];
-    st_error e;
-    if (!max_bytes || st_soup_bounds(soup, lo, hi, &e))
-        return 0;   /* no limit, or the pipeline reports the soup */
-    double d2 = 0;
-    for (int a = 0; a < 3; a++)
-        d2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
-    double h = p->h > 0 ? p->h : st_lattice_h_for_cells(lo, hi, p->cells);
-    if (!(h > 0) || !isfinite(h))
+    if (!max_bytes)
         return 0;
-    double n = floor(sqrt(d2) / h) + 3 + 2 * ST_LATTICE_PAD_DEFAULT;
-    double tets = 12.0 * n * n * n;
-    double at_once = 1;
-#ifdef _OPENMP
-    if (p->tries > 1)
-        at_once = (double)((size_t)omp_get_max_threads() < p->tries
-                               ? (size_t)omp_get_max_threads() : p->tries);
-#endif
-    double need = tets * at_once * TOOL_LATTICE_BYTES_PER_TET;
+    double h = st_pipeline_cell_width(soup, p), tets, at_once;
+    double need = st_pipeline_lattice_bytes(soup, h, p->tries, &tets, &at_once);
     if (need <= (double)max_bytes)
         return 0;
     if (p->h > 0)
@@ -207,19 +190,10 @@ static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
 static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_params *p,
                           const st_pipeline_stats *st)
 {
-    double lo[3], hi[3], d2 = 0;
+    double lo[3], hi[3];
     st_error e;
-    if (st_soup_bounds(soup, lo, hi, &e) == ST_OK)
-        for (int a = 0; a < 3; a++)
-            d2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
-    double n = floor(sqrt(d2) / st->h) + 3 + 2 * ST_LATTICE_PAD_DEFAULT;
-    double at_once = 1;
-#ifdef _OPENMP
-    if (p->tries > 1)
-        at_once = (double)((size_t)omp_get_max_threads() < p->tries
-                               ? (size_t)omp_get_max_threads() : p->tries);
-#endif
-    double lattice = 12.0 * n * n * n * at_once * TOOL_LATTICE_BYTES_PER_TET;
+    st_soup_bounds(soup, lo, hi, &e);   /* the run got here: it has bounds */
+    double lattice = st_pipeline_lattice_bytes(soup, st->h, p->tries, NULL, NULL);
     double field = (double)st->field_dims[0] * (double)st->field_dims[1] *
                    (double)st->field_dims[2] * 2.0 * (sizeof(float) + 1);
     double work = (double)st->estimated_tets * (double)p->tries;
