@@ -406,6 +406,40 @@ int tool_output_unwritable(const tool_ctx *t, const char *path)
     return bad;
 }
 
+int tool_one_input(const tool_ctx *t, int argc, char *argv[], const char *name,
+                   const char *dflt, const char **in)
+{
+    if (optind < argc)
+        *in = argv[optind++];
+    if (optind < argc)
+        return tool_usage_error(t, "one %s at most ('%s' is extra)", name, argv[optind]);
+    if (!*in)
+        *in = dflt;
+    return TOOL_CONTINUE;
+}
+
+int tool_refuse_terminal(const tool_ctx *t, const char *path, int fd, const char *msg)
+{
+    if (st_path_is_stdio(path) && isatty(fd))
+        return tool_usage_error(t, "%s", msg);
+    return TOOL_CONTINUE;
+}
+
+int tool_output_format(const tool_ctx *t, const char *out, int known, const char *exts)
+{
+    if (!st_path_is_stdio(out) && !known)
+        return tool_usage_error(t, "cannot tell the format of '%s' (use %s)", out, exts);
+    return TOOL_CONTINUE;
+}
+
+int tool_output_check(tool_ctx *t, const char *out)
+{
+    if (!tool_output_unwritable(t, out))
+        return TOOL_CONTINUE;
+    tool_finish(t);
+    return TOOL_EXIT_FAIL;
+}
+
 tool_common tool_common_default(void)
 {
     tool_common co;

@@ -137,6 +137,40 @@ void tool_print_version(const tool_ctx *t);
 void tool_json_string(FILE *f, const char *s);
 const char *tool_json_number(char buf[32], double x);
 
+/* ---- the end of option parsing -----------------------------------------
+ *
+ * What every tool checks once its options are read, in this order: its
+ * one input operand, no terminal where data would flow, an output format
+ * it can tell, an output it can write. Each returns TOOL_CONTINUE when all
+ * is well, else the exit status main returns at once (the message already
+ * printed). */
+
+/* In main(): return the exit status call gives unless it is TOOL_CONTINUE. */
+#define TOOL_TRY(call)                                                    \
+    do {                                                                  \
+        int tool_rc_ = (call);                                            \
+        if (tool_rc_ != TOOL_CONTINUE)                                    \
+            return tool_rc_;                                              \
+    } while (0)
+
+/* The operand after the options: *in gets it, or dflt when there is none
+ * (dflt may be NULL); a second one is a usage error "one NAME at most
+ * ('X' is extra)". */
+int tool_one_input(const tool_ctx *t, int argc, char *argv[], const char *name,
+                   const char *dflt, const char **in);
+/* The messages of tool_refuse_terminal for a surface and for binary data. */
+#define TOOL_TTY_SURFACE "will not read a surface from a terminal: give a file or pipe one"
+#define TOOL_TTY_VTU "will not write a .vtu document to a terminal: give -o FILE or pipe it"
+/* When path names stdin or stdout ("-" or NULL) and that descriptor (fd 0
+ * or 1) is a terminal: a usage error with msg. */
+int tool_refuse_terminal(const tool_ctx *t, const char *path, int fd, const char *msg);
+/* When out is a file (not stdout) and known is 0: a usage error "cannot
+ * tell the format of 'OUT' (use EXTS)". */
+int tool_output_format(const tool_ctx *t, const char *out, int known, const char *exts);
+/* When an output (NULL and "-" are fine) cannot be written there
+ * (tool_output_unwritable): TOOL_EXIT_FAIL after tool_finish. */
+int tool_output_check(tool_ctx *t, const char *out);
+
 /* ---- options every tool shares ----------------------------------------
  *
  * A tool's option table starts with its own long options, then

@@ -163,10 +163,7 @@ int main(int argc, char *argv[])
         }
         }
     }
-    if (optind < argc)
-        in = argv[optind++];
-    if (optind < argc)
-        return tool_usage_error(&t, "one input field at most ('%s' is extra)", argv[optind]);
+    TOOL_TRY(tool_one_input(&t, argc, argv, "input field", "-", &in));
     if (sculpt && rho >= 0)
         return tool_usage_error(&t, "--density and --sculpt exclude each other");
     if (!sculpt && rho < 0)
@@ -188,24 +185,15 @@ int main(int argc, char *argv[])
     /* Sculpting: soupmesh's defaults, so the pipe makes soupmesh's mesh. */
     if (!have_seed && sculpt)
         seed = 1;
-    if (!in)
-        in = "-";
-    if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
-        return tool_usage_error(&t, "no input: give a field or pipe one in "
-                                    "(soupdist m.obj | soupsign | latticetet ...)");
-    if (surface && st_path_is_stdio(surface) && isatty(STDIN_FILENO))
-        return tool_usage_error(&t, "will not read a surface from a terminal: give a "
-                                    "file or pipe one");
-    if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
-        return tool_usage_error(&t, "will not write a .vtu document to a "
-                                    "terminal: give -o FILE or pipe it");
-    if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
-        return tool_usage_error(&t, "cannot tell the format of '%s' (use .vtu, "
-                                    ".msh, .node, .ele or .mesh)", out);
-    if (tool_output_unwritable(&t, out)) {
-        tool_finish(&t);
-        return TOOL_EXIT_FAIL;
-    }
+    TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO, "no input: give a field or pipe "
+                                  "one in (soupdist m.obj | soupsign | latticetet ...)"));
+    if (surface)
+        TOOL_TRY(tool_refuse_terminal(&t, surface, STDIN_FILENO, TOOL_TTY_SURFACE));
+    TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, TOOL_TTY_VTU));
+    TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
+                                st_tet_format_from_path(out) != ST_TET_FMT_UNKNOWN,
+                                ".vtu, .msh, .node, .ele or .mesh"));
+    TOOL_TRY(tool_output_check(&t, out));
     tool_set_threads(co.threads);
 
     st_error err;

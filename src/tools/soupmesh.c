@@ -331,20 +331,16 @@ int main(int argc, char *argv[])
     if (p.density_rho > 0 && (p.target_tets || p.dry_run))
         return tool_usage_error(&t, "--tets and --dry-run size the sculpted mesh, "
                                     "not --density's");
-    if (optind < argc)
-        in = argv[optind++];
-    if (optind < argc)
-        return tool_usage_error(&t, "one input surface at most ('%s' is extra)", argv[optind]);
+    TOOL_TRY(tool_one_input(&t, argc, argv, "input surface", NULL, &in));
     if (!in)
         return tool_usage_error(&t, "no input surface (soupmesh -o out.vtu model.obj)");
-    if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
-        return tool_usage_error(&t, "will not read a surface from a terminal: give a file");
-    if (st_path_is_stdio(out) && isatty(STDOUT_FILENO) && !p.dry_run)
-        return tool_usage_error(&t, "will not write a .vtu document to a terminal: "
-                                    "give -o FILE or pipe it");
-    if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
-        return tool_usage_error(&t, "cannot tell the format of '%s' (use .vtu, .msh, "
-                                    ".node, .ele or .mesh)", out);
+    TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO,
+                                  "will not read a surface from a terminal: give a file"));
+    if (!p.dry_run)
+        TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, TOOL_TTY_VTU));
+    TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
+                                st_tet_format_from_path(out) != ST_TET_FMT_UNKNOWN,
+                                ".vtu, .msh, .node, .ele or .mesh"));
     size_t elen = embed ? strlen(embed) : 0;
     int embed_text = elen > 4 && strcmp(embed + elen - 4, ".txt") == 0;
     if (embed && !embed_text && !(elen > 4 && strcmp(embed + elen - 4, ".vtu") == 0))

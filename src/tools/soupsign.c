@@ -288,31 +288,21 @@ int main(int argc, char *argv[])
         }
         }
     }
-    if (optind < argc)
-        in = argv[optind++];
-    if (optind < argc)
-        return tool_usage_error(&t, "one input field at most ('%s' is extra)", argv[optind]);
-    if (!in)
-        in = "-";
-    if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
-        return tool_usage_error(&t, "no input: give a field or pipe one in "
-                                    "(soupdist mesh.obj | soupsign)");
-    if (surface && st_path_is_stdio(surface) && isatty(STDIN_FILENO))
-        return tool_usage_error(&t, "will not read a surface from a terminal: give a "
-                                    "file or pipe one");
-    if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
-        return tool_usage_error(&t, "will not write a binary VDB stream to a "
-                                    "terminal: give -o FILE or pipe it");
-    if (!st_path_is_stdio(out) && st_grid_format_from_path(out) == ST_GRID_FMT_UNKNOWN)
-        return tool_usage_error(&t, "cannot tell the format of '%s' (use .vdb or .vti)", out);
+    TOOL_TRY(tool_one_input(&t, argc, argv, "input field", "-", &in));
+    TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO, "no input: give a field or pipe "
+                                  "one in (soupdist mesh.obj | soupsign)"));
+    if (surface)
+        TOOL_TRY(tool_refuse_terminal(&t, surface, STDIN_FILENO, TOOL_TTY_SURFACE));
+    TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, "will not write a binary VDB "
+                                  "stream to a terminal: give -o FILE or pipe it"));
+    TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
+                                st_grid_format_from_path(out) != ST_GRID_FMT_UNKNOWN,
+                                ".vdb or .vti"));
     if (surface && paper)
         return tool_usage_error(&t, "--rule paper is the paper's rule exactly: it takes no --surface");
     if (surface && st_path_is_stdio(surface) && st_path_is_stdio(in))
         return tool_usage_error(&t, "the field and the surface cannot both come from stdin");
-    if (tool_output_unwritable(&t, out)) {
-        tool_finish(&t);
-        return TOOL_EXIT_FAIL;
-    }
+    TOOL_TRY(tool_output_check(&t, out));
     tool_set_threads(co.threads);
 
     st_error err;

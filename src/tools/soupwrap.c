@@ -170,11 +170,7 @@ int main(int argc, char *argv[])
         }
         }
     }
-    if (optind < argc)
-        in = argv[optind++];
-    if (optind < argc)
-        return tool_usage_error(&t, "one input at most ('%s' is extra)",
-                                argv[optind]);
+    TOOL_TRY(tool_one_input(&t, argc, argv, "input", NULL, &in));
     if (surface && in)
         return tool_usage_error(&t, "give a FIELD or --surface INPUT, not "
                                     "both");
@@ -183,13 +179,12 @@ int main(int argc, char *argv[])
                                     "grid already)");
     if (!surface && !in)
         in = "-";
-    if (in && st_path_is_stdio(in) && isatty(STDIN_FILENO))
-        return tool_usage_error(&t, "no input: give a field or pipe one in "
-                                    "(soupdist mesh.obj | soupsign | "
-                                    "soupwrap), or --surface INPUT");
-    if (surface && st_path_is_stdio(surface) && isatty(STDIN_FILENO))
-        return tool_usage_error(&t, "will not read a surface from a terminal: give a "
-                                    "file or pipe one");
+    if (in)
+        TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO, "no input: give a field or pipe "
+                                      "one in (soupdist mesh.obj | soupsign | soupwrap), "
+                                      "or --surface INPUT"));
+    if (surface)
+        TOOL_TRY(tool_refuse_terminal(&t, surface, STDIN_FILENO, TOOL_TTY_SURFACE));
     st_soup_format fmt = ST_SOUP_OBJ;
     if (!st_path_is_stdio(out)) {
         fmt = st_soup_format_from_path(out);
@@ -198,10 +193,7 @@ int main(int argc, char *argv[])
                                         "(use .obj, .off, .ply or .stl)",
                                     out);
     }
-    if (tool_output_unwritable(&t, out)) {
-        tool_finish(&t);
-        return TOOL_EXIT_FAIL;
-    }
+    TOOL_TRY(tool_output_check(&t, out));
     tool_set_threads(co.threads);
     dp.max_bytes = co.max_bytes;
 

@@ -208,27 +208,16 @@ int main(int argc, char *argv[])
         fp.quality_rounds = 0;   /* whatever the order of the options */
     if (mode == 2 && !surface)
         return tool_usage_error(&t, "--fit needs --surface S (the surface to enclose)");
-    if (optind < argc)
-        in = argv[optind++];
-    if (optind < argc)
-        return tool_usage_error(&t, "one input mesh at most ('%s' is extra)", argv[optind]);
-    if (!in)
-        in = "-";
-    if (st_path_is_stdio(in) && isatty(STDIN_FILENO))
-        return tool_usage_error(&t, "no input: give a mesh or pipe one in "
-                                    "(latticetet ... | tetsmooth ...)");
-    if (surface && st_path_is_stdio(surface) && isatty(STDIN_FILENO))
-        return tool_usage_error(&t, "will not read a surface from a terminal: give a "
-                                    "file or pipe one");
-    if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
-        return tool_usage_error(&t, "cannot tell the format of '%s' (use .vtu)", out);
-    if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
-        return tool_usage_error(&t, "will not write a binary mesh to a terminal: give -o "
-                                    "FILE or pipe it");
-    if (tool_output_unwritable(&t, out)) {
-        tool_finish(&t);
-        return TOOL_EXIT_FAIL;
-    }
+    TOOL_TRY(tool_one_input(&t, argc, argv, "input mesh", "-", &in));
+    TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO, "no input: give a mesh or pipe one "
+                                  "in (latticetet ... | tetsmooth ...)"));
+    if (surface)
+        TOOL_TRY(tool_refuse_terminal(&t, surface, STDIN_FILENO, TOOL_TTY_SURFACE));
+    TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
+                                st_tet_format_from_path(out) != ST_TET_FMT_UNKNOWN, ".vtu"));
+    TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, "will not write a binary mesh to "
+                                  "a terminal: give -o FILE or pipe it"));
+    TOOL_TRY(tool_output_check(&t, out));
     tool_set_threads(co.threads);
 
     st_error err;
