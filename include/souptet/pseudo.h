@@ -67,6 +67,7 @@ typedef struct st_pseudo_stats {
     st_holes_stats holes;
     size_t cap_triangles;
     st_sides_stats sides;
+    size_t mirrored;                /* voxels a one-sided view's mirror added */
     size_t refined;                 /* signs the refinement changed */
     size_t shells;                  /* closed shells */
     size_t shell_open_triangles;    /* triangles in none */
