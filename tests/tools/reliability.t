@@ -12,7 +12,7 @@ skip() {
     echo "ok $TAP_N - $1 # SKIP $2"
 }
 
-# st_outfile's temporaries are "dir/.NAME.XXXXXX" (src/outfile.c).
+# st_outfile's temporaries are "dir/.NAME.tmp-PID@HOST.XXXXXX" (src/outfile.c).
 no_temps() {
     ! ls -A "$1" | grep -Eq '^\..+\.[A-Za-z0-9]{6}$'
 }
@@ -28,7 +28,7 @@ check "the inputs are made" test -s d.vdb -a -s s.vdb -a -s l.vtu -a -s l30.vtu
 # ---- signals -----------------------------------------------------------
 # interrupt SIG DIR: soupdist -r 320 into DIR/big.vti in the background
 # (about 0.5 s of distances, then about 0.5 s writing); once its temporary
-# DIR/.big.vti.XXXXXX exists (the write has begun), send SIG. The tool's
+# DIR/.big.vti.tmp-PID@HOST.XXXXXX exists (the write has begun), send SIG. The tool's
 # exit status is left in $irc ("none" when the temporary never appeared).
 interrupt() {
     soupdist -q -r 320 -o "$2/big.vti" "$BUNNY" &
