@@ -226,6 +226,44 @@ static void test_outfile_stale(void)
     TAP_CHECK(rmdir(name) == 0, "nothing else is left");
 }
 
+/* st_mem_address_space_left: SIZE_MAX with no ulimit -v; under one, the
+ * cap and what is left of it (checked in a child, which the cap cannot
+ * outlive). */
+static void test_address_space(void)
+{
+    struct rlimit rl;
+    getrlimit(RLIMIT_AS, &rl);
+    size_t cap;
+    if (rl.rlim_cur == RLIM_INFINITY)
+        TAP_CHECK(st_mem_address_space_left(&cap) == SIZE_MAX && cap == SIZE_MAX,
+                  "no ulimit -v: no cap, all of it left");
+    pid_t child = fork();
+    if (child == 0) {
+        size_t used = 0;
+        FILE *f = fopen("/proc/self/statm", "r");
+        unsigned long pages = 0;
+        if (f && fscanf(f, "%lu", &pages) == 1)
+            used = (size_t)pages * (size_t)sysconf(_SC_PAGESIZE);
+        if (f)
+            fclose(f);
+        struct rlimit r = rl;
+        r.rlim_cur = (rlim_t)(used + ((size_t)256 << 20));
+        if (r.rlim_max != RLIM_INFINITY && r.rlim_cur > r.rlim_max)
+            _exit(2);
+        if (setrlimit(RLIMIT_AS, &r) != 0)
+            _exit(2);
+        size_t lim, left = st_mem_address_space_left(&lim);
+        /* About 256 MiB left: what the fopen maps may take a little. */
+        _exit(lim == (size_t)r.rlim_cur && left <= ((size_t)256 << 20) &&
+              left > ((size_t)200 << 20) ? 0 : 1);
+    }
+    int ws = 0;
+    waitpid(child, &ws, 0);
+    TAP_CHECK(WIFEXITED(ws) && WEXITSTATUS(ws) == 0,
+              "under ulimit -v: the cap, and what is left of it (exit %d)",
+              WIFEXITED(ws) ? WEXITSTATUS(ws) : -1);
+}
+
 int main(void)
 {
     test_error_format();
@@ -234,5 +272,6 @@ int main(void)
     test_grid();
     test_outfile();
     test_outfile_stale();
+    test_address_space();
     return tap_done();
 }

@@ -248,8 +248,22 @@ if (ulimit -v $VLIM && soupdist -q -r 16 -o v.vdb "$BUNNY") 2>/dev/null; then
     # 710x695x545 floats: 1026 MiB
     expect_fail "capped: soupdist -r 700 --max-memory 1000M: refused by the limit" 1 \
         "over the limit of 1000.0 MiB" capped soupdist -r 700 --max-memory 1000M -o x.vdb "$BUNNY"
-    expect_fail "capped: soupdist -r 700 --max-memory 2G: the allocation fails (the cap works)" 1 \
-        "out of memory" capped soupdist -r 700 --max-memory 2G -o x.vdb "$BUNNY"
+    expect_fail "capped: soupdist -r 700 --max-memory 2G: the allocation fails, naming ulimit -v" 1 \
+        "out of memory.*ulimit -v caps this process's address space at [0-9]+ MiB" \
+        capped soupdist -r 700 --max-memory 2G -o x.vdb "$BUNNY"
+    # With no --max-memory the default is what ulimit -v leaves, so the
+    # estimate refuses the job and names the options, where it was 80% of
+    # the RAM and the allocation failed midway ("out of memory").
+    expect_fail "capped: soupdist -r 700 (default limit): refused by the estimate, names -r and ulimit -v" 1 \
+        "^soupdist: .*bunny.obj: a 710x693x543 grid needs .* over the limit of .*-r.*--max-memory.*ulimit -v leaves" \
+        capped soupdist -r 700 -o x.vdb "$BUNNY"
+    expect_fail "capped: soupwrap --surface -r 700 (default limit): refused by the estimate" 1 \
+        "^soupwrap: .*bunny.obj: a 710x693x543 grid needs .* over the limit of .*-r.*ulimit -v leaves" \
+        capped soupwrap --surface "$BUNNY" -r 700 -o x.obj
+    expect_fail "capped: latticetet --cells 200 (default limit): refused, names --cells and ulimit -v" 1 \
+        "^latticetet: s.vdb: a lattice of .*--cells.*ulimit -v leaves" \
+        capped latticetet --density 0.5 --cells 200 -o x.vtu s.vdb
+    check "capped: nothing left by the refusals" sh -c "test ! -e x.vdb && test ! -e x.obj && test ! -e x.vtu && ! ls -A | grep -q '\.tmp-'"
     expect_fail "capped: soupwrap --surface -r 700 --max-memory 1000M: refused by the limit" 1 \
         "over the limit of 1000.0 MiB" capped soupwrap --surface "$BUNNY" -r 700 --max-memory 1000M -o x.obj
     # 37 million tets of at least 64 bytes: 2.3 GB
