@@ -2,6 +2,7 @@
 #define _GNU_SOURCE
 #include "tool.h"
 #include "../fpenv.h"
+#include "souptet/dist.h"
 #include "souptet/grid.h"
 #include "souptet/mem.h"
 #include "souptet/outfile.h"
@@ -207,6 +208,27 @@ void tool_limit_hint(st_error *err, const char *hint)
                  (double)g_ulimit_left / 1048576.0);
     else
         snprintf(err->msg + n, sizeof err->msg - n, " (%s)", hint);
+}
+
+size_t tool_dist_cells_that_fit(const struct st_soup *s, const struct st_dist_params *p)
+{
+    if (!s || !p || p->voxel > 0 || p->cells < 2 || !p->max_bytes)
+        return 0;
+    st_dist_params q = *p;
+    size_t dims[3], lo = 0, hi = p->cells;   /* lo fits (0: none yet), hi does not */
+    double origin[3], h;
+    while (hi - lo > 1) {
+        q.cells = lo + (hi - lo) / 2;
+        size_t n;
+        /* The layout, then the grid's size as st_grid_new checks it. */
+        if (st_dist_layout(s, &q, dims, origin, &h, NULL) == ST_OK &&
+            !st_size_mul(&n, dims[0], dims[1]) && !st_size_mul(&n, n, dims[2]) &&
+            !st_size_mul(&n, n, sizeof(float)) && n <= p->max_bytes)
+            lo = q.cells;
+        else
+            hi = q.cells;
+    }
+    return lo;
 }
 
 int tool_usage_error(const tool_ctx *t, const char *fmt, ...)

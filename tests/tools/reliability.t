@@ -198,9 +198,14 @@ done
 # ---- memory limits -----------------------------------------------------
 # The exact need: a -r 48 bunny field is 58x57x47 voxels of 4 bytes.
 need=$((58 * 57 * 47 * 4))
-expect_fail "soupdist: --max-memory one byte short of the grid: refused, names -r and --max-memory" 1 \
-    "^soupdist: .*bunny.obj: a 58x57x47 grid .*-r.*--max-memory" \
+expect_fail "soupdist: --max-memory one byte short of the grid: refused, names -r (a value that fits) and --max-memory" 1 \
+    "^soupdist: .*bunny.obj: a 58x57x47 grid .*use -r [0-9]+ or less.*--max-memory" \
     soupdist -r 48 --max-memory $((need - 1)) -o x.vdb "$BUNNY"
+fit=$(sed -n 's/.*use -r \([0-9]*\) or less.*/\1/p' "$WORK/.err")
+check "soupdist: the -r it names ($fit) fits that --max-memory" \
+    soupdist -q -r "${fit:-0}" --max-memory $((need - 1)) -o fit.vdb "$BUNNY"
+expect_fail "soupdist: and one more voxel does not" 1 "over the limit" \
+    soupdist -r $((${fit:-0} + 1)) --max-memory $((need - 1)) -o x.vdb "$BUNNY"
 check "soupdist: --max-memory of exactly the grid: made" soupdist -q -r 48 --max-memory $need -o y.vdb "$BUNNY"
 for c in "soupsign -o x.vdb d.vdb" "soupwrap -o x.obj s.vdb" \
          "latticetet --density 0.5 -o x.vtu s.vdb" "tetstat --field s.vdb l.vtu"; do
