@@ -53,15 +53,10 @@ st_tetformat st_tetformat_from_path(const char *path)
     if (!path || st_path_is_stdio(path))
         return ST_TETFORMAT_NONE;
     st_tetformat f = format_of_ext(path);
-    size_t n = strlen(path);
-    /* st_outfile's temporary name: "dir/.name.msh.XXXXXX". */
-    if (f != ST_TETFORMAT_NONE || n < 8 || path[n - 7] != '.')
-        return f;
-    char *p = st_strdup(path);
-    if (!p)
-        return ST_TETFORMAT_NONE;
-    p[n - 7] = '\0';
-    f = format_of_ext(p);
+    /* st_outfile's temporary name: its target's format. */
+    char *p = f == ST_TETFORMAT_NONE ? st_outfile_target_of(path) : NULL;
+    if (p)
+        f = format_of_ext(p);
     free(p);
     return f;
 }
@@ -1700,22 +1695,12 @@ st_status st_tetmesh_write_medit(const st_tetmesh *m, const char *path,
     return close_written(fp, path, err);
 }
 
-/* The target of st_outfile's temporary name "dir/.NAME.node.XXXXXX" (or
- * .ele), malloc'd; NULL when path is not such a name. */
+/* The target of st_outfile's temporary name (outfile.h) for a .node or
+ * .ele file, malloc'd; NULL when path is not such a name. */
 static char *outfile_target(const char *path)
 {
-    size_t n = strlen(path);
-    const char *slash = strrchr(path, '/');
-    size_t dl = slash ? (size_t)(slash - path) + 1 : 0;
-    if (n < dl + 12 || path[dl] != '.' || path[n - 7] != '.')
-        return NULL;
-    char *t = malloc(n);
-    if (!t)
-        return NULL;
-    memcpy(t, path, dl);
-    memcpy(t + dl, path + dl + 1, n - 8 - dl);
-    t[n - 8] = '\0';
-    if (format_of_ext(t) != ST_TETFORMAT_TETGEN) {
+    char *t = st_outfile_target_of(path);
+    if (t && format_of_ext(t) != ST_TETFORMAT_TETGEN) {
         free(t);
         return NULL;
     }

@@ -63,18 +63,15 @@ st_tet_format st_tet_format_from_path(const char *path)
                                    : from_tetformat(st_tetformat_from_path(path));
 }
 
-/* The format of a path st_outfile_begin made ("dir/.name.vtu.XXXXXX"):
- * the target's, found by dropping the 6-character mkstemp suffix. */
+/* The format of a path st_outfile_begin made: its target's. */
 static st_tet_format format_for_writing(const char *path)
 {
     st_tet_format f = st_tet_format_from_path(path);
-    size_t n = strlen(path);
-    if (f != ST_TET_FMT_UNKNOWN || n < 8 || path[n - 7] != '.')
+    if (f != ST_TET_FMT_UNKNOWN)
         return f;
-    char *p = st_strdup(path);
+    char *p = st_outfile_target_of(path);
     if (!p)
         return ST_TET_FMT_UNKNOWN;
-    p[n - 7] = '\0';
     f = format_of_name(p);
     free(p);
     return f;

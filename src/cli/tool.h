@@ -68,6 +68,11 @@ st_status tool_check_field_finite(const struct st_grid *g, const char *name,
  * the options to change, in place of the library's own parenthesized
  * advice if it ends with one. */
 void tool_limit_hint(st_error *err, const char *hint);
+/* The largest cells (-r) below p->cells whose distance grid for s fits
+ * p->max_bytes (its layout, 4 bytes a voxel, as st_grid_new checks); 0 when none does or p gives
+ * a voxel size instead. For a refusal that names a value that fits. */
+struct st_dist_params;
+size_t tool_dist_cells_that_fit(const struct st_soup *s, const struct st_dist_params *p);
 /* Print "name: msg" and "Try 'name --help'." and return TOOL_EXIT_USAGE. */
 int tool_usage_error(const tool_ctx *t, const char *fmt, ...)
 #ifdef __GNUC__

@@ -127,7 +127,7 @@ static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_er
     char got[32];
     snprintf(got, sizeof got, "%llu", src.size);
     const int same = src.hash[0] && strcmp(got, size) == 0 && strcmp(src.hash, hash) == 0;
-    if (rc && same) {
+    if (rc && (same || rc == ST_ENOMEM)) {   /* out of memory is no "cannot be read" */
         *err = e;
         return 1;
     }
