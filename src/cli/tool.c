@@ -263,6 +263,20 @@ int tool_parse_switch(const tool_ctx *t, const char *opt, const char *arg, int *
     return 0;
 }
 
+int tool_parse_msh_version(const tool_ctx *t, const char *arg,
+                           st_tetformat_opts *o)
+{
+    size_t v;
+    if (tool_parse_size(t, "--msh-version", arg, 2, 41, &v))
+        return -1;
+    if (v != 2 && v != 4 && v != 22 && v != 41) {
+        tool_usage_error(t, "--msh-version is 2 or 4 (2.2 or 4.1), not '%s'", arg);
+        return -1;
+    }
+    o->msh_version = (int)v;
+    return 0;
+}
+
 int tool_parse_bytes(const tool_ctx *t, const char *opt, const char *arg,
                      size_t *out)
 {
