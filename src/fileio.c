@@ -179,6 +179,8 @@ st_status st_file_head(const char *path, unsigned char *buf, size_t cap,
         *n += (size_t)r;
     }
     close(fd);
+    if (*n == 0)
+        return st_error_set(err, ST_EINPUT, path, 0, "empty file");
     return ST_OK;
 }
 

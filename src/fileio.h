@@ -40,7 +40,8 @@ st_status st_file_read(const char *path, unsigned char **data, size_t *size,
                        st_error *err);
 
 /* The first bytes of the file path: up to cap into buf, *n of them (0 for
- * an empty file). ST_EIO "cannot open: why" or "cannot read: why". */
+ * an empty file, which fails). ST_EIO "cannot open: why" or "cannot read:
+ * why"; ST_EINPUT "empty file". */
 st_status st_file_head(const char *path, unsigned char *buf, size_t cap,
                        size_t *n, st_error *err);
 

@@ -81,8 +81,6 @@ st_status st_grid_read(st_grid **out, const char *path, size_t max_bytes,
     st_status s = st_file_head(path, head, sizeof head, &n, err);
     if (s)
         return s;
-    if (n == 0)
-        return st_error_set(err, ST_EINPUT, path, 0, "empty file");
     if (looks_like_vdb(head, n))
         return st_grid_read_vdb(out, path, max_bytes, err);
     if (st_looks_like_xml(head, n))

@@ -110,8 +110,6 @@ st_status st_tetmesh_read(st_tetmesh **out, const char *path,
         st_status s = st_file_head(path, head, sizeof head, &n, err);
         if (s)
             return s;
-        if (n == 0)
-            return st_error_set(err, ST_EINPUT, path, 0, "empty file");
         f = st_tetformat_sniff(head, n);
     }
     switch (f) {

@@ -158,17 +158,17 @@ enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION
 
 /* The tet-mesh format options of every tool that writes a tet mesh
  * (soupmesh, latticetet, tetsmooth): their table entries, their --help
- * lines, and --msh-version's value (2, 4, 22 or 41) into o->msh_version
- * (0 and a usage error, printed, for anything else; --msh-binary sets
- * o->binary). */
+ * lines, and their handling: for c TOOL_OPT_MSH_VERSION (2, 4, 22 or 41
+ * into o->msh_version) or TOOL_OPT_MSH_BINARY (o->binary = 1). Returns 0,
+ * or -1 after a usage error (printed). */
 #define TOOL_LONG_OPTIONS_TETFORMAT                                \
     {"msh-version", required_argument, NULL, TOOL_OPT_MSH_VERSION}, \
     {"msh-binary", no_argument, NULL, TOOL_OPT_MSH_BINARY}
 #define TOOL_HELP_TETFORMAT                                               \
     "      --msh-version V  Gmsh format 4 (4.1, default) or 2 (2.2)\n"   \
     "      --msh-binary     binary .msh instead of ASCII\n"
-int tool_parse_msh_version(const tool_ctx *t, const char *arg,
-                           st_tetformat_opts *o);
+int tool_tetformat_option(const tool_ctx *t, int c, const char *arg,
+                          st_tetformat_opts *o);
 
 /* What the shared options set: threads (0: all cores) and the memory
  * limit (tool_default_max_memory() unless --max-memory). */

@@ -289,11 +289,9 @@ int main(int argc, char *argv[])
                 return TOOL_EXIT_USAGE;
             break;
         case TOOL_OPT_MSH_VERSION:
-            if (tool_parse_msh_version(&t, optarg, &fopts))
-                return TOOL_EXIT_USAGE;
-            break;
         case TOOL_OPT_MSH_BINARY:
-            fopts.binary = 1;
+            if (tool_tetformat_option(&t, c, optarg, &fopts))
+                return TOOL_EXIT_USAGE;
             break;
         case OPT_EMBED:
             embed = optarg;

@@ -192,11 +192,9 @@ int main(int argc, char *argv[])
             out = optarg;
             break;
         case TOOL_OPT_MSH_VERSION:
-            if (tool_parse_msh_version(&t, optarg, &fopts))
-                return TOOL_EXIT_USAGE;
-            break;
         case TOOL_OPT_MSH_BINARY:
-            fopts.binary = 1;
+            if (tool_tetformat_option(&t, c, optarg, &fopts))
+                return TOOL_EXIT_USAGE;
             break;
         default: {
             int rc_opt = tool_common_option(&t, c, argv, usage, &co);
