@@ -28,8 +28,6 @@
  * queried from many threads at once. st_enclosure_compute runs OpenMP
  * loops over soup vertices and boundary faces; its counts and per-item
  * arrays do not depend on the thread count.
- *
- * Module order: ... -> pred -> isect -> bvh -> tetmesh -> enclose -> tetstat
  */
 #ifndef SOUPTET_ENCLOSE_H
 #define SOUPTET_ENCLOSE_H

@@ -25,8 +25,6 @@
  * pseudo-volume density, then volume-preserving boundary fairing; it
  * approximates the pseudo volume and does not try to enclose the soup
  * (enclosure is still measured and reported).
- *
- * Module order: ... dist -> sign -> lattice -> sculpt -> smooth -> pipeline.
  */
 #ifndef SOUPTET_PIPELINE_H
 #define SOUPTET_PIPELINE_H

@@ -23,9 +23,6 @@
  * refine). The field need not come from this process: soupsign reads it
  * from soupdist, and the same call on the same field and soup gives the
  * same bytes, whoever calls it.
- *
- * Module order: ... dist -> sign -> edges -> holes -> shells -> pseudo
- *   -> lattice ...
  */
 #ifndef SOUPTET_PSEUDO_H
 #define SOUPTET_PSEUDO_H

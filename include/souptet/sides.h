@@ -35,8 +35,6 @@
  * Memory: one byte per voxel (the evidence, the caller's) and O(triangles).
  * Deterministic for any number of threads (each voxel sums its triangles
  * in the BVH's fixed order).
- *
- * Module order: ... sign -> edges -> sides -> holes -> shells -> pseudo
  */
 #ifndef SOUPTET_SIDES_H
 #define SOUPTET_SIDES_H

@@ -24,8 +24,6 @@
  * Vertices move in a fixed order (independent sets of a greedy colouring,
  * each set in parallel), so the result does not depend on the thread count.
  * No global state: calls on different meshes may run concurrently.
- *
- * Module order: ... -> bvh -> tetqual -> tetmesh -> smooth -> ...
  */
 #ifndef SOUPTET_SMOOTH_H
 #define SOUPTET_SMOOTH_H

@@ -34,8 +34,6 @@
  *   and the voxels with a negative value.
  *
  * All of it is deterministic and does not depend on the thread count.
- *
- * Module order: ... -> bvh -> tetmesh -> enclose -> tetstat
  */
 #ifndef SOUPTET_TETSTAT_H
 #define SOUPTET_TETSTAT_H

@@ -301,6 +301,24 @@ int tool_parse_switch(const tool_ctx *t, const char *opt, const char *arg, int *
     return 0;
 }
 
+int tool_tetformat_option(const tool_ctx *t, int c, const char *arg,
+                          st_tetformat_opts *o)
+{
+    size_t v;
+    if (c == TOOL_OPT_MSH_BINARY) {
+        o->binary = 1;
+        return 0;
+    }
+    if (tool_parse_size(t, "--msh-version", arg, 2, 41, &v))
+        return -1;
+    if (v != 2 && v != 4 && v != 22 && v != 41) {
+        tool_usage_error(t, "--msh-version is 2 or 4 (2.2 or 4.1), not '%s'", arg);
+        return -1;
+    }
+    o->msh_version = (int)v;
+    return 0;
+}
+
 int tool_parse_bytes(const tool_ctx *t, const char *opt, const char *arg,
                      size_t *out)
 {

@@ -17,6 +17,7 @@
 #include "souptet/err.h"
 #include "souptet/meta.h"
 #include "souptet/progress.h"
+#include "souptet/tetformat.h"
 
 #define TOOL_EXIT_OK 0
 #define TOOL_EXIT_FAIL 1
@@ -150,7 +151,7 @@ const char *tool_json_number(char buf[32], double x);
  * option codes start at TOOL_OPT_FIRST. In the getopt_long loop, every
  * code the tool does not handle itself goes to tool_common_option. */
 enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION,
-       TOOL_OPT_FIRST = 1100 };
+       TOOL_OPT_MSH_VERSION, TOOL_OPT_MSH_BINARY, TOOL_OPT_FIRST = 1100 };
 #define TOOL_LONG_OPTIONS_BASIC                              \
     {"quiet", no_argument, NULL, 'q'},                       \
     {"verbose", no_argument, NULL, 'v'},                     \
@@ -159,6 +160,20 @@ enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION
 #define TOOL_LONG_OPTIONS_RESOURCES                          \
     {"threads", required_argument, NULL, TOOL_OPT_THREADS},  \
     {"max-memory", required_argument, NULL, TOOL_OPT_MAXMEM}
+
+/* The tet-mesh format options of every tool that writes a tet mesh
+ * (soupmesh, latticetet, tetsmooth): their table entries, their --help
+ * lines, and their handling: for c TOOL_OPT_MSH_VERSION (2, 4, 22 or 41
+ * into o->msh_version) or TOOL_OPT_MSH_BINARY (o->binary = 1). Returns 0,
+ * or -1 after a usage error (printed). */
+#define TOOL_LONG_OPTIONS_TETFORMAT                                \
+    {"msh-version", required_argument, NULL, TOOL_OPT_MSH_VERSION}, \
+    {"msh-binary", no_argument, NULL, TOOL_OPT_MSH_BINARY}
+#define TOOL_HELP_TETFORMAT                                               \
+    "      --msh-version V  Gmsh format 4 (4.1, default) or 2 (2.2)\n"   \
+    "      --msh-binary     binary .msh instead of ASCII\n"
+int tool_tetformat_option(const tool_ctx *t, int c, const char *arg,
+                          st_tetformat_opts *o);
 
 /* What the shared options set: threads (0: all cores) and the memory
  * limit (tool_default_max_memory() unless --max-memory). */

@@ -60,6 +60,7 @@ static void usage(void)
 "                       hanging tets, islands and pinched boundaries\n"
 "  -o, --output OUT     .vtu file (or .msh, .node/.ele, .mesh by extension,\n"
 "                       without the arrays); '-' or none: .vtu on stdout\n"
+TOOL_HELP_TETFORMAT
 "      --threads T      threads to use (default: all cores)\n"
 "      --max-memory SZ  refuse fields and lattices larger than SZ\n"
 "                       (default 80%% of RAM)\n"
@@ -90,6 +91,7 @@ int main(int argc, char *argv[])
     double rho = -1, size = 0;
     int sculpt = 0, repair = 1;
     uint64_t seed = 0;
+    st_tetformat_opts fopts = {0, 0};
     static const struct option opts[] = {
         {"density", required_argument, NULL, OPT_DENSITY},
         {"sculpt", no_argument, NULL, OPT_SCULPT},
@@ -100,6 +102,7 @@ int main(int argc, char *argv[])
         {"seed", required_argument, NULL, OPT_SEED},
         {"no-repair", no_argument, NULL, OPT_NOREPAIR},
         {"output", required_argument, NULL, 'o'},
+        TOOL_LONG_OPTIONS_TETFORMAT,
         TOOL_LONG_OPTIONS_BASIC,
         TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
@@ -149,6 +152,11 @@ int main(int argc, char *argv[])
         case 'o':
             out = optarg;
             break;
+        case TOOL_OPT_MSH_VERSION:
+        case TOOL_OPT_MSH_BINARY:
+            if (tool_tetformat_option(&t, c, optarg, &fopts))
+                return TOOL_EXIT_USAGE;
+            break;
         default: {
             int rc_opt = tool_common_option(&t, c, argv, usage, &co);
             if (rc_opt != TOOL_CONTINUE) {
@@ -189,7 +197,7 @@ int main(int argc, char *argv[])
     if (st_path_is_stdio(out) && isatty(STDOUT_FILENO))
         return tool_usage_error(&t, "will not write a .vtu document to a "
                                     "terminal: give -o FILE or pipe it");
-    if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
+    if (!st_path_is_stdio(out) && st_tetformat_from_path(out) == ST_TETFORMAT_NONE)
         return tool_usage_error(&t, "cannot tell the format of '%s' (use .vtu, "
                                     ".msh, .node, .ele or .mesh)", out);
     if (tool_output_unwritable(&t, out)) {
@@ -389,7 +397,7 @@ int main(int argc, char *argv[])
         }
     }
     double tw = tool_now();
-    if (st_tetmesh_save(m, out, &err)) {
+    if (st_tetmesh_save(m, out, &fopts, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

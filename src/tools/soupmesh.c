@@ -42,8 +42,7 @@ static void usage(void)
 "\n"
 "  -o, --output OUT     the mesh, by extension: .vtu (VTK), .msh (Gmsh), .node/.ele\n"
 "                       (TetGen), .mesh (Medit); '-' or none: .vtu on stdout\n"
-"      --msh-version V  Gmsh format 4 (4.1, default) or 2 (2.2)\n"
-"      --msh-binary     binary .msh instead of ASCII\n"
+TOOL_HELP_TETFORMAT
 "      --embed FILE     where each input vertex lies: its tet and barycentric\n"
 "                       coordinates, as text (.txt) or a point cloud (.vtu with\n"
 "                       point arrays embed_tet, embed_bary)\n"
@@ -91,7 +90,7 @@ static void usage(void)
 }
 
 enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
-       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED, OPT_FILL_HOLES, OPT_SHELLS,
+       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_FILL_HOLES, OPT_SHELLS,
        OPT_TETS, OPT_DRY_RUN };
 
 static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
@@ -226,8 +225,7 @@ int main(int argc, char *argv[])
         {"no-quality", no_argument, NULL, OPT_NO_QUALITY},
         {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
         {"shells", required_argument, NULL, OPT_SHELLS},
-        {"msh-version", required_argument, NULL, OPT_MSH_VERSION},
-        {"msh-binary", no_argument, NULL, OPT_MSH_BINARY},
+        TOOL_LONG_OPTIONS_TETFORMAT,
         {"embed", required_argument, NULL, OPT_EMBED},
         {"output", required_argument, NULL, 'o'},
         TOOL_LONG_OPTIONS_BASIC,
@@ -290,18 +288,10 @@ int main(int argc, char *argv[])
             if (tool_parse_switch(&t, "--shells", optarg, &p.closed_shells))
                 return TOOL_EXIT_USAGE;
             break;
-        case OPT_MSH_VERSION: {
-            size_t v;
-            if (tool_parse_size(&t, "--msh-version", optarg, 2, 41, &v))
+        case TOOL_OPT_MSH_VERSION:
+        case TOOL_OPT_MSH_BINARY:
+            if (tool_tetformat_option(&t, c, optarg, &fopts))
                 return TOOL_EXIT_USAGE;
-            if (v != 2 && v != 4 && v != 22 && v != 41)
-                return tool_usage_error(&t, "--msh-version is 2 or 4 (2.2 or 4.1), not '%s'",
-                                        optarg);
-            fopts.msh_version = (int)v;
-            break;
-        }
-        case OPT_MSH_BINARY:
-            fopts.binary = 1;
             break;
         case OPT_EMBED:
             embed = optarg;
@@ -335,7 +325,7 @@ int main(int argc, char *argv[])
     if (st_path_is_stdio(out) && isatty(STDOUT_FILENO) && !p.dry_run)
         return tool_usage_error(&t, "will not write a .vtu document to a terminal: "
                                     "give -o FILE or pipe it");
-    if (!st_path_is_stdio(out) && st_tet_format_from_path(out) == ST_TET_FMT_UNKNOWN)
+    if (!st_path_is_stdio(out) && st_tetformat_from_path(out) == ST_TETFORMAT_NONE)
         return tool_usage_error(&t, "cannot tell the format of '%s' (use .vtu, .msh, "
                                     ".node, .ele or .mesh)", out);
     size_t elen = embed ? strlen(embed) : 0;
@@ -414,9 +404,7 @@ int main(int argc, char *argv[])
             goto done;
         }
     }
-    if (st_tetformat_from_path(out) != ST_TETFORMAT_NONE
-            ? st_tetformat_save(m, ST_TETFORMAT_NONE, out, &fopts, &err)
-            : st_tetmesh_save(m, out, &err)) {
+    if (st_tetmesh_save(m, out, &fopts, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }
@@ -424,7 +412,7 @@ int main(int argc, char *argv[])
         if (embed_text
                 ? st_embed_write_text(embed, et, eb, soup->nverts, m->ntets,
                                       st_path_is_stdio(out) ? "<stdout>" : out, in, &err)
-                : st_tetmesh_save(side, embed, &err)) {
+                : st_tetmesh_save(side, embed, NULL, &err)) {
             rc = tool_fail(&t, &err);
             goto done;
         }
