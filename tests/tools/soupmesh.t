@@ -7,7 +7,7 @@ cd "$WORK" || exit 1
 
 check "--help exits 0" sh -c 'soupmesh --help | grep -q "Usage: soupmesh"'
 check "man page exists" test -s "$ROOT/man/man1/soupmesh.1"
-check "the bunny meshes" soupmesh -q --cells 8 -o b.vtu "$BUNNY"
+check "the bunny meshes" soupmesh -q --offset-best-effort --cells 8 -o b.vtu "$BUNNY"
 
 cat > encl.py <<'PY'
 import json, sys
@@ -37,14 +37,29 @@ with open(sys.argv[2], "w") as o:
         o.write("f %d %d %d\n" % (n + 1, n + 2, n + 3)); n += 3
 PY
 check "a flipped exact soup of the bunny meshes and is enclosed" \
-    sh -c "soupmesh -q --cells 8 -o s.vtu soup.obj && tetstat --json --surface soup.obj s.vtu > s.json && /usr/bin/python3 encl.py s.json 20"
+    sh -c "soupmesh -q --offset-best-effort --cells 8 -o s.vtu soup.obj && tetstat --json --surface soup.obj s.vtu > s.json && /usr/bin/python3 encl.py s.json 20"
 
 mkdir t1 t2
 check "1 and 2 threads, 2 tries: identical output (same command line)" sh -c \
-    "(cd t1 && OMP_NUM_THREADS=1 soupmesh -q --cells 6 --tries 2 -o m.vtu '$BUNNY') &&
-     (cd t2 && OMP_NUM_THREADS=2 soupmesh -q --cells 6 --tries 2 -o m.vtu '$BUNNY') &&
+    "(cd t1 && OMP_NUM_THREADS=1 soupmesh -q --offset-best-effort --cells 6 --tries 2 -o m.vtu '$BUNNY') &&
+     (cd t2 && OMP_NUM_THREADS=2 soupmesh -q --offset-best-effort --cells 6 --tries 2 -o m.vtu '$BUNNY') &&
      cmp t1/m.vtu t2/m.vtu"
 check "the Spillmann mesher (--density)" soupmesh -q --density 0.5 --cells 8 -o d.vtu "$BUNNY"
+
+# Cetra's stopping condition: --offset 0.05 cannot be met at 4 cells. The
+# mesh is written, the count and the farthest distance in h are said even
+# with -q, and the exit status is 4; --offset-best-effort makes it 0 and a
+# warning.
+check "--offset 0.05: exit 4, written, said under -q" \
+    sh -c "soupmesh -q --cells 4 --field-cells 32 --offset 0.05 -o o5.vtu '$BUNNY' 2> o5.err; test \$? -eq 4 && test -s o5.vtu && grep -Eq '^soupmesh: .*bunny.obj: error: [0-9]+ of [0-9]+ boundary vertices stay farther than 0.05 h from the input, the farthest [0-9.]+ h' o5.err"
+check "--offset 0.05 --offset-best-effort: exit 0, a warning" \
+    sh -c "soupmesh --offset-best-effort --cells 4 --field-cells 32 --offset 0.05 -o o5b.vtu '$BUNNY' 2> o5b.err && grep -q 'warning: [0-9]* of [0-9]* boundary vertices stay farther than 0.05 h' o5b.err"
+check "--offset-best-effort -q: silent" \
+    sh -c "soupmesh -q --offset-best-effort --cells 4 --field-cells 32 --offset 0.05 -o o5c.vtu '$BUNNY' 2> o5c.err && ! test -s o5c.err"
+check "-v: both distances in h and per diagonal" \
+    sh -c "soupmesh -v --offset-best-effort --cells 4 --field-cells 32 -o o5d.vtu '$BUNNY' 2>&1 | grep -Eq 'boundary -> input max [0-9.]+ h \\([0-9.]+ diag\\), input -> boundary max [0-9.]+ h \\([0-9.]+ diag\\)'"
+check "tetstat agrees with soupmesh's exit 4" \
+    sh -c "tetstat --json --surface '$BUNNY' o5.vtu | python3 -c 'import json,sys; d=json.load(sys.stdin)[\"surface\"]; assert d[\"offset_ratio\"] == 0.05 and d[\"beyond_offset\"] > 0 and not d[\"offset_met\"], d'"
 
 expect_fail "a missing file" 1 "^soupmesh: missing.obj" soupmesh -o x.vtu missing.obj
 printf 'v 0 0 0\nv 1 0 0\nf 1 2 9\n' > bad.obj
