@@ -565,6 +565,119 @@ void sm_fit_report(const st_fit_params *p, const fit_ctx *c, const char *phase,
 }
 
 
+/* ---- rescue: the vertices the fit left beyond the band --------------- */
+
+/* Directions tried around the way to S (degrees off it) and azimuths. */
+static const double rescue_tilt[] = {0.0, 30.0, 55.0, 75.0, 88.0};
+#define RESCUE_AZIMUTHS 8
+/* Step fractions of the way to the band's middle. */
+static const double rescue_frac[] = {1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125};
+#define RESCUE_NTILT (sizeof rescue_tilt / sizeof rescue_tilt[0])
+#define RESCUE_NFRAC (sizeof rescue_frac / sizeof rescue_frac[0])
+#define RESCUE_NCAND (((RESCUE_NTILT - 1) * RESCUE_AZIMUTHS + 1) * RESCUE_NFRAC)
+/* Rounds over the vertices still beyond the band. */
+#define RESCUE_ROUNDS 40
+/* A rescue move may not bring its star's score below this (degrees), or
+ * below what it was if lower; the quality pass raises it after. */
+#define RESCUE_FLOOR 25.0
+
+static int cmp_rescue(const void *a, const void *b)
+{
+    const double *x = a, *y = b;   /* {distance, px, py, pz, order} */
+    if (x[0] != y[0])
+        return x[0] < y[0] ? -1 : 1;
+    return (x[4] > y[4]) - (x[4] < y[4]);
+}
+
+/* A boundary vertex v beyond d_offset whose ODT-plus-pull step the
+ * invariant refused is held by S near its star; a step along another
+ * direction that still brings it closer to S often passes (it slides past
+ * what holds it). Candidates: the directions within 88 degrees of the way
+ * to S's nearest point, at fractions of the way to the band's middle; the
+ * closest to S first, the first that keeps the invariant and the star's
+ * score floor is taken. 1 when v moved. */
+static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
+{
+    const sm_mesh *sm = &c->sm;
+    double *x = sm->m->xyz + 3 * (size_t)v;
+    double cp[3];
+    double dd = sm_dist_to_s(c, x, cp);
+    if (!(dd > c->d_offset))
+        return 0;
+    double n[3], t1[3], t2[3];
+    for (int a = 0; a < 3; a++)
+        n[a] = (cp[a] - x[a]) / dd;   /* toward S */
+    int k = fabs(n[0]) < 0.6 ? 0 : (fabs(n[1]) < 0.6 ? 1 : 2);
+    double e[3] = {0, 0, 0};
+    e[k] = 1.0;
+    t1[0] = n[1] * e[2] - n[2] * e[1];
+    t1[1] = n[2] * e[0] - n[0] * e[2];
+    t1[2] = n[0] * e[1] - n[1] * e[0];
+    double l = sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
+    for (int a = 0; a < 3; a++)
+        t1[a] /= l;
+    t2[0] = n[1] * t1[2] - n[2] * t1[1];
+    t2[1] = n[2] * t1[0] - n[0] * t1[2];
+    t2[2] = n[0] * t1[1] - n[1] * t1[0];
+    double way = dd - FIT_GOAL_FRACTION * c->d_offset;
+    double cd[RESCUE_NCAND][5];
+    size_t nc = 0;
+    for (size_t ti = 0; ti < RESCUE_NTILT; ti++) {
+        double th = rescue_tilt[ti] * 3.14159265358979323846 / 180.0;
+        int naz = ti == 0 ? 1 : RESCUE_AZIMUTHS;
+        for (int az = 0; az < naz; az++) {
+            double ph = 2.0 * 3.14159265358979323846 * az / RESCUE_AZIMUTHS;
+            double dir[3];
+            for (int a = 0; a < 3; a++)
+                dir[a] = cos(th) * n[a] + sin(th) * (cos(ph) * t1[a] + sin(ph) * t2[a]);
+            for (size_t fi = 0; fi < RESCUE_NFRAC; fi++, nc++) {
+                double st = way * rescue_frac[fi];
+                for (int a = 0; a < 3; a++)
+                    cd[nc][1 + a] = x[a] + st * dir[a];
+                int64_t tri;
+                double d2 = st_bvh_nearest(c->bvh, cd[nc] + 1, dd * dd, &tri, NULL);
+                cd[nc][0] = tri >= 0 ? sqrt(d2) : INFINITY;
+                cd[nc][4] = (double)nc;
+            }
+        }
+    }
+    qsort(cd, nc, sizeof cd[0], cmp_rescue);
+    double floor_score = fmin(RESCUE_FLOOR, sm_star_score(sm, v, x));
+    sm_star_pts_collect(c, v, sp);
+    for (size_t i = 0; i < nc; i++) {
+        if (!(cd[i][0] < dd))
+            break;
+        const double *p = cd[i] + 1;
+        if (sm_star_score(sm, v, p) >= floor_score && sm_move_ok(c, v, p, sp)) {
+            memcpy(x, p, 3 * sizeof *x);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Rounds of rescue_vertex over the boundary vertices beyond d_offset, in
+ * index order (few vertices, serial: the result does not depend on the
+ * thread count). Returns the moves. */
+static size_t rescue_pass(fit_ctx *c, double *dist)
+{
+    size_t moves = 0;
+    star_pts sp = {NULL, 0, 0, 1, 0, 0};
+    for (int round = 0; round < RESCUE_ROUNDS; round++) {
+        size_t moved = 0;
+        for (size_t v = 0; v < c->sm.nv; v++)
+            if (c->sm.onb[v] && dist[v] > c->d_offset && rescue_vertex(c, (uint32_t)v, &sp)) {
+                moved++;
+                dist[v] = sm_dist_to_s(c, c->sm.m->xyz + 3 * v, NULL);
+            }
+        moves += moved;
+        if (moved == 0)
+            break;
+    }
+    free(sp.list);
+    return moves;
+}
+
 /* ---- entry points ----------------------------------------------------- */
 
 static double mesh_h(const st_tetmesh *m, double given)
@@ -703,6 +816,10 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
             break;   /* the rest are held back: thin gaps or blocked moves */
         }
     }
+    if (ds.within < c.sm.nbv) {
+        rescue_pass(&c, dist);
+        ds = sm_boundary_distances(&c, dist);
+    }
     st.converged = ds.within == c.sm.nbv;
     sm_dihedral_range(m, &st.min_dihedral_fit, &st.max_dihedral_fit);
     st.seconds_fit = sm_now() - t0;
@@ -713,6 +830,7 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
         ds = sm_boundary_distances(&c, dist);
     }
     st.within_offset = ds.within;
+    st.converged = ds.within == c.sm.nbv;
     st.beyond_offset = c.sm.nbv - ds.within;
     st.max_distance = ds.max;
     st.mean_distance = ds.mean;
