@@ -61,6 +61,44 @@ check "-v: both distances in h and per diagonal" \
 check "tetstat agrees with soupmesh's exit 4" \
     sh -c "tetstat --json --surface '$BUNNY' o5.vtu | python3 -c 'import json,sys; d=json.load(sys.stdin)[\"surface\"]; assert d[\"offset_ratio\"] == 0.05 and d[\"beyond_offset\"] > 0 and not d[\"offset_met\"], d'"
 
+# Cetra's stopping condition reached where the fit used to be held back
+# (before the rescue pass: 3 and 2 boundary vertices beyond 0.4 h, up to
+# 0.58 h and 0.48 h): a thin slot (two 1 x 1 x 0.1 plates 0.03 apart,
+# 0.24 h at 8 cells) and a sharp crease (a wedge of 20 degrees). Exit 0
+# without --offset-best-effort, every boundary vertex within 0.4 h
+# (tetstat), enclosing, angles kept.
+cat > shapes.py <<'PY'
+import math
+def box(lo, hi, V, F):
+    o = len(V)
+    for k in range(8):
+        V.append((hi[0] if k & 1 else lo[0], hi[1] if k & 2 else lo[1], hi[2] if k & 4 else lo[2]))
+    for a, b, c, d in [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]:
+        F.append((o + a, o + b, o + c))
+        F.append((o + a, o + c, o + d))
+def write(p, V, F):
+    with open(p, "w") as f:
+        f.write("OFF\n%d %d 0\n" % (len(V), len(F)))
+        for v in V:
+            f.write("%.17g %.17g %.17g\n" % v)
+        for t in F:
+            f.write("3 %d %d %d\n" % t)
+V, F = [], []
+box((0, 0, 0), (1, 1, 0.1), V, F)
+box((0, 0, 0.13), (1, 1, 0.23), V, F)
+write("slot.off", V, F)
+a = math.radians(20)
+P = [(0, 0), (1, 0), (math.cos(a), math.sin(a))]
+V = [(x, y, 0.0) for x, y in P] + [(x, y, 0.6) for x, y in P]
+F = [(0, 2, 1), (3, 4, 5), (0, 1, 4), (0, 4, 3), (1, 2, 5), (1, 5, 4), (2, 0, 3), (2, 3, 5)]
+write("wedge.off", V, F)
+PY
+/usr/bin/python3 shapes.py
+for shape in slot wedge; do
+    check "$shape: every boundary vertex within 0.4 h, enclosing, min dihedral >= 33" \
+        sh -c "soupmesh -q --cells 8 --offset 0.4 -o $shape.vtu $shape.off && tetstat --json --surface $shape.off $shape.vtu | python3 -c 'import json,sys; r=json.load(sys.stdin); d=r[\"surface\"]; assert d[\"offset_ratio\"] == 0.4 and d[\"beyond_offset\"] == 0 and d[\"dist_max_h\"] <= 0.4 and d[\"encloses\"] and r[\"min_dihedral\"] >= 33, (d, r[\"min_dihedral\"])'"
+done
+
 expect_fail "a missing file" 1 "^soupmesh: missing.obj" soupmesh -o x.vtu missing.obj
 printf 'v 0 0 0\nv 1 0 0\nf 1 2 9\n' > bad.obj
 expect_fail "an index out of range names the line" 1 "^soupmesh: bad.obj:3: " soupmesh -o x.vtu bad.obj
