@@ -575,6 +575,8 @@ static const double rescue_frac[] = {1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125};
 #define RESCUE_NTILT (sizeof rescue_tilt / sizeof rescue_tilt[0])
 #define RESCUE_NFRAC (sizeof rescue_frac / sizeof rescue_frac[0])
 #define RESCUE_NCAND (((RESCUE_NTILT - 1) * RESCUE_AZIMUTHS + 1) * RESCUE_NFRAC)
+/* Rescue and quality passes again after the quality pass, at most. */
+#define FIT_LATE_RESCUES 2
 /* Rounds over the vertices still beyond the band. */
 #define RESCUE_ROUNDS 40
 /* A rescue move may not bring its star's score below this (degrees), or
@@ -828,6 +830,15 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
         if ((rc = sm_quality_pass(&c, &p, dist, &st, t0, err)))
             goto done;
         ds = sm_boundary_distances(&c, dist);
+        /* the quality moves change the stars of the vertices still held:
+         * another rescue, and the quality pass again after it */
+        for (int k = 0; k < FIT_LATE_RESCUES && ds.within < c.sm.nbv; k++) {
+            if (rescue_pass(&c, dist) == 0)
+                break;
+            if ((rc = sm_quality_pass(&c, &p, dist, &st, t0, err)))
+                goto done;
+            ds = sm_boundary_distances(&c, dist);
+        }
     }
     st.within_offset = ds.within;
     st.converged = ds.within == c.sm.nbv;
