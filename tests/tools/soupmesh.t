@@ -94,9 +94,11 @@ F = [(0, 2, 1), (3, 4, 5), (0, 1, 4), (0, 4, 3), (1, 2, 5), (1, 5, 4), (2, 0, 3)
 write("wedge.off", V, F)
 PY
 /usr/bin/python3 shapes.py
-for shape in slot wedge; do
-    check "$shape: every boundary vertex within 0.4 h, enclosing, min dihedral >= 33" \
-        sh -c "soupmesh -q --cells 8 --offset 0.4 -o $shape.vtu $shape.off && tetstat --json --surface $shape.off $shape.vtu | python3 -c 'import json,sys; r=json.load(sys.stdin); d=r[\"surface\"]; assert d[\"offset_ratio\"] == 0.4 and d[\"beyond_offset\"] == 0 and d[\"dist_max_h\"] <= 0.4 and d[\"encloses\"] and r[\"min_dihedral\"] >= 33, (d, r[\"min_dihedral\"])'"
+# The same at R 0.25 (before: 20 and 17 beyond), min dihedral >= 30.
+for run in "slot 0.4 33" "wedge 0.4 33" "slot 0.25 30" "wedge 0.25 30"; do
+    set -- $run
+    check "$1: every boundary vertex within $2 h, enclosing, min dihedral >= $3" \
+        sh -c "soupmesh -q --cells 8 --offset $2 -o $1-$2.vtu $1.off && tetstat --json --surface $1.off $1-$2.vtu | python3 -c 'import json,sys; r=json.load(sys.stdin); d=r[\"surface\"]; assert d[\"offset_ratio\"] == $2 and d[\"beyond_offset\"] == 0 and d[\"dist_max_h\"] <= $2 and d[\"encloses\"] and r[\"min_dihedral\"] >= $3, (d, r[\"min_dihedral\"])'"
 done
 
 expect_fail "a missing file" 1 "^soupmesh: missing.obj" soupmesh -o x.vtu missing.obj
