@@ -28,6 +28,24 @@
  * nothing, when FIT_STALL_ITERS iterations bring no new vertex into the
  * band, or after max_iters.
  *
+ * Rescue (past the paper). The vertices still beyond d_offset when the
+ * iterations stop are held: every step toward their nearest point of S,
+ * down to 1/16, would let an S vertex out of the star or a boundary face
+ * into S (a thin gap, a sharp crease). A step in another direction that
+ * still brings the vertex closer to S often passes: it slides past what
+ * holds it. rescue_vertex tries directions up to 88 degrees off the way
+ * to S at fractions of the way to the band's middle, closest to S first,
+ * under the same invariant and a star score floor (RESCUE_FLOOR, the
+ * quality pass raises it after); rounds repeat while a vertex moves. It
+ * runs after the iterations, and after the quality pass (whose moves
+ * change the held vertices' stars) again, followed by another quality
+ * pass, at most FIT_LATE_RESCUES times. Measured (--tries 1, cells 10):
+ * beyond 0.4 h before -> after on fandisk 5 -> 0, armadillo 12 -> 0,
+ * cheese 49 -> 0, bunny-soup 1 -> 0, elephant-with-holes 12 -> 0; at
+ * 0.25 h fandisk, bunny-soup, elephant-with-holes, joint all reach 0.
+ * Retrying the fit iterations between rescues did little (0.25 h: 10 ->
+ * 10 beyond over four models) at twice the time, so it does not.
+ *
  * Not checked: that the boundary does not fold onto another part of the
  * mesh far from the moved star (a global self-intersection); small steps
  * and positive stars make it unlikely, tetstat would show it as overlap.
