@@ -801,7 +801,7 @@ def offset_markdown(rows):
     in h, and the targets met or missed (also on stderr)."""
     ours = [r for r in rows if r.get("mesher") == "souptet" and "model" in r]
     if not ours:
-        return []
+        return ""
     md = ["", "### The stopping condition (issue 18)", "",
           "Per input and offset ratio R, souptet (`soupmesh --offset R --offset-best-effort`,"
           " seed 1): boundary vertices farther than R h from the input (*beyond*, tetstat"
@@ -847,7 +847,7 @@ def offset_markdown(rows):
         md.append(line)
         md.append("")
         _log(line)
-    return md
+    return "\n".join(md) + "\n"
 
 
 def _f(v, fmt="%.1f", none="-"):
