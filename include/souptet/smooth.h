@@ -17,7 +17,11 @@
  * the mesh still is, no boundary triangle that did not meet a triangle of S
  * does, and every tet is positively oriented - all decided by the exact
  * predicates (pred.h, isect.h). A move that would break it is halved a few
- * times, then skipped.
+ * times, then skipped. Boundary vertices the fit leaves beyond d_offset
+ * (held by the invariant in thin gaps and at sharp features) get a rescue:
+ * steps in other directions that still bring them closer to S, under the
+ * same invariant; once after the fit, then after the quality pass (and the
+ * quality pass again), see fit.c.
  *
  * Both require every tet of the input to be positively oriented (tetmesh.h)
  * and refuse the mesh otherwise; both never produce an inverted or flat tet.
@@ -154,7 +158,8 @@ st_fit_params st_fit_params_default(void);
  * ST_EINPUT on inverted or flat tets, a mesh without tets, or no cell
  * width (neither p->cell_width nor a meta "h" > 0); ST_ENOMEM when out of
  * memory, the quality pass's memory included (never a silently skipped
- * pass). Not converging is not an error: stats->converged says it. stats and prog may be NULL. */
+ * pass). Not converging is not an error: stats->converged says it (of the
+ * final mesh, after the quality pass). stats and prog may be NULL. */
 st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
                  const st_fit_params *p, st_fit_stats *stats,
                  const st_progress *prog, st_error *err);

@@ -26,6 +26,10 @@
  * surface (or that cannot be verified): a failure of the tool's promise,
  * never only a warning, and always printed (even with -q). */
 #define TOOL_EXIT_NOT_ENCLOSING 3
+/* The output was written and encloses, but the fit's stopping condition
+ * (every boundary vertex within R h of the surface, soupmesh --offset)
+ * does not hold; always printed, like 3. */
+#define TOOL_EXIT_OFFSET_NOT_MET 4
 
 typedef struct tool_ctx {
     const char *name;      /* program name for messages */

@@ -112,7 +112,7 @@ piped() {
 for cmd in "soupdist -r 128 $BUNNY" "soupsign d64.vdb" "soupwrap s.vdb" \
            "latticetet --density 0.5 --cells 30 s64.vdb" \
            "tetsmooth --fair --iters 1 --no-quality l30.vtu" \
-           "soupmesh -q --cells 10 --field-cells 32 --max-iters 5 --no-quality $BUNNY"; do
+           "soupmesh -q --offset-best-effort --cells 10 --field-cells 32 --max-iters 5 --no-quality $BUNNY"; do
     tool=${cmd%% *}
     # shellcheck disable=SC2086
     piped $cmd
@@ -126,7 +126,7 @@ ok $? "closed pipes: no temporary files"
 for cmd in "soupdist -r 32 $BUNNY" "soupsign d.vdb" "soupwrap s.vdb" \
            "latticetet --density 0.5 --cells 8 s.vdb" "tetsmooth --fair l.vtu" \
            "tetstat l.vtu" "tetstat --json l.vtu" "soupinfo $BUNNY" \
-           "soupmesh -q --cells 4 --field-cells 32 $BUNNY"; do
+           "soupmesh -q --offset-best-effort --cells 4 --field-cells 32 $BUNNY"; do
     tool=${cmd%% *}
     expect_fail "$cmd > /dev/full: exit 1, '<stdout>: write failed'" 1 \
         "^$tool: <stdout>: write (failed|error)" sh -c "$cmd > /dev/full"
@@ -164,7 +164,7 @@ if mount -t tmpfs -o size=64k tmpfs full 2>/dev/null; then
              "soupwrap -o full/x.obj s.vdb" "soupwrap -o full/x.stl s.vdb" \
              "latticetet --density 0.5 --cells 30 -o full/x.vtu s64.vdb" \
              "latticetet --density 0.5 --cells 30 -o full/x.msh s64.vdb" \
-             "soupmesh -q --cells 8 --field-cells 32 --max-iters 5 --no-quality -o full/x.node $BUNNY"; do
+             "soupmesh -q --offset-best-effort --cells 8 --field-cells 32 --max-iters 5 --no-quality -o full/x.node $BUNNY"; do
         tool=${c%% -*}
         out=$(echo "$c" | sed 's/.*-o \(full\/[^ ]*\).*/\1/')
         # (a TetGen pair may fail on either file)
