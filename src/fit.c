@@ -356,6 +356,57 @@ static ptrdiff_t in_star(const sm_mesh *sm, uint32_t v, const double p[3],
     return -1;
 }
 
+/* in_star_tet for a star known to be positive with v at p (every tet's
+ * orient3d < 0, as sm_star_positive checks, which move_ok does first):
+ * st_point_in_tet's face tests, in its order, without its orientation
+ * test, and with skip_opposite without the face opposite v, which the
+ * caller knows q is on the closed inner side of (q was in the same closed
+ * tet with v elsewhere, and that tet was positive: the face does not move).
+ * Same answer as in_star_tet, two orient3d calls fewer of five. */
+static int in_pos_star_tet(const sm_mesh *sm, uint32_t v, size_t j, const double p[3],
+                           const double q[3], int skip_opposite)
+{
+    const uint32_t *c = sm->m->tets + 4 * (size_t)sm->vt[sm->vt_off[v] + j];
+    const double *t[4];
+    int kv = -1;
+    for (int k = 0; k < 4; k++) {
+        t[k] = c[k] == v ? p : sm->m->xyz + 3 * (size_t)c[k];
+        if (c[k] == v)
+            kv = k;
+    }
+    for (int a = 0; a < 3; a++)
+        if ((q[a] < t[0][a] && q[a] < t[1][a] && q[a] < t[2][a] && q[a] < t[3][a]) ||
+            (q[a] > t[0][a] && q[a] > t[1][a] && q[a] > t[2][a] && q[a] > t[3][a]))
+            return 0;
+    /* the faces opposite corners 0..3, ordered as isect.c's tet_faces so
+     * that each orient3d is the tet's with that corner replaced by q */
+    const double *F[4][3] = {{t[2], t[1], t[3]}, {t[0], t[2], t[3]},
+                             {t[1], t[0], t[3]}, {t[0], t[1], t[2]}};
+    for (int i = 0; i < 4; i++) {
+        if (skip_opposite && i == kv)
+            continue;
+        if (st_orient3d(F[i][0], F[i][1], F[i][2], q) > 0)
+            return 0;
+    }
+    return 1;
+}
+
+/* in_star for a star that is positive with v at p (see in_pos_star_tet);
+ * with hint_opposite, q is known to be inside the hint tet's face opposite
+ * v. Returns the same tet as in_star. */
+static ptrdiff_t in_pos_star(const sm_mesh *sm, uint32_t v, const double p[3],
+                             const double q[3], ptrdiff_t hint, int hint_opposite)
+{
+    size_t n = sm->vt_off[v + 1] - sm->vt_off[v];
+    if (hint >= 0 && (size_t)hint < n &&
+        in_pos_star_tet(sm, v, (size_t)hint, p, q, hint_opposite))
+        return hint;
+    for (size_t j = 0; j < n; j++)
+        if ((ptrdiff_t)j != hint && in_pos_star_tet(sm, v, j, p, q, 0))
+            return (ptrdiff_t)j;
+    return -1;
+}
+
 /* An S vertex in a star and the star tet that held it. */
 typedef struct star_pt {
     uint32_t pt;     /* index into the point grid */
@@ -411,13 +462,18 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
 }
 
 /* Every listed S vertex lies in the closed star of v with v at p; when
- * one does not, *failed says which (a point grid index). */
+ * one does not, *failed says which (a point grid index). The star with v
+ * at p must be positive (move_ok tests that first); was_positive: it was
+ * positive where the list was gathered, so each point is inside its tet's
+ * face opposite v (issue 23: this loop is most of the fit's time on large
+ * soups, a few thousand points per star on the dragon). */
 static int svertices_kept(const fit_ctx *c, uint32_t v, const double p[3],
-                          const star_pt *list, size_t n, uint32_t *failed)
+                          const star_pt *list, size_t n, int was_positive,
+                          uint32_t *failed)
 {
     for (size_t i = 0; i < n; i++)
-        if (in_star(&c->sm, v, p, c->pg.pts + 3 * (size_t)list[i].pt,
-                    (ptrdiff_t)list[i].tet) < 0) {
+        if (in_pos_star(&c->sm, v, p, c->pg.pts + 3 * (size_t)list[i].pt,
+                        (ptrdiff_t)list[i].tet, was_positive) < 0) {
             *failed = list[i].pt;
             return 0;
         }
@@ -470,6 +526,7 @@ typedef struct star_pts {
     size_t n, cap;
     int ok;          /* 0: out of memory, refuse every move */
     int have;        /* 1: list holds the star of v as it is */
+    int positive;    /* the star as it is: every tet positive */
     uint32_t v;
 } star_pts;
 
@@ -484,8 +541,12 @@ static void star_pts_fill(const fit_ctx *c, star_pts *sp)
     sp->n = 0;
     sp->ok = 1;
     sp->have = 1;
-    if (c->s && (c->sm.onb[sp->v] || c->full_check))
+    sp->positive = 0;
+    if (c->s && (c->sm.onb[sp->v] || c->full_check)) {
         sp->ok = svertices_in_star(c, sp->v, &sp->list, &sp->n, &sp->cap) == 0;
+        sp->positive = sp->n > 0 &&
+                       sm_star_positive(&c->sm, sp->v, c->sm.m->xyz + 3 * (size_t)sp->v);
+    }
 }
 
 /* Start the moves of v: the list is filled when a move first needs it
@@ -519,7 +580,7 @@ static int move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp
     if (!sp->ok)
         return 0;
     uint32_t failed;
-    if (!svertices_kept(c, v, p, sp->list, sp->n, &failed)) {
+    if (!svertices_kept(c, v, p, sp->list, sp->n, sp->positive, &failed)) {
         if (c->blocker)
             c->blocker[v] = failed;   /* v's own slot: v's colour writes it */
         return 0;
@@ -864,7 +925,7 @@ static st_status quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
             #pragma omp parallel reduction(+ : moved, rejected) \
                 if (PAR_CHECKED(sm->col_off[col + 1] - sm->col_off[col]))
             {
-                star_pts sp = {NULL, 0, 0, 1, 0, 0};
+                star_pts sp = {NULL, 0, 0, 1, 0, 0, 0};
                 #pragma omp for schedule(dynamic, 8)
                 for (size_t j = sm->col_off[col]; j < sm->col_off[col + 1]; j++) {
                     uint32_t v = sm->col_v[j];
@@ -1027,7 +1088,7 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
             #pragma omp parallel reduction(+ : moved, rejected, skipped) \
                 if (PAR_CHECKED(c.sm.col_off[col + 1] - c.sm.col_off[col]))
             {
-                star_pts sp = {NULL, 0, 0, 1, 0, 0};
+                star_pts sp = {NULL, 0, 0, 1, 0, 0, 0};
                 #pragma omp for schedule(dynamic, 4)
                 for (size_t j = c.sm.col_off[col]; j < c.sm.col_off[col + 1]; j++) {
                     fit_counts k = {0, 0, 0};
