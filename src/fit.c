@@ -431,6 +431,28 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
         a0[a] = pgrid_coord(g, lo[a], a);
         a1[a] = pgrid_coord(g, hi[a], a);
     }
+    /* The star tets' boxes, once for all the points: in_star's test order
+     * and answers, without recomputing a tet's box for every point (the
+     * box rejects most (point, tet) pairs; issue 23: this scan was the
+     * largest part of the fit on dragon_res3, 9 million tet tests). */
+    enum { BOXED_MAX = 96 };
+    double tbox[BOXED_MAX][6];
+    const size_t nst = sm->vt_off[v + 1] - sm->vt_off[v];
+    const int boxed = nst <= BOXED_MAX;
+    for (size_t j = 0; boxed && j < nst; j++) {
+        const uint32_t *tc = sm->m->tets + 4 * (size_t)sm->vt[sm->vt_off[v] + j];
+        for (int a = 0; a < 3; a++) {
+            tbox[j][a] = INFINITY;
+            tbox[j][3 + a] = -INFINITY;
+        }
+        for (int k = 0; k < 4; k++) {
+            const double *y = sm->m->xyz + 3 * (size_t)tc[k];
+            for (int a = 0; a < 3; a++) {
+                tbox[j][a] = y[a] < tbox[j][a] ? y[a] : tbox[j][a];
+                tbox[j][3 + a] = y[a] > tbox[j][3 + a] ? y[a] : tbox[j][3 + a];
+            }
+        }
+    }
     ptrdiff_t hint = -1;   /* neighbouring points tend to share a tet */
     for (size_t iz = a0[2]; iz <= a1[2]; iz++)
         for (size_t iy = a0[1]; iy <= a1[1]; iy++)
@@ -441,7 +463,25 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
                     if (q[0] < lo[0] || q[0] > hi[0] || q[1] < lo[1] || q[1] > hi[1] ||
                         q[2] < lo[2] || q[2] > hi[2])
                         continue;
-                    ptrdiff_t t = in_star(sm, v, x, q, hint);
+                    ptrdiff_t t = -1;
+                    if (!boxed)
+                        t = in_star(sm, v, x, q, hint);
+                    else
+                        for (size_t r = 0; r <= nst; r++) {
+                            /* hint first, then the others in order */
+                            size_t u = r == 0 ? (size_t)hint : r - 1;
+                            if ((r == 0 && (hint < 0 || (size_t)hint >= nst)) ||
+                                (r > 0 && (ptrdiff_t)u == hint))
+                                continue;
+                            const double *bx = tbox[u];
+                            if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] ||
+                                q[0] > bx[3] || q[1] > bx[4] || q[2] > bx[5])
+                                continue;
+                            if (in_star_tet(sm, v, u, x, q)) {
+                                t = (ptrdiff_t)u;
+                                break;
+                            }
+                        }
                     if (t < 0)
                         continue;
                     hint = t;
