@@ -311,6 +311,56 @@ static ptrdiff_t in_star(const sm_mesh *sm, uint32_t v, const double p[3],
     return -1;
 }
 
+/* in_star_tet for a star known to be positive with v at p (every tet's
+ * orient3d < 0, as sm_star_positive checks, which move_ok does first):
+ * st_point_in_tet's face tests, in its order, without its orientation
+ * test, and with skip_opposite without the face opposite v, which the
+ * caller knows q is on the closed inner side of (q was in the same closed
+ * tet with v elsewhere, and that tet was positive: the face does not move).
+ * Same answer as in_star_tet, two orient3d calls fewer of five. */
+static int in_pos_star_tet(const sm_mesh *sm, uint32_t v, size_t j, const double p[3],
+                           const double q[3], int skip_opposite)
+{
+    const uint32_t *c = sm->m->tets + 4 * (size_t)sm->vt[sm->vt_off[v] + j];
+    const double *t[4];
+    int kv = -1;
+    for (int k = 0; k < 4; k++) {
+        t[k] = c[k] == v ? p : sm->m->xyz + 3 * (size_t)c[k];
+        if (c[k] == v)
+            kv = k;
+    }
+    for (int a = 0; a < 3; a++)
+        if ((q[a] < t[0][a] && q[a] < t[1][a] && q[a] < t[2][a] && q[a] < t[3][a]) ||
+            (q[a] > t[0][a] && q[a] > t[1][a] && q[a] > t[2][a] && q[a] > t[3][a]))
+            return 0;
+    /* the faces opposite corners 0..3, ordered as isect.c's tet_faces so
+     * that each orient3d is the tet's with that corner replaced by q */
+    const double *F[4][3] = {{t[2], t[1], t[3]}, {t[0], t[2], t[3]},
+                             {t[1], t[0], t[3]}, {t[0], t[1], t[2]}};
+    for (int i = 0; i < 4; i++) {
+        if (skip_opposite && i == kv)
+            continue;
+        if (st_orient3d(F[i][0], F[i][1], F[i][2], q) > 0)
+            return 0;
+    }
+    return 1;
+}
+
+/* in_star for a star that is positive with v at p (see in_pos_star_tet);
+ * with hint_opposite, q is known to be inside the hint tet's face opposite
+ * v. Returns the same tet as in_star. */
+static ptrdiff_t in_pos_star(const sm_mesh *sm, uint32_t v, const double p[3],
+                             const double q[3], ptrdiff_t hint, int hint_opposite)
+{
+    size_t n = sm->vt_off[v + 1] - sm->vt_off[v];
+    if (hint >= 0 && (size_t)hint < n &&
+        in_pos_star_tet(sm, v, (size_t)hint, p, q, hint_opposite))
+        return hint;
+    for (size_t j = 0; j < n; j++)
+        if ((ptrdiff_t)j != hint && in_pos_star_tet(sm, v, j, p, q, 0))
+            return (ptrdiff_t)j;
+    return -1;
+}
 
 /* The S vertices in the closed star of v as it is, appended to *list.
  * Returns 0, or -1 out of memory. */
@@ -330,6 +380,28 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
         a0[a] = pgrid_coord(g, lo[a], a);
         a1[a] = pgrid_coord(g, hi[a], a);
     }
+    /* The star tets' boxes, once for all the points: in_star's test order
+     * and answers, without recomputing a tet's box for every point (the
+     * box rejects most (point, tet) pairs; issue 23: this scan was the
+     * largest part of the fit on dragon_res3, 9 million tet tests). */
+    enum { BOXED_MAX = 96 };
+    double tbox[BOXED_MAX][6];
+    const size_t nst = sm->vt_off[v + 1] - sm->vt_off[v];
+    const int boxed = nst <= BOXED_MAX;
+    for (size_t j = 0; boxed && j < nst; j++) {
+        const uint32_t *tc = sm->m->tets + 4 * (size_t)sm->vt[sm->vt_off[v] + j];
+        for (int a = 0; a < 3; a++) {
+            tbox[j][a] = INFINITY;
+            tbox[j][3 + a] = -INFINITY;
+        }
+        for (int k = 0; k < 4; k++) {
+            const double *y = sm->m->xyz + 3 * (size_t)tc[k];
+            for (int a = 0; a < 3; a++) {
+                tbox[j][a] = y[a] < tbox[j][a] ? y[a] : tbox[j][a];
+                tbox[j][3 + a] = y[a] > tbox[j][3 + a] ? y[a] : tbox[j][3 + a];
+            }
+        }
+    }
     ptrdiff_t hint = -1;   /* neighbouring points tend to share a tet */
     for (size_t iz = a0[2]; iz <= a1[2]; iz++)
         for (size_t iy = a0[1]; iy <= a1[1]; iy++)
@@ -340,7 +412,25 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
                     if (q[0] < lo[0] || q[0] > hi[0] || q[1] < lo[1] || q[1] > hi[1] ||
                         q[2] < lo[2] || q[2] > hi[2])
                         continue;
-                    ptrdiff_t t = in_star(sm, v, x, q, hint);
+                    ptrdiff_t t = -1;
+                    if (!boxed)
+                        t = in_star(sm, v, x, q, hint);
+                    else
+                        for (size_t r = 0; r <= nst; r++) {
+                            /* hint first, then the others in order */
+                            size_t u = r == 0 ? (size_t)hint : r - 1;
+                            if ((r == 0 && (hint < 0 || (size_t)hint >= nst)) ||
+                                (r > 0 && (ptrdiff_t)u == hint))
+                                continue;
+                            const double *bx = tbox[u];
+                            if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] ||
+                                q[0] > bx[3] || q[1] > bx[4] || q[2] > bx[5])
+                                continue;
+                            if (in_star_tet(sm, v, u, x, q)) {
+                                t = (ptrdiff_t)u;
+                                break;
+                            }
+                        }
                     if (t < 0)
                         continue;
                     hint = t;
@@ -361,13 +451,18 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
 }
 
 /* Every listed S vertex lies in the closed star of v with v at p; when
- * one does not, *failed says which (a point grid index). */
+ * one does not, *failed says which (a point grid index). The star with v
+ * at p must be positive (move_ok tests that first); was_positive: it was
+ * positive where the list was gathered, so each point is inside its tet's
+ * face opposite v (issue 23: this loop is most of the fit's time on large
+ * soups, a few thousand points per star on the dragon). */
 static int svertices_kept(const fit_ctx *c, uint32_t v, const double p[3],
-                          const star_pt *list, size_t n, uint32_t *failed)
+                          const star_pt *list, size_t n, int was_positive,
+                          uint32_t *failed)
 {
     for (size_t i = 0; i < n; i++)
-        if (in_star(&c->sm, v, p, c->pg.pts + 3 * (size_t)list[i].pt,
-                    (ptrdiff_t)list[i].tet) < 0) {
+        if (in_pos_star(&c->sm, v, p, c->pg.pts + 3 * (size_t)list[i].pt,
+                        (ptrdiff_t)list[i].tet, was_positive) < 0) {
             *failed = list[i].pt;
             return 0;
         }
@@ -426,8 +521,12 @@ static void star_pts_fill(const fit_ctx *c, star_pts *sp)
     sp->n = 0;
     sp->ok = 1;
     sp->have = 1;
-    if (c->s && (c->sm.onb[sp->v] || c->full_check))
+    sp->positive = 0;
+    if (c->s && (c->sm.onb[sp->v] || c->full_check)) {
         sp->ok = svertices_in_star(c, sp->v, &sp->list, &sp->n, &sp->cap) == 0;
+        sp->positive = sp->n > 0 &&
+                       sm_star_positive(&c->sm, sp->v, c->sm.m->xyz + 3 * (size_t)sp->v);
+    }
 }
 
 /* Start the moves of v: the list is filled when a move first needs it
@@ -461,7 +560,7 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
     if (!sp->ok)
         return 0;
     uint32_t failed;
-    if (!svertices_kept(c, v, p, sp->list, sp->n, &failed)) {
+    if (!svertices_kept(c, v, p, sp->list, sp->n, sp->positive, &failed)) {
         if (c->blocker)
             c->blocker[v] = failed;   /* v's own slot: v's colour writes it */
         return 0;
@@ -684,7 +783,7 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
 static size_t rescue_pass(fit_ctx *c, double *dist)
 {
     size_t moves = 0;
-    star_pts sp = {NULL, 0, 0, 1, 0, 0};
+    star_pts sp = {NULL, 0, 0, 1, 0, 0, 0};
     for (int round = 0; round < RESCUE_ROUNDS; round++) {
         size_t moved = 0;
         for (size_t v = 0; v < c->sm.nv; v++)
@@ -803,7 +902,7 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
             #pragma omp parallel reduction(+ : moved, rejected, skipped) \
                 if (PAR_CHECKED(c.sm.col_off[col + 1] - c.sm.col_off[col]))
             {
-                star_pts sp = {NULL, 0, 0, 1, 0, 0};
+                star_pts sp = {NULL, 0, 0, 1, 0, 0, 0};
                 #pragma omp for schedule(dynamic, 4)
                 for (size_t j = c.sm.col_off[col]; j < c.sm.col_off[col + 1]; j++) {
                     fit_counts k = {0, 0, 0};

@@ -143,6 +143,7 @@ typedef struct star_pts {
     size_t n, cap;
     int ok;          /* 0: out of memory, refuse every move */
     int have;        /* 1: list holds the star of v as it is */
+    int positive;    /* the star as it is: every tet positive */
     uint32_t v;
 } star_pts;
 
