@@ -11,6 +11,10 @@
  * triangle does not meet (exact, isect.h), so a large slanted triangle
  * visits the few leaves along it instead of all of its bounding box.
  *
+ * Subtrees over many triangles are built as OpenMP tasks; the median
+ * split makes the tree's shape depend on the triangle count alone, so each
+ * task knows where its nodes go and the layout is the serial one.
+ *
  * Each triangle's box is computed once at build time and kept in slot
  * order (tbox), so neither the build (node boxes at every level) nor the
  * leaf scans of the queries recompute it from the soup.
@@ -87,7 +91,11 @@ static void select_median(build_ctx *c, size_t lo, size_t hi, size_t mid,
     }
 }
 
-static void build(build_ctx *c, size_t node, size_t lo, size_t hi)
+/* The subtree of `node` over order[lo..hi), its nodes numbered from
+ * `next` on, depth first, the right child's subtree before the left's
+ * (the order of the explicit stack). */
+static void build_serial(build_ctx *c, size_t node, size_t lo, size_t hi,
+                         size_t next)
 {
     /* Explicit stack of (node, lo, hi) to stay off the call stack. */
     size_t stack[STACK_DEPTH][3];
@@ -132,8 +140,8 @@ static void build(build_ctx *c, size_t node, size_t lo, size_t hi)
                 axis = k;
         size_t mid = a + (b - a) / 2;
         select_median(c, a, b, mid, axis);
-        size_t left = c->nnodes;
-        c->nnodes += 2;
+        size_t left = next;
+        next += 2;
         n->start = (uint32_t)left;
         n->count = 0;
         stack[sp][0] = left;
@@ -145,6 +153,87 @@ static void build(build_ctx *c, size_t node, size_t lo, size_t hi)
         stack[sp][2] = b;
         sp++;
     }
+}
+
+/* Leaves of a subtree over n triangles, as the pair (L(n), L(n + 1)): the
+ * median split makes the tree's shape a function of n alone (halves
+ * floor(n/2) and ceil(n/2)), and the pair recursion costs log n. */
+static void leaves_pair(size_t n, size_t *ln, size_t *ln1)
+{
+    if (n + 1 <= ST_BVH_LEAF) {
+        *ln = *ln1 = 1;
+        return;
+    }
+    size_t a, b;
+    leaves_pair(n / 2, &a, &b);   /* L(n/2), L(n/2 + 1) */
+    if (n % 2 == 0) {
+        *ln = n <= ST_BVH_LEAF ? 1 : 2 * a;
+        *ln1 = a + b;
+    } else {
+        *ln = n <= ST_BVH_LEAF ? 1 : a + b;
+        *ln1 = 2 * b;
+    }
+}
+
+/* Nodes below the root of a subtree over n triangles. */
+static size_t subtree_nodes(size_t n)
+{
+    size_t l, l1;
+    leaves_pair(n, &l, &l1);
+    return 2 * (l - 1);
+}
+
+/* Subtrees this large are built as tasks of their own. */
+#define PARALLEL_MIN 32768
+
+/* build_serial's tree, node for node, with the two halves of large
+ * subtrees built in parallel: each child's numbering starts where the
+ * serial walk would start it (the right subtree first: its children from
+ * next + 2, the left's after the right's nodes), so the layout, and every
+ * query's answer and order, do not depend on the threads. */
+static void build_parallel(build_ctx *c, size_t node, size_t lo, size_t hi,
+                           size_t next)
+{
+    if (hi - lo < PARALLEL_MIN) {
+        build_serial(c, node, lo, hi, next);
+        return;
+    }
+    st_bvh_node *n = &c->nodes[node];
+    double clo[3] = {INFINITY, INFINITY, INFINITY};
+    double chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int k = 0; k < 3; k++) {
+        n->lo[k] = INFINITY;
+        n->hi[k] = -INFINITY;
+    }
+    for (size_t i = lo; i < hi; i++) {
+        const double *tb = c->box + 6 * (size_t)c->order[i];
+        const double *ce = c->cent + 3 * (size_t)c->order[i];
+        for (int k = 0; k < 3; k++) {
+            if (tb[k] < n->lo[k])
+                n->lo[k] = tb[k];
+            if (tb[3 + k] > n->hi[k])
+                n->hi[k] = tb[3 + k];
+            if (ce[k] < clo[k])
+                clo[k] = ce[k];
+            if (ce[k] > chi[k])
+                chi[k] = ce[k];
+        }
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; k++)
+        if (chi[k] - clo[k] > chi[axis] - clo[axis])
+            axis = k;
+    size_t mid = lo + (hi - lo) / 2;
+    select_median(c, lo, hi, mid, axis);
+    size_t left = next;
+    n->start = (uint32_t)left;
+    n->count = 0;
+    size_t right_next = left + 2;
+    size_t left_next = right_next + subtree_nodes(hi - mid);
+    #pragma omp task default(none) firstprivate(c, left, mid, hi, right_next)
+    build_parallel(c, left + 1, mid, hi, right_next);
+    build_parallel(c, left, lo, mid, left_next);
+    #pragma omp taskwait
 }
 
 st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
@@ -174,6 +263,7 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
                             "out of memory for a BVH over %zu triangles",
                             s->ntris);
     }
+    #pragma omp parallel for schedule(static) if (s->ntris >= PARALLEL_MIN)
     for (size_t t = 0; t < s->ntris; t++) {
         c.order[t] = (uint32_t)t;
         for (int a = 0; a < 3; a++) {
@@ -184,8 +274,15 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
         }
         tri_box(s, (uint32_t)t, c.box + 6 * t, c.box + 6 * t + 3);
     }
-    c.nnodes = 1;
-    build(&c, 0, 0, s->ntris);
+    c.nnodes = 1 + subtree_nodes(s->ntris);
+    if (s->ntris < PARALLEL_MIN)
+        build_serial(&c, 0, 0, s->ntris, 1);
+    else {
+        #pragma omp parallel
+        #pragma omp single
+        build_parallel(&c, 0, 0, s->ntris, 1);
+    }
+    #pragma omp parallel for schedule(static) if (s->ntris >= PARALLEL_MIN)
     for (size_t i = 0; i < s->ntris; i++)
         memcpy(tbox + 6 * i, c.box + 6 * (size_t)c.order[i], 6 * sizeof(double));
     free(c.cent);

@@ -314,17 +314,62 @@ typedef struct cand {
     uint32_t slot;     /* where its setup is cached, or UINT32_MAX */
 } cand;
 
-static int cand_cmp(const void *a, const void *b)
+/* The sort key of a candidate: (key, tri) is a total order (a triangle is
+ * binned into a brick once), so any correct sort gives the same order. */
+typedef struct cand_key {
+    double key;
+    uint32_t tri;
+    uint32_t at;       /* its position before the sort */
+} cand_key;
+
+static inline int cand_key_less(const cand_key *x, const cand_key *y)
 {
-    const cand *x = a, *y = b;
-    if (x->key != y->key)
-        return x->key < y->key ? -1 : 1;
-    return x->tri < y->tri ? -1 : (x->tri > y->tri);
+    return x->key < y->key || (x->key == y->key && x->tri < y->tri);
+}
+
+/* Sort k[0..m) by (key, tri) with tmp[0..m) as scratch: insertion sort of
+ * runs of 16, then bottom-up merges. qsort's indirect comparisons on the
+ * 48-byte candidates cost more than the distances of a dense brick; this
+ * sorts 16-byte keys with the comparison inlined, to the same order. */
+static void sort_cand_keys(cand_key *k, cand_key *tmp, size_t m)
+{
+    enum { RUN = 16 };
+    for (size_t a = 0; a < m; a += RUN) {
+        size_t b = a + RUN < m ? a + RUN : m;
+        for (size_t i = a + 1; i < b; i++) {
+            cand_key x = k[i];
+            size_t j = i;
+            while (j > a && cand_key_less(&x, &k[j - 1])) {
+                k[j] = k[j - 1];
+                j--;
+            }
+            k[j] = x;
+        }
+    }
+    cand_key *src = k, *dst = tmp;
+    for (size_t w = RUN; w < m; w *= 2) {
+        for (size_t a = 0; a < m; a += 2 * w) {
+            size_t mid = a + w < m ? a + w : m, b = a + 2 * w < m ? a + 2 * w : m;
+            size_t i = a, j = mid, o = a;
+            while (i < mid && j < b)
+                dst[o++] = cand_key_less(&src[j], &src[i]) ? src[j++] : src[i++];
+            while (i < mid)
+                dst[o++] = src[i++];
+            while (j < b)
+                dst[o++] = src[j++];
+        }
+        cand_key *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != k)
+        memcpy(k, src, m * sizeof *k);
 }
 
 typedef struct brick_scratch {
     cand *cands;
     tri_setup *setups;
+    cand_key *keys;    /* 2 * cap: the keys and the merge's scratch */
     size_t cap;
 } brick_scratch;
 
@@ -341,6 +386,10 @@ static int scratch_reserve(brick_scratch *sc, size_t m)
     if (!t)
         return -1;
     sc->setups = t;
+    cand_key *k = st_realloc_array(sc->keys, 2 * cap, sizeof *k);
+    if (!k)
+        return -1;
+    sc->keys = k;
     sc->cap = cap;
     return 0;
 }
@@ -376,17 +425,23 @@ static void process_brick(st_grid *g, int32_t *near, const st_soup *s,
     double bc[3];
     brick_center(g, b, bc);
     cand *cs = sc->cands;
+    cand_key *keys = sc->keys;
     for (size_t q = 0; q < m; q++) {
         const tri_ball *tb = &balls[list[q]];
         double w[3];
         st_sub3(w, bc, tb->c);
         /* From the brick's center; a voxel subtracts its own offset. */
-        cs[q].key = sqrt(st_dot3(w, w)) - tb->r;
-        cs[q].ball = *tb;
-        cs[q].tri = list[q];
+        keys[q].key = sqrt(st_dot3(w, w)) - tb->r;
+        keys[q].tri = list[q];
+        keys[q].at = (uint32_t)q;
+    }
+    sort_cand_keys(keys, keys + m, m);
+    for (size_t q = 0; q < m; q++) {
+        cs[q].key = keys[q].key;
+        cs[q].ball = balls[list[keys[q].at]];
+        cs[q].tri = keys[q].tri;
         cs[q].slot = UINT32_MAX;
     }
-    qsort(cs, m, sizeof *cs, cand_cmp);
     uint32_t nsetup = 0;
     double p[3];
     for (size_t k = lo[2]; k < hi[2]; k++) {
@@ -496,7 +551,7 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
     size_t done = 0;
     #pragma omp parallel
     {
-        brick_scratch sc = {NULL, NULL, 0};
+        brick_scratch sc = {NULL, NULL, NULL, 0};
         #pragma omp for schedule(dynamic, 16)
         for (size_t b = 0; b < nb; b++) {
             size_t m = start[b + 1] - start[b];
@@ -518,6 +573,7 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
         }
         free(sc.cands);
         free(sc.setups);
+        free(sc.keys);
     }
     free(list);
     free(start);

@@ -330,3 +330,18 @@ out:
     st_bvh_free(own);
     return rc;
 }
+
+/* st_enclosure_count (enclose.h): the counts of st_enclosure_compute. */
+st_status st_enclosure_count(const st_tetmesh *m, const st_soup *s,
+                             const st_bvh *bvh, size_t *verts_outside,
+                             size_t *tris_crossing, st_error *err)
+{
+    st_enclosure e;
+    st_status rc = st_enclosure_compute(&e, m, s, bvh, NULL, NULL, err);
+    /* On error SIZE_MAX, which no caller can read as "encloses". */
+    if (verts_outside)
+        *verts_outside = rc ? SIZE_MAX : e.vertices_outside;
+    if (tris_crossing)
+        *tris_crossing = rc ? SIZE_MAX : e.crossing_triangles;
+    return rc;
+}

@@ -32,7 +32,7 @@
  *   5. What the back-offs cost in volume is corrected by further rescale
  *      passes until within FAIR_VOLUME_AIM.
  *
- * After the last step, st_fit's quality pass (fit.c) runs on the interior
+ * After the last step, st_fit's quality pass (quality.c) runs on the interior
  * vertices, which raises the worst angles without touching the volume.
  * Every move, in every phase, keeps its star positive (exact) and may not
  * bring its star's score below p.min_angle (or below what it already was).

@@ -1,6 +1,7 @@
 /*
  * fit.c - enclosing vertex adjustment of a tet mesh to a surface (st_fit,
- * smooth.h), and the exact enclosure count (st_enclosure_count).
+ * smooth.h) and its invariant (smooth_internal.h), which the quality pass
+ * (quality.c) keeps too.
  *
  * Stuart, Levine, Jones, Bargteil 2013 ("Cetra"), section 3.3. Each
  * iteration moves every vertex x by tau * (x* - x), x* the volume-weighted
@@ -27,26 +28,32 @@
  * nothing, when FIT_STALL_ITERS iterations bring no new vertex into the
  * band, or after max_iters.
  *
+ * Rescue (past the paper). The vertices still beyond d_offset when the
+ * iterations stop are held: every step toward their nearest point of S,
+ * down to 1/16, would let an S vertex out of the star or a boundary face
+ * into S (a thin gap, a sharp crease). A step in another direction that
+ * still brings the vertex closer to S often passes: it slides past what
+ * holds it. rescue_vertex tries directions up to 88 degrees off the way
+ * to S at fractions of the way to the band's middle, closest to S first,
+ * under the same invariant and a star score floor (RESCUE_FLOOR, the
+ * quality pass raises it after); rounds repeat while a vertex moves. It
+ * runs after the iterations, and after the quality pass (whose moves
+ * change the held vertices' stars) again, followed by another quality
+ * pass, at most FIT_LATE_RESCUES times (4 rather than 2, 12 azimuths
+ * rather than 8 and a last fraction of 1/128: rotor 1 -> 0 beyond 0.4 h,
+ * boeing and fandisk-noise 1 -> 0 beyond 0.25 h). Measured (--tries 1, cells 10):
+ * beyond 0.4 h before -> after on fandisk 5 -> 0, armadillo 12 -> 0,
+ * cheese 49 -> 0, bunny-soup 1 -> 0, elephant-with-holes 12 -> 0; at
+ * 0.25 h fandisk, bunny-soup, elephant-with-holes, joint all reach 0.
+ * Retrying the fit iterations between rescues did little (0.25 h: 10 ->
+ * 10 beyond over four models) at twice the time, so it does not.
+ *
  * Not checked: that the boundary does not fold onto another part of the
  * mesh far from the moved star (a global self-intersection); small steps
  * and positive stars make it unlikely, tetstat would show it as overlap.
  *
- * The quality pass (past the paper) then works on the vertices of the
- * tets whose score min(min dihedral, 0.75 (180 - max dihedral)) is below
- * the goal: for each, a handful of candidate positions (toward its ODT
- * target, toward its neighbours' centroid, line searches along the
- * gradient of its worst tet's score and along the summed unit gradients of
- * the tets within QUAL_ACTIVE of the worst, small steps along the axes),
- * best first; the first that raises the lowest score of the star and keeps
- * the invariant (and, for a boundary vertex, keeps it within
- * max(d_offset, its distance) of S) is taken. A boundary vertex at the
- * band's edge, or past it where a thin gap held it back, can take no step
- * with an outward component, and those are most of the gradient steps: on
- * the armadillo the worst tets (21.7 degrees) all had such vertices, every
- * candidate refused by the distance rule. So a boundary vertex also
- * searches the same gradients projected onto the tangent plane of S's
- * distance (and a little inward of it). Rounds repeat until no tet scores
- * below the goal or nothing moves.
+ * The quality pass (quality.c) then raises the worst dihedral angles under
+ * the same invariant.
  *
  * Cost. Most trial moves of a boundary vertex fail because an S vertex of
  * its star would leave it (on the armadillo, 38K of 46K checks), and a
@@ -99,25 +106,6 @@
  * the band leaves room for the ODT motion and the quality pass without
  * leaving it. */
 #define FIT_GOAL_FRACTION 0.5
-/* Quality pass: the smallest score gain (degrees) worth a move, so rounds
- * end instead of trading rounding noise. */
-#define QUAL_MIN_GAIN 1e-3
-/* Line search steps along the score gradient, in units of h. */
-static const double qual_steps[] = {0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625};
-#define QUAL_NSTEPS (sizeof qual_steps / sizeof qual_steps[0])
-/* Tangential candidates of a boundary vertex: inward components, as a
- * fraction of the step (0: in the tangent plane; 0.25: a quarter inward,
- * which keeps the distance from growing where S curves away by up to
- * about 14 degrees over the step). */
-static const double qual_inward[] = {0.0, 0.25};
-#define QUAL_NTANGENT 2
-/* Tets within this many degrees of the worst one steer the combined
- * gradient direction. */
-#define QUAL_ACTIVE 2.0
-/* The axis-direction candidates' step, in units of h. */
-#define QUAL_AXIS_STEP 0.03
-/* Central-difference step for the score gradient, in units of h. */
-#define QUAL_GRAD_EPS 1e-4
 
 st_fit_params st_fit_params_default(void)
 {
@@ -135,14 +123,6 @@ st_fit_params st_fit_params_default(void)
 
 /* ---- the vertices of S in bins -------------------------------------- */
 
-typedef struct pgrid {
-    double *pts;          /* distinct vertices of S, 3 each */
-    size_t npts;
-    double lo[3], cell;
-    size_t n[3];
-    size_t *off;          /* bin -> points (CSR) */
-    uint32_t *idx;
-} pgrid;
 
 static int cmp_pt(const void *a, const void *b)
 {
@@ -248,34 +228,9 @@ static st_status pgrid_build(pgrid *g, const st_soup *s, double cell)
 
 /* ---- the invariant -------------------------------------------------- */
 
-typedef struct fit_ctx {
-    sm_mesh sm;
-    const st_soup *s;
-    const st_bvh *bvh;
-    pgrid pg;
-    double *dpos;        /* per vertex: where its distance in dist[] was
-                            taken (3 each; NaN: not yet) */
-    uint32_t *blocker;   /* per vertex: the S vertex that last stopped its
-                            move (a point grid index), or UINT32_MAX */
-    double h, d_offset;
-    int full_check;   /* non-conforming faces: test S vertices everywhere */
-    int fair_boundary;   /* no S (after fairing): boundary vertices move in
-                            their tangent plane only (sm_quality_fair) */
-} fit_ctx;
 
-/* Which vertices can be skipped: a vertex move is a deterministic function
- * of the vertex's position and its neighbours' (its star), so a vertex
- * that was tried and did not move, with nothing in its star moved since,
- * would not move again; skipping it changes no result. Steps count colour
- * sets; a vertex and its neighbours never share a colour, so during a
- * colour step no vertex reads a stamp being written. */
-typedef struct dirty {
-    uint32_t *moved_at;   /* step of the last move (0: never) */
-    uint32_t *tried_at;   /* step of the last attempt that did not move */
-    uint32_t step;
-} dirty;
 
-static int dirty_init(dirty *d, size_t nv)
+int sm_dirty_init(dirty *d, size_t nv)
 {
     d->step = 0;
     d->moved_at = st_calloc_array(nv ? nv : 1, sizeof *d->moved_at);
@@ -283,7 +238,7 @@ static int dirty_init(dirty *d, size_t nv)
     return d->moved_at && d->tried_at ? 0 : -1;
 }
 
-static void dirty_free(dirty *d)
+void sm_dirty_free(dirty *d)
 {
     free(d->moved_at);
     free(d->tried_at);
@@ -291,7 +246,7 @@ static void dirty_free(dirty *d)
 }
 
 /* 1 when an attempt to move v would repeat one that did not move. */
-static int dirty_unchanged(const dirty *d, const sm_mesh *sm, uint32_t v)
+int sm_dirty_unchanged(const dirty *d, const sm_mesh *sm, uint32_t v)
 {
     uint32_t t = d->tried_at[v];
     if (t == 0 || d->moved_at[v] >= t)
@@ -302,7 +257,7 @@ static int dirty_unchanged(const dirty *d, const sm_mesh *sm, uint32_t v)
     return 1;
 }
 
-static void dirty_mark(dirty *d, uint32_t v, int moved)
+void sm_dirty_mark(dirty *d, uint32_t v, int moved)
 {
     if (moved)
         d->moved_at[v] = d->step;
@@ -356,11 +311,56 @@ static ptrdiff_t in_star(const sm_mesh *sm, uint32_t v, const double p[3],
     return -1;
 }
 
-/* An S vertex in a star and the star tet that held it. */
-typedef struct star_pt {
-    uint32_t pt;     /* index into the point grid */
-    uint32_t tet;    /* index from vt_off[v] */
-} star_pt;
+/* in_star_tet for a star known to be positive with v at p (every tet's
+ * orient3d < 0, as sm_star_positive checks, which move_ok does first):
+ * st_point_in_tet's face tests, in its order, without its orientation
+ * test, and with skip_opposite without the face opposite v, which the
+ * caller knows q is on the closed inner side of (q was in the same closed
+ * tet with v elsewhere, and that tet was positive: the face does not move).
+ * Same answer as in_star_tet, two orient3d calls fewer of five. */
+static int in_pos_star_tet(const sm_mesh *sm, uint32_t v, size_t j, const double p[3],
+                           const double q[3], int skip_opposite)
+{
+    const uint32_t *c = sm->m->tets + 4 * (size_t)sm->vt[sm->vt_off[v] + j];
+    const double *t[4];
+    int kv = -1;
+    for (int k = 0; k < 4; k++) {
+        t[k] = c[k] == v ? p : sm->m->xyz + 3 * (size_t)c[k];
+        if (c[k] == v)
+            kv = k;
+    }
+    for (int a = 0; a < 3; a++)
+        if ((q[a] < t[0][a] && q[a] < t[1][a] && q[a] < t[2][a] && q[a] < t[3][a]) ||
+            (q[a] > t[0][a] && q[a] > t[1][a] && q[a] > t[2][a] && q[a] > t[3][a]))
+            return 0;
+    /* the faces opposite corners 0..3, ordered as isect.c's tet_faces so
+     * that each orient3d is the tet's with that corner replaced by q */
+    const double *F[4][3] = {{t[2], t[1], t[3]}, {t[0], t[2], t[3]},
+                             {t[1], t[0], t[3]}, {t[0], t[1], t[2]}};
+    for (int i = 0; i < 4; i++) {
+        if (skip_opposite && i == kv)
+            continue;
+        if (st_orient3d(F[i][0], F[i][1], F[i][2], q) > 0)
+            return 0;
+    }
+    return 1;
+}
+
+/* in_star for a star that is positive with v at p (see in_pos_star_tet);
+ * with hint_opposite, q is known to be inside the hint tet's face opposite
+ * v. Returns the same tet as in_star. */
+static ptrdiff_t in_pos_star(const sm_mesh *sm, uint32_t v, const double p[3],
+                             const double q[3], ptrdiff_t hint, int hint_opposite)
+{
+    size_t n = sm->vt_off[v + 1] - sm->vt_off[v];
+    if (hint >= 0 && (size_t)hint < n &&
+        in_pos_star_tet(sm, v, (size_t)hint, p, q, hint_opposite))
+        return hint;
+    for (size_t j = 0; j < n; j++)
+        if ((ptrdiff_t)j != hint && in_pos_star_tet(sm, v, j, p, q, 0))
+            return (ptrdiff_t)j;
+    return -1;
+}
 
 /* The S vertices in the closed star of v as it is, appended to *list.
  * Returns 0, or -1 out of memory. */
@@ -380,6 +380,28 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
         a0[a] = pgrid_coord(g, lo[a], a);
         a1[a] = pgrid_coord(g, hi[a], a);
     }
+    /* The star tets' boxes, once for all the points: in_star's test order
+     * and answers, without recomputing a tet's box for every point (the
+     * box rejects most (point, tet) pairs; issue 23: this scan was the
+     * largest part of the fit on dragon_res3, 9 million tet tests). */
+    enum { BOXED_MAX = 96 };
+    double tbox[BOXED_MAX][6];
+    const size_t nst = sm->vt_off[v + 1] - sm->vt_off[v];
+    const int boxed = nst <= BOXED_MAX;
+    for (size_t j = 0; boxed && j < nst; j++) {
+        const uint32_t *tc = sm->m->tets + 4 * (size_t)sm->vt[sm->vt_off[v] + j];
+        for (int a = 0; a < 3; a++) {
+            tbox[j][a] = INFINITY;
+            tbox[j][3 + a] = -INFINITY;
+        }
+        for (int k = 0; k < 4; k++) {
+            const double *y = sm->m->xyz + 3 * (size_t)tc[k];
+            for (int a = 0; a < 3; a++) {
+                tbox[j][a] = y[a] < tbox[j][a] ? y[a] : tbox[j][a];
+                tbox[j][3 + a] = y[a] > tbox[j][3 + a] ? y[a] : tbox[j][3 + a];
+            }
+        }
+    }
     ptrdiff_t hint = -1;   /* neighbouring points tend to share a tet */
     for (size_t iz = a0[2]; iz <= a1[2]; iz++)
         for (size_t iy = a0[1]; iy <= a1[1]; iy++)
@@ -390,7 +412,25 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
                     if (q[0] < lo[0] || q[0] > hi[0] || q[1] < lo[1] || q[1] > hi[1] ||
                         q[2] < lo[2] || q[2] > hi[2])
                         continue;
-                    ptrdiff_t t = in_star(sm, v, x, q, hint);
+                    ptrdiff_t t = -1;
+                    if (!boxed)
+                        t = in_star(sm, v, x, q, hint);
+                    else
+                        for (size_t r = 0; r <= nst; r++) {
+                            /* hint first, then the others in order */
+                            size_t u = r == 0 ? (size_t)hint : r - 1;
+                            if ((r == 0 && (hint < 0 || (size_t)hint >= nst)) ||
+                                (r > 0 && (ptrdiff_t)u == hint))
+                                continue;
+                            const double *bx = tbox[u];
+                            if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] ||
+                                q[0] > bx[3] || q[1] > bx[4] || q[2] > bx[5])
+                                continue;
+                            if (in_star_tet(sm, v, u, x, q)) {
+                                t = (ptrdiff_t)u;
+                                break;
+                            }
+                        }
                     if (t < 0)
                         continue;
                     hint = t;
@@ -411,13 +451,18 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
 }
 
 /* Every listed S vertex lies in the closed star of v with v at p; when
- * one does not, *failed says which (a point grid index). */
+ * one does not, *failed says which (a point grid index). The star with v
+ * at p must be positive (move_ok tests that first); was_positive: it was
+ * positive where the list was gathered, so each point is inside its tet's
+ * face opposite v (issue 23: this loop is most of the fit's time on large
+ * soups, a few thousand points per star on the dragon). */
 static int svertices_kept(const fit_ctx *c, uint32_t v, const double p[3],
-                          const star_pt *list, size_t n, uint32_t *failed)
+                          const star_pt *list, size_t n, int was_positive,
+                          uint32_t *failed)
 {
     for (size_t i = 0; i < n; i++)
-        if (in_star(&c->sm, v, p, c->pg.pts + 3 * (size_t)list[i].pt,
-                    (ptrdiff_t)list[i].tet) < 0) {
+        if (in_pos_star(&c->sm, v, p, c->pg.pts + 3 * (size_t)list[i].pt,
+                        (ptrdiff_t)list[i].tet, was_positive) < 0) {
             *failed = list[i].pt;
             return 0;
         }
@@ -464,14 +509,6 @@ static int faces_clear(const fit_ctx *c, uint32_t v, const double p[3])
     return 1;
 }
 
-/* The scratch list of S vertices in a star (one per thread and call). */
-typedef struct star_pts {
-    star_pt *list;
-    size_t n, cap;
-    int ok;          /* 0: out of memory, refuse every move */
-    int have;        /* 1: list holds the star of v as it is */
-    uint32_t v;
-} star_pts;
 
 /* Collect the S vertices v's star holds now. Only a boundary vertex (or
  * any vertex of a non-conforming mesh) needs them: the faces of an
@@ -484,13 +521,17 @@ static void star_pts_fill(const fit_ctx *c, star_pts *sp)
     sp->n = 0;
     sp->ok = 1;
     sp->have = 1;
-    if (c->s && (c->sm.onb[sp->v] || c->full_check))
+    sp->positive = 0;
+    if (c->s && (c->sm.onb[sp->v] || c->full_check)) {
         sp->ok = svertices_in_star(c, sp->v, &sp->list, &sp->n, &sp->cap) == 0;
+        sp->positive = sp->n > 0 &&
+                       sm_star_positive(&c->sm, sp->v, c->sm.m->xyz + 3 * (size_t)sp->v);
+    }
 }
 
 /* Start the moves of v: the list is filled when a move first needs it
  * (most trial positions fail the cheaper tests). */
-static void star_pts_collect(const fit_ctx *c, uint32_t v, star_pts *sp)
+void sm_star_pts_collect(const fit_ctx *c, uint32_t v, star_pts *sp)
 {
     (void)c;
     sp->have = 0;
@@ -498,7 +539,7 @@ static void star_pts_collect(const fit_ctx *c, uint32_t v, star_pts *sp)
 }
 
 /* The whole invariant for moving v to p, cheapest test first. */
-static int move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
+int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
 {
     if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])))
         return 0;
@@ -519,7 +560,7 @@ static int move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp
     if (!sp->ok)
         return 0;
     uint32_t failed;
-    if (!svertices_kept(c, v, p, sp->list, sp->n, &failed)) {
+    if (!svertices_kept(c, v, p, sp->list, sp->n, sp->positive, &failed)) {
         if (c->blocker)
             c->blocker[v] = failed;   /* v's own slot: v's colour writes it */
         return 0;
@@ -529,7 +570,7 @@ static int move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp
     return 1;
 }
 
-static double dist_to_s(const fit_ctx *c, const double p[3], double closest[3])
+double sm_dist_to_s(const fit_ctx *c, const double p[3], double closest[3])
 {
     int64_t tri;
     double q[3];
@@ -539,9 +580,6 @@ static double dist_to_s(const fit_ctx *c, const double p[3], double closest[3])
 
 /* ---- fit iterations --------------------------------------------------- */
 
-typedef struct fit_counts {
-    size_t moved, rejected, skipped;
-} fit_counts;
 
 static int fit_vertex(const fit_ctx *c, uint32_t v, double tau, const double *dist,
                       star_pts *sp, fit_counts *n)
@@ -554,7 +592,7 @@ static int fit_vertex(const fit_ctx *c, uint32_t v, double tau, const double *di
         d[a] = tau * (t[a] - x[a]);
     if (sm->onb[v] && dist[v] > c->d_offset) {
         double cp[3];
-        double dd = dist_to_s(c, x, cp);
+        double dd = sm_dist_to_s(c, x, cp);
         if (dd > 0.0) {
             double goal = FIT_GOAL_FRACTION * c->d_offset;
             for (int a = 0; a < 3; a++) {
@@ -565,12 +603,12 @@ static int fit_vertex(const fit_ctx *c, uint32_t v, double tau, const double *di
     }
     if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
         return 0;
-    star_pts_collect(c, v, sp);
+    sm_star_pts_collect(c, v, sp);
     double floor_score = fmin(FIT_SLIVER_FLOOR, sm_star_score(sm, v, x));
     double f = 1.0;
     for (int k = 0; k <= FIT_HALVINGS; k++, f *= 0.5) {
         double p[3] = {x[0] + f * d[0], x[1] + f * d[1], x[2] + f * d[2]};
-        if (sm_star_score(sm, v, p) >= floor_score && move_ok(c, v, p, sp)) {
+        if (sm_star_score(sm, v, p) >= floor_score && sm_move_ok(c, v, p, sp)) {
             memcpy(x, p, sizeof p);
             n->moved++;
             return 1;
@@ -581,12 +619,8 @@ static int fit_vertex(const fit_ctx *c, uint32_t v, double tau, const double *di
     return 0;
 }
 
-typedef struct dist_summary {
-    size_t within;
-    double max, mean;
-} dist_summary;
 
-static dist_summary boundary_distances(const fit_ctx *c, double *dist)
+dist_summary sm_boundary_distances(const fit_ctx *c, double *dist)
 {
     const sm_mesh *sm = &c->sm;
     size_t within = 0;
@@ -609,9 +643,9 @@ static dist_summary boundary_distances(const fit_ctx *c, double *dist)
             double r = (dist[v] + mv) * (1.0 + 1e-9) + 1e-9 * c->h;
             int64_t tri;
             double d2 = st_bvh_nearest(c->bvh, x, r * r, &tri, NULL);
-            dist[v] = tri >= 0 ? sqrt(d2) : dist_to_s(c, x, NULL);
+            dist[v] = tri >= 0 ? sqrt(d2) : sm_dist_to_s(c, x, NULL);
         } else {
-            dist[v] = dist_to_s(c, x, NULL);
+            dist[v] = sm_dist_to_s(c, x, NULL);
         }
         if (o)
             memcpy(o, x, 3 * sizeof *o);
@@ -630,7 +664,7 @@ static dist_summary boundary_distances(const fit_ctx *c, double *dist)
     return r;
 }
 
-static void report(const st_fit_params *p, const fit_ctx *c, const char *phase,
+void sm_fit_report(const st_fit_params *p, const fit_ctx *c, const char *phase,
                    int iter, const dist_summary *ds, const fit_counts *n, double t0)
 {
     if (!p->on_iter)
@@ -649,279 +683,120 @@ static void report(const st_fit_params *p, const fit_ctx *c, const char *phase,
     p->on_iter(p->on_iter_ctx, &it);
 }
 
-/* ---- quality pass ----------------------------------------------------- */
 
-static int cmp_cand(const void *a, const void *b)
+/* ---- rescue: the vertices the fit left beyond the band --------------- */
+
+/* Directions tried around the way to S (degrees off it) and azimuths. */
+static const double rescue_tilt[] = {0.0, 30.0, 55.0, 75.0, 88.0};
+#define RESCUE_AZIMUTHS 12
+/* Step fractions of the way to the band's middle. */
+static const double rescue_frac[] = {1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125, 0.0078125};
+#define RESCUE_NTILT (sizeof rescue_tilt / sizeof rescue_tilt[0])
+#define RESCUE_NFRAC (sizeof rescue_frac / sizeof rescue_frac[0])
+#define RESCUE_NCAND (((RESCUE_NTILT - 1) * RESCUE_AZIMUTHS + 1) * RESCUE_NFRAC)
+/* Rescue and quality passes again after the quality pass, at most. */
+#define FIT_LATE_RESCUES 4
+/* Rounds over the vertices still beyond the band. */
+#define RESCUE_ROUNDS 40
+/* A rescue move may not bring its star's score below this (degrees), or
+ * below what it was if lower; the quality pass raises it after. */
+#define RESCUE_FLOOR 25.0
+
+static int cmp_rescue(const void *a, const void *b)
 {
-    const double *x = a, *y = b;   /* {score, px, py, pz, order} */
+    const double *x = a, *y = b;   /* {distance, px, py, pz, order} */
     if (x[0] != y[0])
-        return x[0] > y[0] ? -1 : 1;
+        return x[0] < y[0] ? -1 : 1;
     return (x[4] > y[4]) - (x[4] < y[4]);
 }
 
-/* Try to raise the lowest score of v's star; 1 when v moved. */
-/* The sum of the area-weighted outward normals of v's boundary faces. */
-static void fair_normal(const sm_mesh *sm, uint32_t v, double n[3])
-{
-    n[0] = n[1] = n[2] = 0.0;
-    for (size_t j = sm->vf_off[v]; j < sm->vf_off[v + 1]; j++) {
-        const uint32_t *f = sm->bf + 3 * (size_t)sm->vf[j];
-        const double *a = sm->m->xyz + 3 * (size_t)f[0];
-        const double *b = sm->m->xyz + 3 * (size_t)f[1];
-        const double *d = sm->m->xyz + 3 * (size_t)f[2];
-        double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-        double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-        n[0] += u[1] * w[2] - u[2] * w[1];
-        n[1] += u[2] * w[0] - u[0] * w[2];
-        n[2] += u[0] * w[1] - u[1] * w[0];
-    }
-    double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (l > 0.0 && isfinite(l))
-        for (int a = 0; a < 3; a++)
-            n[a] /= l;
-    else
-        n[0] = n[1] = n[2] = 0.0;
-}
-
-static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *rejected)
+/* A boundary vertex v beyond d_offset whose ODT-plus-pull step the
+ * invariant refused is held by S near its star; a step along another
+ * direction that still brings it closer to S often passes (it slides past
+ * what holds it). Candidates: the directions within 88 degrees of the way
+ * to S's nearest point, at fractions of the way to the band's middle; the
+ * closest to S first, the first that keeps the invariant and the star's
+ * score floor is taken. 1 when v moved. */
+static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
 {
     const sm_mesh *sm = &c->sm;
-    /* no surface (after fairing): the boundary stays, or with
-     * fair_boundary moves only within its tangent plane */
-    const int tangent_only = !c->s && sm->onb[v];
-    if (tangent_only && !c->fair_boundary)
-        return 0;
     double *x = sm->m->xyz + 3 * (size_t)v;
-    double s0 = sm_star_score(sm, v, x);
-    /* candidates: {score, x, y, z, order} */
-    double cand[5 + 2 * QUAL_NSTEPS + 6 + 2 * QUAL_NTANGENT * QUAL_NSTEPS][5];
-    int nc = 0;
-    double t[3];
-    sm_odt_target(sm, v, t);
-    static const double fr[] = {1.0, 0.5, 0.25};
-    for (int k = 0; k < 3; k++, nc++)
-        for (int a = 0; a < 3; a++)
-            cand[nc][1 + a] = x[a] + fr[k] * (t[a] - x[a]);
-    double cen[3] = {0, 0, 0};
-    size_t deg = sm->vv_off[v + 1] - sm->vv_off[v];
-    for (size_t j = sm->vv_off[v]; j < sm->vv_off[v + 1]; j++)
-        for (int a = 0; a < 3; a++)
-            cen[a] += sm->m->xyz[3 * (size_t)sm->vv[j] + (size_t)a] / (double)deg;
-    for (int k = 0; k < 2; k++, nc++)
-        for (int a = 0; a < 3; a++)
-            cand[nc][1 + a] = x[a] + fr[k] * (cen[a] - x[a]);
-    /* gradients (central differences) of the worst tet's score, and the
-     * sum of the unit gradients of every tet within QUAL_ACTIVE degrees of
-     * it (so that raising the worst does not just lower the next one) */
-    double ws = sm_star_score(sm, v, x);
-    double gw[3] = {0, 0, 0}, ga[3] = {0, 0, 0}, e = QUAL_GRAD_EPS * c->h, best = INFINITY;
-    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
-        const uint32_t *k = sm->m->tets + 4 * (size_t)sm->vt[j];
-        const double *q[4];
-        for (int i = 0; i < 4; i++)
-            q[i] = sm->m->xyz + 3 * (size_t)k[i];
-        double sc = sm_tet_score(q[0], q[1], q[2], q[3]);
-        if (sc > ws + QUAL_ACTIVE)
-            continue;
-        double g[3];
-        for (int a = 0; a < 3; a++) {
-            double pp[3], pm[3];
-            memcpy(pp, x, sizeof pp);
-            memcpy(pm, x, sizeof pm);
-            pp[a] += e;
-            pm[a] -= e;
-            const double *qp[4], *qm[4];
-            for (int i = 0; i < 4; i++) {
-                qp[i] = k[i] == v ? pp : q[i];
-                qm[i] = k[i] == v ? pm : q[i];
-            }
-            g[a] = sm_tet_score(qp[0], qp[1], qp[2], qp[3]) -
-                   sm_tet_score(qm[0], qm[1], qm[2], qm[3]);
-        }
-        double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-        if (!(gl > 0.0) || !isfinite(gl))
-            continue;
-        for (int a = 0; a < 3; a++)
-            ga[a] += g[a] / gl;
-        if (sc < best) {
-            best = sc;
+    double cp[3];
+    double dd = sm_dist_to_s(c, x, cp);
+    if (!(dd > c->d_offset))
+        return 0;
+    double n[3], t1[3], t2[3];
+    for (int a = 0; a < 3; a++)
+        n[a] = (cp[a] - x[a]) / dd;   /* toward S */
+    int k = fabs(n[0]) < 0.6 ? 0 : (fabs(n[1]) < 0.6 ? 1 : 2);
+    double e[3] = {0, 0, 0};
+    e[k] = 1.0;
+    t1[0] = n[1] * e[2] - n[2] * e[1];
+    t1[1] = n[2] * e[0] - n[0] * e[2];
+    t1[2] = n[0] * e[1] - n[1] * e[0];
+    double l = sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
+    for (int a = 0; a < 3; a++)
+        t1[a] /= l;
+    t2[0] = n[1] * t1[2] - n[2] * t1[1];
+    t2[1] = n[2] * t1[0] - n[0] * t1[2];
+    t2[2] = n[0] * t1[1] - n[1] * t1[0];
+    double way = dd - FIT_GOAL_FRACTION * c->d_offset;
+    double cd[RESCUE_NCAND][5];
+    size_t nc = 0;
+    for (size_t ti = 0; ti < RESCUE_NTILT; ti++) {
+        double th = rescue_tilt[ti] * 3.14159265358979323846 / 180.0;
+        int naz = ti == 0 ? 1 : RESCUE_AZIMUTHS;
+        for (int az = 0; az < naz; az++) {
+            double ph = 2.0 * 3.14159265358979323846 * az / RESCUE_AZIMUTHS;
+            double dir[3];
             for (int a = 0; a < 3; a++)
-                gw[a] = g[a] / gl;
-        }
-    }
-    const double *dirs[2] = {gw, ga};
-    for (int d = 0; d < 2; d++) {
-        const double *g = dirs[d];
-        double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-        if (gl > 0.0 && isfinite(gl))
-            for (size_t k2 = 0; k2 < QUAL_NSTEPS; k2++, nc++)
+                dir[a] = cos(th) * n[a] + sin(th) * (cos(ph) * t1[a] + sin(ph) * t2[a]);
+            for (size_t fi = 0; fi < RESCUE_NFRAC; fi++, nc++) {
+                double st = way * rescue_frac[fi];
                 for (int a = 0; a < 3; a++)
-                    cand[nc][1 + a] = x[a] + qual_steps[k2] * c->h * g[a] / gl;
-    }
-    /* a boundary vertex may not move away from S beyond the band (nor
-     * beyond where it is), so at the band's edge or past it (held back by
-     * a thin gap) every step with an outward component fails: search the
-     * same gradients within the tangent plane of S's distance too, and
-     * slightly inward of it, where the surface curves away */
-    double dx = 0.0, nrm[3] = {0, 0, 0};
-    if (c->s && sm->onb[v]) {
-        double cp[3];
-        dx = dist_to_s(c, x, cp);
-        if (dx > 0.0)
-            for (int a = 0; a < 3; a++)
-                nrm[a] = (x[a] - cp[a]) / dx;
-    }
-    if (tangent_only) {
-        /* the boundary's area-weighted normal: the gradient of the volume
-         * in v, so steps across it keep the volume to first order; only
-         * those candidates are kept */
-        nc = 0;
-        fair_normal(sm, v, nrm);
-        dx = nrm[0] != 0.0 || nrm[1] != 0.0 || nrm[2] != 0.0 ? 1.0 : 0.0;
-    }
-    if (dx > 0.0)
-        for (int d = 0; d < 2; d++) {
-            const double *g = dirs[d];
-            double gn = g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2];
-            double gt[3] = {g[0] - gn * nrm[0], g[1] - gn * nrm[1], g[2] - gn * nrm[2]};
-            double gl = sqrt(gt[0] * gt[0] + gt[1] * gt[1] + gt[2] * gt[2]);
-            if (!(gl > 0.0) || !isfinite(gl))
-                continue;
-            for (int b = 0; b < (tangent_only ? 1 : QUAL_NTANGENT); b++)
-                for (size_t k2 = 0; k2 < QUAL_NSTEPS; k2++, nc++) {
-                    double st = qual_steps[k2] * c->h;
-                    for (int a = 0; a < 3; a++)
-                        cand[nc][1 + a] = x[a] + st * (gt[a] / gl - qual_inward[b] * nrm[a]);
-                }
+                    cd[nc][1 + a] = x[a] + st * dir[a];
+                int64_t tri;
+                double d2 = st_bvh_nearest(c->bvh, cd[nc] + 1, dd * dd, &tri, NULL);
+                cd[nc][0] = tri >= 0 ? sqrt(d2) : INFINITY;
+                cd[nc][4] = (double)nc;
+            }
         }
-    /* the six axis directions, a small step: a way out where the
-     * gradients point into the invariant */
-    for (int a = 0; a < 6 && !tangent_only; a++, nc++)
-        for (int b2 = 0; b2 < 3; b2++)
-            cand[nc][1 + b2] = x[b2] + (b2 == a / 2 ? (a & 1 ? -1.0 : 1.0) * QUAL_AXIS_STEP * c->h : 0.0);
-    if (nc == 0)
-        return 0;
-    for (int i = 0; i < nc; i++) {
-        cand[i][0] = sm_star_score(sm, v, cand[i] + 1);
-        cand[i][4] = i;
     }
-    qsort(cand, (size_t)nc, sizeof cand[0], cmp_cand);
-    if (!(cand[0][0] > s0 + QUAL_MIN_GAIN))
-        return 0;
-    star_pts_collect(c, v, sp);
-    double dmax = fmax(c->d_offset, dx);
-    for (int i = 0; i < nc; i++) {
-        if (!(cand[i][0] > s0 + QUAL_MIN_GAIN))
+    qsort(cd, nc, sizeof cd[0], cmp_rescue);
+    double floor_score = fmin(RESCUE_FLOOR, sm_star_score(sm, v, x));
+    sm_star_pts_collect(c, v, sp);
+    for (size_t i = 0; i < nc; i++) {
+        if (!(cd[i][0] < dd))
             break;
-        const double *p = cand[i] + 1;
-        if (sm->onb[v] && c->s) {
-            int64_t tri;
-            double d2 = st_bvh_nearest(c->bvh, p, dmax * dmax, &tri, NULL);
-            if (tri < 0 || sqrt(d2) > dmax)
-                continue;
-        }
-        if (move_ok(c, v, p, sp)) {
+        const double *p = cd[i] + 1;
+        if (sm_star_score(sm, v, p) >= floor_score && sm_move_ok(c, v, p, sp)) {
             memcpy(x, p, 3 * sizeof *x);
             return 1;
         }
-        (*rejected)++;
     }
     return 0;
 }
 
-/* ST_OK, or ST_ENOMEM (err set) before any vertex moved. */
-static st_status quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
-                              st_fit_stats *st, double t0, st_error *err)
+/* Rounds of rescue_vertex over the boundary vertices beyond d_offset, in
+ * index order (few vertices, serial: the result does not depend on the
+ * thread count). Returns the moves. */
+static size_t rescue_pass(fit_ctx *c, double *dist)
 {
-    sm_mesh *sm = &c->sm;
-    st_tetmesh *m = sm->m;
-    unsigned char *mark = st_calloc_array(sm->nv, 1);
-    dirty dy;
-    if (!mark || dirty_init(&dy, sm->nv)) {
-        free(mark);
-        dirty_free(&dy);
-        return st_error_set(err, ST_ENOMEM, NULL, 0,
-                            "out of memory for the quality pass (%zu vertices)", sm->nv);
-    }
-    for (int round = 0; round < p->quality_rounds; round++) {
-        memset(mark, 0, sm->nv);
-        size_t nbad = 0;
-        for (size_t t = 0; t < m->ntets; t++) {
-            const uint32_t *k = m->tets + 4 * t;
-            double sc = sm_tet_score(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
-                                     m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]);
-            if (sc < p->quality_goal) {
-                nbad++;
-                for (int i = 0; i < 4; i++)
-                    mark[k[i]] = 1;
+    size_t moves = 0;
+    star_pts sp = {NULL, 0, 0, 1, 0, 0, 0};
+    for (int round = 0; round < RESCUE_ROUNDS; round++) {
+        size_t moved = 0;
+        for (size_t v = 0; v < c->sm.nv; v++)
+            if (c->sm.onb[v] && dist[v] > c->d_offset && rescue_vertex(c, (uint32_t)v, &sp)) {
+                moved++;
+                dist[v] = sm_dist_to_s(c, c->sm.m->xyz + 3 * v, NULL);
             }
-        }
-        if (nbad == 0)
-            break;
-        size_t moved = 0, rejected = 0;
-        for (size_t col = 0; col < sm->ncolours; col++) {
-            dy.step++;
-            #pragma omp parallel reduction(+ : moved, rejected) \
-                if (PAR_CHECKED(sm->col_off[col + 1] - sm->col_off[col]))
-            {
-                star_pts sp = {NULL, 0, 0, 1, 0, 0};
-                #pragma omp for schedule(dynamic, 8)
-                for (size_t j = sm->col_off[col]; j < sm->col_off[col + 1]; j++) {
-                    uint32_t v = sm->col_v[j];
-                    if (mark[v] && !dirty_unchanged(&dy, sm, v)) {
-                        int k = quality_vertex(c, v, &sp, &rejected);
-                        dirty_mark(&dy, v, k);
-                        moved += (size_t)k;
-                    }
-                }
-                free(sp.list);
-            }
-        }
-        st->quality_rounds = round + 1;
-        st->quality_moves += moved;
-        if (p->on_iter && c->s) {
-            dist_summary ds = boundary_distances(c, dist);
-            fit_counts n = {moved, rejected, 0};
-            report(p, c, "quality", round + 1, &ds, &n, t0);
-        }
+        moves += moved;
         if (moved == 0)
             break;
     }
-    free(mark);
-    dirty_free(&dy);
-    return ST_OK;
-}
-
-/* The quality pass on a borrowed mesh (fairing's), with or without the
- * boundary's tangent moves. */
-static st_status quality_on(sm_mesh *sm, double h, int rounds, double goal, int boundary,
-                            size_t *moves, st_error *err)
-{
-    fit_ctx c;
-    memset(&c, 0, sizeof c);
-    c.sm = *sm;   /* borrowed: not freed here */
-    c.h = h;
-    c.fair_boundary = boundary;
-    st_fit_params p = st_fit_params_default();
-    p.quality_rounds = rounds;
-    p.quality_goal = goal;
-    st_fit_stats st;
-    memset(&st, 0, sizeof st);
-    st_status rc = quality_pass(&c, &p, NULL, &st, 0.0, err);
-    *moves = st.quality_moves;
-    return rc;
-}
-
-st_status sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal,
-                              size_t *moves, st_error *err)
-{
-    return quality_on(sm, h, rounds, goal, 0, moves, err);
-}
-
-st_status sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal, size_t *moves,
-                          st_error *err)
-{
-    return quality_on(sm, h, rounds, goal, 1, moves, err);
+    free(sp.list);
+    return moves;
 }
 
 /* ---- entry points ----------------------------------------------------- */
@@ -996,7 +871,7 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
             goto done;
         c.full_check = nonmanifold > 0;
     }
-    if (pgrid_build(&c.pg, s, h) || dirty_init(&dy, m->npoints) ||
+    if (pgrid_build(&c.pg, s, h) || sm_dirty_init(&dy, m->npoints) ||
         !(c.blocker = st_malloc_array(m->npoints, sizeof *c.blocker)) ||
         !(c.dpos = st_malloc_array(m->npoints, 3 * sizeof *c.dpos)) ||
         !(dist = st_malloc_array(m->npoints, sizeof *dist))) {
@@ -1015,7 +890,7 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
     if (rc)
         goto done;
 
-    dist_summary ds = boundary_distances(&c, dist);
+    dist_summary ds = sm_boundary_distances(&c, dist);
     size_t best_within = ds.within;
     int since_best = 0;
     for (int it = 0; it < p.max_iters && ds.within < c.sm.nbv; it++) {
@@ -1027,16 +902,16 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
             #pragma omp parallel reduction(+ : moved, rejected, skipped) \
                 if (PAR_CHECKED(c.sm.col_off[col + 1] - c.sm.col_off[col]))
             {
-                star_pts sp = {NULL, 0, 0, 1, 0, 0};
+                star_pts sp = {NULL, 0, 0, 1, 0, 0, 0};
                 #pragma omp for schedule(dynamic, 4)
                 for (size_t j = c.sm.col_off[col]; j < c.sm.col_off[col + 1]; j++) {
                     fit_counts k = {0, 0, 0};
                     uint32_t v = c.sm.col_v[j];
-                    if (dirty_unchanged(&dy, &c.sm, v)) {
+                    if (sm_dirty_unchanged(&dy, &c.sm, v)) {
                         skipped++;   /* it would fail as it did */
                         continue;
                     }
-                    dirty_mark(&dy, v, fit_vertex(&c, v, p.step, dist, &sp, &k));
+                    sm_dirty_mark(&dy, v, fit_vertex(&c, v, p.step, dist, &sp, &k));
                     moved += k.moved;
                     rejected += k.rejected;
                     skipped += k.skipped;
@@ -1051,8 +926,8 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
         st.moves += n.moved;
         st.rejected += n.rejected;
         st.skipped += n.skipped;
-        ds = boundary_distances(&c, dist);
-        report(&p, &c, "fit", it + 1, &ds, &n, t0);
+        ds = sm_boundary_distances(&c, dist);
+        sm_fit_report(&p, &c, "fit", it + 1, &ds, &n, t0);
         if (n.moved == 0)
             break;
         if (ds.within > best_within) {
@@ -1062,16 +937,30 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
             break;   /* the rest are held back: thin gaps or blocked moves */
         }
     }
+    if (ds.within < c.sm.nbv) {
+        rescue_pass(&c, dist);
+        ds = sm_boundary_distances(&c, dist);
+    }
     st.converged = ds.within == c.sm.nbv;
     sm_dihedral_range(m, &st.min_dihedral_fit, &st.max_dihedral_fit);
     st.seconds_fit = sm_now() - t0;
     if (p.quality) {
         st_progress_report(prog, "quality", 0.0);
-        if ((rc = quality_pass(&c, &p, dist, &st, t0, err)))
+        if ((rc = sm_quality_pass(&c, &p, dist, &st, t0, err)))
             goto done;
-        ds = boundary_distances(&c, dist);
+        ds = sm_boundary_distances(&c, dist);
+        /* the quality moves change the stars of the vertices still held:
+         * another rescue, and the quality pass again after it */
+        for (int k = 0; k < FIT_LATE_RESCUES && ds.within < c.sm.nbv; k++) {
+            if (rescue_pass(&c, dist) == 0)
+                break;
+            if ((rc = sm_quality_pass(&c, &p, dist, &st, t0, err)))
+                goto done;
+            ds = sm_boundary_distances(&c, dist);
+        }
     }
     st.within_offset = ds.within;
+    st.converged = ds.within == c.sm.nbv;
     st.beyond_offset = c.sm.nbv - ds.within;
     st.max_distance = ds.max;
     st.mean_distance = ds.mean;
@@ -1085,27 +974,10 @@ done:
     free(dist);
     free(c.blocker);
     free(c.dpos);
-    dirty_free(&dy);
+    sm_dirty_free(&dy);
     pgrid_free(&c.pg);
     sm_mesh_free(&c.sm);
     st_bvh_free(own);
     return rc;
 }
 
-/* ---- enclosure count -------------------------------------------------- */
-
-/* The whole-mesh count is enclose.h's (one implementation of the exact
- * enclosure semantics for the project: tetstat, soupmesh and this). */
-st_status st_enclosure_count(const st_tetmesh *m, const st_soup *s,
-                             const st_bvh *bvh, size_t *verts_outside,
-                             size_t *tris_crossing, st_error *err)
-{
-    st_enclosure e;
-    st_status rc = st_enclosure_compute(&e, m, s, bvh, NULL, NULL, err);
-    /* On error SIZE_MAX, which no caller can read as "encloses". */
-    if (verts_outside)
-        *verts_outside = rc ? SIZE_MAX : e.vertices_outside;
-    if (tris_crossing)
-        *tris_crossing = rc ? SIZE_MAX : e.crossing_triangles;
-    return rc;
-}

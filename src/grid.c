@@ -82,6 +82,15 @@ void st_grid_free(st_grid *g)
     free(g);
 }
 
+const char *st_grid_name_for_kind(st_grid_kind kind)
+{
+    switch (kind) {
+    case ST_GRID_DISTANCE: return "distance";
+    case ST_GRID_SIGNED: return "sdf";
+    default: return "field";
+    }
+}
+
 size_t st_grid_count(const st_grid *g)
 {
     return g->nx * g->ny * g->nz;

@@ -12,42 +12,20 @@
  * other.
  */
 #include "souptet/gridio.h"
-#include "souptet/mem.h"
 #include "souptet/outfile.h"
 #include "adapters/gridio_internal.h"
+#include "fileio.h"
 
-#include <errno.h>
-#include <stdint.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
 
 st_grid_format st_grid_format_from_path(const char *path)
 {
-    if (!path)
-        return ST_GRID_FMT_UNKNOWN;
-    /* The extension of the last path component only: "a.vdb/field" has
-     * none. */
-    const char *base = strrchr(path, '/');
-    base = base ? base + 1 : path;
-    const char *dot = strrchr(base, '.');
-    if (!dot || dot == base)    /* ".vdb" alone is a hidden file, no ext */
-        return ST_GRID_FMT_UNKNOWN;
-    if (strcasecmp(dot, ".vdb") == 0)
-        return ST_GRID_FMT_VDB;
-    if (strcasecmp(dot, ".vti") == 0)
-        return ST_GRID_FMT_VTI;
-    return ST_GRID_FMT_UNKNOWN;
-}
-
-const char *st_grid_name_for_kind(st_grid_kind kind)
-{
-    switch (kind) {
-    case ST_GRID_DISTANCE: return "distance";
-    case ST_GRID_SIGNED: return "sdf";
-    default: return "field";
+    static const char *const ext[] = {"vdb", "vti"};
+    switch (st_path_ext_match(path, ext, 2, 0)) {
+    case 0: return ST_GRID_FMT_VDB;
+    case 1: return ST_GRID_FMT_VTI;
+    default: return ST_GRID_FMT_UNKNOWN;
     }
 }
 
@@ -62,79 +40,6 @@ st_status st_grid_write(const st_grid *g, const char *path, st_error *err)
     }
     return st_error_set(err, ST_EINPUT, path, 0,
                         "unknown field format (use .vdb or .vti)");
-}
-
-st_status st_gridio_check_input_file(const char *path, st_error *err)
-{
-    struct stat st;
-    if (stat(path, &st) != 0)
-        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
-                            strerror(errno));
-    if (S_ISDIR(st.st_mode))
-        return st_error_set(err, ST_EIO, path, 0, "is a directory");
-    if (S_ISREG(st.st_mode) && st.st_size == 0)
-        return st_error_set(err, ST_EINPUT, path, 0, "empty file");
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
-                            strerror(errno));
-    fclose(fp);
-    return ST_OK;
-}
-
-st_status st_gridio_read_stdin(unsigned char **data, size_t *size,
-                               st_error *err)
-{
-    size_t cap = 1 << 16, n = 0;
-    unsigned char *buf = malloc(cap);
-    *data = NULL;
-    *size = 0;
-    if (!buf)
-        return st_error_set(err, ST_ENOMEM, ST_GRIDIO_STDIN_NAME, 0,
-                            "out of memory");
-    for (;;) {
-        if (n == cap) {
-            size_t ncap;
-            unsigned char *nb = NULL;
-            if (st_size_mul(&ncap, cap, 2) == 0)
-                nb = realloc(buf, ncap);
-            if (!nb) {
-                free(buf);
-                return st_error_set(err, ST_ENOMEM, ST_GRIDIO_STDIN_NAME, 0,
-                                    "out of memory after %zu bytes", n);
-            }
-            buf = nb;
-            cap = ncap;
-        }
-        size_t got = fread(buf + n, 1, cap - n, stdin);
-        n += got;
-        if (got == 0) {
-            if (ferror(stdin)) {
-                int e = errno;
-                free(buf);
-                clearerr(stdin);
-                return st_error_set(err, ST_EIO, ST_GRIDIO_STDIN_NAME, 0,
-                                    "read failed: %s", strerror(e));
-            }
-            break;      /* end of file */
-        }
-    }
-    *data = buf;
-    *size = n;
-    return ST_OK;
-}
-
-/* VTK XML, by its first significant byte: '<' after an optional UTF-8
- * byte-order mark and white space. */
-static int looks_like_xml(const unsigned char *p, size_t n)
-{
-    size_t i = 0;
-    if (n >= 3 && p[0] == 0xEF && p[1] == 0xBB && p[2] == 0xBF)
-        i = 3;
-    while (i < n && (p[i] == ' ' || p[i] == '\t' || p[i] == '\r' ||
-                     p[i] == '\n'))
-        i++;
-    return i < n && p[i] == '<';
 }
 
 /* OpenVDB files and streams begin with the 64-bit magic number 0x56444220
@@ -153,14 +58,14 @@ st_status st_grid_read(st_grid **out, const char *path, size_t max_bytes,
     if (st_path_is_stdio(path)) {
         unsigned char *data;
         size_t size;
-        st_status s = st_gridio_read_stdin(&data, &size, err);
+        st_status s = st_file_read(NULL, &data, &size, err);
         if (s)
             return s;
-        if (looks_like_xml(data, size))
-            s = st_gridio_read_vti_mem(out, data, size, ST_GRIDIO_STDIN_NAME,
+        if (st_looks_like_xml(data, size))
+            s = st_gridio_read_vti_mem(out, data, size, ST_STDIN_NAME,
                                        max_bytes, err);
         else
-            s = st_gridio_read_vdb_mem(out, data, size, ST_GRIDIO_STDIN_NAME,
+            s = st_gridio_read_vdb_mem(out, data, size, ST_STDIN_NAME,
                                        max_bytes, err);
         free(data);
         return s;
@@ -171,23 +76,14 @@ st_status st_grid_read(st_grid **out, const char *path, size_t max_bytes,
     default: break;
     }
     /* No known extension: look at the first bytes. */
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
-                            strerror(errno));
     unsigned char head[64];
-    size_t n = fread(head, 1, sizeof head, fp);
-    int bad = ferror(fp);
-    int e = errno;
-    fclose(fp);
-    if (bad)
-        return st_error_set(err, ST_EIO, path, 0, "read failed: %s",
-                            strerror(e));
-    if (n == 0)
-        return st_error_set(err, ST_EINPUT, path, 0, "empty file");
+    size_t n;
+    st_status s = st_file_head(path, head, sizeof head, &n, err);
+    if (s)
+        return s;
     if (looks_like_vdb(head, n))
         return st_grid_read_vdb(out, path, max_bytes, err);
-    if (looks_like_xml(head, n))
+    if (st_looks_like_xml(head, n))
         return st_grid_read_vti(out, path, max_bytes, err);
     return st_error_set(err, ST_EINPUT, path, 0,
                         "unknown field format: neither OpenVDB nor VTK XML "

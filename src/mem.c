@@ -3,9 +3,12 @@
 #include "souptet/mem.h"
 
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 /* Measured with a page-touching loop on this project's machines: 350 MB
  * first touched in 4 KiB pages 0.94 s, in 2 MiB pages 0.02 s. */
@@ -88,4 +91,29 @@ char *st_strdup(const char *s)
     if (d)
         memcpy(d, s, n);
     return d;
+}
+
+size_t st_mem_address_space_left(size_t *limit)
+{
+    struct rlimit rl;
+    if (limit)
+        *limit = SIZE_MAX;
+    if (getrlimit(RLIMIT_AS, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY ||
+        rl.rlim_cur >= (rlim_t)SIZE_MAX)
+        return SIZE_MAX;
+    size_t cap = (size_t)rl.rlim_cur;
+    if (limit)
+        *limit = cap;
+    /* What is mapped now (libraries, stacks, the heap so far): the first
+     * field of /proc/self/statm, in pages. Without /proc, all of it. */
+    size_t used = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (f) {
+        unsigned long pages = 0;
+        long page = sysconf(_SC_PAGESIZE);
+        if (fscanf(f, "%lu", &pages) == 1 && page > 0)
+            used = (size_t)pages * (size_t)page;
+        fclose(f);
+    }
+    return used < cap ? cap - used : 0;
 }

@@ -12,12 +12,19 @@
 #include "souptet/outfile.h"
 #include "souptet/mem.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#ifndef HOST_NAME_MAX
+#define HOST_NAME_MAX 255
+#endif
 
 /* Temporary paths in flight, for st_outfile_unlink_pending. A tool has at
  * most a few outputs open at once. The signal handler only reads them. */
@@ -54,6 +61,118 @@ void st_outfile_unlink_pending(void)
     }
 }
 
+/* This machine's name for temporary names: no '/' or '@' (they separate
+ * the name's parts), "localhost" when it has none. */
+static void host_name(char *buf, size_t n)
+{
+    if (gethostname(buf, n) != 0)
+        buf[0] = '\0';
+    buf[n - 1] = '\0';
+    for (char *c = buf; *c; c++)
+        if (*c == '/' || *c == '@' || *c == '.')
+            *c = '_';  /* '.' too: a name is one label, and parses back */
+    if (!buf[0])
+        snprintf(buf, n, "localhost");
+}
+
+/* The temporary name's prefix "dir/.NAME.tmp-" of target path (malloc'd). */
+static char *temp_prefix(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    size_t dirlen = slash ? (size_t)(slash - path) + 1 : 0;
+    size_t base = strlen(path + dirlen);
+    char *p = malloc(dirlen + base + 8);
+    if (!p)
+        return NULL;
+    memcpy(p, path, dirlen);
+    p[dirlen] = '.';
+    memcpy(p + dirlen + 1, path + dirlen, base);
+    memcpy(p + dirlen + 1 + base, ".tmp-", 6);
+    return p;
+}
+
+/* Remove the temporaries of path that a process of this machine left
+ * when it died without cleaning up (SIGKILL, a power cut): names
+ * "PREFIX<pid>@<host>.XXXXXX" whose pid is not running. A live pid (this
+ * process's, another writer's, or a reused one) keeps its file. Best
+ * effort: errors are ignored, nothing else is touched. */
+static void remove_stale(const char *prefix, const char *host)
+{
+    const char *slash = strrchr(prefix, '/');
+    size_t dirlen = slash ? (size_t)(slash - prefix) + 1 : 0;
+    const char *lead = prefix + dirlen;
+    size_t leadlen = strlen(lead), hostlen = strlen(host);
+    char dir[4096];
+    if (dirlen >= sizeof dir)
+        return;
+    if (dirlen)
+        snprintf(dir, sizeof dir, "%.*s", (int)dirlen, prefix);
+    else
+        snprintf(dir, sizeof dir, ".");
+    DIR *d = opendir(dir);
+    if (!d)
+        return;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        const char *n = e->d_name;
+        if (strncmp(n, lead, leadlen) != 0)
+            continue;
+        const char *q = n + leadlen;
+        long pid = 0;
+        int digits = 0;
+        while (*q >= '0' && *q <= '9' && digits < 10) {
+            pid = pid * 10 + (*q++ - '0');
+            digits++;
+        }
+        if (!digits || *q++ != '@' || strncmp(q, host, hostlen) != 0)
+            continue;
+        q += hostlen;
+        if (q[0] != '.' || strlen(q) != 7)
+            continue;
+        if (pid <= 0 || pid == (long)getpid() || pid > INT_MAX)
+            continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH)
+            continue;   /* running (or not ours to signal): in use */
+        char full[4096 + 256];
+        snprintf(full, sizeof full, "%s%s", dirlen ? dir : "", n);
+        unlink(full);
+    }
+    closedir(d);
+}
+
+char *st_outfile_target_of(const char *tmp)
+{
+    if (!tmp)
+        return NULL;
+    size_t n = strlen(tmp);
+    const char *slash = strrchr(tmp, '/');
+    size_t dl = slash ? (size_t)(slash - tmp) + 1 : 0;
+    /* ".NAME.tmp-PID@HOST.XXXXXX": the last '@' ends the pid. */
+    if (n < dl + 1 + 1 + 5 + 1 + 1 + 1 + 7 || tmp[dl] != '.' || tmp[n - 7] != '.')
+        return NULL;
+    const char *at = NULL;
+    for (const char *c = tmp + n - 8; c > tmp + dl; c--)
+        if (*c == '@') {
+            at = c;
+            break;
+        }
+    if (!at)
+        return NULL;
+    const char *c = at;
+    while (c > tmp + dl && c[-1] >= '0' && c[-1] <= '9')
+        c--;
+    if (c == at || c - (tmp + dl) < 6 || strncmp(c - 5, ".tmp-", 5) != 0)
+        return NULL;
+    size_t base = (size_t)(c - 5 - (tmp + dl + 1));
+    char *t = malloc(dl + base + 1);
+    if (!t)
+        return NULL;
+    memcpy(t, tmp, dl);
+    memcpy(t + dl, tmp + dl + 1, base);
+    t[dl + base] = '\0';
+    return t;
+}
+
 st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
                            st_error *err)
 {
@@ -72,21 +191,29 @@ st_status st_outfile_begin(st_outfile *o, const char *path, int open_stream,
     if (stat(path, &st) == 0 && !S_ISREG(st.st_mode))
         return st_error_set(err, ST_EIO, path, 0, "not a regular file "
                             "(write to '-' for standard output)");
-    size_t n = strlen(path);
+    /* Beside the target, hidden, so a reader never mistakes it for output,
+     * and named for what it is and who writes it, so one left behind by a
+     * killed process is known for stale: "dir/.NAME.tmp-PID@HOST.XXXXXX". */
+    char host[HOST_NAME_MAX + 1], who[HOST_NAME_MAX + 32];
+    host_name(host, sizeof host);
+    char *prefix = temp_prefix(path);
+    /* A long NAME shortens the host (the name must fit in NAME_MAX). */
+    const char *slash = strrchr(path, '/');
+    size_t used = strlen(slash ? slash + 1 : path) + 6 + 20 + 8;
+    if (used + strlen(host) > NAME_MAX)
+        host[used < NAME_MAX ? NAME_MAX - used : 0] = '\0';
+    snprintf(who, sizeof who, "%ld@%s.XXXXXX", (long)getpid(), host);
     o->path = st_strdup(path);
-    o->tmp = malloc(n + 16);
+    o->tmp = prefix ? malloc(strlen(prefix) + strlen(who) + 1) : NULL;
     if (!o->path || !o->tmp) {
+        free(prefix);
         st_outfile_abort(o);
         return st_error_set(err, ST_ENOMEM, path, 0, "out of memory");
     }
-    /* Beside the target, hidden, so a reader never mistakes it for output:
-     * "dir/.name.XXXXXX". */
-    const char *slash = strrchr(path, '/');
-    size_t dirlen = slash ? (size_t)(slash - path) + 1 : 0;
-    memcpy(o->tmp, path, dirlen);
-    o->tmp[dirlen] = '.';
-    strcpy(o->tmp + dirlen + 1, path + dirlen);
-    strcat(o->tmp, ".XXXXXX");
+    remove_stale(prefix, host);
+    strcpy(o->tmp, prefix);
+    strcat(o->tmp, who);
+    free(prefix);
     /* Listed before it exists, so no signal finds it on disk but not in
      * the list (mkstemp fills in the name in place; until then the handler
      * unlinks a name that does not exist). Signals are not blocked here:

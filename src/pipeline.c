@@ -7,6 +7,7 @@
 #include "souptet/bvh.h"
 #include "souptet/pseudo.h"
 #include "souptet/dist.h"
+#include "souptet/enclose.h"
 #include "souptet/grid.h"
 #include "souptet/lattice.h"
 #include "souptet/mem.h"
@@ -199,6 +200,7 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
     c->seconds_fit = now_seconds() - t1;
     c->converged = fs.converged;
     c->beyond_offset = fs.beyond_offset;
+    c->boundary_vertices = fs.boundary_vertices;
     c->max_distance = fs.max_distance;
     c->verts_outside = fs.outside_after;
     c->tris_crossing = fs.crossing_after;
@@ -339,6 +341,9 @@ static int better(const st_pipeline_candidate *a, size_t ka,
     int eb = b->verts_outside == 0 && b->tris_crossing == 0;
     if (ea != eb)
         return ea;
+    /* then the stopping condition (the fit's promise), then angles */
+    if (a->converged != b->converged)
+        return a->converged;
     if (a->min_dihedral != b->min_dihedral)
         return a->min_dihedral > b->min_dihedral;
     if (a->max_dihedral != b->max_dihedral)

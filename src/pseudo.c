@@ -90,6 +90,7 @@ static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_pseudo_p
     rc = rc ? rc : st_sign_votes(g, &p->sign, votes, err);
     rc = rc ? rc : st_sides_evidence(evidence, g, votes, decided, s, &sp, &st->sides, err);
     rc = rc ? rc : st_sign_field_evidence(g, &p->sign, evidence, votes, progress, err);
+    rc = rc ? rc : st_sides_mirror(g, &st->sides, &st->mirrored, err);
     free(votes);
     free(evidence);
     return rc;

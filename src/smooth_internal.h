@@ -10,7 +10,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "souptet/bvh.h"
 #include "souptet/err.h"
+#include "souptet/smooth.h"
+#include "souptet/soup.h"
 #include "souptet/tetmesh.h"
 
 /* When a loop is worth a parallel region: each region costs a barrier,
@@ -71,7 +74,7 @@ void sm_odt_target(const sm_mesh *sm, uint32_t v, double out[3]);
  * points at xyz (3 per mesh point): the mesh volume, for a conforming mesh. */
 double sm_boundary_volume(const sm_mesh *sm, const double *xyz);
 
-/* The quality pass of st_fit (fit.c) without a surface: only interior
+/* The quality pass of st_fit (quality.c) without a surface: only interior
  * vertices move, so the volume stays exactly as it is; h scales the trial
  * steps. *moves gets the number of moves. ST_OK, or ST_ENOMEM (nothing
  * moved). */
@@ -82,6 +85,96 @@ st_status sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal,
  * in it: first-order volume kept). As sm_quality_interior otherwise. */
 st_status sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal, size_t *moves,
                           st_error *err);
+
+/* ---- the fit's invariant (fit.c), shared with the quality pass ---- */
+
+/* The vertices of S in bins (fit.c builds it). */
+typedef struct pgrid {
+    double *pts;          /* distinct vertices of S, 3 each */
+    size_t npts;
+    double lo[3], cell;
+    size_t n[3];
+    size_t *off;          /* bin -> points (CSR) */
+    uint32_t *idx;
+} pgrid;
+
+typedef struct fit_ctx {
+    sm_mesh sm;
+    const st_soup *s;
+    const st_bvh *bvh;
+    pgrid pg;
+    double *dpos;        /* per vertex: where its distance in dist[] was
+                            taken (3 each; NaN: not yet) */
+    uint32_t *blocker;   /* per vertex: the S vertex that last stopped its
+                            move (a point grid index), or UINT32_MAX */
+    double h, d_offset;
+    int full_check;   /* non-conforming faces: test S vertices everywhere */
+    int fair_boundary;   /* no S (after fairing): boundary vertices move in
+                            their tangent plane only (sm_quality_fair) */
+} fit_ctx;
+
+/* Which vertices can be skipped: a vertex move is a deterministic function
+ * of the vertex's position and its neighbours' (its star), so a vertex
+ * that was tried and did not move, with nothing in its star moved since,
+ * would not move again; skipping it changes no result. Steps count colour
+ * sets; a vertex and its neighbours never share a colour, so during a
+ * colour step no vertex reads a stamp being written. */
+typedef struct dirty {
+    uint32_t *moved_at;   /* step of the last move (0: never) */
+    uint32_t *tried_at;   /* step of the last attempt that did not move */
+    uint32_t step;
+} dirty;
+
+int sm_dirty_init(dirty *d, size_t nv);   /* 0, or -1 out of memory */
+void sm_dirty_free(dirty *d);
+/* 1 when an attempt to move v would repeat one that did not move. */
+int sm_dirty_unchanged(const dirty *d, const sm_mesh *sm, uint32_t v);
+void sm_dirty_mark(dirty *d, uint32_t v, int moved);
+
+/* An S vertex in a star and the star tet that held it. */
+typedef struct star_pt {
+    uint32_t pt;     /* index into the point grid */
+    uint32_t tet;    /* index from vt_off[v] */
+} star_pt;
+
+/* The scratch list of S vertices in a star (one per thread and call). */
+typedef struct star_pts {
+    star_pt *list;
+    size_t n, cap;
+    int ok;          /* 0: out of memory, refuse every move */
+    int have;        /* 1: list holds the star of v as it is */
+    int positive;    /* the star as it is: every tet positive */
+    uint32_t v;
+} star_pts;
+
+/* Start the moves of v (the list of S vertices is filled when a move
+ * first needs it). */
+void sm_star_pts_collect(const fit_ctx *c, uint32_t v, star_pts *sp);
+/* The whole invariant for moving v to p (fit.c's header comment). */
+int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp);
+/* The distance from p to S; closest (may be NULL) gets the nearest point. */
+double sm_dist_to_s(const fit_ctx *c, const double p[3], double closest[3]);
+
+typedef struct fit_counts {
+    size_t moved, rejected, skipped;
+} fit_counts;
+
+typedef struct dist_summary {
+    size_t within;
+    double max, mean;
+} dist_summary;
+
+/* Every boundary vertex's distance to S into dist[] (0 for the interior). */
+dist_summary sm_boundary_distances(const fit_ctx *c, double *dist);
+/* Tell p->on_iter (when set) how the fit stands. */
+void sm_fit_report(const st_fit_params *p, const fit_ctx *c, const char *phase,
+                   int iter, const dist_summary *ds, const fit_counts *n, double t0);
+
+/* The quality pass (quality.c) of st_fit on c (c->s NULL: no surface, as
+ * sm_quality_interior/sm_quality_fair). ST_OK, or ST_ENOMEM (err set)
+ * before any vertex moved. */
+st_status sm_quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
+                          st_fit_stats *st, double t0, st_error *err);
 
 /* Monotonic seconds. */
 double sm_now(void);

@@ -9,9 +9,8 @@
 #include "fpenv.h"
 #include "souptet/mem.h"
 #include "soup_parse.h"
+#include "fileio.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -19,8 +18,6 @@
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <xxhash.h>
 
 /* ---- building ---------------------------------------------------------- */
@@ -297,40 +294,15 @@ const char *st_soup__quote(char *buf, size_t bufsize,
 
 /* ---- formats ------------------------------------------------------------ */
 
-static int ascii_lower(int c)
-{
-    return (c >= 'A' && c <= 'Z') ? c - 'A' + 'a' : c;
-}
-
-static int ieq(const char *a, const char *b)
-{
-    for (; *a && *b; a++, b++)
-        if (ascii_lower((unsigned char)*a) != ascii_lower((unsigned char)*b))
-            return 0;
-    return *a == *b;
-}
-
 st_soup_format st_soup_format_from_path(const char *path)
 {
-    if (!path)
-        return ST_SOUP_UNKNOWN;
-    const char *slash = strrchr(path, '/');
-    const char *base = slash ? slash + 1 : path;
-    const char *dot = strrchr(base, '.');
-    if (!dot || dot == base)
-        return ST_SOUP_UNKNOWN;
-    dot++;
-    if (ieq(dot, "obj"))
-        return ST_SOUP_OBJ;
-    if (ieq(dot, "off"))
-        return ST_SOUP_OFF;
-    if (ieq(dot, "ply"))
-        return ST_SOUP_PLY;
-    if (ieq(dot, "stl"))
-        return ST_SOUP_STL;
-    if (ieq(dot, "gltf") || ieq(dot, "glb"))
-        return ST_SOUP_GLTF;
-    return ST_SOUP_UNKNOWN;
+    static const char *const ext[] = {"obj", "off", "ply", "stl", "gltf",
+                                      "glb"};
+    static const st_soup_format fmt[] = {ST_SOUP_OBJ, ST_SOUP_OFF,
+                                         ST_SOUP_PLY, ST_SOUP_STL,
+                                         ST_SOUP_GLTF, ST_SOUP_GLTF};
+    int k = st_path_ext_match(path, ext, 6, 0);
+    return k < 0 ? ST_SOUP_UNKNOWN : fmt[k];
 }
 
 const char *st_soup_format_name(st_soup_format format)
@@ -515,47 +487,6 @@ static st_status parse_at(st_soup **out, st_soup_format format,
     return ST_OK;
 }
 
-/* Read all of fd into a growing buffer: the size comes from the bytes that
- * actually arrive (st_size is only a first guess; pipes have none). */
-static st_status read_all(int fd, size_t hint, unsigned char **data,
-                          size_t *size, const char *name, st_error *err)
-{
-    size_t cap = hint ? hint : 65536, n = 0;
-    unsigned char *buf = malloc(cap);
-    if (!buf)
-        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
-    for (;;) {
-        if (n == cap) {
-            size_t ncap;
-            unsigned char *nb = NULL;
-            if (st_size_mul(&ncap, cap, 2) == 0)
-                nb = realloc(buf, ncap);
-            if (!nb) {
-                free(buf);
-                return st_error_set(err, ST_ENOMEM, name, 0,
-                                    "out of memory");
-            }
-            buf = nb;
-            cap = ncap;
-        }
-        ssize_t r = read(fd, buf + n, cap - n);
-        if (r < 0) {
-            if (errno == EINTR)
-                continue;
-            int e = errno;
-            free(buf);
-            return st_error_set(err, ST_EIO, name, 0, "cannot read: %s",
-                                strerror(e));
-        }
-        if (r == 0)
-            break;
-        n += (size_t)r;
-    }
-    *data = buf;
-    *size = n;
-    return ST_OK;
-}
-
 void st_soup_source_of(st_soup_source *src, const void *data, size_t size)
 {
     XXH128_hash_t h = XXH3_128bits(data, size);
@@ -587,34 +518,10 @@ st_status st_soup_read_source(st_soup **out, const char *path, st_soup_source *s
         return st_error_set(err, ST_EINTERNAL, NULL, 0,
                             "st_soup_read: bad arguments");
     int is_stdin = strcmp(path, "-") == 0;
-    const char *name = is_stdin ? "<stdin>" : path;
-    int fd = STDIN_FILENO;
-    if (!is_stdin) {
-        do
-            fd = open(path, O_RDONLY | O_CLOEXEC);
-        while (fd < 0 && errno == EINTR);
-        if (fd < 0)
-            return st_error_set(err, ST_EIO, name, 0, "cannot open: %s",
-                                strerror(errno));
-    }
-    struct stat sb;
-    size_t hint = 0;
-    if (fstat(fd, &sb) == 0) {
-        if (S_ISDIR(sb.st_mode)) {
-            if (!is_stdin)
-                close(fd);
-            return st_error_set(err, ST_EIO, name, 0, "is a directory");
-        }
-        /* +1 so a regular file is read to its end without a regrowth. */
-        if (S_ISREG(sb.st_mode) && sb.st_size > 0 &&
-            (unsigned long long)sb.st_size < SIZE_MAX / 2)
-            hint = (size_t)sb.st_size + 1;
-    }
+    const char *name = is_stdin ? ST_STDIN_NAME : path;
     unsigned char *data = NULL;
     size_t size = 0;
-    st_status st = read_all(fd, hint, &data, &size, name, err);
-    if (!is_stdin)
-        close(fd);
+    st_status st = st_file_read(path, &data, &size, err);
     if (st)
         return st;
     if (size == 0) {

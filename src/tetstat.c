@@ -238,6 +238,8 @@ static void reset(st_tetstat *out)
     out->h = NAN;
     out->dist_min = out->dist_max = out->dist_mean = NAN;
     out->surface_dist_max = NAN;
+    out->surface_diag = NAN;
+    out->offset_ratio = NAN;
     out->surface_volume = out->volume_ratio = NAN;
     out->fraction_inside = NAN;
     out->iou = NAN;
@@ -375,6 +377,13 @@ st_status st_tetstat_mesh(st_tetstat *out, const st_tetmesh *m,
             out->h = v;
         }
     }
+    const char *r = st_meta_get(&m->meta, "offset_ratio");
+    if (r) {
+        char *end;
+        double v = strtod(r, &end);
+        if (end != r && *end == '\0' && isfinite(v) && v > 0.0)
+            out->offset_ratio = v;
+    }
     return ST_OK;
 }
 
@@ -495,6 +504,9 @@ st_status st_tetstat_surface(st_tetstat *out, const st_tetmesh *m,
     out->surface_vertices = out->boundary_vertices = 0;
     out->dist_min = out->dist_max = out->dist_mean = NAN;
     out->surface_dist_max = NAN;
+    out->surface_diag = NAN;
+    out->has_offset = 0;
+    out->beyond_offset = 0;
     out->surface_closed = 0;
     out->surface_volume = out->volume_ratio = NAN;
     out->has_enclosure = out->encloses = out->enclosure_verified = 0;
@@ -556,6 +568,12 @@ st_status st_tetstat_surface(st_tetstat *out, const st_tetmesh *m,
         }
         out->dist_mean = sum / (double)nbv;
     }
+    if (out->has_h && out->h > 0.0 && out->offset_ratio > 0.0) {
+        const double lim = out->offset_ratio * out->h;
+        out->has_offset = 1;
+        for (size_t i = 0; i < nbv; i++)
+            out->beyond_offset += d[i] > lim;
+    }
 
     /* S -> boundary (its referenced vertices are counted here). */
     memset(mark, 0, s->nverts);
@@ -565,6 +583,19 @@ st_status st_tetstat_surface(st_tetstat *out, const st_tetmesh *m,
     for (size_t i = 0; i < s->nverts; i++)
         nsv += mark[i];
     out->surface_vertices = nsv;
+    {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < s->nverts; i++)
+            if (mark[i])
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = fmin(lo[a], s->xyz[3 * i + (size_t)a]);
+                    hi[a] = fmax(hi[a], s->xyz[3 * i + (size_t)a]);
+                }
+        if (nsv)
+            out->surface_diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                                     (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    }
     if (nf) {
         if ((st = st_bvh_build(&bb, bs, err)))
             goto done;
@@ -609,6 +640,23 @@ done:
     free(mark);
     free(list);
     free(d);
+    return st;
+}
+
+st_status st_tetstat_surface_to_boundary(double *out, const st_tetmesh *m,
+                                         const st_soup *s, st_error *err)
+{
+    *out = NAN;
+    uint32_t *faces = NULL;
+    size_t nf = 0;
+    st_soup *bs = NULL;
+    st_bvh *bb = NULL;
+    st_status st = boundary_soup(&bs, m, &faces, &nf, err);
+    if (!st && nf && !(st = st_bvh_build(&bb, bs, err)))
+        *out = surface_to_boundary(bb, s);
+    st_bvh_free(bb);
+    st_soup_free(bs);
+    free(faces);
     return st;
 }
 

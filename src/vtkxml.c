@@ -41,14 +41,12 @@
 
 #include "souptet/mem.h"
 
-#include <errno.h>
 #include <limits.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 /* Limits of what the check understands; VTK's writers stay far below. */
 #define MAX_DEPTH 16     /* VTKFile > T > Piece > PointData > DataArray > .. */
@@ -1658,57 +1656,4 @@ st_status st_vtkxml_check(const unsigned char *data, size_t size,
     free(c.cells);
     free(c.names);
     return s;
-}
-
-st_status st_vtkxml_read_file(const char *path, unsigned char **data,
-                              size_t *size, st_error *err)
-{
-    *data = NULL;
-    *size = 0;
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
-                            strerror(errno));
-    struct stat sb;
-    size_t cap = 1 << 16, n = 0;
-    if (fstat(fileno(fp), &sb) == 0 && sb.st_size > 0 &&
-        (unsigned long long)sb.st_size < SIZE_MAX)
-        cap = (size_t)sb.st_size + 1;   /* +1: sees the end at once */
-    unsigned char *buf = malloc(cap);
-    if (!buf) {
-        fclose(fp);
-        return st_error_set(err, ST_ENOMEM, path, 0,
-                            "out of memory reading %zu bytes", cap);
-    }
-    for (;;) {
-        if (n == cap) {
-            size_t ncap;
-            unsigned char *nb = NULL;
-            if (st_size_mul(&ncap, cap, 2) == 0)
-                nb = realloc(buf, ncap);
-            if (!nb) {
-                free(buf);
-                fclose(fp);
-                return st_error_set(err, ST_ENOMEM, path, 0,
-                                    "out of memory after %zu bytes", n);
-            }
-            buf = nb;
-            cap = ncap;
-        }
-        size_t got = fread(buf + n, 1, cap - n, fp);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    if (ferror(fp)) {
-        int e = errno;
-        free(buf);
-        fclose(fp);
-        return st_error_set(err, ST_EIO, path, 0, "read error: %s",
-                            strerror(e));
-    }
-    fclose(fp);
-    *data = buf;
-    *size = n;
-    return ST_OK;
 }

@@ -68,12 +68,6 @@ size_t st_vtkxml_inflate_vtk(void *user, const char *compressor,
                              const unsigned char *in, size_t n,
                              unsigned char *out, size_t cap);
 
-/* The whole file at path in a malloc'd buffer (*data is never NULL on
- * success; caller frees), so that a by-path reader checks and parses the
- * same bytes as the in-memory one. ST_EIO or ST_ENOMEM naming path. */
-st_status st_vtkxml_read_file(const char *path, unsigned char **data,
-                              size_t *size, st_error *err);
-
 /* The limit the adapters pass for a caller's max_bytes: twice it
  * (saturating), 0 staying "none". VTK decodes an array in its file type
  * before souptet converts it (Float64 values into a float grid, Int64

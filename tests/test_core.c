@@ -16,6 +16,7 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 static void test_error_format(void)
@@ -170,6 +171,110 @@ static void test_outfile(void)
     rmdir(dir);
 }
 
+/* Temporaries are named for their target, pid and machine; a rerun removes
+ * the ones whose process is gone (SIGKILL leaves them: no handler runs),
+ * and only those. */
+static void test_outfile_stale(void)
+{
+    char dir[] = "/tmp/souptet-stale.XXXXXX";
+    TAP_CHECK(mkdtemp(dir) != NULL, "temp dir");
+    char path[512], name[1024];
+    snprintf(path, sizeof path, "%s/a.b@c.tmp-1@x.vtu", dir);
+    st_outfile o;
+    st_error e;
+    TAP_CHECK(st_outfile_begin(&o, path, 1, &e) == ST_OK, "begin");
+    char want[600];
+    snprintf(want, sizeof want, "%s/.a.b@c.tmp-1@x.vtu.tmp-%ld@", dir, (long)getpid());
+    TAP_CHECK(strncmp(o.tmp, want, strlen(want)) == 0,
+              "the temporary says its target, pid and host: %s", o.tmp);
+    char *t = st_outfile_target_of(o.tmp);
+    TAP_CHECK(t && strcmp(t, path) == 0, "st_outfile_target_of gives the target back: %s",
+              t ? t : "(null)");
+    free(t);
+    const char *host = strrchr(o.tmp, '@') + 1;
+    char hostbuf[300];
+    snprintf(hostbuf, sizeof hostbuf, "%.*s", (int)(strrchr(o.tmp, '.') - host), host);
+    TAP_CHECK(st_outfile_target_of("dir/.x.vtu.ABCDEF") == NULL &&
+                  st_outfile_target_of("dir/x.vtu.tmp-12@h.ABCDEF") == NULL &&
+                  st_outfile_target_of(".x.vtu.tmp-@h.ABCDEF") == NULL,
+              "names st_outfile did not make have no target");
+    t = st_outfile_target_of(".x.vtu.tmp-12@h.ABCDEF");
+    TAP_CHECK(t && strcmp(t, "x.vtu") == 0, "a name without a directory");
+    free(t);
+    st_outfile_abort(&o);
+
+    /* A dead pid: a child that has exited and been reaped. */
+    pid_t child = fork();
+    if (child == 0)
+        _exit(0);
+    waitpid(child, NULL, 0);
+    const char *kinds[4] = {"dead", "live", "other host", "other target"};
+    char files[4][1024];
+    snprintf(files[0], sizeof files[0], "%s/.a.b@c.tmp-1@x.vtu.tmp-%ld@%s.Ab12Cd", dir,
+             (long)child, hostbuf);
+    snprintf(files[1], sizeof files[1], "%s/.a.b@c.tmp-1@x.vtu.tmp-%ld@%s.Ab12Cd", dir,
+             (long)getppid(), hostbuf);
+    snprintf(files[2], sizeof files[2], "%s/.a.b@c.tmp-1@x.vtu.tmp-%ld@%s-elsewhere.Ab12Cd",
+             dir, (long)child, hostbuf);
+    snprintf(files[3], sizeof files[3], "%s/.other.vtu.tmp-%ld@%s.Ab12Cd", dir, (long)child,
+             hostbuf);
+    for (int i = 0; i < 4; i++) {
+        FILE *f = fopen(files[i], "w");
+        if (f)
+            fclose(f);
+    }
+    TAP_CHECK(st_outfile_begin(&o, path, 1, &e) == ST_OK, "begin beside four leftovers");
+    struct stat st;
+    for (int i = 0; i < 4; i++)
+        TAP_CHECK((stat(files[i], &st) == 0) == (i != 0),
+                  "a leftover of a %s %s", kinds[i], i == 0 ? "process is removed" : "is kept");
+    fputs("x", o.fp);
+    TAP_CHECK(st_outfile_commit(&o, &e) == ST_OK, "and the output is written");
+    for (int i = 0; i < 4; i++)
+        unlink(files[i]);
+    unlink(path);
+    snprintf(name, sizeof name, "%s", dir);
+    TAP_CHECK(rmdir(name) == 0, "nothing else is left");
+}
+
+/* st_mem_address_space_left: SIZE_MAX with no ulimit -v; under one, the
+ * cap and what is left of it (checked in a child, which the cap cannot
+ * outlive). */
+static void test_address_space(void)
+{
+    struct rlimit rl;
+    getrlimit(RLIMIT_AS, &rl);
+    size_t cap;
+    if (rl.rlim_cur == RLIM_INFINITY)
+        TAP_CHECK(st_mem_address_space_left(&cap) == SIZE_MAX && cap == SIZE_MAX,
+                  "no ulimit -v: no cap, all of it left");
+    pid_t child = fork();
+    if (child == 0) {
+        size_t used = 0;
+        FILE *f = fopen("/proc/self/statm", "r");
+        unsigned long pages = 0;
+        if (f && fscanf(f, "%lu", &pages) == 1)
+            used = (size_t)pages * (size_t)sysconf(_SC_PAGESIZE);
+        if (f)
+            fclose(f);
+        struct rlimit r = rl;
+        r.rlim_cur = (rlim_t)(used + ((size_t)256 << 20));
+        if (r.rlim_max != RLIM_INFINITY && r.rlim_cur > r.rlim_max)
+            _exit(2);
+        if (setrlimit(RLIMIT_AS, &r) != 0)
+            _exit(2);
+        size_t lim, left = st_mem_address_space_left(&lim);
+        /* About 256 MiB left: what the fopen maps may take a little. */
+        _exit(lim == (size_t)r.rlim_cur && left <= ((size_t)256 << 20) &&
+              left > ((size_t)200 << 20) ? 0 : 1);
+    }
+    int ws = 0;
+    waitpid(child, &ws, 0);
+    TAP_CHECK(WIFEXITED(ws) && WEXITSTATUS(ws) == 0,
+              "under ulimit -v: the cap, and what is left of it (exit %d)",
+              WIFEXITED(ws) ? WEXITSTATUS(ws) : -1);
+}
+
 int main(void)
 {
     test_error_format();
@@ -177,5 +282,7 @@ int main(void)
     test_meta();
     test_grid();
     test_outfile();
+    test_outfile_stale();
+    test_address_space();
     return tap_done();
 }

@@ -265,6 +265,80 @@ static void test_bvh_nearest(void)
     st_soup_free(s);
 }
 
+/* A BVH over enough triangles to be built by parallel tasks has the
+ * serial build's layout: inner nodes numbered depth first, the right
+ * child's subtree before the left's, leaves of at most ST_BVH_LEAF slots
+ * covering order[] once, boxes holding their triangles; the same nodes
+ * with 1 and 3 threads; nearest answers equal to brute force. */
+static void test_bvh_parallel_layout(void)
+{
+    st_soup *s = random_soup(70001);
+    st_error err;
+    st_bvh *b1 = NULL, *b3 = NULL;
+#ifdef _OPENMP
+    omp_set_num_threads(1);
+#endif
+    TAP_CHECK(st_bvh_build(&b1, s, &err) == ST_OK, "bvh over 70001 triangles, 1 thread");
+#ifdef _OPENMP
+    omp_set_num_threads(3);
+#endif
+    TAP_CHECK(st_bvh_build(&b3, s, &err) == ST_OK, "bvh over 70001 triangles, 3 threads");
+    TAP_CHECK(b1->nnodes == b3->nnodes &&
+                  memcmp(b1->nodes, b3->nodes, b1->nnodes * sizeof *b1->nodes) == 0 &&
+                  memcmp(b1->order, b3->order, s->ntris * sizeof *b1->order) == 0,
+              "bvh: 1 and 3 threads build the same nodes and order");
+    size_t *stack = malloc(b3->nnodes * sizeof *stack);
+    unsigned char *seen = calloc(s->ntris, 1);
+    size_t sp = 0, next = 1, bad_number = 0, bad_leaf = 0, bad_box = 0, slots = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const st_bvh_node *n = &b3->nodes[stack[--sp]];
+        if (n->count == 0) {
+            if (n->start != next || n->start + 1 >= b3->nnodes) {
+                bad_number++;
+                break;
+            }
+            next += 2;
+            stack[sp++] = n->start;
+            stack[sp++] = n->start + 1;
+            continue;
+        }
+        if (n->count > ST_BVH_LEAF)
+            bad_leaf++;
+        for (uint32_t i = n->start; i < n->start + n->count; i++) {
+            uint32_t t = b3->order[i];
+            if (seen[t]++)
+                bad_leaf++;
+            slots++;
+            for (int k = 0; k < 3; k++) {
+                const double *v = s->xyz + 3 * (size_t)s->tris[3 * (size_t)t + (size_t)k];
+                for (int a = 0; a < 3; a++)
+                    if (v[a] < n->lo[a] || v[a] > n->hi[a])
+                        bad_box++;
+            }
+        }
+    }
+    TAP_CHECK(bad_number == 0 && next == b3->nnodes,
+              "bvh: nodes numbered as the serial walk numbers them (%zu of %zu)", next,
+              b3->nnodes);
+    TAP_CHECK(bad_leaf == 0 && slots == s->ntris && bad_box == 0,
+              "bvh: leaves hold every triangle once, in their boxes");
+    int bad = 0;
+    for (int i = 0; i < 20; i++) {
+        double p[3] = {urand() * 1.6 - 0.3, urand() * 1.6 - 0.3, urand() * 1.6 - 0.3};
+        int64_t tri;
+        double d = sqrt(st_bvh_nearest(b3, p, INFINITY, &tri, NULL));
+        if (fabs(d - brute_dist(s, p)) > 1e-12 || tri < 0)
+            bad++;
+    }
+    TAP_CHECK(bad == 0, "bvh over 70001 triangles: nearest equals brute force (%d bad)", bad);
+    free(stack);
+    free(seen);
+    st_bvh_free(b1);
+    st_bvh_free(b3);
+    st_soup_free(s);
+}
+
 static void test_threads_identical(void)
 {
 #ifdef _OPENMP
@@ -338,6 +412,7 @@ int main(void)
     test_band_exact_on_random_soup();
     test_large_oblique_triangle();
     test_bvh_nearest();
+    test_bvh_parallel_layout();
     test_threads_identical();
     test_real_model();
     return tap_done();

@@ -7,6 +7,7 @@
  * boundary vertex within max(d_offset, where the fit left it) of S while
  * it frees the vertices held at the band's edge. */
 #include "souptet/bvh.h"
+#include "souptet/enclose.h"
 #include "souptet/isect.h"
 #include "souptet/pred.h"
 #include "souptet/smooth.h"

@@ -3,7 +3,8 @@
  * sides of an oriented soup (sides.h): one call gives what the steps give
  * one by one, and large holes close: a box with a whole face missing (of
  * any size), a thin plate with half of one face gone, a one-sided
- * hemisphere shell; an unoriented soup gives what an oriented one gives.
+ * hemisphere shell, a one-sided scan of a ball whose horizon is not
+ * flat; an unoriented soup gives what an oriented one gives.
  */
 #include "souptet/pseudo.h"
 #include "souptet/solid.h"
@@ -177,6 +178,62 @@ static void test_hemisphere(void)
     st_soup_free(t);
 }
 
+/* A ball whose equator waves (z + a cos(3 phi) sin^2 theta), outward:
+ * all of it (up < 0), or only its faces that face up (up > 0). */
+static void add_wavy_ball(st_soup *s, double a, int up)
+{
+    const int nu = 48, nv = 24;
+    for (int i = 0; i < nv; i++)
+        for (int j = 0; j < nu; j++) {
+            double p[4][3];
+            for (int c = 0; c < 4; c++) {
+                int ii = i + (c >= 2), jj = j + (c == 1 || c == 2);
+                double th = M_PI * ii / nv, ph = 2 * M_PI * jj / nu;
+                p[c][0] = sin(th) * cos(ph);
+                p[c][1] = sin(th) * sin(ph);
+                p[c][2] = cos(th) + a * cos(3 * ph) * sin(th) * sin(th);
+            }
+            const int tri[2][3] = {{0, 2, 1}, {0, 3, 2}};   /* outward */
+            for (int k = 0; k < 2; k++) {
+                const double *A = p[tri[k][0]], *B = p[tri[k][1]], *C = p[tri[k][2]];
+                const double nz = (B[0] - A[0]) * (C[1] - A[1]) - (B[1] - A[1]) * (C[0] - A[0]);
+                if (up > 0 && nz < 0.0)
+                    continue;
+                add_tri(s, A, B, C, 0);
+            }
+        }
+}
+
+static void test_onesided(void)
+{
+    /* A one-sided scan from above of a ball whose horizon waves (not flat,
+     * so no hole cap): the least-area closure stops at the horizon; the
+     * mirror (sides.h) continues it below by as much as above. */
+    st_soup *s = st_soup_new(), *t = st_soup_new();
+    add_wavy_ball(s, 0.3, 1);
+    add_wavy_ball(t, 0.3, -1);
+    st_pseudo_params pp = st_pseudo_params_default();
+    const double with = iou_of(s, t, 64, &pp);
+    pp.sides_params.onesided_ratio = 0.0;
+    const double without = iou_of(s, t, 64, &pp);
+    TAP_CHECK(with >= 0.85 && with > without + 0.2,
+              "a one-sided scan of a wavy ball closes below its horizon (IoU %.4f, %.4f "
+              "without the mirror)", with, without);
+    /* the whole ball is not one-sided: the mirror leaves it alone */
+    st_pseudo_stats st;
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = 32;
+    st_grid *g = NULL;
+    st_error err;
+    pp = st_pseudo_params_default();
+    const int ok = !st_pseudo_volume(&g, t, &dp, &pp, &st, NULL, &err);
+    TAP_CHECK(ok && !st.sides.onesided && st.mirrored == 0 && st.sides.back_front > 0.9,
+              "a closed ball is not one-sided (back/front %.3f)", st.sides.back_front);
+    st_grid_free(g);
+    st_soup_free(s);
+    st_soup_free(t);
+}
+
 static void test_sides_orientation(void)
 {
     /* The sides' evidence does not read the file's orientation: a box
@@ -241,6 +298,7 @@ int main(void)
     test_entry_point();
     test_large_holes();
     test_hemisphere();
+    test_onesided();
     test_sides_orientation();
     return tap_done();
 }

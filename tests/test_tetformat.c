@@ -135,7 +135,7 @@ static int write_samples(const char *dir)
         snprintf(path, sizeof path, "%s/%s", dir, k_variants[i].file);
         st_tetformat_opts o = {k_variants[i].version, k_variants[i].binary};
         st_error e;
-        if (st_tetformat_save(m, ST_TETFORMAT_NONE, path, &o, &e)) {
+        if (st_tetmesh_save(m, path, &o, &e)) {
             char buf[1100];
             fprintf(stderr, "test_tetformat: %s\n",
                     st_error_format(&e, buf, sizeof buf));
@@ -160,10 +160,10 @@ static void test_round_trips(void)
         snprintf(path, sizeof path, "%s/%s", g_dir, v->file);
         st_tetformat_opts o = {v->version, v->binary};
         st_error e;
-        st_status s = st_tetformat_save(m, ST_TETFORMAT_NONE, path, &o, &e);
+        st_status s = st_tetmesh_save(m, path, &o, &e);
         TAP_CHECK(s == ST_OK, "%s: written", v->file);
         st_tetmesh *r = NULL;
-        s = st_tetformat_read(&r, ST_TETFORMAT_NONE, path, 0, &e);
+        s = st_tetmesh_read(&r, path, 0, &e);
         TAP_CHECK(s == ST_OK, "%s: read back (%s)", v->file,
                   s ? e.msg : "ok");
         TAP_CHECK(r && same_mesh(m, r),
@@ -194,12 +194,11 @@ static void test_round_trips(void)
         st_outfile of;
         st_error e;
         int okw = st_outfile_begin(&of, path, 0, &e) == ST_OK &&
-                  st_tetformat_write(m, ST_TETFORMAT_NONE, of.tmp, NULL,
-                                     &e) == ST_OK &&
+                  st_tetmesh_write(m, of.tmp, NULL, &e) == ST_OK &&
                   st_outfile_commit(&of, &e) == ST_OK;
         st_outfile_abort(&of);
         st_tetmesh *r = NULL;
-        okw = okw && st_tetformat_read(&r, ST_TETFORMAT_NONE, path, 0, &e) ==
+        okw = okw && st_tetmesh_read(&r, path, 0, &e) ==
                          ST_OK && r && same_mesh(m, r);
         TAP_CHECK(okw, "written through st_outfile's temporary name: %s",
                   targets[i]);
@@ -212,14 +211,14 @@ static void test_round_trips(void)
     rename(path, other);
     st_tetmesh *r = NULL;
     st_error e;
-    TAP_CHECK(st_tetformat_read(&r, ST_TETFORMAT_NONE, other, 0, &e) ==
+    TAP_CHECK(st_tetmesh_read(&r, other, 0, &e) ==
                       ST_OK && r && same_mesh(m, r),
               "an .msh without its extension is recognised by content");
     st_tetmesh_free(r);
     r = NULL;
     /* max_bytes caps the mesh memory. */
     snprintf(path, sizeof path, "%s/m.mesh", g_dir);
-    st_status s = st_tetformat_read(&r, ST_TETFORMAT_NONE, path, 1000, &e);
+    st_status s = st_tetmesh_read(&r, path, 1000, &e);
     TAP_CHECK(s == ST_ELIMIT && !r, "max_bytes 1000 refuses a %zu-byte mesh",
               24 * m->npoints + 16 * m->ntets);
     st_tetmesh_free(m);
@@ -262,7 +261,7 @@ static void test_written_text(void)
                                0};
         st_error e;
         if (cases[i].version >= 0)
-            st_tetformat_save(m, ST_TETFORMAT_NONE, path, &o, &e);
+            st_tetmesh_save(m, path, &o, &e);
         char buf[1024] = {0};
         FILE *fp = fopen(path, "rb");
         size_t n = fp ? fread(buf, 1, sizeof buf - 1, fp) : 0;
@@ -592,11 +591,14 @@ static void test_paths(void)
                   st_tetformat_from_path("b.node") == ST_TETFORMAT_TETGEN &&
                   st_tetformat_from_path("b.ele") == ST_TETFORMAT_TETGEN &&
                   st_tetformat_from_path("b.mesh") == ST_TETFORMAT_MEDIT &&
-                  st_tetformat_from_path("b.vtu") == ST_TETFORMAT_NONE &&
-                  st_tetformat_from_path("-") == ST_TETFORMAT_NONE &&
-                  st_tetformat_from_path(".msh") == ST_TETFORMAT_NONE,
+                  st_tetformat_from_path("b.Vtu") == ST_TETFORMAT_VTU &&
+                  st_tetformat_from_path("-") == ST_TETFORMAT_VTU &&
+                  st_tetformat_from_path(NULL) == ST_TETFORMAT_VTU &&
+                  st_tetformat_from_path("b.obj") == ST_TETFORMAT_NONE &&
+                  st_tetformat_from_path(".msh") == ST_TETFORMAT_NONE &&
+                  st_tetformat_from_path(".vtu") == ST_TETFORMAT_NONE,
               "format by extension");
-    TAP_CHECK(st_tetformat_from_path("d/.x.msh.AbC123") == ST_TETFORMAT_MSH,
+    TAP_CHECK(st_tetformat_from_path("d/.x.msh.tmp-12@host.AbC123") == ST_TETFORMAT_MSH,
               "an st_outfile temporary name has its target's format");
 }
 
@@ -604,9 +606,7 @@ static st_tetmesh *read_any(const char *path)
 {
     st_tetmesh *m = NULL;
     st_error e;
-    st_status s = st_tetformat_from_path(path) != ST_TETFORMAT_NONE
-                      ? st_tetformat_read(&m, ST_TETFORMAT_NONE, path, 0, &e)
-                      : st_tetmesh_read(&m, path, 0, &e);
+    st_status s = st_tetmesh_read(&m, path, 0, &e);
     if (s) {
         char buf[1100];
         fprintf(stderr, "test_tetformat: %s\n",

@@ -127,7 +127,7 @@ static void test_file_roundtrip(void)
     st_error err;
     char p[256];
     path_in(p, sizeof p, "m.vtu");
-    TAP_CHECK(st_tetmesh_write(m, p, &err) == ST_OK, "write m.vtu");
+    TAP_CHECK(st_tetmesh_write(m, p, NULL, &err) == ST_OK, "write m.vtu");
     TAP_CHECK(st_tetmesh_read(&r, p, 0, &err) == ST_OK && same_mesh(m, r),
               "file round trip: points, tets, arrays, meta bit for bit");
     TAP_CHECK(r && !st_tetmesh_find_array(r, "min_dihedral", ST_ON_CELLS),
@@ -135,7 +135,7 @@ static void test_file_roundtrip(void)
     st_tetmesh_free(r);
     r = NULL;
     path_in(p, sizeof p, "saved.vtu");
-    TAP_CHECK(st_tetmesh_save(m, p, &err) == ST_OK &&
+    TAP_CHECK(st_tetmesh_save(m, p, NULL, &err) == ST_OK &&
                   st_tetmesh_read(&r, p, 0, &err) == ST_OK && same_mesh(m, r),
               "st_tetmesh_save writes the file atomically, same content");
     st_tetmesh_free(r);
@@ -149,11 +149,11 @@ static void test_file_roundtrip(void)
     st_tetmesh_free(r);
     r = NULL;
     path_in(p, sizeof p, "m.txt");
-    TAP_CHECK(st_tetmesh_write(m, p, &err) == ST_EINPUT &&
+    TAP_CHECK(st_tetmesh_write(m, p, NULL, &err) == ST_EINPUT &&
                   strstr(err.msg, "unknown tet mesh format"),
               "writing m.txt: unknown format (%s)", err.msg);
     path_in(p, sizeof p, "nodir/x.vtu");
-    TAP_CHECK(st_tetmesh_save(m, p, &err) != ST_OK &&
+    TAP_CHECK(st_tetmesh_save(m, p, NULL, &err) != ST_OK &&
                   strcmp(err.file, p) == 0,
               "save into a missing directory fails naming the target");
     st_tetmesh_free(m);
@@ -171,7 +171,7 @@ static void test_other_formats(void)
         st_error err;
         char p[256];
         path_in(p, sizeof p, names[i]);
-        st_status s = st_tetmesh_save(m, p, &err);
+        st_status s = st_tetmesh_save(m, p, NULL, &err);
         if (s == ST_OK)
             s = st_tetmesh_read(&r, p, 0, &err);
         TAP_CHECK(s == ST_OK && same_mesh(m, r),
@@ -180,13 +180,13 @@ static void test_other_formats(void)
                   names[i], s ? ": " : "", s ? err.msg : "");
         st_tetmesh_free(r);
     }
-    TAP_CHECK(st_tet_format_from_path("a/b.MSH") == ST_TET_FMT_MSH &&
-                  st_tet_format_from_path("x.ele") == ST_TET_FMT_TETGEN &&
-                  st_tet_format_from_path("x.mesh") == ST_TET_FMT_MEDIT &&
-                  st_tet_format_from_path("x.Vtu") == ST_TET_FMT_VTU &&
-                  st_tet_format_from_path("-") == ST_TET_FMT_VTU &&
-                  st_tet_format_from_path("x.obj") == ST_TET_FMT_UNKNOWN &&
-                  st_tet_format_from_path(".vtu") == ST_TET_FMT_UNKNOWN,
+    TAP_CHECK(st_tetformat_from_path("a/b.MSH") == ST_TETFORMAT_MSH &&
+                  st_tetformat_from_path("x.ele") == ST_TETFORMAT_TETGEN &&
+                  st_tetformat_from_path("x.mesh") == ST_TETFORMAT_MEDIT &&
+                  st_tetformat_from_path("x.Vtu") == ST_TETFORMAT_VTU &&
+                  st_tetformat_from_path("-") == ST_TETFORMAT_VTU &&
+                  st_tetformat_from_path("x.obj") == ST_TETFORMAT_NONE &&
+                  st_tetformat_from_path(".vtu") == ST_TETFORMAT_NONE,
               "formats from paths");
     st_tetmesh_free(m);
 }
@@ -206,7 +206,7 @@ static void test_points_only(void)
     st_error err;
     char p[256];
     path_in(p, sizeof p, "pts.vtu");
-    TAP_CHECK(st_tetmesh_write(m, p, &err) == ST_OK, "write a points-only .vtu");
+    TAP_CHECK(st_tetmesh_write(m, p, NULL, &err) == ST_OK, "write a points-only .vtu");
     FILE *f = fopen(p, "rb");
     char buf[4096] = {0};
     size_t n = f ? fread(buf, 1, sizeof buf - 1, f) : 0;
@@ -294,7 +294,7 @@ static void test_pipe(void)
     int fd = open(p, O_WRONLY | O_CREAT | O_TRUNC, 0600);
     dup2(fd, 1);
     close(fd);
-    st_status s = st_tetmesh_write(m, "-", &err);
+    st_status s = st_tetmesh_write(m, "-", NULL, &err);
     fflush(stdout);
     dup2(saved, 1);
     close(saved);
@@ -467,7 +467,7 @@ int main(int argc, char **argv)
     if (argc == 3 && strcmp(argv[1], "--write") == 0) {
         st_tetmesh *m = sample();
         st_error err;
-        st_status s = st_tetmesh_save(m, argv[2], &err);
+        st_status s = st_tetmesh_save(m, argv[2], NULL, &err);
         st_tetmesh_free(m);
         if (s) {
             char buf[1200];

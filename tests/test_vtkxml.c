@@ -22,6 +22,7 @@
 #include "souptet/meta.h"
 #include "souptet/tetio.h"
 #include "souptet/tetmesh.h"
+#include "../src/fileio.h"
 #include "../src/vtkxml.h"
 #include "../src/adapters/gridio_internal.h"
 #include "../src/adapters/tetio_internal.h"
@@ -59,7 +60,7 @@ static unsigned char *load(const char *path, size_t *n)
 {
     unsigned char *d = NULL;
     st_error e;
-    if (st_vtkxml_read_file(path, &d, n, &e) != ST_OK)
+    if (st_file_read(path, &d, n, &e) != ST_OK)
         return NULL;
     return d;
 }
@@ -811,7 +812,7 @@ static void test_own_writers(void)
               "souptet's .vtu reads back");
     st_tetmesh_free(r);
     snprintf(p, sizeof p, "%s/own.vtu", g_tmp);
-    s = st_tetmesh_write(m, p, &e);
+    s = st_tetmesh_write(m, p, NULL, &e);
     r = NULL;
     s = s == ST_OK ? st_tetmesh_read(&r, p, 0, &e) : s;
     TAP_CHECK(s == ST_OK && r && r->ntets == 2,

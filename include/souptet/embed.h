@@ -19,8 +19,6 @@
  * Speed: a uniform grid of bins over the mesh's box, each bin listing the
  * tets whose bounding boxes meet it (about one tet per bin), in tet order;
  * a vertex tests only its bin's tets. Parallel over vertices.
- *
- * Module order: ... -> isect -> tetmesh -> embed -> ...
  */
 #ifndef SOUPTET_EMBED_H
 #define SOUPTET_EMBED_H

@@ -28,8 +28,6 @@
  * queried from many threads at once. st_enclosure_compute runs OpenMP
  * loops over soup vertices and boundary faces; its counts and per-item
  * arrays do not depend on the thread count.
- *
- * Module order: ... -> pred -> isect -> bvh -> tetmesh -> enclose -> tetstat
  */
 #ifndef SOUPTET_ENCLOSE_H
 #define SOUPTET_ENCLOSE_H
@@ -98,6 +96,16 @@ st_status st_enclosure_compute(st_enclosure *out, const st_tetmesh *m,
                                const st_soup *s, const st_bvh *bvh,
                                unsigned char *vertex_in,
                                unsigned char *tri_crossing, st_error *err);
+
+/* Count, exactly, the vertices of s (those its triangles use) not in the
+ * closed union of m's tets, and the triangles of s that meet a boundary
+ * face of m (closed sets: touching counts). Enclosing means both are 0.
+ * On error (ST_ENOMEM, those of st_enclosure_compute) both are SIZE_MAX,
+ * so a caller that ignores the status never reads "encloses".
+ * bvh over s may be NULL. Thread-safe. */
+st_status st_enclosure_count(const st_tetmesh *m, const st_soup *s,
+                             const st_bvh *bvh, size_t *verts_outside,
+                             size_t *tris_crossing, st_error *err);
 
 #ifdef __cplusplus
 }

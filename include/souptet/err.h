@@ -7,8 +7,8 @@
  * file, line and byte offset say where, so a tool can print
  * "tool: FILE:LINE: what" (or "FILE: byte N: what" for binary input).
  *
- * Module order: err -> mem -> meta -> pred -> geom -> soup -> grid -> bvh -> dist
- * A module uses only those before it.
+ * The module order, err first, is written once, in src/MODULES: a module
+ * uses only those above it (make check: tests/tools/layering.t).
  */
 #ifndef SOUPTET_ERR_H
 #define SOUPTET_ERR_H

@@ -52,6 +52,10 @@ st_status st_grid_new_unset(st_grid **out, size_t nx, size_t ny, size_t nz,
                             size_t max_bytes, st_error *err);
 void st_grid_free(st_grid *g);   /* safe on NULL */
 
+/* The name a field of this kind is stored under in files (gridio.h):
+ * "distance", "sdf", else "field". */
+const char *st_grid_name_for_kind(st_grid_kind kind);
+
 /* Number of voxels (never overflows for a grid that exists). */
 size_t st_grid_count(const st_grid *g);
 /* Linear index of voxel (i, j, k). */

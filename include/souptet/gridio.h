@@ -36,9 +36,6 @@ typedef enum st_grid_format {
 /* Format from a path's extension (".vdb", ".vti", case-insensitive). */
 st_grid_format st_grid_format_from_path(const char *path);
 
-/* The grid name a kind is stored under: "distance", "sdf". */
-const char *st_grid_name_for_kind(st_grid_kind kind);
-
 /* Write g to path. "-" or NULL writes an OpenVDB stream to stdout.
  * Files are written to a temporary name beside path and renamed when
  * complete; on failure nothing is left at path. */

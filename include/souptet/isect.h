@@ -7,8 +7,6 @@
  * share only a vertex intersect; a point on a tet's face is in the tet.
  * Degenerate inputs (a triangle whose vertices are collinear, a flat tet)
  * are handled as the point sets they are (a segment, a point, a triangle).
- *
- * Module order: ... -> pred -> isect -> ...
  */
 #ifndef SOUPTET_ISECT_H
 #define SOUPTET_ISECT_H

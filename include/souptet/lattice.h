@@ -38,8 +38,6 @@
  *
  * Every tet is positively oriented (tetmesh.h: signed volume > 0), decided
  * on the integer coordinates (R is a proper rotation).
- *
- * Module order: ... grid -> tetmesh -> lattice -> sculpt ...
  */
 #ifndef SOUPTET_LATTICE_H
 #define SOUPTET_LATTICE_H

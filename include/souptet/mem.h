@@ -33,6 +33,12 @@ void *st_calloc_big(size_t n);
 /* The same without zeroing. */
 void *st_malloc_big(size_t n);
 
+/* The address space this process may still map: the soft RLIMIT_AS
+ * (ulimit -v) less what is mapped now (/proc/self/statm); SIZE_MAX when
+ * there is no such limit. *limit (when not NULL) gets the limit itself,
+ * SIZE_MAX when none. An allocation past it fails whatever the RAM. */
+size_t st_mem_address_space_left(size_t *limit);
+
 /* strdup that returns NULL on failure; NULL in gives NULL out. */
 char *st_strdup(const char *s);
 

@@ -10,6 +10,12 @@
  *
  * Temporary names in flight are remembered so a tool's signal handler can
  * remove them with st_outfile_unlink_pending(), which is async-signal-safe.
+ *
+ * A temporary is "dir/.NAME.tmp-PID@HOST.XXXXXX": hidden, beside its
+ * target NAME, with the pid and machine of the process writing it. One
+ * that SIGKILL or a crash left behind (no handler runs) is therefore
+ * recognisably stale; st_outfile_begin removes those of its target whose
+ * process is gone (same HOST, no such PID), so a rerun cleans up.
  */
 #ifndef SOUPTET_OUTFILE_H
 #define SOUPTET_OUTFILE_H
@@ -45,6 +51,11 @@ st_status st_outfile_commit(st_outfile *o, st_error *err);
 /* Close and remove the temporary file. Safe after commit and on a zeroed
  * st_outfile. */
 void st_outfile_abort(st_outfile *o);
+
+/* The target path of a temporary name st_outfile_begin made (the same
+ * directory, NAME without the leading '.' and the ".tmp-PID@HOST.XXXXXX"
+ * tail), malloc'd; NULL when tmp is not such a name (or out of memory). */
+char *st_outfile_target_of(const char *tmp);
 
 /* Unlink every temporary file still in flight; async-signal-safe. */
 void st_outfile_unlink_pending(void);

@@ -15,9 +15,11 @@
  * that does not depend on which finished first:
  *   1. enclosing before not enclosing (no soup vertex outside the mesh, no
  *      soup triangle meeting the boundary, counted exactly);
- *   2. larger minimum dihedral angle;
- *   3. smaller maximum dihedral angle;
- *   4. smaller k.
+ *   2. the fit's stopping condition met (every boundary vertex within
+ *      offset_ratio * h of the soup) before not met;
+ *   3. larger minimum dihedral angle;
+ *   4. smaller maximum dihedral angle;
+ *   5. smaller k.
  * Every stage is deterministic for any thread count, so the output depends
  * only on the soup and the parameters.
  *
@@ -25,8 +27,6 @@
  * pseudo-volume density, then volume-preserving boundary fairing; it
  * approximates the pseudo volume and does not try to enclose the soup
  * (enclosure is still measured and reported).
- *
- * Module order: ... dist -> sign -> lattice -> sculpt -> smooth -> pipeline.
  */
 #ifndef SOUPTET_PIPELINE_H
 #define SOUPTET_PIPELINE_H
@@ -126,7 +126,8 @@ typedef struct st_pipeline_candidate {
     size_t tets, points;
     size_t bombs, bombs_left;
     int converged;                 /* every boundary vertex within d_offset */
-    size_t beyond_offset;
+    size_t beyond_offset;          /* of boundary_vertices */
+    size_t boundary_vertices;
     double max_distance;           /* boundary vertices to the soup */
     double min_dihedral, max_dihedral;
     size_t verts_outside, tris_crossing;   /* exact, 0 and 0: encloses */

@@ -23,9 +23,6 @@
  * refine). The field need not come from this process: soupsign reads it
  * from soupdist, and the same call on the same field and soup gives the
  * same bytes, whoever calls it.
- *
- * Module order: ... dist -> sign -> edges -> holes -> shells -> pseudo
- *   -> lattice ...
  */
 #ifndef SOUPTET_PSEUDO_H
 #define SOUPTET_PSEUDO_H
@@ -67,6 +64,7 @@ typedef struct st_pseudo_stats {
     st_holes_stats holes;
     size_t cap_triangles;
     st_sides_stats sides;
+    size_t mirrored;                /* voxels a one-sided view's mirror added */
     size_t refined;                 /* signs the refinement changed */
     size_t shells;                  /* closed shells */
     size_t shell_open_triangles;    /* triangles in none */

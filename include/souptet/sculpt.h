@@ -33,8 +33,6 @@
  *
  * Everything is deterministic: classification runs in parallel (OpenMP)
  * per tet, repair sequentially in lattice order.
- *
- * Module order: ... lattice -> bvh -> isect -> sculpt ...
  */
 #ifndef SOUPTET_SCULPT_H
 #define SOUPTET_SCULPT_H

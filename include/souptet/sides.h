@@ -21,15 +21,20 @@
  *      Strackee 1983) of the triangles in the cube of radius_voxels
  *      around it, over 4 pi: near +1/2 just inside a wall, near -1/2 just
  *      outside, less where the wall has a hole. Times `weight`, clamped to
- *      +-max_evidence, rounded, it is evidence in votes of margin.
+ *      +-max_evidence, rounded, it is evidence in votes of margin;
+ *   4. whether the soup is a one-sided view (a scan from one side, whose
+ *      far side was never seen): a closed surface's oriented area sums to
+ *      zero in every projection, so the projected area of the oriented
+ *      soup facing away from its mean normal v equals that facing v; a
+ *      soup whose faces nearly all face v (back_front, that ratio, below
+ *      onesided_ratio) is a view from v. st_sides_mirror then completes
+ *      the signed solid behind it.
  * So the cut (mincut.h) has, on each side of every surviving wall, the
  * side it is on, and spans the holes between walls by the least area.
  *
  * Memory: one byte per voxel (the evidence, the caller's) and O(triangles).
  * Deterministic for any number of threads (each voxel sums its triangles
  * in the BVH's fixed order).
- *
- * Module order: ... sign -> edges -> sides -> holes -> shells -> pseudo
  */
 #ifndef SOUPTET_SIDES_H
 #define SOUPTET_SIDES_H
@@ -50,6 +55,7 @@ typedef struct st_sides_params {
     double radius_voxels;   /* triangles within this cube count */
     double weight;          /* evidence per unit of winding number */
     int max_evidence;       /* |evidence| at most this */
+    double onesided_ratio;  /* one-sided below this back/front ratio (0: never) */
 } st_sides_params;
 
 st_sides_params st_sides_params_default(void);
@@ -59,6 +65,12 @@ typedef struct st_sides_stats {
     size_t turned;          /* regions turned to agree with the votes */
     size_t conflicts;       /* edges where the propagation disagreed */
     size_t voxels;          /* voxels given evidence */
+    double back_front;      /* projected area facing away from the view over
+                               facing it (0 for a one-sided view, 1 closed) */
+    double view[3];         /* the view direction (unit; the mean normal) */
+    int onesided;           /* back_front < onesided_ratio */
+    int step[3];            /* the lattice step nearest view */
+    double far;             /* the soup's farthest point along it */
 } st_sides_stats;
 
 /* evidence (n bytes) gets each voxel's evidence (0 where none). g: the
@@ -70,6 +82,23 @@ st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *v
                             int decided, const st_soup *s,
                             const st_sides_params *p, st_sides_stats *stats,
                             st_error *err);
+
+/* A one-sided view's far side (stats->onesided; nothing otherwise), on
+ * the signed field g of its pseudo volume: along each line of the lattice
+ * step nearest the view (components in -2..2), the run of inside voxels
+ * farthest from the viewer, if it does not end on the soup (its far end is
+ * the cut's least-area cap across the horizon, not a seen wall), is
+ * continued away from the viewer by its own length, stopping at the soup
+ * and at the depth of its farthest point from the viewer (stats->far):
+ * the solid taken as symmetric about the horizon it was seen to. A prior,
+ * not evidence: right for a body whose far half mirrors its near half
+ * (a ball seen to a wavy horizon, a scanned animal), too much where the
+ * part was seen past its widest section. A horizon loop that holes.h caps
+ * (a flat one) ends the runs on the cap and is left as it is. *changed
+ * gets the voxels made inside. Deterministic: each line is one thread's.
+ * ST_ENOMEM. */
+st_status st_sides_mirror(st_grid *g, const st_sides_stats *stats, size_t *changed,
+                          st_error *err);
 
 #ifdef __cplusplus
 }

@@ -17,15 +17,17 @@
  * the mesh still is, no boundary triangle that did not meet a triangle of S
  * does, and every tet is positively oriented - all decided by the exact
  * predicates (pred.h, isect.h). A move that would break it is halved a few
- * times, then skipped.
+ * times, then skipped. Boundary vertices the fit leaves beyond d_offset
+ * (held by the invariant in thin gaps and at sharp features) get a rescue:
+ * steps in other directions that still bring them closer to S, under the
+ * same invariant; once after the fit, then after the quality pass (and the
+ * quality pass again), see fit.c.
  *
  * Both require every tet of the input to be positively oriented (tetmesh.h)
  * and refuse the mesh otherwise; both never produce an inverted or flat tet.
  * Vertices move in a fixed order (independent sets of a greedy colouring,
  * each set in parallel), so the result does not depend on the thread count.
  * No global state: calls on different meshes may run concurrently.
- *
- * Module order: ... -> bvh -> tetqual -> tetmesh -> smooth -> ...
  */
 #ifndef SOUPTET_SMOOTH_H
 #define SOUPTET_SMOOTH_H
@@ -156,20 +158,11 @@ st_fit_params st_fit_params_default(void);
  * ST_EINPUT on inverted or flat tets, a mesh without tets, or no cell
  * width (neither p->cell_width nor a meta "h" > 0); ST_ENOMEM when out of
  * memory, the quality pass's memory included (never a silently skipped
- * pass). Not converging is not an error: stats->converged says it. stats and prog may be NULL. */
+ * pass). Not converging is not an error: stats->converged says it (of the
+ * final mesh, after the quality pass). stats and prog may be NULL. */
 st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
                  const st_fit_params *p, st_fit_stats *stats,
                  const st_progress *prog, st_error *err);
-
-/* Count, exactly, the vertices of s (those its triangles use) not in the
- * closed union of m's tets, and the triangles of s that meet a boundary
- * face of m (closed sets: touching counts). Enclosing means both are 0.
- * On error (ST_ENOMEM, those of st_enclosure_compute) both are SIZE_MAX,
- * so a caller that ignores the status never reads "encloses".
- * bvh over s may be NULL. Thread-safe. */
-st_status st_enclosure_count(const st_tetmesh *m, const st_soup *s,
-                             const st_bvh *bvh, size_t *verts_outside,
-                             size_t *tris_crossing, st_error *err);
 
 #ifdef __cplusplus
 }

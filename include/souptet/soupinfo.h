@@ -65,8 +65,6 @@
  *   A collinear triangle is tested only against triangles with no corner
  *   in common (its point set is a segment: "opposite edge" and "side"
  *   have no meaning for it).
- *
- * Module order: err -> mem -> ... -> pred -> isect -> soup -> bvh -> soupinfo.
  */
 #ifndef SOUPTET_SOUPINFO_H
 #define SOUPTET_SOUPINFO_H

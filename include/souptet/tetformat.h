@@ -1,7 +1,13 @@
 /*
- * tetformat.h - the simulator tet-mesh formats, plain C, no library:
- * Gmsh .msh (4.1 and 2.2, ASCII and binary), TetGen .node/.ele and
- * Medit .mesh. (.vtu is tetio.h's; tetio.c dispatches here by extension.)
+ * tetformat.h - the tet-mesh formats: their one enum and writer options,
+ * and the simulator formats themselves, plain C, no library: Gmsh .msh
+ * (4.1 and 2.2, ASCII and binary), TetGen .node/.ele and Medit .mesh.
+ * .vtu is the VTK adapter's. Tools and library callers read and write
+ * every format through one front door, tetio.h (st_tetmesh_read,
+ * st_tetmesh_save, st_tetmesh_write), which dispatches here; the
+ * per-format functions below are for tests, fuzzers and callers that
+ * hold the bytes. (One file per format: src/tetformat_msh.c,
+ * tetformat_tetgen.c, tetformat_medit.c.)
  *
  * What is kept. Points and tets, exactly (coordinates are written with 17
  * significant digits or as raw doubles, so a round trip is bit-exact), and
@@ -36,8 +42,6 @@
  * without tets. No allocation is ever sized by a count before the bytes
  * that would hold it are known to exist, and max_bytes (0: no limit) caps
  * the mesh memory (24 bytes a point, 16 a tet): more is ST_ELIMIT.
- *
- * Module order: ... -> tetmesh -> tetformat -> tetio (dispatch) -> ...
  */
 #ifndef SOUPTET_TETFORMAT_H
 #define SOUPTET_TETFORMAT_H
@@ -51,41 +55,41 @@
 extern "C" {
 #endif
 
+/* The tet-mesh formats, one enum for all of them. */
 typedef enum st_tetformat {
-    ST_TETFORMAT_NONE = 0,   /* not one of these (maybe .vtu: tetio.h) */
+    ST_TETFORMAT_NONE = 0,   /* unknown */
+    ST_TETFORMAT_VTU,        /* .vtu, and the pipes (tetio.h) */
     ST_TETFORMAT_MSH,        /* .msh */
     ST_TETFORMAT_TETGEN,     /* .node or .ele (the pair) */
     ST_TETFORMAT_MEDIT       /* .mesh */
 } st_tetformat;
 
-/* Writer options; a zeroed struct means the defaults. */
+/* Writer options; a zeroed struct (or NULL where one is taken) means the
+ * defaults. Only .msh has any. */
 typedef struct st_tetformat_opts {
     int msh_version;  /* 41 (default, also 0 and 4) or 22 (also 2) */
     int binary;       /* msh only: 0 ASCII (default), 1 binary */
 } st_tetformat_opts;
 
-/* The format of a path's extension (case-insensitive): .msh, .node, .ele,
- * .mesh; NONE otherwise, for NULL and "-" too (these formats are never
- * piped). A temporary name made by st_outfile_begin for such a path
+/* The format of a path's extension (case-insensitive): .vtu, .msh,
+ * .node, .ele, .mesh; NONE otherwise. NULL and "-" give VTU (the pipe
+ * format). A temporary name made by st_outfile_begin for such a path
  * ("dir/.name.msh.XXXXXX") gives the target's format. */
 st_tetformat st_tetformat_from_path(const char *path);
 
-/* "msh", "tetgen", "medit" or "none". */
+/* "vtu", "msh", "tetgen", "medit" or "none". */
 const char *st_tetformat_name(st_tetformat f);
 
-/* The file's format from its first bytes ("$MeshFormat", "MeshVersion...")
- * or NONE; TetGen files have no signature. */
+/* The format of a document from its first bytes: MSH ("$MeshFormat"),
+ * MEDIT ("MeshVersion..."), VTU (XML: '<' after an optional byte-order
+ * mark and white space) or NONE; TetGen files have no signature. */
 st_tetformat st_tetformat_sniff(const unsigned char *data, size_t size);
 
 /* ---- reading ------------------------------------------------------------ */
 
-/* Read a mesh from path in format f (NONE: from the extension, else the
- * content). For TETGEN, path may be the .node, the .ele or the base name
- * without extension; both files are read. On failure *out is NULL. */
-st_status st_tetformat_read(st_tetmesh **out, st_tetformat f,
-                            const char *path, size_t max_bytes,
-                            st_error *err);
-
+/* Read a mesh file of that format. For TetGen, path may be the .node, the
+ * .ele or the base name without extension; both files are read. On
+ * failure *out is NULL. */
 st_status st_tetmesh_read_msh(st_tetmesh **out, const char *path,
                               size_t max_bytes, st_error *err);
 st_status st_tetmesh_read_tetgen(st_tetmesh **out, const char *path,
@@ -110,8 +114,9 @@ st_status st_tetmesh_parse_medit(st_tetmesh **out, const unsigned char *data,
 
 /* ---- writing ------------------------------------------------------------ */
 
-/* Write m exactly at path (no temporary file; see st_tetformat_save).
- * version: 41 or 22 (0 means 41); binary 0 or 1. */
+/* Write m exactly at path (no temporary file; the tools write through
+ * st_tetmesh_save, tetio.h). version: 41 or 22 (0 means 41); binary 0
+ * or 1. */
 st_status st_tetmesh_write_msh(const st_tetmesh *m, const char *path,
                                int version, int binary, st_error *err);
 /* path: the .node, the .ele or the base name; writes base.node and
@@ -120,20 +125,6 @@ st_status st_tetmesh_write_tetgen(const st_tetmesh *m, const char *path,
                                   st_error *err);
 st_status st_tetmesh_write_medit(const st_tetmesh *m, const char *path,
                                  st_error *err);
-
-/* Write m to path in format f (NONE: from the extension) with opts (NULL:
- * defaults), exactly at path. */
-st_status st_tetformat_write(const st_tetmesh *m, st_tetformat f,
-                             const char *path, const st_tetformat_opts *opts,
-                             st_error *err);
-
-/* As st_tetformat_write, atomically for the tools: every file (both of a
- * TetGen pair) goes to a temporary name beside its target and is renamed
- * only when all were written, so a failure leaves nothing at the targets.
- * Errors name the target. */
-st_status st_tetformat_save(const st_tetmesh *m, st_tetformat f,
-                            const char *path, const st_tetformat_opts *opts,
-                            st_error *err);
 
 #ifdef __cplusplus
 }

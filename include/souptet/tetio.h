@@ -1,6 +1,8 @@
 /*
- * tetio.h - tet meshes on disk and on pipes (the C face of the VTK
- * adapter, src/adapters/tetio_vtu.cpp).
+ * tetio.h - tet meshes on disk and on pipes: the one front door for
+ * reading and writing every tet-mesh format (tetformat.h names them:
+ * .vtu here, in the VTK adapter src/adapters/tetio_vtu.cpp; .msh,
+ * .node/.ele and .mesh in tetformat_*.c).
  *
  * .vtu: VTK XML UnstructuredGrid, binary, zlib-compressed, VTK_TETRA
  * cells. The writer adds per-cell arrays min_dihedral, max_dihedral and
@@ -19,34 +21,25 @@
 #include <stddef.h>
 
 #include "souptet/err.h"
+#include "souptet/tetformat.h"
 #include "souptet/tetmesh.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-typedef enum st_tet_format {
-    ST_TET_FMT_UNKNOWN = 0,
-    ST_TET_FMT_VTU,
-    ST_TET_FMT_MSH,       /* Gmsh .msh (tetformat.h) */
-    ST_TET_FMT_TETGEN,    /* TetGen .node/.ele (tetformat.h) */
-    ST_TET_FMT_MEDIT      /* Medit .mesh (tetformat.h) */
-} st_tet_format;
-
-/* Format from a path's extension (".vtu", ".msh", ".node", ".ele",
- * ".mesh", case-insensitive); "-" / NULL give VTU (the pipe format).
- * Reading and writing dispatch on it: the simulator formats go to
- * tetformat.h (which keeps points, tets and meta, not the arrays). */
-st_tet_format st_tet_format_from_path(const char *path);
-
-/* Write m to path ("-" or NULL: stdout). The caller handles atomic output
- * (st_outfile) for paths; this writes exactly where it is told. */
+/* Write m to path ("-" or NULL: .vtu on stdout), in the format of its
+ * extension (st_tetformat_from_path) with opts (NULL: defaults; only .msh
+ * has options). The simulator formats keep points, tets and meta, not the
+ * named arrays. The caller handles atomic output (st_outfile) for paths;
+ * this writes exactly where it is told. */
 st_status st_tetmesh_write(const st_tetmesh *m, const char *path,
-                           st_error *err);
+                           const st_tetformat_opts *opts, st_error *err);
 
-/* Read a tet mesh; "-" or NULL reads stdin. Refuses more than max_bytes
- * of mesh memory (0: no limit), point indices out of range, non-finite
- * points, non-tet cells. */
+/* Read a tet mesh in any of the formats, by extension, else by content
+ * (st_tetformat_sniff); "-" or NULL reads stdin (.vtu, .msh or .mesh).
+ * Refuses more than max_bytes of mesh memory (0: no limit), point indices
+ * out of range, non-finite points, non-tet cells. */
 st_status st_tetmesh_read(st_tetmesh **out, const char *path,
                           size_t max_bytes, st_error *err);
 
@@ -59,11 +52,13 @@ st_status st_tetmesh_read_mem(st_tetmesh **out, const unsigned char *data,
 st_status st_tetmesh_write_mem(unsigned char **data, size_t *size,
                                const st_tetmesh *m, st_error *err);
 
-/* st_tetmesh_write with atomic output for the tools: a file is written to
- * a temporary name beside path (st_outfile) and renamed when complete, so
- * a failure leaves nothing at path; "-" or NULL writes stdout. */
+/* st_tetmesh_write with atomic output, what the tools call: every file
+ * (both of a TetGen pair) is written to a temporary name beside its
+ * target (st_outfile) and renamed when all are complete, so a failure
+ * leaves nothing at path; "-" or NULL writes .vtu to stdout. Errors name
+ * the target. */
 st_status st_tetmesh_save(const st_tetmesh *m, const char *path,
-                          st_error *err);
+                          const st_tetformat_opts *opts, st_error *err);
 
 #ifdef __cplusplus
 }

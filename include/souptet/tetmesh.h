@@ -11,8 +11,6 @@
  * cell, with 1..9 components (e.g. "min_dihedral" per cell, "h" as field
  * data goes into meta instead). The .vtu writer adds the per-cell quality
  * arrays min_dihedral, max_dihedral and volume itself.
- *
- * Module order: ... -> grid -> tetmesh -> tetio (VTK adapter) -> ...
  */
 #ifndef SOUPTET_TETMESH_H
 #define SOUPTET_TETMESH_H

@@ -7,8 +7,6 @@
  * (0 1) (0 2) (0 3) (1 2) (1 3) (2 3), and the dihedral angle of edge
  * (i j) is the angle between the two faces that contain it, in degrees,
  * in [0, 180]. A regular tet has all six at acos(1/3) = 70.53 degrees.
- *
- * Module order: ... -> pred -> tetqual -> tetmesh ...
  */
 #ifndef SOUPTET_TETQUAL_H
 #define SOUPTET_TETQUAL_H

@@ -20,10 +20,13 @@
  *   total signed volume; the lattice cell width h from meta "h".
  * Against a surface S (st_tetstat_surface):
  *   min/max/mean distance from the boundary vertices of the mesh to S
- *   (Cetra's columns; exact point-triangle distances through a BVH);
+ *   (Cetra's columns; exact point-triangle distances through a BVH), and
+ *   with offset_ratio R and h known, how many boundary vertices are
+ *   farther than R h from S (Cetra's stopping condition: none);
  *   max distance from S to the mesh boundary, sampled at every vertex of
  *   S and at ST_TETSTAT_TRI_SAMPLES interior points of every triangle of S
- *   (so a lost feature shows even between vertices);
+ *   (so a lost feature shows even between vertices); S's box diagonal
+ *   (both distances are also reported relative to it and to h);
  *   the volume of S, by the divergence theorem, only when S is closed and
  *   consistently oriented (soupinfo.h), and the ratio mesh / S;
  *   enclosure (enclose.h): the fraction of S's vertices inside the closed
@@ -34,8 +37,6 @@
  *   and the voxels with a negative value.
  *
  * All of it is deterministic and does not depend on the thread count.
- *
- * Module order: ... -> bvh -> tetmesh -> enclose -> tetstat
  */
 #ifndef SOUPTET_TETSTAT_H
 #define SOUPTET_TETSTAT_H
@@ -85,6 +86,12 @@ typedef struct st_tetstat {
     size_t boundary_vertices;
     double dist_min, dist_max, dist_mean;  /* boundary vertices -> S */
     double surface_dist_max;               /* S -> boundary */
+    double surface_diag;          /* diagonal of S's bounding box */
+    double offset_ratio;          /* R of the condition: meta "offset_ratio"
+                                     (st_tetstat_mesh), or set by the caller
+                                     before st_tetstat_surface; NAN: none */
+    int has_offset;               /* R and h known: the count below */
+    size_t beyond_offset;         /* boundary vertices farther than R h */
     int surface_closed;           /* S closed and consistently oriented */
     double surface_volume;        /* |signed volume of S|; NAN if not closed */
     double volume_ratio;          /* volume / surface_volume; NAN if n/a */
@@ -112,9 +119,15 @@ st_status st_tetstat_mesh(st_tetstat *out, const st_tetmesh *m,
 
 /* Fill the surface part of *out for surface s (at least one triangle).
  * Call st_tetstat_mesh on *out first: encloses needs its inverted,
- * degenerate and nonmanifold_faces counts. */
+ * degenerate and nonmanifold_faces counts, the condition its h and
+ * offset_ratio (which the caller may set in between). */
 st_status st_tetstat_surface(st_tetstat *out, const st_tetmesh *m,
                              const st_soup *s, st_error *err);
+
+/* The largest distance from S to the boundary of m (surface_dist_max
+ * alone: S's vertices and ST_TETSTAT_TRI_SAMPLES points per triangle). */
+st_status st_tetstat_surface_to_boundary(double *out, const st_tetmesh *m,
+                                         const st_soup *s, st_error *err);
 
 /* Fill the field part of *out for a signed field f. */
 st_status st_tetstat_field(st_tetstat *out, const st_tetmesh *m,

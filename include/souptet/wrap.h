@@ -38,8 +38,6 @@
  * polygons. Merged meshes are not always manifold: when the result fails
  * the check (st_wrap_check), the extraction is repeated with half the
  * adaptivity, down to 0; stats say what was used.
- *
- * Module order: ... -> soupinfo -> sign -> wrap.
  */
 #ifndef SOUPTET_WRAP_H
 #define SOUPTET_WRAP_H

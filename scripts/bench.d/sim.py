@@ -117,7 +117,7 @@ def _tetgen(bench, off, stem):
 
 def _souptet(bench, sim, model, cells, tmp):
     mesh, emb = os.path.join(tmp, "s.mesh"), os.path.join(tmp, "s.txt")
-    r = bench.run([os.path.join(bench.BUILD, "bin", "soupmesh"), "-q", "--cells", str(cells),
+    r = bench.run([os.path.join(bench.BUILD, "bin", "soupmesh"), "-q", "--offset-best-effort", "--cells", str(cells),
                    "--tries", str(TRIES), "--threads", str(bench.THREADS), "--embed", emb,
                    "-o", mesh, model], timeout=600)
     if r.returncode != 0:

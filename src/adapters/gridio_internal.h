@@ -3,7 +3,9 @@
  * adapters src/adapters/gridio_vdb.cpp and gridio_vti.cpp (C++).
  *
  * Not installed and not part of the API: the tools use gridio.h only.
- * Everything here is extern "C", never throws, never prints.
+ * Everything here is extern "C", never throws, never prints. The calls go
+ * one way, gridio.c to the adapters; what both need (reading standard
+ * input, checking an input file) is src/fileio.h's.
  */
 #ifndef SOUPTET_GRIDIO_INTERNAL_H
 #define SOUPTET_GRIDIO_INTERNAL_H
@@ -15,23 +17,6 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* The name errors use for standard input and output. */
-#define ST_GRIDIO_STDIN_NAME "<stdin>"
-#define ST_GRIDIO_STDOUT_NAME "<stdout>"
-
-/* Read all of stdin into a malloc'd buffer (*data is never NULL on
- * success, even for 0 bytes; caller frees). Stdin has to be read whole
- * anyway: its format is sniffed from the first bytes, and neither reader
- * may seek on a pipe. ST_EIO on a read error. */
-/* Checks by path before a library reads a file by name, so that the usual
- * failures get the system's words, not the library's: ST_EIO "cannot open:
- * why" or "is a directory", ST_EINPUT "empty file". Shared by the field
- * and tet-mesh adapters. */
-st_status st_gridio_check_input_file(const char *path, st_error *err);
-
-st_status st_gridio_read_stdin(unsigned char **data, size_t *size,
-                               st_error *err);
 
 /* Parse a field held in memory; `name` is used in messages only. */
 st_status st_gridio_read_vdb_mem(st_grid **out, const unsigned char *data,

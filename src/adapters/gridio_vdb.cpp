@@ -72,6 +72,7 @@
 #include "souptet/meta.h"
 #include "souptet/outfile.h"
 #include "gridio_internal.h"
+#include "../fileio.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/io/Stream.h>
@@ -573,7 +574,7 @@ st_status read_stream(st_grid **out, std::istream &is, const char *name,
     int c = is.peek();      // peek() at the end sets only eofbit
     if (c == std::char_traits<char>::eof())
         return st_error_set(err, ST_EINPUT, name, 0, "empty %s",
-                            std::strcmp(name, ST_GRIDIO_STDIN_NAME) == 0
+                            std::strcmp(name, ST_STDIN_NAME) == 0
                                 ? "input"
                                 : "file");
     if (c == '<')
@@ -759,7 +760,7 @@ st_status write_file(const st_grid *g, const char *path, st_error *err)
 
 st_status write_stdout(const st_grid *g, st_error *err)
 {
-    const char *name = ST_GRIDIO_STDOUT_NAME;
+    const char *name = ST_STDOUT_NAME;
     return guarded(name, "writing", err, nullptr, [&]() -> st_status {
         FloatGrid::Ptr grid = st_to_grid(g);
         // Whatever C stdio holds goes out first. A fresh ostream on
@@ -798,7 +799,7 @@ extern "C" {
 st_status st_grid_write_vdb(const st_grid *g, const char *path, st_error *err)
 {
     const bool out = st_path_is_stdio(path);
-    const char *name = out ? ST_GRIDIO_STDOUT_NAME : path;
+    const char *name = out ? ST_STDOUT_NAME : path;
     // No exception can leave this function: guarded() catches everything,
     // and so does this for what happens outside it (initialize()).
     try {
@@ -839,22 +840,20 @@ st_status st_grid_read_vdb(st_grid **out, const char *path, size_t max_bytes,
     if (st_path_is_stdio(path)) {
         unsigned char *data;
         size_t size;
-        if (st_status s = st_gridio_read_stdin(&data, &size, err))
+        if (st_status s = st_file_read(nullptr, &data, &size, err))
             return s;
         st_status s = st_gridio_read_vdb_mem(out, data, size,
-                                             ST_GRIDIO_STDIN_NAME, max_bytes,
+                                             ST_STDIN_NAME, max_bytes,
                                              err);
         std::free(data);
         return s;
     }
+    if (st_status s = st_file_check_input(path, err))
+        return s;
     struct stat st;
     if (stat(path, &st) != 0)
         return st_error_set(err, ST_EIO, path, 0, "cannot open: %s",
                             std::strerror(errno));
-    if (S_ISDIR(st.st_mode))
-        return st_error_set(err, ST_EIO, path, 0, "is a directory");
-    if (S_ISREG(st.st_mode) && st.st_size == 0)
-        return st_error_set(err, ST_EINPUT, path, 0, "empty file");
     if (S_ISREG(st.st_mode)) {
         /* Walk the length-prefixed parts first (see VdbWalk), mapped, not
          * copied; a FIFO is read by OpenVDB as it comes. */

@@ -45,6 +45,7 @@
 #include "souptet/meta.h"
 #include "souptet/outfile.h"
 #include "gridio_internal.h"
+#include "../fileio.h"
 #include "../vtkxml.h"
 #include "vtk_capture.h"
 
@@ -404,7 +405,7 @@ extern "C" {
 st_status st_grid_write_vti(const st_grid *g, const char *path, st_error *err)
 {
     if (st_path_is_stdio(path))
-        return st_error_set(err, ST_EINPUT, ST_GRIDIO_STDOUT_NAME, 0,
+        return st_error_set(err, ST_EINPUT, ST_STDOUT_NAME, 0,
                             "standard output carries OpenVDB streams only; "
                             "write .vti to a file");
     return st_vtk::guarded(path, "writing", err,
@@ -425,15 +426,15 @@ st_status st_grid_read_vti(st_grid **out, const char *path, size_t max_bytes,
     unsigned char *data;
     size_t size;
     if (st_path_is_stdio(path)) {
-        if (st_status s = st_gridio_read_stdin(&data, &size, err))
+        if (st_status s = st_file_read(nullptr, &data, &size, err))
             return s;
-        return read_mem(out, data, size, ST_GRIDIO_STDIN_NAME, max_bytes,
+        return read_mem(out, data, size, ST_STDIN_NAME, max_bytes,
                         data, err);
     }
-    if (st_status s = st_gridio_check_input_file(path, err))
+    if (st_status s = st_file_check_input(path, err))
         return s;
     // Through memory, so that the bytes checked are the bytes VTK reads.
-    if (st_status s = st_vtkxml_read_file(path, &data, &size, err))
+    if (st_status s = st_file_read(path, &data, &size, err))
         return s;
     return read_mem(out, data, size, path, max_bytes, data, err);
 }

@@ -14,9 +14,6 @@
 extern "C" {
 #endif
 
-#define ST_TETIO_STDIN_NAME "<stdin>"
-#define ST_TETIO_STDOUT_NAME "<stdout>"
-
 /* Write m as .vtu to the file path (exactly there, no temporary). */
 st_status st_tetio_write_vtu_file(const st_tetmesh *m, const char *path,
                                   st_error *err);

@@ -45,7 +45,7 @@
 #include "souptet/mem.h"
 #include "souptet/meta.h"
 #include "souptet/tetmesh.h"
-#include "gridio_internal.h"
+#include "../fileio.h"
 #include "tetio_internal.h"
 #include "../vtkxml.h"
 #include "vtk_capture.h"
@@ -268,7 +268,7 @@ st_status write_file(const st_tetmesh *m, const char *path, st_error *err)
 st_status write_mem(unsigned char **data, size_t *size, const st_tetmesh *m,
                     st_error *err)
 {
-    const char *name = ST_TETIO_STDOUT_NAME;
+    const char *name = ST_STDOUT_NAME;
     if (st_status s = check_mesh(m, name, err))
         return s;
     vtkNew<vtkUnstructuredGrid> ug;
@@ -523,7 +523,7 @@ st_status read_mem(st_tetmesh **out, const unsigned char *data, size_t size,
     } own{owned};
     *out = nullptr;
     if (!name)
-        name = ST_TETIO_STDIN_NAME;
+        name = ST_STDIN_NAME;
     if (size == 0)
         return st_error_set(err, ST_EINPUT, name, 0, "empty input");
     return st_vtk::guarded(name, "reading", err, [&] {
@@ -561,7 +561,7 @@ st_status st_tetio_write_vtu_mem(unsigned char **data, size_t *size,
 {
     *data = nullptr;
     *size = 0;
-    return st_vtk::guarded(ST_TETIO_STDOUT_NAME, "writing", err,
+    return st_vtk::guarded(ST_STDOUT_NAME, "writing", err,
                    [&] { return write_mem(data, size, m, err); });
 }
 
@@ -576,12 +576,12 @@ st_status st_tetio_read_vtu_file(st_tetmesh **out, const char *path,
                                  size_t max_bytes, st_error *err)
 {
     *out = nullptr;
-    if (st_status s = st_gridio_check_input_file(path, err))
+    if (st_status s = st_file_check_input(path, err))
         return s;
     // Through memory, so that the bytes checked are the bytes VTK reads.
     unsigned char *data;
     size_t size;
-    if (st_status s = st_vtkxml_read_file(path, &data, &size, err))
+    if (st_status s = st_file_read(path, &data, &size, err))
         return s;
     return read_mem(out, data, size, path, max_bytes, data, err);
 }

@@ -2,7 +2,9 @@
 #define _GNU_SOURCE
 #include "tool.h"
 #include "../fpenv.h"
+#include "souptet/dist.h"
 #include "souptet/grid.h"
+#include "souptet/mem.h"
 #include "souptet/outfile.h"
 #include "souptet/soup.h"
 
@@ -28,6 +30,7 @@ static char *g_command_line;   /* freed at exit, whatever path main takes */
 static int g_progress_drawn;
 static double g_progress_last;
 static int g_failed;           /* tool_fail has printed an error */
+static size_t g_ulimit_left;   /* >0: the default --max-memory came from ulimit -v */
 
 /* Remove the temporary outputs, then die of the signal at once (its
  * default action, unblocked: the raise does not return). The signal comes
@@ -126,7 +129,16 @@ int tool_fail(const tool_ctx *t, const st_error *err)
     char buf[1200];
     g_failed = 1;
     tool_progress_end((tool_ctx *)t);
-    fprintf(stderr, "%s: %s\n", t->name, st_error_format(err, buf, sizeof buf));
+    st_error_format(err, buf, sizeof buf);
+    /* Under ulimit -v an allocation fails long before the RAM runs out:
+     * say which limit it met. */
+    size_t cap;
+    if (err && err->status == ST_ENOMEM && st_mem_address_space_left(&cap) != SIZE_MAX) {
+        size_t n = strlen(buf);
+        snprintf(buf + n, sizeof buf - n, " (ulimit -v caps this process's address space "
+                 "at %.0f MiB: raise it, or ask for less)", (double)cap / 1048576.0);
+    }
+    fprintf(stderr, "%s: %s\n", t->name, buf);
     return TOOL_EXIT_FAIL;
 }
 
@@ -190,7 +202,33 @@ void tool_limit_hint(st_error *err, const char *hint)
     if (n > 0 && err->msg[n - 1] == ')' && paren && paren > err->msg &&
         paren[-1] == ' ')
         n = (size_t)(paren - 1 - err->msg);
-    snprintf(err->msg + n, sizeof err->msg - n, " (%s)", hint);
+    if (g_ulimit_left)
+        snprintf(err->msg + n, sizeof err->msg - n, " (%s; the default --max-memory "
+                 "here is 80%% of the %.0f MiB that ulimit -v leaves)", hint,
+                 (double)g_ulimit_left / 1048576.0);
+    else
+        snprintf(err->msg + n, sizeof err->msg - n, " (%s)", hint);
+}
+
+size_t tool_dist_cells_that_fit(const struct st_soup *s, const struct st_dist_params *p)
+{
+    if (!s || !p || p->voxel > 0 || p->cells < 2 || !p->max_bytes)
+        return 0;
+    st_dist_params q = *p;
+    size_t dims[3], lo = 0, hi = p->cells;   /* lo fits (0: none yet), hi does not */
+    double origin[3], h;
+    while (hi - lo > 1) {
+        q.cells = lo + (hi - lo) / 2;
+        size_t n;
+        /* The layout, then the grid's size as st_grid_new checks it. */
+        if (st_dist_layout(s, &q, dims, origin, &h, NULL) == ST_OK &&
+            !st_size_mul(&n, dims[0], dims[1]) && !st_size_mul(&n, n, dims[2]) &&
+            !st_size_mul(&n, n, sizeof(float)) && n <= p->max_bytes)
+            lo = q.cells;
+        else
+            hi = q.cells;
+    }
+    return lo;
 }
 
 int tool_usage_error(const tool_ctx *t, const char *fmt, ...)
@@ -263,6 +301,24 @@ int tool_parse_switch(const tool_ctx *t, const char *opt, const char *arg, int *
     return 0;
 }
 
+int tool_tetformat_option(const tool_ctx *t, int c, const char *arg,
+                          st_tetformat_opts *o)
+{
+    size_t v;
+    if (c == TOOL_OPT_MSH_BINARY) {
+        o->binary = 1;
+        return 0;
+    }
+    if (tool_parse_size(t, "--msh-version", arg, 2, 41, &v))
+        return -1;
+    if (v != 2 && v != 4 && v != 22 && v != 41) {
+        tool_usage_error(t, "--msh-version is 2 or 4 (2.2 or 4.1), not '%s'", arg);
+        return -1;
+    }
+    o->msh_version = (int)v;
+    return 0;
+}
+
 int tool_parse_bytes(const tool_ctx *t, const char *opt, const char *arg,
                      size_t *out)
 {
@@ -292,9 +348,18 @@ int tool_parse_bytes(const tool_ctx *t, const char *opt, const char *arg,
 size_t tool_default_max_memory(void)
 {
     long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
-    if (pages <= 0 || size <= 0)
-        return 0;
-    return (size_t)((double)pages * (double)size * 0.8);
+    size_t def = pages > 0 && size > 0 ? (size_t)((double)pages * (double)size * 0.8) : 0;
+    /* Under ulimit -v, what it leaves (libraries, stacks and the reader's
+     * temporaries need room too: 80% of it), so a job too large for it is
+     * refused by the estimate, naming the option to lower, rather than by
+     * a failed allocation midway. */
+    size_t left = st_mem_address_space_left(NULL);
+    g_ulimit_left = 0;
+    if (left != SIZE_MAX && (def == 0 || (double)left * 0.8 < (double)def)) {
+        g_ulimit_left = left > 0 ? left : 1;
+        def = left > 1 ? (size_t)((double)left * 0.8) : 1;
+    }
+    return def;
 }
 
 size_t tool_max_lattice_tets(size_t max_bytes)
@@ -456,6 +521,7 @@ int tool_common_option(tool_ctx *t, int c, char *const argv[],
         return tool_parse_size(t, "--threads", optarg, 1, 4096, &co->threads)
                    ? TOOL_EXIT_USAGE : TOOL_CONTINUE;
     case TOOL_OPT_MAXMEM:
+        g_ulimit_left = 0;   /* the limit is the user's now */
         return tool_parse_bytes(t, "--max-memory", optarg, &co->max_bytes)
                    ? TOOL_EXIT_USAGE : TOOL_CONTINUE;
     case 'q':

@@ -18,6 +18,7 @@
 #include "souptet/lattice.h"
 #include "souptet/meta.h"
 #include "souptet/progress.h"
+#include "souptet/tetformat.h"
 
 #define TOOL_EXIT_OK 0
 #define TOOL_EXIT_FAIL 1
@@ -26,6 +27,10 @@
  * surface (or that cannot be verified): a failure of the tool's promise,
  * never only a warning, and always printed (even with -q). */
 #define TOOL_EXIT_NOT_ENCLOSING 3
+/* The output was written and encloses, but the fit's stopping condition
+ * (every boundary vertex within R h of the surface, soupmesh --offset)
+ * does not hold; always printed, like 3. */
+#define TOOL_EXIT_OFFSET_NOT_MET 4
 
 typedef struct tool_ctx {
     const char *name;      /* program name for messages */
@@ -69,6 +74,11 @@ st_status tool_check_field_finite(const struct st_grid *g, const char *name,
  * the options to change, in place of the library's own parenthesized
  * advice if it ends with one. */
 void tool_limit_hint(st_error *err, const char *hint);
+/* The largest cells (-r) below p->cells whose distance grid for s fits
+ * p->max_bytes (its layout, 4 bytes a voxel, as st_grid_new checks); 0 when none does or p gives
+ * a voxel size instead. For a refusal that names a value that fits. */
+struct st_dist_params;
+size_t tool_dist_cells_that_fit(const struct st_soup *s, const struct st_dist_params *p);
 /* Print "name: msg" and "Try 'name --help'." and return TOOL_EXIT_USAGE. */
 int tool_usage_error(const tool_ctx *t, const char *fmt, ...)
 #ifdef __GNUC__
@@ -179,7 +189,7 @@ int tool_output_check(tool_ctx *t, const char *out);
  * option codes start at TOOL_OPT_FIRST. In the getopt_long loop, every
  * code the tool does not handle itself goes to tool_common_option. */
 enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION,
-       TOOL_OPT_FIRST = 1100 };
+       TOOL_OPT_MSH_VERSION, TOOL_OPT_MSH_BINARY, TOOL_OPT_FIRST = 1100 };
 #define TOOL_LONG_OPTIONS_BASIC                              \
     {"quiet", no_argument, NULL, 'q'},                       \
     {"verbose", no_argument, NULL, 'v'},                     \
@@ -188,6 +198,20 @@ enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION
 #define TOOL_LONG_OPTIONS_RESOURCES                          \
     {"threads", required_argument, NULL, TOOL_OPT_THREADS},  \
     {"max-memory", required_argument, NULL, TOOL_OPT_MAXMEM}
+
+/* The tet-mesh format options of every tool that writes a tet mesh
+ * (soupmesh, latticetet, tetsmooth): their table entries, their --help
+ * lines, and their handling: for c TOOL_OPT_MSH_VERSION (2, 4, 22 or 41
+ * into o->msh_version) or TOOL_OPT_MSH_BINARY (o->binary = 1). Returns 0,
+ * or -1 after a usage error (printed). */
+#define TOOL_LONG_OPTIONS_TETFORMAT                                \
+    {"msh-version", required_argument, NULL, TOOL_OPT_MSH_VERSION}, \
+    {"msh-binary", no_argument, NULL, TOOL_OPT_MSH_BINARY}
+#define TOOL_HELP_TETFORMAT                                               \
+    "      --msh-version V  Gmsh format 4 (4.1, default) or 2 (2.2)\n"   \
+    "      --msh-binary     binary .msh instead of ASCII\n"
+int tool_tetformat_option(const tool_ctx *t, int c, const char *arg,
+                          st_tetformat_opts *o);
 
 /* What the shared options set: threads (0: all cores) and the memory
  * limit (tool_default_max_memory() unless --max-memory). */

@@ -62,6 +62,7 @@ static void usage(void)
 "                       hanging tets, islands and pinched boundaries\n"
 "  -o, --output OUT     .vtu file (or .msh, .node/.ele, .mesh by extension,\n"
 "                       without the arrays); '-' or none: .vtu on stdout\n"
+TOOL_HELP_TETFORMAT
 "      --threads T      threads to use (default: all cores)\n"
 "      --max-memory SZ  refuse fields and lattices larger than SZ\n"
 "                       (default 80%% of RAM)\n"
@@ -93,6 +94,7 @@ int main(int argc, char *argv[])
     int sculpt = 0, repair = 1;
     uint64_t seed = 0;
     int have_seed = 0;
+    st_tetformat_opts fopts = {0, 0};
     static const struct option opts[] = {
         {"density", required_argument, NULL, OPT_DENSITY},
         {"sculpt", no_argument, NULL, OPT_SCULPT},
@@ -103,6 +105,7 @@ int main(int argc, char *argv[])
         {"seed", required_argument, NULL, OPT_SEED},
         {"no-repair", no_argument, NULL, OPT_NOREPAIR},
         {"output", required_argument, NULL, 'o'},
+        TOOL_LONG_OPTIONS_TETFORMAT,
         TOOL_LONG_OPTIONS_BASIC,
         TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
@@ -153,6 +156,11 @@ int main(int argc, char *argv[])
         case 'o':
             out = optarg;
             break;
+        case TOOL_OPT_MSH_VERSION:
+        case TOOL_OPT_MSH_BINARY:
+            if (tool_tetformat_option(&t, c, optarg, &fopts))
+                return TOOL_EXIT_USAGE;
+            break;
         default: {
             int rc_opt = tool_common_option(&t, c, argv, usage, &co);
             if (rc_opt != TOOL_CONTINUE) {
@@ -191,7 +199,7 @@ int main(int argc, char *argv[])
         TOOL_TRY(tool_refuse_terminal(&t, surface, STDIN_FILENO, TOOL_TTY_SURFACE));
     TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, TOOL_TTY_VTU));
     TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
-                                st_tet_format_from_path(out) != ST_TET_FMT_UNKNOWN,
+                                st_tetformat_from_path(out) != ST_TETFORMAT_NONE,
                                 ".vtu, .msh, .node, .ele or .mesh"));
     TOOL_TRY(tool_output_check(&t, out));
     tool_set_threads(co.threads);
@@ -390,7 +398,7 @@ int main(int argc, char *argv[])
         }
     }
     double tw = tool_now();
-    if (st_tetmesh_save(m, out, &err)) {
+    if (st_tetmesh_save(m, out, &fopts, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

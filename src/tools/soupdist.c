@@ -162,8 +162,15 @@ int main(int argc, char *argv[])
     if (st_dist_field(&g, soup, &p, &prog, &err)) {
         if (!err.file[0])
             snprintf(err.file, sizeof err.file, "%s", in);
-        tool_limit_hint(&err, "use a smaller -r or a larger -s, or raise "
-                              "--max-memory");
+        size_t fit = err.status == ST_ELIMIT ? tool_dist_cells_that_fit(soup, &p) : 0;
+        char hint[160];
+        if (fit)
+            snprintf(hint, sizeof hint, "use -r %zu or less, a larger -s, or raise "
+                     "--max-memory", fit);
+        else
+            snprintf(hint, sizeof hint, "use a smaller -r or a larger -s, or raise "
+                     "--max-memory");
+        tool_limit_hint(&err, hint);
         rc = tool_fail(&t, &err);
         goto done;
     }

@@ -19,6 +19,7 @@
 #include "souptet/soupwrite.h"
 #include "souptet/tetformat.h"
 #include "souptet/tetio.h"
+#include "souptet/tetstat.h"
 
 #include <getopt.h>
 #include <inttypes.h>
@@ -43,8 +44,7 @@ static void usage(void)
 "\n"
 "  -o, --output OUT     the mesh, by extension: .vtu (VTK), .msh (Gmsh), .node/.ele\n"
 "                       (TetGen), .mesh (Medit); '-' or none: .vtu on stdout\n"
-"      --msh-version V  Gmsh format 4 (4.1, default) or 2 (2.2)\n"
-"      --msh-binary     binary .msh instead of ASCII\n"
+TOOL_HELP_TETFORMAT
 "      --embed FILE     where each input vertex lies: its tet and barycentric\n"
 "                       coordinates, as text (.txt) or a point cloud (.vtu with\n"
 "                       point arrays embed_tet, embed_bary)\n"
@@ -60,7 +60,11 @@ static void usage(void)
 "                       and a time class, then exit (the field and signs are\n"
 "                       computed, the fit is not)\n"
 "      --offset R       stop fitting when every boundary vertex is within\n"
-"                       R * h of the surface (h = cell width; default 0.4)\n"
+"                       R * h of the surface (h = cell width; default 0.4);\n"
+"                       when some vertex stays farther: a message (even\n"
+"                       with -q) and exit status 4\n"
+"      --offset-best-effort  keep a mesh that misses --offset with exit\n"
+"                       status 0 and a warning\n"
 "      --tries K        candidates with randomly rotated and offset lattices,\n"
 "                       run in parallel; the best enclosing one is kept\n"
 "                       (default 1)\n"
@@ -90,12 +94,14 @@ static void usage(void)
 "  soupmesh -o bunny.vtu bunny.obj\n"
 "  soupmesh --cells 14 --tries 8 -o scan.vtu scan.ply && tetstat --surface scan.ply scan.vtu\n"
 "\n"
-"Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
+"Exit status: 0 ok, 1 bad input or failure, 2 usage error, 3 the mesh was\n"
+"written but does not enclose the input, 4 the mesh was written and encloses\n"
+"the input but some boundary vertex is farther than --offset R * h from it.\n");
 }
 
 enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
-       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_MSH_VERSION, OPT_MSH_BINARY, OPT_EMBED, OPT_FILL_HOLES, OPT_SHELLS,
-       OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY };
+       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_FILL_HOLES, OPT_SHELLS,
+       OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY, OPT_BEST_EFFORT };
 
 /* -v: a line as each stage, sculpt, fit iteration and candidate ends, so a
  * long run is never silent (pipeline.h, st_pipeline_event). */
@@ -212,7 +218,7 @@ int main(int argc, char *argv[])
     tool_common co = tool_common_default();
     st_pipeline_params p = st_pipeline_params_default();
     size_t max_iters = 0, seed = 1;
-    int have_cells = 0;
+    int have_cells = 0, best_effort = 0;
     const char *out = NULL, *in = NULL, *embed = NULL, *boundary = NULL;
     st_tetformat_opts fopts = {0, 0};
     static const struct option opts[] = {
@@ -221,6 +227,7 @@ int main(int argc, char *argv[])
         {"tets", required_argument, NULL, OPT_TETS},
         {"dry-run", no_argument, NULL, OPT_DRY_RUN},
         {"offset", required_argument, NULL, OPT_OFFSET},
+        {"offset-best-effort", no_argument, NULL, OPT_BEST_EFFORT},
         {"tries", required_argument, NULL, OPT_TRIES},
         {"seed", required_argument, NULL, OPT_SEED},
         {"density", required_argument, NULL, OPT_DENSITY},
@@ -229,8 +236,7 @@ int main(int argc, char *argv[])
         {"no-quality", no_argument, NULL, OPT_NO_QUALITY},
         {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
         {"shells", required_argument, NULL, OPT_SHELLS},
-        {"msh-version", required_argument, NULL, OPT_MSH_VERSION},
-        {"msh-binary", no_argument, NULL, OPT_MSH_BINARY},
+        TOOL_LONG_OPTIONS_TETFORMAT,
         {"embed", required_argument, NULL, OPT_EMBED},
         {"boundary", required_argument, NULL, OPT_BOUNDARY},
         {"output", required_argument, NULL, 'o'},
@@ -260,6 +266,9 @@ int main(int argc, char *argv[])
         case OPT_OFFSET:
             if (tool_parse_double(&t, "--offset", optarg, 1e-3, 10.0, &p.offset_ratio))
                 return TOOL_EXIT_USAGE;
+            break;
+        case OPT_BEST_EFFORT:
+            best_effort = 1;
             break;
         case OPT_TRIES:
             if (tool_parse_size(&t, "--tries", optarg, 1, ST_PIPELINE_MAX_TRIES, &p.tries))
@@ -294,18 +303,10 @@ int main(int argc, char *argv[])
             if (tool_parse_switch(&t, "--shells", optarg, &p.closed_shells))
                 return TOOL_EXIT_USAGE;
             break;
-        case OPT_MSH_VERSION: {
-            size_t v;
-            if (tool_parse_size(&t, "--msh-version", optarg, 2, 41, &v))
+        case TOOL_OPT_MSH_VERSION:
+        case TOOL_OPT_MSH_BINARY:
+            if (tool_tetformat_option(&t, c, optarg, &fopts))
                 return TOOL_EXIT_USAGE;
-            if (v != 2 && v != 4 && v != 22 && v != 41)
-                return tool_usage_error(&t, "--msh-version is 2 or 4 (2.2 or 4.1), not '%s'",
-                                        optarg);
-            fopts.msh_version = (int)v;
-            break;
-        }
-        case OPT_MSH_BINARY:
-            fopts.binary = 1;
             break;
         case OPT_EMBED:
             embed = optarg;
@@ -339,7 +340,7 @@ int main(int argc, char *argv[])
     if (!p.dry_run)
         TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, TOOL_TTY_VTU));
     TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
-                                st_tet_format_from_path(out) != ST_TET_FMT_UNKNOWN,
+                                st_tetformat_from_path(out) != ST_TETFORMAT_NONE,
                                 ".vtu, .msh, .node, .ele or .mesh"));
     size_t elen = embed ? strlen(embed) : 0;
     int embed_text = elen > 4 && strcmp(embed + elen - 4, ".txt") == 0;
@@ -456,9 +457,7 @@ int main(int argc, char *argv[])
             goto done;
         }
     }
-    if (st_tetformat_from_path(out) != ST_TETFORMAT_NONE
-            ? st_tetformat_save(m, ST_TETFORMAT_NONE, out, &fopts, &err)
-            : st_tetmesh_save(m, out, &err)) {
+    if (st_tetmesh_save(m, out, &fopts, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }
@@ -470,7 +469,7 @@ int main(int argc, char *argv[])
         if (embed_text
                 ? st_embed_write_text(embed, et, eb, soup->nverts, m->ntets,
                                       st_path_is_stdio(out) ? "<stdout>" : out, in, &err)
-                : st_tetmesh_save(side, embed, &err)) {
+                : st_tetmesh_save(side, embed, NULL, &err)) {
             rc = tool_fail(&t, &err);
             goto done;
         }
@@ -484,6 +483,27 @@ int main(int argc, char *argv[])
              b->tets, b->points, b->min_dihedral, b->max_dihedral,
              st.encloses ? "encloses the input" : "DOES NOT enclose the input",
              b->verts_outside, b->tris_crossing, tool_now() - t0);
+    if (t.verbosity >= 2 && p.density_rho <= 0) {
+        /* both directions, in h and per the input's box diagonal */
+        double sb = NAN, lo[3] = {INFINITY, INFINITY, INFINITY},
+               hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < 3 * soup->ntris; i++)
+            for (int a = 0; a < 3; a++) {
+                double x = soup->xyz[3 * (size_t)soup->tris[i] + (size_t)a];
+                lo[a] = fmin(lo[a], x);
+                hi[a] = fmax(hi[a], x);
+            }
+        double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                           (hi[2] - lo[2]) * (hi[2] - lo[2]));
+        if (st_tetstat_surface_to_boundary(&sb, m, soup, &err)) {
+            rc = tool_fail(&t, &err);
+            goto done;
+        }
+        tool_say(&t, 2, "boundary -> input max %.4f h (%.6f diag), input -> boundary max "
+                 "%.4f h (%.6f diag); %zu of %zu boundary vertices beyond %.3g h",
+                 b->max_distance / st.h, b->max_distance / diag, sb / st.h, sb / diag,
+                 b->beyond_offset, b->boundary_vertices, p.offset_ratio);
+    }
     rc = TOOL_EXIT_OK;
     if (!st.encloses && p.density_rho <= 0) {
         /* Level 0: printed even with -q, and the exit status says it. */
@@ -492,10 +512,20 @@ int main(int argc, char *argv[])
                  "try more --cells or --tries", st_path_is_stdio(in) ? "<stdin>" : in, st_path_is_stdio(out) ? "<stdout>" : out,
                  b->verts_outside, b->tris_crossing, st.ncandidates);
         rc = TOOL_EXIT_NOT_ENCLOSING;
-    } else if (p.density_rho <= 0 && !b->converged) {
-        tool_say(&t, 2, "%zu boundary vertices stayed farther than %.3g * h from the "
-                 "surface (thin gaps), up to %.4g", b->beyond_offset, p.offset_ratio,
-                 b->max_distance);
+    }
+    if (p.density_rho <= 0 && !b->converged) {
+        /* Cetra's stopping condition (every boundary vertex within
+         * R h of the input) is the fit's promise: said at level 0 and in
+         * the exit status unless the user settles for less. */
+        tool_say(&t, best_effort ? 1 : 0,
+                 "%s: %s: %zu of %zu boundary vertices stay farther than %.3g h from the "
+                 "input, the farthest %.4g h (%.4g); best of %zu candidates%s",
+                 st_path_is_stdio(in) ? "<stdin>" : in, best_effort ? "warning" : "error",
+                 b->beyond_offset, b->boundary_vertices, p.offset_ratio,
+                 b->max_distance / st.h, b->max_distance, st.ncandidates,
+                 best_effort ? "" : "; try more --tries or --cells, or --offset-best-effort");
+        if (!best_effort && rc == TOOL_EXIT_OK)
+            rc = TOOL_EXIT_OFFSET_NOT_MET;
     }
 done:
     st_outfile_abort(&bof);

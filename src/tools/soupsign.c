@@ -80,7 +80,9 @@ static void usage(void)
 "      --sides on|off   with --surface: the side of the surface's oriented walls\n"
 "                       each voxel near them is on (its pieces oriented by\n"
 "                       propagation, each turned the way the votes read it)\n"
-"                       joins the votes as evidence for the cut (default on)\n"
+"                       joins the votes as evidence for the cut, and a\n"
+"                       one-sided scan's far side is mirrored about its\n"
+"                       horizon (default on)\n"
 "      --refine-band D  refine voxels nearer than D voxels (default 1.5)\n"
 "      --refine-radius R  neighbours within R voxels per axis (default 2)\n"
 "      --refine-answers A  neighbours' answers combined per voxel (default 6)\n"
@@ -125,7 +127,7 @@ static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_er
     char got[32];
     snprintf(got, sizeof got, "%llu", src.size);
     const int same = src.hash[0] && strcmp(got, size) == 0 && strcmp(src.hash, hash) == 0;
-    if (rc && same) {
+    if (rc && (same || rc == ST_ENOMEM)) {   /* out of memory is no "cannot be read" */
         *err = e;
         return 1;
     }
@@ -378,6 +380,13 @@ int main(int argc, char *argv[])
         tool_say(&t, 2, "sides: %zu orientable regions (%zu turned to the votes, %zu edges "
                  "disagreeing), %zu voxels given their side", ps.sides.regions, ps.sides.turned,
                  ps.sides.conflicts, ps.sides.voxels);
+    if (surface && use_sides && p.cut)
+        tool_say(&t, 2, "view: back/front %.3f along (%.3f %.3f %.3f): %s", ps.sides.back_front,
+                 ps.sides.view[0], ps.sides.view[1], ps.sides.view[2],
+                 ps.sides.onesided ? "one-sided" : "not one-sided");
+    if (surface && use_sides && p.cut && ps.sides.onesided)
+        tool_say(&t, 2, "far side mirrored along step (%d %d %d): %zu voxels",
+                 ps.sides.step[0], ps.sides.step[1], ps.sides.step[2], ps.mirrored);
     if (surface)
         tool_say(&t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
                  rp.band_voxels, ps.refined, ps.seconds_refine);

@@ -56,7 +56,9 @@ static void usage(void)
 "      --quality-rounds N  quality rounds at most (default 40)\n"
 "      --no-quality     skip the quality pass (after --fair: interior vertices\n"
 "                       only, the volume does not change)\n"
-"  -o, --output OUT     .vtu file; '-' or none: standard output\n"
+"  -o, --output OUT     .vtu file (or .msh, .node/.ele, .mesh by extension,\n"
+"                       without the arrays); '-' or none: .vtu on stdout\n"
+TOOL_HELP_TETFORMAT
 "      --threads T      threads to use (default: all cores)\n"
 "      --max-memory SZ  refuse meshes larger than SZ (default 80%% of RAM)\n"
 "  -q, --quiet          no messages but errors\n"
@@ -100,6 +102,7 @@ int main(int argc, char *argv[])
     const char *out = NULL, *in = NULL, *surface = NULL;
     int mode = 0; /* 1 fair, 2 fit */
     int fair_only = 0, fit_only = 0, noq = 0;
+    st_tetformat_opts fopts = {0, 0};
     static const struct option opts[] = {
         {"fair", no_argument, NULL, OPT_FAIR},
         {"fit", no_argument, NULL, OPT_FIT},
@@ -115,6 +118,7 @@ int main(int argc, char *argv[])
         {"quality-rounds", required_argument, NULL, OPT_QROUNDS},
         {"no-quality", no_argument, NULL, OPT_NOQ},
         {"output", required_argument, NULL, 'o'},
+        TOOL_LONG_OPTIONS_TETFORMAT,
         TOOL_LONG_OPTIONS_BASIC,
         TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
@@ -187,6 +191,11 @@ int main(int argc, char *argv[])
         case 'o':
             out = optarg;
             break;
+        case TOOL_OPT_MSH_VERSION:
+        case TOOL_OPT_MSH_BINARY:
+            if (tool_tetformat_option(&t, c, optarg, &fopts))
+                return TOOL_EXIT_USAGE;
+            break;
         default: {
             int rc_opt = tool_common_option(&t, c, argv, usage, &co);
             if (rc_opt != TOOL_CONTINUE) {
@@ -214,7 +223,8 @@ int main(int argc, char *argv[])
     if (surface)
         TOOL_TRY(tool_refuse_terminal(&t, surface, STDIN_FILENO, TOOL_TTY_SURFACE));
     TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
-                                st_tet_format_from_path(out) != ST_TET_FMT_UNKNOWN, ".vtu"));
+                                st_tetformat_from_path(out) != ST_TETFORMAT_NONE,
+                                ".vtu, .msh, .node, .ele or .mesh"));
     TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, "will not write a binary mesh to "
                                   "a terminal: give -o FILE or pipe it"));
     TOOL_TRY(tool_output_check(&t, out));
@@ -312,7 +322,7 @@ int main(int argc, char *argv[])
         rc = tool_fail(&t, &err);
         goto done;
     }
-    if (st_tetmesh_save(m, out, &err)) {
+    if (st_tetmesh_save(m, out, &fopts, &err)) {
         rc = tool_fail(&t, &err);
         goto done;
     }

@@ -39,7 +39,11 @@ static void usage(void)
 "\n"
 "  -S, --surface S      also measure against surface S (.obj .off .ply .stl .gltf .glb):\n"
 "                       distances boundary <-> S, volume ratio (when S is\n"
-"                       closed and oriented), enclosure of S by the mesh\n"
+"                       closed and oriented), enclosure of S by the mesh;\n"
+"                       distances also in h and relative to S's box diagonal\n"
+"      --offset R       with --surface: count the boundary vertices farther\n"
+"                       than R * h from S (Cetra's stopping condition; default\n"
+"                       the mesh's meta \"offset_ratio\", as soupmesh writes)\n"
 "  -F, --field F        also give the IoU of the mesh with the pseudo volume\n"
 "                       (negative voxels) of signed field F (.vdb .vti)\n"
 "      --json           one JSON object (default: a table)\n"
@@ -125,6 +129,23 @@ static void print_json(FILE *f, const char *name, const char *sname,
                 tool_json_number(b[1], r->dist_max), tool_json_number(b[2], r->dist_mean),
                 tool_json_number(b[3], r->surface_dist_max), yesno(r->surface_closed),
                 tool_json_number(b[4], r->surface_volume), tool_json_number(b[5], r->volume_ratio));
+        /* both distances in h and relative to S's box diagonal */
+        int hh = r->has_h && r->h > 0.0, dd = r->surface_diag > 0.0;
+        fprintf(f,
+                ",\n    \"diagonal\": %s, \"dist_max_h\": %s, \"dist_max_diag\": %s, "
+                "\"surface_dist_max_h\": %s, \"surface_dist_max_diag\": %s",
+                tool_json_number(b[6], r->surface_diag),
+                hh ? tool_json_number(b[7], r->dist_max / r->h) : "null",
+                dd ? tool_json_number(b[8], r->dist_max / r->surface_diag) : "null",
+                hh ? tool_json_number(b[9], r->surface_dist_max / r->h) : "null",
+                dd ? tool_json_number(b[10], r->surface_dist_max / r->surface_diag) : "null");
+        if (r->has_offset)
+            fprintf(f, ",\n    \"offset_ratio\": %s, \"beyond_offset\": %zu, \"offset_met\": %s",
+                    tool_json_number(b[11], r->offset_ratio), r->beyond_offset,
+                    yesno(r->beyond_offset == 0));
+        else
+            fprintf(f, ",\n    \"offset_ratio\": null, \"beyond_offset\": null, "
+                       "\"offset_met\": null");
         if (r->has_enclosure)
             fprintf(f,
                     ",\n    \"vertices_inside\": %zu, \"fraction_inside\": "
@@ -207,6 +228,21 @@ static void print_table(FILE *f, const char *name, const char *sname,
         ROW("boundary -> S max", "%.9g", r->dist_max);
         ROW("boundary -> S mean", "%.9g", r->dist_mean);
         ROW("S -> boundary max", "%.9g", r->surface_dist_max);
+        ROW("S box diagonal", "%.9g", r->surface_diag);
+        if (r->has_h && r->h > 0.0) {
+            ROW("boundary -> S max / h", "%.4f", r->dist_max / r->h);
+            ROW("S -> boundary max / h", "%.4f", r->surface_dist_max / r->h);
+        }
+        if (r->surface_diag > 0.0) {
+            ROW("boundary -> S max / diag", "%.6f", r->dist_max / r->surface_diag);
+            ROW("S -> boundary max / diag", "%.6f", r->surface_dist_max / r->surface_diag);
+        }
+        if (r->has_offset) {
+            char lab[64];
+            snprintf(lab, sizeof lab, "beyond %.3g h (offset)", r->offset_ratio);
+            ROW(lab, "%zu%s", r->beyond_offset,
+                r->beyond_offset ? "   <- OFFSET NOT MET" : "   (met)");
+        }
         if (r->surface_closed) {
             ROW("surface volume", "%.9g", r->surface_volume);
             ROW("volume ratio", "%.6f", r->volume_ratio);
@@ -243,7 +279,7 @@ static void print_table(FILE *f, const char *name, const char *sname,
 
 /* ---- main ------------------------------------------------------------------ */
 
-enum { OPT_JSON = TOOL_OPT_FIRST };
+enum { OPT_JSON = TOOL_OPT_FIRST, OPT_OFFSET };
 
 int main(int argc, char *argv[])
 {
@@ -251,11 +287,13 @@ int main(int argc, char *argv[])
     tool_init(&t, "tetstat", argc, argv);
     tool_common co = tool_common_default();
     int json = 0;
+    double offset = 0.0;   /* 0: the mesh's meta "offset_ratio" */
         const char *surface = NULL, *field = NULL;
     static const struct option opts[] = {
         {"surface", required_argument, NULL, 'S'},
         {"field", required_argument, NULL, 'F'},
         {"json", no_argument, NULL, OPT_JSON},
+        {"offset", required_argument, NULL, OPT_OFFSET},
         TOOL_LONG_OPTIONS_BASIC,
         TOOL_LONG_OPTIONS_RESOURCES,
         {NULL, 0, NULL, 0}};
@@ -272,6 +310,12 @@ int main(int argc, char *argv[])
         case OPT_JSON:
             json = 1;
             break;
+        case OPT_OFFSET:
+            if (tool_parse_double(&t, "--offset", optarg, 1e-3, 10.0, &offset)) {
+                tool_finish(&t);
+                return TOOL_EXIT_USAGE;
+            }
+            break;
         default: {
             int rc_opt = tool_common_option(&t, c, argv, usage, &co);
             if (rc_opt != TOOL_CONTINUE) {
@@ -286,6 +330,10 @@ int main(int argc, char *argv[])
         tool_finish(&t);
         return tool_usage_error(&t, "one mesh at a time (got %d)",
                                 argc - optind);
+    }
+    if (offset > 0.0 && !surface) {
+        tool_finish(&t);
+        return tool_usage_error(&t, "--offset needs --surface");
     }
     const char *in = optind < argc ? argv[optind] : "-";
     const char *name = strcmp(in, "-") == 0 ? "<stdin>" : in;
@@ -343,6 +391,8 @@ int main(int argc, char *argv[])
     double t1 = tool_now();
     if (st_tetstat_mesh(&r, m, &err))
         goto failed;
+    if (offset > 0.0)
+        r.offset_ratio = offset;
     double t2 = tool_now();
     if (s && st_tetstat_surface(&r, m, s, &err))
         goto failed;
@@ -385,6 +435,13 @@ int main(int argc, char *argv[])
                  "outside, %zu triangles crossing the boundary",
                  name, sname, r.surface_vertices - r.vertices_inside,
                  r.surface_vertices, r.crossing_triangles);
+    if (offset > 0.0 && !r.has_h)
+        tool_say(&t, 1, "%s: warning: no cell width h in the mesh (meta \"h\"): "
+                 "--offset not reported", name);
+    if (r.has_surface && r.has_offset && r.beyond_offset)
+        tool_say(&t, 1, "%s: warning: %zu boundary vertices farther than %.3g h from %s "
+                 "(up to %.4g h)", name, r.beyond_offset, r.offset_ratio, sname,
+                 r.dist_max / r.h);
     rc = TOOL_EXIT_OK;
     goto done;
 failed:

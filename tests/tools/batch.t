@@ -83,4 +83,76 @@ ok $? "batch --one skips a model done with the same options"
 [ $? -eq 0 ] && [ "$(stat -c %Y out/cube.vtu)" != "$before" ] && grep -q '^option 4$' out/cube.key
 ok $? "batch --one redoes it with other options"
 
+# ---- a job killed by SIGKILL -----------------------------------------------
+# soupmesh on one model dies by SIGKILL (no handler sees it) with its mesh
+# written to the temporary and not yet renamed: a preloaded rename() raises
+# SIGKILL for that target. The batch (-j 2, three models) then leaves only
+# that temporary, named for the target and the dead pid; a rerun removes
+# it (the pid is gone) and completes. The old temporary name held no pid,
+# so nothing could tell it was stale and it stayed.
+cat >killrename.c <<'EOF2'
+#define _GNU_SOURCE
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+int rename(const char *from, const char *to)
+{
+    const char *victim = getenv("KILL_AT_RENAME");
+    if (victim && strstr(to, victim))
+        raise(SIGKILL);
+    return renameat(AT_FDCWD, from, AT_FDCWD, to);
+}
+EOF2
+if cc -shared -fPIC -o killrename.so killrename.c 2>cc.err; then
+    mkdir -p kin kout kbin
+    cp in/cube.obj in/tet.off kin/
+    printf 'OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n' >kin/victim.off
+    ln -s "$SOUPTET_BIN/tetstat" kbin/tetstat
+    # (ASan insists on coming first among the preloaded libraries.)
+    cat >kbin/soupmesh <<EOF2
+#!/bin/sh
+ASAN_OPTIONS=\${ASAN_OPTIONS:+\$ASAN_OPTIONS:}verify_asan_link_order=0 \\
+    LD_PRELOAD=$WORK/killrename.so KILL_AT_RENAME=victim.vtu exec "$SOUPTET_BIN/soupmesh" "\$@"
+EOF2
+    chmod +x kbin/soupmesh
+    "$B" --bin kbin -j 2 kin kout -- $OPTS >ktable 2>kmsg
+    rc=$?
+    [ $rc -eq 1 ] && grep -q '^victim .*FAILED' ktable && [ "$(grep -c ' ok$' ktable)" -eq 2 ] &&
+        grep -q 'soupmesh failed' kout/victim.log
+    ok $? "soupmesh killed by SIGKILL on one model: that model failed, the two others meshed"
+    [ $rc -eq 1 ] || { echo "#   exit $rc"; sed 's/^/#   /' kmsg ktable | head; }
+    left=$(cd kout && ls -A | grep '^\.')
+    n=$(printf '%s\n' "$left" | grep -c .)
+    pat="^\.victim\.vtu\.tmp-[0-9]+@$(hostname | tr './@' '___')\.[A-Za-z0-9]{6}\$"
+    [ "$n" -eq 1 ] && printf '%s\n' "$left" | grep -Eq "$pat" &&
+        [ ! -e kout/victim.vtu ] && [ ! -e kout/victim.json ] && [ ! -e kout/victim.key ]
+    ok $? "what is left is the one temporary, named for its target, pid and host: $left"
+    pid=$(printf '%s\n' "$left" | sed 's/.*\.tmp-\([0-9]*\)@.*/\1/')
+    [ -n "$pid" ] && [ ! -d "/proc/$pid" ]
+    ok $? "its pid ($pid) is gone"
+    # A live process's temporary (this shell's) and one of another machine
+    # stay; a dead process's beside a model that is not redone goes.
+    live=".cube.vtu.tmp-$$@$(hostname | tr './@' '___').AbC123"
+    other=".tet.vtu.tmp-$pid@not-$(hostname | tr './@' '___').AbC123"
+    dead=".tet.json.tmp-$pid@$(hostname | tr './@' '___').AbC123"
+    : >"kout/$live"; : >"kout/$other"; : >"kout/$dead"
+    rm kbin/soupmesh && ln -s "$SOUPTET_BIN/soupmesh" kbin/soupmesh
+    "$B" --bin kbin -j 2 kin kout -- $OPTS >ktable 2>kmsg
+    rc=$?
+    [ $rc -eq 0 ] && grep -q '3 models, 1 to mesh, 2 already done' kmsg &&
+        grep -q '^victim .* ok$' ktable && [ -s kout/victim.vtu ] && [ -s kout/victim.json ]
+    ok $? "the rerun completes the corpus (victim meshed, the others cached)"
+    [ $rc -eq 0 ] || { echo "#   exit $rc"; sed 's/^/#   /' kmsg ktable | head; }
+    grep -q "removed .*/$(printf '%s' "$left" | sed 's/\./\\./g'), left by process $pid (gone)" kmsg &&
+        [ ! -e "kout/$left" ] && [ ! -e "kout/$dead" ]
+    ok $? "and removes the dead process's temporaries, saying so"
+    [ "$(cd kout && ls -A | grep '^\.' | sort | tr '\n' ' ')" = "$(printf '%s\n' "$live" "$other" | sort | tr '\n' ' ')" ]
+    ok $? "a live process's temporary and another machine's stay, nothing else is left"
+else
+    sed 's/^/#   /' cc.err
+    ok 1 "a C compiler for the SIGKILL test's preloaded rename()"
+fi
+
 done_testing

@@ -25,12 +25,35 @@ grep -q '^64 135$' "$WORK/.out"
 ok $? "the sample has 64 points and 135 tets"
 
 # A real mesh from the tools, when they are built (small: a few seconds).
-SM="--cells 4 --field-cells 32"
+SM="--cells 4 --field-cells 32 --offset-best-effort"
 have_soupmesh=0
 if [ -x "$SOUPTET_BIN/soupmesh" ]; then
     check "soupmesh makes b4.vtu from the bunny" \
         soupmesh -q $SM -o b4.vtu "$ROOT/corpus/bunny.obj"
     [ -s b4.vtu ] && have_soupmesh=1
+fi
+
+# latticetet and tetsmooth take soupmesh's .msh options (tetio.h's one
+# front door): each variant holds the same mesh as the tool's .vtu.
+if [ -x "$SOUPTET_BIN/latticetet" ]; then
+    soupdist -q -r 24 "$ROOT/corpus/bunny.obj" | soupsign -q > f24.vdb &&
+        latticetet -q --density 0.5 --cells 4 -o lo.vtu f24.vdb &&
+        tetsmooth -q --fair -o to.vtu lo.vtu
+    ok $? "latticetet and tetsmooth write .vtu"
+    for opt in "--msh-binary" "--msh-version 2" "--msh-version 2 --msh-binary"; do
+        tag=$(echo "$opt" | tr -dc 'a-z0-9')
+        latticetet -q --density 0.5 --cells 4 $opt -o "lo$tag.msh" f24.vdb &&
+            "$T" --compare lo.vtu "lo$tag.msh" &&
+            tetsmooth -q --fair $opt -o "to$tag.msh" lo.vtu &&
+            "$T" --compare to.vtu "to$tag.msh"
+        ok $? "latticetet and tetsmooth $opt: the same mesh as their .vtu"
+    done
+    head -c 200 lomshbinary.msh | grep -aq '^4.1 1 8' &&
+        head -c 200 lomshversion2.msh | grep -aq '^2.2 0 8' &&
+        head -c 200 lomshversion2mshbinary.msh | grep -aq '^2.2 1 8'
+    ok $? "the options give msh 4.1 binary, 2.2 ASCII, 2.2 binary"
+    expect_fail "tetsmooth --msh-version 3 is a usage error" 2 \
+        "^tetsmooth: --msh-version is 2 or 4" tetsmooth --msh-version 3 -o x.msh lo.vtu
 fi
 
 # ---- Gmsh -------------------------------------------------------------------

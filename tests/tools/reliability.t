@@ -12,7 +12,7 @@ skip() {
     echo "ok $TAP_N - $1 # SKIP $2"
 }
 
-# st_outfile's temporaries are "dir/.NAME.XXXXXX" (src/outfile.c).
+# st_outfile's temporaries are "dir/.NAME.tmp-PID@HOST.XXXXXX" (src/outfile.c).
 no_temps() {
     ! ls -A "$1" | grep -Eq '^\..+\.[A-Za-z0-9]{6}$'
 }
@@ -28,7 +28,7 @@ check "the inputs are made" test -s d.vdb -a -s s.vdb -a -s l.vtu -a -s l30.vtu
 # ---- signals -----------------------------------------------------------
 # interrupt SIG DIR: soupdist -r 320 into DIR/big.vti in the background
 # (about 0.5 s of distances, then about 0.5 s writing); once its temporary
-# DIR/.big.vti.XXXXXX exists (the write has begun), send SIG. The tool's
+# DIR/.big.vti.tmp-PID@HOST.XXXXXX exists (the write has begun), send SIG. The tool's
 # exit status is left in $irc ("none" when the temporary never appeared).
 interrupt() {
     soupdist -q -r 320 -o "$2/big.vti" "$BUNNY" &
@@ -112,7 +112,7 @@ piped() {
 for cmd in "soupdist -r 128 $BUNNY" "soupsign d64.vdb" "soupwrap s.vdb" \
            "latticetet --density 0.5 --cells 30 s64.vdb" \
            "tetsmooth --fair --iters 1 --no-quality l30.vtu" \
-           "soupmesh -q --cells 10 --field-cells 32 --max-iters 5 --no-quality $BUNNY"; do
+           "soupmesh -q --offset-best-effort --cells 10 --field-cells 32 --max-iters 5 --no-quality $BUNNY"; do
     tool=${cmd%% *}
     # shellcheck disable=SC2086
     piped $cmd
@@ -126,7 +126,7 @@ ok $? "closed pipes: no temporary files"
 for cmd in "soupdist -r 32 $BUNNY" "soupsign d.vdb" "soupwrap s.vdb" \
            "latticetet --density 0.5 --cells 8 s.vdb" "tetsmooth --fair l.vtu" \
            "tetstat l.vtu" "tetstat --json l.vtu" "soupinfo $BUNNY" \
-           "soupmesh -q --cells 4 --field-cells 32 $BUNNY"; do
+           "soupmesh -q --offset-best-effort --cells 4 --field-cells 32 $BUNNY"; do
     tool=${cmd%% *}
     expect_fail "$cmd > /dev/full: exit 1, '<stdout>: write failed'" 1 \
         "^$tool: <stdout>: write (failed|error)" sh -c "$cmd > /dev/full"
@@ -164,7 +164,7 @@ if mount -t tmpfs -o size=64k tmpfs full 2>/dev/null; then
              "soupwrap -o full/x.obj s.vdb" "soupwrap -o full/x.stl s.vdb" \
              "latticetet --density 0.5 --cells 30 -o full/x.vtu s64.vdb" \
              "latticetet --density 0.5 --cells 30 -o full/x.msh s64.vdb" \
-             "soupmesh -q --cells 8 --field-cells 32 --max-iters 5 --no-quality -o full/x.node $BUNNY"; do
+             "soupmesh -q --offset-best-effort --cells 8 --field-cells 32 --max-iters 5 --no-quality -o full/x.node $BUNNY"; do
         tool=${c%% -*}
         out=$(echo "$c" | sed 's/.*-o \(full\/[^ ]*\).*/\1/')
         # (a TetGen pair may fail on either file)
@@ -198,9 +198,14 @@ done
 # ---- memory limits -----------------------------------------------------
 # The exact need: a -r 48 bunny field is 58x57x47 voxels of 4 bytes.
 need=$((58 * 57 * 47 * 4))
-expect_fail "soupdist: --max-memory one byte short of the grid: refused, names -r and --max-memory" 1 \
-    "^soupdist: .*bunny.obj: a 58x57x47 grid .*-r.*--max-memory" \
+expect_fail "soupdist: --max-memory one byte short of the grid: refused, names -r (a value that fits) and --max-memory" 1 \
+    "^soupdist: .*bunny.obj: a 58x57x47 grid .*use -r [0-9]+ or less.*--max-memory" \
     soupdist -r 48 --max-memory $((need - 1)) -o x.vdb "$BUNNY"
+fit=$(sed -n 's/.*use -r \([0-9]*\) or less.*/\1/p' "$WORK/.err")
+check "soupdist: the -r it names ($fit) fits that --max-memory" \
+    soupdist -q -r "${fit:-0}" --max-memory $((need - 1)) -o fit.vdb "$BUNNY"
+expect_fail "soupdist: and one more voxel does not" 1 "over the limit" \
+    soupdist -r $((${fit:-0} + 1)) --max-memory $((need - 1)) -o x.vdb "$BUNNY"
 check "soupdist: --max-memory of exactly the grid: made" soupdist -q -r 48 --max-memory $need -o y.vdb "$BUNNY"
 for c in "soupsign -o x.vdb d.vdb" "soupwrap -o x.obj s.vdb" \
          "latticetet --density 0.5 -o x.vtu s.vdb" "tetstat --field s.vdb l.vtu"; do
@@ -248,8 +253,22 @@ if (ulimit -v $VLIM && soupdist -q -r 16 -o v.vdb "$BUNNY") 2>/dev/null; then
     # 710x695x545 floats: 1026 MiB
     expect_fail "capped: soupdist -r 700 --max-memory 1000M: refused by the limit" 1 \
         "over the limit of 1000.0 MiB" capped soupdist -r 700 --max-memory 1000M -o x.vdb "$BUNNY"
-    expect_fail "capped: soupdist -r 700 --max-memory 2G: the allocation fails (the cap works)" 1 \
-        "out of memory" capped soupdist -r 700 --max-memory 2G -o x.vdb "$BUNNY"
+    expect_fail "capped: soupdist -r 700 --max-memory 2G: the allocation fails, naming ulimit -v" 1 \
+        "out of memory.*ulimit -v caps this process's address space at [0-9]+ MiB" \
+        capped soupdist -r 700 --max-memory 2G -o x.vdb "$BUNNY"
+    # With no --max-memory the default is what ulimit -v leaves, so the
+    # estimate refuses the job and names the options, where it was 80% of
+    # the RAM and the allocation failed midway ("out of memory").
+    expect_fail "capped: soupdist -r 700 (default limit): refused by the estimate, names -r and ulimit -v" 1 \
+        "^soupdist: .*bunny.obj: a 710x693x543 grid needs .* over the limit of .*-r.*--max-memory.*ulimit -v leaves" \
+        capped soupdist -r 700 -o x.vdb "$BUNNY"
+    expect_fail "capped: soupwrap --surface -r 700 (default limit): refused by the estimate" 1 \
+        "^soupwrap: .*bunny.obj: a 710x693x543 grid needs .* over the limit of .*-r.*ulimit -v leaves" \
+        capped soupwrap --surface "$BUNNY" -r 700 -o x.obj
+    expect_fail "capped: latticetet --cells 200 (default limit): refused, names --cells and ulimit -v" 1 \
+        "^latticetet: s.vdb: a lattice of .*--cells.*ulimit -v leaves" \
+        capped latticetet --density 0.5 --cells 200 -o x.vtu s.vdb
+    check "capped: nothing left by the refusals" sh -c "test ! -e x.vdb && test ! -e x.obj && test ! -e x.vtu && ! ls -A | grep -q '\.tmp-'"
     expect_fail "capped: soupwrap --surface -r 700 --max-memory 1000M: refused by the limit" 1 \
         "over the limit of 1000.0 MiB" capped soupwrap --surface "$BUNNY" -r 700 --max-memory 1000M -o x.obj
     # 37 million tets of at least 64 bytes: 2.3 GB

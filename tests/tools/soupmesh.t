@@ -7,7 +7,7 @@ cd "$WORK" || exit 1
 
 check "--help exits 0" sh -c 'soupmesh --help | grep -q "Usage: soupmesh"'
 check "man page exists" test -s "$ROOT/man/man1/soupmesh.1"
-check "the bunny meshes" soupmesh -q --cells 8 -o b.vtu "$BUNNY"
+check "the bunny meshes" soupmesh -q --offset-best-effort --cells 8 -o b.vtu "$BUNNY"
 
 cat > encl.py <<'PY'
 import json, sys
@@ -37,14 +37,69 @@ with open(sys.argv[2], "w") as o:
         o.write("f %d %d %d\n" % (n + 1, n + 2, n + 3)); n += 3
 PY
 check "a flipped exact soup of the bunny meshes and is enclosed" \
-    sh -c "soupmesh -q --cells 8 -o s.vtu soup.obj && tetstat --json --surface soup.obj s.vtu > s.json && /usr/bin/python3 encl.py s.json 20"
+    sh -c "soupmesh -q --offset-best-effort --cells 8 -o s.vtu soup.obj && tetstat --json --surface soup.obj s.vtu > s.json && /usr/bin/python3 encl.py s.json 20"
 
 mkdir t1 t2
 check "1 and 2 threads, 2 tries: identical output (same command line)" sh -c \
-    "(cd t1 && OMP_NUM_THREADS=1 soupmesh -q --cells 6 --tries 2 -o m.vtu '$BUNNY') &&
-     (cd t2 && OMP_NUM_THREADS=2 soupmesh -q --cells 6 --tries 2 -o m.vtu '$BUNNY') &&
+    "(cd t1 && OMP_NUM_THREADS=1 soupmesh -q --offset-best-effort --cells 6 --tries 2 -o m.vtu '$BUNNY') &&
+     (cd t2 && OMP_NUM_THREADS=2 soupmesh -q --offset-best-effort --cells 6 --tries 2 -o m.vtu '$BUNNY') &&
      cmp t1/m.vtu t2/m.vtu"
 check "the Spillmann mesher (--density)" soupmesh -q --density 0.5 --cells 8 -o d.vtu "$BUNNY"
+
+# Cetra's stopping condition: --offset 0.05 cannot be met at 4 cells. The
+# mesh is written, the count and the farthest distance in h are said even
+# with -q, and the exit status is 4; --offset-best-effort makes it 0 and a
+# warning.
+check "--offset 0.05: exit 4, written, said under -q" \
+    sh -c "soupmesh -q --cells 4 --field-cells 32 --offset 0.05 -o o5.vtu '$BUNNY' 2> o5.err; test \$? -eq 4 && test -s o5.vtu && grep -Eq '^soupmesh: .*bunny.obj: error: [0-9]+ of [0-9]+ boundary vertices stay farther than 0.05 h from the input, the farthest [0-9.]+ h' o5.err"
+check "--offset 0.05 --offset-best-effort: exit 0, a warning" \
+    sh -c "soupmesh --offset-best-effort --cells 4 --field-cells 32 --offset 0.05 -o o5b.vtu '$BUNNY' 2> o5b.err && grep -q 'warning: [0-9]* of [0-9]* boundary vertices stay farther than 0.05 h' o5b.err"
+check "--offset-best-effort -q: silent" \
+    sh -c "soupmesh -q --offset-best-effort --cells 4 --field-cells 32 --offset 0.05 -o o5c.vtu '$BUNNY' 2> o5c.err && ! test -s o5c.err"
+check "-v: both distances in h and per diagonal" \
+    sh -c "soupmesh -v --offset-best-effort --cells 4 --field-cells 32 -o o5d.vtu '$BUNNY' 2>&1 | grep -Eq 'boundary -> input max [0-9.]+ h \\([0-9.]+ diag\\), input -> boundary max [0-9.]+ h \\([0-9.]+ diag\\)'"
+check "tetstat agrees with soupmesh's exit 4" \
+    sh -c "tetstat --json --surface '$BUNNY' o5.vtu | python3 -c 'import json,sys; d=json.load(sys.stdin)[\"surface\"]; assert d[\"offset_ratio\"] == 0.05 and d[\"beyond_offset\"] > 0 and not d[\"offset_met\"], d'"
+
+# Cetra's stopping condition reached where the fit used to be held back
+# (before the rescue pass: 3 and 2 boundary vertices beyond 0.4 h, up to
+# 0.58 h and 0.48 h): a thin slot (two 1 x 1 x 0.1 plates 0.03 apart,
+# 0.24 h at 8 cells) and a sharp crease (a wedge of 20 degrees). Exit 0
+# without --offset-best-effort, every boundary vertex within 0.4 h
+# (tetstat), enclosing, angles kept.
+cat > shapes.py <<'PY'
+import math
+def box(lo, hi, V, F):
+    o = len(V)
+    for k in range(8):
+        V.append((hi[0] if k & 1 else lo[0], hi[1] if k & 2 else lo[1], hi[2] if k & 4 else lo[2]))
+    for a, b, c, d in [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]:
+        F.append((o + a, o + b, o + c))
+        F.append((o + a, o + c, o + d))
+def write(p, V, F):
+    with open(p, "w") as f:
+        f.write("OFF\n%d %d 0\n" % (len(V), len(F)))
+        for v in V:
+            f.write("%.17g %.17g %.17g\n" % v)
+        for t in F:
+            f.write("3 %d %d %d\n" % t)
+V, F = [], []
+box((0, 0, 0), (1, 1, 0.1), V, F)
+box((0, 0, 0.13), (1, 1, 0.23), V, F)
+write("slot.off", V, F)
+a = math.radians(20)
+P = [(0, 0), (1, 0), (math.cos(a), math.sin(a))]
+V = [(x, y, 0.0) for x, y in P] + [(x, y, 0.6) for x, y in P]
+F = [(0, 2, 1), (3, 4, 5), (0, 1, 4), (0, 4, 3), (1, 2, 5), (1, 5, 4), (2, 0, 3), (2, 3, 5)]
+write("wedge.off", V, F)
+PY
+/usr/bin/python3 shapes.py
+# The same at R 0.25 (before: 20 and 17 beyond), min dihedral >= 30.
+for run in "slot 0.4 33" "wedge 0.4 33" "slot 0.25 30" "wedge 0.25 30"; do
+    set -- $run
+    check "$1: every boundary vertex within $2 h, enclosing, min dihedral >= $3" \
+        sh -c "soupmesh -q --cells 8 --offset $2 -o $1-$2.vtu $1.off && tetstat --json --surface $1.off $1-$2.vtu | python3 -c 'import json,sys; r=json.load(sys.stdin); d=r[\"surface\"]; assert d[\"offset_ratio\"] == $2 and d[\"beyond_offset\"] == 0 and d[\"dist_max_h\"] <= $2 and d[\"encloses\"] and r[\"min_dihedral\"] >= $3, (d, r[\"min_dihedral\"])'"
+done
 
 expect_fail "a missing file" 1 "^soupmesh: missing.obj" soupmesh -o x.vtu missing.obj
 printf 'v 0 0 0\nv 1 0 0\nf 1 2 9\n' > bad.obj

@@ -84,6 +84,7 @@ tets[2][2], tets[2][3] = tets[2][3], tets[2][2]
 write_vtu("inverted.vtu", pts, tets)
 write_vtu("twocubes.vtu", *lattice((2, 1, 1)))
 write_vtu("big.vtu", *lattice((2, 2, 2)))
+write_vtu("big-h.vtu", *lattice((2, 2, 2)), {"h": "1"})
 pts, tets = lattice((2, 2, 2))
 tets[0][2], tets[0][3] = tets[0][3], tets[0][2]
 write_vtu("big-inverted.vtu", pts, tets)
@@ -165,6 +166,20 @@ check "inner box: distances, volume ratio 8" \
 # The enclosure test is always built: a null "encloses" is a failure here.
 check "inner box: enclosed (every vertex inside, nothing crossing)" \
     python3 want.py inner.json surface/encloses=true surface/enclosure=yes surface/vertices_inside=8 surface/fraction_inside=1 surface/crossing_triangles=0
+# Both distances in h (h = 1) and relative to the inner box's diagonal
+# (sqrt 3); the stopping condition: 8 corners at 0.866 h, 12 edge
+# midpoints at 0.707 h, 6 face centres at 0.5 h.
+check "inner box: both distances in h and per diagonal" \
+    sh -c "tetstat --json --surface inner.off big-h.vtu > innerh.json && python3 want.py innerh.json surface/diagonal=1.7320508 surface/dist_max_h=0.8660254 surface/dist_max_diag=0.5 surface/surface_dist_max_h=0.5 surface/surface_dist_max_diag=0.2886751 surface/offset_ratio=null"
+check "--offset 0.9: condition met" \
+    sh -c "tetstat --json --offset 0.9 --surface inner.off big-h.vtu > o9.json && python3 want.py o9.json surface/offset_ratio=0.9 surface/beyond_offset=0 surface/offset_met=true"
+check "--offset 0.75: the 8 corners beyond, a warning" \
+    sh -c "tetstat --json --offset 0.75 --surface inner.off big-h.vtu > o75.json 2> o75.err && python3 want.py o75.json surface/beyond_offset=8 surface/offset_met=false && grep -q '8 boundary vertices farther than 0.75 h' o75.err"
+check "--offset 0.6: corners and edge midpoints beyond, in the table" \
+    sh -c "tetstat --offset 0.6 --surface inner.off big-h.vtu 2>/dev/null | grep -q 'beyond 0.6 h (offset) *20 *<- OFFSET NOT MET'"
+expect_fail "--offset without --surface" 2 "needs --surface" tetstat --offset 0.4 big.vtu
+check "--offset on a mesh without h: not reported, said on stderr" \
+    sh -c "tetstat --json --offset 0.6 --surface inner.off big.vtu > noh.json 2> noh.err && python3 want.py noh.json surface/beyond_offset=null surface/dist_max_h=null && grep -q 'no cell width' noh.err"
 check "box sticking out: not enclosed, said on stderr" \
     sh -c "tetstat --json --surface out.off big.vtu > out.json 2> out.err && python3 want.py out.json surface/encloses=false surface/enclosure=no surface/vertices_inside=4 surface/fraction_inside=0.5 && grep -q 'does not enclose out.off' out.err"
 check "box sticking out: the table says so" sh -c "tetstat --surface out.off big.vtu 2>/dev/null | grep -q 'DOES NOT ENCLOSE'"

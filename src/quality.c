@@ -1,0 +1,324 @@
+/*
+ * quality.c - the quality pass of st_fit (past the paper), and on a mesh
+ * without a surface, fairing's (sm_quality_interior, sm_quality_fair).
+ *
+ * It works on the vertices of the tets whose score min(min dihedral,
+ * 0.75 (180 - max dihedral)) is below the goal: for each, a handful of
+ * candidate positions (toward its ODT target, toward its neighbours'
+ * centroid, line searches along the gradient of its worst tet's score and
+ * along the summed unit gradients of the tets within QUAL_ACTIVE of the
+ * worst, small steps along the axes), best first; the first that raises
+ * the lowest score of the star and keeps the fit's invariant (fit.c; and,
+ * for a boundary vertex, keeps it within max(d_offset, its distance) of
+ * S) is taken. A boundary vertex at the band's edge, or past it where a
+ * thin gap held it back, can take no step with an outward component, and
+ * those are most of the gradient steps: on the armadillo the worst tets
+ * (21.7 degrees) all had such vertices, every candidate refused by the
+ * distance rule. So a boundary vertex also searches the same gradients
+ * projected onto the tangent plane of S's distance (and a little inward
+ * of it). Rounds repeat until no tet scores below the goal or nothing
+ * moves. Vertices move colour by colour, within a colour in parallel,
+ * each check reading only its own star: the result does not depend on
+ * the thread count.
+ */
+#include "smooth_internal.h"
+#include "fpenv.h"
+
+#include "souptet/mem.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Quality pass: the smallest score gain (degrees) worth a move, so rounds
+ * end instead of trading rounding noise. */
+#define QUAL_MIN_GAIN 1e-3
+/* Line search steps along the score gradient, in units of h. */
+static const double qual_steps[] = {0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625};
+#define QUAL_NSTEPS (sizeof qual_steps / sizeof qual_steps[0])
+/* Tangential candidates of a boundary vertex: inward components, as a
+ * fraction of the step (0: in the tangent plane; 0.25: a quarter inward,
+ * which keeps the distance from growing where S curves away by up to
+ * about 14 degrees over the step). */
+static const double qual_inward[] = {0.0, 0.25};
+#define QUAL_NTANGENT 2
+/* Tets within this many degrees of the worst one steer the combined
+ * gradient direction. */
+#define QUAL_ACTIVE 2.0
+/* The axis-direction candidates' step, in units of h. */
+#define QUAL_AXIS_STEP 0.03
+/* Central-difference step for the score gradient, in units of h. */
+#define QUAL_GRAD_EPS 1e-4
+
+static int cmp_cand(const void *a, const void *b)
+{
+    const double *x = a, *y = b;   /* {score, px, py, pz, order} */
+    if (x[0] != y[0])
+        return x[0] > y[0] ? -1 : 1;
+    return (x[4] > y[4]) - (x[4] < y[4]);
+}
+
+/* Try to raise the lowest score of v's star; 1 when v moved. */
+/* The sum of the area-weighted outward normals of v's boundary faces. */
+static void fair_normal(const sm_mesh *sm, uint32_t v, double n[3])
+{
+    n[0] = n[1] = n[2] = 0.0;
+    for (size_t j = sm->vf_off[v]; j < sm->vf_off[v + 1]; j++) {
+        const uint32_t *f = sm->bf + 3 * (size_t)sm->vf[j];
+        const double *a = sm->m->xyz + 3 * (size_t)f[0];
+        const double *b = sm->m->xyz + 3 * (size_t)f[1];
+        const double *d = sm->m->xyz + 3 * (size_t)f[2];
+        double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+        n[0] += u[1] * w[2] - u[2] * w[1];
+        n[1] += u[2] * w[0] - u[0] * w[2];
+        n[2] += u[0] * w[1] - u[1] * w[0];
+    }
+    double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (l > 0.0 && isfinite(l))
+        for (int a = 0; a < 3; a++)
+            n[a] /= l;
+    else
+        n[0] = n[1] = n[2] = 0.0;
+}
+
+static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *rejected)
+{
+    const sm_mesh *sm = &c->sm;
+    /* no surface (after fairing): the boundary stays, or with
+     * fair_boundary moves only within its tangent plane */
+    const int tangent_only = !c->s && sm->onb[v];
+    if (tangent_only && !c->fair_boundary)
+        return 0;
+    double *x = sm->m->xyz + 3 * (size_t)v;
+    double s0 = sm_star_score(sm, v, x);
+    /* candidates: {score, x, y, z, order} */
+    double cand[5 + 2 * QUAL_NSTEPS + 6 + 2 * QUAL_NTANGENT * QUAL_NSTEPS][5];
+    int nc = 0;
+    double t[3];
+    sm_odt_target(sm, v, t);
+    static const double fr[] = {1.0, 0.5, 0.25};
+    for (int k = 0; k < 3; k++, nc++)
+        for (int a = 0; a < 3; a++)
+            cand[nc][1 + a] = x[a] + fr[k] * (t[a] - x[a]);
+    double cen[3] = {0, 0, 0};
+    size_t deg = sm->vv_off[v + 1] - sm->vv_off[v];
+    for (size_t j = sm->vv_off[v]; j < sm->vv_off[v + 1]; j++)
+        for (int a = 0; a < 3; a++)
+            cen[a] += sm->m->xyz[3 * (size_t)sm->vv[j] + (size_t)a] / (double)deg;
+    for (int k = 0; k < 2; k++, nc++)
+        for (int a = 0; a < 3; a++)
+            cand[nc][1 + a] = x[a] + fr[k] * (cen[a] - x[a]);
+    /* gradients (central differences) of the worst tet's score, and the
+     * sum of the unit gradients of every tet within QUAL_ACTIVE degrees of
+     * it (so that raising the worst does not just lower the next one) */
+    double ws = sm_star_score(sm, v, x);
+    double gw[3] = {0, 0, 0}, ga[3] = {0, 0, 0}, e = QUAL_GRAD_EPS * c->h, best = INFINITY;
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
+        const uint32_t *k = sm->m->tets + 4 * (size_t)sm->vt[j];
+        const double *q[4];
+        for (int i = 0; i < 4; i++)
+            q[i] = sm->m->xyz + 3 * (size_t)k[i];
+        double sc = sm_tet_score(q[0], q[1], q[2], q[3]);
+        if (sc > ws + QUAL_ACTIVE)
+            continue;
+        double g[3];
+        for (int a = 0; a < 3; a++) {
+            double pp[3], pm[3];
+            memcpy(pp, x, sizeof pp);
+            memcpy(pm, x, sizeof pm);
+            pp[a] += e;
+            pm[a] -= e;
+            const double *qp[4], *qm[4];
+            for (int i = 0; i < 4; i++) {
+                qp[i] = k[i] == v ? pp : q[i];
+                qm[i] = k[i] == v ? pm : q[i];
+            }
+            g[a] = sm_tet_score(qp[0], qp[1], qp[2], qp[3]) -
+                   sm_tet_score(qm[0], qm[1], qm[2], qm[3]);
+        }
+        double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        if (!(gl > 0.0) || !isfinite(gl))
+            continue;
+        for (int a = 0; a < 3; a++)
+            ga[a] += g[a] / gl;
+        if (sc < best) {
+            best = sc;
+            for (int a = 0; a < 3; a++)
+                gw[a] = g[a] / gl;
+        }
+    }
+    const double *dirs[2] = {gw, ga};
+    for (int d = 0; d < 2; d++) {
+        const double *g = dirs[d];
+        double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        if (gl > 0.0 && isfinite(gl))
+            for (size_t k2 = 0; k2 < QUAL_NSTEPS; k2++, nc++)
+                for (int a = 0; a < 3; a++)
+                    cand[nc][1 + a] = x[a] + qual_steps[k2] * c->h * g[a] / gl;
+    }
+    /* a boundary vertex may not move away from S beyond the band (nor
+     * beyond where it is), so at the band's edge or past it (held back by
+     * a thin gap) every step with an outward component fails: search the
+     * same gradients within the tangent plane of S's distance too, and
+     * slightly inward of it, where the surface curves away */
+    double dx = 0.0, nrm[3] = {0, 0, 0};
+    if (c->s && sm->onb[v]) {
+        double cp[3];
+        dx = sm_dist_to_s(c, x, cp);
+        if (dx > 0.0)
+            for (int a = 0; a < 3; a++)
+                nrm[a] = (x[a] - cp[a]) / dx;
+    }
+    if (tangent_only) {
+        /* the boundary's area-weighted normal: the gradient of the volume
+         * in v, so steps across it keep the volume to first order; only
+         * those candidates are kept */
+        nc = 0;
+        fair_normal(sm, v, nrm);
+        dx = nrm[0] != 0.0 || nrm[1] != 0.0 || nrm[2] != 0.0 ? 1.0 : 0.0;
+    }
+    if (dx > 0.0)
+        for (int d = 0; d < 2; d++) {
+            const double *g = dirs[d];
+            double gn = g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2];
+            double gt[3] = {g[0] - gn * nrm[0], g[1] - gn * nrm[1], g[2] - gn * nrm[2]};
+            double gl = sqrt(gt[0] * gt[0] + gt[1] * gt[1] + gt[2] * gt[2]);
+            if (!(gl > 0.0) || !isfinite(gl))
+                continue;
+            for (int b = 0; b < (tangent_only ? 1 : QUAL_NTANGENT); b++)
+                for (size_t k2 = 0; k2 < QUAL_NSTEPS; k2++, nc++) {
+                    double st = qual_steps[k2] * c->h;
+                    for (int a = 0; a < 3; a++)
+                        cand[nc][1 + a] = x[a] + st * (gt[a] / gl - qual_inward[b] * nrm[a]);
+                }
+        }
+    /* the six axis directions, a small step: a way out where the
+     * gradients point into the invariant */
+    for (int a = 0; a < 6 && !tangent_only; a++, nc++)
+        for (int b2 = 0; b2 < 3; b2++)
+            cand[nc][1 + b2] = x[b2] + (b2 == a / 2 ? (a & 1 ? -1.0 : 1.0) * QUAL_AXIS_STEP * c->h : 0.0);
+    if (nc == 0)
+        return 0;
+    for (int i = 0; i < nc; i++) {
+        cand[i][0] = sm_star_score(sm, v, cand[i] + 1);
+        cand[i][4] = i;
+    }
+    qsort(cand, (size_t)nc, sizeof cand[0], cmp_cand);
+    if (!(cand[0][0] > s0 + QUAL_MIN_GAIN))
+        return 0;
+    sm_star_pts_collect(c, v, sp);
+    double dmax = fmax(c->d_offset, dx);
+    for (int i = 0; i < nc; i++) {
+        if (!(cand[i][0] > s0 + QUAL_MIN_GAIN))
+            break;
+        const double *p = cand[i] + 1;
+        if (sm->onb[v] && c->s) {
+            int64_t tri;
+            double d2 = st_bvh_nearest(c->bvh, p, dmax * dmax, &tri, NULL);
+            if (tri < 0 || sqrt(d2) > dmax)
+                continue;
+        }
+        if (sm_move_ok(c, v, p, sp)) {
+            memcpy(x, p, 3 * sizeof *x);
+            return 1;
+        }
+        (*rejected)++;
+    }
+    return 0;
+}
+
+/* ST_OK, or ST_ENOMEM (err set) before any vertex moved. */
+st_status sm_quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
+                              st_fit_stats *st, double t0, st_error *err)
+{
+    sm_mesh *sm = &c->sm;
+    st_tetmesh *m = sm->m;
+    unsigned char *mark = st_calloc_array(sm->nv, 1);
+    dirty dy;
+    if (!mark || sm_dirty_init(&dy, sm->nv)) {
+        free(mark);
+        sm_dirty_free(&dy);
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory for the quality pass (%zu vertices)", sm->nv);
+    }
+    for (int round = 0; round < p->quality_rounds; round++) {
+        memset(mark, 0, sm->nv);
+        size_t nbad = 0;
+        for (size_t t = 0; t < m->ntets; t++) {
+            const uint32_t *k = m->tets + 4 * t;
+            double sc = sm_tet_score(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
+                                     m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]);
+            if (sc < p->quality_goal) {
+                nbad++;
+                for (int i = 0; i < 4; i++)
+                    mark[k[i]] = 1;
+            }
+        }
+        if (nbad == 0)
+            break;
+        size_t moved = 0, rejected = 0;
+        for (size_t col = 0; col < sm->ncolours; col++) {
+            dy.step++;
+            #pragma omp parallel reduction(+ : moved, rejected) \
+                if (PAR_CHECKED(sm->col_off[col + 1] - sm->col_off[col]))
+            {
+                star_pts sp = {NULL, 0, 0, 1, 0, 0, 0};
+                #pragma omp for schedule(dynamic, 8)
+                for (size_t j = sm->col_off[col]; j < sm->col_off[col + 1]; j++) {
+                    uint32_t v = sm->col_v[j];
+                    if (mark[v] && !sm_dirty_unchanged(&dy, sm, v)) {
+                        int k = quality_vertex(c, v, &sp, &rejected);
+                        sm_dirty_mark(&dy, v, k);
+                        moved += (size_t)k;
+                    }
+                }
+                free(sp.list);
+            }
+        }
+        st->quality_rounds = round + 1;
+        st->quality_moves += moved;
+        if (p->on_iter && c->s) {
+            dist_summary ds = sm_boundary_distances(c, dist);
+            fit_counts n = {moved, rejected, 0};
+            sm_fit_report(p, c, "quality", round + 1, &ds, &n, t0);
+        }
+        if (moved == 0)
+            break;
+    }
+    free(mark);
+    sm_dirty_free(&dy);
+    return ST_OK;
+}
+
+/* The quality pass on a borrowed mesh (fairing's), with or without the
+ * boundary's tangent moves. */
+static st_status quality_on(sm_mesh *sm, double h, int rounds, double goal, int boundary,
+                            size_t *moves, st_error *err)
+{
+    fit_ctx c;
+    memset(&c, 0, sizeof c);
+    c.sm = *sm;   /* borrowed: not freed here */
+    c.h = h;
+    c.fair_boundary = boundary;
+    st_fit_params p = st_fit_params_default();
+    p.quality_rounds = rounds;
+    p.quality_goal = goal;
+    st_fit_stats st;
+    memset(&st, 0, sizeof st);
+    st_status rc = sm_quality_pass(&c, &p, NULL, &st, 0.0, err);
+    *moves = st.quality_moves;
+    return rc;
+}
+
+st_status sm_quality_interior(sm_mesh *sm, double h, int rounds, double goal,
+                              size_t *moves, st_error *err)
+{
+    return quality_on(sm, h, rounds, goal, 0, moves, err);
+}
+
+st_status sm_quality_fair(sm_mesh *sm, double h, int rounds, double goal, size_t *moves,
+                          st_error *err)
+{
+    return quality_on(sm, h, rounds, goal, 1, moves, err);
+}
