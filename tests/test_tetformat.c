@@ -10,11 +10,14 @@
  *   test_tetformat --write DIR  write a sample mesh in every variant into
  *                               DIR (for tests/tools/formats.t, which feeds
  *                               them to gmsh, tetgen and meshio)
- *   test_tetformat --compare A B [--sets]
+ *   test_tetformat --compare A B [--sets|--renumbered]
  *                               exit 0 when meshes A and B (any format,
  *                               .vtu too) have the same points within 1e-15
  *                               of their size and the same tets (--sets:
- *                               the same corner sets in any order)
+ *                               the same corner sets in any order;
+ *                               --renumbered: B's points also in any order,
+ *                               matched to A's by coordinates, as Gmsh
+ *                               renumbers the nodes it saves by entity)
  */
 #include "souptet/outfile.h"
 #include "souptet/tetformat.h"
@@ -635,6 +638,56 @@ static void canonical(st_tetmesh *m)
     qsort(m->tets, m->ntets, 4 * sizeof(uint32_t), cmp_tet);
 }
 
+static const double *g_xyz;
+
+static int cmp_point(const void *a, const void *b)
+{
+    const double *p = g_xyz + 3 * (size_t)*(const uint32_t *)a;
+    const double *q = g_xyz + 3 * (size_t)*(const uint32_t *)b;
+    for (int k = 0; k < 3; k++)
+        if (p[k] != q[k])
+            return p[k] < q[k] ? -1 : 1;
+    return 0;
+}
+
+/* The points of m in lexicographic order (malloc'd indices). */
+static uint32_t *point_order(const st_tetmesh *m)
+{
+    uint32_t *o = malloc((m->npoints ? m->npoints : 1) * sizeof *o);
+    if (!o)
+        return NULL;
+    for (size_t i = 0; i < m->npoints; i++)
+        o[i] = (uint32_t)i;
+    g_xyz = m->xyz;
+    qsort(o, m->npoints, sizeof *o, cmp_point);
+    return o;
+}
+
+/* Renumber y's points into x's order, matched by sorted coordinates (the
+ * tolerance check that follows compares them). */
+static int match_points(const st_tetmesh *x, st_tetmesh *y)
+{
+    uint32_t *ox = point_order(x), *oy = point_order(y);
+    uint32_t *to = malloc((y->npoints ? y->npoints : 1) * sizeof *to);
+    double *xyz = malloc((y->npoints ? y->npoints : 1) * 3 * sizeof *xyz);
+    int rc = ox && oy && to && xyz ? 0 : 1;
+    for (size_t i = 0; !rc && i < y->npoints; i++) {
+        to[oy[i]] = ox[i];
+        memcpy(xyz + 3 * (size_t)ox[i], y->xyz + 3 * (size_t)oy[i],
+               3 * sizeof *xyz);
+    }
+    if (!rc) {
+        memcpy(y->xyz, xyz, 3 * y->npoints * sizeof *xyz);
+        for (size_t i = 0; i < 4 * y->ntets; i++)
+            y->tets[i] = to[y->tets[i]];
+    }
+    free(ox);
+    free(oy);
+    free(to);
+    free(xyz);
+    return rc;
+}
+
 static int compare_files(const char *a, const char *b, int sets)
 {
     st_tetmesh *x = read_any(a), *y = read_any(b);
@@ -644,6 +697,10 @@ static int compare_files(const char *a, const char *b, int sets)
     if (x->npoints != y->npoints || x->ntets != y->ntets) {
         fprintf(stderr, "%s: %zu points %zu tets, %s: %zu points %zu tets\n",
                 a, x->npoints, x->ntets, b, y->npoints, y->ntets);
+        goto out;
+    }
+    if (sets == 2 && match_points(x, y)) {
+        fprintf(stderr, "out of memory\n");
         goto out;
     }
     double size = 0, diff = 0;
@@ -680,8 +737,11 @@ int main(int argc, char **argv)
     if (argc == 3 && strcmp(argv[1], "--write") == 0)
         return write_samples(argv[2]);
     if ((argc == 4 || argc == 5) && strcmp(argv[1], "--compare") == 0)
-        return compare_files(argv[2], argv[3],
-                             argc == 5 && strcmp(argv[4], "--sets") == 0);
+        return compare_files(
+            argv[2], argv[3],
+            argc == 5 && strcmp(argv[4], "--sets") == 0          ? 1
+            : argc == 5 && strcmp(argv[4], "--renumbered") == 0 ? 2
+                                                                 : 0);
     if (!mkdtemp(g_dir)) {
         perror("mkdtemp");
         return 1;
