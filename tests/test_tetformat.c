@@ -242,18 +242,26 @@ static void test_written_text(void)
         const char *want;
     } cases[] = {
         {"one41.msh", 41,
-         "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n"
-         "1 0 0 0 1 1 0.5 1 1 0\n$EndEntities\n$Nodes\n1 4 1 4\n3 1 0 4\n"
+         "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n2\n"
+         "2 2 \"boundary\"\n3 1 \"volume\"\n$EndPhysicalNames\n"
+         "$Entities\n0 0 1 1\n2 0 0 0 1 1 0.5 1 2 0\n"
+         "1 0 0 0 1 1 0.5 1 1 1 2\n$EndEntities\n$Nodes\n1 4 1 4\n3 1 0 4\n"
          "1\n2\n3\n4\n0 0 0\n1 0 0\n0 1 0\n0 0 0.5\n$EndNodes\n"
-         "$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n"},
+         "$Elements\n2 5 1 5\n3 1 4 1\n1 1 2 3 4\n2 2 2 4\n2 2 3 4\n"
+         "3 1 4 3\n4 1 2 4\n5 1 3 2\n$EndElements\n"},
         {"one22.msh", 22,
-         "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n"
-         "2 1 0 0\n3 0 1 0\n4 0 0 0.5\n$EndNodes\n$Elements\n1\n"
-         "1 4 2 1 1 1 2 3 4\n$EndElements\n"},
+         "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n2\n"
+         "2 2 \"boundary\"\n3 1 \"volume\"\n$EndPhysicalNames\n"
+         "$Nodes\n4\n1 0 0 0\n"
+         "2 1 0 0\n3 0 1 0\n4 0 0 0.5\n$EndNodes\n$Elements\n5\n"
+         "1 4 2 1 1 1 2 3 4\n2 2 2 2 2 2 3 4\n3 2 2 2 2 1 4 3\n"
+         "4 2 2 2 2 1 2 4\n5 2 2 2 2 1 3 2\n$EndElements\n"},
+        /* The boundary faces point out of the tet: 2 3 4 away from the
+         * origin, 1 4 3 to -x, 1 2 4 to -y, 1 3 2 to -z. */
         {"one.mesh", 0,
          "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n4\n0 0 0 0\n"
          "1 0 0 0\n0 1 0 0\n0 0 0.5 0\n\nTetrahedra\n1\n1 2 3 4 1\n\n"
-         "End\n"},
+         "Triangles\n4\n2 3 4 2\n1 4 3 2\n1 2 4 2\n1 3 2 2\n\nEnd\n"},
         {"one.node", 0, "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 0.5\n"},
         {"one.ele", -1, "1 4 0\n1 1 2 3 4\n"},
     };
@@ -276,6 +284,27 @@ static void test_written_text(void)
         if (strcmp(buf, cases[i].want) != 0)
             TAP_NOTE("got:\n%s", buf);
     }
+    /* A negatively oriented tet (read from a foreign file) still gets
+     * outward boundary triangles. */
+    m->tets[1] = 2;
+    m->tets[2] = 1;
+    char path[256], buf[1024] = {0};
+    snprintf(path, sizeof path, "%s/inv.mesh", g_dir);
+    st_error e;
+    st_tetmesh_save(m, path, NULL, &e);
+    FILE *fp = fopen(path, "rb");
+    size_t n = fp ? fread(buf, 1, sizeof buf - 1, fp) : 0;
+    if (fp)
+        fclose(fp);
+    buf[n] = '\0';
+    /* The same four outward faces as above (3 4 2 is 2 3 4 turned). */
+    const char *want = "Triangles\n4\n3 4 2 2\n1 2 4 2\n1 4 3 2\n"
+                       "1 3 2 2\n\nEnd\n";
+    const char *tri = strstr(buf, "Triangles\n");
+    TAP_CHECK(tri && strcmp(tri, want) == 0,
+              "an inverted tet's boundary triangles point outward");
+    if (!tri || strcmp(tri, want) != 0)
+        TAP_NOTE("got:\n%s", buf);
     st_tetmesh_free(m);
 }
 
