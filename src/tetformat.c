@@ -26,6 +26,7 @@
 #include "souptet/outfile.h"
 #include "tetformat_internal.h"
 #include "fileio.h"
+#include "souptet/pred.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -157,11 +158,43 @@ st_status st_tf_check_writable(const st_tetmesh *m, st_tetformat f,
     if (f == ST_TETFORMAT_MSH && version < 0)
         return st_error_set(err, ST_EINPUT, path, 0,
                             "msh version must be 41 or 22");
+    /* Elements are the tets and their boundary faces (at most 4 each). */
     if (f == ST_TETFORMAT_MSH && version == 22 && binary &&
-        (m->npoints > INT32_MAX || m->ntets > INT32_MAX))
+        (m->npoints > INT32_MAX || m->ntets > INT32_MAX / 5))
         return st_error_set(err, ST_ELIMIT, path, 0,
                             "msh 2.2 binary holds at most %ld nodes and "
-                            "elements", (long)INT32_MAX);
+                            "%ld tets (with their boundary faces, %ld "
+                            "elements)", (long)INT32_MAX,
+                            (long)(INT32_MAX / 5), (long)INT32_MAX);
+    return ST_OK;
+}
+
+st_status st_tf_boundary(const st_tetmesh *m, uint32_t **faces,
+                         size_t *nfaces, const char *path, st_error *err)
+{
+    uint32_t *owner = NULL;
+    st_status s = st_tetmesh_boundary(m, faces, &owner, nfaces, err);
+    if (s) {
+        if (err && !err->file[0] && path) {
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "%s", err->msg);
+            return st_error_set(err, s, path, 0, "%s", msg);
+        }
+        return s;
+    }
+    for (size_t f = 0; f < *nfaces; f++) {
+        const uint32_t *t = m->tets + 4 * (size_t)owner[f];
+        /* Positive orientation (tetmesh.h) is st_orient3d < 0. */
+        if (st_orient3d(m->xyz + 3 * (size_t)t[0], m->xyz + 3 * (size_t)t[1],
+                        m->xyz + 3 * (size_t)t[2],
+                        m->xyz + 3 * (size_t)t[3]) > 0) {
+            uint32_t *q = *faces + 3 * f;
+            uint32_t x = q[1];
+            q[1] = q[2];
+            q[2] = x;
+        }
+    }
+    free(owner);
     return ST_OK;
 }
 
@@ -209,6 +242,11 @@ st_status st_tf_save(const st_tetmesh *m, st_tetformat f, const char *path,
     st_status s = st_tf_check_writable(m, f, version, o.binary, path, err);
     if (s)
         return s;
+    uint32_t *faces = NULL;
+    size_t nfaces = 0;
+    if (f != ST_TETFORMAT_TETGEN &&
+        (s = st_tf_boundary(m, &faces, &nfaces, path, err)))
+        return s;
     char *names[2] = {NULL, NULL};
     int nfiles = 1;
     if (f == ST_TETFORMAT_TETGEN) {
@@ -217,8 +255,10 @@ st_status st_tf_save(const st_tetmesh *m, st_tetformat f, const char *path,
         nfiles = 2;
     } else {
         names[0] = st_strdup(path);
-        if (!names[0])
+        if (!names[0]) {
+            free(faces);
             return st_error_set(err, ST_ENOMEM, path, 0, "out of memory");
+        }
     }
     st_outfile out[2];
     memset(out, 0, sizeof out);
@@ -228,9 +268,10 @@ st_status st_tf_save(const st_tetmesh *m, st_tetformat f, const char *path,
             break;
     if (!s) {
         if (f == ST_TETFORMAT_MSH)
-            st_tf_write_msh_fp(out[0].fp, m, version, o.binary ? 1 : 0);
+            st_tf_write_msh_fp(out[0].fp, m, version, o.binary ? 1 : 0,
+                               faces, nfaces);
         else if (f == ST_TETFORMAT_MEDIT)
-            st_tf_write_medit_fp(out[0].fp, m);
+            st_tf_write_medit_fp(out[0].fp, m, faces, nfaces);
         else {
             st_tf_write_node_fp(out[0].fp, m);
             st_tf_write_ele_fp(out[1].fp, m);
@@ -247,5 +288,6 @@ st_status st_tf_save(const st_tetmesh *m, st_tetformat f, const char *path,
         st_outfile_abort(&out[i]);
     free(names[0]);
     free(names[1]);
+    free(faces);
     return s;
 }

@@ -320,16 +320,25 @@ int st_tf_msh_version(int v);
 st_status st_tf_check_writable(const st_tetmesh *m, st_tetformat f,
                                int version, int binary, const char *path,
                                st_error *err);
+/* The boundary faces written as triangles by .msh and .mesh: those of
+ * st_tetmesh_boundary, each turned outward also when its tet is
+ * negatively oriented (the exact sign of st_orient3d decides; a flat tet's
+ * face is kept as it is). *faces (3 point indices a face) is freed by
+ * the caller with free(). (tetformat.c) */
+st_status st_tf_boundary(const st_tetmesh *m, uint32_t **faces,
+                         size_t *nfaces, const char *path, st_error *err);
 FILE *st_tf_open_out(const char *path, st_error *err);
 st_status st_tf_close_written(FILE *fp, const char *path, st_error *err);
 
 /* The writers on an open stream (tetformat_msh.c, tetformat_tetgen.c,
- * tetformat_medit.c); errors show in ferror(fp). */
+ * tetformat_medit.c); errors show in ferror(fp). The .msh and .mesh
+ * writers also write the nfaces boundary triangles faces (st_tf_boundary). */
 void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
-                        int binary);
+                        int binary, const uint32_t *faces, size_t nfaces);
 void st_tf_write_node_fp(FILE *fp, const st_tetmesh *m);
 void st_tf_write_ele_fp(FILE *fp, const st_tetmesh *m);
-void st_tf_write_medit_fp(FILE *fp, const st_tetmesh *m);
+void st_tf_write_medit_fp(FILE *fp, const st_tetmesh *m,
+                          const uint32_t *faces, size_t nfaces);
 
 /* m to path in format f (NONE: by path; MSH, TETGEN or MEDIT) with opts
  * (NULL: defaults), atomically: every file (both of a TetGen pair) goes

@@ -167,7 +167,8 @@ st_status st_tetmesh_read_medit(st_tetmesh **out, const char *path,
 
 /* ---- Medit .mesh: writing ------------------------------------------------ */
 
-void st_tf_write_medit_fp(FILE *fp, const st_tetmesh *m)
+void st_tf_write_medit_fp(FILE *fp, const st_tetmesh *m,
+                          const uint32_t *faces, size_t nfaces)
 {
     fputs("MeshVersionFormatted 2\n", fp);
     st_tf_put_meta(fp, &m->meta, "# ");
@@ -183,15 +184,32 @@ void st_tf_write_medit_fp(FILE *fp, const st_tetmesh *m)
                 (unsigned long)t[1] + 1, (unsigned long)t[2] + 1,
                 (unsigned long)t[3] + 1);
     }
+    /* The boundary, outward, with reference 2. */
+    if (nfaces) {
+        fprintf(fp, "\nTriangles\n%zu\n", nfaces);
+        for (size_t i = 0; i < nfaces; i++) {
+            const uint32_t *q = faces + 3 * i;
+            fprintf(fp, "%lu %lu %lu 2\n", (unsigned long)q[0] + 1,
+                    (unsigned long)q[1] + 1, (unsigned long)q[2] + 1);
+        }
+    }
     fputs("\nEnd\n", fp);
 }
 
 st_status st_tetmesh_write_medit(const st_tetmesh *m, const char *path,
                                  st_error *err)
 {
+    uint32_t *faces = NULL;
+    size_t nfaces = 0;
+    st_status s = st_tf_boundary(m, &faces, &nfaces, path, err);
+    if (s)
+        return s;
     FILE *fp = st_tf_open_out(path, err);
-    if (!fp)
+    if (!fp) {
+        free(faces);
         return err ? err->status : ST_EIO;
-    st_tf_write_medit_fp(fp, m);
+    }
+    st_tf_write_medit_fp(fp, m, faces, nfaces);
+    free(faces);
     return st_tf_close_written(fp, path, err);
 }

@@ -607,8 +607,92 @@ static void put_u64(FILE *fp, uint64_t v) { fwrite(&v, sizeof v, 1, fp); }
 static void put_i32(FILE *fp, int32_t v) { fwrite(&v, sizeof v, 1, fp); }
 static void put_f64(FILE *fp, double v) { fwrite(&v, sizeof v, 1, fp); }
 
+/* The physical groups, as gmsh and meshio name them: the volume (3-D,
+ * physical 1) and its boundary triangles (2-D, physical 2). The entity
+ * tags equal the physical tags, so a reader that mixes the two up still
+ * sees the right group. */
+#define MSH_VOLUME 1
+#define MSH_BOUNDARY 2
+
+static void msh_physical_names(FILE *fp)
+{
+    fprintf(fp, "$PhysicalNames\n2\n2 %d \"boundary\"\n3 %d \"volume\"\n"
+            "$EndPhysicalNames\n", MSH_BOUNDARY, MSH_VOLUME);
+}
+
+static void msh22_elements(FILE *fp, const st_tetmesh *m, int binary,
+                           const uint32_t *faces, size_t nf)
+{
+    size_t nt = m->ntets;
+    fprintf(fp, "$Elements\n%zu\n", nt + nf);
+    if (binary && nt) {
+        put_i32(fp, 4);
+        put_i32(fp, (int32_t)nt);
+        put_i32(fp, 2);
+    }
+    for (size_t i = 0; i < nt; i++) {
+        const uint32_t *t = m->tets + 4 * i;
+        if (binary) {
+            int32_t rec[7] = {(int32_t)(i + 1), MSH_VOLUME, MSH_VOLUME,
+                              (int32_t)(t[0] + 1), (int32_t)(t[1] + 1),
+                              (int32_t)(t[2] + 1), (int32_t)(t[3] + 1)};
+            fwrite(rec, sizeof rec[0], 7, fp);
+        } else {
+            fprintf(fp, "%zu 4 2 %d %d %lu %lu %lu %lu\n", i + 1, MSH_VOLUME,
+                    MSH_VOLUME, (unsigned long)t[0] + 1,
+                    (unsigned long)t[1] + 1, (unsigned long)t[2] + 1,
+                    (unsigned long)t[3] + 1);
+        }
+    }
+    if (binary && nf) {
+        put_i32(fp, 2);
+        put_i32(fp, (int32_t)nf);
+        put_i32(fp, 2);
+    }
+    for (size_t i = 0; i < nf; i++) {
+        const uint32_t *q = faces + 3 * i;
+        if (binary) {
+            int32_t rec[6] = {(int32_t)(nt + i + 1), MSH_BOUNDARY,
+                              MSH_BOUNDARY, (int32_t)(q[0] + 1),
+                              (int32_t)(q[1] + 1), (int32_t)(q[2] + 1)};
+            fwrite(rec, sizeof rec[0], 6, fp);
+        } else {
+            fprintf(fp, "%zu 2 2 %d %d %lu %lu %lu\n", nt + i + 1,
+                    MSH_BOUNDARY, MSH_BOUNDARY, (unsigned long)q[0] + 1,
+                    (unsigned long)q[1] + 1, (unsigned long)q[2] + 1);
+        }
+    }
+    fprintf(fp, "%s$EndElements\n", binary ? "\n" : "");
+}
+
+/* One 4.1 entity (a surface or a volume) with one physical tag and, for
+ * the volume, the surface bounding it. */
+static void msh41_entity(FILE *fp, int binary, int tag, const double lo[3],
+                         const double hi[3], int bounded_by)
+{
+    if (binary) {
+        put_i32(fp, tag);
+        for (int k = 0; k < 3; k++)
+            put_f64(fp, lo[k]);
+        for (int k = 0; k < 3; k++)
+            put_f64(fp, hi[k]);
+        put_u64(fp, 1);
+        put_i32(fp, tag);
+        put_u64(fp, bounded_by ? 1 : 0);
+        if (bounded_by)
+            put_i32(fp, bounded_by);
+    } else {
+        fprintf(fp, "%d %.17g %.17g %.17g %.17g %.17g %.17g 1 %d ", tag,
+                lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], tag);
+        if (bounded_by)
+            fprintf(fp, "1 %d\n", bounded_by);
+        else
+            fputs("0\n", fp);
+    }
+}
+
 void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
-                         int binary)
+                        int binary, const uint32_t *faces, size_t nf)
 {
     size_t np = m->npoints, nt = m->ntets;
     fprintf(fp, "$MeshFormat\n%s %d 8\n", version == 22 ? "2.2" : "4.1",
@@ -618,6 +702,7 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
         fputc('\n', fp);
     }
     fputs("$EndMeshFormat\n", fp);
+    msh_physical_names(fp);
     if (m->meta.count) {
         fputs("$Comments\n", fp);
         st_tf_put_meta(fp, &m->meta, "");
@@ -635,30 +720,13 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
                         p[2]);
             }
         }
-        fprintf(fp, "%s$EndNodes\n$Elements\n%zu\n", binary ? "\n" : "", nt);
-        if (binary && nt) {
-            put_i32(fp, 4);
-            put_i32(fp, (int32_t)nt);
-            put_i32(fp, 2);
-        }
-        for (size_t i = 0; i < nt; i++) {
-            const uint32_t *t = m->tets + 4 * i;
-            if (binary) {
-                int32_t rec[7] = {(int32_t)(i + 1), 1, 1,
-                                  (int32_t)(t[0] + 1), (int32_t)(t[1] + 1),
-                                  (int32_t)(t[2] + 1), (int32_t)(t[3] + 1)};
-                fwrite(rec, sizeof rec[0], 7, fp);
-            } else {
-                fprintf(fp, "%zu 4 2 1 1 %lu %lu %lu %lu\n", i + 1,
-                        (unsigned long)t[0] + 1, (unsigned long)t[1] + 1,
-                        (unsigned long)t[2] + 1, (unsigned long)t[3] + 1);
-            }
-        }
-        fprintf(fp, "%s$EndElements\n", binary ? "\n" : "");
+        fprintf(fp, "%s$EndNodes\n", binary ? "\n" : "");
+        msh22_elements(fp, m, binary, faces, nf);
         return;
     }
 
-    /* 4.1: one volume entity (tag 1, physical group 1) holding everything. */
+    /* 4.1: the boundary surface entity (tag 2, physical 2) and the volume
+     * it bounds (tag 1, physical 1), which holds every node. */
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (size_t i = 0; i < np; i++)
         for (int k = 0; k < 3; k++) {
@@ -672,21 +740,15 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
     if (binary) {
         put_u64(fp, 0);
         put_u64(fp, 0);
-        put_u64(fp, 0);
         put_u64(fp, 1);
-        put_i32(fp, 1);
-        for (int k = 0; k < 3; k++)
-            put_f64(fp, lo[k]);
-        for (int k = 0; k < 3; k++)
-            put_f64(fp, hi[k]);
         put_u64(fp, 1);
-        put_i32(fp, 1);
-        put_u64(fp, 0);
-        fputc('\n', fp);
     } else {
-        fprintf(fp, "0 0 0 1\n1 %.17g %.17g %.17g %.17g %.17g %.17g 1 1 0\n",
-                lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+        fputs("0 0 1 1\n", fp);
     }
+    msh41_entity(fp, binary, MSH_BOUNDARY, lo, hi, 0);
+    msh41_entity(fp, binary, MSH_VOLUME, lo, hi, MSH_BOUNDARY);
+    if (binary)
+        fputc('\n', fp);
     fputs("$EndEntities\n$Nodes\n", fp);
     size_t nb = np ? 1 : 0;
     if (binary) {
@@ -696,7 +758,7 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
         put_u64(fp, np);
         if (np) {
             put_i32(fp, 3);
-            put_i32(fp, 1);
+            put_i32(fp, MSH_VOLUME);
             put_i32(fp, 0);
             put_u64(fp, np);
             for (size_t i = 0; i < np; i++)
@@ -707,7 +769,7 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
     } else {
         fprintf(fp, "%zu %zu %zu %zu\n", nb, np, np ? (size_t)1 : 0, np);
         if (np) {
-            fprintf(fp, "3 1 0 %zu\n", np);
+            fprintf(fp, "3 %d 0 %zu\n", MSH_VOLUME, np);
             for (size_t i = 0; i < np; i++)
                 fprintf(fp, "%zu\n", i + 1);
             for (size_t i = 0; i < np; i++) {
@@ -716,16 +778,18 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
             }
         }
     }
+    /* The tets are elements 1..nt, the boundary triangles nt+1..nt+nf. */
     fputs("$EndNodes\n$Elements\n", fp);
-    nb = nt ? 1 : 0;
+    size_t ne = nt + nf;
+    nb = (nt ? 1 : 0) + (nf ? 1 : 0);
     if (binary) {
         put_u64(fp, nb);
-        put_u64(fp, nt);
-        put_u64(fp, nt ? 1 : 0);
-        put_u64(fp, nt);
+        put_u64(fp, ne);
+        put_u64(fp, ne ? 1 : 0);
+        put_u64(fp, ne);
         if (nt) {
             put_i32(fp, 3);
-            put_i32(fp, 1);
+            put_i32(fp, MSH_VOLUME);
             put_i32(fp, 4);
             put_u64(fp, nt);
             for (size_t i = 0; i < nt; i++) {
@@ -736,16 +800,37 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
                 fwrite(rec, sizeof rec[0], 5, fp);
             }
         }
+        if (nf) {
+            put_i32(fp, 2);
+            put_i32(fp, MSH_BOUNDARY);
+            put_i32(fp, 2);
+            put_u64(fp, nf);
+            for (size_t i = 0; i < nf; i++) {
+                const uint32_t *q = faces + 3 * i;
+                uint64_t rec[4] = {nt + i + 1, (uint64_t)q[0] + 1,
+                                   (uint64_t)q[1] + 1, (uint64_t)q[2] + 1};
+                fwrite(rec, sizeof rec[0], 4, fp);
+            }
+        }
         fputc('\n', fp);
     } else {
-        fprintf(fp, "%zu %zu %zu %zu\n", nb, nt, nt ? (size_t)1 : 0, nt);
+        fprintf(fp, "%zu %zu %zu %zu\n", nb, ne, ne ? (size_t)1 : 0, ne);
         if (nt) {
-            fprintf(fp, "3 1 4 %zu\n", nt);
+            fprintf(fp, "3 %d 4 %zu\n", MSH_VOLUME, nt);
             for (size_t i = 0; i < nt; i++) {
                 const uint32_t *t = m->tets + 4 * i;
                 fprintf(fp, "%zu %lu %lu %lu %lu\n", i + 1,
                         (unsigned long)t[0] + 1, (unsigned long)t[1] + 1,
                         (unsigned long)t[2] + 1, (unsigned long)t[3] + 1);
+            }
+        }
+        if (nf) {
+            fprintf(fp, "2 %d 2 %zu\n", MSH_BOUNDARY, nf);
+            for (size_t i = 0; i < nf; i++) {
+                const uint32_t *q = faces + 3 * i;
+                fprintf(fp, "%zu %lu %lu %lu\n", nt + i + 1,
+                        (unsigned long)q[0] + 1, (unsigned long)q[1] + 1,
+                        (unsigned long)q[2] + 1);
             }
         }
     }
@@ -760,9 +845,16 @@ st_status st_tetmesh_write_msh(const st_tetmesh *m, const char *path,
                                  err);
     if (s)
         return s;
+    uint32_t *faces = NULL;
+    size_t nfaces = 0;
+    if ((s = st_tf_boundary(m, &faces, &nfaces, path, err)))
+        return s;
     FILE *fp = st_tf_open_out(path, err);
-    if (!fp)
+    if (!fp) {
+        free(faces);
         return err ? err->status : ST_EIO;
-    st_tf_write_msh_fp(fp, m, version, binary ? 1 : 0);
+    }
+    st_tf_write_msh_fp(fp, m, version, binary ? 1 : 0, faces, nfaces);
+    free(faces);
     return st_tf_close_written(fp, path, err);
 }

@@ -10,11 +10,14 @@
  *   test_tetformat --write DIR  write a sample mesh in every variant into
  *                               DIR (for tests/tools/formats.t, which feeds
  *                               them to gmsh, tetgen and meshio)
- *   test_tetformat --compare A B [--sets]
+ *   test_tetformat --compare A B [--sets|--renumbered]
  *                               exit 0 when meshes A and B (any format,
  *                               .vtu too) have the same points within 1e-15
  *                               of their size and the same tets (--sets:
- *                               the same corner sets in any order)
+ *                               the same corner sets in any order;
+ *                               --renumbered: B's points also in any order,
+ *                               matched to A's by coordinates, as Gmsh
+ *                               renumbers the nodes it saves by entity)
  */
 #include "souptet/outfile.h"
 #include "souptet/tetformat.h"
@@ -239,18 +242,26 @@ static void test_written_text(void)
         const char *want;
     } cases[] = {
         {"one41.msh", 41,
-         "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n"
-         "1 0 0 0 1 1 0.5 1 1 0\n$EndEntities\n$Nodes\n1 4 1 4\n3 1 0 4\n"
+         "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n2\n"
+         "2 2 \"boundary\"\n3 1 \"volume\"\n$EndPhysicalNames\n"
+         "$Entities\n0 0 1 1\n2 0 0 0 1 1 0.5 1 2 0\n"
+         "1 0 0 0 1 1 0.5 1 1 1 2\n$EndEntities\n$Nodes\n1 4 1 4\n3 1 0 4\n"
          "1\n2\n3\n4\n0 0 0\n1 0 0\n0 1 0\n0 0 0.5\n$EndNodes\n"
-         "$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n"},
+         "$Elements\n2 5 1 5\n3 1 4 1\n1 1 2 3 4\n2 2 2 4\n2 2 3 4\n"
+         "3 1 4 3\n4 1 2 4\n5 1 3 2\n$EndElements\n"},
         {"one22.msh", 22,
-         "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n"
-         "2 1 0 0\n3 0 1 0\n4 0 0 0.5\n$EndNodes\n$Elements\n1\n"
-         "1 4 2 1 1 1 2 3 4\n$EndElements\n"},
+         "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n2\n"
+         "2 2 \"boundary\"\n3 1 \"volume\"\n$EndPhysicalNames\n"
+         "$Nodes\n4\n1 0 0 0\n"
+         "2 1 0 0\n3 0 1 0\n4 0 0 0.5\n$EndNodes\n$Elements\n5\n"
+         "1 4 2 1 1 1 2 3 4\n2 2 2 2 2 2 3 4\n3 2 2 2 2 1 4 3\n"
+         "4 2 2 2 2 1 2 4\n5 2 2 2 2 1 3 2\n$EndElements\n"},
+        /* The boundary faces point out of the tet: 2 3 4 away from the
+         * origin, 1 4 3 to -x, 1 2 4 to -y, 1 3 2 to -z. */
         {"one.mesh", 0,
          "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n4\n0 0 0 0\n"
          "1 0 0 0\n0 1 0 0\n0 0 0.5 0\n\nTetrahedra\n1\n1 2 3 4 1\n\n"
-         "End\n"},
+         "Triangles\n4\n2 3 4 2\n1 4 3 2\n1 2 4 2\n1 3 2 2\n\nEnd\n"},
         {"one.node", 0, "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 0.5\n"},
         {"one.ele", -1, "1 4 0\n1 1 2 3 4\n"},
     };
@@ -273,6 +284,27 @@ static void test_written_text(void)
         if (strcmp(buf, cases[i].want) != 0)
             TAP_NOTE("got:\n%s", buf);
     }
+    /* A negatively oriented tet (read from a foreign file) still gets
+     * outward boundary triangles. */
+    m->tets[1] = 2;
+    m->tets[2] = 1;
+    char path[256], buf[1024] = {0};
+    snprintf(path, sizeof path, "%s/inv.mesh", g_dir);
+    st_error e;
+    st_tetmesh_save(m, path, NULL, &e);
+    FILE *fp = fopen(path, "rb");
+    size_t n = fp ? fread(buf, 1, sizeof buf - 1, fp) : 0;
+    if (fp)
+        fclose(fp);
+    buf[n] = '\0';
+    /* The same four outward faces as above (3 4 2 is 2 3 4 turned). */
+    const char *want = "Triangles\n4\n3 4 2 2\n1 2 4 2\n1 4 3 2\n"
+                       "1 3 2 2\n\nEnd\n";
+    const char *tri = strstr(buf, "Triangles\n");
+    TAP_CHECK(tri && strcmp(tri, want) == 0,
+              "an inverted tet's boundary triangles point outward");
+    if (!tri || strcmp(tri, want) != 0)
+        TAP_NOTE("got:\n%s", buf);
     st_tetmesh_free(m);
 }
 
@@ -635,6 +667,56 @@ static void canonical(st_tetmesh *m)
     qsort(m->tets, m->ntets, 4 * sizeof(uint32_t), cmp_tet);
 }
 
+static const double *g_xyz;
+
+static int cmp_point(const void *a, const void *b)
+{
+    const double *p = g_xyz + 3 * (size_t)*(const uint32_t *)a;
+    const double *q = g_xyz + 3 * (size_t)*(const uint32_t *)b;
+    for (int k = 0; k < 3; k++)
+        if (p[k] != q[k])
+            return p[k] < q[k] ? -1 : 1;
+    return 0;
+}
+
+/* The points of m in lexicographic order (malloc'd indices). */
+static uint32_t *point_order(const st_tetmesh *m)
+{
+    uint32_t *o = malloc((m->npoints ? m->npoints : 1) * sizeof *o);
+    if (!o)
+        return NULL;
+    for (size_t i = 0; i < m->npoints; i++)
+        o[i] = (uint32_t)i;
+    g_xyz = m->xyz;
+    qsort(o, m->npoints, sizeof *o, cmp_point);
+    return o;
+}
+
+/* Renumber y's points into x's order, matched by sorted coordinates (the
+ * tolerance check that follows compares them). */
+static int match_points(const st_tetmesh *x, st_tetmesh *y)
+{
+    uint32_t *ox = point_order(x), *oy = point_order(y);
+    uint32_t *to = malloc((y->npoints ? y->npoints : 1) * sizeof *to);
+    double *xyz = malloc((y->npoints ? y->npoints : 1) * 3 * sizeof *xyz);
+    int rc = ox && oy && to && xyz ? 0 : 1;
+    for (size_t i = 0; !rc && i < y->npoints; i++) {
+        to[oy[i]] = ox[i];
+        memcpy(xyz + 3 * (size_t)ox[i], y->xyz + 3 * (size_t)oy[i],
+               3 * sizeof *xyz);
+    }
+    if (!rc) {
+        memcpy(y->xyz, xyz, 3 * y->npoints * sizeof *xyz);
+        for (size_t i = 0; i < 4 * y->ntets; i++)
+            y->tets[i] = to[y->tets[i]];
+    }
+    free(ox);
+    free(oy);
+    free(to);
+    free(xyz);
+    return rc;
+}
+
 static int compare_files(const char *a, const char *b, int sets)
 {
     st_tetmesh *x = read_any(a), *y = read_any(b);
@@ -644,6 +726,10 @@ static int compare_files(const char *a, const char *b, int sets)
     if (x->npoints != y->npoints || x->ntets != y->ntets) {
         fprintf(stderr, "%s: %zu points %zu tets, %s: %zu points %zu tets\n",
                 a, x->npoints, x->ntets, b, y->npoints, y->ntets);
+        goto out;
+    }
+    if (sets == 2 && match_points(x, y)) {
+        fprintf(stderr, "out of memory\n");
         goto out;
     }
     double size = 0, diff = 0;
@@ -680,8 +766,11 @@ int main(int argc, char **argv)
     if (argc == 3 && strcmp(argv[1], "--write") == 0)
         return write_samples(argv[2]);
     if ((argc == 4 || argc == 5) && strcmp(argv[1], "--compare") == 0)
-        return compare_files(argv[2], argv[3],
-                             argc == 5 && strcmp(argv[4], "--sets") == 0);
+        return compare_files(
+            argv[2], argv[3],
+            argc == 5 && strcmp(argv[4], "--sets") == 0          ? 1
+            : argc == 5 && strcmp(argv[4], "--renumbered") == 0 ? 2
+                                                                 : 0);
     if (!mkdtemp(g_dir)) {
         perror("mkdtemp");
         return 1;

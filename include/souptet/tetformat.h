@@ -17,14 +17,20 @@
  * arrays are not written (use .vtu for per-cell quality).
  *
  * What is written.
- *  - .msh 4.1: $MeshFormat, $Comments, $Entities (one volume, tag 1, in
- *    physical group 1), $Nodes (one block, tags 1..n), $Elements (one block
- *    of type 4, tags 1..m). 2.2: $MeshFormat, $Comments, $Nodes,
- *    $Elements (type 4, tags: physical 1, elementary 1). Binary: native
- *    byte order with the format's "1" marker, data size 8.
+ *  - The boundary faces (st_tetmesh_boundary's, each turned outward by
+ *    the exact orientation of its tet, so also for an inverted tet) go
+ *    into .msh and .mesh as triangles, after the tets.
+ *  - .msh 4.1: $MeshFormat, $PhysicalNames (3-D 1 "volume", 2-D 2
+ *    "boundary"), $Comments, $Entities (surface tag 2 in physical group 2;
+ *    volume tag 1 in physical group 1, bounded by surface 2), $Nodes (one
+ *    block on the volume, tags 1..n), $Elements (a block of type 4 on the
+ *    volume, tags 1..m, then one of type 2 on the surface, tags m+1..).
+ *    2.2: $MeshFormat, $PhysicalNames, $Comments, $Nodes, $Elements (type
+ *    4 with tags physical 1, elementary 1; type 2 with 2, 2). Binary:
+ *    native byte order with the format's "1" marker, data size 8.
  *  - .node/.ele: "n 3 0 0" / "m 4 0", numbered from 1.
  *  - .mesh: MeshVersionFormatted 2, Dimension 3, Vertices (ref 0),
- *    Tetrahedra (ref 1), End; 1-based.
+ *    Tetrahedra (ref 1), Triangles (ref 2), End; 1-based.
  * Tets keep their corner order; souptet's positive orientation (signed
  * volume > 0, tetmesh.h) is also Gmsh's, TetGen's and Medit's.
  *

@@ -56,29 +56,59 @@ if [ -x "$SOUPTET_BIN/latticetet" ]; then
         "^tetsmooth: --msh-version is 2 or 4" tetsmooth --msh-version 3 -o x.msh lo.vtu
 fi
 
+# The boundary the .msh and .mesh files carry as triangles (physical group
+# "boundary", Medit reference 2): as many as tetstat counts boundary faces,
+# and outward: the cones from the origin over them sum to the mesh volume.
+NB= VOL=
+if [ -x "$SOUPTET_BIN/tetstat" ] && tetstat -q --json m.node >nb.json; then
+    NB=$(sed -n 's/.*"boundary_faces": \([0-9]*\).*/\1/p' nb.json)
+    VOL=$(sed -n 's/.*"volume": \([-0-9.e+]*\).*/\1/p' nb.json)
+fi
+[ -n "$NB" ] && [ "$NB" -gt 0 ] && [ -n "$VOL" ]
+ok $? "tetstat counts the sample's boundary faces ($NB) and volume ($VOL)"
+for f in m41.msh m41b.msh m22.msh m22b.msh; do
+    sed -n '/^\$PhysicalNames/,/^\$EndPhysicalNames/p' "$f" >pn.txt
+    grep -q '^2 2 "boundary"$' pn.txt && grep -q '^3 1 "volume"$' pn.txt
+    ok $? "$f names its physical groups: 3-D 1 \"volume\", 2-D 2 \"boundary\""
+done
+grep -q '^Triangles$' m.mesh && [ "$(sed -n '/^Triangles$/{n;p;q}' m.mesh)" = "$NB" ]
+ok $? "m.mesh has a Triangles section of the $NB boundary faces"
+
 # ---- Gmsh -------------------------------------------------------------------
 if command -v gmsh >/dev/null 2>&1; then
+    NE=$((135 + ${NB:-0}))
     for f in m41.msh m41b.msh m22.msh m22b.msh m.mesh; do
         timeout 60 gmsh -check "$f" >gmsh.log 2>&1
         rc=$?
         if [ $rc -eq 0 ] && grep -q 'Info *: 64 nodes' gmsh.log &&
-           grep -Eq 'Info *: 135 (elements|tetrahedra)$' gmsh.log &&
+           { grep -Eq "Info *: $NE elements\$" gmsh.log ||
+             { grep -q 'Info *: 135 tetrahedra$' gmsh.log &&
+               grep -q "Info *: $NB triangles\$" gmsh.log; }; } &&
            ! grep -q '^Error' gmsh.log; then
-            ok 0 "gmsh -check reads $f: 64 nodes, 135 elements, no error"
+            ok 0 "gmsh -check reads $f: 64 nodes, $NE elements (135 tets, $NB triangles), no error"
         else
-            ok 1 "gmsh -check reads $f: 64 nodes, 135 elements, no error"
+            ok 1 "gmsh -check reads $f: 64 nodes, $NE elements (135 tets, $NB triangles), no error"
             grep -E 'Error|Warning|nodes|elements' gmsh.log | head -5 |
                 sed 's/^/#   /'
         fi
     done
-    # Gmsh re-saves each file; we read its output back.
+    # Gmsh re-saves each file; we read its output back. Gmsh numbers the
+    # nodes it saves by entity (boundary nodes on the surface first) in
+    # 2.2 and from .mesh: those are matched by coordinates.
     for f in m41b.msh m22.msh m.mesh; do
         for fmt in msh22 msh41; do
             out="g-${f%.*}-$fmt.msh"
+            how=--renumbered
+            [ "$f" = m41b.msh ] && how=
             timeout 60 gmsh "$f" -save -format "$fmt" -o "$out" >gmsh.log 2>&1
             check "gmsh saves $f as $fmt and we read back the same mesh" \
-                "$T" --compare m.node "$out"
+                "$T" --compare m.node "$out" $how
         done
+    done
+    for f in m41.msh m22b.msh; do
+        timeout 60 gmsh "$f" -0 -o "g0-$f" >gmsh.log 2>&1
+        grep -q '^2 2 "boundary"$' "g0-$f" && grep -q '^3 1 "volume"$' "g0-$f"
+        ok $? "gmsh keeps the physical groups of $f (gmsh $f -0)"
     done
     timeout 60 gmsh m41.msh -save -format msh41 -bin -o g-bin.msh >gmsh.log 2>&1
     check "gmsh's own 4.1 binary reads back to the same mesh" \
@@ -142,6 +172,45 @@ EOF
     [ $rc -eq 0 ] && grep -q '^64 135$' meshio.log
     ok $? "meshio reads all six variants: identical points and tets, all positive"
     [ $rc -eq 0 ] || grep '^#' meshio.log | head -5
+    cat >meshio_bnd.py <<'EOF'
+import sys, warnings
+import numpy as np
+import meshio
+warnings.simplefilter("ignore")
+nb, vol = int(sys.argv[1]), float(sys.argv[2])
+bad = 0
+for f in sys.argv[3:]:
+    m = meshio.read(f)
+    tri = [(i, c.data) for i, c in enumerate(m.cells) if c.type == "triangle"]
+    tet = [(i, c.data) for i, c in enumerate(m.cells) if c.type == "tetra"]
+    if len(tri) != 1 or len(tet) != 1 or len(tri[0][1]) != nb:
+        print("#   %s: %s, want one tetra and one triangle block of %d"
+              % (f, [(c.type, len(c.data)) for c in m.cells], nb)); bad = 1; continue
+    key = "medit:ref" if f.endswith(".mesh") else "gmsh:physical"
+    cd = m.cell_data.get(key)
+    if cd is None or set(cd[tet[0][0]]) != {1} or set(cd[tri[0][0]]) != {2}:
+        print("#   %s: %s is not 1 on tets and 2 on triangles" % (f, key)); bad = 1
+    if not f.endswith(".mesh"):
+        fd = {k: list(v) for k, v in m.field_data.items()}
+        if fd.get("volume") != [1, 3] or fd.get("boundary") != [2, 2]:
+            print("#   %s: field_data %s" % (f, fd)); bad = 1
+    if "41" in f:   # meshio makes cell_sets from 4.1 files only
+        cs = m.cell_sets
+        if "volume" not in cs or "boundary" not in cs or \
+           len(cs["boundary"][tri[0][0]]) != nb or len(cs["volume"][tet[0][0]]) != len(tet[0][1]):
+            print("#   %s: cell_sets %s" % (f, sorted(cs))); bad = 1
+    p, t = m.points, tri[0][1]
+    s = np.einsum("ij,ij->i", p[t[:, 0]], np.cross(p[t[:, 1]], p[t[:, 2]])).sum() / 6
+    if not abs(s - vol) <= 1e-9 * abs(vol):
+        print("#   %s: boundary cones sum to %.17g, the mesh volume is %.17g" % (f, s, vol)); bad = 1
+    print("%s %d %.17g" % (f, len(t), s))
+sys.exit(bad)
+EOF
+    "$PY" meshio_bnd.py "${NB:-0}" "${VOL:-0}" m41.msh m41b.msh m22.msh m22b.msh \
+        m.mesh >mbnd.log 2>&1
+    rc=$?
+    ok $rc "meshio: $NB outward boundary triangles in every .msh (physical 2, \"boundary\") and .mesh (ref 2)"
+    [ $rc -eq 0 ] || grep '^#' mbnd.log | head -5
     for f in mio41.msh mio22.msh mio.mesh mio.node; do
         check "meshio's $f reads back to the same mesh" "$T" --compare m.node "$f"
     done
