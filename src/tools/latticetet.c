@@ -247,6 +247,7 @@ int main(int argc, char *argv[])
     const size_t max_tets = tool_max_lattice_tets(co.max_bytes);
     const char *limit_hint = "use fewer --cells or a larger -h, or raise "
                              "--max-memory";
+    size_t thin_parts = 0;   /* of the last density try: why no tets */
     if (!sculpt) {
       /* --cells auto: the first size of AUTO_CELLS (coarse to fine) at
        * which no part of the pseudo volume is too thin. */
@@ -325,6 +326,7 @@ int main(int argc, char *argv[])
                 tool_say(&t, final ? 1 : 2, "%s: warning: %zu more parts too thin",
                          in_name, cs.nthin - ST_CLEAN_MAX_THIN);
         }
+        thin_parts = cs.nthin;
         if (!auto_cells)
             break;
         if (cs.nthin == 0) {
@@ -384,7 +386,11 @@ int main(int argc, char *argv[])
                      "vertices", ss.nonmanifold_vertices_left);
     }
     if (m->ntets == 0)
-        tool_say(&t, 1, "warning: no tets kept (empty pseudo volume?)");
+        tool_say(&t, 1, thin_parts
+                 ? "%s: warning: no tets kept: the pseudo volume is thinner than this "
+                   "lattice holds (the --cells above would hold it)"
+                 : "%s: warning: no tets kept: the pseudo volume is empty (a field "
+                   "soupsign made has its inside negative)", in_name);
     /* The field's metadata (source, history) carries over; the lattice's
      * own keys win. */
     {
