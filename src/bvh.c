@@ -91,6 +91,39 @@ static void select_median(build_ctx *c, size_t lo, size_t hi, size_t mid,
     }
 }
 
+/* Set n's box to that of the triangles order[lo..hi); return the axis
+ * along which their centroids spread widest (the split axis). */
+static int node_bounds(const build_ctx *c, st_bvh_node *n, size_t lo,
+                       size_t hi)
+{
+    double clo[3] = {INFINITY, INFINITY, INFINITY};
+    double chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int k = 0; k < 3; k++) {
+        n->lo[k] = INFINITY;
+        n->hi[k] = -INFINITY;
+    }
+    for (size_t i = lo; i < hi; i++) {
+        const double *tb = c->box + 6 * (size_t)c->order[i];
+        const double *ce = c->cent + 3 * (size_t)c->order[i];
+        for (int k = 0; k < 3; k++) {
+            /* plain comparisons: coordinates are finite (soup.h) */
+            if (tb[k] < n->lo[k])
+                n->lo[k] = tb[k];
+            if (tb[3 + k] > n->hi[k])
+                n->hi[k] = tb[3 + k];
+            if (ce[k] < clo[k])
+                clo[k] = ce[k];
+            if (ce[k] > chi[k])
+                chi[k] = ce[k];
+        }
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; k++)
+        if (chi[k] - clo[k] > chi[axis] - clo[axis])
+            axis = k;
+    return axis;
+}
+
 /* The subtree of `node` over order[lo..hi), its nodes numbered from
  * `next` on, depth first, the right child's subtree before the left's
  * (the order of the explicit stack). */
@@ -108,36 +141,12 @@ static void build_serial(build_ctx *c, size_t node, size_t lo, size_t hi,
         sp--;
         size_t nd = stack[sp][0], a = stack[sp][1], b = stack[sp][2];
         st_bvh_node *n = &c->nodes[nd];
-        double clo[3] = {INFINITY, INFINITY, INFINITY};
-        double chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (int k = 0; k < 3; k++) {
-            n->lo[k] = INFINITY;
-            n->hi[k] = -INFINITY;
-        }
-        for (size_t i = a; i < b; i++) {
-            const double *tb = c->box + 6 * (size_t)c->order[i];
-            const double *ce = c->cent + 3 * (size_t)c->order[i];
-            for (int k = 0; k < 3; k++) {
-                /* plain comparisons: coordinates are finite (soup.h) */
-                if (tb[k] < n->lo[k])
-                    n->lo[k] = tb[k];
-                if (tb[3 + k] > n->hi[k])
-                    n->hi[k] = tb[3 + k];
-                if (ce[k] < clo[k])
-                    clo[k] = ce[k];
-                if (ce[k] > chi[k])
-                    chi[k] = ce[k];
-            }
-        }
+        int axis = node_bounds(c, n, a, b);
         if (b - a <= ST_BVH_LEAF) {
             n->start = (uint32_t)a;
             n->count = (uint32_t)(b - a);
             continue;
         }
-        int axis = 0;
-        for (int k = 1; k < 3; k++)
-            if (chi[k] - clo[k] > chi[axis] - clo[axis])
-                axis = k;
         size_t mid = a + (b - a) / 2;
         select_median(c, a, b, mid, axis);
         size_t left = next;
@@ -199,30 +208,7 @@ static void build_parallel(build_ctx *c, size_t node, size_t lo, size_t hi,
         return;
     }
     st_bvh_node *n = &c->nodes[node];
-    double clo[3] = {INFINITY, INFINITY, INFINITY};
-    double chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int k = 0; k < 3; k++) {
-        n->lo[k] = INFINITY;
-        n->hi[k] = -INFINITY;
-    }
-    for (size_t i = lo; i < hi; i++) {
-        const double *tb = c->box + 6 * (size_t)c->order[i];
-        const double *ce = c->cent + 3 * (size_t)c->order[i];
-        for (int k = 0; k < 3; k++) {
-            if (tb[k] < n->lo[k])
-                n->lo[k] = tb[k];
-            if (tb[3 + k] > n->hi[k])
-                n->hi[k] = tb[3 + k];
-            if (ce[k] < clo[k])
-                clo[k] = ce[k];
-            if (ce[k] > chi[k])
-                chi[k] = ce[k];
-        }
-    }
-    int axis = 0;
-    for (int k = 1; k < 3; k++)
-        if (chi[k] - clo[k] > chi[axis] - clo[axis])
-            axis = k;
+    int axis = node_bounds(c, n, lo, hi);
     size_t mid = lo + (hi - lo) / 2;
     select_median(c, lo, hi, mid, axis);
     size_t left = next;
