@@ -434,6 +434,7 @@ st_status st_soup_parse(st_soup **out, st_soup_format format,
 static st_status parse_at(st_soup **out, st_soup_format format,
                           const unsigned char *data, size_t size,
                           const char *name, const char *path,
+                          const st_soup__file_hook *hook,
                           st_soup_warnings *warn, st_error *err);
 
 st_status st_soup_parse_warn(st_soup **out, st_soup_format format,
@@ -441,13 +442,14 @@ st_status st_soup_parse_warn(st_soup **out, st_soup_format format,
                              const char *name, st_soup_warnings *warn,
                              st_error *err)
 {
-    return parse_at(out, format, data, size, name, NULL, warn, err);
+    return parse_at(out, format, data, size, name, NULL, NULL, warn, err);
 }
 
 /* st_soup_parse_warn, with the file's path for glTF's external buffers. */
 static st_status parse_at(st_soup **out, st_soup_format format,
                           const unsigned char *data, size_t size,
                           const char *name, const char *path,
+                          const st_soup__file_hook *hook,
                           st_soup_warnings *warn, st_error *err)
 {
     warnings_clear(warn);
@@ -470,7 +472,7 @@ static st_status parse_at(st_soup **out, st_soup_format format,
     case ST_SOUP_PLY: st = st_soup__parse_ply(s, data, size, name, warn, err); break;
     case ST_SOUP_STL: st = st_soup__parse_stl(s, data, size, name, err); break;
     case ST_SOUP_GLTF:
-        st = st_soup__parse_gltf(s, data, size, name, path, warn, err);
+        st = st_soup__parse_gltf(s, data, size, name, path, hook, warn, err);
         break;
     default:
         st = st_error_set(err, ST_EINPUT, name, 0,
@@ -487,12 +489,37 @@ static st_status parse_at(st_soup **out, st_soup_format format,
     return ST_OK;
 }
 
-void st_soup_source_of(st_soup_source *src, const void *data, size_t size)
+static void source_set(st_soup_source *src, XXH128_hash_t h,
+                       unsigned long long size)
 {
-    XXH128_hash_t h = XXH3_128bits(data, size);
-    src->size = (unsigned long long)size;
+    src->size = size;
     snprintf(src->hash, sizeof src->hash, "xxh3-128:%016llx%016llx",
              (unsigned long long)h.high64, (unsigned long long)h.low64);
+}
+
+void st_soup_source_of(st_soup_source *src, const void *data, size_t size)
+{
+    source_set(src, XXH3_128bits(data, size), (unsigned long long)size);
+}
+
+/* A glTF's source is its JSON (or GLB) file followed by every external
+ * buffer file the reader loads, each after its length: a changed .bin
+ * beside an unchanged .gltf is a changed source. */
+typedef struct source_stream {
+    XXH3_state_t *state;
+    unsigned long long size;
+} source_stream;
+
+static void source_stream_bytes(void *ctx, const unsigned char *data,
+                                size_t size)
+{
+    source_stream *ss = ctx;
+    unsigned char len[8];
+    for (int i = 0; i < 8; i++)
+        len[i] = (unsigned char)((unsigned long long)size >> (8 * i));
+    XXH3_128bits_update(ss->state, len, sizeof len);
+    XXH3_128bits_update(ss->state, data, size);
+    ss->size += (unsigned long long)size;
 }
 
 st_status st_soup_read(st_soup **out, const char *path, st_error *err)
@@ -532,14 +559,30 @@ st_status st_soup_read_source(st_soup **out, const char *path, st_soup_source *s
         is_stdin ? ST_SOUP_UNKNOWN : st_soup_format_from_path(path);
     if (fmt == ST_SOUP_UNKNOWN)
         fmt = st_soup_format_sniff(data, size);
-    if (src)
+    source_stream ss = {NULL, 0};
+    st_soup__file_hook hook = {source_stream_bytes, &ss};
+    if (src && fmt == ST_SOUP_GLTF && !is_stdin) {
+        ss.state = XXH3_createState();
+        if (!ss.state) {
+            free(data);
+            return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
+        }
+        XXH3_128bits_reset(ss.state);
+        XXH3_128bits_update(ss.state, data, size);
+        ss.size = (unsigned long long)size;
+    } else if (src) {
         st_soup_source_of(src, data, size);
+    }
     if (fmt == ST_SOUP_UNKNOWN)
         st = st_error_set(err, ST_EINPUT, name, 0,
                           "unknown format (not OBJ, OFF, PLY, STL or glTF)");
     else
         st = parse_at(out, fmt, data, size, name, is_stdin ? NULL : path,
-                      warn, err);
+                      ss.state ? &hook : NULL, warn, err);
+    if (ss.state) {
+        source_set(src, XXH3_128bits_digest(ss.state), ss.size);
+        XXH3_freeState(ss.state);
+    }
     free(data);
     return st;
 }

@@ -480,6 +480,7 @@ typedef struct gltf {
     const jnode *root;
     const char *name;           /* for messages */
     const char *path;           /* the .gltf's path, NULL: no files */
+    const st_soup__file_hook *hook; /* told each file's bytes, or NULL */
     const unsigned char *glb_bin;
     size_t glb_bin_size;
     int have_glb_bin;
@@ -715,6 +716,8 @@ static st_status load_file(gltf *g, size_t bi, const char *uri, buffer *b)
         return st;
     }
     free(full);
+    if (g->hook && g->hook->bytes)
+        g->hook->bytes(g->hook->ctx, data, b->size);
     b->owned = data;
     b->data = data;
     return ST_OK;
@@ -1383,12 +1386,14 @@ static uint32_t le32(const unsigned char *p)
 
 st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
                               size_t size, const char *name, const char *path,
+                              const st_soup__file_hook *hook,
                               st_soup_warnings *warn, st_error *err)
 {
     gltf g;
     memset(&g, 0, sizeof g);
     g.name = name;
     g.path = path;
+    g.hook = hook;
     g.s = s;
     g.warn = warn;
     g.err = err;

@@ -196,10 +196,19 @@ st_status st_soup__parse_ply(st_soup *s, const unsigned char *data,
 st_status st_soup__parse_stl(st_soup *s, const unsigned char *data,
                              size_t size, const char *name, st_error *err);
 
+/* Told the bytes of each external buffer file a glTF reader loads, in
+ * the order it loads them (so a caller can hash what the soup came from). */
+typedef struct st_soup__file_hook {
+    void (*bytes)(void *ctx, const unsigned char *data, size_t size);
+    void *ctx;
+} st_soup__file_hook;
+
 /* glTF: path is the .gltf's own path, for buffers in files beside it
- * (NULL: such buffers are an error). */
+ * (NULL: such buffers are an error); hook (may be NULL) is told each such
+ * file's bytes. */
 st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
                               size_t size, const char *name, const char *path,
+                              const st_soup__file_hook *hook,
                               st_soup_warnings *warn, st_error *err);
 
 /* Record a warning at a text line (offset < 0) or a byte offset: the first

@@ -115,7 +115,10 @@ typedef struct st_soup_source {
 
 /* st_soup_read that also gives the source's size and hash (src may be
  * NULL) and the reader's warnings (warn may be NULL; st_soup_read_warn).
- * For a .gltf the hash covers the JSON file, not its external buffers. *src is filled whenever the file's bytes were read, even when
+ * For a .gltf the hash covers the JSON file and the external buffer files
+ * the reader loaded (each after its length), and the size is their sum: a
+ * changed .bin is a changed source. *src is filled whenever the file's
+ * bytes were read, even when
  * they do not parse (so a changed file is told from a broken one), and
  * zeroed otherwise. */
 st_status st_soup_read_source(st_soup **out, const char *path, st_soup_source *src,

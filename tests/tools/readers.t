@@ -49,6 +49,14 @@ grep -q '"encloses": true' ts.json
 ok $? "tetstat --surface nodes.gltf: the mesh encloses all 12 triangles"
 check "soupdist reads a .glb" sh -c 'soupdist -q -r 16 -o s.vti strips.glb && [ -s s.vti ]'
 
+# The pipe's record of its soup covers a .gltf's external buffer: a .bin
+# changed beside an unchanged .gltf is a changed soup, never acted on.
+check "soupdist | soupsign uses an unchanged nodes.gltf" sh -c \
+    'soupdist -q -r 16 -o nd.vdb nodes.gltf && soupsign -v -o n1.vdb nd.vdb 2>&1 | grep -q "surface: .*nodes.gltf, as soupdist read it"'
+"$PY" -c "import sys; d = bytearray(open(sys.argv[1], 'rb').read()); d[0] ^= 0x40; open(sys.argv[1], 'wb').write(d)" nodes.bin
+check "a changed nodes.bin makes nodes.gltf a changed soup" sh -c \
+    'soupsign -o n2.vdb nd.vdb 2>&1 | grep -q "note: .*nodes.gltf has changed since soupdist read it"'
+
 # ---- glTF from a real exporter, checked against a real reader -------------
 # VTK's vtkGLTFExporter writes the bunny (an actor moved and rotated: a node
 # matrix) with inline and with external buffers; vtkGLTFReader reads it
