@@ -1,7 +1,7 @@
 /*
  * cubetets.h - what the tet-mesh tests build their meshes from (header
  * only): points one at a time, positive tets, the 5-tet cube lattice,
- * three tets on one face, and a count of the tets that are not positive.
+ * three tets on one face, the tets that are not positive, the volume.
  */
 #ifndef SOUPTET_TESTS_CUBETETS_H
 #define SOUPTET_TESTS_CUBETETS_H
@@ -137,6 +137,18 @@ static inline size_t nonpositive(const st_tetmesh *m)
                              m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]) < 0);
     }
     return bad;
+}
+
+/* The signed volume of m: its tets' volumes summed in order. */
+static inline double mesh_volume(const st_tetmesh *m)
+{
+    double v = 0.0;
+    for (size_t t = 0; t < m->ntets; t++) {
+        const uint32_t *k = m->tets + 4 * t;
+        v += st_tet_volume(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
+                           m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]);
+    }
+    return v;
 }
 
 #endif

@@ -25,17 +25,6 @@ static double rnd(void)   /* xorshift64, uniform in [0, 1) */
     return (double)(rng_state >> 11) / 9007199254740992.0;
 }
 
-static double mesh_volume(const st_tetmesh *m)
-{
-    double v = 0.0;
-    for (size_t t = 0; t < m->ntets; t++) {
-        const uint32_t *k = m->tets + 4 * t;
-        v += st_tet_volume(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
-                           m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]);
-    }
-    return v;
-}
-
 static int in_ball(const double c[3], void *ctx)
 {
     double r = *(const double *)ctx;

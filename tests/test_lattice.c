@@ -8,6 +8,7 @@
 #include "souptet/tetmesh.h"
 #include "souptet/tetqual.h"
 #include "shapes.h"
+#include "cubetets.h"
 #include "tap.h"
 
 #include <math.h>
@@ -235,17 +236,6 @@ static double sphere_sdf(const double c[3], double r)
 static st_grid *sphere_grid(double r, size_t n)
 {
     return signed_grid(n, 1.5, sphere_sdf, r);
-}
-
-static double mesh_volume(const st_tetmesh *m)
-{
-    double v = 0;
-    for (size_t t = 0; t < m->ntets; t++) {
-        const uint32_t *q = m->tets + 4 * t;
-        v += st_tet_volume(m->xyz + 3 * (size_t)q[0], m->xyz + 3 * (size_t)q[1],
-                           m->xyz + 3 * (size_t)q[2], m->xyz + 3 * (size_t)q[3]);
-    }
-    return v;
 }
 
 static void test_density(void)
