@@ -278,6 +278,34 @@ static inline void rd_meta_free(rd *r)
     r->nmeta = 0;
 }
 
+/* The start of every reader: r cleared, errors to err, meshes of
+ * max_bytes at most, and an empty mesh (out of memory named NAME). */
+static inline st_status rd_begin(rd *r, size_t max_bytes, st_error *err, const char *name)
+{
+    memset(r, 0, sizeof *r);
+    r->err = err;
+    r->max_bytes = max_bytes;
+    r->m = st_tetmesh_new();
+    return r->m ? ST_OK : st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
+}
+
+/* The end of every reader, after the parse's status s: the collected
+ * meta into the mesh, then the mesh into *out (ST_OK), or freed (the
+ * error returned). */
+static inline st_status rd_finish(rd *r, st_status s, st_tetmesh **out)
+{
+    if (!s)
+        s = rd_meta_flush(r);
+    rd_meta_free(r);
+    if (s) {
+        st_tetmesh_free(r->m);
+        r->m = NULL;
+        return s;
+    }
+    *out = r->m;
+    return ST_OK;
+}
+
 /* Every "# souptet KEY: VALUE" line of a '#'-commented text file. */
 static inline st_status rd_hash_meta(rd *r)
 {

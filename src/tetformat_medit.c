@@ -137,26 +137,14 @@ st_status st_tetmesh_parse_medit(st_tetmesh **out, const unsigned char *data,
 {
     *out = NULL;
     rd r;
-    memset(&r, 0, sizeof r);
+    if (rd_begin(&r, max_bytes, err, name))
+        return ST_ENOMEM;
     st_text_init(&r.t, data, size, ST_TEXT_HASH);
     r.name = name ? name : "<mesh>";
-    r.err = err;
-    r.max_bytes = max_bytes;
-    r.m = st_tetmesh_new();
-    if (!r.m)
-        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
     st_status s = rd_hash_meta(&r);
     if (!s)
         s = medit_parse(&r);
-    if (!s)
-        s = rd_meta_flush(&r);
-    rd_meta_free(&r);
-    if (s) {
-        st_tetmesh_free(r.m);
-        return s;
-    }
-    *out = r.m;
-    return ST_OK;
+    return rd_finish(&r, s, out);
 }
 
 st_status st_tetmesh_read_medit(st_tetmesh **out, const char *path,

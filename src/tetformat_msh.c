@@ -575,24 +575,13 @@ st_status st_tetmesh_parse_msh(st_tetmesh **out, const unsigned char *data,
     *out = NULL;
     msh ms;
     memset(&ms, 0, sizeof ms);
+    if (rd_begin(&ms.r, max_bytes, err, name))
+        return ST_ENOMEM;
     st_text_init(&ms.r.t, data, size, 0);
     ms.r.name = name ? name : "<msh>";
-    ms.r.err = err;
-    ms.r.max_bytes = max_bytes;
-    ms.r.m = st_tetmesh_new();
-    if (!ms.r.m)
-        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
     st_status s = msh_parse(&ms);
-    if (!s)
-        s = rd_meta_flush(&ms.r);
-    rd_meta_free(&ms.r);
     free(ms.tags);
-    if (s) {
-        st_tetmesh_free(ms.r.m);
-        return s;
-    }
-    *out = ms.r.m;
-    return ST_OK;
+    return rd_finish(&ms.r, s, out);
 }
 
 st_status st_tetmesh_read_msh(st_tetmesh **out, const char *path,

@@ -150,12 +150,8 @@ st_status st_tetmesh_parse_tetgen(st_tetmesh **out,
 {
     *out = NULL;
     rd r;
-    memset(&r, 0, sizeof r);
-    r.err = err;
-    r.max_bytes = max_bytes;
-    r.m = st_tetmesh_new();
-    if (!r.m)
-        return st_error_set(err, ST_ENOMEM, node_name, 0, "out of memory");
+    if (rd_begin(&r, max_bytes, err, node_name))
+        return ST_ENOMEM;
     st_text_init(&r.t, node, node_size, ST_TEXT_HASH);
     r.name = node_name ? node_name : "<node>";
     long long base = 0;
@@ -165,15 +161,7 @@ st_status st_tetmesh_parse_tetgen(st_tetmesh **out,
         r.name = ele_name ? ele_name : "<ele>";
         s = tg_ele(&r, base);
     }
-    if (!s)
-        s = rd_meta_flush(&r);
-    rd_meta_free(&r);
-    if (s) {
-        st_tetmesh_free(r.m);
-        return s;
-    }
-    *out = r.m;
-    return ST_OK;
+    return rd_finish(&r, s, out);
 }
 
 st_status st_tetmesh_read_tetgen(st_tetmesh **out, const char *path,

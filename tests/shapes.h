@@ -1,6 +1,7 @@
 /*
  * shapes.h - small closed and damaged test surfaces built in code (header
- * only, for the unit tests): exact soups of boxes and UV spheres.
+ * only, for the unit tests): exact soups of boxes and UV spheres, and
+ * signed fields of shapes given by a function.
  */
 #ifndef SOUPTET_TESTS_SHAPES_H
 #define SOUPTET_TESTS_SHAPES_H
@@ -8,6 +9,7 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "souptet/grid.h"
 #include "souptet/soup.h"
 
 #ifndef M_PI
@@ -26,8 +28,10 @@ static inline void add_tri(st_soup *s, const double a[3], const double b[3], con
         st_soup_add_triangle(s, v, v + 1, v + 2, NULL);
 }
 
-/* An axis-aligned box as an exact soup, every other triangle flipped. */
-static inline void add_box(st_soup *s, const double lo[3], const double hi[3])
+/* The 12 triangles of an axis-aligned box: every other one flipped, or
+ * (oriented) all with their normals outward. */
+static inline void box_triangles(st_soup *s, const double lo[3], const double hi[3],
+                                 int oriented)
 {
     for (int axis = 0; axis < 3; axis++)
         for (int side = 0; side < 2; side++) {
@@ -38,27 +42,44 @@ static inline void add_box(st_soup *s, const double lo[3], const double hi[3])
                 q[c][u] = (c == 1 || c == 2) ? hi[u] : lo[u];
                 q[c][w] = (c >= 2) ? hi[w] : lo[w];
             }
-            add_tri(s, q[0], q[1], q[2], side);
+            /* (q0, q1, q2) faces +axis: oriented, flip it on the low side. */
+            add_tri(s, q[0], q[1], q[2], oriented ? !side : side);
             add_tri(s, q[0], q[2], q[3], !side);
         }
+}
+
+/* An axis-aligned box as an exact soup, every other triangle flipped. */
+static inline void add_box(st_soup *s, const double lo[3], const double hi[3])
+{
+    box_triangles(s, lo, hi, 0);
 }
 
 /* An axis-aligned box, consistently oriented (normals outward). */
 static inline void add_box_oriented(st_soup *s, const double lo[3], const double hi[3])
 {
-    for (int axis = 0; axis < 3; axis++)
-        for (int side = 0; side < 2; side++) {
-            int u = (axis + 1) % 3, w = (axis + 2) % 3;
-            double q[4][3];
-            for (int c = 0; c < 4; c++) {
-                q[c][axis] = side ? hi[axis] : lo[axis];
-                q[c][u] = (c == 1 || c == 2) ? hi[u] : lo[u];
-                q[c][w] = (c >= 2) ? hi[w] : lo[w];
+    box_triangles(s, lo, hi, 1);
+}
+
+/* A signed field on [-w, w]^3 in n^3 voxels: f(center, arg) at each
+ * voxel (NULL when it cannot be allocated). */
+static inline st_grid *signed_grid(size_t n, double w,
+                                   double (*f)(const double c[3], double arg), double arg)
+{
+    double vox = 2.0 * w / (double)n;
+    double o[3] = {-w + vox / 2, -w + vox / 2, -w + vox / 2};
+    st_grid *g = NULL;
+    st_error err;
+    if (st_grid_new(&g, n, n, n, o, vox, 0.0f, 0, &err))
+        return NULL;
+    g->kind = ST_GRID_SIGNED;
+    for (size_t k = 0; k < n; k++)
+        for (size_t j = 0; j < n; j++)
+            for (size_t i = 0; i < n; i++) {
+                double c[3];
+                st_grid_center(g, i, j, k, c);
+                g->data[st_grid_index(g, i, j, k)] = (float)f(c, arg);
             }
-            /* (q0, q1, q2) faces +axis: flip it on the low side. */
-            add_tri(s, q[0], q[1], q[2], !side);
-            add_tri(s, q[0], q[2], q[3], !side);
-        }
+    return g;
 }
 
 /* A UV sphere of radius r at the origin, without the faces above z_cut. */

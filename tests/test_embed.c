@@ -8,6 +8,7 @@
  */
 #include "souptet/embed.h"
 #include "souptet/isect.h"
+#include "cubetets.h"
 #include "tap.h"
 
 #include <math.h>
@@ -16,27 +17,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-static void add_pt(st_tetmesh *m, double x, double y, double z)
-{
-    const double p[3] = {x, y, z};
-    st_tetmesh_add_point(m, p, NULL);
-}
-
-static double vol6(const st_tetmesh *m, const uint32_t t[4])
-{
-    const double *a = m->xyz + 3 * t[0], *b = m->xyz + 3 * t[1],
-                 *c = m->xyz + 3 * t[2], *d = m->xyz + 3 * t[3];
-    double u[3], v[3], w[3];
-    for (int k = 0; k < 3; k++) {
-        u[k] = b[k] - a[k];
-        v[k] = c[k] - a[k];
-        w[k] = d[k] - a[k];
-    }
-    return u[0] * (v[1] * w[2] - v[2] * w[1]) -
-           u[1] * (v[0] * w[2] - v[2] * w[0]) +
-           u[2] * (v[0] * w[1] - v[1] * w[0]);
-}
 
 /* n^3 unit cubes of 5 positive tets each (the middle tet first in every
  * cube); corner q of a cube is (q&1, q>>1&1, q>>2&1). */
@@ -47,37 +27,7 @@ static st_tetmesh *cubes(int n)
         for (int j = 0; j <= n; j++)
             for (int i = 0; i <= n; i++)
                 add_pt(m, i, j, k);
-    for (int k = 0; k < n; k++)
-        for (int j = 0; j < n; j++)
-            for (int i = 0; i < n; i++) {
-                uint32_t c[8];
-                for (int q = 0; q < 8; q++)
-                    c[q] = (uint32_t)((i + (q & 1)) +
-                                      (n + 1) * ((j + (q >> 1 & 1)) +
-                                                 (n + 1) * (k + (q >> 2 & 1))));
-                static const int mid[2][4] = {{1, 2, 4, 7}, {0, 3, 5, 6}};
-                static const int cor[2][4] = {{0, 3, 5, 6}, {1, 2, 4, 7}};
-                int odd = (i + j + k) & 1;
-                uint32_t t[5][4];
-                for (int q = 0; q < 4; q++)
-                    t[0][q] = c[mid[odd][q]];
-                for (int q = 0; q < 4; q++) {
-                    int a = cor[odd][q];
-                    t[q + 1][0] = c[a];
-                    t[q + 1][1] = c[a ^ 1];
-                    t[q + 1][2] = c[a ^ 2];
-                    t[q + 1][3] = c[a ^ 4];
-                }
-                for (int q = 0; q < 5; q++) {
-                    if (vol6(m, t[q]) < 0) {
-                        uint32_t x = t[q][2];
-                        t[q][2] = t[q][3];
-                        t[q][3] = x;
-                    }
-                    st_tetmesh_add_tet(m, t[q][0], t[q][1], t[q][2], t[q][3],
-                                       NULL);
-                }
-            }
+    add_cube_tets(m, 0, n, n, n);
     return m;
 }
 

@@ -6,6 +6,7 @@
 #include "souptet/smooth.h"
 #include "souptet/tetmesh.h"
 #include "souptet/tetqual.h"
+#include "cubetets.h"
 #include "tap.h"
 
 #include <math.h>
@@ -22,81 +23,6 @@ static double rnd(void)   /* xorshift64, uniform in [0, 1) */
     rng_state ^= rng_state >> 7;
     rng_state ^= rng_state << 17;
     return (double)(rng_state >> 11) / 9007199254740992.0;
-}
-
-/* A 5-tet cube lattice of n^3 cells of width h from lo, keeping the cells
- * for which keep(center) is nonzero (NULL: all); mirrored splits on
- * alternating cells so shared faces match; every tet positive. */
-static st_tetmesh *lattice5(int n, double h, const double lo[3],
-                            int (*keep)(const double c[3], void *), void *ctx)
-{
-    st_tetmesh *m = st_tetmesh_new();
-    int np = n + 1;
-    for (int k = 0; k < np; k++)
-        for (int j = 0; j < np; j++)
-            for (int i = 0; i < np; i++) {
-                double p[3] = {lo[0] + i * h, lo[1] + j * h, lo[2] + k * h};
-                st_tetmesh_add_point(m, p, NULL);
-            }
-    for (int k = 0; k < n; k++)
-        for (int j = 0; j < n; j++)
-            for (int i = 0; i < n; i++) {
-                double c[3] = {lo[0] + (i + 0.5) * h, lo[1] + (j + 0.5) * h, lo[2] + (k + 0.5) * h};
-                if (keep && !keep(c, ctx))
-                    continue;
-                uint32_t v[8];
-                for (int b = 0; b < 8; b++)
-                    v[b] = (uint32_t)((i + (b & 1)) + np * ((j + ((b >> 1) & 1)) + np * (k + ((b >> 2) & 1))));
-                int odd = (i + j + k) & 1;
-                /* corner tets at the even (or odd) corners, the middle one
-                 * at the others */
-                static const int even_c[4] = {0, 3, 5, 6}, odd_c[4] = {1, 2, 4, 7};
-                const int *cor = odd ? odd_c : even_c, *mid = odd ? even_c : odd_c;
-                uint32_t t[5][4];
-                for (int q = 0; q < 4; q++) {
-                    int cc = cor[q];
-                    t[q][0] = v[cc];
-                    t[q][1] = v[cc ^ 1];
-                    t[q][2] = v[cc ^ 2];
-                    t[q][3] = v[cc ^ 4];
-                }
-                for (int q = 0; q < 4; q++)
-                    t[4][q] = v[mid[q]];
-                for (int q = 0; q < 5; q++) {
-                    const double *a = m->xyz + 3 * (size_t)t[q][0], *b = m->xyz + 3 * (size_t)t[q][1],
-                                 *d = m->xyz + 3 * (size_t)t[q][2], *e = m->xyz + 3 * (size_t)t[q][3];
-                    if (st_orient3d(a, b, d, e) > 0) {
-                        uint32_t s = t[q][0];
-                        t[q][0] = t[q][1];
-                        t[q][1] = s;
-                    }
-                    st_tetmesh_add_tet(m, t[q][0], t[q][1], t[q][2], t[q][3], NULL);
-                }
-            }
-    st_tetmesh_compact(m, NULL);
-    return m;
-}
-
-static double mesh_volume(const st_tetmesh *m)
-{
-    double v = 0.0;
-    for (size_t t = 0; t < m->ntets; t++) {
-        const uint32_t *k = m->tets + 4 * t;
-        v += st_tet_volume(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
-                           m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]);
-    }
-    return v;
-}
-
-static size_t nonpositive(const st_tetmesh *m)
-{
-    size_t bad = 0;
-    for (size_t t = 0; t < m->ntets; t++) {
-        const uint32_t *k = m->tets + 4 * t;
-        bad += !(st_orient3d(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
-                             m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]) < 0);
-    }
-    return bad;
 }
 
 static int in_ball(const double c[3], void *ctx)

@@ -14,25 +14,8 @@
 #include <string.h>
 #include <time.h>
 
-static uint64_t rng_state = 0x1234567887654321ULL;
-
-static uint64_t rng_next(void)
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
-static int64_t rng_int(int64_t r)
-{
-    return (int64_t)(rng_next() % (uint64_t)(2 * r + 1)) - r;
-}
-
-static double rng_unif(double lo, double hi)
-{
-    return lo + (hi - lo) * (double)(rng_next() >> 11) * 0x1p-53;
-}
+#define SPLITMIX_SEED 0x1234567887654321ULL
+#include "splitmix.h"
 
 static void rand_pt(double p[3], int64_t r)
 {

@@ -7,6 +7,8 @@
 #include "souptet/pred.h"
 #include "souptet/tetmesh.h"
 #include "souptet/tetqual.h"
+#include "shapes.h"
+#include "cubetets.h"
 #include "tap.h"
 
 #include <math.h>
@@ -225,36 +227,15 @@ static void test_seeded(void)
     }
 }
 
+static double sphere_sdf(const double c[3], double r)
+{
+    return sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) - r;
+}
+
 /* A signed field of the sphere |x| = r on [-1.5, 1.5]^3. */
 static st_grid *sphere_grid(double r, size_t n)
 {
-    double vox = 3.0 / (double)n;
-    double o[3] = {-1.5 + vox / 2, -1.5 + vox / 2, -1.5 + vox / 2};
-    st_grid *g = NULL;
-    st_error err;
-    if (st_grid_new(&g, n, n, n, o, vox, 0.0f, 0, &err))
-        return NULL;
-    g->kind = ST_GRID_SIGNED;
-    for (size_t k = 0; k < n; k++)
-        for (size_t j = 0; j < n; j++)
-            for (size_t i = 0; i < n; i++) {
-                double c[3];
-                st_grid_center(g, i, j, k, c);
-                g->data[st_grid_index(g, i, j, k)] =
-                    (float)(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) - r);
-            }
-    return g;
-}
-
-static double mesh_volume(const st_tetmesh *m)
-{
-    double v = 0;
-    for (size_t t = 0; t < m->ntets; t++) {
-        const uint32_t *q = m->tets + 4 * t;
-        v += st_tet_volume(m->xyz + 3 * (size_t)q[0], m->xyz + 3 * (size_t)q[1],
-                           m->xyz + 3 * (size_t)q[2], m->xyz + 3 * (size_t)q[3]);
-    }
-    return v;
+    return signed_grid(n, 1.5, sphere_sdf, r);
 }
 
 static void test_density(void)

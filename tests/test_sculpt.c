@@ -23,25 +23,15 @@ static const double *P(const st_lattice *L, size_t t, int c)
     return L->xyz + 3 * (size_t)L->tets[4 * t + (size_t)c];
 }
 
+static double cube_sdf(const double c[3], double half)
+{
+    return fmax(fabs(c[0]), fmax(fabs(c[1]), fabs(c[2]))) - half;
+}
+
 /* The signed field of the cube [-1, 1]^3 on [-2.5, 2.5]^3. */
 static st_grid *cube_grid(size_t n)
 {
-    double vox = 5.0 / (double)n;
-    double o[3] = {-2.5 + vox / 2, -2.5 + vox / 2, -2.5 + vox / 2};
-    st_grid *g = NULL;
-    st_error err;
-    if (st_grid_new(&g, n, n, n, o, vox, 0.0f, 0, &err))
-        return NULL;
-    g->kind = ST_GRID_SIGNED;
-    for (size_t k = 0; k < n; k++)
-        for (size_t j = 0; j < n; j++)
-            for (size_t i = 0; i < n; i++) {
-                double c[3];
-                st_grid_center(g, i, j, k, c);
-                double d = fmax(fabs(c[0]), fmax(fabs(c[1]), fabs(c[2]))) - 1.0;
-                g->data[st_grid_index(g, i, j, k)] = (float)d;
-            }
-    return g;
+    return signed_grid(n, 2.5, cube_sdf, 1.0);
 }
 
 static size_t nearest_tet(const st_lattice *L, const double q[3])

@@ -22,6 +22,7 @@
 #include "souptet/outfile.h"
 #include "souptet/tetformat.h"
 #include "souptet/tetio.h"
+#include "cubetets.h"
 #include "tap.h"
 
 #include <math.h>
@@ -31,21 +32,6 @@
 #include <unistd.h>
 
 /* ---- a sample mesh ------------------------------------------------------- */
-
-static double signed_vol(const st_tetmesh *m, const uint32_t *t)
-{
-    const double *a = m->xyz + 3 * t[0], *b = m->xyz + 3 * t[1],
-                 *c = m->xyz + 3 * t[2], *d = m->xyz + 3 * t[3];
-    double u[3], v[3], w[3];
-    for (int k = 0; k < 3; k++) {
-        u[k] = b[k] - a[k];
-        v[k] = c[k] - a[k];
-        w[k] = d[k] - a[k];
-    }
-    return u[0] * (v[1] * w[2] - v[2] * w[1]) -
-           u[1] * (v[0] * w[2] - v[2] * w[0]) +
-           u[2] * (v[0] * w[1] - v[1] * w[0]);
-}
 
 /* n^3 cubes of 5 positive tets, mirrored on alternating cubes; the points
  * are moved off the grid by irrational amounts so that every coordinate
@@ -61,37 +47,7 @@ static st_tetmesh *sample_mesh(int n)
                                k / 3.0 + 1e5};
                 st_tetmesh_add_point(m, p, NULL);
             }
-#define V(i, j, k) ((uint32_t)((i) + (n + 1) * ((j) + (n + 1) * (k))))
-    for (int k = 0; k < n; k++)
-        for (int j = 0; j < n; j++)
-            for (int i = 0; i < n; i++) {
-                uint32_t c[8];
-                for (int q = 0; q < 8; q++)
-                    c[q] = V(i + (q & 1), j + (q >> 1 & 1), k + (q >> 2 & 1));
-                static const int mid[2][4] = {{1, 2, 4, 7}, {0, 3, 5, 6}};
-                static const int cor[2][4] = {{0, 3, 5, 6}, {1, 2, 4, 7}};
-                int odd = (i + j + k) & 1;
-                uint32_t t[5][4];
-                for (int q = 0; q < 4; q++)
-                    t[0][q] = c[mid[odd][q]];
-                for (int q = 0; q < 4; q++) {
-                    int a = cor[odd][q];
-                    t[q + 1][0] = c[a];
-                    t[q + 1][1] = c[a ^ 1];
-                    t[q + 1][2] = c[a ^ 2];
-                    t[q + 1][3] = c[a ^ 4];
-                }
-                for (int q = 0; q < 5; q++) {
-                    if (signed_vol(m, t[q]) < 0) {
-                        uint32_t x = t[q][2];
-                        t[q][2] = t[q][3];
-                        t[q][3] = x;
-                    }
-                    st_tetmesh_add_tet(m, t[q][0], t[q][1], t[q][2], t[q][3],
-                                       NULL);
-                }
-            }
-#undef V
+    add_cube_tets(m, 0, n, n, n);
     st_meta_set(&m->meta, "source", "test_tetformat sample");
     st_meta_set(&m->meta, "h", "1");
     st_meta_history_append(&m->meta, "latticetet -r 3 x.vdb");

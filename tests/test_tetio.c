@@ -8,6 +8,7 @@
 #include "souptet/tetmesh.h"
 #include "souptet/tetqual.h"
 #include "../src/adapters/gridio_internal.h"
+#include "cubetets.h"
 #include "tap.h"
 
 #include <fcntl.h>
@@ -19,12 +20,6 @@
 #include <unistd.h>
 
 static char g_dir[] = "/tmp/test_tetio.XXXXXX";
-
-static void add_pt(st_tetmesh *m, double x, double y, double z)
-{
-    const double p[3] = {x, y, z};
-    st_tetmesh_add_point(m, p, NULL);
-}
 
 /* Two tets sharing a face, points with many significant digits, a point
  * array and a 3-component cell array, meta with a multi-line history. */

@@ -5,6 +5,7 @@
  */
 #include "souptet/tetmesh.h"
 #include "souptet/tetqual.h"
+#include "cubetets.h"
 #include "tap.h"
 
 #include <math.h>
@@ -13,23 +14,6 @@
 
 static const double k_regular = 70.528779365509308630754;   /* acos(1/3) */
 static const double k_cube_slant = 54.735610317245345684622; /* acos(1/sqrt 3) */
-
-static void add_pt(st_tetmesh *m, double x, double y, double z)
-{
-    const double p[3] = {x, y, z};
-    st_tetmesh_add_point(m, p, NULL);
-}
-
-/* Adds tet (a b c d), swapping c and d when that makes it positive. */
-static void add_pos(st_tetmesh *m, uint32_t a, uint32_t b, uint32_t c,
-                    uint32_t d)
-{
-    const double *x = m->xyz;
-    if (st_tet_volume(x + 3 * a, x + 3 * b, x + 3 * c, x + 3 * d) < 0)
-        st_tetmesh_add_tet(m, a, b, d, c, NULL);
-    else
-        st_tetmesh_add_tet(m, a, b, c, d, NULL);
-}
 
 /* n x n x n unit cubes, 5 tets each, the split mirrored on alternating
  * cubes so that shared faces match. Cube corner c = (c&1, c>>1&1, c>>2&1). */
@@ -40,27 +24,7 @@ static void add_lattice(st_tetmesh *m, int nx, int ny, int nz)
         for (int j = 0; j <= ny; j++)
             for (int i = 0; i <= nx; i++)
                 add_pt(m, i, j, k);
-#define V(i, j, k) (base + (uint32_t)((i) + (nx + 1) * ((j) + (ny + 1) * (k))))
-    for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                uint32_t c[8];
-                for (int q = 0; q < 8; q++)
-                    c[q] = V(i + (q & 1), j + (q >> 1 & 1), k + (q >> 2 & 1));
-                /* Even cubes: the middle tet on corners 1 2 4 7; odd cubes
-                 * mirrored: on 0 3 5 6. A corner tet is a corner and its
-                 * three neighbours along the edges. */
-                const int odd = (i + j + k) & 1;
-                static const int mid[2][4] = {{1, 2, 4, 7}, {0, 3, 5, 6}};
-                static const int corners[2][4] = {{0, 3, 5, 6}, {1, 2, 4, 7}};
-                add_pos(m, c[mid[odd][0]], c[mid[odd][1]], c[mid[odd][2]],
-                        c[mid[odd][3]]);
-                for (int q = 0; q < 4; q++) {
-                    int a = corners[odd][q];
-                    add_pos(m, c[a], c[a ^ 1], c[a ^ 2], c[a ^ 4]);
-                }
-            }
-#undef V
+    add_cube_tets(m, base, nx, ny, nz);
 }
 
 static void test_regular(void)
@@ -365,16 +329,7 @@ static void test_adjacency(void)
 
     /* Three tets on one triangle: a non-manifold face, on nobody's
      * boundary and nobody's neighbour. */
-    m = st_tetmesh_new();
-    add_pt(m, 0, 0, 0);
-    add_pt(m, 1, 0, 0);
-    add_pt(m, 0, 1, 0);
-    add_pt(m, 0, 0, 1);
-    add_pt(m, 0, 0, -1);
-    add_pt(m, 0.2, 0.2, 2);
-    add_pos(m, 0, 1, 2, 3);
-    add_pos(m, 0, 1, 2, 4);
-    add_pos(m, 0, 1, 2, 5);
+    m = three_tets_on_a_face();
     check_neighbors(m, 12, 1, "three tets on one face");
     uint32_t *f;
     size_t nf;

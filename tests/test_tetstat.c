@@ -8,6 +8,7 @@
 #include "souptet/tetstat.h"
 #include "souptet/tetmesh.h"
 #include "souptet/tetqual.h"
+#include "cubetets.h"
 #include "shapes.h"
 #include "tap.h"
 
@@ -17,22 +18,6 @@
 
 static const double k_regular = 70.528779365509308630754;    /* acos(1/3) */
 static const double k_cube_slant = 54.735610317245345684622; /* acos(1/sqrt 3) */
-
-static void add_pt(st_tetmesh *m, double x, double y, double z)
-{
-    const double p[3] = {x, y, z};
-    st_tetmesh_add_point(m, p, NULL);
-}
-
-static void add_pos(st_tetmesh *m, uint32_t a, uint32_t b, uint32_t c,
-                    uint32_t d)
-{
-    const double *x = m->xyz;
-    if (st_tet_volume(x + 3 * a, x + 3 * b, x + 3 * c, x + 3 * d) < 0)
-        st_tetmesh_add_tet(m, a, b, d, c, NULL);
-    else
-        st_tetmesh_add_tet(m, a, b, c, d, NULL);
-}
 
 /* nx x ny x nz cubes of edge s from o, 5 tets each, mirrored on
  * alternating cubes so faces match. */
@@ -44,26 +29,7 @@ static void add_lattice(st_tetmesh *m, const double o[3], double s, int nx,
         for (int j = 0; j <= ny; j++)
             for (int i = 0; i <= nx; i++)
                 add_pt(m, o[0] + s * i, o[1] + s * j, o[2] + s * k);
-    for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                uint32_t c[8];
-                for (int q = 0; q < 8; q++) {
-                    int ii = i + (q & 1), jj = j + (q >> 1 & 1),
-                        kk = k + (q >> 2 & 1);
-                    c[q] = base +
-                           (uint32_t)(ii + (nx + 1) * (jj + (ny + 1) * kk));
-                }
-                const int odd = (i + j + k) & 1;
-                static const int mid[2][4] = {{1, 2, 4, 7}, {0, 3, 5, 6}};
-                static const int corners[2][4] = {{0, 3, 5, 6}, {1, 2, 4, 7}};
-                add_pos(m, c[mid[odd][0]], c[mid[odd][1]], c[mid[odd][2]],
-                        c[mid[odd][3]]);
-                for (int q = 0; q < 4; q++) {
-                    int a = corners[odd][q];
-                    add_pos(m, c[a], c[a ^ 1], c[a ^ 2], c[a ^ 4]);
-                }
-            }
+    add_cube_tets(m, base, nx, ny, nz);
 }
 
 static st_tetmesh *cubes(const double o[3], double s, int nx, int ny, int nz)
@@ -183,16 +149,7 @@ static void test_bad_tets(void)
     st_tetmesh_free(m);
 
     /* Three tets on one face. */
-    m = st_tetmesh_new();
-    add_pt(m, 0, 0, 0);
-    add_pt(m, 1, 0, 0);
-    add_pt(m, 0, 1, 0);
-    add_pt(m, 0, 0, 1);
-    add_pt(m, 0, 0, -1);
-    add_pt(m, 0.2, 0.2, 2);
-    add_pos(m, 0, 1, 2, 3);
-    add_pos(m, 0, 1, 2, 4);
-    add_pos(m, 0, 1, 2, 5);
+    m = three_tets_on_a_face();
     st_tetstat_mesh(&r, m, &err);
     TAP_CHECK(r.nonmanifold_faces == 1 && !r.conforming &&
                   r.boundary_faces == 9 && r.interior_faces == 0,

@@ -4,6 +4,7 @@
 #include "../fpenv.h"
 #include "souptet/dist.h"
 #include "souptet/grid.h"
+#include "souptet/gridio.h"
 #include "souptet/mem.h"
 #include "souptet/outfile.h"
 #include "souptet/soup.h"
@@ -140,6 +141,34 @@ int tool_fail(const tool_ctx *t, const st_error *err)
     }
     fprintf(stderr, "%s: %s\n", t->name, buf);
     return TOOL_EXIT_FAIL;
+}
+
+int tool_fail_file(const tool_ctx *t, st_error *err, const char *file)
+{
+    if (!err->file[0])
+        snprintf(err->file, sizeof err->file, "%s", file);
+    return tool_fail(t, err);
+}
+
+int tool_fail_nomem(const tool_ctx *t, st_error *err)
+{
+    st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    return tool_fail(t, err);
+}
+
+const char *tool_in_name(const char *path)
+{
+    return st_path_is_stdio(path) ? "<stdin>" : path;
+}
+
+const char *tool_out_name(const char *path)
+{
+    return st_path_is_stdio(path) ? "<stdout>" : path;
+}
+
+const char *tool_command(const tool_ctx *t)
+{
+    return t->command_line ? t->command_line : t->name;
 }
 
 st_status tool_soup_read(const tool_ctx *t, struct st_soup **out,
@@ -319,6 +348,14 @@ int tool_tetformat_option(const tool_ctx *t, int c, const char *arg,
     return 0;
 }
 
+int tool_pseudo_option(const tool_ctx *t, int c, const char *arg, int *fill_holes,
+                       int *shells)
+{
+    int fill = c == TOOL_OPT_FILL_HOLES;
+    return tool_parse_switch(t, fill ? "--fill-holes" : "--shells", arg,
+                             fill ? fill_holes : shells) ? TOOL_EXIT_USAGE : TOOL_CONTINUE;
+}
+
 int tool_parse_bytes(const tool_ctx *t, const char *opt, const char *arg,
                      size_t *out)
 {
@@ -483,6 +520,19 @@ int tool_one_input(const tool_ctx *t, int argc, char *argv[], const char *name,
     return TOOL_CONTINUE;
 }
 
+int tool_stdin_once(const tool_ctx *t, const char *const *paths, size_t n,
+                    const char *tty_msg)
+{
+    int nstdin = 0;
+    for (size_t i = 0; i < n; i++)
+        nstdin += paths[i] && strcmp(paths[i], "-") == 0;
+    if (nstdin > 1)
+        return tool_usage_error(t, "standard input ('-') given %d times", nstdin);
+    if (nstdin && isatty(STDIN_FILENO))
+        return tool_usage_error(t, "%s", tty_msg);
+    return TOOL_CONTINUE;
+}
+
 int tool_refuse_terminal(const tool_ctx *t, const char *path, int fd, const char *msg)
 {
     if (st_path_is_stdio(path) && isatty(fd))
@@ -495,6 +545,24 @@ int tool_output_format(const tool_ctx *t, const char *out, int known, const char
     if (!st_path_is_stdio(out) && !known)
         return tool_usage_error(t, "cannot tell the format of '%s' (use %s)", out, exts);
     return TOOL_CONTINUE;
+}
+
+int tool_grid_output(const tool_ctx *t, const char *out)
+{
+    TOOL_TRY(tool_refuse_terminal(t, out, STDOUT_FILENO, "will not write a binary VDB "
+                                  "stream to a terminal: give -o FILE or pipe it"));
+    return tool_output_format(t, out, st_path_is_stdio(out) ||
+                              st_grid_format_from_path(out) != ST_GRID_FMT_UNKNOWN,
+                              ".vdb or .vti");
+}
+
+int tool_tetmesh_output(const tool_ctx *t, const char *out, const char *tty_msg)
+{
+    if (tty_msg)
+        TOOL_TRY(tool_refuse_terminal(t, out, STDOUT_FILENO, tty_msg));
+    return tool_output_format(t, out, st_path_is_stdio(out) ||
+                              st_tetformat_from_path(out) != ST_TETFORMAT_NONE,
+                              ".vtu, .msh, .node, .ele or .mesh");
 }
 
 int tool_output_check(tool_ctx *t, const char *out)
@@ -510,6 +578,9 @@ tool_common tool_common_default(void)
     tool_common co;
     co.threads = 0;
     co.max_bytes = tool_default_max_memory();
+    co.out = NULL;
+    co.tetformat.msh_version = 0;
+    co.tetformat.binary = 0;
     return co;
 }
 
@@ -541,6 +612,35 @@ int tool_common_option(tool_ctx *t, int c, char *const argv[],
     default:
         return tool_usage_error(t, "unknown option '%s'", argv[optind - 1]);
     }
+}
+
+int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
+              tool_common *co)
+{
+    tool_ctx t;
+    tool_init(&t, spec->name, argc, argv);
+    *co = tool_common_default();
+    int c, rc = TOOL_CONTINUE;
+    opterr = 0;
+    while (rc == TOOL_CONTINUE &&
+           (c = getopt_long(argc, argv, spec->shortopts, spec->longopts, NULL)) != -1) {
+        if (c == 'o')
+            co->out = optarg;
+        else if (c == TOOL_OPT_MSH_VERSION || c == TOOL_OPT_MSH_BINARY)
+            rc = tool_tetformat_option(&t, c, optarg, &co->tetformat) ? TOOL_EXIT_USAGE
+                                                                       : TOOL_CONTINUE;
+        else if (c == 'q' || c == 'v' || c == ':' || c == '?' || c == TOOL_OPT_THREADS ||
+                 c == TOOL_OPT_MAXMEM || c == TOOL_OPT_HELP || c == TOOL_OPT_VERSION)
+            rc = tool_common_option(&t, c, argv, spec->usage, co);
+        else
+            rc = spec->option(&t, c, optarg, settings);
+    }
+    if (rc == TOOL_CONTINUE)
+        rc = spec->check(&t, argc, argv, settings);
+    if (rc == TOOL_CONTINUE)
+        rc = spec->run(&t, settings);
+    tool_finish(&t);
+    return rc;
 }
 
 void tool_print_version(const tool_ctx *t)

@@ -12,6 +12,7 @@
 #ifndef SOUPTET_CLI_TOOL_H
 #define SOUPTET_CLI_TOOL_H
 
+#include <getopt.h>
 #include <stddef.h>
 #include <stdio.h>
 #include "souptet/err.h"
@@ -51,6 +52,18 @@ void tool_finish(tool_ctx *t);
 
 /* Print "name: FILE:LINE: msg" and return TOOL_EXIT_FAIL. */
 int tool_fail(const tool_ctx *t, const st_error *err);
+/* The same, naming FILE when err names no file (the library knows the
+ * data, the tool knows where it came from). */
+int tool_fail_file(const tool_ctx *t, st_error *err, const char *file);
+/* Fail with "out of memory" (set in err). */
+int tool_fail_nomem(const tool_ctx *t, st_error *err);
+/* What an input or output path is called in messages: "<stdin>" or
+ * "<stdout>" for "-" and NULL (st_path_is_stdio), else the path. */
+const char *tool_in_name(const char *path);
+const char *tool_out_name(const char *path);
+/* The command line for an output's history (the tool's name when it could
+ * not be put together). */
+const char *tool_command(const tool_ctx *t);
 /* st_soup_read, printing the reader's warnings (unless -q) as
  * "name: warning: FILE:LINE: what" and "name: warning: FILE: N more like
  * it", before any error. */
@@ -163,6 +176,11 @@ const char *tool_json_number(char buf[32], double x);
             return tool_rc_;                                              \
     } while (0)
 
+/* Where several inputs may come from stdin (n paths, NULL ones not
+ * given): "-" more than once is a usage error "standard input ('-') given
+ * N times", and "-" when stdin is a terminal one with tty_msg. */
+int tool_stdin_once(const tool_ctx *t, const char *const *paths, size_t n,
+                    const char *tty_msg);
 /* The operand after the options: *in gets it, or dflt when there is none
  * (dflt may be NULL); a second one is a usage error "one NAME at most
  * ('X' is extra)". */
@@ -177,6 +195,12 @@ int tool_refuse_terminal(const tool_ctx *t, const char *path, int fd, const char
 /* When out is a file (not stdout) and known is 0: a usage error "cannot
  * tell the format of 'OUT' (use EXTS)". */
 int tool_output_format(const tool_ctx *t, const char *out, int known, const char *exts);
+/* The two checks above for a tool's output: a grid (.vdb or .vti; an
+ * OpenVDB stream on stdout, never to a terminal), or a tet mesh (.vtu
+ * .msh .node .ele .mesh; on stdout .vtu, and with tty_msg not NULL never
+ * to a terminal). */
+int tool_grid_output(const tool_ctx *t, const char *out);
+int tool_tetmesh_output(const tool_ctx *t, const char *out, const char *tty_msg);
 /* When an output (NULL and "-" are fine) cannot be written there
  * (tool_output_unwritable): TOOL_EXIT_FAIL after tool_finish. */
 int tool_output_check(tool_ctx *t, const char *out);
@@ -184,20 +208,41 @@ int tool_output_check(tool_ctx *t, const char *out);
 /* ---- options every tool shares ----------------------------------------
  *
  * A tool's option table starts with its own long options, then
+ * TOOL_LONG_OPTIONS_OUTPUT (-o) when it writes a file, then
  * TOOL_LONG_OPTIONS_BASIC (-q, -v, --help, --version) and, for tools that
- * compute, TOOL_LONG_OPTIONS_RESOURCES (--threads, --max-memory); its own
- * option codes start at TOOL_OPT_FIRST. In the getopt_long loop, every
- * code the tool does not handle itself goes to tool_common_option. */
+ * compute, TOOL_LONG_OPTIONS_RESOURCES (--threads, --max-memory), the two
+ * of them with the table's end as TOOL_LONG_OPTIONS_END; its own option
+ * codes start at TOOL_OPT_FIRST. tool_main's getopt_long loop hands the
+ * shared codes to tool_common_option (below). */
 enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION,
-       TOOL_OPT_MSH_VERSION, TOOL_OPT_MSH_BINARY, TOOL_OPT_FIRST = 1100 };
+       TOOL_OPT_MSH_VERSION, TOOL_OPT_MSH_BINARY, TOOL_OPT_FILL_HOLES, TOOL_OPT_SHELLS,
+       TOOL_OPT_FIRST = 1100 };
 #define TOOL_LONG_OPTIONS_BASIC                              \
     {"quiet", no_argument, NULL, 'q'},                       \
     {"verbose", no_argument, NULL, 'v'},                     \
     {"help", no_argument, NULL, TOOL_OPT_HELP},              \
     {"version", no_argument, NULL, TOOL_OPT_VERSION}
+/* -o, --output OUT (into tool_common's out). */
+#define TOOL_LONG_OPTIONS_OUTPUT {"output", required_argument, NULL, 'o'}
 #define TOOL_LONG_OPTIONS_RESOURCES                          \
     {"threads", required_argument, NULL, TOOL_OPT_THREADS},  \
     {"max-memory", required_argument, NULL, TOOL_OPT_MAXMEM}
+/* The end of the table of a tool that computes. */
+#define TOOL_LONG_OPTIONS_END                                \
+    TOOL_LONG_OPTIONS_BASIC,                                 \
+    TOOL_LONG_OPTIONS_RESOURCES,                             \
+    {NULL, 0, NULL, 0}
+
+/* The pseudo volume's switches --fill-holes on|off and --shells on|off
+ * (soupsign, soupwrap, soupmesh: pseudo.h): their table entries, and
+ * their handling for c TOOL_OPT_FILL_HOLES or TOOL_OPT_SHELLS into
+ * *fill_holes or *shells. Returns TOOL_CONTINUE, or TOOL_EXIT_USAGE after
+ * a usage error (printed). */
+#define TOOL_LONG_OPTIONS_PSEUDO                                   \
+    {"fill-holes", required_argument, NULL, TOOL_OPT_FILL_HOLES},  \
+    {"shells", required_argument, NULL, TOOL_OPT_SHELLS}
+int tool_pseudo_option(const tool_ctx *t, int c, const char *arg, int *fill_holes,
+                       int *shells);
 
 /* The tet-mesh format options of every tool that writes a tet mesh
  * (soupmesh, latticetet, tetsmooth): their table entries, their --help
@@ -213,11 +258,15 @@ enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION
 int tool_tetformat_option(const tool_ctx *t, int c, const char *arg,
                           st_tetformat_opts *o);
 
-/* What the shared options set: threads (0: all cores) and the memory
- * limit (tool_default_max_memory() unless --max-memory). */
+/* What the shared options set: threads (0: all cores), the memory limit
+ * (tool_default_max_memory() unless --max-memory), the output (-o; NULL
+ * when not given) and, in the tools that write tet meshes, the format
+ * options (TOOL_LONG_OPTIONS_TETFORMAT). */
 typedef struct tool_common {
     size_t threads;
     size_t max_bytes;
+    const char *out;
+    st_tetformat_opts tetformat;
 } tool_common;
 
 /* The shared options' defaults. */
@@ -234,5 +283,41 @@ tool_common tool_common_default(void);
  * usage error, already printed). Uses optarg and optind. */
 int tool_common_option(tool_ctx *t, int c, char *const argv[],
                        void (*usage)(void), tool_common *co);
+
+/* ---- a tool's main: parse into settings, then run ----------------------
+ *
+ * Every tool parses its command line into a settings struct of its own
+ * (the library's defaults first), then runs from that struct alone:
+ *
+ *     static const tool_spec spec = {"NAME", usage, ":o:qv", longopts,
+ *                                    option, check, run};
+ *     int main(int argc, char *argv[])
+ *     {
+ *         NAME_settings s = {...the library's defaults...};
+ *         return tool_main(&spec, argc, argv, &s, &s.co);
+ *     }
+ *
+ * tool_main: tool_init; *co = tool_common_default(); the getopt_long
+ * loop over shortopts (":" first, for missing values) and longopts (the
+ * tool's own, then the TOOL_LONG_OPTIONS_* tables it takes), where the
+ * shared options go to tool_common_option, tool_tetformat_option and -o
+ * (into co) and every other code to option; then check (the operands from
+ * optind, the checks between options and of the output); then run;
+ * tool_finish. option and check return TOOL_CONTINUE or the exit status
+ * at once (a usage error already printed); run returns the exit status. */
+typedef int (*tool_option_fn)(tool_ctx *t, int c, const char *arg, void *settings);
+typedef int (*tool_check_fn)(tool_ctx *t, int argc, char *argv[], void *settings);
+typedef int (*tool_run_fn)(tool_ctx *t, void *settings);
+typedef struct tool_spec {
+    const char *name;
+    void (*usage)(void);
+    const char *shortopts;
+    const struct option *longopts;
+    tool_option_fn option;
+    tool_check_fn check;
+    tool_run_fn run;
+} tool_spec;
+int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
+              tool_common *co);
 
 #endif

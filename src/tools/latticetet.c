@@ -82,128 +82,122 @@ TOOL_HELP_TETFORMAT
 enum { OPT_DENSITY = TOOL_OPT_FIRST, OPT_SCULPT, OPT_SURFACE, OPT_LATTICE, OPT_CELLS,
        OPT_SEED, OPT_NOREPAIR };
 
-int main(int argc, char *argv[])
-{
-    tool_ctx t;
-    tool_init(&t, "latticetet", argc, argv);
-    tool_common co = tool_common_default();
-    size_t cells = 0;
-    int auto_cells = 0;
-    const char *out = NULL, *in = NULL, *surface = NULL, *lattice = NULL;
-    double rho = -1, size = 0;
-    int sculpt = 0, repair = 1;
-    uint64_t seed = 0;
-    int have_seed = 0;
-    st_tetformat_opts fopts = {0, 0};
-    static const struct option opts[] = {
-        {"density", required_argument, NULL, OPT_DENSITY},
-        {"sculpt", no_argument, NULL, OPT_SCULPT},
-        {"surface", required_argument, NULL, OPT_SURFACE},
-        {"lattice", required_argument, NULL, OPT_LATTICE},
-        {"cells", required_argument, NULL, OPT_CELLS},
-        {"size", required_argument, NULL, 'h'},
-        {"seed", required_argument, NULL, OPT_SEED},
-        {"no-repair", no_argument, NULL, OPT_NOREPAIR},
-        {"output", required_argument, NULL, 'o'},
-        TOOL_LONG_OPTIONS_TETFORMAT,
-        TOOL_LONG_OPTIONS_BASIC,
-        TOOL_LONG_OPTIONS_RESOURCES,
-        {NULL, 0, NULL, 0}};
-    int c;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, ":h:o:qv", opts, NULL)) != -1) {
-        switch (c) {
-        case OPT_DENSITY:
-            if (tool_parse_double(&t, "--density", optarg, 0.0, 1.0, &rho))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_SCULPT:
-            sculpt = 1;
-            break;
-        case OPT_SURFACE:
-            surface = optarg;
-            break;
-        case OPT_LATTICE:
-            lattice = optarg;
-            break;
-        case OPT_CELLS:
-            if (!strcmp(optarg, "auto")) {
-                auto_cells = 1;
-                break;
-            }
-            if (tool_parse_size(&t, "--cells", optarg, 1, 100000, &cells))
-                return TOOL_EXIT_USAGE;
-            auto_cells = 0;
-            break;
-        case 'h':
-            if (tool_parse_double(&t, "-h", optarg, 1e-300, 1e300, &size))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_SEED: {
-            char *end;
-            errno = 0;
-            unsigned long long v = strtoull(optarg, &end, 10);
-            if (!*optarg || *end || errno || optarg[0] == '-')
-                return tool_usage_error(&t, "--seed wants a non-negative "
-                                            "integer, not '%s'", optarg);
-            seed = (uint64_t)v;
-            have_seed = 1;
-            break;
-        }
-        case OPT_NOREPAIR:
-            repair = 0;
-            break;
-        case 'o':
-            out = optarg;
-            break;
-        case TOOL_OPT_MSH_VERSION:
-        case TOOL_OPT_MSH_BINARY:
-            if (tool_tetformat_option(&t, c, optarg, &fopts))
-                return TOOL_EXIT_USAGE;
-            break;
-        default: {
-            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
-            if (rc_opt != TOOL_CONTINUE) {
-                tool_finish(&t);
-                return rc_opt;
-            }
-            break;
-        }
-        }
-    }
-    TOOL_TRY(tool_one_input(&t, argc, argv, "input field", "-", &in));
-    if (sculpt && rho >= 0)
-        return tool_usage_error(&t, "--density and --sculpt exclude each other");
-    if (!sculpt && rho < 0)
-        return tool_usage_error(&t, "say --density RHO or --sculpt --surface S");
-    if (sculpt && !surface)
-        return tool_usage_error(&t, "--sculpt needs --surface S (the input surface)");
-    if (!sculpt && surface)
-        return tool_usage_error(&t, "--surface goes with --sculpt");
-    if ((cells || auto_cells) && size > 0)
-        return tool_usage_error(&t, "--cells and -h exclude each other");
-    if (auto_cells && (sculpt || !repair))
-        return tool_usage_error(&t, "--cells auto goes with --density (and its "
-                                    "cleanup: not with --no-repair)");
-    st_lattice_kind kind = sculpt ? ST_LATTICE_BCC : ST_LATTICE_CUBIC5;
-    if (lattice && st_lattice_kind_from_name(lattice, &kind))
-        return tool_usage_error(&t, "--lattice is cubic5 or bcc, not '%s'", lattice);
-    if (!cells)   /* sculpting keeps a layer more: coarser by default */
-        cells = sculpt ? 10 : 16;
-    /* Sculpting: soupmesh's defaults, so the pipe makes soupmesh's mesh. */
-    if (!have_seed && sculpt)
-        seed = 1;
-    TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO, "no input: give a field or pipe "
-                                  "one in (soupdist m.obj | soupsign | latticetet ...)"));
-    if (surface)
-        TOOL_TRY(tool_refuse_terminal(&t, surface, STDIN_FILENO, TOOL_TTY_SURFACE));
-    TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, TOOL_TTY_VTU));
-    TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
-                                st_tetformat_from_path(out) != ST_TETFORMAT_NONE,
-                                ".vtu, .msh, .node, .ele or .mesh"));
-    TOOL_TRY(tool_output_check(&t, out));
-    tool_set_threads(co.threads);
+/* What the command line asks for. */
+typedef struct latticetet_settings {
+    tool_common co;
+    const char *in, *surface, *lattice_name;
+    st_lattice_kind kind;
+    size_t cells;      /* 0 until given, then the default of the mode */
+    int auto_cells;    /* --cells auto */
+    double rho;        /* --density; < 0 with --sculpt */
+    double size;       /* -h; 0: from cells */
+    int sculpt, repair, have_seed;
+    uint64_t seed;
+} latticetet_settings;
 
+static const struct option longopts[] = {
+    {"density", required_argument, NULL, OPT_DENSITY},
+    {"sculpt", no_argument, NULL, OPT_SCULPT},
+    {"surface", required_argument, NULL, OPT_SURFACE},
+    {"lattice", required_argument, NULL, OPT_LATTICE},
+    {"cells", required_argument, NULL, OPT_CELLS},
+    {"size", required_argument, NULL, 'h'},
+    {"seed", required_argument, NULL, OPT_SEED},
+    {"no-repair", no_argument, NULL, OPT_NOREPAIR},
+    TOOL_LONG_OPTIONS_OUTPUT,
+    TOOL_LONG_OPTIONS_TETFORMAT,
+    TOOL_LONG_OPTIONS_END};
+
+static int option(tool_ctx *t, int c, const char *arg, void *settings)
+{
+    latticetet_settings *s = settings;
+    switch (c) {
+    case OPT_DENSITY:
+        if (tool_parse_double(t, "--density", arg, 0.0, 1.0, &s->rho))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_SCULPT:
+        s->sculpt = 1;
+        break;
+    case OPT_SURFACE:
+        s->surface = arg;
+        break;
+    case OPT_LATTICE:
+        s->lattice_name = arg;
+        break;
+    case OPT_CELLS:
+        if (!strcmp(arg, "auto")) {
+            s->auto_cells = 1;
+            break;
+        }
+        if (tool_parse_size(t, "--cells", arg, 1, 100000, &s->cells))
+            return TOOL_EXIT_USAGE;
+        s->auto_cells = 0;
+        break;
+    case 'h':
+        if (tool_parse_double(t, "-h", arg, 1e-300, 1e300, &s->size))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_SEED: {
+        char *end;
+        errno = 0;
+        unsigned long long v = strtoull(arg, &end, 10);
+        if (!*arg || *end || errno || arg[0] == '-')
+            return tool_usage_error(t, "--seed wants a non-negative integer, not '%s'", arg);
+        s->seed = (uint64_t)v;
+        s->have_seed = 1;
+        break;
+    }
+    case OPT_NOREPAIR:
+        s->repair = 0;
+        break;
+    }
+    return TOOL_CONTINUE;
+}
+
+static int check(tool_ctx *t, int argc, char *argv[], void *settings)
+{
+    latticetet_settings *s = settings;
+    TOOL_TRY(tool_one_input(t, argc, argv, "input field", "-", &s->in));
+    if (s->sculpt && s->rho >= 0)
+        return tool_usage_error(t, "--density and --sculpt exclude each other");
+    if (!s->sculpt && s->rho < 0)
+        return tool_usage_error(t, "say --density RHO or --sculpt --surface S");
+    if (s->sculpt && !s->surface)
+        return tool_usage_error(t, "--sculpt needs --surface S (the input surface)");
+    if (!s->sculpt && s->surface)
+        return tool_usage_error(t, "--surface goes with --sculpt");
+    if ((s->cells || s->auto_cells) && s->size > 0)
+        return tool_usage_error(t, "--cells and -h exclude each other");
+    if (s->auto_cells && (s->sculpt || !s->repair))
+        return tool_usage_error(t, "--cells auto goes with --density (and its "
+                                   "cleanup: not with --no-repair)");
+    s->kind = s->sculpt ? ST_LATTICE_BCC : ST_LATTICE_CUBIC5;
+    if (s->lattice_name && st_lattice_kind_from_name(s->lattice_name, &s->kind))
+        return tool_usage_error(t, "--lattice is cubic5 or bcc, not '%s'", s->lattice_name);
+    if (!s->cells)   /* sculpting keeps a layer more: coarser by default */
+        s->cells = s->sculpt ? 10 : 16;
+    /* Sculpting: soupmesh's defaults, so the pipe makes soupmesh's mesh. */
+    if (!s->have_seed && s->sculpt)
+        s->seed = 1;
+    TOOL_TRY(tool_refuse_terminal(t, s->in, STDIN_FILENO, "no input: give a field or pipe "
+                                  "one in (soupdist m.obj | soupsign | latticetet ...)"));
+    if (s->surface)
+        TOOL_TRY(tool_refuse_terminal(t, s->surface, STDIN_FILENO, TOOL_TTY_SURFACE));
+    TOOL_TRY(tool_tetmesh_output(t, s->co.out, TOOL_TTY_VTU));
+    return tool_output_check(t, s->co.out);
+}
+
+static int run(tool_ctx *t, void *settings)
+{
+    const latticetet_settings *s = settings;
+    const char *in = s->in, *surface = s->surface;
+    const st_lattice_kind kind = s->kind;
+    const int sculpt = s->sculpt, repair = s->repair, auto_cells = s->auto_cells;
+    const double rho = s->rho, size = s->size;
+    const uint64_t seed = s->seed;
+    size_t cells = s->cells;
+    tool_set_threads(s->co.threads);
     st_error err;
     st_error_clear(&err);
     st_grid *g = NULL;
@@ -211,22 +205,22 @@ int main(int argc, char *argv[])
     st_lattice *L = NULL;
     st_tetmesh *m = NULL;
     int rc = TOOL_EXIT_FAIL;
-    const char *in_name = st_path_is_stdio(in) ? "<stdin>" : in;
+    const char *in_name = tool_in_name(in);
     double t0 = tool_now();
-    if (st_grid_read(&g, in, co.max_bytes, &err) ||
+    if (st_grid_read(&g, in, s->co.max_bytes, &err) ||
         tool_check_field_finite(g, in_name, &err)) {
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
     if (g->kind != ST_GRID_SIGNED) {
         st_error_set(&err, ST_EINPUT, in_name, 0,
                      "the field is %s, not signed (run soupsign first)",
                      st_grid_kind_name(g->kind));
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
-    if (sculpt && tool_soup_read(&t, &soup, surface, &err)) {
-        rc = tool_fail(&t, &err);
+    if (sculpt && tool_soup_read(t, &soup, surface, &err)) {
+        rc = tool_fail(t, &err);
         goto done;
     }
     double t1 = tool_now();
@@ -237,14 +231,14 @@ int main(int argc, char *argv[])
         /* --cells over the surface's box, as soupmesh counts them. */
         double slo[3], shi[3];
         if (st_soup_bounds(soup, slo, shi, &err)) {
-            rc = tool_fail(&t, &err);
+            rc = tool_fail(t, &err);
             goto done;
         }
         h = st_lattice_h_for_cells(slo, shi, cells);
     }
     /* A lattice that cannot fit in --max-memory (or past 2^31 tets, far
      * beyond what a coarse mesh needs) is refused before it is built. */
-    const size_t max_tets = tool_max_lattice_tets(co.max_bytes);
+    const size_t max_tets = tool_max_lattice_tets(s->co.max_bytes);
     const char *limit_hint = "use fewer --cells or a larger -h, or raise "
                              "--max-memory";
     size_t thin_parts = 0;   /* of the last density try: why no tets */
@@ -273,7 +267,7 @@ int main(int argc, char *argv[])
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", in_name);
             tool_limit_hint(&err, limit_hint);
-            rc = tool_fail(&t, &err);
+            rc = tool_fail(t, &err);
             goto done;
         }
         double t2 = tool_now();
@@ -281,40 +275,38 @@ int main(int argc, char *argv[])
         memset(&cs, 0, sizeof cs);
         if (st_lattice_density_filter_clean(&m, &ds, &cs, L, g, rho, repair,
                                             &err)) {
-            if (!err.file[0])
-                snprintf(err.file, sizeof err.file, "%s", in_name);
-            rc = tool_fail(&t, &err);
+            rc = tool_fail_file(t, &err, in_name);
             goto done;
         }
         double t3 = tool_now();
-        tool_say(&t, 2, "grid %zux%zux%zu, voxel %.6g; %s lattice, h %.6g "
+        tool_say(t, 2, "grid %zux%zux%zu, voxel %.6g; %s lattice, h %.6g "
                  "(%.3g voxels), %zux%zux%zu cells, seed %" PRIu64,
                  g->nx, g->ny, g->nz, g->voxel, st_lattice_kind_name(kind), h,
                  h / g->voxel, L->n[0], L->n[1], L->n[2], seed);
-        tool_say(&t, 2, "%zu of %zu lattice tets kept (rho >= %g); %zu decided "
+        tool_say(t, 2, "%zu of %zu lattice tets kept (rho >= %g); %zu decided "
                  "by their centroid's voxel; %zu point tests",
                  ds.kept, ds.lattice_tets, rho, ds.centroid_rule, ds.point_tests);
-        tool_say(&t, 2, "read %.3f s, lattice %.3f s, density %.3f s",
+        tool_say(t, 2, "read %.3f s, lattice %.3f s, density %.3f s",
                  t1 - t0, t2 - t1, t3 - t2);
         if (repair) {
-            tool_say(&t, 2, "cleanup: %zu pieces of pseudo volume, %zu of "
+            tool_say(t, 2, "cleanup: %zu pieces of pseudo volume, %zu of "
                      "tets; %zu tets filled and %zu dropped at pinched "
                      "vertices; %zu pieces joined (%zu tets), %zu islands "
                      "dropped (%zu tets)", cs.pieces, cs.tet_pieces,
                      cs.filled, cs.dropped, cs.joins, cs.join_tets,
                      cs.islands, cs.island_tets);
             if (cs.specks)
-                tool_say(&t, 2, "%zu specks of the pseudo volume smaller than "
+                tool_say(t, 2, "%zu specks of the pseudo volume smaller than "
                          "a tet (%zu voxels) not meshed", cs.specks,
                          cs.speck_voxels);
             if (cs.bad_vertices_left)
-                tool_say(&t, 1, "warning: the boundary is not manifold at "
+                tool_say(t, 1, "warning: the boundary is not manifold at "
                          "%zu vertices", cs.bad_vertices_left);
             /* with --cells auto, only the last try's parts are news */
             const int final = !auto_cells || cs.nthin == 0 || try_i + 1 == n_auto;
             for (size_t q = 0; q < cs.nthin && q < ST_CLEAN_MAX_THIN; q++) {
                 const st_thin_part *p = &cs.thin[q];
-                tool_say(&t, final ? 1 : 2, "%s: warning: a part of the pseudo volume is "
+                tool_say(t, final ? 1 : 2, "%s: warning: a part of the pseudo volume is "
                          "too thin for this lattice (h %.4g): %zu voxels in "
                          "(%.4g %.4g %.4g)-(%.4g %.4g %.4g), %.4g thick, "
                          "%.0f%% of it meshed; --cells %zu would hold it",
@@ -323,18 +315,18 @@ int main(int argc, char *argv[])
                          100.0 * p->held, p->cells);
             }
             if (cs.nthin > ST_CLEAN_MAX_THIN)
-                tool_say(&t, final ? 1 : 2, "%s: warning: %zu more parts too thin",
+                tool_say(t, final ? 1 : 2, "%s: warning: %zu more parts too thin",
                          in_name, cs.nthin - ST_CLEAN_MAX_THIN);
         }
         thin_parts = cs.nthin;
         if (!auto_cells)
             break;
         if (cs.nthin == 0) {
-            tool_say(&t, 1, "--cells auto: %zu cells (h %.6g)", cells, h);
+            tool_say(t, 1, "--cells auto: %zu cells (h %.6g)", cells, h);
             break;
         }
         if (try_i + 1 == n_auto) {
-            tool_say(&t, 1, "%s: warning: --cells auto: parts still too thin at "
+            tool_say(t, 1, "%s: warning: --cells auto: parts still too thin at "
                      "%zu cells, the finest it tries", in_name, cells);
             break;
         }
@@ -352,17 +344,17 @@ int main(int argc, char *argv[])
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", in_name);
             tool_limit_hint(&err, limit_hint);
-            rc = tool_fail(&t, &err);
+            rc = tool_fail(t, &err);
             goto done;
         }
-        tool_say(&t, 2, "grid %zux%zux%zu, voxel %.6g; %s lattice, h %.6g "
+        tool_say(t, 2, "grid %zux%zux%zu, voxel %.6g; %s lattice, h %.6g "
                  "(%.3g voxels), seed %" PRIu64 "; surface %s: %zu triangles",
                  g->nx, g->ny, g->nz, g->voxel, st_lattice_kind_name(kind), h,
                  h / g->voxel, seed, surface, soup->ntris);
-        tool_say(&t, 2, "%zu lattice tets: %zu overlap the pseudo volume, "
+        tool_say(t, 2, "%zu lattice tets: %zu overlap the pseudo volume, "
                  "%zu more meet a triangle", ss.lattice_tets, ss.kept_volume,
                  ss.kept_surface);
-        tool_say(&t, 2, "bombs: %zu found (%zu with 3 boundary faces, %zu "
+        tool_say(t, 2, "bombs: %zu found (%zu with 3 boundary faces, %zu "
                  "isolated), %zu clusters (largest %zu; %zu searched exactly, "
                  "%zu too large: greedy), %zu snowflakes add %zu tets "
                  "(greedy: %zu), %zu rounds, %zu left",
@@ -370,45 +362,40 @@ int main(int argc, char *argv[])
                  ss.largest_cluster, ss.clusters_exact, ss.clusters_greedy,
                  ss.snowflakes, ss.bomb_tets, ss.greedy_tets, ss.repair_rounds,
                  ss.bombs_left);
-        tool_say(&t, 2, "boundary: %zu non-manifold vertices, %zu edges; "
+        tool_say(t, 2, "boundary: %zu non-manifold vertices, %zu edges; "
                  "%zu tets added; %zu vertices, %zu edges left",
                  ss.nonmanifold_vertices, ss.nonmanifold_edges,
                  ss.manifold_tets, ss.nonmanifold_vertices_left,
                  ss.nonmanifold_edges_left);
-        tool_say(&t, 2, "%zu tets; read %.3f s, lattice %.3f s, classify "
+        tool_say(t, 2, "%zu tets; read %.3f s, lattice %.3f s, classify "
                  "%.3f s, repair %.3f s, mesh %.3f s", ss.tets, t1 - t0,
                  ss.t_lattice, ss.t_classify, ss.t_repair, ss.t_mesh);
         if (ss.bombs_left)
-            tool_say(&t, 1, "warning: %zu bombs could not be repaired",
+            tool_say(t, 1, "warning: %zu bombs could not be repaired",
                      ss.bombs_left);
         if (ss.nonmanifold_vertices_left)
-            tool_say(&t, 1, "warning: the boundary is not manifold at %zu "
+            tool_say(t, 1, "warning: the boundary is not manifold at %zu "
                      "vertices", ss.nonmanifold_vertices_left);
     }
     if (m->ntets == 0)
-        tool_say(&t, 1, thin_parts
+        tool_say(t, 1, thin_parts
                  ? "%s: warning: no tets kept: the pseudo volume is thinner than this "
                    "lattice holds (the --cells above would hold it)"
                  : "%s: warning: no tets kept: the pseudo volume is empty (a field "
                    "soupsign made has its inside negative)", in_name);
     /* The field's metadata (source, history) carries over; the lattice's
      * own keys win. */
-    {
-        int bad = st_meta_inherit(&m->meta, &g->meta) != ST_OK;
-        bad = bad || st_meta_history_append(&m->meta, t.command_line ? t.command_line
-                                                                     : "latticetet") != ST_OK;
-        if (bad) {
-            st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
-            rc = tool_fail(&t, &err);
-            goto done;
-        }
-    }
-    double tw = tool_now();
-    if (st_tetmesh_save(m, out, &fopts, &err)) {
-        rc = tool_fail(&t, &err);
+    if (st_meta_inherit(&m->meta, &g->meta) != ST_OK ||
+        st_meta_history_append(&m->meta, tool_command(t)) != ST_OK) {
+        rc = tool_fail_nomem(t, &err);
         goto done;
     }
-    tool_say(&t, 2, "%zu tets, %zu points; write %.3f s", m->ntets, m->npoints,
+    double tw = tool_now();
+    if (st_tetmesh_save(m, s->co.out, &s->co.tetformat, &err)) {
+        rc = tool_fail(t, &err);
+        goto done;
+    }
+    tool_say(t, 2, "%zu tets, %zu points; write %.3f s", m->ntets, m->npoints,
              tool_now() - tw);
     rc = TOOL_EXIT_OK;
 done:
@@ -416,6 +403,13 @@ done:
     st_lattice_free(L);
     st_soup_free(soup);
     st_grid_free(g);
-    tool_finish(&t);
     return rc;
+}
+
+static const tool_spec spec = {"latticetet", usage, ":h:o:qv", longopts, option, check, run};
+
+int main(int argc, char *argv[])
+{
+    latticetet_settings s = {.rho = -1, .repair = 1};
+    return tool_main(&spec, argc, argv, &s, &s.co);
 }

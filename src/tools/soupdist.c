@@ -75,77 +75,71 @@ static int record_source(st_grid *g, const char *in, const st_soup_source *src)
     return rc;
 }
 
-int main(int argc, char *argv[])
-{
-    tool_ctx t;
-    tool_init(&t, "soupdist", argc, argv);
-    tool_common co = tool_common_default();
-    st_dist_params p = st_dist_params_default();
-    const char *out = NULL, *in = NULL;
-    int have_cells = 0, have_voxel = 0;
-    static const struct option opts[] = {
-        {"cells", required_argument, NULL, 'r'},
-        {"voxel", required_argument, NULL, 's'},
-        {"pad", required_argument, NULL, OPT_PAD},
-        {"band", required_argument, NULL, OPT_BAND},
-        {"output", required_argument, NULL, 'o'},
-        TOOL_LONG_OPTIONS_BASIC,
-        TOOL_LONG_OPTIONS_RESOURCES,
-        {NULL, 0, NULL, 0}};
-    int c;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, ":r:s:o:qv", opts, NULL)) != -1) {
-        switch (c) {
-        case 'r':
-            if (tool_parse_size(&t, "-r", optarg, 1, 65536, &p.cells))
-                return TOOL_EXIT_USAGE;
-            have_cells = 1;
-            break;
-        case 's':
-            if (tool_parse_double(&t, "-s", optarg, 1e-300, 1e300, &p.voxel))
-                return TOOL_EXIT_USAGE;
-            have_voxel = 1;
-            break;
-        case OPT_PAD: {
-            size_t pad;
-            if (tool_parse_size(&t, "--pad", optarg, 0, 1000000, &pad))
-                return TOOL_EXIT_USAGE;
-            p.pad = (long)pad;
-            break;
-        }
-        case OPT_BAND:
-            if (strcmp(optarg, "full") == 0)
-                p.band = INFINITY;
-            else if (tool_parse_double(&t, "--band", optarg, ST_DIST_MIN_BAND,
-                                       1e6, &p.band))
-                return TOOL_EXIT_USAGE;
-            break;
-        case 'o':
-            out = optarg;
-            break;
-        default: {
-            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
-            if (rc_opt != TOOL_CONTINUE) {
-                tool_finish(&t);
-                return rc_opt;
-            }
-            break;
-        }
-        }
-    }
-    if (have_cells && have_voxel)
-        return tool_usage_error(&t, "give -r or -s, not both");
-    TOOL_TRY(tool_one_input(&t, argc, argv, "input file", "-", &in));
-    TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO, TOOL_TTY_SURFACE));
-    TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, "will not write a binary VDB "
-                                  "stream to a terminal: give -o FILE or pipe it"));
-    TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
-                                st_grid_format_from_path(out) != ST_GRID_FMT_UNKNOWN,
-                                ".vdb or .vti"));
-    TOOL_TRY(tool_output_check(&t, out));
-    tool_set_threads(co.threads);
-    p.max_bytes = co.max_bytes;
+/* What the command line asks for. */
+typedef struct soupdist_settings {
+    tool_common co;
+    st_dist_params dist;
+    const char *in;
+    int have_cells, have_voxel;
+} soupdist_settings;
 
+static const struct option longopts[] = {
+    {"cells", required_argument, NULL, 'r'},
+    {"voxel", required_argument, NULL, 's'},
+    {"pad", required_argument, NULL, OPT_PAD},
+    {"band", required_argument, NULL, OPT_BAND},
+    TOOL_LONG_OPTIONS_OUTPUT,
+    TOOL_LONG_OPTIONS_END};
+
+static int option(tool_ctx *t, int c, const char *arg, void *settings)
+{
+    soupdist_settings *s = settings;
+    switch (c) {
+    case 'r':
+        if (tool_parse_size(t, "-r", arg, 1, 65536, &s->dist.cells))
+            return TOOL_EXIT_USAGE;
+        s->have_cells = 1;
+        break;
+    case 's':
+        if (tool_parse_double(t, "-s", arg, 1e-300, 1e300, &s->dist.voxel))
+            return TOOL_EXIT_USAGE;
+        s->have_voxel = 1;
+        break;
+    case OPT_PAD: {
+        size_t pad;
+        if (tool_parse_size(t, "--pad", arg, 0, 1000000, &pad))
+            return TOOL_EXIT_USAGE;
+        s->dist.pad = (long)pad;
+        break;
+    }
+    case OPT_BAND:
+        if (strcmp(arg, "full") == 0)
+            s->dist.band = INFINITY;
+        else if (tool_parse_double(t, "--band", arg, ST_DIST_MIN_BAND, 1e6, &s->dist.band))
+            return TOOL_EXIT_USAGE;
+        break;
+    }
+    return TOOL_CONTINUE;
+}
+
+static int check(tool_ctx *t, int argc, char *argv[], void *settings)
+{
+    soupdist_settings *s = settings;
+    if (s->have_cells && s->have_voxel)
+        return tool_usage_error(t, "give -r or -s, not both");
+    TOOL_TRY(tool_one_input(t, argc, argv, "input file", "-", &s->in));
+    TOOL_TRY(tool_refuse_terminal(t, s->in, STDIN_FILENO, TOOL_TTY_SURFACE));
+    TOOL_TRY(tool_grid_output(t, s->co.out));
+    TOOL_TRY(tool_output_check(t, s->co.out));
+    s->dist.max_bytes = s->co.max_bytes;
+    return TOOL_CONTINUE;
+}
+
+static int run(tool_ctx *t, void *settings)
+{
+    const soupdist_settings *s = settings;
+    const char *in = s->in;
+    tool_set_threads(s->co.threads);
     st_error err;
     st_error_clear(&err);
     st_soup *soup = NULL;
@@ -153,16 +147,16 @@ int main(int argc, char *argv[])
     int rc = TOOL_EXIT_FAIL;
     double t_read = tool_now();
     st_soup_source src;
-    if (tool_soup_read_source(&t, &soup, in, &src, &err)) {
-        rc = tool_fail(&t, &err);
+    if (tool_soup_read_source(t, &soup, in, &src, &err)) {
+        rc = tool_fail(t, &err);
         goto done;
     }
     double t_dist = tool_now();
-    st_progress prog = tool_progress(&t);
-    if (st_dist_field(&g, soup, &p, &prog, &err)) {
+    st_progress prog = tool_progress(t);
+    if (st_dist_field(&g, soup, &s->dist, &prog, &err)) {
         if (!err.file[0])
             snprintf(err.file, sizeof err.file, "%s", in);
-        size_t fit = err.status == ST_ELIMIT ? tool_dist_cells_that_fit(soup, &p) : 0;
+        size_t fit = err.status == ST_ELIMIT ? tool_dist_cells_that_fit(soup, &s->dist) : 0;
         char hint[160];
         if (fit)
             snprintf(hint, sizeof hint, "use -r %zu or less, a larger -s, or raise "
@@ -171,39 +165,43 @@ int main(int argc, char *argv[])
             snprintf(hint, sizeof hint, "use a smaller -r or a larger -s, or raise "
                      "--max-memory");
         tool_limit_hint(&err, hint);
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
-    tool_progress_end(&t);
+    tool_progress_end(t);
     double t_write = tool_now();
-    if (st_meta_set(&g->meta, "source",
-                    strcmp(in, "-") == 0 ? "<stdin>" : in) ||
+    if (st_meta_set(&g->meta, "source", tool_in_name(in)) ||
         record_source(g, in, &src) ||
-        st_meta_history_append(&g->meta, t.command_line ? t.command_line
-                                                        : "soupdist")) {
-        st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
-        rc = tool_fail(&t, &err);
+        st_meta_history_append(&g->meta, tool_command(t))) {
+        rc = tool_fail_nomem(t, &err);
         goto done;
     }
-    if (st_grid_write(g, out, &err)) {
-        rc = tool_fail(&t, &err);
+    if (st_grid_write(g, s->co.out, &err)) {
+        rc = tool_fail(t, &err);
         goto done;
     }
     double t_end = tool_now();
-    tool_say(&t, 2, "%s: %zu vertices, %zu triangles", in, soup->nverts,
+    tool_say(t, 2, "%s: %zu vertices, %zu triangles", in, soup->nverts,
              soup->ntris);
     if (isinf(g->band))
-        tool_say(&t, 2, "grid %zux%zux%zu, voxel %.6g, full field",
+        tool_say(t, 2, "grid %zux%zux%zu, voxel %.6g, full field",
                  g->nx, g->ny, g->nz, g->voxel);
     else
-        tool_say(&t, 2, "grid %zux%zux%zu, voxel %.6g, band %.6g (%g voxels)",
+        tool_say(t, 2, "grid %zux%zux%zu, voxel %.6g, band %.6g (%g voxels)",
                  g->nx, g->ny, g->nz, g->voxel, g->band, g->band / g->voxel);
-    tool_say(&t, 2, "read %.3f s, distance %.3f s, write %.3f s",
+    tool_say(t, 2, "read %.3f s, distance %.3f s, write %.3f s",
              t_dist - t_read, t_write - t_dist, t_end - t_write);
     rc = TOOL_EXIT_OK;
 done:
     st_grid_free(g);
     st_soup_free(soup);
-    tool_finish(&t);
     return rc;
+}
+
+static const tool_spec spec = {"soupdist", usage, ":r:s:o:qv", longopts, option, check, run};
+
+int main(int argc, char *argv[])
+{
+    soupdist_settings s = {.dist = st_dist_params_default()};
+    return tool_main(&spec, argc, argv, &s, &s.co);
 }

@@ -131,90 +131,72 @@ static void print_table(FILE *f, const char *name, const st_soupinfo *r)
 
 enum { OPT_JSON = TOOL_OPT_FIRST, OPT_NOSELF };
 
-int main(int argc, char *argv[])
-{
-    tool_ctx t;
-    tool_init(&t, "soupinfo", argc, argv);
-    tool_common co = tool_common_default();
-    int json = 0, self_check = 1;
-    static const struct option opts[] = {
-        {"json", no_argument, NULL, OPT_JSON},
-        {"no-self-check", no_argument, NULL, OPT_NOSELF},
-        TOOL_LONG_OPTIONS_BASIC,
-        {NULL, 0, NULL, 0}};
-    int c;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, ":qv", opts, NULL)) != -1) {
-        switch (c) {
-        case OPT_JSON:
-            json = 1;
-            break;
-        case OPT_NOSELF:
-            self_check = 0;
-            break;
-        default: {
-            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
-            if (rc_opt != TOOL_CONTINUE) {
-                tool_finish(&t);
-                return rc_opt;
-            }
-            break;
-        }
-        }
-    }
-    static char *const stdin_only[] = {"-", NULL};
-    char *const *inputs = optind < argc ? argv + optind : stdin_only;
-    int ninputs = optind < argc ? argc - optind : 1;
-    int nstdin = 0;
-    for (int i = 0; i < ninputs; i++)
-        nstdin += strcmp(inputs[i], "-") == 0;
-    if (nstdin > 1) {
-        tool_finish(&t);
-        return tool_usage_error(&t, "standard input ('-') given %d times",
-                                nstdin);
-    }
-    if (nstdin && isatty(STDIN_FILENO)) {
-        tool_finish(&t);
-        return tool_usage_error(&t, "will not read a surface from a terminal: "
-                                    "give a file or pipe one");
-    }
+/* What the command line asks for. */
+typedef struct soupinfo_settings {
+    tool_common co;
+    int json, self_check;
+    char *const *inputs;   /* ninputs paths; "-" is stdin */
+    int ninputs;
+} soupinfo_settings;
 
+static const struct option longopts[] = {
+    {"json", no_argument, NULL, OPT_JSON},
+    {"no-self-check", no_argument, NULL, OPT_NOSELF},
+    TOOL_LONG_OPTIONS_BASIC,
+    {NULL, 0, NULL, 0}};
+
+static int option(tool_ctx *t, int c, const char *arg, void *settings)
+{
+    soupinfo_settings *s = settings;
+    (void)t;
+    (void)arg;
+    if (c == OPT_JSON)
+        s->json = 1;
+    else if (c == OPT_NOSELF)
+        s->self_check = 0;
+    return TOOL_CONTINUE;
+}
+
+static int check(tool_ctx *t, int argc, char *argv[], void *settings)
+{
+    static char *const stdin_only[] = {"-", NULL};
+    soupinfo_settings *s = settings;
+    s->inputs = optind < argc ? argv + optind : stdin_only;
+    s->ninputs = optind < argc ? argc - optind : 1;
+    return tool_stdin_once(t, (const char *const *)s->inputs, (size_t)s->ninputs,
+                           TOOL_TTY_SURFACE);
+}
+
+static int run(tool_ctx *t, void *settings)
+{
+    const soupinfo_settings *s = settings;
     /* A bad input is reported and skipped: the others are still worth a
      * report (as wc does), and the exit status says something failed. */
     int rc = TOOL_EXIT_OK, printed = 0;
-    if (json)
+    if (s->json)
         fputs("[", stdout);
-    for (int i = 0; i < ninputs; i++) {
-        const char *in = inputs[i];
-        const char *name = strcmp(in, "-") == 0 ? "<stdin>" : in;
+    for (int i = 0; i < s->ninputs; i++) {
+        const char *in = s->inputs[i];
+        const char *name = tool_in_name(in);
         st_error err;
         st_error_clear(&err);
         st_soup *soup = NULL;
         st_soupinfo r;
         double t_read = tool_now();
-        if (tool_soup_read(&t, &soup, in, &err)) {
-            rc = tool_fail(&t, &err);
+        if (tool_soup_read(t, &soup, in, &err)) {
+            rc = tool_fail(t, &err);
             continue;
         }
         double t_info = tool_now();
-        if (st_soupinfo_compute(&r, soup, &err)) {
-            if (!err.file[0])
-                snprintf(err.file, sizeof err.file, "%s", name);
-            rc = tool_fail(&t, &err);
-            st_soup_free(soup);
-            continue;
-        }
-        if (self_check &&
-            st_soupinfo_self_intersections(&r, soup, NULL, &err)) {
-            if (!err.file[0])
-                snprintf(err.file, sizeof err.file, "%s", name);
-            rc = tool_fail(&t, &err);
+        if (st_soupinfo_compute(&r, soup, &err) ||
+            (s->self_check && st_soupinfo_self_intersections(&r, soup, NULL, &err))) {
+            rc = tool_fail_file(t, &err, name);
             st_soup_free(soup);
             continue;
         }
         double t_end = tool_now();
         st_soup_free(soup);
-        if (json) {
+        if (s->json) {
             fputs(printed ? ",\n " : "", stdout);
             print_json(stdout, name, &r);
         } else {
@@ -223,13 +205,20 @@ int main(int argc, char *argv[])
             print_table(stdout, name, &r);
         }
         printed++;
-        tool_say(&t, 2, "%s: read %.3f s, analysis %.3f s", name,
+        tool_say(t, 2, "%s: read %.3f s, analysis %.3f s", name,
                  t_info - t_read, t_end - t_info);
     }
-    if (json)
+    if (s->json)
         fputs("]\n", stdout);
-    if (tool_flush_stdout(&t))
+    if (tool_flush_stdout(t))
         rc = TOOL_EXIT_FAIL;
-    tool_finish(&t);
     return rc;
+}
+
+static const tool_spec spec = {"soupinfo", usage, ":qv", longopts, option, check, run};
+
+int main(int argc, char *argv[])
+{
+    soupinfo_settings s = {.self_check = 1};
+    return tool_main(&spec, argc, argv, &s, &s.co);
 }

@@ -100,8 +100,8 @@ TOOL_HELP_TETFORMAT
 }
 
 enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
-       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_FILL_HOLES, OPT_SHELLS,
-       OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY, OPT_BEST_EFFORT };
+       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY,
+       OPT_BEST_EFFORT };
 
 /* -v: a line as each stage, sculpt, fit iteration and candidate ends, so a
  * long run is never silent (pipeline.h, st_pipeline_event). */
@@ -211,160 +211,148 @@ static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_pa
     return tool_flush_stdout(t) ? TOOL_EXIT_FAIL : TOOL_EXIT_OK;
 }
 
-int main(int argc, char *argv[])
-{
-    tool_ctx t;
-    tool_init(&t, "soupmesh", argc, argv);
-    tool_common co = tool_common_default();
-    st_pipeline_params p = st_pipeline_params_default();
-    size_t max_iters = 0, seed = 1;
-    int have_cells = 0, best_effort = 0;
-    const char *out = NULL, *in = NULL, *embed = NULL, *boundary = NULL;
-    st_tetformat_opts fopts = {0, 0};
-    static const struct option opts[] = {
-        {"cells", required_argument, NULL, OPT_CELLS},
-        {"size", required_argument, NULL, 'h'},
-        {"tets", required_argument, NULL, OPT_TETS},
-        {"dry-run", no_argument, NULL, OPT_DRY_RUN},
-        {"offset", required_argument, NULL, OPT_OFFSET},
-        {"offset-best-effort", no_argument, NULL, OPT_BEST_EFFORT},
-        {"tries", required_argument, NULL, OPT_TRIES},
-        {"seed", required_argument, NULL, OPT_SEED},
-        {"density", required_argument, NULL, OPT_DENSITY},
-        {"field-cells", required_argument, NULL, OPT_FIELD_CELLS},
-        {"max-iters", required_argument, NULL, OPT_MAX_ITERS},
-        {"no-quality", no_argument, NULL, OPT_NO_QUALITY},
-        {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
-        {"shells", required_argument, NULL, OPT_SHELLS},
-        TOOL_LONG_OPTIONS_TETFORMAT,
-        {"embed", required_argument, NULL, OPT_EMBED},
-        {"boundary", required_argument, NULL, OPT_BOUNDARY},
-        {"output", required_argument, NULL, 'o'},
-        TOOL_LONG_OPTIONS_BASIC,
-        TOOL_LONG_OPTIONS_RESOURCES,
-        {NULL, 0, NULL, 0}};
-    int c;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, ":o:h:qv", opts, NULL)) != -1) {
-        switch (c) {
-        case OPT_CELLS:
-            if (tool_parse_size(&t, "--cells", optarg, 1, ST_PIPELINE_MAX_CELLS, &p.cells))
-                return TOOL_EXIT_USAGE;
-            have_cells = 1;
-            break;
-        case 'h':
-            if (tool_parse_double(&t, "--size", optarg, 1e-300, 1e300, &p.h))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_TETS:
-            if (tool_parse_size(&t, "--tets", optarg, 10, 100000000, &p.target_tets))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_DRY_RUN:
-            p.dry_run = 1;
-            break;
-        case OPT_OFFSET:
-            if (tool_parse_double(&t, "--offset", optarg, 1e-3, 10.0, &p.offset_ratio))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_BEST_EFFORT:
-            best_effort = 1;
-            break;
-        case OPT_TRIES:
-            if (tool_parse_size(&t, "--tries", optarg, 1, ST_PIPELINE_MAX_TRIES, &p.tries))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_SEED:
-            if (tool_parse_size(&t, "--seed", optarg, 0, SIZE_MAX, &seed))
-                return TOOL_EXIT_USAGE;
-            p.seed = (uint64_t)seed;
-            break;
-        case OPT_DENSITY:
-            if (tool_parse_double(&t, "--density", optarg, 1e-6, 1.0, &p.density_rho))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_FIELD_CELLS:
-            if (tool_parse_size(&t, "--field-cells", optarg, 8, 4096, &p.field_cells))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_MAX_ITERS:
-            if (tool_parse_size(&t, "--max-iters", optarg, 1, 100000, &max_iters))
-                return TOOL_EXIT_USAGE;
-            p.fit_max_iters = (int)max_iters;
-            break;
-        case OPT_NO_QUALITY:
-            p.quality = 0;
-            break;
-        case OPT_FILL_HOLES:
-            if (tool_parse_switch(&t, "--fill-holes", optarg, &p.fill_holes))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_SHELLS:
-            if (tool_parse_switch(&t, "--shells", optarg, &p.closed_shells))
-                return TOOL_EXIT_USAGE;
-            break;
-        case TOOL_OPT_MSH_VERSION:
-        case TOOL_OPT_MSH_BINARY:
-            if (tool_tetformat_option(&t, c, optarg, &fopts))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_EMBED:
-            embed = optarg;
-            break;
-        case OPT_BOUNDARY:
-            boundary = optarg;
-            break;
-        case 'o':
-            out = optarg;
-            break;
-        default: {
-            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
-            if (rc_opt != TOOL_CONTINUE) {
-                tool_finish(&t);
-                return rc_opt;
-            }
-            break;
-        }
-        }
-    }
-    if (have_cells && p.h > 0)
-        return tool_usage_error(&t, "--cells and --size exclude each other");
-    if (p.density_rho > 0 && (p.target_tets || p.dry_run))
-        return tool_usage_error(&t, "--tets and --dry-run size the sculpted mesh, "
-                                    "not --density's");
-    TOOL_TRY(tool_one_input(&t, argc, argv, "input surface", NULL, &in));
-    if (!in)
-        return tool_usage_error(&t, "no input surface (soupmesh -o out.vtu model.obj)");
-    TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO,
-                                  "will not read a surface from a terminal: give a file"));
-    if (!p.dry_run)
-        TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, TOOL_TTY_VTU));
-    TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
-                                st_tetformat_from_path(out) != ST_TETFORMAT_NONE,
-                                ".vtu, .msh, .node, .ele or .mesh"));
-    size_t elen = embed ? strlen(embed) : 0;
-    int embed_text = elen > 4 && strcmp(embed + elen - 4, ".txt") == 0;
-    if (embed && !embed_text && !(elen > 4 && strcmp(embed + elen - 4, ".vtu") == 0))
-        return tool_usage_error(&t, "--embed writes .txt or .vtu, not '%s'", embed);
-    st_soup_format bfmt = boundary ? st_soup_format_from_path(boundary) : ST_SOUP_UNKNOWN;
-    if (boundary && (st_path_is_stdio(boundary) || bfmt == ST_SOUP_UNKNOWN ||
-                     bfmt == ST_SOUP_GLTF))
-        return tool_usage_error(&t, "--boundary writes .obj, .off, .ply or .stl, not '%s'",
-                                boundary);
-    if (boundary && p.density_rho > 0)
-        return tool_usage_error(&t, "--boundary goes with the enclosing mesh, not --density");
-    if (tool_output_unwritable(&t, out) || tool_output_unwritable(&t, embed) ||
-        tool_output_unwritable(&t, boundary)) {
-        tool_finish(&t);
-        return TOOL_EXIT_FAIL;
-    }
-    tool_set_threads(co.threads);
-    p.max_bytes = co.max_bytes;
-    if (t.verbosity >= 2) {
-        p.on_event = on_event;
-        p.on_event_ctx = &t;
-    }
+/* What the command line asks for. */
+typedef struct soupmesh_settings {
+    tool_common co;
+    st_pipeline_params pipeline;
+    const char *in, *embed, *boundary;
+    int have_cells, best_effort;
+    int embed_text;            /* --embed FILE.txt, else .vtu */
+    st_soup_format boundary_format;
+} soupmesh_settings;
 
+static const struct option longopts[] = {
+    {"cells", required_argument, NULL, OPT_CELLS},
+    {"size", required_argument, NULL, 'h'},
+    {"tets", required_argument, NULL, OPT_TETS},
+    {"dry-run", no_argument, NULL, OPT_DRY_RUN},
+    {"offset", required_argument, NULL, OPT_OFFSET},
+    {"offset-best-effort", no_argument, NULL, OPT_BEST_EFFORT},
+    {"tries", required_argument, NULL, OPT_TRIES},
+    {"seed", required_argument, NULL, OPT_SEED},
+    {"density", required_argument, NULL, OPT_DENSITY},
+    {"field-cells", required_argument, NULL, OPT_FIELD_CELLS},
+    {"max-iters", required_argument, NULL, OPT_MAX_ITERS},
+    {"no-quality", no_argument, NULL, OPT_NO_QUALITY},
+    TOOL_LONG_OPTIONS_PSEUDO,
+    TOOL_LONG_OPTIONS_TETFORMAT,
+    {"embed", required_argument, NULL, OPT_EMBED},
+    {"boundary", required_argument, NULL, OPT_BOUNDARY},
+    TOOL_LONG_OPTIONS_OUTPUT,
+    TOOL_LONG_OPTIONS_END};
+
+static int option(tool_ctx *t, int c, const char *arg, void *settings)
+{
+    soupmesh_settings *s = settings;
+    size_t n;
+    switch (c) {
+    case OPT_CELLS:
+        if (tool_parse_size(t, "--cells", arg, 1, ST_PIPELINE_MAX_CELLS, &s->pipeline.cells))
+            return TOOL_EXIT_USAGE;
+        s->have_cells = 1;
+        break;
+    case 'h':
+        if (tool_parse_double(t, "--size", arg, 1e-300, 1e300, &s->pipeline.h))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_TETS:
+        if (tool_parse_size(t, "--tets", arg, 10, 100000000, &s->pipeline.target_tets))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_DRY_RUN:
+        s->pipeline.dry_run = 1;
+        break;
+    case OPT_OFFSET:
+        if (tool_parse_double(t, "--offset", arg, 1e-3, 10.0, &s->pipeline.offset_ratio))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_BEST_EFFORT:
+        s->best_effort = 1;
+        break;
+    case OPT_TRIES:
+        if (tool_parse_size(t, "--tries", arg, 1, ST_PIPELINE_MAX_TRIES, &s->pipeline.tries))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_SEED:
+        if (tool_parse_size(t, "--seed", arg, 0, SIZE_MAX, &n))
+            return TOOL_EXIT_USAGE;
+        s->pipeline.seed = (uint64_t)n;
+        break;
+    case OPT_DENSITY:
+        if (tool_parse_double(t, "--density", arg, 1e-6, 1.0, &s->pipeline.density_rho))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_FIELD_CELLS:
+        if (tool_parse_size(t, "--field-cells", arg, 8, 4096, &s->pipeline.field_cells))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_MAX_ITERS:
+        if (tool_parse_size(t, "--max-iters", arg, 1, 100000, &n))
+            return TOOL_EXIT_USAGE;
+        s->pipeline.fit_max_iters = (int)n;
+        break;
+    case OPT_NO_QUALITY:
+        s->pipeline.quality = 0;
+        break;
+    case TOOL_OPT_FILL_HOLES:
+    case TOOL_OPT_SHELLS:
+        return tool_pseudo_option(t, c, arg, &s->pipeline.fill_holes,
+                                  &s->pipeline.closed_shells);
+    case OPT_EMBED:
+        s->embed = arg;
+        break;
+    case OPT_BOUNDARY:
+        s->boundary = arg;
+        break;
+    }
+    return TOOL_CONTINUE;
+}
+
+static int check(tool_ctx *t, int argc, char *argv[], void *settings)
+{
+    soupmesh_settings *s = settings;
+    const st_pipeline_params *p = &s->pipeline;
+    if (s->have_cells && p->h > 0)
+        return tool_usage_error(t, "--cells and --size exclude each other");
+    if (p->density_rho > 0 && (p->target_tets || p->dry_run))
+        return tool_usage_error(t, "--tets and --dry-run size the sculpted mesh, "
+                                   "not --density's");
+    TOOL_TRY(tool_one_input(t, argc, argv, "input surface", NULL, &s->in));
+    if (!s->in)
+        return tool_usage_error(t, "no input surface (soupmesh -o out.vtu model.obj)");
+    TOOL_TRY(tool_refuse_terminal(t, s->in, STDIN_FILENO,
+                                  "will not read a surface from a terminal: give a file"));
+    TOOL_TRY(tool_tetmesh_output(t, s->co.out, p->dry_run ? NULL : TOOL_TTY_VTU));
+    const char *embed = s->embed, *boundary = s->boundary;
+    size_t elen = embed ? strlen(embed) : 0;
+    s->embed_text = elen > 4 && strcmp(embed + elen - 4, ".txt") == 0;
+    if (embed && !s->embed_text && !(elen > 4 && strcmp(embed + elen - 4, ".vtu") == 0))
+        return tool_usage_error(t, "--embed writes .txt or .vtu, not '%s'", embed);
+    s->boundary_format = boundary ? st_soup_format_from_path(boundary) : ST_SOUP_UNKNOWN;
+    if (boundary && (st_path_is_stdio(boundary) || s->boundary_format == ST_SOUP_UNKNOWN ||
+                     s->boundary_format == ST_SOUP_GLTF))
+        return tool_usage_error(t, "--boundary writes .obj, .off, .ply or .stl, not '%s'",
+                                boundary);
+    if (boundary && p->density_rho > 0)
+        return tool_usage_error(t, "--boundary goes with the enclosing mesh, not --density");
+    if (tool_output_unwritable(t, s->co.out) || tool_output_unwritable(t, embed) ||
+        tool_output_unwritable(t, boundary))
+        return TOOL_EXIT_FAIL;
+    s->pipeline.max_bytes = s->co.max_bytes;
+    return TOOL_CONTINUE;
+}
+
+static int run(tool_ctx *t, void *settings)
+{
+    soupmesh_settings *s = settings;
+    const st_pipeline_params *p = &s->pipeline;
+    const char *in = s->in, *out = s->co.out, *embed = s->embed, *boundary = s->boundary;
+    const char *in_name = tool_in_name(in);
+    tool_set_threads(s->co.threads);
+    if (t->verbosity >= 2) {
+        s->pipeline.on_event = on_event;
+        s->pipeline.on_event_ctx = t;
+    }
     st_error err;
     st_error_clear(&err);
     st_soup *soup = NULL;
@@ -381,38 +369,36 @@ int main(int argc, char *argv[])
     int rc = TOOL_EXIT_FAIL;
     double t0 = tool_now();
     if (st_soup_read(&soup, in, &err)) {
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
-    tool_say(&t, 2, "%s: %zu vertices, %zu triangles", in, soup->nverts, soup->ntris);
-    if (lattice_over_limit(soup, &p, co.max_bytes, &err)) {
-        snprintf(err.file, sizeof err.file, "%s", st_path_is_stdio(in) ? "<stdin>" : in);
-        rc = tool_fail(&t, &err);
+    tool_say(t, 2, "%s: %zu vertices, %zu triangles", in, soup->nverts, soup->ntris);
+    if (lattice_over_limit(soup, p, s->co.max_bytes, &err)) {
+        rc = tool_fail_file(t, &err, in_name);
         goto done;
     }
-    st_progress prog = tool_progress(&t);
-    if (st_pipeline_run(&m, &st, soup, &p, &prog, &err)) {
-        tool_progress_end(&t);
+    st_progress prog = tool_progress(t);
+    if (st_pipeline_run(&m, &st, soup, p, &prog, &err)) {
+        tool_progress_end(t);
         if (!err.file[0])
-            snprintf(err.file, sizeof err.file, "%s", st_path_is_stdio(in) ? "<stdin>" : in);
+            snprintf(err.file, sizeof err.file, "%s", in_name);
         tool_limit_hint(&err, "use fewer --cells or --field-cells, or raise --max-memory");
-        report(&t, &st, p.density_rho > 0);
-        rc = tool_fail(&t, &err);
+        report(t, &st, p->density_rho > 0);
+        rc = tool_fail(t, &err);
         goto done;
     }
-    tool_progress_end(&t);
-    if (p.dry_run) {
-        rc = dry_run_report(&t, soup, &p, &st);
+    tool_progress_end(t);
+    if (p->dry_run) {
+        rc = dry_run_report(t, soup, p, &st);
         goto done;
     }
-    if (p.target_tets)
-        tool_say(&t, 2, "h %.6g for about %zu tets: %zu sculpts, %.2f s", st.h,
-                 p.target_tets, st.sculpts, st.seconds_size);
-    report(&t, &st, p.density_rho > 0);
-    if (st_meta_set(&m->meta, "source", st_path_is_stdio(in) ? "<stdin>" : in) ||
-        st_meta_history_append(&m->meta, t.command_line ? t.command_line : "soupmesh")) {
-        st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
-        rc = tool_fail(&t, &err);
+    if (p->target_tets)
+        tool_say(t, 2, "h %.6g for about %zu tets: %zu sculpts, %.2f s", st.h,
+                 p->target_tets, st.sculpts, st.seconds_size);
+    report(t, &st, p->density_rho > 0);
+    if (st_meta_set(&m->meta, "source", in_name) ||
+        st_meta_history_append(&m->meta, tool_command(t))) {
+        rc = tool_fail_nomem(t, &err);
         goto done;
     }
     /* Where the input vertices lie is worked out before anything is
@@ -423,14 +409,13 @@ int main(int argc, char *argv[])
         et = st_malloc_array(soup->nverts ? soup->nverts : 1, sizeof *et);
         eb = st_malloc_array(soup->nverts ? soup->nverts : 1, 4 * sizeof *eb);
         if (!et || !eb) {
-            st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
-            rc = tool_fail(&t, &err);
+            rc = tool_fail_nomem(t, &err);
             goto done;
         }
         if (st_embed_compute(et, eb, &nout, &first, m, soup, &err) ||
-            (!embed_text &&
+            (!s->embed_text &&
              st_embed_to_tetmesh(&side, soup->xyz, et, eb, soup->nverts, &err))) {
-            rc = tool_fail(&t, &err);
+            rc = tool_fail(t, &err);
             goto done;
         }
     }
@@ -438,52 +423,51 @@ int main(int argc, char *argv[])
      * mesh is saved and renamed into place after it, so a failure on
      * either side leaves neither half-done. */
     if (boundary) {
-        const char *cmd = t.command_line ? t.command_line : "soupmesh";
+        const char *cmd = tool_command(t);
         size_t n = strlen(cmd) + strlen(in) + 64;
         char *comment = malloc(n);
         if (!comment) {
-            st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
-            rc = tool_fail(&t, &err);
+            rc = tool_fail_nomem(t, &err);
             goto done;
         }
         snprintf(comment, n, "souptet soupmesh: the boundary of the mesh; source: %s\n%s",
-                 st_path_is_stdio(in) ? "<stdin>" : in, cmd);
+                 in_name, cmd);
         st_status bs = st_tetmesh_boundary_soup(&bsoup, m, &err);
         if (!bs && !(bs = st_outfile_begin(&bof, boundary, 1, &err)))
-            bs = st_soup_write(bof.fp, bsoup, bfmt, comment, boundary, &err);
+            bs = st_soup_write(bof.fp, bsoup, s->boundary_format, comment, boundary, &err);
         free(comment);
         if (bs) {
-            rc = tool_fail(&t, &err);
+            rc = tool_fail(t, &err);
             goto done;
         }
     }
-    if (st_tetmesh_save(m, out, &fopts, &err)) {
-        rc = tool_fail(&t, &err);
+    if (st_tetmesh_save(m, out, &s->co.tetformat, &err)) {
+        rc = tool_fail(t, &err);
         goto done;
     }
     if (boundary && st_outfile_commit(&bof, &err)) {
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
     if (embed) {
-        if (embed_text
+        if (s->embed_text
                 ? st_embed_write_text(embed, et, eb, soup->nverts, m->ntets,
-                                      st_path_is_stdio(out) ? "<stdout>" : out, in, &err)
+                                      tool_out_name(out), in, &err)
                 : st_tetmesh_save(side, embed, NULL, &err)) {
-            rc = tool_fail(&t, &err);
+            rc = tool_fail(t, &err);
             goto done;
         }
         if (nout)
-            tool_say(&t, 1, "warning: %zu input vertices are in no tet (first: %lld)", nout,
+            tool_say(t, 1, "warning: %zu input vertices are in no tet (first: %lld)", nout,
                      (long long)first);
     }
     const st_pipeline_candidate *b = &st.candidates[st.best];
-    tool_say(&t, 1, "%zu tets, %zu points, dihedral %.2f..%.2f degrees, %s "
+    tool_say(t, 1, "%zu tets, %zu points, dihedral %.2f..%.2f degrees, %s "
              "(%zu vertices outside, %zu triangles crossing), %.2f s",
              b->tets, b->points, b->min_dihedral, b->max_dihedral,
              st.encloses ? "encloses the input" : "DOES NOT enclose the input",
              b->verts_outside, b->tris_crossing, tool_now() - t0);
-    if (t.verbosity >= 2 && p.density_rho <= 0) {
+    if (t->verbosity >= 2 && p->density_rho <= 0) {
         /* both directions, in h and per the input's box diagonal */
         double sb = NAN, lo[3] = {INFINITY, INFINITY, INFINITY},
                hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -496,35 +480,35 @@ int main(int argc, char *argv[])
         double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                            (hi[2] - lo[2]) * (hi[2] - lo[2]));
         if (st_tetstat_surface_to_boundary(&sb, m, soup, &err)) {
-            rc = tool_fail(&t, &err);
+            rc = tool_fail(t, &err);
             goto done;
         }
-        tool_say(&t, 2, "boundary -> input max %.4f h (%.6f diag), input -> boundary max "
+        tool_say(t, 2, "boundary -> input max %.4f h (%.6f diag), input -> boundary max "
                  "%.4f h (%.6f diag); %zu of %zu boundary vertices beyond %.3g h",
                  b->max_distance / st.h, b->max_distance / diag, sb / st.h, sb / diag,
-                 b->beyond_offset, b->boundary_vertices, p.offset_ratio);
+                 b->beyond_offset, b->boundary_vertices, p->offset_ratio);
     }
     rc = TOOL_EXIT_OK;
-    if (!st.encloses && p.density_rho <= 0) {
+    if (!st.encloses && p->density_rho <= 0) {
         /* Level 0: printed even with -q, and the exit status says it. */
-        tool_say(&t, 0, "%s: error: the mesh written to %s does not enclose the input "
+        tool_say(t, 0, "%s: error: the mesh written to %s does not enclose the input "
                  "(%zu vertices outside, %zu triangles crossing; best of %zu candidates); "
-                 "try more --cells or --tries", st_path_is_stdio(in) ? "<stdin>" : in, st_path_is_stdio(out) ? "<stdout>" : out,
+                 "try more --cells or --tries", in_name, tool_out_name(out),
                  b->verts_outside, b->tris_crossing, st.ncandidates);
         rc = TOOL_EXIT_NOT_ENCLOSING;
     }
-    if (p.density_rho <= 0 && !b->converged) {
+    if (p->density_rho <= 0 && !b->converged) {
         /* Cetra's stopping condition (every boundary vertex within
          * R h of the input) is the fit's promise: said at level 0 and in
          * the exit status unless the user settles for less. */
-        tool_say(&t, best_effort ? 1 : 0,
+        tool_say(t, s->best_effort ? 1 : 0,
                  "%s: %s: %zu of %zu boundary vertices stay farther than %.3g h from the "
                  "input, the farthest %.4g h (%.4g); best of %zu candidates%s",
-                 st_path_is_stdio(in) ? "<stdin>" : in, best_effort ? "warning" : "error",
-                 b->beyond_offset, b->boundary_vertices, p.offset_ratio,
+                 in_name, s->best_effort ? "warning" : "error",
+                 b->beyond_offset, b->boundary_vertices, p->offset_ratio,
                  b->max_distance / st.h, b->max_distance, st.ncandidates,
-                 best_effort ? "" : "; try more --tries or --cells, or --offset-best-effort");
-        if (!best_effort && rc == TOOL_EXIT_OK)
+                 s->best_effort ? "" : "; try more --tries or --cells, or --offset-best-effort");
+        if (!s->best_effort && rc == TOOL_EXIT_OK)
             rc = TOOL_EXIT_OFFSET_NOT_MET;
     }
 done:
@@ -536,6 +520,13 @@ done:
     free(st.candidates);
     st_tetmesh_free(m);
     st_soup_free(soup);
-    tool_finish(&t);
     return rc;
+}
+
+static const tool_spec spec = {"soupmesh", usage, ":o:h:qv", longopts, option, check, run};
+
+int main(int argc, char *argv[])
+{
+    soupmesh_settings s = {.pipeline = st_pipeline_params_default()};
+    return tool_main(&spec, argc, argv, &s, &s.co);
 }

@@ -150,163 +150,153 @@ static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_er
     return 0;
 }
 
-enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_FILL_HOLES, OPT_SHELLS, OPT_SIDES, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
+enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT,
+       OPT_SIDES, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
 
-int main(int argc, char *argv[])
+static const struct option longopts[] = {
+    {"band", required_argument, NULL, OPT_BAND},
+    {"rays", required_argument, NULL, OPT_RAYS},
+    {"toggle", required_argument, NULL, OPT_TOGGLE},
+    {"odd", required_argument, NULL, OPT_ODD},
+    {"nested", required_argument, NULL, OPT_NESTED},
+    {"runs", required_argument, NULL, OPT_RUNS},
+    {"cut", required_argument, NULL, OPT_CUT},
+    TOOL_LONG_OPTIONS_PSEUDO,
+    {"sides", required_argument, NULL, OPT_SIDES},
+    {"rule", required_argument, NULL, OPT_RULE},
+    {"surface", required_argument, NULL, OPT_SURFACE},
+    {"refine-band", required_argument, NULL, OPT_REFINE_BAND},
+    {"refine-radius", required_argument, NULL, OPT_REFINE_RADIUS},
+    {"refine-answers", required_argument, NULL, OPT_REFINE_ANSWERS},
+    TOOL_LONG_OPTIONS_OUTPUT,
+    TOOL_LONG_OPTIONS_END};
+
+/* What the command line asks for. */
+typedef struct soupsign_settings {
+    tool_common co;
+    st_sign_params sign;
+    st_sign_refine_params refine;
+    const char *in, *surface;
+    int paper, fill_holes, use_shells, use_sides, no_surface;
+} soupsign_settings;
+
+static int option(tool_ctx *t, int c, const char *arg, void *settings)
 {
-    tool_ctx t;
-    tool_init(&t, "soupsign", argc, argv);
-    tool_common co = tool_common_default();
-    st_sign_params p = st_sign_params_default();
-    const char *out = NULL, *in = NULL, *surface = NULL;
-    st_sign_refine_params rp = st_sign_refine_params_default();
-    int paper = 0, fill_holes = 1, use_shells = 1, use_sides = 1, no_surface = 0;
-    static const struct option opts[] = {
-        {"band", required_argument, NULL, OPT_BAND},
-        {"rays", required_argument, NULL, OPT_RAYS},
-        {"toggle", required_argument, NULL, OPT_TOGGLE},
-        {"odd", required_argument, NULL, OPT_ODD},
-        {"nested", required_argument, NULL, OPT_NESTED},
-        {"runs", required_argument, NULL, OPT_RUNS},
-        {"cut", required_argument, NULL, OPT_CUT},
-        {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
-        {"shells", required_argument, NULL, OPT_SHELLS},
-        {"sides", required_argument, NULL, OPT_SIDES},
-        {"rule", required_argument, NULL, OPT_RULE},
-        {"surface", required_argument, NULL, OPT_SURFACE},
-        {"refine-band", required_argument, NULL, OPT_REFINE_BAND},
-        {"refine-radius", required_argument, NULL, OPT_REFINE_RADIUS},
-        {"refine-answers", required_argument, NULL, OPT_REFINE_ANSWERS},
-        {"output", required_argument, NULL, 'o'},
-        TOOL_LONG_OPTIONS_BASIC,
-        TOOL_LONG_OPTIONS_RESOURCES,
-        {NULL, 0, NULL, 0}};
-    int c;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, ":k:o:qv", opts, NULL)) != -1) {
-        switch (c) {
-        case 'k':
-            if (tool_parse_double(&t, "-k", optarg, 1e-9, 1.0, &p.k))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_BAND:
-            if (tool_parse_double(&t, "--band", optarg, 1e-3, 1e6, &p.band_voxels))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_RAYS:
-            if (strcmp(optarg, "13") == 0)
-                p.rays = 13;
-            else if (strcmp(optarg, "26") == 0)
-                p.rays = 26;
-            else
-                return tool_usage_error(&t, "--rays is 13 or 26, not '%s'", optarg);
-            break;
-        case OPT_TOGGLE:
-            if (strcmp(optarg, "first") == 0)
-                p.toggle = ST_TOGGLE_FIRST;
-            else if (strcmp(optarg, "nearest") == 0)
-                p.toggle = ST_TOGGLE_NEAREST;
-            else if (strcmp(optarg, "crossing") == 0)
-                p.toggle = ST_TOGGLE_CROSSING;
-            else
-                return tool_usage_error(&t, "--toggle is first, nearest or crossing, not '%s'",
-                                        optarg);
-            break;
-        case OPT_ODD:
-            if (strcmp(optarg, "keep") == 0)
-                p.ignore_odd = 0;
-            else if (strcmp(optarg, "ignore") == 0)
-                p.ignore_odd = 1;
-            else
-                return tool_usage_error(&t, "--odd is keep or ignore, not '%s'", optarg);
-            break;
-        case OPT_NESTED:
-            if (strcmp(optarg, "union") == 0)
-                p.nested_union = 1;
-            else if (strcmp(optarg, "parity") == 0)
-                p.nested_union = 0;
-            else
-                return tool_usage_error(&t, "--nested is union or parity, not '%s'", optarg);
-            break;
-        case OPT_RUNS:
-            if (strcmp(optarg, "split") == 0)
-                p.split_runs = 1;
-            else if (strcmp(optarg, "whole") == 0)
-                p.split_runs = 0;
-            else
-                return tool_usage_error(&t, "--runs is split or whole, not '%s'", optarg);
-            break;
-        case OPT_CUT:
-            if (tool_parse_switch(&t, "--cut", optarg, &p.cut))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_FILL_HOLES:
-            if (tool_parse_switch(&t, "--fill-holes", optarg, &fill_holes))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_SHELLS:
-            if (tool_parse_switch(&t, "--shells", optarg, &use_shells))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_SIDES:
-            if (tool_parse_switch(&t, "--sides", optarg, &use_sides))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_RULE:
-            if (st_sign_params_named(&p, optarg))
-                return tool_usage_error(&t, "unknown rule '%s' (paper, parity, default)", optarg);
-            paper = strcmp(optarg, "paper") == 0;
-            break;
-        case OPT_SURFACE:
-            no_surface = strcmp(optarg, "none") == 0;
-            surface = no_surface ? NULL : optarg;
-            break;
-        case OPT_REFINE_RADIUS:
-        case OPT_REFINE_ANSWERS: {
-            size_t v;
-            if (tool_parse_size(&t, c == OPT_REFINE_RADIUS ? "--refine-radius" : "--refine-answers",
-                                optarg, 1, c == OPT_REFINE_RADIUS ? 3 : 124, &v))
-                return TOOL_EXIT_USAGE;
-            if (c == OPT_REFINE_RADIUS)
-                rp.radius = (int)v;
-            else
-                rp.answers = (int)v;
-            break;
-        }
-        case OPT_REFINE_BAND:
-            if (tool_parse_double(&t, "--refine-band", optarg, 1e-3, 8.0, &rp.band_voxels))
-                return TOOL_EXIT_USAGE;
-            break;
-        case 'o':
-            out = optarg;
-            break;
-        default: {
-            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
-            if (rc_opt != TOOL_CONTINUE) {
-                tool_finish(&t);
-                return rc_opt;
-            }
-            break;
-        }
-        }
+    soupsign_settings *s = settings;
+    switch (c) {
+    case 'k':
+        if (tool_parse_double(t, "-k", arg, 1e-9, 1.0, &s->sign.k))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_BAND:
+        if (tool_parse_double(t, "--band", arg, 1e-3, 1e6, &s->sign.band_voxels))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_RAYS:
+        if (strcmp(arg, "13") == 0)
+            s->sign.rays = 13;
+        else if (strcmp(arg, "26") == 0)
+            s->sign.rays = 26;
+        else
+            return tool_usage_error(t, "--rays is 13 or 26, not '%s'", arg);
+        break;
+    case OPT_TOGGLE:
+        if (strcmp(arg, "first") == 0)
+            s->sign.toggle = ST_TOGGLE_FIRST;
+        else if (strcmp(arg, "nearest") == 0)
+            s->sign.toggle = ST_TOGGLE_NEAREST;
+        else if (strcmp(arg, "crossing") == 0)
+            s->sign.toggle = ST_TOGGLE_CROSSING;
+        else
+            return tool_usage_error(t, "--toggle is first, nearest or crossing, not '%s'",
+                                    arg);
+        break;
+    case OPT_ODD:
+        if (strcmp(arg, "keep") == 0)
+            s->sign.ignore_odd = 0;
+        else if (strcmp(arg, "ignore") == 0)
+            s->sign.ignore_odd = 1;
+        else
+            return tool_usage_error(t, "--odd is keep or ignore, not '%s'", arg);
+        break;
+    case OPT_NESTED:
+        if (strcmp(arg, "union") == 0)
+            s->sign.nested_union = 1;
+        else if (strcmp(arg, "parity") == 0)
+            s->sign.nested_union = 0;
+        else
+            return tool_usage_error(t, "--nested is union or parity, not '%s'", arg);
+        break;
+    case OPT_RUNS:
+        if (strcmp(arg, "split") == 0)
+            s->sign.split_runs = 1;
+        else if (strcmp(arg, "whole") == 0)
+            s->sign.split_runs = 0;
+        else
+            return tool_usage_error(t, "--runs is split or whole, not '%s'", arg);
+        break;
+    case OPT_CUT:
+        if (tool_parse_switch(t, "--cut", arg, &s->sign.cut))
+            return TOOL_EXIT_USAGE;
+        break;
+    case TOOL_OPT_FILL_HOLES:
+    case TOOL_OPT_SHELLS:
+        return tool_pseudo_option(t, c, arg, &s->fill_holes, &s->use_shells);
+    case OPT_SIDES:
+        if (tool_parse_switch(t, "--sides", arg, &s->use_sides))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_RULE:
+        if (st_sign_params_named(&s->sign, arg))
+            return tool_usage_error(t, "unknown rule '%s' (paper, parity, default)", arg);
+        s->paper = strcmp(arg, "paper") == 0;
+        break;
+    case OPT_SURFACE:
+        s->no_surface = strcmp(arg, "none") == 0;
+        s->surface = s->no_surface ? NULL : arg;
+        break;
+    case OPT_REFINE_RADIUS:
+    case OPT_REFINE_ANSWERS: {
+        size_t v;
+        if (tool_parse_size(t, c == OPT_REFINE_RADIUS ? "--refine-radius" : "--refine-answers",
+                            arg, 1, c == OPT_REFINE_RADIUS ? 3 : 124, &v))
+            return TOOL_EXIT_USAGE;
+        if (c == OPT_REFINE_RADIUS)
+            s->refine.radius = (int)v;
+        else
+            s->refine.answers = (int)v;
+        break;
     }
-    TOOL_TRY(tool_one_input(&t, argc, argv, "input field", "-", &in));
-    TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO, "no input: give a field or pipe "
-                                  "one in (soupdist mesh.obj | soupsign)"));
-    if (surface)
-        TOOL_TRY(tool_refuse_terminal(&t, surface, STDIN_FILENO, TOOL_TTY_SURFACE));
-    TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, "will not write a binary VDB "
-                                  "stream to a terminal: give -o FILE or pipe it"));
-    TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
-                                st_grid_format_from_path(out) != ST_GRID_FMT_UNKNOWN,
-                                ".vdb or .vti"));
-    if (surface && paper)
-        return tool_usage_error(&t, "--rule paper is the paper's rule exactly: it takes no --surface");
-    if (surface && st_path_is_stdio(surface) && st_path_is_stdio(in))
-        return tool_usage_error(&t, "the field and the surface cannot both come from stdin");
-    TOOL_TRY(tool_output_check(&t, out));
-    tool_set_threads(co.threads);
+    case OPT_REFINE_BAND:
+        if (tool_parse_double(t, "--refine-band", arg, 1e-3, 8.0, &s->refine.band_voxels))
+            return TOOL_EXIT_USAGE;
+        break;
+    }
+    return TOOL_CONTINUE;
+}
 
+static int check(tool_ctx *t, int argc, char *argv[], void *settings)
+{
+    soupsign_settings *s = settings;
+    TOOL_TRY(tool_one_input(t, argc, argv, "input field", "-", &s->in));
+    TOOL_TRY(tool_refuse_terminal(t, s->in, STDIN_FILENO, "no input: give a field or pipe "
+                                  "one in (soupdist mesh.obj | soupsign)"));
+    if (s->surface)
+        TOOL_TRY(tool_refuse_terminal(t, s->surface, STDIN_FILENO, TOOL_TTY_SURFACE));
+    TOOL_TRY(tool_grid_output(t, s->co.out));
+    if (s->surface && s->paper)
+        return tool_usage_error(t, "--rule paper is the paper's rule exactly: it takes no --surface");
+    if (s->surface && st_path_is_stdio(s->surface) && st_path_is_stdio(s->in))
+        return tool_usage_error(t, "the field and the surface cannot both come from stdin");
+    return tool_output_check(t, s->co.out);
+}
+
+static int run(tool_ctx *t, void *settings)
+{
+    const soupsign_settings *s = settings;
+    const char *in = s->in, *surface = s->surface;
+    const st_sign_params *p = &s->sign;
+    tool_set_threads(s->co.threads);
     st_error err;
     st_error_clear(&err);
     st_grid *g = NULL;
@@ -315,20 +305,20 @@ int main(int argc, char *argv[])
     memset(&ps, 0, sizeof ps);
     int rc = TOOL_EXIT_FAIL;
     double t0 = tool_now();
-    if (st_grid_read(&g, in, co.max_bytes, &err)) {
-        rc = tool_fail(&t, &err);
+    if (st_grid_read(&g, in, s->co.max_bytes, &err)) {
+        rc = tool_fail(t, &err);
         goto done;
     }
     double t1 = tool_now();
     if (surface) {
-        if (tool_soup_read(&t, &soup, surface, &err)) {
-            rc = tool_fail(&t, &err);
+        if (tool_soup_read(t, &soup, surface, &err)) {
+            rc = tool_fail(t, &err);
             goto done;
         }
         t1 = tool_now();   /* reading the surface is not signing */
-    } else if (!no_surface && !paper && st_meta_get(&g->meta, "source_path")) {
-        if (recorded_surface(&t, g, &soup, &err)) {
-            rc = tool_fail(&t, &err);
+    } else if (!s->no_surface && !s->paper && st_meta_get(&g->meta, "source_path")) {
+        if (recorded_surface(t, g, &soup, &err)) {
+            rc = tool_fail(t, &err);
             goto done;
         }
         if (soup)
@@ -336,71 +326,77 @@ int main(int argc, char *argv[])
         t1 = tool_now();
     }
     st_pseudo_params pp = st_pseudo_params_default();
-    pp.sign = p;
-    pp.refine = rp;
-    pp.fill_holes = fill_holes;
-    pp.closed_shells = use_shells;
-    pp.sides = use_sides;
-    st_progress prog = tool_progress(&t);
+    pp.sign = *p;
+    pp.refine = s->refine;
+    pp.fill_holes = s->fill_holes;
+    pp.closed_shells = s->use_shells;
+    pp.sides = s->use_sides;
+    st_progress prog = tool_progress(t);
     const double c0 = cpu_now();
     if (st_pseudo_sign(g, soup, &pp, &ps, &prog, &err)) {
-        tool_progress_end(&t);
-        if (!err.file[0])
-            snprintf(err.file, sizeof err.file, "%s",
-                     surface && ps.failed_step && strcmp(ps.failed_step, "vote") != 0 ? surface
-                     : st_path_is_stdio(in) ? "<stdin>" : in);
-        rc = tool_fail(&t, &err);
+        tool_progress_end(t);
+        rc = tool_fail_file(t, &err, surface && ps.failed_step &&
+                                         strcmp(ps.failed_step, "vote") != 0 ? surface
+                                                                             : tool_in_name(in));
         goto done;
     }
     const double cpu_sign = cpu_now() - c0;
-    tool_progress_end(&t);
+    tool_progress_end(t);
     double t2 = tool_now();
-    if (st_meta_history_append(&g->meta, t.command_line ? t.command_line : "soupsign")) {
-        st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
-        rc = tool_fail(&t, &err);
+    if (st_meta_history_append(&g->meta, tool_command(t))) {
+        rc = tool_fail_nomem(t, &err);
         goto done;
     }
-    if (st_grid_write(g, out, &err)) {
-        rc = tool_fail(&t, &err);
+    if (st_grid_write(g, s->co.out, &err)) {
+        rc = tool_fail(t, &err);
         goto done;
     }
     double t3 = tool_now();
     size_t n = st_grid_count(g);
-    tool_say(&t, 2, "grid %zux%zux%zu, rule: %s", g->nx, g->ny, g->nz,
+    tool_say(t, 2, "grid %zux%zux%zu, rule: %s", g->nx, g->ny, g->nz,
              st_meta_get(&g->meta, "sign_rule"));
-    tool_say(&t, 2, "event distance %.6g (%.3g voxels); %zu of %zu voxels inside (%.2f%%)",
+    tool_say(t, 2, "event distance %.6g (%.3g voxels); %zu of %zu voxels inside (%.2f%%)",
              ps.event_distance, ps.event_distance / g->voxel, ps.inside, n,
              100.0 * (double)ps.inside / (double)n);
-    if (surface && fill_holes)
-        tool_say(&t, 2, "holes: %zu of %zu boundary loops capped (%zu too large, %zu too long, "
+    if (surface && s->fill_holes)
+        tool_say(t, 2, "holes: %zu of %zu boundary loops capped (%zu too large, %zu too long, "
                  "%zu edges left open where holes touch unpaired), %.3f s",
                  ps.holes.filled, ps.holes.loops, ps.holes.too_large, ps.holes.too_long,
                  ps.holes.pinched, ps.seconds_holes);
-    if (surface && use_sides && p.cut)
-        tool_say(&t, 2, "sides: %zu orientable regions (%zu turned to the votes, %zu edges "
+    if (surface && s->use_sides && p->cut)
+        tool_say(t, 2, "sides: %zu orientable regions (%zu turned to the votes, %zu edges "
                  "disagreeing), %zu voxels given their side", ps.sides.regions, ps.sides.turned,
                  ps.sides.conflicts, ps.sides.voxels);
-    if (surface && use_sides && p.cut)
-        tool_say(&t, 2, "view: back/front %.3f along (%.3f %.3f %.3f): %s", ps.sides.back_front,
+    if (surface && s->use_sides && p->cut)
+        tool_say(t, 2, "view: back/front %.3f along (%.3f %.3f %.3f): %s", ps.sides.back_front,
                  ps.sides.view[0], ps.sides.view[1], ps.sides.view[2],
                  ps.sides.onesided ? "one-sided" : "not one-sided");
-    if (surface && use_sides && p.cut && ps.sides.onesided)
-        tool_say(&t, 2, "far side mirrored along step (%d %d %d): %zu voxels",
+    if (surface && s->use_sides && p->cut && ps.sides.onesided)
+        tool_say(t, 2, "far side mirrored along step (%d %d %d): %zu voxels",
                  ps.sides.step[0], ps.sides.step[1], ps.sides.step[2], ps.mirrored);
     if (surface)
-        tool_say(&t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
-                 rp.band_voxels, ps.refined, ps.seconds_refine);
-    if (surface && use_shells)
-        tool_say(&t, 2, "closed shells: %zu (%zu triangles in none%s), %zu signs changed, "
+        tool_say(t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
+                 s->refine.band_voxels, ps.refined, ps.seconds_refine);
+    if (surface && s->use_shells)
+        tool_say(t, 2, "closed shells: %zu (%zu triangles in none%s), %zu signs changed, "
                  "%.3f s", ps.shells, ps.shell_open_triangles,
                  ps.shells && !ps.shell_open_triangles ? ": the signs are their solid" : "",
                  ps.shell_changed, ps.seconds_shells);
-    tool_say(&t, 2, "read %.3f s, signs %.3f s (CPU %.3f s, all threads), write %.3f s",
+    tool_say(t, 2, "read %.3f s, signs %.3f s (CPU %.3f s, all threads), write %.3f s",
              t1 - t0, ps.seconds_vote, cpu_sign, t3 - t2);
     rc = TOOL_EXIT_OK;
 done:
     st_grid_free(g);
     st_soup_free(soup);
-    tool_finish(&t);
     return rc;
+}
+
+static const tool_spec spec = {"soupsign", usage, ":k:o:qv", longopts, option, check, run};
+
+int main(int argc, char *argv[])
+{
+    soupsign_settings s = {.sign = st_sign_params_default(),
+                           .refine = st_sign_refine_params_default(), .fill_holes = 1,
+                           .use_shells = 1, .use_sides = 1};
+    return tool_main(&spec, argc, argv, &s, &s.co);
 }

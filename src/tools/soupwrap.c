@@ -74,8 +74,7 @@ static void usage(void)
         ST_WRAP_DEFAULT_MIN_VOLUME, ST_DIST_DEFAULT_CELLS);
 }
 
-enum { OPT_ISO = TOOL_OPT_FIRST, OPT_ADAPT, OPT_SMOOTH, OPT_MINVOL, OPT_CAVITIES, OPT_SURFACE,
-       OPT_FILL_HOLES, OPT_SHELLS };
+enum { OPT_ISO = TOOL_OPT_FIRST, OPT_ADAPT, OPT_SMOOTH, OPT_MINVOL, OPT_CAVITIES, OPT_SURFACE };
 
 /* The history lines of the field plus this command line. Caller frees. */
 static char *history(const st_grid *g, const char *source, const char *cmd)
@@ -91,112 +90,98 @@ static char *history(const st_grid *g, const char *source, const char *cmd)
     return s;
 }
 
-int main(int argc, char *argv[])
-{
-    tool_ctx t;
-    tool_init(&t, "soupwrap", argc, argv);
-    tool_common co = tool_common_default();
-    st_wrap_params p = st_wrap_params_default();
-    st_dist_params dp = st_dist_params_default();
-    size_t smooth = 0;
-    const char *out = NULL, *in = NULL, *surface = NULL;
-    int have_cells = 0, fill_holes = 1, use_shells = 1;
-    static const struct option opts[] = {
-        {"iso", required_argument, NULL, OPT_ISO},
-        {"adaptivity", required_argument, NULL, OPT_ADAPT},
-        {"smooth", required_argument, NULL, OPT_SMOOTH},
-        {"min-volume", required_argument, NULL, OPT_MINVOL},
-        {"keep-cavities", no_argument, NULL, OPT_CAVITIES},
-        {"surface", required_argument, NULL, OPT_SURFACE},
-        {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
-        {"shells", required_argument, NULL, OPT_SHELLS},
-        {"cells", required_argument, NULL, 'r'},
-        {"output", required_argument, NULL, 'o'},
-        TOOL_LONG_OPTIONS_BASIC,
-        TOOL_LONG_OPTIONS_RESOURCES,
-        {NULL, 0, NULL, 0}};
-    int c;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, ":r:o:qv", opts, NULL)) != -1) {
-        switch (c) {
-        case OPT_ISO:
-            if (tool_parse_double(&t, "--iso", optarg, -1e300, 1e300, &p.iso))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_ADAPT:
-            if (tool_parse_double(&t, "--adaptivity", optarg, 0.0, 1.0,
-                                  &p.adaptivity))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_SMOOTH:
-            if (tool_parse_size(&t, "--smooth", optarg, 0, 1000, &smooth))
-                return TOOL_EXIT_USAGE;
-            p.smooth = (int)smooth;
-            break;
-        case OPT_MINVOL:
-            if (tool_parse_double(&t, "--min-volume", optarg, 0.0, 1e300,
-                                  &p.min_volume))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_CAVITIES:
-            p.keep_cavities = 1;
-            break;
-        case OPT_SURFACE:
-            surface = optarg;
-            break;
-        case OPT_FILL_HOLES:
-            if (tool_parse_switch(&t, "--fill-holes", optarg, &fill_holes))
-                return TOOL_EXIT_USAGE;
-            break;
-        case OPT_SHELLS:
-            if (tool_parse_switch(&t, "--shells", optarg, &use_shells))
-                return TOOL_EXIT_USAGE;
-            break;
-        case 'r':
-            if (tool_parse_size(&t, "-r", optarg, 1, 65536, &dp.cells))
-                return TOOL_EXIT_USAGE;
-            have_cells = 1;
-            break;
-        case 'o':
-            out = optarg;
-            break;
-        default: {
-            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
-            if (rc_opt != TOOL_CONTINUE) {
-                tool_finish(&t);
-                return rc_opt;
-            }
-            break;
-        }
-        }
-    }
-    TOOL_TRY(tool_one_input(&t, argc, argv, "input", NULL, &in));
-    if (surface && in)
-        return tool_usage_error(&t, "give a FIELD or --surface INPUT, not "
-                                    "both");
-    if (have_cells && !surface)
-        return tool_usage_error(&t, "-r needs --surface (a field has its "
-                                    "grid already)");
-    if (!surface && !in)
-        in = "-";
-    if (in)
-        TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO, "no input: give a field or pipe "
-                                      "one in (soupdist mesh.obj | soupsign | soupwrap), "
-                                      "or --surface INPUT"));
-    if (surface)
-        TOOL_TRY(tool_refuse_terminal(&t, surface, STDIN_FILENO, TOOL_TTY_SURFACE));
-    st_soup_format fmt = ST_SOUP_OBJ;
-    if (!st_path_is_stdio(out)) {
-        fmt = st_soup_format_from_path(out);
-        if (fmt == ST_SOUP_UNKNOWN)
-            return tool_usage_error(&t, "cannot tell the format of '%s' "
-                                        "(use .obj, .off, .ply or .stl)",
-                                    out);
-    }
-    TOOL_TRY(tool_output_check(&t, out));
-    tool_set_threads(co.threads);
-    dp.max_bytes = co.max_bytes;
+/* What the command line asks for. */
+typedef struct soupwrap_settings {
+    tool_common co;
+    st_wrap_params wrap;
+    st_dist_params dist;
+    const char *in, *surface;
+    st_soup_format format;
+    int have_cells, fill_holes, use_shells;
+} soupwrap_settings;
 
+static const struct option longopts[] = {
+    {"iso", required_argument, NULL, OPT_ISO},
+    {"adaptivity", required_argument, NULL, OPT_ADAPT},
+    {"smooth", required_argument, NULL, OPT_SMOOTH},
+    {"min-volume", required_argument, NULL, OPT_MINVOL},
+    {"keep-cavities", no_argument, NULL, OPT_CAVITIES},
+    {"surface", required_argument, NULL, OPT_SURFACE},
+    TOOL_LONG_OPTIONS_PSEUDO,
+    {"cells", required_argument, NULL, 'r'},
+    TOOL_LONG_OPTIONS_OUTPUT,
+    TOOL_LONG_OPTIONS_END};
+
+static int option(tool_ctx *t, int c, const char *arg, void *settings)
+{
+    soupwrap_settings *s = settings;
+    size_t smooth;
+    switch (c) {
+    case OPT_ISO:
+        if (tool_parse_double(t, "--iso", arg, -1e300, 1e300, &s->wrap.iso))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_ADAPT:
+        if (tool_parse_double(t, "--adaptivity", arg, 0.0, 1.0, &s->wrap.adaptivity))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_SMOOTH:
+        if (tool_parse_size(t, "--smooth", arg, 0, 1000, &smooth))
+            return TOOL_EXIT_USAGE;
+        s->wrap.smooth = (int)smooth;
+        break;
+    case OPT_MINVOL:
+        if (tool_parse_double(t, "--min-volume", arg, 0.0, 1e300, &s->wrap.min_volume))
+            return TOOL_EXIT_USAGE;
+        break;
+    case OPT_CAVITIES:
+        s->wrap.keep_cavities = 1;
+        break;
+    case OPT_SURFACE:
+        s->surface = arg;
+        break;
+    case TOOL_OPT_FILL_HOLES:
+    case TOOL_OPT_SHELLS:
+        return tool_pseudo_option(t, c, arg, &s->fill_holes, &s->use_shells);
+    case 'r':
+        if (tool_parse_size(t, "-r", arg, 1, 65536, &s->dist.cells))
+            return TOOL_EXIT_USAGE;
+        s->have_cells = 1;
+        break;
+    }
+    return TOOL_CONTINUE;
+}
+
+static int check(tool_ctx *t, int argc, char *argv[], void *settings)
+{
+    soupwrap_settings *s = settings;
+    TOOL_TRY(tool_one_input(t, argc, argv, "input", NULL, &s->in));
+    if (s->surface && s->in)
+        return tool_usage_error(t, "give a FIELD or --surface INPUT, not both");
+    if (s->have_cells && !s->surface)
+        return tool_usage_error(t, "-r needs --surface (a field has its grid already)");
+    if (!s->surface && !s->in)
+        s->in = "-";
+    if (s->in)
+        TOOL_TRY(tool_refuse_terminal(t, s->in, STDIN_FILENO, "no input: give a field or "
+                                      "pipe one in (soupdist mesh.obj | soupsign | soupwrap), "
+                                      "or --surface INPUT"));
+    if (s->surface)
+        TOOL_TRY(tool_refuse_terminal(t, s->surface, STDIN_FILENO, TOOL_TTY_SURFACE));
+    if (!st_path_is_stdio(s->co.out))
+        s->format = st_soup_format_from_path(s->co.out);
+    TOOL_TRY(tool_output_format(t, s->co.out, s->format != ST_SOUP_UNKNOWN,
+                                ".obj, .off, .ply or .stl"));
+    TOOL_TRY(tool_output_check(t, s->co.out));
+    s->dist.max_bytes = s->co.max_bytes;
+    return TOOL_CONTINUE;
+}
+
+static int run(tool_ctx *t, void *settings)
+{
+    const soupwrap_settings *s = settings;
+    const char *in = s->in, *surface = s->surface, *out = s->co.out;
+    tool_set_threads(s->co.threads);
     st_error err;
     st_error_clear(&err);
     st_grid *g = NULL;
@@ -205,76 +190,73 @@ int main(int argc, char *argv[])
     st_outfile of = {0};
     int rc = TOOL_EXIT_FAIL;
     const char *src = surface ? surface : in;
-    const char *srcname = st_path_is_stdio(src) ? "<stdin>" : src;
+    const char *srcname = tool_in_name(src);
     double t0 = tool_now(), t_field, t_wrap;
-    st_progress prog = tool_progress(&t);
+    st_progress prog = tool_progress(t);
     if (surface) {
         if (st_soup_read(&input, surface, &err)) {
-            rc = tool_fail(&t, &err);
+            rc = tool_fail(t, &err);
             goto done;
         }
         /* As soupsign --surface (pseudo.h). */
         st_pseudo_params pp = st_pseudo_params_default();
-        pp.fill_holes = fill_holes;
-        pp.closed_shells = use_shells;
-        if (st_pseudo_volume(&g, input, &dp, &pp, NULL, &prog, &err)) {
+        pp.fill_holes = s->fill_holes;
+        pp.closed_shells = s->use_shells;
+        if (st_pseudo_volume(&g, input, &s->dist, &pp, NULL, &prog, &err)) {
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", srcname);
             tool_limit_hint(&err, "use a smaller -r or raise --max-memory");
-            rc = tool_fail(&t, &err);
+            rc = tool_fail(t, &err);
             goto done;
         }
-    } else if (st_grid_read(&g, in, co.max_bytes, &err) ||
+    } else if (st_grid_read(&g, in, s->co.max_bytes, &err) ||
                tool_check_field_finite(g, srcname, &err)) {
         if (st_soup_format_from_path(in) != ST_SOUP_UNKNOWN) snprintf(err.msg + strlen(err.msg), sizeof err.msg - strlen(err.msg), "; a surface? soupwrap --surface %s", in);
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
     t_field = tool_now();
     st_wrap_stats stats;
-    if (st_wrap_field(&res, g, &p, &stats, &prog, &err)) {
-        tool_progress_end(&t);
-        if (!err.file[0])
-            snprintf(err.file, sizeof err.file, "%s", srcname);
-        rc = tool_fail(&t, &err);
+    if (st_wrap_field(&res, g, &s->wrap, &stats, &prog, &err)) {
+        tool_progress_end(t);
+        rc = tool_fail_file(t, &err, srcname);
         goto done;
     }
-    tool_progress_end(&t);
+    tool_progress_end(t);
     t_wrap = tool_now();
     comment = history(g, surface ? srcname : st_meta_get(&g->meta, "source"),
-                      t.command_line ? t.command_line : "soupwrap");
+                      tool_command(t));
     if (!comment) {
-        st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
-        rc = tool_fail(&t, &err);
+        rc = tool_fail_nomem(t, &err);
         goto done;
     }
-    const char *outname = st_path_is_stdio(out) ? "<stdout>" : out;
+    const char *outname = tool_out_name(out);
     if (st_outfile_begin(&of, out, 1, &err) ||
-        st_soup_write(of.fp, res, fmt, comment, outname, &err) ||
+        st_soup_write(of.fp, res, s->format, comment, outname, &err) ||
         st_outfile_commit(&of, &err)) {
         st_outfile_abort(&of);
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
-    tool_say(&t, 2, "grid %zux%zux%zu, voxel %.6g", g->nx, g->ny, g->nz,
+    tool_say(t, 2, "grid %zux%zux%zu, voxel %.6g", g->nx, g->ny, g->nz,
              g->voxel);
     if (stats.edge_voxels_inside)
-        tool_say(&t, 1, "warning: %zu inside voxels on the grid's edge: the "
+        tool_say(t, 1, "warning: %zu inside voxels on the grid's edge: the "
                         "surface is closed there, half a voxel beyond the "
                         "grid", stats.edge_voxels_inside);
-    tool_say(&t, 2, "volumeToMesh: %zu quads, %zu triangles (adaptivity "
+    tool_say(t, 2, "volumeToMesh: %zu quads, %zu triangles (adaptivity "
                     "%.4g); %zu quads re-split",
              stats.quads, stats.triangles, stats.adaptivity_used,
              stats.resplit);
-    tool_say(&t, 2, "pieces: %zu cavities filled, %zu specks dropped",
+    tool_say(t, 2, "pieces: %zu cavities filled, %zu specks dropped",
              stats.cavities_filled, stats.specks_dropped);
-    if (p.smooth)
-        tool_say(&t, 2, "smoothing: %zu steps, %zu moves undone",
+    if (s->wrap.smooth)
+        tool_say(t, 2, "smoothing: %zu steps, %zu moves undone",
                  stats.smooth_steps, stats.smooth_reverted);
-    tool_say(&t, 2, "output: %zu vertices, %zu triangles; closed, manifold, "
+    tool_say(t, 2, "output: %zu vertices, %zu triangles; closed, manifold, "
                     "outward, no degenerate or self-intersecting triangles "
                     "(checked)", res->nverts, res->ntris);
-    tool_say(&t, 2, "%s %.3f s, wrap %.3f s, write %.3f s",
+    tool_say(t, 2, "%s %.3f s, wrap %.3f s, write %.3f s",
              surface ? "distance and signs" : "read", t_field - t0,
              t_wrap - t_field, tool_now() - t_wrap);
     rc = TOOL_EXIT_OK;
@@ -283,6 +265,14 @@ done:
     st_soup_free(res);
     st_soup_free(input);
     st_grid_free(g);
-    tool_finish(&t);
     return rc;
+}
+
+static const tool_spec spec = {"soupwrap", usage, ":r:o:qv", longopts, option, check, run};
+
+int main(int argc, char *argv[])
+{
+    soupwrap_settings s = {.wrap = st_wrap_params_default(), .dist = st_dist_params_default(),
+                           .format = ST_SOUP_OBJ, .fill_holes = 1, .use_shells = 1};
+    return tool_main(&spec, argc, argv, &s, &s.co);
 }

@@ -91,256 +91,247 @@ static void on_iter(void *ctx, const st_fit_iter *it)
              it->min_dihedral, it->max_dihedral, it->moved, it->rejected, it->seconds);
 }
 
-int main(int argc, char *argv[])
-{
-    tool_ctx t;
-    tool_init(&t, "tetsmooth", argc, argv);
-    tool_common co = tool_common_default();
-    st_fair_params fp = st_fair_params_default();
-    st_fit_params gp = st_fit_params_default();
-    size_t n;
-    const char *out = NULL, *in = NULL, *surface = NULL;
-    int mode = 0; /* 1 fair, 2 fit */
-    int fair_only = 0, fit_only = 0, noq = 0;
-    st_tetformat_opts fopts = {0, 0};
-    static const struct option opts[] = {
-        {"fair", no_argument, NULL, OPT_FAIR},
-        {"fit", no_argument, NULL, OPT_FIT},
-        {"iters", required_argument, NULL, OPT_ITERS},
-        {"lambda", required_argument, NULL, OPT_LAMBDA},
-        {"min-angle", required_argument, NULL, OPT_MINANGLE},
-        {"interior-quality", no_argument, NULL, OPT_INTQ},
-        {"surface", required_argument, NULL, OPT_SURFACE},
-        {"offset", required_argument, NULL, OPT_OFFSET},
-        {"cell-width", required_argument, NULL, OPT_CELL},
-        {"step", required_argument, NULL, OPT_STEP},
-        {"max-iters", required_argument, NULL, OPT_MAXIT},
-        {"quality-rounds", required_argument, NULL, OPT_QROUNDS},
-        {"no-quality", no_argument, NULL, OPT_NOQ},
-        {"output", required_argument, NULL, 'o'},
-        TOOL_LONG_OPTIONS_TETFORMAT,
-        TOOL_LONG_OPTIONS_BASIC,
-        TOOL_LONG_OPTIONS_RESOURCES,
-        {NULL, 0, NULL, 0}};
-    int c;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, ":o:qv", opts, NULL)) != -1) {
-        switch (c) {
-        case OPT_FAIR:
-        case OPT_FIT:
-            if (mode && mode != (c == OPT_FAIR ? 1 : 2))
-                return tool_usage_error(&t, "--fair and --fit exclude each other");
-            mode = c == OPT_FAIR ? 1 : 2;
-            break;
-        case OPT_ITERS:
-            if (tool_parse_size(&t, "--iters", optarg, 0, 10000, &n))
-                return TOOL_EXIT_USAGE;
-            fp.iters = (int)n;
-            fair_only = 1;
-            break;
-        case OPT_LAMBDA:
-            if (tool_parse_double(&t, "--lambda", optarg, 0.0, 1e6, &fp.lambda_dt))
-                return TOOL_EXIT_USAGE;
-            fair_only = 1;
-            break;
-        case OPT_MINANGLE:
-            if (tool_parse_double(&t, "--min-angle", optarg, 0.0, 59.0, &fp.min_angle))
-                return TOOL_EXIT_USAGE;
-            fair_only = 1;
-            break;
-        case OPT_SURFACE:
-            surface = optarg;
-            fit_only = 1;
-            break;
-        case OPT_OFFSET:
-            if (tool_parse_double(&t, "--offset", optarg, 1e-6, 1e6, &gp.offset_ratio))
-                return TOOL_EXIT_USAGE;
-            fit_only = 1;
-            break;
-        case OPT_CELL:
-            if (tool_parse_double(&t, "--cell-width", optarg, 1e-300, 1e300, &gp.cell_width))
-                return TOOL_EXIT_USAGE;
-            fit_only = 1;
-            break;
-        case OPT_STEP:
-            if (tool_parse_double(&t, "--step", optarg, 1e-6, 1.0, &gp.step))
-                return TOOL_EXIT_USAGE;
-            fit_only = 1;
-            break;
-        case OPT_MAXIT:
-            if (tool_parse_size(&t, "--max-iters", optarg, 0, 1000000, &n))
-                return TOOL_EXIT_USAGE;
-            gp.max_iters = (int)n;
-            fit_only = 1;
-            break;
-        case OPT_QROUNDS:
-            if (tool_parse_size(&t, "--quality-rounds", optarg, 0, 1000000, &n))
-                return TOOL_EXIT_USAGE;
-            gp.quality_rounds = (int)n;
-            fp.quality_rounds = (int)n;
-            break;
-        case OPT_INTQ:
-            fp.boundary_quality = 0;
-            fair_only = 1;
-            break;
-        case OPT_NOQ:
-            gp.quality = 0;
-            fp.quality_rounds = 0;
-            noq = 1;
-            break;
-        case 'o':
-            out = optarg;
-            break;
-        case TOOL_OPT_MSH_VERSION:
-        case TOOL_OPT_MSH_BINARY:
-            if (tool_tetformat_option(&t, c, optarg, &fopts))
-                return TOOL_EXIT_USAGE;
-            break;
-        default: {
-            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
-            if (rc_opt != TOOL_CONTINUE) {
-                tool_finish(&t);
-                return rc_opt;
-            }
-            break;
-        }
-        }
-    }
-    if (!mode)
-        return tool_usage_error(&t, "say what to do: --fair or --fit --surface S");
-    if (mode == 1 && fit_only)
-        return tool_usage_error(&t, "--surface, --offset, --cell-width, --step and --max-iters "
-                                    "go with --fit");
-    if (mode == 2 && fair_only)
-        return tool_usage_error(&t, "--iters, --lambda, --min-angle and --interior-quality go with --fair");
-    if (noq)
-        fp.quality_rounds = 0;   /* whatever the order of the options */
-    if (mode == 2 && !surface)
-        return tool_usage_error(&t, "--fit needs --surface S (the surface to enclose)");
-    TOOL_TRY(tool_one_input(&t, argc, argv, "input mesh", "-", &in));
-    TOOL_TRY(tool_refuse_terminal(&t, in, STDIN_FILENO, "no input: give a mesh or pipe one "
-                                  "in (latticetet ... | tetsmooth ...)"));
-    if (surface)
-        TOOL_TRY(tool_refuse_terminal(&t, surface, STDIN_FILENO, TOOL_TTY_SURFACE));
-    TOOL_TRY(tool_output_format(&t, out, st_path_is_stdio(out) ||
-                                st_tetformat_from_path(out) != ST_TETFORMAT_NONE,
-                                ".vtu, .msh, .node, .ele or .mesh"));
-    TOOL_TRY(tool_refuse_terminal(&t, out, STDOUT_FILENO, "will not write a binary mesh to "
-                                  "a terminal: give -o FILE or pipe it"));
-    TOOL_TRY(tool_output_check(&t, out));
-    tool_set_threads(co.threads);
+/* What the command line asks for. */
+typedef struct tetsmooth_settings {
+    tool_common co;
+    st_fair_params fair;
+    st_fit_params fit;
+    const char *in, *surface;
+    int mode; /* 1 fair, 2 fit */
+    int fair_only, fit_only, noq;
+} tetsmooth_settings;
 
+static const struct option longopts[] = {
+    {"fair", no_argument, NULL, OPT_FAIR},
+    {"fit", no_argument, NULL, OPT_FIT},
+    {"iters", required_argument, NULL, OPT_ITERS},
+    {"lambda", required_argument, NULL, OPT_LAMBDA},
+    {"min-angle", required_argument, NULL, OPT_MINANGLE},
+    {"interior-quality", no_argument, NULL, OPT_INTQ},
+    {"surface", required_argument, NULL, OPT_SURFACE},
+    {"offset", required_argument, NULL, OPT_OFFSET},
+    {"cell-width", required_argument, NULL, OPT_CELL},
+    {"step", required_argument, NULL, OPT_STEP},
+    {"max-iters", required_argument, NULL, OPT_MAXIT},
+    {"quality-rounds", required_argument, NULL, OPT_QROUNDS},
+    {"no-quality", no_argument, NULL, OPT_NOQ},
+    TOOL_LONG_OPTIONS_OUTPUT,
+    TOOL_LONG_OPTIONS_TETFORMAT,
+    TOOL_LONG_OPTIONS_END};
+
+static int option(tool_ctx *t, int c, const char *arg, void *settings)
+{
+    tetsmooth_settings *s = settings;
+    size_t n;
+    switch (c) {
+    case OPT_FAIR:
+    case OPT_FIT:
+        if (s->mode && s->mode != (c == OPT_FAIR ? 1 : 2))
+            return tool_usage_error(t, "--fair and --fit exclude each other");
+        s->mode = c == OPT_FAIR ? 1 : 2;
+        break;
+    case OPT_ITERS:
+        if (tool_parse_size(t, "--iters", arg, 0, 10000, &n))
+            return TOOL_EXIT_USAGE;
+        s->fair.iters = (int)n;
+        s->fair_only = 1;
+        break;
+    case OPT_LAMBDA:
+        if (tool_parse_double(t, "--lambda", arg, 0.0, 1e6, &s->fair.lambda_dt))
+            return TOOL_EXIT_USAGE;
+        s->fair_only = 1;
+        break;
+    case OPT_MINANGLE:
+        if (tool_parse_double(t, "--min-angle", arg, 0.0, 59.0, &s->fair.min_angle))
+            return TOOL_EXIT_USAGE;
+        s->fair_only = 1;
+        break;
+    case OPT_SURFACE:
+        s->surface = arg;
+        s->fit_only = 1;
+        break;
+    case OPT_OFFSET:
+        if (tool_parse_double(t, "--offset", arg, 1e-6, 1e6, &s->fit.offset_ratio))
+            return TOOL_EXIT_USAGE;
+        s->fit_only = 1;
+        break;
+    case OPT_CELL:
+        if (tool_parse_double(t, "--cell-width", arg, 1e-300, 1e300, &s->fit.cell_width))
+            return TOOL_EXIT_USAGE;
+        s->fit_only = 1;
+        break;
+    case OPT_STEP:
+        if (tool_parse_double(t, "--step", arg, 1e-6, 1.0, &s->fit.step))
+            return TOOL_EXIT_USAGE;
+        s->fit_only = 1;
+        break;
+    case OPT_MAXIT:
+        if (tool_parse_size(t, "--max-iters", arg, 0, 1000000, &n))
+            return TOOL_EXIT_USAGE;
+        s->fit.max_iters = (int)n;
+        s->fit_only = 1;
+        break;
+    case OPT_QROUNDS:
+        if (tool_parse_size(t, "--quality-rounds", arg, 0, 1000000, &n))
+            return TOOL_EXIT_USAGE;
+        s->fit.quality_rounds = (int)n;
+        s->fair.quality_rounds = (int)n;
+        break;
+    case OPT_INTQ:
+        s->fair.boundary_quality = 0;
+        s->fair_only = 1;
+        break;
+    case OPT_NOQ:
+        s->fit.quality = 0;
+        s->fair.quality_rounds = 0;
+        s->noq = 1;
+        break;
+    }
+    return TOOL_CONTINUE;
+}
+
+static int check(tool_ctx *t, int argc, char *argv[], void *settings)
+{
+    tetsmooth_settings *s = settings;
+    if (!s->mode)
+        return tool_usage_error(t, "say what to do: --fair or --fit --surface S");
+    if (s->mode == 1 && s->fit_only)
+        return tool_usage_error(t, "--surface, --offset, --cell-width, --step and --max-iters "
+                                   "go with --fit");
+    if (s->mode == 2 && s->fair_only)
+        return tool_usage_error(t, "--iters, --lambda, --min-angle and --interior-quality go with --fair");
+    if (s->noq)
+        s->fair.quality_rounds = 0;   /* whatever the order of the options */
+    if (s->mode == 2 && !s->surface)
+        return tool_usage_error(t, "--fit needs --surface S (the surface to enclose)");
+    TOOL_TRY(tool_one_input(t, argc, argv, "input mesh", "-", &s->in));
+    TOOL_TRY(tool_refuse_terminal(t, s->in, STDIN_FILENO, "no input: give a mesh or pipe one "
+                                  "in (latticetet ... | tetsmooth ...)"));
+    if (s->surface)
+        TOOL_TRY(tool_refuse_terminal(t, s->surface, STDIN_FILENO, TOOL_TTY_SURFACE));
+    TOOL_TRY(tool_tetmesh_output(t, s->co.out, "will not write a binary mesh to a "
+                                 "terminal: give -o FILE or pipe it"));
+    return tool_output_check(t, s->co.out);
+}
+
+static int run(tool_ctx *t, void *settings)
+{
+    tetsmooth_settings *s = settings;
+    const char *in = s->in, *out = s->co.out, *surface = s->surface;
+    tool_set_threads(s->co.threads);
     st_error err;
     st_error_clear(&err);
     st_tetmesh *m = NULL;
-    st_soup *s = NULL;
+    st_soup *soup = NULL;
     st_bvh *bvh = NULL;
     int rc = TOOL_EXIT_FAIL;
     int not_enclosing = 0;
     st_fit_stats fst;
     memset(&fst, 0, sizeof fst);
-    const char *inname = st_path_is_stdio(in) ? "<stdin>" : in;
+    const char *inname = tool_in_name(in);
     double t0 = tool_now();
-    if (st_tetmesh_read(&m, in, co.max_bytes, &err)) {
+    if (st_tetmesh_read(&m, in, s->co.max_bytes, &err)) {
         tool_limit_hint(&err, "raise --max-memory");
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
-    tool_say(&t, 2, "%s: %zu points, %zu tets (read in %.3f s)", inname, m->npoints, m->ntets,
+    tool_say(t, 2, "%s: %zu points, %zu tets (read in %.3f s)", inname, m->npoints, m->ntets,
              tool_now() - t0);
-    st_progress prog = tool_progress(&t);
+    st_progress prog = tool_progress(t);
     char param[256];
-    if (mode == 1) {
+    if (s->mode == 1) {
         st_fair_stats st;
-        st_status s1 = st_fair(m, &fp, &st, &prog, &err);
-        tool_progress_end(&t);
+        st_status s1 = st_fair(m, &s->fair, &st, &prog, &err);
+        tool_progress_end(t);
         if (s1) {
-            if (!err.file[0])
-                snprintf(err.file, sizeof err.file, "%s", inname);
-            rc = tool_fail(&t, &err);
+            rc = tool_fail_file(t, &err, inname);
             goto done;
         }
-        tool_say(&t, 2, "fair: %d steps, volume %.6g -> %.6g (%+.4f%%), %zu moves, "
+        tool_say(t, 2, "fair: %d steps, volume %.6g -> %.6g (%+.4f%%), %zu moves, "
                         "%zu back-offs, %zu blocked, %.3f s",
                  st.iters, st.volume_before, st.volume_after,
                  100.0 * (st.volume_after / st.volume_before - 1.0), st.moves, st.backoffs,
                  st.stuck, st.seconds);
-        tool_say(&t, 2, "dihedral: input %.2f..%.2f, after fairing %.2f..%.2f, after quality "
+        tool_say(t, 2, "dihedral: input %.2f..%.2f, after fairing %.2f..%.2f, after quality "
                         "%.2f..%.2f (%zu moves)",
                  st.min_dihedral_before, st.max_dihedral_before, st.min_dihedral_fair,
                  st.max_dihedral_fair, st.min_dihedral_after, st.max_dihedral_after,
                  st.quality_moves);
         snprintf(param, sizeof param, "fair iters=%d lambda_dt=%.6g min_angle=%.6g quality_rounds=%d",
-                 fp.iters, fp.lambda_dt, fp.min_angle, fp.quality_rounds);
+                 s->fair.iters, s->fair.lambda_dt, s->fair.min_angle, s->fair.quality_rounds);
     } else {
-        if (tool_soup_read(&t, &s, surface, &err) || st_bvh_build(&bvh, s, &err)) {
-            rc = tool_fail(&t, &err);
+        if (tool_soup_read(t, &soup, surface, &err) || st_bvh_build(&bvh, soup, &err)) {
+            rc = tool_fail(t, &err);
             goto done;
         }
-        iter_ctx ic = {&t};
-        if (t.verbosity >= 2) {
-            gp.on_iter = on_iter;
-            gp.on_iter_ctx = &ic;
+        iter_ctx ic = {t};
+        if (t->verbosity >= 2) {
+            s->fit.on_iter = on_iter;
+            s->fit.on_iter_ctx = &ic;
         }
         st_fit_stats st;
-        st_status s2 = st_fit(m, s, bvh, &gp, &st, &prog, &err);
-        tool_progress_end(&t);
+        st_status s2 = st_fit(m, soup, bvh, &s->fit, &st, &prog, &err);
+        tool_progress_end(t);
         if (s2) {
-            if (!err.file[0])
-                snprintf(err.file, sizeof err.file, "%s", inname);
-            rc = tool_fail(&t, &err);
+            rc = tool_fail_file(t, &err, inname);
             goto done;
         }
-        tool_say(&t, 2, "fit: h %.6g, d_offset %.6g, %d iterations, %zu moves, %zu halvings, "
+        tool_say(t, 2, "fit: h %.6g, d_offset %.6g, %d iterations, %zu moves, %zu halvings, "
                         "%zu skipped, %.3f s",
                  st.h, st.d_offset, st.iters, st.moves, st.rejected, st.skipped, st.seconds_fit);
-        tool_say(&t, 2, "dihedral: input %.2f..%.2f, after fit %.2f..%.2f, after quality "
+        tool_say(t, 2, "dihedral: input %.2f..%.2f, after fit %.2f..%.2f, after quality "
                         "%.2f..%.2f (%d rounds, %zu moves, %.3f s)",
                  st.min_dihedral_before, st.max_dihedral_before, st.min_dihedral_fit,
                  st.max_dihedral_fit, st.min_dihedral_after, st.max_dihedral_after,
                  st.quality_rounds, st.quality_moves, st.seconds_quality);
-        tool_say(&t, 2, "enclosure: S vertices outside %zu -> %zu, S triangles crossing "
+        tool_say(t, 2, "enclosure: S vertices outside %zu -> %zu, S triangles crossing "
                         "%zu -> %zu",
                  st.outside_before, st.outside_after, st.crossing_before, st.crossing_after);
-        tool_say(&t, 2, "boundary: %zu of %zu vertices within %.6g of S; distance mean %.4g, "
+        tool_say(t, 2, "boundary: %zu of %zu vertices within %.6g of S; distance mean %.4g, "
                         "max %.4g",
                  st.within_offset, st.boundary_vertices, st.d_offset, st.mean_distance,
                  st.max_distance);
         if (st.beyond_offset)
-            tool_say(&t, 1, "%zu of %zu boundary vertices could not get within %.4g of the "
+            tool_say(t, 1, "%zu of %zu boundary vertices could not get within %.4g of the "
                             "surface (up to %.4g away: thin gaps or blocked moves)",
                      st.beyond_offset, st.boundary_vertices, st.d_offset, st.max_distance);
         not_enclosing = st.outside_after || st.crossing_after;
         fst = st;
         snprintf(param, sizeof param, "fit offset=%.6g h=%.6g step=%.6g quality=%d "
                  "converged=%d beyond_offset=%zu",
-                 gp.offset_ratio, st.h, gp.step, gp.quality, st.converged, st.beyond_offset);
+                 s->fit.offset_ratio, st.h, s->fit.step, s->fit.quality, st.converged, st.beyond_offset);
     }
     if (st_meta_set(&m->meta, "tetsmooth", param) ||
-        st_meta_history_append(&m->meta, t.command_line ? t.command_line : "tetsmooth")) {
-        st_error_set(&err, ST_ENOMEM, NULL, 0, "out of memory");
-        rc = tool_fail(&t, &err);
+        st_meta_history_append(&m->meta, tool_command(t))) {
+        rc = tool_fail_nomem(t, &err);
         goto done;
     }
-    if (st_tetmesh_save(m, out, &fopts, &err)) {
-        rc = tool_fail(&t, &err);
+    if (st_tetmesh_save(m, out, &s->co.tetformat, &err)) {
+        rc = tool_fail(t, &err);
         goto done;
     }
-    tool_say(&t, 2, "total %.3f s", tool_now() - t0);
+    tool_say(t, 2, "total %.3f s", tool_now() - t0);
     rc = TOOL_EXIT_OK;
     if (not_enclosing) {
         /* Level 0: printed even with -q, and the exit status says it. */
-        tool_say(&t, 0, "%s: error: the mesh written to %s does not enclose %s: %zu of its "
+        tool_say(t, 0, "%s: error: the mesh written to %s does not enclose %s: %zu of its "
                         "vertices outside, %zu triangles crossing the boundary (as on input: "
                         "%zu, %zu)",
-                 inname, st_path_is_stdio(out) ? "<stdout>" : out, surface, fst.outside_after,
+                 inname, tool_out_name(out), surface, fst.outside_after,
                  fst.crossing_after, fst.outside_before, fst.crossing_before);
         rc = TOOL_EXIT_NOT_ENCLOSING;
     }
 done:
     st_bvh_free(bvh);
-    st_soup_free(s);
+    st_soup_free(soup);
     st_tetmesh_free(m);
-    tool_finish(&t);
     return rc;
+}
+
+static const tool_spec spec = {"tetsmooth", usage, ":o:qv", longopts, option, check, run};
+
+int main(int argc, char *argv[])
+{
+    tetsmooth_settings s = {.fair = st_fair_params_default(), .fit = st_fit_params_default()};
+    return tool_main(&spec, argc, argv, &s, &s.co);
 }

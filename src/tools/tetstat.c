@@ -281,177 +281,167 @@ static void print_table(FILE *f, const char *name, const char *sname,
 
 enum { OPT_JSON = TOOL_OPT_FIRST, OPT_OFFSET };
 
-int main(int argc, char *argv[])
-{
-    tool_ctx t;
-    tool_init(&t, "tetstat", argc, argv);
-    tool_common co = tool_common_default();
-    int json = 0;
-    double offset = 0.0;   /* 0: the mesh's meta "offset_ratio" */
-        const char *surface = NULL, *field = NULL;
-    static const struct option opts[] = {
-        {"surface", required_argument, NULL, 'S'},
-        {"field", required_argument, NULL, 'F'},
-        {"json", no_argument, NULL, OPT_JSON},
-        {"offset", required_argument, NULL, OPT_OFFSET},
-        TOOL_LONG_OPTIONS_BASIC,
-        TOOL_LONG_OPTIONS_RESOURCES,
-        {NULL, 0, NULL, 0}};
-    int c;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, ":S:F:qv", opts, NULL)) != -1) {
-        switch (c) {
-        case 'S':
-            surface = optarg;
-            break;
-        case 'F':
-            field = optarg;
-            break;
-        case OPT_JSON:
-            json = 1;
-            break;
-        case OPT_OFFSET:
-            if (tool_parse_double(&t, "--offset", optarg, 1e-3, 10.0, &offset)) {
-                tool_finish(&t);
-                return TOOL_EXIT_USAGE;
-            }
-            break;
-        default: {
-            int rc_opt = tool_common_option(&t, c, argv, usage, &co);
-            if (rc_opt != TOOL_CONTINUE) {
-                tool_finish(&t);
-                return rc_opt;
-            }
-            break;
-        }
-        }
-    }
-    if (argc - optind > 1) {
-        tool_finish(&t);
-        return tool_usage_error(&t, "one mesh at a time (got %d)",
-                                argc - optind);
-    }
-    if (offset > 0.0 && !surface) {
-        tool_finish(&t);
-        return tool_usage_error(&t, "--offset needs --surface");
-    }
-    const char *in = optind < argc ? argv[optind] : "-";
-    const char *name = strcmp(in, "-") == 0 ? "<stdin>" : in;
-    int nstdin = (strcmp(in, "-") == 0) + (surface && !strcmp(surface, "-")) +
-                 (field && !strcmp(field, "-"));
-    if (nstdin > 1) {
-        tool_finish(&t);
-        return tool_usage_error(&t, "standard input ('-') given %d times",
-                                nstdin);
-    }
-    if (nstdin && isatty(STDIN_FILENO)) {
-        tool_finish(&t);
-        return tool_usage_error(&t, "will not read from a terminal: give a "
-                                    "file or pipe one");
-    }
-    tool_set_threads(co.threads);
+/* What the command line asks for. */
+typedef struct tetstat_settings {
+    tool_common co;
+    int json;
+    double offset;   /* 0: the mesh's meta "offset_ratio" */
+    const char *in, *surface, *field;
+} tetstat_settings;
 
+static const struct option longopts[] = {
+    {"surface", required_argument, NULL, 'S'},
+    {"field", required_argument, NULL, 'F'},
+    {"json", no_argument, NULL, OPT_JSON},
+    {"offset", required_argument, NULL, OPT_OFFSET},
+    TOOL_LONG_OPTIONS_END};
+
+static int option(tool_ctx *t, int c, const char *arg, void *settings)
+{
+    tetstat_settings *s = settings;
+    switch (c) {
+    case 'S':
+        s->surface = arg;
+        break;
+    case 'F':
+        s->field = arg;
+        break;
+    case OPT_JSON:
+        s->json = 1;
+        break;
+    case OPT_OFFSET:
+        if (tool_parse_double(t, "--offset", arg, 1e-3, 10.0, &s->offset))
+            return TOOL_EXIT_USAGE;
+        break;
+    }
+    return TOOL_CONTINUE;
+}
+
+static int check(tool_ctx *t, int argc, char *argv[], void *settings)
+{
+    tetstat_settings *s = settings;
+    if (argc - optind > 1)
+        return tool_usage_error(t, "one mesh at a time (got %d)", argc - optind);
+    if (s->offset > 0.0 && !s->surface)
+        return tool_usage_error(t, "--offset needs --surface");
+    s->in = optind < argc ? argv[optind] : "-";
+    const char *inputs[] = {s->in, s->surface, s->field};
+    return tool_stdin_once(t, inputs, 3, "will not read from a terminal: give a file or "
+                                         "pipe one");
+}
+
+static int run(tool_ctx *t, void *settings)
+{
+    const tetstat_settings *s = settings;
+    const char *in = s->in, *surface = s->surface, *field = s->field;
+    const char *name = tool_in_name(in);
+    tool_set_threads(s->co.threads);
     st_error err;
     st_error_clear(&err);
     st_tetmesh *m = NULL;
-    st_soup *s = NULL;
+    st_soup *soup = NULL;
     st_grid *g = NULL;
     st_tetstat r;
     int rc = TOOL_EXIT_FAIL;
     double t0 = tool_now();
     /* Read every input first: a bad one gives no half report. */
-    if (st_tetmesh_read(&m, in, co.max_bytes, &err)) {
+    if (st_tetmesh_read(&m, in, s->co.max_bytes, &err)) {
         tool_limit_hint(&err, "raise --max-memory");
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
-    if (surface && tool_soup_read(&t, &s, surface, &err)) {
-        rc = tool_fail(&t, &err);
+    if (surface && tool_soup_read(t, &soup, surface, &err)) {
+        rc = tool_fail(t, &err);
         goto done;
     }
-    if (field && st_grid_read(&g, field, co.max_bytes, &err)) {
-        rc = tool_fail(&t, &err);
+    if (field && st_grid_read(&g, field, s->co.max_bytes, &err)) {
+        rc = tool_fail(t, &err);
         goto done;
     }
-    if (g && tool_check_field_finite(g, strcmp(field, "-") ? field : "<stdin>",
+    if (g && tool_check_field_finite(g, tool_in_name(field),
                                      &err)) {
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
     /* The IoU is with the negative voxels: an unsigned field has none,
      * and a report of 0 would look like a finding. (A foreign field of
      * unknown kind is taken as signed.) */
     if (g && g->kind == ST_GRID_DISTANCE) {
-        st_error_set(&err, ST_EINPUT, strcmp(field, "-") ? field : "<stdin>",
+        st_error_set(&err, ST_EINPUT, tool_in_name(field),
                      0, "the field is %s, not signed (run soupsign first)",
                      st_grid_kind_name(g->kind));
-        rc = tool_fail(&t, &err);
+        rc = tool_fail(t, &err);
         goto done;
     }
     double t1 = tool_now();
     if (st_tetstat_mesh(&r, m, &err))
         goto failed;
-    if (offset > 0.0)
-        r.offset_ratio = offset;
+    if (s->offset > 0.0)
+        r.offset_ratio = s->offset;
     double t2 = tool_now();
-    if (s && st_tetstat_surface(&r, m, s, &err))
+    if (soup && st_tetstat_surface(&r, m, soup, &err))
         goto failed;
     double t3 = tool_now();
     if (g && st_tetstat_field(&r, m, g, &err))
         goto failed;
     double t4 = tool_now();
-    tool_say(&t, 2, "read %.3f s, mesh %.3f s, surface %.3f s, field %.3f s",
+    tool_say(t, 2, "read %.3f s, mesh %.3f s, surface %.3f s, field %.3f s",
              t1 - t0, t2 - t1, t3 - t2, t4 - t3);
 
-    const char *sname = surface && strcmp(surface, "-") ? surface : "<stdin>";
-    const char *fname = field && strcmp(field, "-") ? field : "<stdin>";
-    if (json)
+    const char *sname = surface ? tool_in_name(surface) : "<stdin>";
+    const char *fname = field ? tool_in_name(field) : "<stdin>";
+    if (s->json)
         print_json(stdout, name, sname, fname, &r);
     else
         print_table(stdout, name, sname, fname, &r);
-    if (tool_flush_stdout(&t)) {
+    if (tool_flush_stdout(t)) {
         rc = TOOL_EXIT_FAIL;
         goto done;
     }
     /* The report is the result; what is wrong with the mesh is also said
      * where a script's user sees it. */
     if (r.inverted)
-        tool_say(&t, 1, "%s: warning: %zu inverted tet%s", name, r.inverted,
+        tool_say(t, 1, "%s: warning: %zu inverted tet%s", name, r.inverted,
                  r.inverted == 1 ? "" : "s");
     if (r.degenerate)
-        tool_say(&t, 1, "%s: warning: %zu degenerate (flat) tet%s", name,
+        tool_say(t, 1, "%s: warning: %zu degenerate (flat) tet%s", name,
                  r.degenerate, r.degenerate == 1 ? "" : "s");
     if (r.nonmanifold_faces)
-        tool_say(&t, 1, "%s: warning: not conforming: %zu faces shared by "
+        tool_say(t, 1, "%s: warning: not conforming: %zu faces shared by "
                  "more than two tets", name, r.nonmanifold_faces);
     if (r.has_surface && r.has_enclosure && !r.encloses &&
         !strcmp(enclosure_word(&r), "unverified"))
-        tool_say(&t, 1, "%s: warning: enclosure of %s unverified: no vertex outside and "
+        tool_say(t, 1, "%s: warning: enclosure of %s unverified: no vertex outside and "
                  "no triangle crossing, but the mesh has inverted or flat tets or is not "
                  "conforming", name, sname);
     else if (r.has_surface && r.has_enclosure && !r.encloses)
-        tool_say(&t, 1,
+        tool_say(t, 1,
                  "%s: warning: does not enclose %s: %zu of %zu vertices "
                  "outside, %zu triangles crossing the boundary",
                  name, sname, r.surface_vertices - r.vertices_inside,
                  r.surface_vertices, r.crossing_triangles);
-    if (offset > 0.0 && !r.has_h)
-        tool_say(&t, 1, "%s: warning: no cell width h in the mesh (meta \"h\"): "
+    if (s->offset > 0.0 && !r.has_h)
+        tool_say(t, 1, "%s: warning: no cell width h in the mesh (meta \"h\"): "
                  "--offset not reported", name);
     if (r.has_surface && r.has_offset && r.beyond_offset)
-        tool_say(&t, 1, "%s: warning: %zu boundary vertices farther than %.3g h from %s "
+        tool_say(t, 1, "%s: warning: %zu boundary vertices farther than %.3g h from %s "
                  "(up to %.4g h)", name, r.beyond_offset, r.offset_ratio, sname,
                  r.dist_max / r.h);
     rc = TOOL_EXIT_OK;
     goto done;
 failed:
-    if (!err.file[0])
-        snprintf(err.file, sizeof err.file, "%s", name);
-    rc = tool_fail(&t, &err);
+    rc = tool_fail_file(t, &err, name);
 done:
     st_tetmesh_free(m);
-    st_soup_free(s);
+    st_soup_free(soup);
     st_grid_free(g);
-    tool_finish(&t);
     return rc;
+}
+
+static const tool_spec spec = {"tetstat", usage, ":S:F:qv", longopts, option, check, run};
+
+int main(int argc, char *argv[])
+{
+    tetstat_settings s = {.offset = 0.0};   /* 0: the mesh's offset_ratio */
+    return tool_main(&spec, argc, argv, &s, &s.co);
 }
