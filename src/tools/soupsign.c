@@ -73,6 +73,8 @@ static void usage(void)
 "                       boundary edges, by the triangulation of least area,\n"
 "                       when small beside the surface around them) before\n"
 "                       voting (default on)\n"
+"      --caps area|bend  with --fill-holes: each cap is the loop's triangulation\n"
+"                       of least area (default) or the one that bends least\n"
 "      --shells on|off  with --surface: the surface's closed pieces (every edge\n"
 "                       shared by two faces) bound their solid exactly: inside\n"
 "                       them is inside, and when the surface is nothing else\n"
@@ -150,7 +152,7 @@ static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_er
     return 0;
 }
 
-enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_FILL_HOLES, OPT_SHELLS, OPT_SIDES, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
+enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT, OPT_FILL_HOLES, OPT_CAPS, OPT_SHELLS, OPT_SIDES, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
 
 int main(int argc, char *argv[])
 {
@@ -160,7 +162,7 @@ int main(int argc, char *argv[])
     st_sign_params p = st_sign_params_default();
     const char *out = NULL, *in = NULL, *surface = NULL;
     st_sign_refine_params rp = st_sign_refine_params_default();
-    int paper = 0, fill_holes = 1, use_shells = 1, use_sides = 1, no_surface = 0;
+    int paper = 0, fill_holes = 1, bend_caps = 0, use_shells = 1, use_sides = 1, no_surface = 0;
     static const struct option opts[] = {
         {"band", required_argument, NULL, OPT_BAND},
         {"rays", required_argument, NULL, OPT_RAYS},
@@ -170,6 +172,7 @@ int main(int argc, char *argv[])
         {"runs", required_argument, NULL, OPT_RUNS},
         {"cut", required_argument, NULL, OPT_CUT},
         {"fill-holes", required_argument, NULL, OPT_FILL_HOLES},
+        {"caps", required_argument, NULL, OPT_CAPS},
         {"shells", required_argument, NULL, OPT_SHELLS},
         {"sides", required_argument, NULL, OPT_SIDES},
         {"rule", required_argument, NULL, OPT_RULE},
@@ -243,6 +246,14 @@ int main(int argc, char *argv[])
         case OPT_FILL_HOLES:
             if (tool_parse_switch(&t, "--fill-holes", optarg, &fill_holes))
                 return TOOL_EXIT_USAGE;
+            break;
+        case OPT_CAPS:
+            if (strcmp(optarg, "area") == 0)
+                bend_caps = 0;
+            else if (strcmp(optarg, "bend") == 0)
+                bend_caps = 1;
+            else
+                return tool_usage_error(&t, "--caps is area or bend, not '%s'", optarg);
             break;
         case OPT_SHELLS:
             if (tool_parse_switch(&t, "--shells", optarg, &use_shells))
@@ -339,6 +350,7 @@ int main(int argc, char *argv[])
     pp.sign = p;
     pp.refine = rp;
     pp.fill_holes = fill_holes;
+    pp.holes.bend = bend_caps;
     pp.closed_shells = use_shells;
     pp.sides = use_sides;
     st_progress prog = tool_progress(&t);
