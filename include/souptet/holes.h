@@ -12,16 +12,34 @@
  * triangulation of the loop of least area (dynamic programming over the
  * loop's vertices, Barequet and Sharir's minimal-area polygon
  * triangulation): a flat hole gets a flat cap, a hole across a tube the
- * chord across it.
+ * chord across it. With bend, it is the
+ * triangulation of the loop's own vertices that bends least: the sum over
+ * its edges, inner ones and the loop's (where it meets the soup's triangle
+ * there, whose orientation is read relative to the cap only), of length
+ * times dihedral angle, the discrete total mean curvature, is least; ties
+ * by area (dynamic programming over the loop's vertices as for the
+ * minimal-area triangulation of Barequet and Sharir, the bends taken
+ * across each diagonal with the best triangulation behind it, after
+ * Liepa's fairest one). A flat hole gets a flat cap; a CAD part's missing
+ * cylindrical or conical face (ruled between two rims of the loop) its
+ * facets; a hole through both faces of a thin wall the faces, where the
+ * least-area cap is a wall across the solid, and a hole over several
+ * faces of a part a cap along them rather than one folding through the
+ * solid. Lost corners (points of the part inside the hole) stay lost: the
+ * cap has the loop's points only; where such a corner was concave (a
+ * notch) the cap that bends least extends the faces across it, and on a
+ * one-sided scan it continues the walls past the far side: not the
+ * default (the numbers at st_holes_params_default in holes.c).
  *
  * Not every loop is a hole: an open patch (a panel of a CAD part, one of a
  * teapot's patches, a sheet) has a loop around itself, and capping it would
  * add a second surface beside or across the patch. A loop is capped only
- * when its cap is small beside the surface around it: at most
- * max_cap_ratio times the area of the pieces (edge-connected triangles)
- * near it, those with a triangle whose bounding box meets the loop's box
- * grown by a quarter of its extent each way (its own pieces among them;
- * where faces were deleted at random, the fragments beside the hole).
+ * when its least-area triangulation is small beside the surface around
+ * it: at most max_cap_ratio times the area of the pieces (edge-connected
+ * triangles) near it, those with a triangle whose bounding box meets the
+ * loop's box grown by a quarter of its extent each way (its own pieces
+ * among them; where faces were deleted at random, the fragments beside
+ * the hole).
  * A flat loop is capped whatever its size (a CAD part that lost a face:
  * its cap is the face) unless the triangles along it that lie in its plane
  * are mostly inside it (the rim of a flat sheet, which is no hole).
@@ -48,11 +66,13 @@ extern "C" {
 #endif
 
 typedef struct st_holes_params {
-    double max_cap_ratio;   /* cap area / area of the pieces around it */
+    double max_cap_ratio;   /* least-area cap / area of the pieces around it */
     size_t max_loop;        /* loops with more edges are left open */
     double flat;            /* a loop within flat times its extent of a
                              * plane, not along a flat sheet's rim, is
                              * capped whatever its size (0: never) */
+    int bend;               /* 1: the cap that bends least; 0 (default):
+                             * the cap of least area */
 } st_holes_params;
 
 typedef struct st_holes_stats {

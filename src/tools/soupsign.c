@@ -73,6 +73,8 @@ static void usage(void)
 "                       boundary edges, by the triangulation of least area,\n"
 "                       when small beside the surface around them) before\n"
 "                       voting (default on)\n"
+"      --caps area|bend  with --fill-holes: each cap is the loop's triangulation\n"
+"                       of least area (default) or the one that bends least\n"
 "      --shells on|off  with --surface: the surface's closed pieces (every edge\n"
 "                       shared by two faces) bound their solid exactly: inside\n"
 "                       them is inside, and when the surface is nothing else\n"
@@ -151,7 +153,7 @@ static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_er
 }
 
 enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT,
-       OPT_SIDES, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
+       OPT_CAPS, OPT_SIDES, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
 
 static const struct option longopts[] = {
     {"band", required_argument, NULL, OPT_BAND},
@@ -162,6 +164,7 @@ static const struct option longopts[] = {
     {"runs", required_argument, NULL, OPT_RUNS},
     {"cut", required_argument, NULL, OPT_CUT},
     TOOL_LONG_OPTIONS_PSEUDO,
+    {"caps", required_argument, NULL, OPT_CAPS},
     {"sides", required_argument, NULL, OPT_SIDES},
     {"rule", required_argument, NULL, OPT_RULE},
     {"surface", required_argument, NULL, OPT_SURFACE},
@@ -177,7 +180,7 @@ typedef struct soupsign_settings {
     st_sign_params sign;
     st_sign_refine_params refine;
     const char *in, *surface;
-    int paper, fill_holes, use_shells, use_sides, no_surface;
+    int paper, fill_holes, bend_caps, use_shells, use_sides, no_surface;
 } soupsign_settings;
 
 static int option(tool_ctx *t, int c, const char *arg, void *settings)
@@ -242,6 +245,14 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
     case TOOL_OPT_FILL_HOLES:
     case TOOL_OPT_SHELLS:
         return tool_pseudo_option(t, c, arg, &s->fill_holes, &s->use_shells);
+    case OPT_CAPS:
+        if (strcmp(arg, "area") == 0)
+            s->bend_caps = 0;
+        else if (strcmp(arg, "bend") == 0)
+            s->bend_caps = 1;
+        else
+            return tool_usage_error(t, "--caps is area or bend, not '%s'", arg);
+        break;
     case OPT_SIDES:
         if (tool_parse_switch(t, "--sides", arg, &s->use_sides))
             return TOOL_EXIT_USAGE;
@@ -329,6 +340,7 @@ static int run(tool_ctx *t, void *settings)
     pp.sign = *p;
     pp.refine = s->refine;
     pp.fill_holes = s->fill_holes;
+    pp.holes.bend = s->bend_caps;
     pp.closed_shells = s->use_shells;
     pp.sides = s->use_sides;
     st_progress prog = tool_progress(t);
