@@ -19,13 +19,9 @@
  * of it). Where several tets of a star are within a fraction of a degree
  * of the worst (a plateau: the worst tet's gradient lowers the next, the
  * summed one cancels), steps along the 26 directions to a cube's
- * neighbours at 0.1, 0.04 and 0.015 h still find a way up (issue 18,
- * --tries 1, min dihedral before -> after at R 0.4: armadillo 29.24 ->
- * 31.06, man-interpenetrating 27.58 -> 30.21, teapot 31.24 -> 34.72;
- * R 0.25: b9_mesh 25.39 -> 30.94, rotor 32.40 -> 33.81; tetsmooth --fit
- * on the bunny's 6-cell lattice 29.96 -> 35.09; two steps, 0.08 and 0.02
- * h, did less: man-interpenetrating 25.99). Rounds repeat until no tet
- * scores below the goal or nothing moves. Vertices move colour by colour, within a colour in parallel,
+ * neighbours at 0.1, 0.04 and 0.015 h still find a way up; st_fit adds
+ * them (cube_steps) in one last pass after its rescues (fit.c says why).
+ * Rounds repeat until no tet scores below the goal or nothing moves. Vertices move colour by colour, within a colour in parallel,
  * each check reading only its own star: the result does not depend on
  * the thread count.
  */
@@ -213,7 +209,7 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
     /* the 26 directions to a cube's neighbours at a few step lengths:
      * where the worst tets' gradients cancel (a plateau of equally bad
      * tets) a step off them may still raise the lowest score */
-    for (int dz = -1; dz <= 1 && !tangent_only; dz++)
+    for (int dz = -1; dz <= 1 && c->cube_steps && !tangent_only; dz++)
         for (int dy = -1; dy <= 1; dy++)
             for (int dxx = -1; dxx <= 1; dxx++) {
                 if (!dxx && !dy && !dz)

@@ -27,9 +27,9 @@ assert r["inverted"] == 0 and r["degenerate"] == 0, r
 # near [30, 140] on this closed model at R = 0.4. On this lattice (seed 1,
 # soupmesh's) the fit's rescue reaches the stopping condition; the quality
 # pass then ended at 29.96..132.9 degrees (its candidates along the score
-# gradients stalled on a plateau of equally bad tets), with the 26 cube
-# directions it ends at 35.09..131.5 (issue 18).
-assert r["min_dihedral"] >= 34.5 and r["max_dihedral"] <= 140.0, (r["min_dihedral"], r["max_dihedral"])
+# gradients stalled on a plateau of equally bad tets); with a last pass
+# along the 26 cube directions too it ends at 34.13..131.4 (issue 18).
+assert r["min_dihedral"] >= 33.5 and r["max_dihedral"] <= 140.0, (r["min_dihedral"], r["max_dihedral"])
 s = r["surface"]
 # Cetra's stopping condition: every boundary vertex within 0.4 h
 assert s["dist_max_h"] <= 0.4, (s["dist_max_h"], r["h"])
