@@ -16,8 +16,12 @@
  * (21.7 degrees) all had such vertices, every candidate refused by the
  * distance rule. So a boundary vertex also searches the same gradients
  * projected onto the tangent plane of S's distance (and a little inward
- * of it). Rounds repeat until no tet scores below the goal or nothing
- * moves. Vertices move colour by colour, within a colour in parallel,
+ * of it). Where several tets of a star are within a fraction of a degree
+ * of the worst (a plateau: the worst tet's gradient lowers the next, the
+ * summed one cancels), steps along the 26 directions to a cube's
+ * neighbours at 0.1, 0.04 and 0.015 h still find a way up; st_fit adds
+ * them (cube_steps) in one last pass after its rescues (fit.c says why).
+ * Rounds repeat until no tet scores below the goal or nothing moves. Vertices move colour by colour, within a colour in parallel,
  * each check reading only its own star: the result does not depend on
  * the thread count.
  */
@@ -47,6 +51,9 @@ static const double qual_inward[] = {0.0, 0.25};
 #define QUAL_ACTIVE 2.0
 /* The axis-direction candidates' step, in units of h. */
 #define QUAL_AXIS_STEP 0.03
+/* Step lengths (units of h) along the 26 cube-neighbour directions. */
+static const double qual_sphere[] = {0.1, 0.04, 0.015};
+#define QUAL_NSPHERE (sizeof qual_sphere / sizeof qual_sphere[0])
 /* Central-difference step for the score gradient, in units of h. */
 #define QUAL_GRAD_EPS 1e-4
 
@@ -93,7 +100,8 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
     double *x = sm->m->xyz + 3 * (size_t)v;
     double s0 = sm_star_score(sm, v, x);
     /* candidates: {score, x, y, z, order} */
-    double cand[5 + 2 * QUAL_NSTEPS + 6 + 2 * QUAL_NTANGENT * QUAL_NSTEPS][5];
+    double cand[5 + 2 * QUAL_NSTEPS + 6 + 2 * QUAL_NTANGENT * QUAL_NSTEPS +
+                26 * QUAL_NSPHERE][5];
     int nc = 0;
     double t[3];
     sm_odt_target(sm, v, t);
@@ -198,6 +206,22 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
     for (int a = 0; a < 6 && !tangent_only; a++, nc++)
         for (int b2 = 0; b2 < 3; b2++)
             cand[nc][1 + b2] = x[b2] + (b2 == a / 2 ? (a & 1 ? -1.0 : 1.0) * QUAL_AXIS_STEP * c->h : 0.0);
+    /* the 26 directions to a cube's neighbours at a few step lengths:
+     * where the worst tets' gradients cancel (a plateau of equally bad
+     * tets) a step off them may still raise the lowest score */
+    for (int dz = -1; dz <= 1 && c->cube_steps && !tangent_only; dz++)
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dxx = -1; dxx <= 1; dxx++) {
+                if (!dxx && !dy && !dz)
+                    continue;
+                double l = sqrt((double)(dxx * dxx + dy * dy + dz * dz));
+                for (size_t k2 = 0; k2 < QUAL_NSPHERE; k2++, nc++) {
+                    double st = qual_sphere[k2] * c->h / l;
+                    cand[nc][1] = x[0] + st * dxx;
+                    cand[nc][2] = x[1] + st * dy;
+                    cand[nc][3] = x[2] + st * dz;
+                }
+            }
     if (nc == 0)
         return 0;
     for (int i = 0; i < nc; i++) {

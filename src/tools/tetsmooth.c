@@ -4,7 +4,8 @@
  * quality pass (Stuart et al. 2013).
  *
  *   tetsmooth (--fair [--iters N] | --fit --surface S [--offset R]
- *             [--step T] [--max-iters N] [--no-quality]) [-o OUT] [MESH]
+ *             [--step T] [--max-iters N] [--no-quality]
+ *             [--offset-best-effort]) [-o OUT] [MESH]
  *
  * See man/man1/tetsmooth.1 and smooth.h.
  */
@@ -47,6 +48,8 @@ static void usage(void)
 "      --surface S      the surface to enclose (.obj .off .ply .stl .gltf .glb); required\n"
 "      --offset R       stop when every boundary vertex is within R*h of S\n"
 "                       (default 0.4)\n"
+"      --offset-best-effort  keep a mesh that misses --offset with exit\n"
+"                       status 0 and a warning (default: an error, exit 4)\n"
 "      --cell-width H   the lattice cell width h when the mesh does not record\n"
 "                       it (meta \"h\", written by latticetet)\n"
 "      --step T         fraction of the way to the target per iteration,\n"
@@ -71,11 +74,13 @@ TOOL_HELP_TETFORMAT
 "  soupdist b.obj | soupsign | latticetet --sculpt --surface b.obj --cells 12 \\\n"
 "      | tetsmooth --fit --surface b.obj -o b.vtu\n"
 "\n"
-"Exit status: 0 ok, 1 bad input or failure, 2 usage error.\n");
+"Exit status: 0 ok, 1 bad input or failure, 2 usage error, 3 the fitted mesh\n"
+"does not enclose S, 4 a boundary vertex stays farther than --offset R*h from S\n"
+"(the mesh is written in both cases).\n");
 }
 
 enum { OPT_FAIR = TOOL_OPT_FIRST, OPT_FIT, OPT_ITERS, OPT_LAMBDA, OPT_MINANGLE, OPT_SURFACE, OPT_OFFSET,
-       OPT_CELL, OPT_STEP, OPT_MAXIT, OPT_QROUNDS, OPT_NOQ, OPT_INTQ };
+       OPT_CELL, OPT_STEP, OPT_MAXIT, OPT_QROUNDS, OPT_NOQ, OPT_INTQ, OPT_BEST_EFFORT };
 
 typedef struct iter_ctx {
     tool_ctx *t;
@@ -98,7 +103,7 @@ typedef struct tetsmooth_settings {
     st_fit_params fit;
     const char *in, *surface;
     int mode; /* 1 fair, 2 fit */
-    int fair_only, fit_only, noq;
+    int fair_only, fit_only, noq, best_effort;
 } tetsmooth_settings;
 
 static const struct option longopts[] = {
@@ -110,6 +115,7 @@ static const struct option longopts[] = {
     {"interior-quality", no_argument, NULL, OPT_INTQ},
     {"surface", required_argument, NULL, OPT_SURFACE},
     {"offset", required_argument, NULL, OPT_OFFSET},
+    {"offset-best-effort", no_argument, NULL, OPT_BEST_EFFORT},
     {"cell-width", required_argument, NULL, OPT_CELL},
     {"step", required_argument, NULL, OPT_STEP},
     {"max-iters", required_argument, NULL, OPT_MAXIT},
@@ -160,6 +166,10 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
             return TOOL_EXIT_USAGE;
         s->fit_only = 1;
         break;
+    case OPT_BEST_EFFORT:
+        s->best_effort = 1;
+        s->fit_only = 1;
+        break;
     case OPT_STEP:
         if (tool_parse_double(t, "--step", arg, 1e-6, 1.0, &s->fit.step))
             return TOOL_EXIT_USAGE;
@@ -196,8 +206,8 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
     if (!s->mode)
         return tool_usage_error(t, "say what to do: --fair or --fit --surface S");
     if (s->mode == 1 && s->fit_only)
-        return tool_usage_error(t, "--surface, --offset, --cell-width, --step and --max-iters "
-                                   "go with --fit");
+        return tool_usage_error(t, "--surface, --offset, --offset-best-effort, --cell-width, "
+                                   "--step and --max-iters go with --fit");
     if (s->mode == 2 && s->fair_only)
         return tool_usage_error(t, "--iters, --lambda, --min-angle and --interior-quality go with --fair");
     if (s->noq)
@@ -291,10 +301,6 @@ static int run(tool_ctx *t, void *settings)
                         "max %.4g",
                  st.within_offset, st.boundary_vertices, st.d_offset, st.mean_distance,
                  st.max_distance);
-        if (st.beyond_offset)
-            tool_say(t, 1, "%zu of %zu boundary vertices could not get within %.4g of the "
-                            "surface (up to %.4g away: thin gaps or blocked moves)",
-                     st.beyond_offset, st.boundary_vertices, st.d_offset, st.max_distance);
         not_enclosing = st.outside_after || st.crossing_after;
         fst = st;
         snprintf(param, sizeof param, "fit offset=%.6g h=%.6g step=%.6g quality=%d "
@@ -320,6 +326,19 @@ static int run(tool_ctx *t, void *settings)
                  inname, tool_out_name(out), surface, fst.outside_after,
                  fst.crossing_after, fst.outside_before, fst.crossing_before);
         rc = TOOL_EXIT_NOT_ENCLOSING;
+    }
+    if (s->mode == 2 && fst.beyond_offset) {
+        /* Cetra's stopping condition missed: soupmesh's message and exit
+         * status (level 0, exit 4) unless the user settles for less. */
+        tool_say(t, s->best_effort ? 1 : 0,
+                 "%s: %s: %zu of %zu boundary vertices stay farther than %.3g h from the "
+                 "input, the farthest %.4g h (%.4g)%s",
+                 inname, s->best_effort ? "warning" : "error", fst.beyond_offset,
+                 fst.boundary_vertices, s->fit.offset_ratio, fst.max_distance / fst.h,
+                 fst.max_distance, s->best_effort ? "" : "; try a finer lattice, or "
+                 "--offset-best-effort");
+        if (!s->best_effort && rc == TOOL_EXIT_OK)
+            rc = TOOL_EXIT_OFFSET_NOT_MET;
     }
 done:
     st_bvh_free(bvh);

@@ -25,10 +25,11 @@ r = json.load(open(sys.argv[1]))
 assert r["inverted"] == 0 and r["degenerate"] == 0, r
 # the BCC lattice starts at 60..90; the fit and quality pass must end
 # near [30, 140] on this closed model at R = 0.4. On this lattice (seed 1,
-# soupmesh's) the fit's rescue reaches the stopping condition at 29.96..132.9
-# degrees; without the rescue it stayed at 0.52 h with 34.9..131.2 (issue 18:
-# the trade is measured in the closing note).
-assert r["min_dihedral"] >= 29.5 and r["max_dihedral"] <= 140.0, (r["min_dihedral"], r["max_dihedral"])
+# soupmesh's) the fit's rescue reaches the stopping condition; the quality
+# pass then ended at 29.96..132.9 degrees (its candidates along the score
+# gradients stalled on a plateau of equally bad tets); with a last pass
+# along the 26 cube directions too it ends at 34.13..131.4 (issue 18).
+assert r["min_dihedral"] >= 33.5 and r["max_dihedral"] <= 140.0, (r["min_dihedral"], r["max_dihedral"])
 s = r["surface"]
 # Cetra's stopping condition: every boundary vertex within 0.4 h
 assert s["dist_max_h"] <= 0.4, (s["dist_max_h"], r["h"])
@@ -53,7 +54,19 @@ mkdir t1 t2
 (cd t1 && OMP_NUM_THREADS=1 tetsmooth --fit --surface "$BUNNY" -o f.vtu ../b6.vtu 2>/dev/null)
 (cd t2 && OMP_NUM_THREADS=2 tetsmooth --fit --surface "$BUNNY" -o f.vtu ../b6.vtu 2>/dev/null)
 check "fit: 1 and 2 threads write identical files" cmp t1/f.vtu t2/f.vtu
-check "fit --no-quality --max-iters 3" tetsmooth --fit --surface "$BUNNY" --no-quality --max-iters 3 -o n6.vtu b6.vtu
+check "fit --no-quality --max-iters 3" tetsmooth --offset-best-effort --fit --surface "$BUNNY" --no-quality --max-iters 3 -o n6.vtu b6.vtu
+
+# Cetra's stopping condition as soupmesh says it: --offset 0.05 cannot be
+# met on 6 cells. The mesh is written, the count and the farthest distance
+# in h are said even with -q, and the exit status is 4;
+# --offset-best-effort makes it 0 and a warning (silent under -q).
+check "--offset 0.05: exit 4, written, said under -q" \
+    sh -c "tetsmooth -q --fit --surface '$BUNNY' --offset 0.05 -o o5.vtu b6.vtu 2> o5.err; test \$? -eq 4 && tetstat --json o5.vtu > o5.json && grep -Eq '^tetsmooth: b6.vtu: error: [0-9]+ of [0-9]+ boundary vertices stay farther than 0.05 h from the input, the farthest [0-9.]+ h' o5.err"
+check "--offset 0.05 --offset-best-effort: exit 0, a warning" \
+    sh -c "tetsmooth --offset-best-effort --fit --surface '$BUNNY' --offset 0.05 -o o5b.vtu b6.vtu 2> o5b.err && grep -Eq '^tetsmooth: b6.vtu: warning: [0-9]+ of [0-9]+ boundary vertices stay farther than 0.05 h' o5b.err"
+check "--offset-best-effort -q: silent" \
+    sh -c "tetsmooth -q --offset-best-effort --fit --surface '$BUNNY' --offset 0.05 -o o5c.vtu b6.vtu 2> o5c.err && ! test -s o5c.err"
+expect_fail "--offset-best-effort with --fair" 2 "go with --fit" tetsmooth --fair --offset-best-effort -o x.vtu b6.vtu
 
 check "fair" sh -c "tetsmooth -v --fair -o fd8.vtu d8.vtu 2> fair.log"
 tetstat --json d8.vtu > d8.json 2>/dev/null
@@ -86,7 +99,7 @@ PY
 /usr/bin/python3 noh.py b6.vtu noh.vtu
 expect_fail "a mesh without h and no --cell-width" 1 "^tetsmooth: .*cell width" \
     tetsmooth --fit --surface "$BUNNY" -o x.vtu noh.vtu
-check "--cell-width stands in for h" tetsmooth --fit --surface "$BUNNY" --cell-width 2 --max-iters 2 \
+check "--cell-width stands in for h" tetsmooth --offset-best-effort --fit --surface "$BUNNY" --cell-width 2 --max-iters 2 \
     --quality-rounds 2 -o cw.vtu noh.vtu
 check "fair --min-angle 25 --no-quality" sh -c "tetsmooth -v --fair --min-angle 25 --no-quality -o fa.vtu d8.vtu 2> fa.log && grep -q 'after fairing 2[5-9]' fa.log"
 
