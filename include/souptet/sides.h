@@ -46,6 +46,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "souptet/edges.h"
 #include "souptet/err.h"
 #include "souptet/grid.h"
 #include "souptet/soup.h"
@@ -84,12 +85,18 @@ typedef struct st_sides_stats {
  * them as they are, mincut.h) get none, and a voxel whose margin counts
  * (a majority inside, or seen from outside) and whose margin plus evidence
  * is at least decided either way may get any evidence that keeps it so
- * (the cut reads only its side); decided <= 0: the exact evidence. stats may be NULL. ST_ENOMEM,
- * ST_ELIMIT. */
+ * (the cut reads only its side); decided <= 0: the exact evidence.
+ * stats may be NULL. ST_ENOMEM, ST_ELIMIT. */
 st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
                             int decided, const st_soup *s,
                             const st_sides_params *p, st_sides_stats *stats,
                             st_error *err);
+/* The same with s's edge table (st_soup_edges_build) when the caller has
+ * it (NULL: built here). */
+st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint8_t *votes,
+                                  int decided, const st_soup *s, const st_soup_edges *edges,
+                                  const st_sides_params *p, st_sides_stats *stats,
+                                  st_error *err);
 
 /* A one-sided view's far side (stats->onesided; nothing otherwise), on
  * the signed field g of its pseudo volume: along each line of the lattice
