@@ -94,120 +94,6 @@ static void tri_normal(const st_soup *s, size_t t, double n[3])
     n[2] = u[0] * w[1] - u[1] * w[0];
 }
 
-/* The far field (step 3). Each BVH node's oriented area vector D (the sum
- * of a_t n_t over its triangles), its total area A, the centre c of its
- * box and rho, half the box's diagonal (every point of its triangles lies
- * within rho of c). Seen from q with r = |c - q| > rho, the node's solid
- * angle is the integral over its triangles of K(x - q) = (x - q).n / |x - q|^3;
- * |grad K(y)| = sqrt(1 + 3 cos^2) / |y|^3 <= 2 / |y|^3, so replacing x by c
- * costs at most 2 rho A / (r - rho)^3: the dipole D.(c - q) / r^3 with that
- * error bound. */
-typedef struct far_node {
-    double c[3], rho;
-    double d[3], area;
-} far_node;
-
-static void far_moments(const st_bvh *b, const st_soup *o, far_node *f, uint32_t ni)
-{
-    const st_bvh_node *n = &b->nodes[ni];
-    far_node *m = &f[ni];
-    double diag2 = 0.0;
-    for (int k = 0; k < 3; k++) {
-        m->c[k] = 0.5 * (n->lo[k] + n->hi[k]);
-        diag2 += (n->hi[k] - n->lo[k]) * (n->hi[k] - n->lo[k]);
-        m->d[k] = 0.0;
-    }
-    /* rounding slack: rho and A only need to be upper bounds */
-    m->rho = 0.5 * sqrt(diag2) * (1.0 + 1e-12);
-    m->area = 0.0;
-    if (n->count) {
-        for (uint32_t i = 0; i < n->count; i++) {
-            double nrm[3];
-            tri_normal(o, b->order[n->start + i], nrm);
-            for (int k = 0; k < 3; k++)
-                m->d[k] += 0.5 * nrm[k];
-            m->area += 0.5 * sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-        }
-    } else {
-        far_moments(b, o, f, n->start);
-        far_moments(b, o, f, n->start + 1);
-        for (int k = 0; k < 3; k++)
-            m->d[k] = f[n->start].d[k] + f[n->start + 1].d[k];
-        m->area = f[n->start].area + f[n->start + 1].area;
-    }
-    m->area *= 1.0 + 1e-12;
-}
-
-/* The sum of the solid angles of the triangles whose boxes meet [lo, hi]
- * (st_bvh_query_box's set) seen from q, within *bound: exact terms for the
- * triangles of nodes that straddle the box or are near q, dipoles for
- * nodes inside the box whose error bound is at most tol. */
-static double far_sum(const st_bvh *b, const far_node *f, const double q[3],
-                      const double lo[3], const double hi[3], double tol, double *bound)
-{
-    uint32_t stack[128];
-    int sp = 0;
-    double sum = 0.0, err = 0.0, mag = 0.0;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        const uint32_t ni = stack[--sp];
-        const st_bvh_node *n = &b->nodes[ni];
-        if (!(n->lo[0] <= hi[0] && lo[0] <= n->hi[0] && n->lo[1] <= hi[1] &&
-              lo[1] <= n->hi[1] && n->lo[2] <= hi[2] && lo[2] <= n->hi[2]))
-            continue;
-        if (lo[0] <= n->lo[0] && n->hi[0] <= hi[0] && lo[1] <= n->lo[1] &&
-            n->hi[1] <= hi[1] && lo[2] <= n->lo[2] && n->hi[2] <= hi[2]) {
-            const far_node *m = &f[ni];
-            const double y[3] = {m->c[0] - q[0], m->c[1] - q[1], m->c[2] - q[2]};
-            const double r = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
-            const double d = r - m->rho;
-            if (d > 0.0) {
-                const double e = 2.0 * m->rho * m->area / (d * d * d);
-                if (e <= tol) {
-                    const double t = (m->d[0] * y[0] + m->d[1] * y[1] + m->d[2] * y[2]) /
-                                     (r * r * r);
-                    sum += t;
-                    err += e;
-                    mag += fabs(t) + m->area / (d * d);
-                    continue;
-                }
-            }
-        }
-        if (n->count) {
-            const st_soup *o = b->soup;
-            for (uint32_t i = 0; i < n->count; i++) {
-                const double *tb = b->tbox + 6 * (size_t)(n->start + i);
-                if (!(tb[0] <= hi[0] && lo[0] <= tb[3] && tb[1] <= hi[1] && lo[1] <= tb[4] &&
-                      tb[2] <= hi[2] && lo[2] <= tb[5]))
-                    continue;
-                wsum w = {o, q, 0.0};
-                add_angle(&w, b->order[n->start + i]);
-                sum += w.sum;
-                mag += fabs(w.sum);
-            }
-            continue;
-        }
-        if (sp + 2 > (int)(sizeof stack / sizeof *stack)) {
-            /* deeper than any tree of 2^32 triangles: no bound */
-            *bound = INFINITY;
-            return sum;
-        }
-        stack[sp++] = n->start + 1;
-        stack[sp++] = n->start;
-    }
-    /* the exact path's rounding (and ours) is far below 1e-9 of the terms */
-    *bound = err + 1e-9 * (mag + 1.0);
-    return sum;
-}
-
-/* A winding sum's evidence: scaled, clamped to +-cap, rounded; monotone. */
-static int evidence_of(double sum, double scale, double cap)
-{
-    double e = scale * sum;
-    e = e > cap ? cap : e < -cap ? -cap : e;
-    return (int)lround(e);
-}
-
 /* 4. A one-sided view (sides.h): the view v from the oriented soup o's
  * projected areas, and the lattice step nearest it. */
 static void view_of(const st_soup *o, const st_sides_params *p, st_sides_stats *st)
@@ -368,7 +254,6 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
     double *score = st_calloc_array(nt + 1, sizeof *score);
     st_soup *o = st_soup_new();
     st_bvh *bvh = NULL;
-    far_node *far = NULL;
     if (!nbr || !same || !flip || !region || !queue || !score || !o) {
         rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's sides");
         goto done;
@@ -454,23 +339,13 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
     if ((rc = st_bvh_build(&bvh, o, err)))
         goto done;
 
-    /* 3. the local winding number near the soup: first within a bound
-     * (far_sum); the exact sum, in the BVH's order, only where the bound
-     * leaves the evidence open and it can matter to the cut */
-    far = st_malloc_array(bvh->nnodes, sizeof *far);
-    if (!far) {
-        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's sides");
-        goto done;
-    }
-    far_moments(bvh, o, far, 0);
+    /* 3. the local winding number near the soup */
     const float band = (float)(p->band_voxels * g->voxel);
     const double r = p->radius_voxels * g->voxel;
     const double scale = p->weight / (4.0 * M_PI);
     const double cap = (double)p->max_evidence;
-    /* a dipole's error bound at most this (steradians) */
-    const double tol = 0.05;
-    size_t count = 0, exact = 0;
-    #pragma omp parallel for schedule(dynamic, 1) reduction(+ : count, exact)
+    size_t count = 0;
+    #pragma omp parallel for schedule(dynamic, 1) reduction(+ : count)
     for (size_t z = 0; z < g->nz; z++)
         for (size_t y = 0; y < g->ny; y++)
             for (size_t x = 0; x < g->nx; x++) {
@@ -483,34 +358,16 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
                                      g->origin[2] + g->voxel * (double)z};
                 const double lo[3] = {q[0] - r, q[1] - r, q[2] - r};
                 const double hi[3] = {q[0] + r, q[1] + r, q[2] + r};
-                double bound;
-                const double s0 = far_sum(bvh, far, q, lo, hi, tol, &bound);
-                const int elo = evidence_of(s0 - bound, scale, cap);
-                const int ehi = evidence_of(s0 + bound, scale, cap);
-                /* the cut's evidence is margin + ours where the votes' majority
-                 * is inside or a ray sees the voxel (sign.c, cut_undecided) */
-                const int counted = margin > 0 || (votes[i] & ST_SIGN_VOTES_SEEN);
-                int e;
-                if (elo == ehi)
-                    e = elo;
-                else if (decided > 0 && counted && margin + elo >= decided)
-                    e = elo;
-                else if (decided > 0 && counted && margin + ehi <= -decided)
-                    e = ehi;
-                else {
-                    wsum w = {o, q, 0.0};
-                    st_bvh_query_box(bvh, lo, hi, add_angle, &w);
-                    e = evidence_of(w.sum, scale, cap);
-                    exact++;
-                }
-                evidence[i] = (int8_t)e;
+                wsum w = {o, q, 0.0};
+                st_bvh_query_box(bvh, lo, hi, add_angle, &w);
+                double e = scale * w.sum;
+                e = e > cap ? cap : e < -cap ? -cap : e;
+                evidence[i] = (int8_t)lround(e);
                 count++;
             }
-    st->exact = exact;
     st->voxels = count;
     view_of(o, p, st);
 done:
-    free(far);
     st_bvh_free(bvh);
     st_soup_free(o);
     if (!edges)

@@ -4,8 +4,7 @@
  * one by one, and large holes close: a box with a whole face missing (of
  * any size), a thin plate with half of one face gone, a one-sided
  * hemisphere shell, a one-sided scan of a ball whose horizon is not
- * flat; an unoriented soup gives what an oriented one gives; the sides'
- * evidence from far-field bounds is the brute-force winding sum.
+ * flat; an unoriented soup gives what an oriented one gives.
  */
 #include "souptet/pseudo.h"
 #include "souptet/solid.h"
@@ -294,141 +293,6 @@ static void test_sides_orientation(void)
     st_soup_free(b);
 }
 
-/* The signed solid angle of (a, b, c) seen from q (Van Oosterom and
- * Strackee 1983), for the brute force below. */
-static double tri_solid_angle(const double *A, const double *B, const double *C, const double q[3])
-{
-    double a[3], b[3], c[3];
-    for (int k = 0; k < 3; k++) {
-        a[k] = A[k] - q[k];
-        b[k] = B[k] - q[k];
-        c[k] = C[k] - q[k];
-    }
-    const double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-    const double lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-    const double lc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                       a[2] * (b[0] * c[1] - b[1] * c[0]);
-    const double den = la * lb * lc + (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) * lc +
-                       (b[0] * c[0] + b[1] * c[1] + b[2] * c[2]) * la +
-                       (c[0] * a[0] + c[1] * a[1] + c[2] * a[2]) * lb;
-    return 2.0 * atan2(det, den);
-}
-
-static void test_sides_far_field(void)
-{
-    /* A finely meshed ball (triangles much smaller than a voxel, shared
-     * vertices, outward) with a cap cut off above z = 0.6: the evidence,
-     * summed in part from far-field bounds, is the brute-force local
-     * winding number of every triangle whose box meets the voxel's cube
-     * (up to the one turn of the whole region to the votes); with
-     * decided > 0 the cut sees the same sides; and most voxels never need
-     * the triangle-by-triangle sum. */
-    const int nu = 160, nv = 80;
-    st_soup *s = st_soup_new();
-    for (int i = 0; i <= nv; i++)
-        for (int j = 0; j < nu; j++) {
-            const double th = M_PI * i / nv, ph = 2 * M_PI * j / nu;
-            st_soup_add_vertex(s, sin(th) * cos(ph), sin(th) * sin(ph), cos(th), NULL);
-        }
-    for (int i = 0; i < nv; i++)
-        for (int j = 0; j < nu; j++) {
-            const uint32_t a = (uint32_t)(i * nu + j), b = (uint32_t)(i * nu + (j + 1) % nu);
-            const uint32_t c = a + (uint32_t)nu, d = b + (uint32_t)nu;
-            if (cos(M_PI * i / nv) > 0.6)
-                continue;
-            if (i > 0)
-                st_soup_add_triangle(s, a, c, b, NULL);
-            if (i < nv - 1)
-                st_soup_add_triangle(s, b, c, d, NULL);
-        }
-    st_dist_params dp = st_dist_params_default();
-    dp.cells = 32;
-    st_grid *g = NULL;
-    st_error err;
-    int ok = !st_dist_field(&g, s, &dp, NULL, &err);
-    const size_t n = ok ? st_grid_count(g) : 1;
-    uint8_t *votes = malloc(n);
-    int8_t *e0 = malloc(n), *e1 = malloc(n);
-    const st_sides_params sp = st_sides_params_default();
-    const st_sign_params sgp = st_sign_params_default();
-    const int decided = 10;
-    st_sides_stats s0, s1;
-    ok = ok && votes && e0 && e1 && !st_sign_votes(g, &sgp, votes, &err) &&
-         !st_sides_evidence(e0, g, votes, 0, s, &sp, &s0, &err) &&
-         !st_sides_evidence(e1, g, votes, decided, s, &sp, &s1, &err);
-    TAP_CHECK(ok && s0.regions == 1, "one region (%zu)", ok ? s0.regions : 0);
-    size_t wrong = 0, open = 0, same_side = 0, checked = 0;
-    int turn = 0;
-    if (ok) {
-        const double r = sp.radius_voxels * g->voxel, scale = sp.weight / (4.0 * M_PI);
-        const float band = (float)(sp.band_voxels * g->voxel);
-        for (size_t z = 0; z < g->nz; z++)
-            for (size_t y = 0; y < g->ny; y++)
-                for (size_t x = 0; x < g->nx; x++) {
-                    const size_t i = st_grid_index(g, x, y, z);
-                    /* a quarter of the band's voxels, for time */
-                    if (!(fabsf(g->data[i]) < band) || (x + y + z) % 4)
-                        continue;
-                    const double q[3] = {g->origin[0] + g->voxel * (double)x,
-                                         g->origin[1] + g->voxel * (double)y,
-                                         g->origin[2] + g->voxel * (double)z};
-                    double sum = 0.0;
-                    for (size_t t = 0; t < s->ntris; t++) {
-                        const double *P[3];
-                        int meets = 1;
-                        for (int k = 0; k < 3; k++)
-                            P[k] = s->xyz + 3 * (size_t)s->tris[3 * t + k];
-                        for (int k = 0; k < 3; k++) {
-                            const double lo = fmin(P[0][k], fmin(P[1][k], P[2][k]));
-                            const double hi = fmax(P[0][k], fmax(P[1][k], P[2][k]));
-                            meets &= lo <= q[k] + r && q[k] - r <= hi;
-                        }
-                        if (meets)
-                            sum += tri_solid_angle(P[0], P[1], P[2], q);
-                    }
-                    double e = scale * sum;
-                    e = e > sp.max_evidence ? sp.max_evidence
-                      : e < -sp.max_evidence ? -sp.max_evidence : e;
-                    const int want = (int)lround(e);
-                    if (!turn && want)
-                        turn = e0[i] == -want ? -1 : 1;
-                    checked++;
-                    /* the brute force sums in another order: a value within
-                     * 1e-9 of a rounding boundary may round either way */
-                    const double frac = fabs(e - floor(e));
-                    if (e0[i] != turn * want && fabs(frac - 0.5) > 1e-9)
-                        wrong++;
-                    const int m = (int)(votes[i] & ST_SIGN_VOTES_COUNT) - 13;
-                    if (abs(m) >= decided)
-                        continue;
-                    if (e1[i] != e0[i]) {
-                        const int seen = m > 0 || (votes[i] & ST_SIGN_VOTES_SEEN);
-                        if (seen && ((m + e0[i] >= decided && m + e1[i] >= decided) ||
-                                     (m + e0[i] <= -decided && m + e1[i] <= -decided)))
-                            same_side++;
-                        else
-                            open++;
-                    }
-                }
-    }
-    TAP_CHECK(ok && checked > 1000 && wrong == 0,
-              "the evidence is the brute-force winding sum (%zu of %zu voxels differ)", wrong,
-              checked);
-    TAP_CHECK(ok && open == 0,
-              "with decided voxels skipped the cut sees the same evidence (%zu differ, %zu on "
-              "the same decided side)", open, same_side);
-    TAP_CHECK(ok && s1.exact * 4 < s1.voxels,
-              "most voxels' sums stay within their bound (%zu of %zu summed exactly; "
-              "%zu of %zu when every value counts)", ok ? s1.exact : 0,
-              ok ? s1.voxels : 0, ok ? s0.exact : 0, ok ? s0.voxels : 0);
-    free(votes);
-    free(e0);
-    free(e1);
-    st_grid_free(g);
-    st_soup_free(s);
-}
-
 int main(void)
 {
     test_entry_point();
@@ -436,6 +300,5 @@ int main(void)
     test_hemisphere();
     test_onesided();
     test_sides_orientation();
-    test_sides_far_field();
     return tap_done();
 }

@@ -21,11 +21,7 @@
  *      Strackee 1983) of the triangles in the cube of radius_voxels
  *      around it, over 4 pi: near +1/2 just inside a wall, near -1/2 just
  *      outside, less where the wall has a hole. Times `weight`, clamped to
- *      +-max_evidence, rounded, it is evidence in votes of margin.
- *      The sum is first taken within a bound (exact solid angles near the
- *      voxel, each BVH node farther away than its size as a dipole with
- *      a bound on its error); only where that leaves the evidence open
- *      and the cut could tell the difference is it summed exactly;
+ *      +-max_evidence, rounded, it is evidence in votes of margin;
  *   4. whether the soup is a one-sided view (a scan from one side, whose
  *      far side was never seen): a closed surface's oriented area sums to
  *      zero in every projection, so the projected area of the oriented
@@ -70,7 +66,6 @@ typedef struct st_sides_stats {
     size_t turned;          /* regions turned to agree with the votes */
     size_t conflicts;       /* edges where the propagation disagreed */
     size_t voxels;          /* voxels given evidence */
-    size_t exact;           /* of them, summed triangle by triangle */
     double back_front;      /* projected area facing away from the view over
                                facing it (0 for a one-sided view, 1 closed) */
     double view[3];         /* the view direction (unit; the mean normal) */
@@ -82,11 +77,8 @@ typedef struct st_sides_stats {
 /* evidence (n bytes) gets each voxel's evidence (0 where none). g: the
  * soup's unsigned distance field; votes: its votes (st_sign_votes);
  * decided > 0: voxels whose votes' margin is at least that (the cut takes
- * them as they are, mincut.h) get none, and a voxel whose margin counts
- * (a majority inside, or seen from outside) and whose margin plus evidence
- * is at least decided either way may get any evidence that keeps it so
- * (the cut reads only its side); decided <= 0: the exact evidence.
- * stats may be NULL. ST_ENOMEM, ST_ELIMIT. */
+ * them as they are, mincut.h) get none. stats may be NULL. ST_ENOMEM,
+ * ST_ELIMIT. */
 st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
                             int decided, const st_soup *s,
                             const st_sides_params *p, st_sides_stats *stats,

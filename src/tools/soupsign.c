@@ -378,8 +378,8 @@ int main(int argc, char *argv[])
                  ps.holes.pinched, ps.seconds_holes);
     if (surface && use_sides && p.cut)
         tool_say(&t, 2, "sides: %zu orientable regions (%zu turned to the votes, %zu edges "
-                 "disagreeing), %zu voxels given their side (%zu summed exactly)", ps.sides.regions,
-                 ps.sides.turned, ps.sides.conflicts, ps.sides.voxels, ps.sides.exact);
+                 "disagreeing), %zu voxels given their side", ps.sides.regions, ps.sides.turned,
+                 ps.sides.conflicts, ps.sides.voxels);
     if (surface && use_sides && p.cut)
         tool_say(&t, 2, "view: back/front %.3f along (%.3f %.3f %.3f): %s", ps.sides.back_front,
                  ps.sides.view[0], ps.sides.view[1], ps.sides.view[2],
