@@ -105,6 +105,15 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
                          st_pseudo_stats *stats, const st_progress *progress,
                          st_error *err)
 {
+    return st_pseudo_sign_bvh(g, s, p, stats, progress, NULL, err);
+}
+
+st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+                             st_pseudo_stats *stats, const st_progress *progress,
+                             st_bvh **bvh_out, st_error *err)
+{
+    if (bvh_out)
+        *bvh_out = NULL;
     st_pseudo_stats local;
     st_pseudo_stats *st = stats ? stats : &local;
     memset(st, 0, sizeof *st);
@@ -180,6 +189,12 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
         inside += g->data[i] < 0.0f;
     st->inside = inside;
     st->failed_step = NULL;
+    if (bvh_out && s) {
+        if (!bvh && (rc = st_bvh_build(&bvh, s, err)))
+            goto done;
+        *bvh_out = bvh;
+        bvh = NULL;
+    }
 done:
     st_bvh_free(bvh);
     if (have_edges)
@@ -193,13 +208,22 @@ st_status st_pseudo_volume(st_grid **out, const st_soup *s, const st_dist_params
                            const st_pseudo_params *p, st_pseudo_stats *stats,
                            const st_progress *progress, st_error *err)
 {
+    return st_pseudo_volume_bvh(out, s, dp, p, stats, progress, NULL, err);
+}
+
+st_status st_pseudo_volume_bvh(st_grid **out, const st_soup *s, const st_dist_params *dp,
+                               const st_pseudo_params *p, st_pseudo_stats *stats,
+                               const st_progress *progress, st_bvh **bvh_out, st_error *err)
+{
+    if (bvh_out)
+        *bvh_out = NULL;
     if (out)
         *out = NULL;
     if (!out || !s || !dp || !p)
         return st_error_set(err, ST_EINTERNAL, NULL, 0, "st_pseudo_volume: bad arguments");
     st_grid *g = NULL;
     st_status rc = st_dist_field(&g, s, dp, progress, err);
-    rc = rc ? rc : st_pseudo_sign(g, s, p, stats, progress, err);
+    rc = rc ? rc : st_pseudo_sign_bvh(g, s, p, stats, progress, bvh_out, err);
     if (rc) {
         st_grid_free(g);
         return rc;
