@@ -513,39 +513,68 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
 
     tri_ball *balls = st_malloc_array(s->ntris, sizeof *balls);
     size_t *start = st_calloc_array(nb + 1, sizeof(size_t));
-    size_t *fill = st_malloc_array(nb, sizeof(size_t));
-    if (!balls || !start || !fill) {
+    if (!balls || !start) {
         free(balls);
         free(start);
-        free(fill);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     }
     #pragma omp parallel for schedule(static)
     for (size_t t = 0; t < s->ntris; t++)
         triangle_ball(&balls[t], s, t);
-    /* Counting sort of (brick, triangle) pairs, triangles in input order. */
-    bin_ctx bc = {start, NULL, NULL, 0};
-    for (size_t t = 0; t < s->ntris; t++)
-        triangle_bricks(g, &bg, s, t, &balls[t], B, count_visit, &bc);
-    for (size_t b = 0; b < nb; b++)
-        start[b + 1] += start[b];
-    const size_t npairs = start[nb];
-    uint32_t *list = st_malloc_array(npairs, sizeof(uint32_t));
-    if (!list) {
+    /* Counting sort of (brick, triangle) pairs, triangles in input order:
+     * the triangles cut into `chunks` runs, each counted and filled by one
+     * thread into its own part of every brick's list (the runs' parts in
+     * run order), so the lists are the serial ones for any thread count. */
+    int chunks = omp_get_max_threads();
+    chunks = chunks < 1 ? 1 : chunks > 8 ? 8 : chunks;
+    if (s->ntris < 4096)
+        chunks = 1;
+    size_t *cnt = st_calloc_array((size_t)chunks * (nb + 1), sizeof(size_t));
+    if (!cnt) {
         free(balls);
         free(start);
-        free(fill);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    #pragma omp parallel for schedule(static, 1) num_threads(chunks)
+    for (int c = 0; c < chunks; c++) {
+        const size_t t0 = s->ntris * (size_t)c / (size_t)chunks;
+        const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)chunks;
+        bin_ctx cc = {cnt + (size_t)c * (nb + 1), NULL, NULL, 0};
+        for (size_t t = t0; t < t1; t++)
+            triangle_bricks(g, &bg, s, t, &balls[t], B, count_visit, &cc);
+    }
+    /* start[b]: brick b's first slot; cnt[c][b + 1] becomes run c's */
+    size_t at = 0;
+    for (size_t b = 0; b < nb; b++) {
+        start[b] = at;
+        for (int c = 0; c < chunks; c++) {
+            size_t *x = &cnt[(size_t)c * (nb + 1) + b + 1];
+            const size_t k = *x;
+            *x = at;
+            at += k;
+        }
+    }
+    start[nb] = at;
+    const size_t npairs = start[nb];
+    uint32_t *list = st_malloc_array(npairs ? npairs : 1, sizeof(uint32_t));
+    if (!list) {
+        free(cnt);
+        free(balls);
+        free(start);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for "
                             "%zu brick candidates", npairs);
     }
-    memcpy(fill, start, nb * sizeof(size_t));
-    bc.fill = fill;
-    bc.list = list;
-    for (size_t t = 0; t < s->ntris; t++) {
-        bc.tri = (uint32_t)t;
-        triangle_bricks(g, &bg, s, t, &balls[t], B, fill_visit, &bc);
+    #pragma omp parallel for schedule(static, 1) num_threads(chunks)
+    for (int c = 0; c < chunks; c++) {
+        const size_t t0 = s->ntris * (size_t)c / (size_t)chunks;
+        const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)chunks;
+        bin_ctx cc = {NULL, cnt + (size_t)c * (nb + 1) + 1, list, 0};
+        for (size_t t = t0; t < t1; t++) {
+            cc.tri = (uint32_t)t;
+            triangle_bricks(g, &bg, s, t, &balls[t], B, fill_visit, &cc);
+        }
     }
-    free(fill);
+    free(cnt);
 
     int oom = 0;
     size_t done = 0;

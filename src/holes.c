@@ -524,6 +524,14 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
                             const st_holes_params *p, st_holes_stats *stats,
                             st_error *err)
 {
+    return st_soup_hole_caps_shared(caps, s, NULL, NULL, p, stats, err);
+}
+
+st_status st_soup_hole_caps_shared(st_soup **caps, const st_soup *s,
+                                   const st_soup_edges *edges, const st_bvh *shared_bvh,
+                                   const st_holes_params *p, st_holes_stats *stats,
+                                   st_error *err)
+{
     st_holes_stats st0;
     memset(&st0, 0, sizeof st0);
     *caps = NULL;
@@ -535,14 +543,18 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
                             "hole filling: loops of at most 4096 edges, a cap ratio >= 0");
     const size_t nt = s->ntris;
     st_status rc = ST_ENOMEM;
-    st_soup_edges E;
-    if ((rc = st_soup_edges_build(&E, s, err)))
-        return rc;
+    st_soup_edges own_edges;
+    const st_soup_edges *Ep = edges;
+    if (!Ep) {
+        if ((rc = st_soup_edges_build(&own_edges, s, err)))
+            return rc;
+        Ep = &own_edges;
+    }
     rc = ST_ENOMEM;
-    const uint32_t *weld = E.weld, *piece = E.piece;
-    const uint8_t *kept = E.kept;
-    const st_half_edge *he = E.he;
-    const size_t nh = E.nhalf, nw = E.nweld;
+    const uint32_t *weld = Ep->weld, *piece = Ep->piece;
+    const uint8_t *kept = Ep->kept;
+    const st_half_edge *he = Ep->he;
+    const size_t nh = Ep->nhalf, nw = Ep->nweld;
     st_soup *out = st_soup_new();
     double *piece_area = st_calloc_array(nt ? nt : 1, sizeof *piece_area);
     uint32_t *stamp = NULL, *be_a = NULL, *be_b = NULL, *be_t = NULL,
@@ -551,11 +563,13 @@ st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
     uint32_t *pa = NULL, *pb = NULL, *bdeg = NULL, *vstart = NULL, *vlist = NULL,
              *tstart = NULL, *tlist = NULL, *wpos = NULL;
     const double **pts = NULL, **side = NULL;
-    st_bvh *bvh = NULL;
+    st_bvh *own_bvh = NULL;
+    const st_bvh *bvh = shared_bvh;
     if (!out || !piece_area)
         goto done;
-    if ((rc = st_bvh_build(&bvh, s, err)))
+    if (!bvh && (rc = st_bvh_build(&own_bvh, s, err)))
         goto fail;
+    bvh = bvh ? bvh : own_bvh;
     rc = ST_ENOMEM;
 
     /* the pieces' areas and the boundary edges */
@@ -775,8 +789,9 @@ done:
     if (rc == ST_ENOMEM)
         st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
 fail:
-    st_soup_edges_free(&E);
-    st_bvh_free(bvh);
+    if (!edges)
+        st_soup_edges_free(&own_edges);
+    st_bvh_free(own_bvh);
     free(piece_area);
     free(stamp);
     free(be_a);

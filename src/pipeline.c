@@ -426,15 +426,14 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     pp.fill_holes = p->fill_holes;
     pp.closed_shells = p->closed_shells;
     st_pseudo_stats ps;
-    st_status rc = st_pseudo_volume(&g, s, &dp, &pp, &ps, prog, err);
+    /* the soup's BVH from the pseudo volume (the caps and the refinement
+     * used it): the fit's, the sculpting's and the checks' */
+    st_status rc = st_pseudo_volume_bvh(&g, s, &dp, &pp, &ps, prog, &bvh, err);
     if (rc)
         goto done;
     double t_sign = t_start + (now_seconds() - t_start) -
                     (ps.seconds_shells + ps.seconds_holes + ps.seconds_vote + ps.seconds_refine);
     st->seconds_dist = t_sign - t_start;
-    rc = st_bvh_build(&bvh, s, err);
-    if (rc)
-        goto done;
     double t_cand = now_seconds();
     st->seconds_sign = t_cand - t_sign;
     st->field_dims[0] = g->nx;

@@ -6,6 +6,9 @@
 #include "souptet/pseudo.h"
 
 #include "souptet/mem.h"
+#include "souptet/bvh.h"
+#include "souptet/edges.h"
+#include "souptet/holes.h"
 #include "souptet/mincut.h"
 #include "souptet/shells.h"
 
@@ -40,12 +43,13 @@ st_pseudo_params st_pseudo_params_default(void)
 
 /* Step 2: the caps of s's holes, lowered into g; *with_caps gets s and its
  * caps as one soup (NULL when there are none). */
-static st_status add_caps(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+static st_status add_caps(st_grid *g, const st_soup *s, const st_soup_edges *edges,
+                          const st_bvh *bvh, const st_pseudo_params *p,
                           st_pseudo_stats *st, st_soup **with_caps, st_error *err)
 {
     *with_caps = NULL;
     st_soup *caps = NULL;
-    st_status rc = st_soup_hole_caps(&caps, s, &p->holes, &st->holes, err);
+    st_status rc = st_soup_hole_caps_shared(&caps, s, edges, bvh, &p->holes, &st->holes, err);
     if (rc)
         return rc;
     st->cap_triangles = caps->ntris;
@@ -75,9 +79,9 @@ static st_status add_caps(st_grid *g, const st_soup *s, const st_pseudo_params *
 /* Step 3 with the sides (sides.h): the plain majority turns each
  * orientable region, the regions' local winding numbers join the votes as
  * the cut's evidence. */
-static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_pseudo_params *p,
-                                 st_pseudo_stats *st, const st_progress *progress,
-                                 st_error *err)
+static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_soup_edges *edges,
+                                 const st_pseudo_params *p, st_pseudo_stats *st,
+                                 const st_progress *progress, st_error *err)
 {
     const size_t n = st_grid_count(g);
     uint8_t *votes = st_malloc_array(n ? n : 1, 1);
@@ -88,7 +92,8 @@ static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_pseudo_p
     /* voxels the cut takes as the votes say get no evidence (mincut.h) */
     const int decided = st_mincut_params_default().fixed_evidence;
     rc = rc ? rc : st_sign_votes(g, &p->sign, votes, err);
-    rc = rc ? rc : st_sides_evidence(evidence, g, votes, decided, s, &sp, &st->sides, err);
+    rc = rc ? rc : st_sides_evidence_edges(evidence, g, votes, decided, s, edges, &sp,
+                                           &st->sides, err);
     rc = rc ? rc : st_sign_field_evidence(g, &p->sign, evidence, votes, progress, err);
     rc = rc ? rc : st_sides_mirror(g, &st->sides, &st->mirrored, err);
     free(votes);
@@ -100,6 +105,15 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
                          st_pseudo_stats *stats, const st_progress *progress,
                          st_error *err)
 {
+    return st_pseudo_sign_bvh(g, s, p, stats, progress, NULL, err);
+}
+
+st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+                             st_pseudo_stats *stats, const st_progress *progress,
+                             st_bvh **bvh_out, st_error *err)
+{
+    if (bvh_out)
+        *bvh_out = NULL;
     st_pseudo_stats local;
     st_pseudo_stats *st = stats ? stats : &local;
     memset(st, 0, sizeof *st);
@@ -110,11 +124,21 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
     st_shells shells;
     memset(&shells, 0, sizeof shells);
     st_soup *with_caps = NULL;
+    /* s's edge table and BVH, built once for the steps that read them */
+    st_soup_edges edges;
+    int have_edges = 0;
+    st_bvh *bvh = NULL;
     st_status rc = ST_OK;
     double t0 = now_seconds();
+    if (s && (p->closed_shells || p->fill_holes || (p->sides && p->sign.cut))) {
+        st->failed_step = p->closed_shells ? "shells" : p->fill_holes ? "holes" : "vote";
+        if ((rc = st_soup_edges_build(&edges, s, err)))
+            goto done;
+        have_edges = 1;
+    }
     if (s && p->closed_shells) {
         st->failed_step = "shells";
-        rc = st_soup_closed_shells(&shells, s, err);
+        rc = st_soup_closed_shells_edges(&shells, s, &edges, err);
         if (rc)
             goto done;
         st->shells = shells.count;
@@ -123,22 +147,36 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
     double t1 = now_seconds();
     st->seconds_shells = t1 - t0;
     st->failed_step = "holes";
-    if (s && p->fill_holes && (rc = add_caps(g, s, p, st, &with_caps, err)))
-        goto done;
+    if (s && p->fill_holes) {
+        if ((rc = st_bvh_build(&bvh, s, err)) ||
+            (rc = add_caps(g, s, &edges, bvh, p, st, &with_caps, err)))
+            goto done;
+    }
     double t2 = now_seconds();
     st->seconds_holes = t2 - t1;
     st->failed_step = "vote";
     if (s && p->sides && p->sign.cut) {
-        if ((rc = vote_with_sides(g, with_caps ? with_caps : s, p, st, progress, err)))
+        /* the caps are new triangles: their soup gets its own edges */
+        if ((rc = vote_with_sides(g, with_caps ? with_caps : s, with_caps ? NULL : &edges, p, st,
+                                  progress, err)))
             goto done;
     } else if ((rc = st_sign_field(g, &p->sign, progress, err)))
         goto done;
+    if (have_edges) {
+        st_soup_edges_free(&edges);
+        have_edges = 0;
+    }
     double t3 = now_seconds();
     st->seconds_vote = t3 - t2;
     st->failed_step = "refine";
-    if (s && p->refine_signs &&
-        (rc = st_sign_refine(g, with_caps ? with_caps : s, &p->refine, &st->refined, err)))
-        goto done;
+    if (s && p->refine_signs) {
+        if (!with_caps && bvh && s->ntris)
+            rc = st_sign_refine_bvh(g, bvh, &p->refine, &st->refined, err);
+        else
+            rc = st_sign_refine(g, with_caps ? with_caps : s, &p->refine, &st->refined, err);
+        if (rc)
+            goto done;
+    }
     double t4 = now_seconds();
     st->seconds_refine = t4 - t3;
     st->failed_step = "shells";
@@ -151,7 +189,16 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
         inside += g->data[i] < 0.0f;
     st->inside = inside;
     st->failed_step = NULL;
+    if (bvh_out && s) {
+        if (!bvh && (rc = st_bvh_build(&bvh, s, err)))
+            goto done;
+        *bvh_out = bvh;
+        bvh = NULL;
+    }
 done:
+    st_bvh_free(bvh);
+    if (have_edges)
+        st_soup_edges_free(&edges);
     st_soup_free(with_caps);
     st_shells_free(&shells);
     return rc;
@@ -161,13 +208,22 @@ st_status st_pseudo_volume(st_grid **out, const st_soup *s, const st_dist_params
                            const st_pseudo_params *p, st_pseudo_stats *stats,
                            const st_progress *progress, st_error *err)
 {
+    return st_pseudo_volume_bvh(out, s, dp, p, stats, progress, NULL, err);
+}
+
+st_status st_pseudo_volume_bvh(st_grid **out, const st_soup *s, const st_dist_params *dp,
+                               const st_pseudo_params *p, st_pseudo_stats *stats,
+                               const st_progress *progress, st_bvh **bvh_out, st_error *err)
+{
+    if (bvh_out)
+        *bvh_out = NULL;
     if (out)
         *out = NULL;
     if (!out || !s || !dp || !p)
         return st_error_set(err, ST_EINTERNAL, NULL, 0, "st_pseudo_volume: bad arguments");
     st_grid *g = NULL;
     st_status rc = st_dist_field(&g, s, dp, progress, err);
-    rc = rc ? rc : st_pseudo_sign(g, s, p, stats, progress, err);
+    rc = rc ? rc : st_pseudo_sign_bvh(g, s, p, stats, progress, bvh_out, err);
     if (rc) {
         st_grid_free(g);
         return rc;

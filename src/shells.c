@@ -45,11 +45,18 @@ static double tet_volume6(const double *r, const double *a, const double *b, con
 
 st_status st_soup_closed_shells(st_shells *out, const st_soup *s, st_error *err)
 {
+    return st_soup_closed_shells_edges(out, s, NULL, err);
+}
+
+st_status st_soup_closed_shells_edges(st_shells *out, const st_soup *s,
+                                      const st_soup_edges *edges, st_error *err)
+{
     memset(out, 0, sizeof *out);
-    st_soup_edges E;
-    st_status rc = st_soup_edges_build(&E, s, err);
+    st_soup_edges own;
+    st_status rc = edges ? ST_OK : st_soup_edges_build(&own, s, err);
     if (rc)
         return rc;
+    const st_soup_edges E = edges ? *edges : own;
     const size_t nt = s->ntris;
     rc = ST_ENOMEM;
     uint32_t *nbr = st_malloc_array(3 * nt + 1, sizeof *nbr);     /* 3 slots per triangle */
@@ -125,7 +132,8 @@ done:
         st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the closed shells");
 fail:
     st_soup_free(closed);
-    st_soup_edges_free(&E);
+    if (!edges)
+        st_soup_edges_free(&own);
     free(nbr);
     free(same);
     free(open);

@@ -227,15 +227,24 @@ st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *v
                             const st_sides_params *p, st_sides_stats *stats,
                             st_error *err)
 {
+    return st_sides_evidence_edges(evidence, g, votes, decided, s, NULL, p, stats, err);
+}
+
+st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint8_t *votes,
+                                  int decided, const st_soup *s, const st_soup_edges *edges,
+                                  const st_sides_params *p, st_sides_stats *stats,
+                                  st_error *err)
+{
     st_sides_stats local;
     st_sides_stats *st = stats ? stats : &local;
     memset(st, 0, sizeof *st);
     const size_t n = st_grid_count(g);
     memset(evidence, 0, n);
-    st_soup_edges E;
-    st_status rc = st_soup_edges_build(&E, s, err);
+    st_soup_edges own;
+    st_status rc = edges ? ST_OK : st_soup_edges_build(&own, s, err);
     if (rc)
         return rc;
+    const st_soup_edges E = edges ? *edges : own;
     const size_t nt = s->ntris;
     uint32_t *nbr = st_malloc_array(3 * nt + 1, sizeof *nbr);
     uint8_t *same = st_malloc_array(3 * nt + 1, 1);
@@ -361,7 +370,8 @@ st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *v
 done:
     st_bvh_free(bvh);
     st_soup_free(o);
-    st_soup_edges_free(&E);
+    if (!edges)
+        st_soup_edges_free(&own);
     free(nbr);
     free(same);
     free(flip);

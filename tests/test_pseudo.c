@@ -4,9 +4,11 @@
  * one by one, and large holes close: a box with a whole face missing (of
  * any size), a thin plate with half of one face gone, a one-sided
  * hemisphere shell, a one-sided scan of a ball whose horizon is not
- * flat; an unoriented soup gives what an oriented one gives.
+ * flat; an unoriented soup gives what an oriented one gives; the steps
+ * given the soup's edge table and BVH give what they give alone.
  */
 #include "souptet/pseudo.h"
+#include "souptet/shells.h"
 #include "souptet/solid.h"
 #include "shapes.h"
 #include "tap.h"
@@ -293,6 +295,59 @@ static void test_sides_orientation(void)
     st_soup_free(b);
 }
 
+static void test_shared_tables(void)
+{
+    /* The steps given the soup's edge table and BVH (built once) give what
+     * they give building their own; st_pseudo_sign_bvh signs as
+     * st_pseudo_sign does and hands over the soup's BVH. */
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    st_soup *s = st_soup_new();
+    add_box_faces(s, lo, hi, 4, top_face, 1);
+    st_error err;
+    st_soup_edges E;
+    st_bvh *own = NULL, *handed = NULL;
+    int ok = !st_soup_edges_build(&E, s, &err) && !st_bvh_build(&own, s, &err);
+    st_shells a, b;
+    memset(&a, 0, sizeof a);
+    memset(&b, 0, sizeof b);
+    ok = ok && !st_soup_closed_shells(&a, s, &err) && !st_soup_closed_shells_edges(&b, s, &E, &err);
+    TAP_CHECK(ok && a.count == b.count && a.open_triangles == b.open_triangles &&
+              a.closed->ntris == b.closed->ntris,
+              "closed shells from a shared edge table");
+    st_soup *ca = NULL, *cb = NULL;
+    const st_holes_params hp = st_holes_params_default();
+    ok = ok && !st_soup_hole_caps(&ca, s, &hp, NULL, &err) &&
+         !st_soup_hole_caps_shared(&cb, s, &E, own, &hp, NULL, &err);
+    TAP_CHECK(ok && ca->ntris > 0 && ca->ntris == cb->ntris && ca->nverts == cb->nverts &&
+              !memcmp(ca->tris, cb->tris, 3 * ca->ntris * sizeof *ca->tris) &&
+              !memcmp(ca->xyz, cb->xyz, 3 * ca->nverts * sizeof *ca->xyz),
+              "the same hole caps from a shared edge table and BVH (%zu triangles)",
+              ok ? ca->ntris : 0);
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = 24;
+    st_grid *g1 = NULL, *g2 = NULL;
+    const st_pseudo_params pp = st_pseudo_params_default();
+    ok = ok && !st_dist_field(&g1, s, &dp, NULL, &err) && !st_dist_field(&g2, s, &dp, NULL, &err) &&
+         !st_pseudo_sign(g1, s, &pp, NULL, NULL, &err) &&
+         !st_pseudo_sign_bvh(g2, s, &pp, NULL, NULL, &handed, &err);
+    TAP_CHECK(ok && !memcmp(g1->data, g2->data, st_grid_count(g1) * sizeof *g1->data),
+              "st_pseudo_sign_bvh signs as st_pseudo_sign");
+    TAP_CHECK(ok && handed && handed->soup == s && handed->nnodes == own->nnodes &&
+              !memcmp(handed->nodes, own->nodes, own->nnodes * sizeof *own->nodes) &&
+              !memcmp(handed->order, own->order, s->ntris * sizeof *own->order),
+              "and hands over the soup's BVH");
+    st_grid_free(g1);
+    st_grid_free(g2);
+    st_soup_free(ca);
+    st_soup_free(cb);
+    st_shells_free(&a);
+    st_shells_free(&b);
+    st_bvh_free(own);
+    st_bvh_free(handed);
+    st_soup_edges_free(&E);
+    st_soup_free(s);
+}
+
 int main(void)
 {
     test_entry_point();
@@ -300,5 +355,6 @@ int main(void)
     test_hemisphere();
     test_onesided();
     test_sides_orientation();
+    test_shared_tables();
     return tap_done();
 }

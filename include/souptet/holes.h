@@ -58,6 +58,8 @@
 #define SOUPTET_HOLES_H
 
 #include <stddef.h>
+#include "souptet/bvh.h"
+#include "souptet/edges.h"
 #include "souptet/err.h"
 #include "souptet/soup.h"
 
@@ -93,6 +95,14 @@ st_holes_params st_holes_params_default(void);
 st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
                             const st_holes_params *p, st_holes_stats *stats,
                             st_error *err);
+
+/* The same with s's edge table (st_soup_edges_build) and BVH
+ * (st_bvh_build) when the caller has them (either may be NULL: built here
+ * and freed). The same caps. */
+st_status st_soup_hole_caps_shared(st_soup **caps, const st_soup *s,
+                                   const st_soup_edges *edges, const st_bvh *bvh,
+                                   const st_holes_params *p, st_holes_stats *stats,
+                                   st_error *err);
 
 #ifdef __cplusplus
 }

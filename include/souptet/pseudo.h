@@ -29,6 +29,7 @@
 
 #include <stddef.h>
 
+#include "souptet/bvh.h"
 #include "souptet/dist.h"
 #include "souptet/err.h"
 #include "souptet/grid.h"
@@ -88,6 +89,16 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
 st_status st_pseudo_volume(st_grid **out, const st_soup *s, const st_dist_params *dp,
                            const st_pseudo_params *p, st_pseudo_stats *stats,
                            const st_progress *progress, st_error *err);
+
+/* The same, handing the caller s's BVH (st_bvh_build; the one the caps
+ * and the refinement used, else built at the end): *bvh gets it (the
+ * caller's to free with st_bvh_free), NULL on failure. */
+st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+                             st_pseudo_stats *stats, const st_progress *progress,
+                             st_bvh **bvh, st_error *err);
+st_status st_pseudo_volume_bvh(st_grid **out, const st_soup *s, const st_dist_params *dp,
+                               const st_pseudo_params *p, st_pseudo_stats *stats,
+                               const st_progress *progress, st_bvh **bvh, st_error *err);
 
 #ifdef __cplusplus
 }

@@ -26,6 +26,7 @@
 #define SOUPTET_SHELLS_H
 
 #include <stddef.h>
+#include "souptet/edges.h"
 #include "souptet/err.h"
 #include "souptet/grid.h"
 #include "souptet/soup.h"
@@ -43,6 +44,10 @@ typedef struct st_shells {
 
 /* ST_ENOMEM, ST_ELIMIT (more than 2^31 triangles). */
 st_status st_soup_closed_shells(st_shells *out, const st_soup *s, st_error *err);
+/* The same with s's edge table (st_soup_edges_build) when the caller has
+ * it (NULL: built here). */
+st_status st_soup_closed_shells_edges(st_shells *out, const st_soup *s,
+                                      const st_soup_edges *edges, st_error *err);
 void st_shells_free(st_shells *sh);
 
 /* Give the signed field g (st_sign_field) the closed shells' solid: every

@@ -42,6 +42,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "souptet/edges.h"
 #include "souptet/err.h"
 #include "souptet/grid.h"
 #include "souptet/soup.h"
@@ -82,6 +83,12 @@ st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *v
                             int decided, const st_soup *s,
                             const st_sides_params *p, st_sides_stats *stats,
                             st_error *err);
+/* The same with s's edge table (st_soup_edges_build) when the caller has
+ * it (NULL: built here). */
+st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint8_t *votes,
+                                  int decided, const st_soup *s, const st_soup_edges *edges,
+                                  const st_sides_params *p, st_sides_stats *stats,
+                                  st_error *err);
 
 /* A one-sided view's far side (stats->onesided; nothing otherwise), on
  * the signed field g of its pseudo volume: along each line of the lattice
