@@ -55,6 +55,30 @@ static double tri_area(const double *a, const double *b, const double *c)
     return 0.5 * st_norm3(n);
 }
 
+/* The triangles of a polygon triangulation chosen by dynamic programming:
+ * best[i n + j] is the apex over the edge (i, j); tri[3 (n - 2)] gets them
+ * with local indices, from the edge (0, n - 1) down (stack holds 2 n). */
+static void emit_triangles(const uint16_t *best, size_t n, size_t *stack, uint32_t *tri)
+{
+    size_t top = 0, nt = 0;
+    stack[top++] = 0;
+    stack[top++] = n - 1;
+    while (top) {
+        const size_t j = stack[--top], i = stack[--top];
+        if (j - i < 2)
+            continue;
+        const size_t k = best[i * n + j];
+        tri[3 * nt] = (uint32_t)i;
+        tri[3 * nt + 1] = (uint32_t)k;
+        tri[3 * nt + 2] = (uint32_t)j;
+        nt++;
+        stack[top++] = i;
+        stack[top++] = k;
+        stack[top++] = k;
+        stack[top++] = j;
+    }
+}
+
 /* The least-area triangulation of the polygon pts[0..n) (n >= 3): fills
  * tri[3 (n - 2)] with local indices and returns its area; -1 when out of
  * memory. */
@@ -87,23 +111,7 @@ static double least_area(const double *const *pts, size_t n, uint32_t *tri)
             best[i * n + j] = (uint16_t)mk;
         }
     const double area = w[n - 1];
-    size_t top = 0, nt = 0;
-    stack[top++] = 0;
-    stack[top++] = n - 1;
-    while (top) {
-        const size_t j = stack[--top], i = stack[--top];
-        if (j - i < 2)
-            continue;
-        const size_t k = best[i * n + j];
-        tri[3 * nt] = (uint32_t)i;
-        tri[3 * nt + 1] = (uint32_t)k;
-        tri[3 * nt + 2] = (uint32_t)j;
-        nt++;
-        stack[top++] = i;
-        stack[top++] = k;
-        stack[top++] = k;
-        stack[top++] = j;
-    }
+    emit_triangles(best, n, stack, tri);
     free(w);
     free(best);
     free(stack);
@@ -209,23 +217,7 @@ static double least_bend(const double *const *pts, const double *const *side, si
             memcpy(nrm + 3 * (i * n + j), bn, sizeof bn);
         }
     const double area = w[n - 1];
-    size_t top = 0, nt = 0;
-    stack[top++] = 0;
-    stack[top++] = n - 1;
-    while (top) {
-        const size_t j = stack[--top], i = stack[--top];
-        if (j - i < 2)
-            continue;
-        const size_t k = best[i * n + j];
-        tri[3 * nt] = (uint32_t)i;
-        tri[3 * nt + 1] = (uint32_t)k;
-        tri[3 * nt + 2] = (uint32_t)j;
-        nt++;
-        stack[top++] = i;
-        stack[top++] = k;
-        stack[top++] = k;
-        stack[top++] = j;
-    }
+    emit_triangles(best, n, stack, tri);
     free(ang), free(w), free(nrm), free(best), free(stack);
     return area;
 }
