@@ -176,16 +176,16 @@ static void test_which_loops(void)
     st_soup_free(box);
 }
 
-/* The box [0,4] x [0,1] x [0,1] as an exact soup on a grid of spacing
- * 1/10 on every face (so the faces' edges meet), every other triangle
- * flipped; with slot 1, the top face (z = 1) has a slot 3 long and 0.8
- * wide cut out of it: a gutter; with slot 2, two of its triangles that
- * share only a vertex are missing: two holes touching there. */
-static st_soup *slotted_box(int slot)
+/* The box [0, hi] with n[axis] cells along each axis, every face split
+ * into two triangles per cell (q0 q1 q2, flipped on every other cell, and
+ * q0 q2 q3), each kept when keep(arg, axis, side, a, b, q, second) says
+ * so. */
+typedef int (*facet_keep)(int arg, int axis, int side, int a, int b, const double q[4][3],
+                          int second);
+
+static st_soup *gridded_box(const double hi[3], const int n[3], facet_keep keep, int arg)
 {
     st_soup *s = st_soup_new();
-    const double hi[3] = {4, 1, 1};
-    const int n[3] = {40, 10, 10};
     for (int axis = 0; axis < 3; axis++)
         for (int side = 0; side < 2; side++) {
             const int u = (axis + 1) % 3, w = (axis + 2) % 3;
@@ -198,24 +198,42 @@ static st_soup *slotted_box(int slot)
                         q[c][u] = hi[u] * (a + da) / n[u];
                         q[c][w] = hi[w] * (b + db) / n[w];
                     }
-                    const double cx = (q[0][0] + q[2][0]) / 2, cy = (q[0][1] + q[2][1]) / 2;
-                    if (slot == 1 && axis == 2 && side && cx > 0.5 && cx < 3.5 && cy > 0.1 &&
-                        cy < 0.9)
-                        continue;
-                    /* slot 2: two triangles of the top face that share
-                     * one vertex and no edge */
-                    const int top = slot == 2 && axis == 2 && side;
-                    /* slot 3: about half of all triangles deleted, by a
-                     * fixed hash of where they are */
-                    const unsigned h = (unsigned)(((axis * 2 + side) * 64 + a) * 64 + b) * 2654435761u;
-                    const int del1 = slot == 3 && (h >> 13 & 1), del2 = slot == 3 && (h >> 17 & 1);
-                    if (!(top && a == 10 && b == 5) && !del1)
+                    if (keep(arg, axis, side, a, b, (const double(*)[3])q, 0))
                         add_tri(s, q[0], q[1], q[2], (a + b) & 1);
-                    if (!(top && a == 9 && b == 4) && !del2)
+                    if (keep(arg, axis, side, a, b, (const double(*)[3])q, 1))
                         add_tri(s, q[0], q[2], q[3], 0);
                 }
         }
     return s;
+}
+
+/* The box [0,4] x [0,1] x [0,1] as an exact soup on a grid of spacing
+ * 1/10 on every face (so the faces' edges meet), every other triangle
+ * flipped; with slot 1, the top face (z = 1) has a slot 3 long and 0.8
+ * wide cut out of it: a gutter; with slot 2, two of its triangles that
+ * share only a vertex are missing: two holes touching there. */
+static int slotted_keep(int slot, int axis, int side, int a, int b, const double q[4][3],
+                        int second)
+{
+    const double cx = (q[0][0] + q[2][0]) / 2, cy = (q[0][1] + q[2][1]) / 2;
+    if (slot == 1 && axis == 2 && side && cx > 0.5 && cx < 3.5 && cy > 0.1 && cy < 0.9)
+        return 0;
+    /* slot 2: two triangles of the top face that share one vertex and
+     * no edge */
+    const int top = slot == 2 && axis == 2 && side;
+    if (top && (second ? a == 9 && b == 4 : a == 10 && b == 5))
+        return 0;
+    /* slot 3: about half of all triangles deleted, by a fixed hash of
+     * where they are */
+    const unsigned h = (unsigned)(((axis * 2 + side) * 64 + a) * 64 + b) * 2654435761u;
+    return !(slot == 3 && (h >> (second ? 17 : 13) & 1));
+}
+
+static st_soup *slotted_box(int slot)
+{
+    static const double hi[3] = {4, 1, 1};
+    static const int n[3] = {40, 10, 10};
+    return gridded_box(hi, n, slotted_keep, slot);
 }
 
 /* A prism over a regular 16-gon of radius 1, z in [0, 8], its ends fans
@@ -250,31 +268,19 @@ static st_soup *prism(int missing)
  * 0.1, every other triangle flipped; with notch, the triangles of its top,
  * bottom and x = 2 rim over x > 1.4, 0.6 < y < 1.4 are missing: one hole
  * through both faces of the plate, across its edge. */
+static int plate_keep(int notch, int axis, int side, int a, int b, const double q[4][3],
+                      int second)
+{
+    (void)a, (void)b, (void)second;
+    const double cx = (q[0][0] + q[2][0]) / 2, cy = (q[0][1] + q[2][1]) / 2;
+    return !(notch && cx > 1.4 && cy > 0.6 && cy < 1.4 && (axis == 2 || (axis == 0 && side)));
+}
+
 static st_soup *plate(int notch)
 {
-    st_soup *s = st_soup_new();
-    const double hi[3] = {2, 2, 0.2};
-    const int n[3] = {20, 20, 2};
-    for (int axis = 0; axis < 3; axis++)
-        for (int side = 0; side < 2; side++) {
-            const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-            for (int a = 0; a < n[u]; a++)
-                for (int b = 0; b < n[w]; b++) {
-                    double q[4][3];
-                    for (int c = 0; c < 4; c++) {
-                        int da = c == 1 || c == 2, db = c >= 2;
-                        q[c][axis] = side ? hi[axis] : 0.0;
-                        q[c][u] = hi[u] * (a + da) / n[u];
-                        q[c][w] = hi[w] * (b + db) / n[w];
-                    }
-                    const double cx = (q[0][0] + q[2][0]) / 2, cy = (q[0][1] + q[2][1]) / 2;
-                    if (notch && cx > 1.4 && cy > 0.6 && cy < 1.4 && (axis == 2 || (axis == 0 && side)))
-                        continue;
-                    add_tri(s, q[0], q[1], q[2], (a + b) & 1);
-                    add_tri(s, q[0], q[2], q[3], 0);
-                }
-        }
-    return s;
+    static const double hi[3] = {2, 2, 0.2};
+    static const int n[3] = {20, 20, 2};
+    return gridded_box(hi, n, plate_keep, notch);
 }
 
 /* IoU of the default pseudo volume of s (with its caps when capped: 1 the
