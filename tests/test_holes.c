@@ -284,7 +284,7 @@ static st_soup *plate(int notch)
 }
 
 /* IoU of the default pseudo volume of s (with its caps when capped: 1 the
- * default caps, 2 the caps that bend least) with the solid of the closed
+ * default caps, 2 the caps that bend least, 3 rebuilt corners) with the solid of the closed
  * soup `whole`, at 64 voxels along the longest side; *cap_tris gets the
  * caps' size. */
 static double capped_iou(const st_soup *s, const st_soup *whole, int capped, size_t *cap_tris)
@@ -298,6 +298,7 @@ static double capped_iou(const st_soup *s, const st_soup *whole, int capped, siz
     uint8_t *truth = NULL;
     st_holes_params hp = st_holes_params_default();
     hp.bend = capped == 2;
+    hp.planes = capped == 3;
     st_sign_params sp = st_sign_params_default();
     if (st_dist_field(&g, s, &dp, NULL, &err) || st_soup_hole_caps(&caps, s, &hp, NULL, &err))
         goto out;
@@ -434,10 +435,68 @@ static void test_bend(void)
     st_soup_free(whole);
 }
 
+/* The unit box on a grid of spacing 0.1; with corner, the triangles of
+ * its faces x = 1, y = 1 and z = 1 within 0.4 of the corner (1, 1, 1)
+ * are missing: the corner is lost, and the loop (6 segments 0.4 long)
+ * runs over the three faces around it. */
+static int corner_keep(int corner, int axis, int side, int a, int b, const double q[4][3],
+                       int second)
+{
+    (void)axis, (void)a, (void)b, (void)second;
+    int near = 1;
+    for (int k = 0; k < 3; k++)
+        near &= (q[0][k] + q[2][k]) / 2 > 0.6;
+    return !(corner && side && near);
+}
+
+static st_soup *cornered_box(int corner)
+{
+    static const double hi[3] = {1, 1, 1};
+    static const int n[3] = {10, 10, 10};
+    return gridded_box(hi, n, corner_keep, corner);
+}
+
+/* A box with a whole corner cut out of its surface (issue 17): a cap over
+ * the loop's own points chamfers the corner away; the planes of the three
+ * faces around the hole meet at it, and the cone from there over the loop
+ * is the lost corner's three squares. */
+static void test_corner(void)
+{
+    st_soup *whole = cornered_box(0), *cut = cornered_box(1), *caps = NULL;
+    st_holes_params hp = st_holes_params_default();
+    st_holes_stats hs;
+    st_error err;
+    size_t nt = 0;
+    TAP_CHECK(hp.planes == 0, "corners are not rebuilt by default");
+    hp.planes = 1;
+    int ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err);
+    TAP_CHECK(ok && hs.loops == 1 && hs.filled == 1 && hs.rebuilt == 1 && caps->ntris == 24,
+              "a box without its corner: one loop of 24 edges, capped by the cone from the "
+              "corner (%zu loops, %zu rebuilt, %zu triangles)", hs.loops, hs.rebuilt,
+              ok ? caps->ntris : 0);
+    if (ok) {
+        TAP_NEAR(soup_area(caps), 3 * 0.4 * 0.4, 1e-12, "the cap is the three lost squares");
+        int at = 0;
+        for (size_t v = 0; v < caps->nverts; v++)
+            at += caps->xyz[3 * v] == 1.0 && caps->xyz[3 * v + 1] == 1.0 &&
+                  caps->xyz[3 * v + 2] == 1.0;
+        TAP_CHECK(at == 1, "its apex is the corner (1, 1, 1) exactly");
+    }
+    st_soup_free(caps);
+    const double iou_whole = capped_iou(whole, whole, 1, &nt);
+    const double iou_area = capped_iou(cut, whole, 1, &nt), iou = capped_iou(cut, whole, 3, &nt);
+    TAP_CHECK(iou >= iou_whole - 1e-9 && iou_area < iou_whole - 0.002,
+              "the box without its corner signs as the whole box: IoU %.4f (the whole box %.4f, "
+              "with the least-area cap %.4f)", iou, iou_whole, iou_area);
+    st_soup_free(cut);
+    st_soup_free(whole);
+}
+
 int main(void)
 {
     test_which_loops();
     test_pseudo_volume();
     test_bend();
+    test_corner();
     return tap_done();
 }

@@ -29,7 +29,16 @@
  * cap has the loop's points only; where such a corner was concave (a
  * notch) the cap that bends least extends the faces across it, and on a
  * one-sided scan it continues the walls past the far side: not the
- * default (the numbers at st_holes_params_default in holes.c).
+ * default (the numbers at st_holes_params_default in holes.c). With
+ * planes, a lost corner is rebuilt where the planes of the soup's
+ * triangles along the loop meet: the cone from the point where three of
+ * them meet (or from the line where two meet, nearest the loop's
+ * centroid), within the loop's box grown by 0.75 of its extent, over the
+ * loop replaces the cap when its triangles continue the soup's along the
+ * loop clearly better (the sum over the loop's edges of length times
+ * dihedral angle below half the cap's): a box's lost corner comes back
+ * whole. Not the default either: it helps the large holes of CAD parts
+ * but loses on one-sided scans.
  *
  * Not every loop is a hole: an open patch (a panel of a CAD part, one of a
  * teapot's patches, a sheet) has a loop around itself, and capping it would
@@ -75,12 +84,16 @@ typedef struct st_holes_params {
                              * capped whatever its size (0: never) */
     int bend;               /* 1: the cap that bends least; 0 (default):
                              * the cap of least area */
+    int planes;             /* 1: the cap rebuilt from the planes along
+                             * the loop where they agree on one, else as
+                             * bend says */
 } st_holes_params;
 
 typedef struct st_holes_stats {
     size_t boundary_edges;
     size_t loops;           /* loops traced */
     size_t filled;          /* loops capped */
+    size_t rebuilt;         /* of them, rebuilt from the planes around */
     size_t too_large;       /* cap above max_cap_ratio (or of no area) */
     size_t too_long;        /* more than max_loop edges */
     size_t pinched;         /* boundary edges on paths through a vertex

@@ -73,8 +73,12 @@ static void usage(void)
 "                       boundary edges, by the triangulation of least area,\n"
 "                       when small beside the surface around them) before\n"
 "                       voting (default on)\n"
-"      --caps area|bend  with --fill-holes: each cap is the loop's triangulation\n"
-"                       of least area (default) or the one that bends least\n"
+"      --caps area|bend|planes|planes-bend  with --fill-holes: each cap is the\n"
+"                       loop's triangulation of least area (default) or the\n"
+"                       one that bends least; planes: a lost corner rebuilt\n"
+"                       where the faces' planes along the loop meet, when it\n"
+"                       continues them better, else the least-area cap\n"
+"                       (planes-bend: else the one that bends least)\n"
 "      --shells on|off  with --surface: the surface's closed pieces (every edge\n"
 "                       shared by two faces) bound their solid exactly: inside\n"
 "                       them is inside, and when the surface is nothing else\n"
@@ -250,8 +254,13 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
             s->bend_caps = 0;
         else if (strcmp(arg, "bend") == 0)
             s->bend_caps = 1;
+        else if (strcmp(arg, "planes") == 0)
+            s->bend_caps = 2;
+        else if (strcmp(arg, "planes-bend") == 0)
+            s->bend_caps = 3;
         else
-            return tool_usage_error(t, "--caps is area or bend, not '%s'", arg);
+            return tool_usage_error(t, "--caps is area, bend, planes or planes-bend, not '%s'",
+                                    arg);
         break;
     case OPT_SIDES:
         if (tool_parse_switch(t, "--sides", arg, &s->use_sides))
@@ -340,7 +349,8 @@ static int run(tool_ctx *t, void *settings)
     pp.sign = *p;
     pp.refine = s->refine;
     pp.fill_holes = s->fill_holes;
-    pp.holes.bend = s->bend_caps;
+    pp.holes.bend = s->bend_caps & 1;
+    pp.holes.planes = (s->bend_caps & 2) != 0;
     pp.closed_shells = s->use_shells;
     pp.sides = s->use_sides;
     st_progress prog = tool_progress(t);

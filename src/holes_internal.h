@@ -1,0 +1,59 @@
+/*
+ * holes_internal.h - the caps rebuilt from the planes around a hole
+ * (holes_planes.c), for holes.c.
+ */
+#ifndef SOUPTET_HOLES_INTERNAL_H
+#define SOUPTET_HOLES_INTERNAL_H
+
+#include <stddef.h>
+#include <math.h>
+#include "souptet/err.h"
+#include "souptet/geom.h"
+#include "souptet/soup.h"
+
+/* The distance between a and b. */
+static inline double dist3(const double *a, const double *b)
+{
+    double d[3];
+    st_sub3(d, a, b);
+    return st_norm3(d);
+}
+
+/* Unit normal of triangle (p, q, r), (q - p) x (r - p); zero when
+ * degenerate. */
+static inline void unit_normal(double *nrm, const double *p, const double *q, const double *r)
+{
+    double u[3], v[3];
+    st_sub3(u, q, p);
+    st_sub3(v, r, p);
+    st_cross3(nrm, u, v);
+    const double l = st_norm3(nrm);
+    for (int k = 0; k < 3; k++)
+        nrm[k] = l > 0.0 ? nrm[k] / l : 0.0;
+}
+
+/* The bend across an edge between two triangles whose unit normals are a
+ * and b (both of one orientation, each passing the edge the other way):
+ * their dihedral deviation in radians, 0 where they continue flat, pi
+ * where one folds back onto the other; 4 (more than any fold) where a
+ * triangle is degenerate. */
+static inline double bend(const double *a, const double *b)
+{
+    if (st_dot3(a, a) == 0.0 || st_dot3(b, b) == 0.0)
+        return 4.0;
+    double c[3];
+    st_cross3(c, a, b);
+    return atan2(st_norm3(c), st_dot3(a, b));
+}
+
+/* The cap of the loop pts[0..n) (n >= 3) from a corner rebuilt from the
+ * planes of the soup's triangles along it (side[i]: the third point of
+ * the triangle on edge pts[i] -> pts[i + 1 mod n]; see holes_planes.c):
+ * the cone from the apex that bends least, when it bends less than
+ * `below`, is appended to out (n + 1 vertices, n triangles) and *done set
+ * to 1; else out is left as it was and *done is 0. ST_ENOMEM, ST_ELIMIT. */
+st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
+                              const double *const *side, size_t n, double below,
+                              st_error *err);
+
+#endif
