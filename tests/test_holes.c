@@ -449,6 +449,17 @@ static int corner_keep(int corner, int axis, int side, int a, int b, const doubl
     return !(corner && side && near);
 }
 
+/* corner_keep's box with 2: its face x = 1 missing; plate_keep's plate
+ * with 2: the half x > 1 of its top face missing. */
+static int face_keep(int which, int axis, int side, int a, int b, const double q[4][3],
+                     int second)
+{
+    if (which == 2)
+        return !(axis == 0 && side);
+    return plate_keep(0, axis, side, a, b, q, second) &&
+           !(axis == 2 && side && (q[0][0] + q[2][0]) / 2 > 1.0);
+}
+
 static st_soup *cornered_box(int corner)
 {
     static const double hi[3] = {1, 1, 1};
@@ -488,6 +499,28 @@ static void test_corner(void)
     TAP_CHECK(iou >= iou_whole - 1e-9 && iou_area < iou_whole - 0.002,
               "the box without its corner signs as the whole box: IoU %.4f (the whole box %.4f, "
               "with the least-area cap %.4f)", iou, iou_whole, iou_area);
+    st_soup_free(cut);
+    st_soup_free(whole);
+
+    /* issue 17's first two: a box with one whole face missing, a thin
+     * plate with half of one face missing (flat loops: their caps are the
+     * faces, by default) */
+    static const double bhi[3] = {1, 1, 1}, phi[3] = {2, 2, 0.2};
+    static const int bn[3] = {10, 10, 10}, pn[3] = {20, 20, 2};
+    whole = cornered_box(0);
+    cut = gridded_box(bhi, bn, face_keep, 2);
+    const double iou_face = capped_iou(cut, whole, 1, &nt);
+    TAP_CHECK(cut->ntris == whole->ntris - 200 && iou_face >= iou_whole - 1e-9,
+              "a box without one face signs as the whole box: IoU %.4f", iou_face);
+    st_soup_free(cut);
+    st_soup_free(whole);
+    whole = plate(0);
+    cut = gridded_box(phi, pn, face_keep, 1);
+    const double plate_whole = capped_iou(whole, whole, 1, &nt);
+    const double iou_half = capped_iou(cut, whole, 1, &nt);
+    TAP_CHECK(cut->ntris == whole->ntris - 400 && iou_half >= plate_whole - 1e-9,
+              "a thin plate without half of one face signs as the whole plate: IoU %.4f (%.4f)",
+              iou_half, plate_whole);
     st_soup_free(cut);
     st_soup_free(whole);
 }
