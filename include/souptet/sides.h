@@ -57,6 +57,14 @@ typedef struct st_sides_params {
     double weight;          /* evidence per unit of winding number */
     int max_evidence;       /* |evidence| at most this */
     double onesided_ratio;  /* one-sided below this back/front ratio (0: never) */
+    size_t seen_triangles;  /* the view reads the first this many triangles
+                               of the soup (the seen surface; the rest are
+                               its caps); 0: all */
+    double wall_cosine;     /* a rim face is a wall where |cos| to the view
+                               is at most this */
+    double walls_ratio;     /* mirrored below this walls' share of the rim */
+    int past_caps;          /* the view of the seen soup alone, and the
+                               mirror past its caps (0; see st_sides_mirror) */
 } st_sides_params;
 
 st_sides_params st_sides_params_default(void);
@@ -70,8 +78,14 @@ typedef struct st_sides_stats {
                                facing it (0 for a one-sided view, 1 closed) */
     double view[3];         /* the view direction (unit; the mean normal) */
     int onesided;           /* back_front < onesided_ratio */
+    double walls;           /* the rim's area share of walls (faces along
+                               the view) */
+    int fold;               /* mirrored: onesided, and with past_caps
+                               walls < walls_ratio */
+    int past_caps;          /* the params' past_caps */
+    double far;             /* without past_caps: the soup's farthest point
+                               along the step (-INFINITY with it) */
     int step[3];            /* the lattice step nearest view */
-    double far;             /* the soup's farthest point along it */
 } st_sides_stats;
 
 /* evidence (n bytes) gets each voxel's evidence (0 where none). g: the
@@ -104,8 +118,8 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
  * (a flat one) ends the runs on the cap and is left as it is. *changed
  * gets the voxels made inside. Deterministic: each line is one thread's.
  * ST_ENOMEM. */
-st_status st_sides_mirror(st_grid *g, const st_sides_stats *stats, size_t *changed,
-                          st_error *err);
+st_status st_sides_mirror(st_grid *g, const st_soup *s, size_t seen_triangles,
+                          const st_sides_stats *stats, size_t *changed, st_error *err);
 
 #ifdef __cplusplus
 }
