@@ -157,7 +157,8 @@ static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_er
 }
 
 enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT,
-       OPT_CAPS, OPT_SIDES, OPT_ONESIDED, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
+       OPT_CAPS, OPT_SIDES, OPT_ONESIDED, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS,
+       OPT_REFINE_ANSWERS };
 
 static const struct option longopts[] = {
     {"band", required_argument, NULL, OPT_BAND},
