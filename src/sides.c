@@ -135,6 +135,30 @@ static void least_eigenvector(double a[3][3], double out[3])
         out[k] = v[k][m];
 }
 
+/* The area share of o's rim faces (rim, of the first nview) within
+ * p->wall_cosine of square to view: walls along the view. When mm is not
+ * NULL it gets their second moments weighted 1/|cos| (at most 1e6). */
+static double walls_share(const st_soup *o, size_t nview, const uint8_t *rim,
+                          const double view[3], const st_sides_params *p, double mm[3][3])
+{
+    double all = 0.0, wall = 0.0;
+    for (size_t t = 0; t < nview; t++) {
+        double n[3];
+        tri_normal(o, t, n);
+        const double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!rim[t] || !(l > 0.0))
+            continue;
+        const double c = fabs(n[0] * view[0] + n[1] * view[1] + n[2] * view[2]) / l;
+        all += l;
+        wall += c <= p->wall_cosine ? l : 0.0;
+        const double w = 1.0 / (l * (c > 1e-6 ? c : 1e-6));
+        for (int a = 0; mm && a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                mm[a][b] += n[a] * n[b] * w;
+    }
+    return all > 0.0 ? wall / all : 0.0;
+}
+
 /* 4. A one-sided view (sides.h): the view v of the oriented soup o's
  * first nview triangles (the seen ones), and the lattice step nearest it.
  * A scan's faces turn away from the viewer at its horizon, where it was
@@ -180,43 +204,15 @@ static void view_of(const st_soup *o, size_t nview, const uint8_t *rim,
         for (int k = 0; k < 3; k++)
             st->view[k] = d > 0.0 ? e[k] : -e[k];
         memset(mm, 0, sizeof mm);
-        nrim = 0;
-        double all = 0.0, wall = 0.0;
-        for (size_t t = 0; t < nview; t++) {
-            double n[3];
-            tri_normal(o, t, n);
-            const double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            if (!rim[t] || !(l > 0.0))
-                continue;
-            const double c = fabs(n[0] * st->view[0] + n[1] * st->view[1] + n[2] * st->view[2]) / l;
-            all += l;
-            wall += c <= p->wall_cosine ? l : 0.0;
-            nrim++;
-            const double w = 1.0 / (l * (c > 1e-6 ? c : 1e-6));
-            for (int a = 0; a < 3; a++)
-                for (int b = 0; b < 3; b++)
-                    mm[a][b] += n[a] * n[b] * w;
-        }
-        st->walls = all > 0.0 ? wall / all : 0.0;
+        st->walls = walls_share(o, nview, rim, st->view, p, mm);
     }
     /* a rim square to a direction far from where the faces face (a gear's
      * teeth seen askew: their flanks run along its axis) is not the view */
     if (p->past_caps &&
         st->view[0] * m[0] + st->view[1] * m[1] + st->view[2] * m[2] < 0.5 * sqrt(2.0) * lm) {
-        double all = 0.0, wall = 0.0;
         for (int k = 0; k < 3; k++)
             st->view[k] = m[k] / lm;
-        for (size_t t = 0; t < nview; t++) {
-            double n[3];
-            tri_normal(o, t, n);
-            const double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            if (!rim[t] || !(l > 0.0))
-                continue;
-            const double c = fabs(n[0] * st->view[0] + n[1] * st->view[1] + n[2] * st->view[2]) / l;
-            all += l;
-            wall += c <= p->wall_cosine ? l : 0.0;
-        }
-        st->walls = all > 0.0 ? wall / all : 0.0;
+        st->walls = walls_share(o, nview, rim, st->view, p, NULL);
     }
     double front = 0.0, back = 0.0;
     for (size_t t = 0; t < nview; t++) {

@@ -50,15 +50,17 @@ static void add_box_faces(st_soup *s, const double lo[3], const double hi[3], in
 
 /* IoU of the pseudo volume of `s` (a field of `cells` voxels along the
  * longest side) with the solid of the closed `truth` by `rule`. */
-static double iou_by(const st_soup *s, const st_soup *truth, size_t cells,
-                     const st_pseudo_params *pp, st_solid_rule rule)
+/* IoU of s's pseudo volume (cells, pp) against truth's solid by rule;
+ * st (may be NULL) gets the pseudo volume's stats. */
+static double iou_stats(const st_soup *s, const st_soup *truth, size_t cells,
+                        const st_pseudo_params *pp, st_solid_rule rule, st_pseudo_stats *st)
 {
     st_dist_params dp = st_dist_params_default();
     dp.cells = cells;
     st_grid *g = NULL;
     st_error err;
     double iou = -1, prec, rec;
-    if (st_pseudo_volume(&g, s, &dp, pp, NULL, NULL, &err))
+    if (st_pseudo_volume(&g, s, &dp, pp, st, NULL, &err))
         return -1;
     uint8_t *in = malloc(st_grid_count(g));
     const st_soup *shells[1] = {truth};
@@ -67,6 +69,12 @@ static double iou_by(const st_soup *s, const st_soup *truth, size_t cells,
     free(in);
     st_grid_free(g);
     return iou;
+}
+
+static double iou_by(const st_soup *s, const st_soup *truth, size_t cells,
+                     const st_pseudo_params *pp, st_solid_rule rule)
+{
+    return iou_stats(s, truth, cells, pp, rule, NULL);
 }
 
 static double iou_of(const st_soup *s, const st_soup *truth, size_t cells,
@@ -277,19 +285,8 @@ static void test_onesided_caps(void)
     st_pseudo_params pp = st_pseudo_params_default();
     const double plain = iou_of(s, t, 64, &pp);
     pp.sides_params.past_caps = 1;
-    st_dist_params dp = st_dist_params_default();
-    dp.cells = 64;
-    st_grid *g = NULL;
-    st_error err;
     st_pseudo_stats st;
-    double iou = -1, prec, rec;
-    if (!st_pseudo_volume(&g, s, &dp, &pp, &st, NULL, &err)) {
-        uint8_t *in = malloc(st_grid_count(g));
-        const st_soup *shells[1] = {t};
-        if (in && !st_solid_inside(in, g, shells, 1, ST_SOLID_NONZERO, &err))
-            st_solid_iou(&iou, &prec, &rec, in, g, &err);
-        free(in);
-    }
+    double iou = iou_stats(s, t, 64, &pp, ST_SOLID_NONZERO, &st);
     TAP_CHECK(st.sides.onesided && st.sides.fold && st.mirrored > 0 && iou >= 0.95 &&
                   plain < 0.8,
               "with past_caps, a one-sided torus closes below its equators (IoU %.4f, "
@@ -297,7 +294,6 @@ static void test_onesided_caps(void)
               st.sides.back_front, st.sides.walls, st.mirrored);
     TAP_CHECK(st.sides.view[2] > 0.99, "its view is within 8 degrees of its axis (%.4f %.4f %.4f)",
               st.sides.view[0], st.sides.view[1], st.sides.view[2]);
-    st_grid_free(g);
     /* A box scanned from above, its bottom unseen: the rim is walls along
      * the view, a crease where an unseen flat face begins; no mirror */
     st_soup *b = st_soup_new(), *bt = st_soup_new();
@@ -307,20 +303,11 @@ static void test_onesided_caps(void)
     pp = st_pseudo_params_default();
     const double box_plain = iou_of(b, bt, 64, &pp);
     pp.sides_params.past_caps = 1;
-    g = NULL;
-    iou = -1;
-    if (!st_pseudo_volume(&g, b, &dp, &pp, &st, NULL, &err)) {
-        uint8_t *in = malloc(st_grid_count(g));
-        const st_soup *shells[1] = {bt};
-        if (in && !st_solid_inside(in, g, shells, 1, ST_SOLID_NONZERO, &err))
-            st_solid_iou(&iou, &prec, &rec, in, g, &err);
-        free(in);
-    }
+    iou = iou_stats(b, bt, 64, &pp, ST_SOLID_NONZERO, &st);
     TAP_CHECK(st.sides.onesided && !st.sides.fold && st.sides.walls > 0.5 && st.mirrored == 0 &&
                   iou == box_plain,
               "a box seen from above: walls %.2f of its rim, not mirrored (IoU %.4f, %.4f by "
               "default)", st.sides.walls, iou, box_plain);
-    st_grid_free(g);
     st_soup_free(b);
     st_soup_free(bt);
     st_soup_free(s);
