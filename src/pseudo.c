@@ -88,14 +88,16 @@ static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_soup_edg
     int8_t *evidence = st_malloc_array(n ? n : 1, 1);
     st_status rc = votes && evidence ? ST_OK
                  : st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the sides");
-    const st_sides_params sp = p->sides_params;
+    st_sides_params sp = p->sides_params;
+    if (sp.past_caps && !edges && !sp.seen_triangles)   /* s: the soup, then its caps */
+        sp.seen_triangles = st->cap_triangles ? s->ntris - st->cap_triangles : 0;
     /* voxels the cut takes as the votes say get no evidence (mincut.h) */
     const int decided = st_mincut_params_default().fixed_evidence;
     rc = rc ? rc : st_sign_votes(g, &p->sign, votes, err);
     rc = rc ? rc : st_sides_evidence_edges(evidence, g, votes, decided, s, edges, &sp,
                                            &st->sides, err);
     rc = rc ? rc : st_sign_field_evidence(g, &p->sign, evidence, votes, progress, err);
-    rc = rc ? rc : st_sides_mirror(g, &st->sides, &st->mirrored, err);
+    rc = rc ? rc : st_sides_mirror(g, s, sp.seen_triangles, &st->sides, &st->mirrored, err);
     free(votes);
     free(evidence);
     return rc;

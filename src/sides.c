@@ -26,7 +26,7 @@ st_sides_params st_sides_params_default(void)
      * (mincut.h), so the votes and the cut's area still have a say. */
     /* one-sided below 0.25: the corpus's one-sided scans read 0.00-0.16,
      * its soups with holes and deleted faces 0.41 and up, closed ones 1 */
-    st_sides_params p = {2.5, 3.0, 24.0, 9, 0.25};
+    st_sides_params p = {2.5, 3.0, 24.0, 9, 0.25, 0, 1e-3, 0.25, 0};
     return p;
 }
 
@@ -94,24 +94,128 @@ static void tri_normal(const st_soup *s, size_t t, double n[3])
     n[2] = u[0] * w[1] - u[1] * w[0];
 }
 
-/* 4. A one-sided view (sides.h): the view v from the oriented soup o's
- * projected areas, and the lattice step nearest it. */
-static void view_of(const st_soup *o, const st_sides_params *p, st_sides_stats *st)
+/* The eigenvector of the least eigenvalue of the symmetric 3x3 matrix a
+ * (cyclic Jacobi rotations; a is overwritten). */
+static void least_eigenvector(double a[3][3], double out[3])
 {
-    double m[3] = {0.0, 0.0, 0.0};
-    for (size_t t = 0; t < o->ntris; t++) {
+    double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int sweep = 0; sweep < 50; sweep++) {
+        const double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        if (!(off > 1e-30 * (a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2])))
+            break;
+        for (int p = 0; p < 2; p++)
+            for (int q = p + 1; q < 3; q++) {
+                if (a[p][q] == 0.0)
+                    continue;
+                const double th = 0.5 * (a[q][q] - a[p][p]) / a[p][q];
+                const double t = (th >= 0.0 ? 1.0 : -1.0) / (fabs(th) + sqrt(th * th + 1.0));
+                const double c = 1.0 / sqrt(t * t + 1.0), sn = t * c;
+                for (int k = 0; k < 3; k++) {   /* a <- a J */
+                    const double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - sn * akq;
+                    a[k][q] = sn * akp + c * akq;
+                }
+                for (int k = 0; k < 3; k++) {   /* a <- J^T a */
+                    const double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - sn * aqk;
+                    a[q][k] = sn * apk + c * aqk;
+                }
+                for (int k = 0; k < 3; k++) {
+                    const double vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = c * vkp - sn * vkq;
+                    v[k][q] = sn * vkp + c * vkq;
+                }
+            }
+    }
+    int m = 0;
+    for (int k = 1; k < 3; k++)
+        if (a[k][k] < a[m][m])
+            m = k;
+    for (int k = 0; k < 3; k++)
+        out[k] = v[k][m];
+}
+
+/* The area share of o's rim faces (rim, of the first nview) within
+ * p->wall_cosine of square to view: walls along the view. When mm is not
+ * NULL it gets their second moments weighted 1/|cos| (at most 1e6). */
+static double walls_share(const st_soup *o, size_t nview, const uint8_t *rim,
+                          const double view[3], const st_sides_params *p, double mm[3][3])
+{
+    double all = 0.0, wall = 0.0;
+    for (size_t t = 0; t < nview; t++) {
+        double n[3];
+        tri_normal(o, t, n);
+        const double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!rim[t] || !(l > 0.0))
+            continue;
+        const double c = fabs(n[0] * view[0] + n[1] * view[1] + n[2] * view[2]) / l;
+        all += l;
+        wall += c <= p->wall_cosine ? l : 0.0;
+        const double w = 1.0 / (l * (c > 1e-6 ? c : 1e-6));
+        for (int a = 0; mm && a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                mm[a][b] += n[a] * n[b] * w;
+    }
+    return all > 0.0 ? wall / all : 0.0;
+}
+
+/* 4. A one-sided view (sides.h): the view v of the oriented soup o's
+ * first nview triangles (the seen ones), and the lattice step nearest it.
+ * A scan's faces turn away from the viewer at its horizon, where it was
+ * cut off: there (the triangles rim marks, on a boundary of the seen
+ * surface) the normals are square to v, so v is the direction most square
+ * to them (the least eigenvector of their area-weighted normals' second
+ * moments), turned to their mean normal; the mean normal alone where there
+ * is no rim. */
+static void view_of(const st_soup *o, size_t nview, const uint8_t *rim,
+                    const st_sides_params *p, st_sides_stats *st)
+{
+    double m[3] = {0.0, 0.0, 0.0}, mm[3][3] = {{0}};
+    size_t nrim = 0;
+    for (size_t t = 0; t < nview; t++) {
         double n[3];
         tri_normal(o, t, n);
         for (int k = 0; k < 3; k++)
             m[k] += n[k];
+        const double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!rim[t] || !(l > 0.0))
+            continue;
+        nrim++;
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                mm[a][b] += n[a] * n[b] / l;
     }
     const double lm = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
     if (!(lm > 0.0))
         return;
-    double front = 0.0, back = 0.0;
     for (int k = 0; k < 3; k++)
         st->view[k] = m[k] / lm;
-    for (size_t t = 0; t < o->ntris; t++) {
+    /* the least sum of |cos| rather than of its square, so that faces
+     * square to the view outweigh the seen faces that meet unseen ones at
+     * a sharp edge: iteratively reweighted by 1/|cos| (at most 1e6; on a
+     * rim that folds smoothly this may tilt a few degrees, one lattice
+     * step's worth of nothing) */
+    for (int pass = 0; p->past_caps && pass < 12 && nrim >= 3; pass++) {
+        double e[3];
+        least_eigenvector(mm, e);
+        const double d = e[0] * m[0] + e[1] * m[1] + e[2] * m[2];
+        if (d == 0.0)
+            break;
+        for (int k = 0; k < 3; k++)
+            st->view[k] = d > 0.0 ? e[k] : -e[k];
+        memset(mm, 0, sizeof mm);
+        st->walls = walls_share(o, nview, rim, st->view, p, mm);
+    }
+    /* a rim square to a direction far from where the faces face (a gear's
+     * teeth seen askew: their flanks run along its axis) is not the view */
+    if (p->past_caps &&
+        st->view[0] * m[0] + st->view[1] * m[1] + st->view[2] * m[2] < 0.5 * sqrt(2.0) * lm) {
+        for (int k = 0; k < 3; k++)
+            st->view[k] = m[k] / lm;
+        st->walls = walls_share(o, nview, rim, st->view, p, NULL);
+    }
+    double front = 0.0, back = 0.0;
+    for (size_t t = 0; t < nview; t++) {
         double n[3];
         tri_normal(o, t, n);
         const double a = n[0] * st->view[0] + n[1] * st->view[1] + n[2] * st->view[2];
@@ -122,7 +226,9 @@ static void view_of(const st_soup *o, const st_sides_params *p, st_sides_stats *
     }
     st->back_front = front > 0.0 ? back / front : 1.0;
     st->onesided = st->back_front < p->onesided_ratio;
-    st->far = INFINITY;
+    st->fold = st->onesided && (!p->past_caps || st->walls < p->walls_ratio);
+    st->past_caps = p->past_caps;
+    st->far = p->past_caps ? -INFINITY : INFINITY;
     /* the lattice step nearest v (the first of equals) */
     double best = -2.0;
     for (int a = -2; a <= 2; a++)
@@ -142,19 +248,56 @@ static void view_of(const st_soup *o, const st_sides_params *p, st_sides_stats *
     /* the soup's farthest point from the viewer, along the step */
     const double l = sqrt((double)(st->step[0] * st->step[0] + st->step[1] * st->step[1] +
                                    st->step[2] * st->step[2]));
-    for (size_t v = 0; v < o->nverts; v++) {
+    for (size_t v = 0; v < o->nverts && !p->past_caps; v++) {
         const double *x = o->xyz + 3 * v;
         const double h = (x[0] * st->step[0] + x[1] * st->step[1] + x[2] * st->step[2]) / l;
         st->far = h < st->far ? h : st->far;
     }
 }
 
-st_status st_sides_mirror(st_grid *g, const st_sides_stats *st, size_t *changed,
-                          st_error *err)
+/* The center of sample i of the line from q0 by -s. */
+static const double *point_of(const st_grid *g, const long q0[3], const int s[3], long i,
+                              double pt[3])
+{
+    for (int c = 0; c < 3; c++)
+        pt[c] = g->origin[c] + g->voxel * (double)(q0[c] - i * s[c]);
+    return pt;
+}
+
+/* Whether point q is within sqrt(d2) of the seen soup (seen NULL: yes). */
+static int near_seen(const st_bvh *seen, const double q[3], double d2)
+{
+    int64_t tri = -1;
+    if (!seen)
+        return 1;
+    st_bvh_nearest(seen, q, d2, &tri, NULL);
+    return tri >= 0;
+}
+
+st_status st_sides_mirror(st_grid *g, const st_soup *soup, size_t seen_triangles,
+                          const st_sides_stats *st, size_t *changed, st_error *err)
 {
     *changed = 0;
-    if (!st->onesided)
+    if (!st->fold)
         return ST_OK;
+    /* the seen soup alone, when soup has caps: the runs continue past them */
+    st_bvh *seen = NULL;
+    st_soup *o = NULL;   /* the BVH's soup: kept while it is */
+    if (soup && seen_triangles && seen_triangles < soup->ntris) {
+        o = st_soup_new();
+        st_status rc = o ? ST_OK : st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        for (size_t v = 0; !rc && v < soup->nverts; v++)
+            rc = st_soup_add_vertex(o, soup->xyz[3 * v], soup->xyz[3 * v + 1],
+                                    soup->xyz[3 * v + 2], err);
+        for (size_t t = 0; !rc && t < seen_triangles; t++)
+            rc = st_soup_add_triangle(o, soup->tris[3 * t], soup->tris[3 * t + 1],
+                                      soup->tris[3 * t + 2], err);
+        rc = rc ? rc : st_bvh_build(&seen, o, err);
+        if (rc) {
+            st_soup_free(o);
+            return rc;
+        }
+    }
     const int *s = st->step;
     const double sl = sqrt((double)(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]));
     /* a line crossing the surface between two samples a step apart has
@@ -162,6 +305,7 @@ st_status st_sides_mirror(st_grid *g, const st_sides_stats *st, size_t *changed,
     const float near = (float)(0.5 * sl * g->voxel);
     const long dims[3] = {(long)g->nx, (long)g->ny, (long)g->nz};
     const long maxlen = dims[0] + dims[1] + dims[2] + 1;
+    const double d2 = (double)near * (double)near;
     size_t count = 0;
     int oom = 0;
     /* Each line {q - k s} starts where q + s leaves the grid; lines are
@@ -182,6 +326,7 @@ st_status st_sides_mirror(st_grid *g, const st_sides_stats *st, size_t *changed,
                     if (!start)
                         continue;
                     long n = 0;
+                    double pt[3];
                     long q[3] = {q0[0], q0[1], q0[2]};
                     while (q[0] >= 0 && q[0] < dims[0] && q[1] >= 0 && q[1] < dims[1] &&
                            q[2] >= 0 && q[2] < dims[2]) {
@@ -199,8 +344,10 @@ st_status st_sides_mirror(st_grid *g, const st_sides_stats *st, size_t *changed,
                     while (a > 0 && g->data[line[a - 1]] < 0.0f)
                         a--;
                     /* ends on a seen wall: nothing to continue */
-                    if (fabsf(g->data[line[b]]) <= near ||
-                        (b + 1 < n && fabsf(g->data[line[b + 1]]) <= near))
+                    if ((fabsf(g->data[line[b]]) <= near &&
+                         near_seen(seen, point_of(g, q0, s, b, pt), d2)) ||
+                        (b + 1 < n && fabsf(g->data[line[b + 1]]) <= near &&
+                         near_seen(seen, point_of(g, q0, s, b + 1, pt), d2)))
                         continue;
                     const long len = b - a + 1;
                     for (long i = b + 1; i < n && i <= b + len; i++) {
@@ -208,7 +355,8 @@ st_status st_sides_mirror(st_grid *g, const st_sides_stats *st, size_t *changed,
                         double h = 0.0;
                         for (int c = 0; c < 3; c++)
                             h += (g->origin[c] + g->voxel * (double)(q0[c] - i * s[c])) * s[c];
-                        if (fabsf(*d) <= near || h / sl < st->far)
+                        if ((fabsf(*d) <= near && near_seen(seen, point_of(g, q0, s, i, pt), d2)) ||
+                            h / sl < st->far)
                             break;
                         *d = st_grid_signed_value(*d, 1);
                         count++;
@@ -216,6 +364,8 @@ st_status st_sides_mirror(st_grid *g, const st_sides_stats *st, size_t *changed,
                 }
         free(line);
     }
+    st_bvh_free(seen);
+    st_soup_free(o);
     *changed = count;
     if (oom)
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the mirror");
@@ -249,12 +399,13 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
     uint32_t *nbr = st_malloc_array(3 * nt + 1, sizeof *nbr);
     uint8_t *same = st_malloc_array(3 * nt + 1, 1);
     uint8_t *flip = st_malloc_array(nt + 1, 1);
+    uint8_t *rim = st_malloc_array(nt + 1, 1);
     uint32_t *region = st_malloc_array(nt + 1, sizeof *region);
     uint32_t *queue = st_malloc_array(nt + 1, sizeof *queue);
     double *score = st_calloc_array(nt + 1, sizeof *score);
     st_soup *o = st_soup_new();
     st_bvh *bvh = NULL;
-    if (!nbr || !same || !flip || !region || !queue || !score || !o) {
+    if (!nbr || !same || !flip || !rim || !region || !queue || !score || !o) {
         rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's sides");
         goto done;
     }
@@ -324,9 +475,19 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
         if ((rc = st_soup_add_vertex(o, s->xyz[3 * v], s->xyz[3 * v + 1], s->xyz[3 * v + 2],
                                      err)))
             goto done;
+    size_t nview = 0;
+    const size_t seen = p->seen_triangles && p->seen_triangles < nt ? p->seen_triangles : nt;
     for (size_t t = 0; t < nt; t++) {
         if (!E.kept[t])
             continue;
+        if (t < seen) {
+            /* on the seen surface's boundary: a free edge or one shared
+             * with a cap */
+            int edge = 0;
+            for (size_t slot = 3 * t; slot < 3 * t + 3; slot++)
+                edge |= nbr[slot] == ST_EDGES_NONE || nbr[slot] >= seen;
+            rim[nview++] = (uint8_t)edge;
+        }
         if (region[t] == t && score[t] < 0.0)
             st->turned++;
         const int back = flip[t] ^ (score[region[t]] < 0.0);
@@ -366,7 +527,7 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
                 count++;
             }
     st->voxels = count;
-    view_of(o, p, st);
+    view_of(o, nview, rim, p, st);
 done:
     st_bvh_free(bvh);
     st_soup_free(o);
@@ -375,6 +536,7 @@ done:
     free(nbr);
     free(same);
     free(flip);
+    free(rim);
     free(region);
     free(queue);
     free(score);

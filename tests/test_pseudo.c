@@ -50,15 +50,17 @@ static void add_box_faces(st_soup *s, const double lo[3], const double hi[3], in
 
 /* IoU of the pseudo volume of `s` (a field of `cells` voxels along the
  * longest side) with the solid of the closed `truth` by `rule`. */
-static double iou_by(const st_soup *s, const st_soup *truth, size_t cells,
-                     const st_pseudo_params *pp, st_solid_rule rule)
+/* IoU of s's pseudo volume (cells, pp) against truth's solid by rule;
+ * st (may be NULL) gets the pseudo volume's stats. */
+static double iou_stats(const st_soup *s, const st_soup *truth, size_t cells,
+                        const st_pseudo_params *pp, st_solid_rule rule, st_pseudo_stats *st)
 {
     st_dist_params dp = st_dist_params_default();
     dp.cells = cells;
     st_grid *g = NULL;
     st_error err;
     double iou = -1, prec, rec;
-    if (st_pseudo_volume(&g, s, &dp, pp, NULL, NULL, &err))
+    if (st_pseudo_volume(&g, s, &dp, pp, st, NULL, &err))
         return -1;
     uint8_t *in = malloc(st_grid_count(g));
     const st_soup *shells[1] = {truth};
@@ -67,6 +69,12 @@ static double iou_by(const st_soup *s, const st_soup *truth, size_t cells,
     free(in);
     st_grid_free(g);
     return iou;
+}
+
+static double iou_by(const st_soup *s, const st_soup *truth, size_t cells,
+                     const st_pseudo_params *pp, st_solid_rule rule)
+{
+    return iou_stats(s, truth, cells, pp, rule, NULL);
 }
 
 static double iou_of(const st_soup *s, const st_soup *truth, size_t cells,
@@ -84,6 +92,11 @@ static int big_side_face(int axis, int side, const double c[3])
 {
     (void)c;
     return axis == 1 && side == 0;
+}
+static int bottom_face(int axis, int side, const double c[3])
+{
+    (void)c;
+    return axis == 2 && side == 0;
 }
 static int half_top(int axis, int side, const double c[3])
 {
@@ -236,6 +249,71 @@ static void test_onesided(void)
     st_soup_free(t);
 }
 
+/* A torus lying flat (major radius 1, minor 0.35), outward: all of it
+ * (up < 0), or its upper half only (up > 0): a scan from above, cut off at
+ * its two equators, which are flat loops (the hole caps close them). */
+static void add_torus(st_soup *s, int up)
+{
+    const int nu = 48, nv = 24;
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            if (up > 0 && j >= nv / 2)
+                continue;
+            double p[4][3];
+            for (int c = 0; c < 4; c++) {
+                const double u = 2 * M_PI * (i + (c == 1 || c == 2)) / nu;
+                const double v = 2 * M_PI * (j + (c >= 2)) / nv;
+                p[c][0] = (1.0 + 0.35 * cos(v)) * cos(u);
+                p[c][1] = (1.0 + 0.35 * cos(v)) * sin(u);
+                p[c][2] = 0.35 * sin(v);
+            }
+            add_tri(s, p[0], p[1], p[2], 0);
+            add_tri(s, p[0], p[2], p[3], 0);
+        }
+}
+
+static void test_onesided_caps(void)
+{
+    /* A one-sided scan of a torus cut off at its equators, the soup's
+     * lowest points: by default the mirror stops there; with past_caps
+     * (the view of the seen soup alone, the mirror past its caps and past
+     * the soup's lowest point, only where the rim folds) it continues the
+     * runs to the grid's end. */
+    st_soup *s = st_soup_new(), *t = st_soup_new();
+    add_torus(s, 1);
+    add_torus(t, -1);
+    st_pseudo_params pp = st_pseudo_params_default();
+    const double plain = iou_of(s, t, 64, &pp);
+    pp.sides_params.past_caps = 1;
+    st_pseudo_stats st;
+    double iou = iou_stats(s, t, 64, &pp, ST_SOLID_NONZERO, &st);
+    TAP_CHECK(st.sides.onesided && st.sides.fold && st.mirrored > 0 && iou >= 0.95 &&
+                  plain < 0.8,
+              "with past_caps, a one-sided torus closes below its equators (IoU %.4f, "
+              "%.4f by default; back/front %.3f, walls %.2f, %zu voxels mirrored)", iou, plain,
+              st.sides.back_front, st.sides.walls, st.mirrored);
+    TAP_CHECK(st.sides.view[2] > 0.99, "its view is within 8 degrees of its axis (%.4f %.4f %.4f)",
+              st.sides.view[0], st.sides.view[1], st.sides.view[2]);
+    /* A box scanned from above, its bottom unseen: the rim is walls along
+     * the view, a crease where an unseen flat face begins; no mirror */
+    st_soup *b = st_soup_new(), *bt = st_soup_new();
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 0.7, 0.5};
+    add_box_faces(b, lo, hi, 3, bottom_face, 0);
+    add_box_oriented(bt, lo, hi);
+    pp = st_pseudo_params_default();
+    const double box_plain = iou_of(b, bt, 64, &pp);
+    pp.sides_params.past_caps = 1;
+    iou = iou_stats(b, bt, 64, &pp, ST_SOLID_NONZERO, &st);
+    TAP_CHECK(st.sides.onesided && !st.sides.fold && st.sides.walls > 0.5 && st.mirrored == 0 &&
+                  iou == box_plain,
+              "a box seen from above: walls %.2f of its rim, not mirrored (IoU %.4f, %.4f by "
+              "default)", st.sides.walls, iou, box_plain);
+    st_soup_free(b);
+    st_soup_free(bt);
+    st_soup_free(s);
+    st_soup_free(t);
+}
+
 static void test_sides_orientation(void)
 {
     /* The sides' evidence does not read the file's orientation: a box
@@ -354,6 +432,7 @@ int main(void)
     test_large_holes();
     test_hemisphere();
     test_onesided();
+    test_onesided_caps();
     test_sides_orientation();
     test_shared_tables();
     return tap_done();

@@ -28,7 +28,12 @@
  *      soup facing away from its mean normal v equals that facing v; a
  *      soup whose faces nearly all face v (back_front, that ratio, below
  *      onesided_ratio) is a view from v. st_sides_mirror then completes
- *      the signed solid behind it.
+ *      the signed solid behind it. With past_caps the view reads only the
+ *      seen surface (not its caps) and v is the direction most square to
+ *      the faces on its rim, where the scan turned away (iteratively
+ *      reweighted least absolute cosines, so walls along v outweigh the
+ *      faces that meet an unseen one at a sharp edge; the mean normal when
+ *      that is over 45 degrees from it).
  * So the cut (mincut.h) has, on each side of every surviving wall, the
  * side it is on, and spans the holes between walls by the least area.
  *
@@ -57,6 +62,14 @@ typedef struct st_sides_params {
     double weight;          /* evidence per unit of winding number */
     int max_evidence;       /* |evidence| at most this */
     double onesided_ratio;  /* one-sided below this back/front ratio (0: never) */
+    size_t seen_triangles;  /* the view reads the first this many triangles
+                               of the soup (the seen surface; the rest are
+                               its caps); 0: all */
+    double wall_cosine;     /* a rim face is a wall where |cos| to the view
+                               is at most this */
+    double walls_ratio;     /* mirrored below this walls' share of the rim */
+    int past_caps;          /* the view of the seen soup alone, and the
+                               mirror past its caps (0; see st_sides_mirror) */
 } st_sides_params;
 
 st_sides_params st_sides_params_default(void);
@@ -70,8 +83,14 @@ typedef struct st_sides_stats {
                                facing it (0 for a one-sided view, 1 closed) */
     double view[3];         /* the view direction (unit; the mean normal) */
     int onesided;           /* back_front < onesided_ratio */
+    double walls;           /* the rim's area share of walls (faces along
+                               the view) */
+    int fold;               /* mirrored: onesided, and with past_caps
+                               walls < walls_ratio */
+    int past_caps;          /* the params' past_caps */
+    double far;             /* without past_caps: the soup's farthest point
+                               along the step (-INFINITY with it) */
     int step[3];            /* the lattice step nearest view */
-    double far;             /* the soup's farthest point along it */
 } st_sides_stats;
 
 /* evidence (n bytes) gets each voxel's evidence (0 where none). g: the
@@ -90,22 +109,28 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
                                   const st_sides_params *p, st_sides_stats *stats,
                                   st_error *err);
 
-/* A one-sided view's far side (stats->onesided; nothing otherwise), on
+/* A one-sided view's far side (stats->fold; nothing otherwise), on
  * the signed field g of its pseudo volume: along each line of the lattice
  * step nearest the view (components in -2..2), the run of inside voxels
  * farthest from the viewer, if it does not end on the soup (its far end is
  * the cut's least-area cap across the horizon, not a seen wall), is
  * continued away from the viewer by its own length, stopping at the soup
- * and at the depth of its farthest point from the viewer (stats->far):
- * the solid taken as symmetric about the horizon it was seen to. A prior,
- * not evidence: right for a body whose far half mirrors its near half
- * (a ball seen to a wavy horizon, a scanned animal), too much where the
- * part was seen past its widest section. A horizon loop that holes.h caps
- * (a flat one) ends the runs on the cap and is left as it is. *changed
+ * and, without past_caps, at the depth of its farthest point from the
+ * viewer (stats->far): the solid taken as symmetric about the horizon it
+ * was seen to. A prior, not evidence: right for a body whose far half
+ * mirrors its near half (a ball seen to a wavy horizon, a scanned animal),
+ * too much where the part was seen past its widest section. Without
+ * past_caps a horizon loop that holes.h caps (a flat one) ends the runs on
+ * the cap and is left as it is. With it (s given, its first
+ * seen_triangles the seen surface, the rest caps: the soup
+ * st_sides_evidence read) only the seen surface ends a run or stops its
+ * continuation, and stats->fold also asks that walls along the view are
+ * under walls_ratio of the rim (a crease where an unseen flat face begins
+ * is closed flat). s may be NULL (every near voxel is the soup). *changed
  * gets the voxels made inside. Deterministic: each line is one thread's.
  * ST_ENOMEM. */
-st_status st_sides_mirror(st_grid *g, const st_sides_stats *stats, size_t *changed,
-                          st_error *err);
+st_status st_sides_mirror(st_grid *g, const st_soup *s, size_t seen_triangles,
+                          const st_sides_stats *stats, size_t *changed, st_error *err);
 
 #ifdef __cplusplus
 }

@@ -89,6 +89,10 @@ static void usage(void)
 "                       joins the votes as evidence for the cut, and a\n"
 "                       one-sided scan's far side is mirrored about its\n"
 "                       horizon (default on)\n"
+"      --onesided plain|past-caps  with --sides on: past-caps reads the view of\n"
+"                       the surface alone (not its caps), mirrors only where\n"
+"                       its rim folds (not walls along the view) and past\n"
+"                       caps and the surface's lowest point (default plain)\n"
 "      --refine-band D  refine voxels nearer than D voxels (default 1.5)\n"
 "      --refine-radius R  neighbours within R voxels per axis (default 2)\n"
 "      --refine-answers A  neighbours' answers combined per voxel (default 6)\n"
@@ -157,7 +161,8 @@ static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_er
 }
 
 enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT,
-       OPT_CAPS, OPT_SIDES, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS, OPT_REFINE_ANSWERS };
+       OPT_CAPS, OPT_SIDES, OPT_ONESIDED, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS,
+       OPT_REFINE_ANSWERS };
 
 static const struct option longopts[] = {
     {"band", required_argument, NULL, OPT_BAND},
@@ -170,6 +175,7 @@ static const struct option longopts[] = {
     TOOL_LONG_OPTIONS_PSEUDO,
     {"caps", required_argument, NULL, OPT_CAPS},
     {"sides", required_argument, NULL, OPT_SIDES},
+    {"onesided", required_argument, NULL, OPT_ONESIDED},
     {"rule", required_argument, NULL, OPT_RULE},
     {"surface", required_argument, NULL, OPT_SURFACE},
     {"refine-band", required_argument, NULL, OPT_REFINE_BAND},
@@ -184,7 +190,7 @@ typedef struct soupsign_settings {
     st_sign_params sign;
     st_sign_refine_params refine;
     const char *in, *surface;
-    int paper, fill_holes, bend_caps, use_shells, use_sides, no_surface;
+    int paper, fill_holes, bend_caps, use_shells, use_sides, past_caps, no_surface;
 } soupsign_settings;
 
 static int option(tool_ctx *t, int c, const char *arg, void *settings)
@@ -265,6 +271,14 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
     case OPT_SIDES:
         if (tool_parse_switch(t, "--sides", arg, &s->use_sides))
             return TOOL_EXIT_USAGE;
+        break;
+    case OPT_ONESIDED:
+        if (strcmp(arg, "plain") == 0)
+            s->past_caps = 0;
+        else if (strcmp(arg, "past-caps") == 0)
+            s->past_caps = 1;
+        else
+            return tool_usage_error(t, "--onesided is plain or past-caps, not '%s'", arg);
         break;
     case OPT_RULE:
         if (st_sign_params_named(&s->sign, arg))
@@ -353,6 +367,7 @@ static int run(tool_ctx *t, void *settings)
     pp.holes.planes = (s->bend_caps & 2) != 0;
     pp.closed_shells = s->use_shells;
     pp.sides = s->use_sides;
+    pp.sides_params.past_caps = s->past_caps;
     st_progress prog = tool_progress(t);
     const double c0 = cpu_now();
     if (st_pseudo_sign(g, soup, &pp, &ps, &prog, &err)) {
@@ -390,10 +405,10 @@ static int run(tool_ctx *t, void *settings)
                  "disagreeing), %zu voxels given their side", ps.sides.regions, ps.sides.turned,
                  ps.sides.conflicts, ps.sides.voxels);
     if (surface && s->use_sides && p->cut)
-        tool_say(t, 2, "view: back/front %.3f along (%.3f %.3f %.3f): %s", ps.sides.back_front,
-                 ps.sides.view[0], ps.sides.view[1], ps.sides.view[2],
-                 ps.sides.onesided ? "one-sided" : "not one-sided");
-    if (surface && s->use_sides && p->cut && ps.sides.onesided)
+        tool_say(t, 2, "view: back/front %.3f along (%.3f %.3f %.3f): %s; walls %.2f of its rim",
+                 ps.sides.back_front, ps.sides.view[0], ps.sides.view[1], ps.sides.view[2],
+                 ps.sides.onesided ? "one-sided" : "not one-sided", ps.sides.walls);
+    if (surface && s->use_sides && p->cut && ps.sides.fold)
         tool_say(t, 2, "far side mirrored along step (%d %d %d): %zu voxels",
                  ps.sides.step[0], ps.sides.step[1], ps.sides.step[2], ps.mirrored);
     if (surface)
