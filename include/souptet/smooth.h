@@ -21,7 +21,11 @@
  * (held by the invariant in thin gaps and at sharp features) get a rescue:
  * steps in other directions that still bring them closer to S, under the
  * same invariant; once after the fit, then after the quality pass (and the
- * quality pass again), see fit.c.
+ * quality pass again), see fit.c. Last, peeling (st_fit_params.peel):
+ * boundary tets below the quality goal that hold no part of S, and were
+ * not sculpted for the pseudo volume, are removed where the boundary stays
+ * a manifold; so st_fit may leave fewer tets than it was given (never
+ * more, and the points stay).
  *
  * Both require every tet of the input to be positively oriented (tetmesh.h)
  * and refuse the mesh otherwise; both never produce an inverted or flat tet.
