@@ -841,34 +841,37 @@ static int peel_face_visit(void *ctx, uint32_t tri)
                                 q->s->xyz + 3 * (size_t)t[1], q->s->xyz + 3 * (size_t)t[2]);
 }
 
-/* 1 when some vertex of S lies in the closed tet t. */
+typedef struct tet_query {
+    const st_soup *s;
+    const double *t[4];
+} tet_query;
+
+/* 1 when a vertex of S triangle tri lies in the closed tet q->t. */
+static int tet_vertex_visit(void *ctx, uint32_t tri)
+{
+    const tet_query *q = ctx;
+    const uint32_t *k = q->s->tris + 3 * (size_t)tri;
+    for (int i = 0; i < 3; i++)
+        if (st_point_in_tet(q->s->xyz + 3 * (size_t)k[i], q->t[0], q->t[1], q->t[2], q->t[3]) !=
+            ST_OUTSIDE)
+            return 1;
+    return 0;
+}
+
+/* 1 when some vertex of S lies in the closed tet t: the triangles whose
+ * boxes meet the tet's box hold every such vertex. */
 static int svertex_in_tet(const fit_ctx *c, const double *t[4])
 {
-    const pgrid *g = &c->pg;
-    if (g->npts == 0)
-        return 0;
+    tet_query q;
+    q.s = c->s;
     double lo[3], hi[3];
-    size_t a0[3], a1[3];
     for (int a = 0; a < 3; a++) {
         lo[a] = fmin(fmin(t[0][a], t[1][a]), fmin(t[2][a], t[3][a]));
         hi[a] = fmax(fmax(t[0][a], t[1][a]), fmax(t[2][a], t[3][a]));
-        a0[a] = pgrid_coord(g, lo[a], a);
-        a1[a] = pgrid_coord(g, hi[a], a);
     }
-    for (size_t iz = a0[2]; iz <= a1[2]; iz++)
-        for (size_t iy = a0[1]; iy <= a1[1]; iy++)
-            for (size_t ix = a0[0]; ix <= a1[0]; ix++) {
-                size_t b = ix + g->n[0] * (iy + g->n[1] * iz);
-                for (size_t j = g->off[b]; j < g->off[b + 1]; j++) {
-                    const double *q = g->pts + 3 * (size_t)g->idx[j];
-                    if (q[0] < lo[0] || q[0] > hi[0] || q[1] < lo[1] || q[1] > hi[1] ||
-                        q[2] < lo[2] || q[2] > hi[2])
-                        continue;
-                    if (st_point_in_tet(q, t[0], t[1], t[2], t[3]) != ST_OUTSIDE)
-                        return 1;
-                }
-            }
-    return 0;
+    for (int i = 0; i < 4; i++)
+        q.t[i] = t[i];
+    return st_bvh_query_box(c->bvh, lo, hi, tet_vertex_visit, &q) != 0;
 }
 
 /* 1 when r and s share a boundary face (rs is a boundary edge). */
