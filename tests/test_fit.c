@@ -5,11 +5,14 @@
  * what did not hold on entry does not get worse; the BVH's triangle query
  * (the fit's face check) misses no triangle; the quality pass keeps every
  * boundary vertex within max(d_offset, where the fit left it) of S while
- * it frees the vertices held at the band's edge. */
+ * it frees the vertices held at the band's edge; peeling keeps the
+ * enclosure and a manifold boundary, never lowers the lowest score and
+ * spares the tets that overlapped the pseudo volume. */
 #include "souptet/bvh.h"
 #include "souptet/enclose.h"
 #include "souptet/isect.h"
 #include "souptet/pred.h"
+#include "souptet/sculpt.h"
 #include "souptet/smooth.h"
 #include "souptet/tetmesh.h"
 #include "souptet/tetqual.h"
@@ -435,6 +438,136 @@ static void test_band_edge(void)
     st_soup_free(s);
 }
 
+/* 1 when the boundary of m is a closed manifold: every boundary vertex's
+ * boundary faces form one cycle around it (each link vertex on exactly
+ * two of its link edges, the link edges connected). */
+static int boundary_manifold(const st_tetmesh *m)
+{
+    uint32_t *faces = NULL;
+    size_t nf = 0;
+    st_tetmesh_boundary(m, &faces, NULL, &nf, NULL);
+    int ok = 1;
+    uint32_t (*link)[2] = malloc((nf ? nf : 1) * sizeof *link);
+    for (size_t v = 0; v < m->npoints && ok; v++) {
+        size_t n = 0;
+        for (size_t f = 0; f < nf; f++)
+            for (int i = 0; i < 3; i++)
+                if (faces[3 * f + (size_t)i] == v) {
+                    link[n][0] = faces[3 * f + (size_t)((i + 1) % 3)];
+                    link[n][1] = faces[3 * f + (size_t)((i + 2) % 3)];
+                    n++;
+                }
+        if (n == 0)
+            continue;
+        /* walk the cycle from link[0]: each step finds the one edge that
+         * starts where the last ended (oriented faces: a disc's link is a
+         * directed cycle); a walk that closes before using every edge, or
+         * a vertex starting two edges, is not a manifold */
+        size_t steps = 0;
+        uint32_t at = link[0][1];
+        while (ok && steps < n) {
+            size_t hits = 0, next = 0;
+            for (size_t j = 0; j < n; j++)
+                if (link[j][0] == at) {
+                    hits++;
+                    next = j;
+                }
+            if (hits != 1)
+                ok = 0;
+            at = link[next][1];
+            steps++;
+            if (next == 0)
+                break;
+        }
+        if (steps != n)
+            ok = 0;
+    }
+    free(link);
+    free(faces);
+    return ok;
+}
+
+/* The lowest tet score of m (smooth_internal.h). */
+static double min_score(const st_tetmesh *m)
+{
+    double lo = INFINITY;
+    for (size_t t = 0; t < m->ntets; t++) {
+        const uint32_t *k = m->tets + 4 * t;
+        lo = fmin(lo, sm_tet_score(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
+                                   m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]));
+    }
+    return lo;
+}
+
+/* Every tet in a "sculpt" cell array: class `cls`, and every other one
+ * `other` (a different class). */
+static void set_classes(st_tetmesh *m, double cls, double other)
+{
+    double *a = NULL;
+    st_tetmesh_add_array(m, "sculpt", ST_ON_CELLS, 1, &a, NULL);
+    for (size_t t = 0; t < m->ntets; t++)
+        a[t] = t % 2 ? cls : other;
+}
+
+static size_t count_class(const st_tetmesh *m, double cls)
+{
+    const st_tet_array *a = st_tetmesh_find_array(m, "sculpt", ST_ON_CELLS);
+    size_t n = 0;
+    for (size_t t = 0; a && t < m->ntets; t++)
+        n += a->values[t] == cls;
+    return n;
+}
+
+/* Peeling (fit.c): on the thin band of test_band_edge, the fit removes
+ * boundary tets below the goal that hold nothing of S. The mesh must still
+ * enclose S (brute force), stay positive with a manifold boundary, lose
+ * only tets (no worse lowest score than without peeling, which runs the
+ * same up to the peel), keep its cell arrays in step with its tets, and
+ * never peel a tet classed ST_SCULPT_VOLUME (it overlapped the pseudo
+ * volume when sculpted). */
+static void test_peel(void)
+{
+    st_soup *s = st_soup_new();
+    add_sphere(s, 1.0, 2.0);
+    st_bvh *b = NULL;
+    st_error err;
+    st_bvh_build(&b, s, &err);
+    st_fit_params p = st_fit_params_default();
+    p.offset_ratio = 0.15;
+    st_fit_stats st0, st1, st2;
+    st_tetmesh *m0 = ball_mesh(0.5, 1.6), *m1 = ball_mesh(0.5, 1.6), *m2 = ball_mesh(0.5, 1.6);
+    size_t n = m1->ntets;
+    set_classes(m1, ST_SCULPT_SURFACE, ST_SCULPT_BOMB);
+    set_classes(m2, ST_SCULPT_VOLUME, ST_SCULPT_BOMB);
+    size_t vol2 = count_class(m2, ST_SCULPT_VOLUME);
+    p.peel = 0;
+    st_status rc0 = st_fit(m0, s, b, &p, &st0, NULL, &err);
+    p.peel = 1;
+    st_status rc1 = st_fit(m1, s, b, &p, &st1, NULL, &err);
+    st_status rc2 = st_fit(m2, s, b, &p, &st2, NULL, &err);
+    brute r = brute_check(m1, s);
+    TAP_CHECK(rc0 == ST_OK && rc1 == ST_OK && st0.peeled == 0 && st1.peeled > 0 &&
+              m1->ntets + st1.peeled == n && m0->ntets == n,
+              "peeling removes boundary tets (%zu of %zu)", st1.peeled, n);
+    TAP_CHECK(r.outside == 0 && r.crossing == 0 && r.inverted == 0 && boundary_manifold(m1) &&
+              boundary_manifold(m0),
+              "the peeled mesh encloses the sphere, nothing inverted, its boundary a manifold");
+    TAP_CHECK(min_score(m1) >= min_score(m0),
+              "peeling does not lower the lowest score (%.2f, %.2f without; angles %.2f..%.2f "
+              "-> %.2f..%.2f)", min_score(m1), min_score(m0), st0.min_dihedral_after,
+              st0.max_dihedral_after, st1.min_dihedral_after, st1.max_dihedral_after);
+    TAP_CHECK(count_class(m1, ST_SCULPT_SURFACE) + count_class(m1, ST_SCULPT_BOMB) == m1->ntets &&
+              rc2 == ST_OK && count_class(m2, ST_SCULPT_VOLUME) == vol2 &&
+              m2->ntets + st2.peeled == n,
+              "the cell array follows the tets; no ST_SCULPT_VOLUME tet peeled (%zu peeled of "
+              "the other half)", st2.peeled);
+    st_tetmesh_free(m0);
+    st_tetmesh_free(m1);
+    st_tetmesh_free(m2);
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
 int main(void)
 {
     test_sphere();
@@ -443,5 +576,6 @@ int main(void)
     test_refusals();
     test_bvh_query_tri();
     test_band_edge();
+    test_peel();
     return tap_done();
 }

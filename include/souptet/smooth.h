@@ -21,7 +21,11 @@
  * (held by the invariant in thin gaps and at sharp features) get a rescue:
  * steps in other directions that still bring them closer to S, under the
  * same invariant; once after the fit, then after the quality pass (and the
- * quality pass again), see fit.c.
+ * quality pass again), see fit.c. Last, peeling (st_fit_params.peel):
+ * boundary tets below the quality goal that hold no part of S, and were
+ * not sculpted for the pseudo volume, are removed where the boundary stays
+ * a manifold; so st_fit may leave fewer tets than it was given (never
+ * more, and the points stay).
  *
  * Both require every tet of the input to be positively oriented (tetmesh.h)
  * and refuse the mesh otherwise; both never produce an inverted or flat tet.
@@ -118,6 +122,10 @@ typedef struct st_fit_params {
     double quality_goal;   /* degrees: the pass works on tets whose min
                               dihedral is below this or whose max is above
                               180 - goal / ST_FIT_MAX_WEIGHT (default 35) */
+    int peel;              /* 1: after the quality pass, remove boundary
+                              tets scoring below quality_goal that hold no
+                              part of S, where the boundary stays a manifold
+                              (fit.c); the tet count may drop (default 1) */
     st_fit_iter_fn on_iter;   /* called after every iteration; may be NULL */
     void *on_iter_ctx;
 } st_fit_params;
@@ -139,6 +147,7 @@ typedef struct st_fit_stats {
     size_t moves, rejected, skipped;  /* fit: accepted, halvings, given up */
     int quality_rounds;
     size_t quality_moves;
+    size_t peeled;                /* tets removed by peeling */
     double min_dihedral_before, max_dihedral_before;   /* the input */
     double min_dihedral_fit, max_dihedral_fit;         /* after the fit */
     double min_dihedral_after, max_dihedral_after;     /* after quality */

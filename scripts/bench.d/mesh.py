@@ -487,7 +487,17 @@ def fill_measure(bench, build, mesh, truth, own=None):
             return {"fill_error": "tetstat reported no enclosure of %s" % os.path.basename(t)}
         inside += m["vertices_inside"]
         total += m["surface_vertices"]
-    return {"undamaged_inside": inside, "undamaged_vertices": total}
+    out = {"undamaged_inside": inside, "undamaged_vertices": total}
+    if len(truth) == 1:
+        # Issue 18: the stopping condition against the undamaged model too
+        # (the mesh's own R, from its meta). Where the pseudo volume fills
+        # a side the input lacks (onesided), the boundary on that fill
+        # stands for the undamaged surface, not for the input; the
+        # condition stays measured against the input (soupmesh(1),
+        # --offset), and this is shown beside the misses.
+        out["undamaged_beyond"] = m.get("beyond_offset")
+        out["undamaged_dist_max_h"] = m.get("dist_max_h")
+    return out
 
 
 def previous_rows(bench):
@@ -828,9 +838,13 @@ def offset_markdown(rows):
         if ok and beyond == 0 and r.get("encloses"):
             s["met"] += 1
         else:
-            s["miss"].append("%s %s (tries %s: %s beyond, %s h)" % (
+            vs = ""
+            if r.get("undamaged_beyond") is not None and r.get("damage") not in ("closed", "as is"):
+                vs = "; against the undamaged model %s beyond, %s h" % (
+                    r["undamaged_beyond"], _f(r.get("undamaged_dist_max_h"), "%.3f"))
+            s["miss"].append("%s %s (tries %s: %s beyond, %s h%s)" % (
                 r["model"], r["damage"], r.get("tries"), beyond,
-                _f(r.get("dist_max_h"), "%.3f")))
+                _f(r.get("dist_max_h"), "%.3f"), vs))
         if ok and r.get("tries") == 8:
             lo, hi = OFFSET_MIN_DIHEDRAL.get(R), OFFSET_MAX_DIHEDRAL.get(R)
             if (lo is not None and (r.get("min_dihedral") or 0) < lo) or \

@@ -290,10 +290,10 @@ static int run(tool_ctx *t, void *settings)
                         "%zu skipped, %.3f s",
                  st.h, st.d_offset, st.iters, st.moves, st.rejected, st.skipped, st.seconds_fit);
         tool_say(t, 2, "dihedral: input %.2f..%.2f, after fit %.2f..%.2f, after quality "
-                        "%.2f..%.2f (%d rounds, %zu moves, %.3f s)",
+                        "%.2f..%.2f (%d rounds, %zu moves, %zu tets peeled, %.3f s)",
                  st.min_dihedral_before, st.max_dihedral_before, st.min_dihedral_fit,
                  st.max_dihedral_fit, st.min_dihedral_after, st.max_dihedral_after,
-                 st.quality_rounds, st.quality_moves, st.seconds_quality);
+                 st.quality_rounds, st.quality_moves, st.peeled, st.seconds_quality);
         tool_say(t, 2, "enclosure: S vertices outside %zu -> %zu, S triangles crossing "
                         "%zu -> %zu",
                  st.outside_before, st.outside_after, st.crossing_before, st.crossing_after);
