@@ -295,6 +295,31 @@ static int in_star_tet(const sm_mesh *sm, uint32_t v, size_t j, const double p[3
     return st_point_in_tet(q, t[0], t[1], t[2], t[3]) != ST_OUTSIDE;
 }
 
+/* in_star_tet given o, the sign of st_orient3d of the tet's corners with v
+ * at p (st_point_in_tet's first test, which does not depend on q): its
+ * answer, with the face tests alone. */
+static int in_star_tet_o(const sm_mesh *sm, uint32_t v, size_t j, const double p[3],
+                         const double q[3], int o)
+{
+    if (o == 0)
+        return in_star_tet(sm, v, j, p, q);
+    const uint32_t *c = sm->m->tets + 4 * (size_t)sm->vt[sm->vt_off[v] + j];
+    const double *t[4];
+    for (int k = 0; k < 4; k++)
+        t[k] = c[k] == v ? p : sm->m->xyz + 3 * (size_t)c[k];
+    for (int a = 0; a < 3; a++)
+        if ((q[a] < t[0][a] && q[a] < t[1][a] && q[a] < t[2][a] && q[a] < t[3][a]) ||
+            (q[a] > t[0][a] && q[a] > t[1][a] && q[a] > t[2][a] && q[a] > t[3][a]))
+            return 0;
+    /* isect.c's tet_faces order, as st_point_in_tet tests them */
+    const double *F[4][3] = {{t[2], t[1], t[3]}, {t[0], t[2], t[3]},
+                             {t[1], t[0], t[3]}, {t[0], t[1], t[2]}};
+    for (int i = 0; i < 4; i++)
+        if (st_sign(st_orient3d(F[i][0], F[i][1], F[i][2], q)) == -o)
+            return 0;
+    return 1;
+}
+
 /* The tet of v's star (with v at p) that holds q, trying `hint` first:
  * its index from vt_off[v], or -1 when q is outside the closed star. A
  * small move keeps most points in the tet they were in, so the hint makes
@@ -386,6 +411,7 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
      * largest part of the fit on dragon_res3, 9 million tet tests). */
     enum { BOXED_MAX = 96 };
     double tbox[BOXED_MAX][6];
+    int tor[BOXED_MAX];   /* and their orientations (in_star_tet_o) */
     const size_t nst = sm->vt_off[v + 1] - sm->vt_off[v];
     const int boxed = nst <= BOXED_MAX;
     for (size_t j = 0; boxed && j < nst; j++) {
@@ -401,6 +427,9 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
                 tbox[j][3 + a] = y[a] > tbox[j][3 + a] ? y[a] : tbox[j][3 + a];
             }
         }
+        const double *y0 = sm->m->xyz + 3 * (size_t)tc[0], *y1 = sm->m->xyz + 3 * (size_t)tc[1],
+                     *y2 = sm->m->xyz + 3 * (size_t)tc[2], *y3 = sm->m->xyz + 3 * (size_t)tc[3];
+        tor[j] = st_sign(st_orient3d(y0, y1, y2, y3));
     }
     ptrdiff_t hint = -1;   /* neighbouring points tend to share a tet */
     for (size_t iz = a0[2]; iz <= a1[2]; iz++)
@@ -426,7 +455,7 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
                             if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] ||
                                 q[0] > bx[3] || q[1] > bx[4] || q[2] > bx[5])
                                 continue;
-                            if (in_star_tet(sm, v, u, x, q)) {
+                            if (in_star_tet_o(sm, v, u, x, q, tor[u])) {
                                 t = (ptrdiff_t)u;
                                 break;
                             }
