@@ -295,31 +295,6 @@ static int in_star_tet(const sm_mesh *sm, uint32_t v, size_t j, const double p[3
     return st_point_in_tet(q, t[0], t[1], t[2], t[3]) != ST_OUTSIDE;
 }
 
-/* in_star_tet given o, the sign of st_orient3d of the tet's corners with v
- * at p (st_point_in_tet's first test, which does not depend on q): its
- * answer, with the face tests alone. */
-static int in_star_tet_o(const sm_mesh *sm, uint32_t v, size_t j, const double p[3],
-                         const double q[3], int o)
-{
-    if (o == 0)
-        return in_star_tet(sm, v, j, p, q);
-    const uint32_t *c = sm->m->tets + 4 * (size_t)sm->vt[sm->vt_off[v] + j];
-    const double *t[4];
-    for (int k = 0; k < 4; k++)
-        t[k] = c[k] == v ? p : sm->m->xyz + 3 * (size_t)c[k];
-    for (int a = 0; a < 3; a++)
-        if ((q[a] < t[0][a] && q[a] < t[1][a] && q[a] < t[2][a] && q[a] < t[3][a]) ||
-            (q[a] > t[0][a] && q[a] > t[1][a] && q[a] > t[2][a] && q[a] > t[3][a]))
-            return 0;
-    /* isect.c's tet_faces order, as st_point_in_tet tests them */
-    const double *F[4][3] = {{t[2], t[1], t[3]}, {t[0], t[2], t[3]},
-                             {t[1], t[0], t[3]}, {t[0], t[1], t[2]}};
-    for (int i = 0; i < 4; i++)
-        if (st_sign(st_orient3d(F[i][0], F[i][1], F[i][2], q)) == -o)
-            return 0;
-    return 1;
-}
-
 /* The tet of v's star (with v at p) that holds q, trying `hint` first:
  * its index from vt_off[v], or -1 when q is outside the closed star. A
  * small move keeps most points in the tet they were in, so the hint makes
@@ -369,6 +344,16 @@ static int in_pos_star_tet(const sm_mesh *sm, uint32_t v, size_t j, const double
             return 0;
     }
     return 1;
+}
+
+/* in_star_tet given o, the sign of st_orient3d of the tet's corners with v
+ * at p (st_point_in_tet's first test, which does not depend on q): for a
+ * positive tet (o < 0) in_pos_star_tet's face tests alone, the same
+ * answer. */
+static int in_star_tet_o(const sm_mesh *sm, uint32_t v, size_t j, const double p[3],
+                         const double q[3], int o)
+{
+    return o < 0 ? in_pos_star_tet(sm, v, j, p, q, 0) : in_star_tet(sm, v, j, p, q);
 }
 
 /* in_star for a star that is positive with v at p (see in_pos_star_tet);
