@@ -24,21 +24,48 @@ typedef struct tri_key {
     uint32_t t;
 } tri_key;
 
-static int cmp_tri_key(const void *pa, const void *pb)
+/* Stable least-significant-digit radix sort of n elements of `size` bytes
+ * (at most 16) by `passes` 16-bit digits, digit(x, 0) the least
+ * significant; tmp holds n elements. A pass whose digit is the same for
+ * every element moves nothing. Both orders below are total (ties by
+ * triangle), so this is qsort's order with its comparator, without its
+ * comparisons (issue 23: qsort was a third of the dragon's edge table). */
+static void radix_sort(void *a, void *tmp, size_t n, size_t size, int passes,
+                       uint32_t (*digit)(const void *x, int pass), size_t *count)
 {
-    const tri_key *a = pa, *b = pb;
-    for (int i = 0; i < 3; i++)
-        if (a->k[i] != b->k[i])
-            return a->k[i] < b->k[i] ? -1 : 1;
-    return (a->t > b->t) - (a->t < b->t);
+    unsigned char *src = a, *dst = tmp;
+    for (int pass = 0; pass < passes; pass++) {
+        memset(count, 0, 65537 * sizeof *count);
+        for (size_t i = 0; i < n; i++)
+            count[digit(src + i * size, pass) + 1]++;
+        if (n == 0 || count[digit(src, pass) + 1] == n)
+            continue;
+        for (size_t d = 0; d < 65536; d++)
+            count[d + 1] += count[d];
+        for (size_t i = 0; i < n; i++)
+            memcpy(dst + size * count[digit(src + i * size, pass)]++, src + i * size, size);
+        unsigned char *x = src;
+        src = dst;
+        dst = x;
+    }
+    if (src != a)
+        memcpy(a, src, n * size);
 }
 
-static int cmp_half(const void *pa, const void *pb)
+/* (k[0], k[1], k[2]) from the least significant 16 bits; the keys are
+ * made in triangle order, so the stable passes leave ties by t */
+static uint32_t tri_digit(const void *x, int pass)
 {
-    const st_half_edge *a = pa, *b = pb;
-    if (a->key != b->key)
-        return a->key < b->key ? -1 : 1;
-    return (a->t > b->t) - (a->t < b->t);
+    const tri_key *k = x;
+    return (k->k[2 - pass / 2] >> (16 * (pass & 1))) & 0xffffu;
+}
+
+/* t first (the ties), then the key */
+static uint32_t half_digit(const void *x, int pass)
+{
+    const st_half_edge *h = x;
+    return pass < 2 ? (h->t >> (16 * pass)) & 0xffffu
+                    : (uint32_t)(h->key >> (16 * (pass - 2))) & 0xffffu;
 }
 
 void st_soup_edges_free(st_soup_edges *e)
@@ -88,11 +115,16 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
     e->he = st_malloc_array(3 * nt + 1, sizeof *e->he);
     e->piece = st_malloc_array(nt ? nt : 1, sizeof *e->piece);
     size_t *uf = st_malloc_array(nt ? nt : 1, sizeof *uf);
+    /* the radix sorts' scratch: the half-edges, and the digits' counts */
+    st_half_edge *tmp = st_malloc_array(3 * nt + 1, sizeof *tmp);
+    size_t *count = st_malloc_array(65537, sizeof *count);
     long long nw = -1;
-    if (!keys || !e->weld || !e->kept || !e->he || !e->piece || !uf ||
+    if (!keys || !e->weld || !e->kept || !e->he || !e->piece || !uf || !tmp || !count ||
         (nw = st_weld_vertices(e->weld, s)) < 0) {
         free(keys);
         free(uf);
+        free(tmp);
+        free(count);
         st_soup_edges_free(e);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
     }
@@ -113,7 +145,8 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
         keys[nk].t = (uint32_t)t;
         nk++;
     }
-    qsort(keys, nk, sizeof *keys, cmp_tri_key);
+    _Static_assert(sizeof(tri_key) <= sizeof(st_half_edge), "the scratch holds the keys");
+    radix_sort(keys, tmp, nk, sizeof *keys, 6, tri_digit, count);
 
     /* 2. half-edges of the kept triangles */
     size_t nh = 0;
@@ -133,7 +166,9 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
         e->kept[t] = (uint8_t)!dup;
     }
     free(keys);
-    qsort(e->he, nh, sizeof *e->he, cmp_half);
+    radix_sort(e->he, tmp, nh, sizeof *e->he, 6, half_digit, count);
+    free(tmp);
+    free(count);
     e->nhalf = nh;
 
     /* 3. pieces */

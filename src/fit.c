@@ -372,6 +372,16 @@ static int in_pos_star_tet(const sm_mesh *sm, uint32_t v, size_t j, const double
     return 1;
 }
 
+/* in_star_tet given o, the sign of st_orient3d of the tet's corners with v
+ * at p (st_point_in_tet's first test, which does not depend on q): for a
+ * positive tet (o < 0) in_pos_star_tet's face tests alone, the same
+ * answer. */
+static int in_star_tet_o(const sm_mesh *sm, uint32_t v, size_t j, const double p[3],
+                         const double q[3], int o)
+{
+    return o < 0 ? in_pos_star_tet(sm, v, j, p, q, 0) : in_star_tet(sm, v, j, p, q);
+}
+
 /* in_star for a star that is positive with v at p (see in_pos_star_tet);
  * with hint_opposite, q is known to be inside the hint tet's face opposite
  * v. Returns the same tet as in_star. */
@@ -412,6 +422,7 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
      * largest part of the fit on dragon_res3, 9 million tet tests). */
     enum { BOXED_MAX = 96 };
     double tbox[BOXED_MAX][6];
+    int tor[BOXED_MAX];   /* and their orientations (in_star_tet_o) */
     const size_t nst = sm->vt_off[v + 1] - sm->vt_off[v];
     const int boxed = nst <= BOXED_MAX;
     for (size_t j = 0; boxed && j < nst; j++) {
@@ -427,6 +438,9 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
                 tbox[j][3 + a] = y[a] > tbox[j][3 + a] ? y[a] : tbox[j][3 + a];
             }
         }
+        const double *y0 = sm->m->xyz + 3 * (size_t)tc[0], *y1 = sm->m->xyz + 3 * (size_t)tc[1],
+                     *y2 = sm->m->xyz + 3 * (size_t)tc[2], *y3 = sm->m->xyz + 3 * (size_t)tc[3];
+        tor[j] = st_sign(st_orient3d(y0, y1, y2, y3));
     }
     ptrdiff_t hint = -1;   /* neighbouring points tend to share a tet */
     for (size_t iz = a0[2]; iz <= a1[2]; iz++)
@@ -452,7 +466,7 @@ static int svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
                             if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] ||
                                 q[0] > bx[3] || q[1] > bx[4] || q[2] > bx[5])
                                 continue;
-                            if (in_star_tet(sm, v, u, x, q)) {
+                            if (in_star_tet_o(sm, v, u, x, q, tor[u])) {
                                 t = (ptrdiff_t)u;
                                 break;
                             }

@@ -432,10 +432,12 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     if (rc)
         goto done;
     double t_sign = t_start + (now_seconds() - t_start) -
-                    (ps.seconds_shells + ps.seconds_holes + ps.seconds_vote + ps.seconds_refine);
+                    (ps.seconds_shells + ps.seconds_holes + ps.seconds_vote + ps.seconds_refine +
+                     ps.seconds_bvh);
     st->seconds_dist = t_sign - t_start;
     double t_cand = now_seconds();
     st->seconds_sign = t_cand - t_sign;
+    st->shells_only = ps.shells_only;
     st->field_dims[0] = g->nx;
     st->field_dims[1] = g->ny;
     st->field_dims[2] = g->nz;

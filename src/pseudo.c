@@ -38,7 +38,30 @@ st_pseudo_params st_pseudo_params_default(void)
     p.cap_reach = 3.0;
     p.sides = 1;
     p.sides_params = st_sides_params_default();
+    p.shells_shortcut = 1;
     return p;
+}
+
+/* The shortcut (pseudo.h): every kept triangle of s is in a closed shell,
+ * so step 5 would overwrite every sign; g gets the shells' solid alone,
+ * each voxel st_grid_signed_value(its distance, inside the solid). */
+static st_status shells_only(st_grid *g, const st_shells *shells, const st_pseudo_params *p,
+                             st_pseudo_stats *st, st_error *err)
+{
+    st->failed_step = "vote";   /* the field's checks: the field is to blame */
+    st_status rc = st_sign_check_field(g, &p->sign, err);
+    if (rc)
+        return rc;
+    st->failed_step = "shells";
+    /* an unsigned field read as signed is every voxel outside (no value is
+     * negative); the shells then turn inside exactly their solid */
+    g->kind = ST_GRID_SIGNED;
+    rc = st_shells_sign(g, shells, &st->shell_changed, err);
+    if (!rc && st_meta_set(&g->meta, "sign_rule",
+                           "closed shells: every triangle is in one, the signs are their "
+                           "solid (no caps, vote or refinement)"))
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    return rc;
 }
 
 /* Step 2: the caps of s's holes, lowered into g; *with_caps gets s and its
@@ -145,6 +168,15 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
             goto done;
         st->shells = shells.count;
         st->shell_open_triangles = shells.open_triangles;
+        if (p->shells_shortcut && shells.count > 0 && shells.open_triangles == 0) {
+            st_soup_edges_free(&edges);
+            have_edges = 0;
+            st->shells_only = 1;
+            if ((rc = shells_only(g, &shells, p, st, err)))
+                goto done;
+            st->seconds_shells = now_seconds() - t0;
+            goto count_inside;
+        }
     }
     double t1 = now_seconds();
     st->seconds_shells = t1 - t0;
@@ -185,6 +217,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     if (s && p->closed_shells && (rc = st_shells_sign(g, &shells, &st->shell_changed, err)))
         goto done;
     st->seconds_shells += now_seconds() - t4;
+count_inside:;
     size_t inside = 0;
     const size_t n = st_grid_count(g);
     for (size_t i = 0; i < n; i++)
@@ -192,8 +225,10 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     st->inside = inside;
     st->failed_step = NULL;
     if (bvh_out && s) {
+        const double tb = now_seconds();
         if (!bvh && (rc = st_bvh_build(&bvh, s, err)))
             goto done;
+        st->seconds_bvh = now_seconds() - tb;
         *bvh_out = bvh;
         bvh = NULL;
     }

@@ -839,10 +839,7 @@ unsigned st_sign_line(const float *d, size_t n, float t,
     return events;
 }
 
-/* The checks and the 13 sweeps: v (n bytes, zeroed) gets every voxel's
- * votes (see above). */
-static st_status vote_all(const st_grid *g, const st_sign_params *p, uint8_t *v,
-                          const st_progress *progress, st_error *err)
+st_status st_sign_check_field(const st_grid *g, const st_sign_params *p, st_error *err)
 {
     if (g->kind == ST_GRID_SIGNED)
         return st_error_set(err, ST_EINPUT, NULL, 0,
@@ -892,7 +889,17 @@ static st_status vote_all(const st_grid *g, const st_sign_params *p, uint8_t *v,
         return st_error_set(err, ST_EINPUT, NULL, 0,
                             "the field is constant (%g): no surface in it",
                             (double)first);
+    return ST_OK;
+}
 
+/* The checks and the 13 sweeps: v (n bytes, zeroed) gets every voxel's
+ * votes (see above). */
+static st_status vote_all(const st_grid *g, const st_sign_params *p, uint8_t *v,
+                          const st_progress *progress, st_error *err)
+{
+    st_status cs = st_sign_check_field(g, p, err);
+    if (cs)
+        return cs;
     const double t = st_sign_event_distance(p, g);
     sweep w;
     sweep_init(&w, (st_grid *)g, p, g->data, v, (float)t);

@@ -241,6 +241,8 @@ static void test_onesided(void)
     st_grid *g = NULL;
     st_error err;
     pp = st_pseudo_params_default();
+    pp.shells_shortcut = 0;   /* the ball is one closed shell: the sides
+                                 run only on the full path */
     const int ok = !st_pseudo_volume(&g, t, &dp, &pp, &st, NULL, &err);
     TAP_CHECK(ok && !st.sides.onesided && st.mirrored == 0 && st.sides.back_front > 0.9,
               "a closed ball is not one-sided (back/front %.3f)", st.sides.back_front);
@@ -426,6 +428,167 @@ static void test_shared_tables(void)
     st_soup_free(s);
 }
 
+/* A UV ball of radius 1 that is exactly closed (add_sphere's seam and
+ * poles are not: sin(2 pi) and sin(pi) are not 0): each vertex computed
+ * once from its grid position, the poles exact; faces turned at random. */
+static void ball_vertex(int i, int j, double p[3])
+{
+    const int nu = 24, nv = 12;
+    j %= nu;
+    const double th = M_PI * i / nv, ph = 2 * M_PI * j / nu;
+    p[0] = i == 0 || i == nv ? 0.0 : sin(th) * cos(ph);
+    p[1] = i == 0 || i == nv ? 0.0 : sin(th) * sin(ph);
+    p[2] = i == 0 ? 1.0 : i == nv ? -1.0 : cos(th);
+}
+
+static void add_closed_ball(st_soup *s)
+{
+    const int nu = 24, nv = 12;
+    for (int i = 0; i < nv; i++)
+        for (int j = 0; j < nu; j++) {
+            double p[4][3];
+            ball_vertex(i, j, p[0]);
+            ball_vertex(i, j + 1, p[1]);
+            ball_vertex(i + 1, j + 1, p[2]);
+            ball_vertex(i + 1, j, p[3]);
+            if (i > 0)
+                add_tri(s, p[0], p[1], p[2], (i + j) & 1);
+            if (i < nv - 1)
+                add_tri(s, p[0], p[2], p[3], (i * j) & 1);
+        }
+}
+
+/* The pseudo volume of s on the shortcut (pp as given) and on the full
+ * path (shells_shortcut 0), and s's unsigned field; 0 on failure. */
+static int both_paths(const st_soup *s, size_t cells, st_grid **fast, st_grid **full,
+                      st_grid **dist, st_pseudo_stats *sf, st_pseudo_stats *sl)
+{
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = cells;
+    st_pseudo_params pp = st_pseudo_params_default();
+    st_error err;
+    *fast = *full = *dist = NULL;
+    if (st_pseudo_volume(fast, s, &dp, &pp, sf, NULL, &err))
+        return 0;
+    pp.shells_shortcut = 0;
+    return !st_pseudo_volume(full, s, &dp, &pp, sl, NULL, &err) &&
+           !st_dist_field(dist, s, &dp, NULL, &err);
+}
+
+/* Voxels where the fast field's value is not st_grid_signed_value(the
+ * distance, inside the truth), or its sign is not the full path's. */
+static size_t disagree(const st_grid *fast, const st_grid *full, const st_grid *dist,
+                       const uint8_t *truth, size_t *sign_vs_full)
+{
+    size_t bad = 0, sign = 0;
+    for (size_t i = 0; i < st_grid_count(fast); i++) {
+        const float want = st_grid_signed_value(dist->data[i], truth[i]);
+        bad += memcmp(&fast->data[i], &want, sizeof want) != 0;
+        sign += (fast->data[i] < 0.0f) != (full->data[i] < 0.0f);
+    }
+    *sign_vs_full = sign;
+    return bad;
+}
+
+static void test_shells_shortcut(void)
+{
+    /* A closed ball (faces turned at random), and two interpenetrating
+     * closed boxes: every triangle in a closed shell, so the signs are the
+     * shells' solid alone (pseudo.h, the shortcut), each voxel
+     * st_grid_signed_value(its distance, inside) by the exact solid
+     * (solid.h): the ball by parity, the boxes' union (their overlap
+     * inside) by nonzero winding. The full path's signs are the same. */
+    for (int shape = 0; shape < 2; shape++) {
+        st_soup *s = st_soup_new();
+        const double lo1[3] = {0.01, 0.02, 0.03}, hi1[3] = {2.01, 2.02, 2.03};
+        const double lo2[3] = {1.3, 1.31, 1.32}, hi2[3] = {3.3, 3.31, 3.32};
+        st_soup *b1 = st_soup_new(), *b2 = st_soup_new();
+        if (shape == 0)
+            add_closed_ball(s);
+        else {
+            add_box_oriented(b1, lo1, hi1);
+            add_box_oriented(b2, lo2, hi2);
+            st_error e;
+            st_soup_append(s, b1, &e);
+            st_soup_append(s, b2, &e);
+        }
+        st_grid *fast, *full, *dist;
+        st_pseudo_stats sf, sl;
+        int ok = both_paths(s, 40, &fast, &full, &dist, &sf, &sl);
+        const size_t n = ok ? st_grid_count(fast) : 1;
+        uint8_t *truth = malloc(n);
+        st_error err;
+        const st_soup *ball[1] = {s}, *boxes[2] = {b1, b2};
+        ok = ok && truth &&
+             !st_solid_inside(truth, dist, shape ? boxes : ball, shape ? 2 : 1,
+                              shape ? ST_SOLID_NONZERO : ST_SOLID_PARITY, &err);
+        size_t sign_vs_full = 0, inside = 0, overlap = 0;
+        const size_t bad = ok ? disagree(fast, full, dist, truth, &sign_vs_full) : n;
+        for (size_t i = 0; ok && i < n; i++) {
+            inside += truth[i];
+            if (shape && truth[i]) {
+                double c[3];
+                const size_t i0 = i % dist->nx, j0 = (i / dist->nx) % dist->ny,
+                             k0 = i / (dist->nx * dist->ny);
+                st_grid_center(dist, i0, j0, k0, c);
+                overlap += c[0] > lo2[0] && c[1] > lo2[1] && c[2] > lo2[2] && c[0] < hi1[0] &&
+                           c[1] < hi1[1] && c[2] < hi1[2];
+            }
+        }
+        const char *name = shape ? "two interpenetrating boxes" : "a closed ball";
+        TAP_CHECK(ok && sf.shells_only && sf.shells == (size_t)(shape ? 2 : 1) &&
+                  sf.shell_open_triangles == 0 && sf.holes.loops == 0 && sf.sides.regions == 0 &&
+                  sf.refined == 0 && sf.seconds_vote == 0 && sf.shell_changed == sf.inside,
+                  "%s takes the shortcut: the shells' signs alone (%zu inside)", name,
+                  sf.inside);
+        TAP_CHECK(ok && !sl.shells_only && sl.sides.regions > 0,
+                  "%s with shells_shortcut 0: every step runs (%zu regions)", name,
+                  ok ? sl.sides.regions : 0);
+        TAP_CHECK(ok && inside > 0 && bad == 0 && (!shape || overlap > 0),
+                  "%s: every value is its distance signed by the exact solid (%zu of %zu "
+                  "differ; %zu inside, %zu in the overlap)", name, bad, n, inside, overlap);
+        TAP_CHECK(ok && sign_vs_full == 0, "%s: the full path's signs, voxel for voxel "
+                  "(%zu differ)", name, sign_vs_full);
+        TAP_CHECK(ok && st_meta_get(&fast->meta, "closed_shells") &&
+                  st_meta_get(&fast->meta, "sign_rule") && !st_meta_get(&fast->meta, "hole_caps") &&
+                  !st_meta_get(&fast->meta, "sign_refine"),
+                  "%s: the metadata records the shells, no caps, no refinement", name);
+        if (shape == 0) {
+            /* the shortcut checks the field as the vote does */
+            st_pseudo_params pp = st_pseudo_params_default();
+            st_pseudo_stats st;
+            const st_status rc = ok ? st_pseudo_sign(fast, s, &pp, &st, NULL, &err) : ST_OK;
+            TAP_CHECK(rc == ST_EINPUT && st.failed_step && !strcmp(st.failed_step, "vote"),
+                      "a signed field is refused on the shortcut too");
+        }
+        free(truth);
+        st_grid_free(fast);
+        st_grid_free(full);
+        st_grid_free(dist);
+        st_soup_free(s);
+        st_soup_free(b1);
+        st_soup_free(b2);
+    }
+    /* One open triangle beside the ball: no shortcut, the same bytes with
+     * shells_shortcut on and off. */
+    st_soup *s = st_soup_new();
+    add_closed_ball(s);
+    const double a[3] = {0.1, 0.1, 0.1}, b[3] = {0.5, 0.1, 0.2}, c[3] = {0.1, 0.6, 0.3};
+    add_tri(s, a, b, c, 0);
+    st_grid *fast, *full, *dist;
+    st_pseudo_stats sf, sl;
+    const int ok = both_paths(s, 40, &fast, &full, &dist, &sf, &sl);
+    TAP_CHECK(ok && !sf.shells_only && sf.shells == 1 && sf.shell_open_triangles == 1 &&
+              sf.sides.regions > 0 && st_meta_get(&fast->meta, "sign_refine"),
+              "one open triangle: every step runs (%zu open)", ok ? sf.shell_open_triangles : 0);
+    TAP_CHECK(ok && !memcmp(fast->data, full->data, st_grid_count(fast) * sizeof *fast->data),
+              "and gives the bytes it gives without the shortcut");
+    st_grid_free(fast);
+    st_grid_free(full);
+    st_grid_free(dist);
+    st_soup_free(s);
+}
+
 int main(void)
 {
     test_entry_point();
@@ -435,5 +598,6 @@ int main(void)
     test_onesided_caps();
     test_sides_orientation();
     test_shared_tables();
+    test_shells_shortcut();
     return tap_done();
 }

@@ -148,6 +148,9 @@ typedef struct st_pipeline_stats {
                                             dry_run; the fit keeps them) */
     size_t sculpts;                      /* sculpts spent choosing h */
     double seconds_size;                 /* and their time */
+    int shells_only;                     /* the pseudo volume's signs are
+                                            its closed shells' alone
+                                            (pseudo.h, the shortcut) */
 } st_pipeline_stats;
 
 /* The lattice cell width p gives for s: p->h, or the width of p->cells

@@ -17,6 +17,21 @@
  *   4. the near-surface refinement against s and its caps (sign.h,
  *      st_sign_refine);
  *   5. the shells' solid (st_shells_sign).
+ * The shortcut (shells_shortcut, on by default): when step 1 finds that
+ * every triangle of s is in a closed shell (at least one shell, no open
+ * triangle; degenerate and duplicated triangles do not count), step 5
+ * decides every sign whatever steps 2 to 4 said, so they do not run: the
+ * field is checked as the vote checks it, and each voxel becomes
+ * st_grid_signed_value(its distance, inside the shells' solid). The signs
+ * are the shells' alone, the same as the full path's voxel for voxel; a
+ * voxel whose center lies on the surface (distance 0) is inside or outside
+ * as the solid's simulation of simplicity says (solid.h), and holds
+ * -FLT_MIN inside, +0.0 outside (the full path can leave +FLT_MIN there,
+ * where an earlier step had called it inside: that bit pattern comes from
+ * the skipped steps, not the shells). The metadata then records
+ * "closed_shells" and a "sign_rule" naming the shells, and no "hole_caps"
+ * or "sign_refine"; stats->shells_only is 1, and the other steps' stats
+ * and seconds are 0.
  * Without the soup (s NULL) only step 3 runs: the vote of Spillmann et al.
  * 2006, section 3, and whatever the rule adds. Steps 1, 2 and 4 are not
  * in the paper; each can be turned off (fill_holes, closed_shells,
@@ -53,6 +68,8 @@ typedef struct st_pseudo_params {
     int sides;                      /* step 3 with the sides' evidence (1) */
     st_sides_params sides_params;   /* (st_sides_params_default) */
     double cap_reach;               /* voxels (3; the field's band if less) */
+    int shells_shortcut;            /* the shells alone when they are the
+                                       whole soup (1; 0: every step runs) */
 } st_pseudo_params;
 
 /* Every step on, the project's default rule. */
@@ -69,9 +86,14 @@ typedef struct st_pseudo_stats {
     size_t refined;                 /* signs the refinement changed */
     size_t shells;                  /* closed shells */
     size_t shell_open_triangles;    /* triangles in none */
-    size_t shell_changed;           /* signs the shells changed */
+    size_t shell_changed;           /* signs the shells changed (the
+                                       shortcut: voxels inside, from all
+                                       outside) */
+    int shells_only;                /* the shortcut ran: steps 2 to 4 did not */
     size_t inside;                  /* voxels inside at the end */
     double seconds_shells, seconds_holes, seconds_vote, seconds_refine;
+    double seconds_bvh;             /* the BVH handed over (_bvh calls) when
+                                       no step built it (the shortcut) */
     const char *failed_step;        /* on failure: "shells", "holes", "vote",
                                        "refine" (whose input to blame) */
 } st_pseudo_stats;

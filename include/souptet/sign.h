@@ -112,6 +112,10 @@ double st_sign_event_distance(const st_sign_params *p, const st_grid *g);
 st_status st_sign_field(st_grid *g, const st_sign_params *p,
                         const st_progress *progress, st_error *err);
 
+/* st_sign_field's checks alone (g unsigned, finite, not constant; k and
+ * rays in range): ST_OK, or the ST_EINPUT st_sign_field would give. */
+st_status st_sign_check_field(const st_grid *g, const st_sign_params *p, st_error *err);
+
 /* st_sign_field with more evidence for the cut (p->cut only): extra[i]
  * (NULL: none) is added to voxel i's evidence from the votes (a margin of
  * U - 13 votes; see mincut.h for its weight), for what the votes cannot

@@ -133,9 +133,10 @@ static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
 {
     tool_say(t, 2, "field %zux%zux%zu, voxel %.6g; lattice cell h %.6g",
              st->field_dims[0], st->field_dims[1], st->field_dims[2], st->voxel, st->h);
-    tool_say(t, 2, "distance %.3f s, signs %.3f s, %zu candidate%s %.3f s",
-             st->seconds_dist, st->seconds_sign, st->ncandidates,
-             st->ncandidates == 1 ? "" : "s", st->seconds_candidates);
+    tool_say(t, 2, "distance %.3f s, signs %.3f s%s, %zu candidate%s %.3f s",
+             st->seconds_dist, st->seconds_sign,
+             st->shells_only ? " (the closed shells' solid: no caps, vote or refinement)" : "",
+             st->ncandidates, st->ncandidates == 1 ? "" : "s", st->seconds_candidates);
     for (size_t k = 0; k < st->ncandidates; k++) {
         const st_pipeline_candidate *c = &st->candidates[k];
         if (c->failed) {

@@ -395,23 +395,27 @@ static int run(tool_ctx *t, void *settings)
     tool_say(t, 2, "event distance %.6g (%.3g voxels); %zu of %zu voxels inside (%.2f%%)",
              ps.event_distance, ps.event_distance / g->voxel, ps.inside, n,
              100.0 * (double)ps.inside / (double)n);
-    if (surface && s->fill_holes)
+    if (ps.shells_only)
+        tool_say(t, 2, "every triangle is in a closed shell: the signs are the shells' "
+                 "solid; no caps, sides, vote or refinement");
+    if (surface && s->fill_holes && !ps.shells_only)
         tool_say(t, 2, "holes: %zu of %zu boundary loops capped (%zu too large, %zu too long, "
                  "%zu edges left open where holes touch unpaired), %.3f s",
                  ps.holes.filled, ps.holes.loops, ps.holes.too_large, ps.holes.too_long,
                  ps.holes.pinched, ps.seconds_holes);
-    if (surface && s->use_sides && p->cut)
+    const int voted = !ps.shells_only;
+    if (surface && s->use_sides && p->cut && voted)
         tool_say(t, 2, "sides: %zu orientable regions (%zu turned to the votes, %zu edges "
                  "disagreeing), %zu voxels given their side", ps.sides.regions, ps.sides.turned,
                  ps.sides.conflicts, ps.sides.voxels);
-    if (surface && s->use_sides && p->cut)
+    if (surface && s->use_sides && p->cut && voted)
         tool_say(t, 2, "view: back/front %.3f along (%.3f %.3f %.3f): %s; walls %.2f of its rim",
                  ps.sides.back_front, ps.sides.view[0], ps.sides.view[1], ps.sides.view[2],
                  ps.sides.onesided ? "one-sided" : "not one-sided", ps.sides.walls);
-    if (surface && s->use_sides && p->cut && ps.sides.fold)
+    if (surface && s->use_sides && p->cut && voted && ps.sides.fold)
         tool_say(t, 2, "far side mirrored along step (%d %d %d): %zu voxels",
                  ps.sides.step[0], ps.sides.step[1], ps.sides.step[2], ps.mirrored);
-    if (surface)
+    if (surface && voted)
         tool_say(t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
                  s->refine.band_voxels, ps.refined, ps.seconds_refine);
     if (surface && s->use_shells)
@@ -420,7 +424,7 @@ static int run(tool_ctx *t, void *settings)
                  ps.shells && !ps.shell_open_triangles ? ": the signs are their solid" : "",
                  ps.shell_changed, ps.seconds_shells);
     tool_say(t, 2, "read %.3f s, signs %.3f s (CPU %.3f s, all threads), write %.3f s",
-             t1 - t0, ps.seconds_vote, cpu_sign, t3 - t2);
+             t1 - t0, voted ? ps.seconds_vote : ps.seconds_shells, cpu_sign, t3 - t2);
     rc = TOOL_EXIT_OK;
 done:
     st_grid_free(g);

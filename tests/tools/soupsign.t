@@ -44,8 +44,9 @@ expect_fail "unknown toggle" 2 "--toggle is first, nearest or crossing" soupsign
 
 # The near-surface refinement with the soup (--surface).
 check "--surface refines: a .vti" sh -c "soupdist -r 48 '$BUNNY' | soupsign --surface '$BUNNY' -o r.vti"
-check "--surface records the refinement in the history metadata" sh -c "soupsign --surface '$BUNNY' -o r.vdb d.vdb && grep -aq 'sign_refine' r.vdb"
-check "-v reports the refinement" sh -c "soupsign -v --surface '$BUNNY' -o r2.vdb d.vdb 2>&1 | grep -q 'refinement (band 1.5 voxels): [0-9]* signs changed'"
+# (the bunny is one closed shell, which alone signs it: --shells off runs the refinement)
+check "--surface records the refinement in the history metadata" sh -c "soupsign --shells off --surface '$BUNNY' -o r.vdb d.vdb && grep -aq 'sign_refine' r.vdb"
+check "-v reports the refinement" sh -c "soupsign -v --shells off --surface '$BUNNY' -o r2.vdb d.vdb 2>&1 | grep -q 'refinement (band 1.5 voxels): [0-9]* signs changed'"
 mkdir r1 r2
 (cd r1 && OMP_NUM_THREADS=1 soupsign --surface "$BUNNY" -o s.vti ../d.vdb)
 (cd r2 && OMP_NUM_THREADS=2 soupsign --surface "$BUNNY" -o s.vti ../d.vdb)
@@ -57,7 +58,7 @@ expect_fail "bad --refine-band" 2 "refine-band" soupsign --refine-band 0 --surfa
 
 # The steps after the per-line rule: split runs, the cut, hole caps.
 check "--runs whole and --cut off run" sh -c "soupsign --runs whole -o w.vdb d.vdb && soupsign --cut off -o c.vdb d.vdb"
-check "the rule metadata names the runs and the cut" sh -c "soupsign -v -o m.vdb d.vdb 2>&1 | grep -q 'runs=split undecided=cut'"
+check "the rule metadata names the runs and the cut" sh -c "soupsign -v --surface none -o m.vdb d.vdb 2>&1 | grep -q 'runs=split undecided=cut'"
 expect_fail "bad --runs" 2 "--runs is split or whole" soupsign --runs some d.vdb
 expect_fail "bad --cut" 2 "--cut is on or off" soupsign --cut maybe d.vdb
 expect_fail "bad --fill-holes" 2 "--fill-holes is on or off" soupsign --fill-holes yes d.vdb
@@ -138,6 +139,15 @@ check "the signs are the cubes' union exactly, overlap included" $PYVTK union.py
 check "--shells off: no shells reported" sh -c \
     "soupsign -v --shells off --surface cubes.obj -o co.vdb cubes.vdb 2>&1 | (! grep -q 'closed shells') && ! grep -aq closed_shells co.vdb"
 check "the bunny is one closed shell" sh -c "soupsign -v --surface '$BUNNY' -o b1.vdb d.vdb 2>&1 | grep -q 'closed shells: 1 (0 triangles'"
+# Nothing but closed shells: they alone sign (pseudo.h, the shortcut), the
+# caps, sides, vote and refinement do not run; the same signs as with them.
+soupsign -v --surface cubes.obj -o cs.vdb cubes.vdb 2> cs.log
+check "closed shells only: -v says the other steps did not run" sh -c \
+    "grep -q 'every triangle is in a closed shell: the signs are the shells. solid; no caps, sides, vote or refinement' cs.log && ! grep -q 'holes:\\|sides:\\|refinement (band' cs.log"
+check "closed shells only: the metadata names the shells, no caps or refinement" sh -c \
+    "grep -aq 'closed shells: every triangle is in one' cs.vdb && grep -aq closed_shells cs.vdb && ! grep -aq 'hole_caps\\|sign_refine' cs.vdb"
+check "the holed bunny runs every step" sh -c \
+    "soupsign -v --surface holed.obj -o h4.vdb h.vdb 2>&1 | grep -q 'refinement (band' && grep -aq sign_refine h4.vdb"
 check "the holed bunny has none" sh -c "soupsign -v --surface holed.obj -o h3.vdb h.vdb 2>&1 | grep -q 'closed shells: 0 ('"
 expect_fail "bad --shells" 2 "--shells is on or off" soupsign --shells 1 d.vdb
 
@@ -162,8 +172,8 @@ soupsign --surface pipe.obj -o surf.vti pd.vdb
 soupsign --surface none -o none.vti pd.vdb
 check "the pipe's signs are byte-identical to --surface" $PYVTK same.py pipe.vti surf.vti same
 check "--surface none is the vote alone, and differs" $PYVTK same.py none.vti surf.vti differ
-check "the pipe names its rule with the surface's steps" sh -c \
-    "soupsign -o pr.vdb pd.vdb && grep -aq sign_refine pr.vdb && grep -aq hole_caps pr.vdb"
+check "the pipe names its rule with the surface's steps (the bunny's closed shell)" sh -c \
+    "soupsign -o pr.vdb pd.vdb && grep -aq closed_shells pr.vdb"
 echo "# changed" >> pipe.obj
 check "a changed soup: a one-line note, the vote alone" sh -c \
     "soupsign -o ch.vti pd.vdb 2>&1 | grep -q 'note: .*pipe.obj has changed since soupdist read it' && $PYVTK same.py ch.vti none.vti same"
@@ -173,6 +183,6 @@ check "a moved soup: a note, the vote alone" sh -c \
     "soupsign -o mv.vti pd.vdb 2>&1 | grep -q 'note: the field.s soup cannot be read' && $PYVTK same.py mv.vti none.vti same"
 check "--surface FILE still works on such a field" soupsign --surface moved.obj -o mf.vdb pd.vdb
 check "a field from stdin records no soup" sh -c "soupdist -r 24 - < moved.obj | soupsign -v -o st.vdb 2>&1 | (! grep -q 'surface:')"
-check "--rule paper ignores the recorded soup" sh -c "cp moved.obj pipe.obj && soupsign --rule paper -o pp.vdb pd.vdb && ! grep -aq sign_refine pp.vdb"
+check "--rule paper ignores the recorded soup" sh -c "cp moved.obj pipe.obj && soupsign --rule paper -o pp.vdb pd.vdb && ! grep -aq 'sign_refine\\|closed_shells' pp.vdb"
 
 done_testing
