@@ -209,8 +209,9 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
 }
 
 /* Choose h for about p->target_tets tets (pipeline.h): sculpt the first
- * candidate's lattice (the fit moves vertices, never adds or removes a
- * tet, so its count is the mesh's) and step h in log-log space. The
+ * candidate's lattice (the fit moves vertices and at most peels a few
+ * boundary tets that hold nothing of the soup, so the sculpted count is
+ * the mesh's count or a little above it) and step h in log-log space. The
  * slope starts at -3 (a solid: tets ~ 1/h^3) and is then measured from
  * the last two sculpts, kept within [-4, -1.5] (thin parts count like a
  * surface, ~ 1/h^2); a step changes h by a factor within [1/2, 2] so one
