@@ -31,19 +31,21 @@ typedef struct tri_key {
  * triangle), so this is qsort's order with its comparator, without its
  * comparisons (issue 23: qsort was a third of the dragon's edge table). */
 static void radix_sort(void *a, void *tmp, size_t n, size_t size, int passes,
-                       uint32_t (*digit)(const void *x, int pass), size_t *count)
+                       uint32_t (*digit)(const void *x, int pass, unsigned bits),
+                       unsigned bits, size_t *count)
 {
     unsigned char *src = a, *dst = tmp;
     for (int pass = 0; pass < passes; pass++) {
         memset(count, 0, 65537 * sizeof *count);
         for (size_t i = 0; i < n; i++)
-            count[digit(src + i * size, pass) + 1]++;
-        if (n == 0 || count[digit(src, pass) + 1] == n)
+            count[digit(src + i * size, pass, bits) + 1]++;
+        if (n == 0 || count[digit(src, pass, bits) + 1] == n)
             continue;
         for (size_t d = 0; d < 65536; d++)
             count[d + 1] += count[d];
         for (size_t i = 0; i < n; i++)
-            memcpy(dst + size * count[digit(src + i * size, pass)]++, src + i * size, size);
+            memcpy(dst + size * count[digit(src + i * size, pass, bits)]++, src + i * size,
+                   size);
         unsigned char *x = src;
         src = dst;
         dst = x;
@@ -54,18 +56,21 @@ static void radix_sort(void *a, void *tmp, size_t n, size_t size, int passes,
 
 /* (k[0], k[1], k[2]) from the least significant 16 bits; the keys are
  * made in triangle order, so the stable passes leave ties by t */
-static uint32_t tri_digit(const void *x, int pass)
+static uint32_t tri_digit(const void *x, int pass, unsigned bits)
 {
     const tri_key *k = x;
+    (void)bits;
     return (k->k[2 - pass / 2] >> (16 * (pass & 1))) & 0xffffu;
 }
 
-/* t first (the ties), then the key */
-static uint32_t half_digit(const void *x, int pass)
+/* The key's ends packed into 2 * bits bits (both ends are below
+ * 2^bits): the same order as the key's, in fewer passes. The half-edges
+ * are made in triangle order, so the stable passes leave ties by t. */
+static uint32_t half_digit(const void *x, int pass, unsigned bits)
 {
     const st_half_edge *h = x;
-    return pass < 2 ? (h->t >> (16 * pass)) & 0xffffu
-                    : (uint32_t)(h->key >> (16 * (pass - 2))) & 0xffffu;
+    const uint64_t packed = (h->key >> 32) << bits | (h->key & 0xffffffffu);
+    return (uint32_t)(packed >> (16 * pass)) & 0xffffu;
 }
 
 void st_soup_edges_free(st_soup_edges *e)
@@ -146,27 +151,39 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
         nk++;
     }
     _Static_assert(sizeof(tri_key) <= sizeof(st_half_edge), "the scratch holds the keys");
-    radix_sort(keys, tmp, nk, sizeof *keys, 6, tri_digit, count);
+    radix_sort(keys, tmp, nk, sizeof *keys, 6, tri_digit, 0, count);
 
-    /* 2. half-edges of the kept triangles */
-    size_t nh = 0;
+    /* 2. half-edges of the kept triangles (with ST_EDGES_DUPLICATES, of
+     * every non-degenerate one), made in triangle order */
     for (size_t i = 0; i < nk; i++) {
         const uint32_t *k = keys[i].k, t = keys[i].t;
         const int dup = i > 0 && memcmp(k, keys[i - 1].k, sizeof keys[i].k) == 0;
         e->duplicates += dup;
-        if (k[0] == k[1] || k[1] == k[2] || (dup && !(flags & ST_EDGES_DUPLICATES)))
-            continue;
-        const uint64_t ends[3] = {(uint64_t)k[0] << 32 | k[1], (uint64_t)k[1] << 32 | k[2],
-                                  (uint64_t)k[0] << 32 | k[2]};
-        for (int j = 0; j < 3; j++) {
-            e->he[nh].key = ends[j];
-            e->he[nh].t = t;
-            nh++;
-        }
-        e->kept[t] = (uint8_t)!dup;
+        e->kept[t] = (uint8_t)(k[0] != k[1] && k[1] != k[2] && !dup);
     }
     free(keys);
-    radix_sort(e->he, tmp, nh, sizeof *e->he, 6, half_digit, count);
+    size_t nh = 0;
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t a = e->weld[s->tris[3 * t]], b = e->weld[s->tris[3 * t + 1]],
+                 c = e->weld[s->tris[3 * t + 2]], x;
+        if (a > b) { x = a; a = b; b = x; }
+        if (b > c) { x = b; b = c; c = x; }
+        if (a > b) { x = a; a = b; b = x; }
+        if (a == b || b == c || (!e->kept[t] && !(flags & ST_EDGES_DUPLICATES)))
+            continue;
+        const uint64_t ends[3] = {(uint64_t)a << 32 | b, (uint64_t)b << 32 | c,
+                                  (uint64_t)a << 32 | c};
+        for (int j = 0; j < 3; j++) {
+            e->he[nh].key = ends[j];
+            e->he[nh].t = (uint32_t)t;
+            nh++;
+        }
+    }
+    unsigned bits = 0;
+    while (bits < 32 && (e->nweld - 1) >> bits)
+        bits++;
+    radix_sort(e->he, tmp, nh, sizeof *e->he, (int)((2 * bits + 15) / 16), half_digit, bits,
+               count);
     free(tmp);
     free(count);
     e->nhalf = nh;

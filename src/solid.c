@@ -9,6 +9,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 /* Sign of orient2d(a, b, q') in the (y, z) plane for the perturbed query
  * q' = q + (e, e^2): the exact sign when it is not zero, else the sign of
@@ -60,9 +63,19 @@ typedef struct row_bins {
     uint32_t *tri;      /* triangle indices, grouped by row */
 } row_bins;
 
-/* The rows (j, k) a triangle may cover: its (y, z) box widened by one row
- * each way, so rounding in the index arithmetic never drops a row (the
- * exact test decides). */
+/* The rows (j, k) whose perturbed line (y + e, z + e^2) may pass through
+ * triangle t: those with ylo <= y < yhi and zlo <= z < zhi for the
+ * triangle's (y, z) box (a row at y == yhi lies above the box once
+ * perturbed, one at y == ylo inside it; the same for z). A line outside
+ * the box misses the triangle, so only rows line_hits would refuse are
+ * left out. The index arithmetic guesses one row wider each way; the
+ * rows' own coordinates, computed as st_solid_inside computes them, then
+ * trim it exactly. An empty range has *j0 > *j1 or *k0 > *k1. */
+static double row_coord(const st_grid *g, int a, size_t j)
+{
+    return g->origin[1 + a] + g->voxel * (double)j;
+}
+
 static void tri_rows(const st_grid *g, const st_soup *s, size_t t,
                      size_t *j0, size_t *j1, size_t *k0, size_t *k1)
 {
@@ -78,13 +91,20 @@ static void tri_rows(const st_grid *g, const st_soup *s, size_t t,
     for (int a = 0; a < 2; a++) {
         double f0 = floor((lo[a] - g->origin[1 + a]) / g->voxel) - 1.0;
         double f1 = ceil((hi[a] - g->origin[1 + a]) / g->voxel) + 1.0;
-        if (f1 < 0.0 || f0 > (double)n[a] - 1.0) {
-            r0[a] = 1;
-            r1[a] = 0;  /* empty */
+        r0[a] = 1;
+        r1[a] = 0;  /* empty */
+        if (f1 < 0.0 || f0 > (double)n[a] - 1.0)
             continue;
+        size_t b = f0 < 0.0 ? 0 : (size_t)f0;
+        size_t e = f1 > (double)n[a] - 1.0 ? n[a] : (size_t)f1 + 1;   /* rows [b, e) */
+        while (b < e && row_coord(g, a, b) < lo[a])
+            b++;
+        while (e > b && !(row_coord(g, a, e - 1) < hi[a]))
+            e--;
+        if (b < e) {
+            r0[a] = b;
+            r1[a] = e - 1;
         }
-        r0[a] = f0 < 0.0 ? 0 : (size_t)f0;
-        r1[a] = f1 > (double)n[a] - 1.0 ? n[a] - 1 : (size_t)f1;
     }
     *j0 = r0[0];
     *j1 = r1[0];
@@ -92,44 +112,76 @@ static void tri_rows(const st_grid *g, const st_soup *s, size_t t,
     *k1 = r1[1];
 }
 
+/* Bin the triangles by row, each row's triangles in input order: the
+ * triangles cut into runs, each counted and filled by one thread into its
+ * own part of every row's list (the runs' parts in run order), so the
+ * lists are the serial ones for any thread count. */
 static st_status bin_rows(row_bins *b, const st_grid *g, const st_soup *s,
                           st_error *err)
 {
-    size_t nrows = g->ny * g->nz;
+    const size_t nrows = g->ny * g->nz;
     b->start = st_calloc_array(nrows + 1, sizeof *b->start);
     b->tri = NULL;
-    if (!b->start)
+    int runs = 1;
+#ifdef _OPENMP
+    runs = omp_get_max_threads();
+#endif
+    runs = runs < 1 ? 1 : runs > 8 ? 8 : runs;
+    if (s->ntris < 4096)
+        runs = 1;
+    size_t *cnt = st_calloc_array((size_t)runs * (nrows + 1), sizeof *cnt);
+    if (!b->start || !cnt) {
+        free(cnt);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory binning triangles");
+    }
+    #pragma omp parallel for schedule(static, 1) num_threads(runs)
+    for (int c = 0; c < runs; c++) {
+        const size_t t0 = s->ntris * (size_t)c / (size_t)runs;
+        const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)runs;
+        size_t *mine = cnt + (size_t)c * (nrows + 1);
+        for (size_t t = t0; t < t1; t++) {
+            size_t j0, j1, k0, k1;
+            tri_rows(g, s, t, &j0, &j1, &k0, &k1);
+            if (j0 > j1 || k0 > k1)
+                continue;
+            for (size_t k = k0; k <= k1; k++)
+                for (size_t j = j0; j <= j1; j++)
+                    mine[j + g->ny * k]++;
+        }
+    }
+    /* b->start[r]: row r's first slot; cnt[c][r] becomes run c's */
     size_t total = 0;
-    for (size_t t = 0; t < s->ntris; t++) {
-        size_t j0, j1, k0, k1;
-        tri_rows(g, s, t, &j0, &j1, &k0, &k1);
-        if (j0 > j1 || k0 > k1)
-            continue;
-        for (size_t k = k0; k <= k1; k++)
-            for (size_t j = j0; j <= j1; j++)
-                b->start[j + g->ny * k + 1]++;
-        total += (j1 - j0 + 1) * (k1 - k0 + 1);
+    for (size_t r = 0; r < nrows; r++) {
+        b->start[r] = total;
+        for (int c = 0; c < runs; c++) {
+            size_t *x = &cnt[(size_t)c * (nrows + 1) + r];
+            const size_t k = *x;
+            *x = total;
+            total += k;
+        }
     }
-    for (size_t r = 0; r < nrows; r++)
-        b->start[r + 1] += b->start[r];
+    b->start[nrows] = total;
     b->tri = st_malloc_array(total ? total : 1, sizeof *b->tri);
-    size_t *fill = st_malloc_array(nrows, sizeof *fill);
-    if (!b->tri || !fill) {
-        free(fill);
+    if (!b->tri) {
+        free(cnt);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory binning triangles");
     }
-    memcpy(fill, b->start, nrows * sizeof *fill);
-    for (size_t t = 0; t < s->ntris; t++) {
-        size_t j0, j1, k0, k1;
-        tri_rows(g, s, t, &j0, &j1, &k0, &k1);
-        if (j0 > j1 || k0 > k1)
-            continue;
-        for (size_t k = k0; k <= k1; k++)
-            for (size_t j = j0; j <= j1; j++)
-                b->tri[fill[j + g->ny * k]++] = (uint32_t)t;
+    #pragma omp parallel for schedule(static, 1) num_threads(runs)
+    for (int c = 0; c < runs; c++) {
+        const size_t t0 = s->ntris * (size_t)c / (size_t)runs;
+        const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)runs;
+        size_t *fill = cnt + (size_t)c * (nrows + 1);
+        for (size_t t = t0; t < t1; t++) {
+            size_t j0, j1, k0, k1;
+            tri_rows(g, s, t, &j0, &j1, &k0, &k1);
+            if (j0 > j1 || k0 > k1)
+                continue;
+            for (size_t k = k0; k <= k1; k++)
+                for (size_t j = j0; j <= j1; j++)
+                    b->tri[fill[j + g->ny * k]++] = (uint32_t)t;
+        }
     }
-    free(fill);
+    free(cnt);
     return ST_OK;
 }
 
@@ -189,8 +241,8 @@ st_status st_solid_inside(uint8_t *inside, const st_grid *g,
                 if (!wind)
                     continue;
                 size_t j = r % g->ny, k = r / g->ny;
-                double y = g->origin[1] + g->voxel * (double)j;
-                double z = g->origin[2] + g->voxel * (double)k;
+                double y = row_coord(g, 0, j);
+                double z = row_coord(g, 1, k);
                 const double q[2] = {y, z};
                 memset(wind, 0, g->nx * sizeof *wind);
                 for (size_t e = b.start[r]; e < b.start[r + 1]; e++) {
