@@ -219,14 +219,19 @@ typedef struct brick_grid {
     double half_diag;   /* from a brick's center to its farthest voxel center */
 } brick_grid;
 
+/* The center of brick b's voxels along axis a. */
+static double brick_center_axis(const st_grid *g, int a, size_t b)
+{
+    const size_t n = a == 0 ? g->nx : a == 1 ? g->ny : g->nz;
+    size_t lo = b * BRICK;
+    size_t hi = lo + BRICK - 1 < n - 1 ? lo + BRICK - 1 : n - 1;
+    return g->origin[a] + g->voxel * 0.5 * (double)(lo + hi);
+}
+
 static void brick_center(const st_grid *g, const size_t b[3], double c[3])
 {
-    const size_t n[3] = {g->nx, g->ny, g->nz};
-    for (int a = 0; a < 3; a++) {
-        size_t lo = b[a] * BRICK;
-        size_t hi = lo + BRICK - 1 < n[a] - 1 ? lo + BRICK - 1 : n[a] - 1;
-        c[a] = g->origin[a] + g->voxel * 0.5 * (double)(lo + hi);
-    }
+    for (int a = 0; a < 3; a++)
+        c[a] = brick_center_axis(g, a, b[a]);
 }
 
 /* Call visit(b, ctx) for every brick the band around triangle t may reach:
@@ -270,11 +275,14 @@ static void triangle_bricks(const st_grid *g, const brick_grid *bg,
     const double reach = (B + bg->half_diag) * (1.0 + 1e-9) + 1e-12 * h;
     const double reach_ball = reach + ball->r;
     size_t b[3];
-    for (b[2] = lo[2]; b[2] <= hi[2]; b[2]++)
-        for (b[1] = lo[1]; b[1] <= hi[1]; b[1]++)
+    double c[3];    /* brick b's center, each axis set where b[a] moves */
+    for (b[2] = lo[2]; b[2] <= hi[2]; b[2]++) {
+        c[2] = brick_center_axis(g, 2, b[2]);
+        for (b[1] = lo[1]; b[1] <= hi[1]; b[1]++) {
+            c[1] = brick_center_axis(g, 1, b[1]);
             for (b[0] = lo[0]; b[0] <= hi[0]; b[0]++) {
-                double c[3], w[3];
-                brick_center(g, b, c);
+                double w[3];
+                c[0] = brick_center_axis(g, 0, b[0]);
                 st_sub3(w, c, ball->c);
                 if (st_dot3(w, w) > reach_ball * reach_ball)
                     continue;
@@ -285,6 +293,8 @@ static void triangle_bricks(const st_grid *g, const brick_grid *bg,
                 }
                 visit(b[0] + bg->n[0] * (b[1] + bg->n[1] * b[2]), ctx);
             }
+        }
+    }
 }
 
 typedef struct bin_ctx {
