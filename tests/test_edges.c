@@ -180,11 +180,67 @@ static void test_order(void)
     st_soup_free(r);
 }
 
+/* More than 2^16 welded vertices (the half-edges' sort then packs two
+ * 17-bit ends into three 16-bit digits), the triangles scrambled and some
+ * duplicated: the half-edges still run by key, ties by triangle, and a
+ * grid's edges come out as counted by hand. */
+static void test_many_vertices(void)
+{
+    enum { N = 260 };   /* N * N = 67600 vertices */
+    const size_t quads = (size_t)(N - 1) * (N - 1), nt = 2 * quads;
+    st_soup *s = new_soup();
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++)
+            vert(s, i, j, 0.25 * ((i * 7 + j * 3) % 5));
+    for (size_t q = 0; q < nt; q++) {
+        const size_t x = (q * 40503u) % nt;   /* 40503 is coprime to nt: a permutation */
+        const uint32_t i = (uint32_t)(x / 2 % (N - 1)), j = (uint32_t)(x / 2 / (N - 1));
+        const uint32_t a = j * N + i, b = a + 1, c = a + N, d = c + 1;
+        if (x % 2)
+            st_soup_add_triangle(s, b, d, c, NULL);
+        else
+            st_soup_add_triangle(s, a, b, c, NULL);
+    }
+    for (size_t t = 0; t < nt; t += 97)       /* reversed copies */
+        st_soup_add_triangle(s, s->tris[3 * t + 2], s->tris[3 * t + 1], s->tris[3 * t], NULL);
+    for (unsigned flags = 0; flags <= ST_EDGES_DUPLICATES; flags += ST_EDGES_DUPLICATES) {
+        st_soup_edges e;
+        st_error err;
+        TAP_CHECK(st_soup_edges_build_opts(&e, s, flags, &err) == ST_OK && e.nweld == N * N,
+                  "many vertices (flags %u): built, %zu welded", flags, e.nweld);
+        int sorted = 1, ends = 1;
+        for (size_t h = 0; h < e.nhalf; h++) {
+            const uint64_t lo = e.he[h].key >> 32, hi = e.he[h].key & 0xffffffffu;
+            ends &= lo < hi && hi < e.nweld;
+            if (h > 0)
+                sorted &= e.he[h - 1].key < e.he[h].key ||
+                          (e.he[h - 1].key == e.he[h].key && e.he[h - 1].t < e.he[h].t);
+        }
+        TAP_CHECK(sorted && ends, "many vertices (flags %u): by key, ties by triangle", flags);
+        const size_t copies = (nt + 96) / 97, boundary = 4 * (N - 1);
+        const size_t all = 3 * quads + 2 * (N - 1);    /* the grid's edges */
+        TAP_CHECK(e.duplicates == copies &&
+                  e.nhalf == 3 * (flags ? nt + copies : nt), "many vertices (flags %u): "
+                  "%zu duplicates, %zu half-edges", flags, e.duplicates, e.nhalf);
+        if (!flags)
+            TAP_CHECK(edges_of(&e, 1) == boundary && edges_of(&e, 2) == all - boundary &&
+                      pieces(&e, s) == 1, "many vertices: the grid's %zu boundary and %zu "
+                      "inner edges, one piece", boundary, all - boundary);
+        else
+            TAP_CHECK(edges_of(&e, 1) + edges_of(&e, 2) + edges_of(&e, 3) + edges_of(&e, 4) ==
+                      all && edges_of(&e, 3) + edges_of(&e, 4) > 0,
+                      "many vertices, duplicates kept: the same %zu edges, some of 3 or 4", all);
+        st_soup_edges_free(&e);
+    }
+    st_soup_free(s);
+}
+
 int main(void)
 {
     test_weld();
     test_closed_box();
     test_damage();
     test_order();
+    test_many_vertices();
     return tap_done();
 }
