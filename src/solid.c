@@ -112,6 +112,26 @@ static void tri_rows(const st_grid *g, const st_soup *s, size_t t,
     *k1 = r1[1];
 }
 
+/* Triangles [t0, t1) into their rows: with tri NULL, count each row's in
+ * slot[row]; else write each to tri[slot[row]++]. */
+static void bin_run(const st_grid *g, const st_soup *s, size_t t0, size_t t1, size_t *slot,
+                    uint32_t *tri)
+{
+    for (size_t t = t0; t < t1; t++) {
+        size_t j0, j1, k0, k1;
+        tri_rows(g, s, t, &j0, &j1, &k0, &k1);
+        if (j0 > j1 || k0 > k1)
+            continue;
+        for (size_t k = k0; k <= k1; k++)
+            for (size_t j = j0; j <= j1; j++) {
+                size_t *x = &slot[j + g->ny * k];
+                if (tri)
+                    tri[*x] = (uint32_t)t;
+                ++*x;
+            }
+    }
+}
+
 /* Bin the triangles by row, each row's triangles in input order: the
  * triangles cut into runs, each counted and filled by one thread into its
  * own part of every row's list (the runs' parts in run order), so the
@@ -134,52 +154,31 @@ static st_status bin_rows(row_bins *b, const st_grid *g, const st_soup *s,
         free(cnt);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory binning triangles");
     }
-    #pragma omp parallel for schedule(static, 1) num_threads(runs)
-    for (int c = 0; c < runs; c++) {
-        const size_t t0 = s->ntris * (size_t)c / (size_t)runs;
-        const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)runs;
-        size_t *mine = cnt + (size_t)c * (nrows + 1);
-        for (size_t t = t0; t < t1; t++) {
-            size_t j0, j1, k0, k1;
-            tri_rows(g, s, t, &j0, &j1, &k0, &k1);
-            if (j0 > j1 || k0 > k1)
-                continue;
-            for (size_t k = k0; k <= k1; k++)
-                for (size_t j = j0; j <= j1; j++)
-                    mine[j + g->ny * k]++;
+    for (int pass = 0; pass < 2; pass++) {
+        if (pass == 1) {
+            /* b->start[r]: row r's first slot; cnt[c][r] becomes run c's */
+            size_t total = 0;
+            for (size_t r = 0; r < nrows; r++) {
+                b->start[r] = total;
+                for (int c = 0; c < runs; c++) {
+                    size_t *x = &cnt[(size_t)c * (nrows + 1) + r];
+                    const size_t k = *x;
+                    *x = total;
+                    total += k;
+                }
+            }
+            b->start[nrows] = total;
+            b->tri = st_malloc_array(total ? total : 1, sizeof *b->tri);
+            if (!b->tri) {
+                free(cnt);
+                return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory binning triangles");
+            }
         }
-    }
-    /* b->start[r]: row r's first slot; cnt[c][r] becomes run c's */
-    size_t total = 0;
-    for (size_t r = 0; r < nrows; r++) {
-        b->start[r] = total;
-        for (int c = 0; c < runs; c++) {
-            size_t *x = &cnt[(size_t)c * (nrows + 1) + r];
-            const size_t k = *x;
-            *x = total;
-            total += k;
-        }
-    }
-    b->start[nrows] = total;
-    b->tri = st_malloc_array(total ? total : 1, sizeof *b->tri);
-    if (!b->tri) {
-        free(cnt);
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory binning triangles");
-    }
-    #pragma omp parallel for schedule(static, 1) num_threads(runs)
-    for (int c = 0; c < runs; c++) {
-        const size_t t0 = s->ntris * (size_t)c / (size_t)runs;
-        const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)runs;
-        size_t *fill = cnt + (size_t)c * (nrows + 1);
-        for (size_t t = t0; t < t1; t++) {
-            size_t j0, j1, k0, k1;
-            tri_rows(g, s, t, &j0, &j1, &k0, &k1);
-            if (j0 > j1 || k0 > k1)
-                continue;
-            for (size_t k = k0; k <= k1; k++)
-                for (size_t j = j0; j <= j1; j++)
-                    b->tri[fill[j + g->ny * k]++] = (uint32_t)t;
-        }
+        #pragma omp parallel for schedule(static, 1) num_threads(runs)
+        for (int c = 0; c < runs; c++)
+            bin_run(g, s, s->ntris * (size_t)c / (size_t)runs,
+                    s->ntris * (size_t)(c + 1) / (size_t)runs, cnt + (size_t)c * (nrows + 1),
+                    pass ? b->tri : NULL);
     }
     free(cnt);
     return ST_OK;
