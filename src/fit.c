@@ -164,6 +164,7 @@ static void pgrid_free(pgrid *g)
     free(g->pts);
     free(g->off);
     free(g->idx);
+    free(g->bpts);
     memset(g, 0, sizeof *g);
 }
 
@@ -265,6 +266,11 @@ static st_status pgrid_build(pgrid *g, const st_soup *s, double cell)
         g->idx[fill[bin[i]]++] = (uint32_t)i;
     free(fill);
     free(bin);
+    g->bpts = st_malloc_array(k ? k : 1, 3 * sizeof *g->bpts);
+    if (!g->bpts)
+        return ST_ENOMEM;
+    for (size_t j = 0; j < k; j++)
+        memcpy(g->bpts + 3 * j, g->pts + 3 * (size_t)g->idx[j], 3 * sizeof *g->bpts);
     return ST_OK;
 }
 

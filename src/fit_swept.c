@@ -162,7 +162,7 @@ int sm_swept_kept(const fit_ctx *c, uint32_t v, const double p[3], uint32_t *fai
             for (size_t ix = a0[0]; ix <= a1[0]; ix++) {
                 size_t b = ix + g->n[0] * (iy + g->n[1] * iz);
                 for (size_t j = g->off[b]; j < g->off[b + 1]; j++) {
-                    const double *q = g->pts + 3 * (size_t)g->idx[j];
+                    const double *q = g->bpts + 3 * j;
                     if (q[0] < lo[0] || q[0] > hi[0] || q[1] < lo[1] || q[1] > hi[1] ||
                         q[2] < lo[2] || q[2] > hi[2])
                         continue;

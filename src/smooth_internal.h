@@ -96,6 +96,8 @@ typedef struct pgrid {
     size_t n[3];
     size_t *off;          /* bin -> points (CSR) */
     uint32_t *idx;
+    double *bpts;         /* the points in bin order: bpts + 3 j is
+                             pts + 3 idx[j] (fit_swept.c's scans) */
 } pgrid;
 
 typedef struct fit_ctx {
