@@ -11,9 +11,10 @@
  * point, so a point inside a tet's box always falls in one of the bins the
  * tet was listed in: the grid only prunes, it never decides.
  *
- * Enclosure: every used soup vertex through the locator; every boundary
- * face of the mesh against the soup triangles a BVH box query returns,
- * with st_tri_tri_intersect. Both loops write per-item flags or integer
+ * Enclosure: every used soup vertex through the locator (the tet that
+ * held the vertex before tried first: any tet will do); every boundary
+ * face of the mesh against the soup triangles a BVH triangle query
+ * returns, with st_tri_tri_intersect. Both loops write per-item flags or integer
  * reductions only, so the results do not depend on the thread count.
  */
 #include "souptet/enclose.h"
@@ -210,6 +211,27 @@ int64_t st_locator_find(const st_locator *l, const double p[3],
 
 /* ---- enclosure --------------------------------------------------------- */
 
+/* 1 when p lies in some closed tet. *hint: a tet to try first (the last
+ * one found; a soup's consecutive vertices are usually near each other),
+ * updated; the answer does not depend on it. */
+static int locate_any(const st_locator *l, const double p[3], int64_t *hint)
+{
+    const st_tetmesh *m = l->m;
+    if (*hint >= 0 && (size_t)*hint < m->ntets) {
+        const double *b = l->tbox + 6 * (size_t)*hint;
+        const uint32_t *q = m->tets + 4 * (size_t)*hint;
+        if (p[0] >= b[0] && p[1] >= b[1] && p[2] >= b[2] && p[0] <= b[3] && p[1] <= b[4] &&
+            p[2] <= b[5] &&
+            st_point_in_tet(p, m->xyz + 3 * (size_t)q[0], m->xyz + 3 * (size_t)q[1],
+                            m->xyz + 3 * (size_t)q[2], m->xyz + 3 * (size_t)q[3]) != ST_OUTSIDE)
+            return 1;
+    }
+    int64_t t = st_locator_find(l, p, NULL);
+    if (t >= 0)
+        *hint = t;
+    return t >= 0;
+}
+
 typedef struct cross_ctx {
     const st_soup *s;
     const double *f[3];
@@ -274,14 +296,18 @@ st_status st_enclosure_compute(st_enclosure *out, const st_tetmesh *m,
     size_t used = 0, inside = 0;
     {
         const long long nv = (long long)s->nverts;
-#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : used, inside)
-        for (long long i = 0; i < nv; i++) {
-            if (vin[i] == 2)
-                continue;
-            used++;
-            int in = st_locator_find(loc, s->xyz + 3 * (size_t)i, NULL) >= 0;
-            vin[i] = (unsigned char)in;
-            inside += (size_t)in;
+#pragma omp parallel reduction(+ : used, inside)
+        {
+            int64_t hint = -1;   /* per thread */
+#pragma omp for schedule(dynamic, 1024)
+            for (long long i = 0; i < nv; i++) {
+                if (vin[i] == 2)
+                    continue;
+                used++;
+                int in = locate_any(loc, s->xyz + 3 * (size_t)i, &hint);
+                vin[i] = (unsigned char)in;
+                inside += (size_t)in;
+            }
         }
     }
     out->vertices = used;
@@ -306,14 +332,13 @@ st_status st_enclosure_compute(st_enclosure *out, const st_tetmesh *m,
             cross_ctx c;
             c.s = s;
             c.hit = hit;
-            double lo[3], hi[3];
             for (int k = 0; k < 3; k++)
                 c.f[k] = m->xyz + 3 * (size_t)faces[3 * (size_t)f + (size_t)k];
-            for (int a = 0; a < 3; a++) {
-                lo[a] = fmin(c.f[0][a], fmin(c.f[1][a], c.f[2][a]));
-                hi[a] = fmax(c.f[0][a], fmax(c.f[1][a], c.f[2][a]));
-            }
-            st_bvh_query_box(bvh, lo, hi, cross_visit, &c);
+            /* nodes pruned by the face itself: a face is much larger
+             * than the soup's triangles, and its box holds many more
+             * of them than it meets (every triangle meeting it is
+             * visited, so the flags are those of a box query) */
+            st_bvh_query_tri(bvh, c.f[0], c.f[1], c.f[2], cross_visit, &c);
         }
     }
     size_t crossing = 0;

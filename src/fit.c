@@ -164,6 +164,7 @@ static void pgrid_free(pgrid *g)
     free(g->pts);
     free(g->off);
     free(g->idx);
+    free(g->bpts);
     memset(g, 0, sizeof *g);
 }
 
@@ -177,19 +178,35 @@ static size_t pgrid_coord(const pgrid *g, double x, int a)
     return (size_t)f;
 }
 
+size_t sm_pgrid_coord(const pgrid *g, double x, int a)
+{
+    return pgrid_coord(g, x, a);
+}
+
 /* The distinct vertices of s's triangles, binned at about `cell`. */
 static st_status pgrid_build(pgrid *g, const st_soup *s, double cell)
 {
     memset(g, 0, sizeof *g);
-    size_t n3;
-    if (st_size_mul(&n3, s->ntris, 9))
+    /* the used vertex indices first (a vertex is in ~6 triangles), then
+     * the sort by position merges the ones at one position */
+    unsigned char *used = st_calloc_array(s->nverts ? s->nverts : 1, 1);
+    if (!used)
         return ST_ENOMEM;
-    g->pts = st_malloc_array(n3 ? n3 : 1, sizeof *g->pts);
-    if (!g->pts)
-        return ST_ENOMEM;
+    size_t n = 0;
     for (size_t i = 0; i < 3 * s->ntris; i++)
-        memcpy(g->pts + 3 * i, s->xyz + 3 * (size_t)s->tris[i], 3 * sizeof(double));
-    size_t n = 3 * s->ntris;
+        if (!used[s->tris[i]]) {
+            used[s->tris[i]] = 1;
+            n++;
+        }
+    g->pts = st_malloc_array(n ? n : 1, 3 * sizeof *g->pts);
+    if (!g->pts) {
+        free(used);
+        return ST_ENOMEM;
+    }
+    for (size_t v = 0, i = 0; v < s->nverts; v++)
+        if (used[v])
+            memcpy(g->pts + 3 * i++, s->xyz + 3 * v, 3 * sizeof(double));
+    free(used);
     qsort(g->pts, n, 3 * sizeof(double), cmp_pt);
     size_t k = 0;
     for (size_t i = 0; i < n; i++)
@@ -249,6 +266,11 @@ static st_status pgrid_build(pgrid *g, const st_soup *s, double cell)
         g->idx[fill[bin[i]]++] = (uint32_t)i;
     free(fill);
     free(bin);
+    g->bpts = st_malloc_array(k ? k : 1, 3 * sizeof *g->bpts);
+    if (!g->bpts)
+        return ST_ENOMEM;
+    for (size_t j = 0; j < k; j++)
+        memcpy(g->bpts + 3 * j, g->pts + 3 * (size_t)g->idx[j], 3 * sizeof *g->bpts);
     return ST_OK;
 }
 
@@ -556,13 +578,21 @@ static int faces_clear(const fit_ctx *c, uint32_t v, const double p[3])
  * move, and when every tet of the new star is positive, the new star
  * covers each point exactly winding-number-of-that-surface times, i.e.
  * it is the same closed region as before. */
-static void star_pts_fill(const fit_ctx *c, star_pts *sp)
+static void star_pts_fill(const fit_ctx *c, star_pts *sp, int swept)
 {
     sp->n = 0;
     sp->ok = 1;
     sp->have = 1;
     sp->positive = 0;
+    sp->swept = 0;
     if (c->s && (c->sm.onb[sp->v] || c->full_check)) {
+        /* a boundary vertex with a positive star: only the points its
+         * boundary faces sweep can leave (fit_swept.c), no list */
+        if (swept && !c->full_check && sm_swept_applies(c, sp->v) &&
+            sm_star_positive(&c->sm, sp->v, c->sm.m->xyz + 3 * (size_t)sp->v)) {
+            sp->swept = 1;
+            return;
+        }
         sp->ok = svertices_in_star(c, sp->v, &sp->list, &sp->n, &sp->cap) == 0;
         sp->positive = sp->n > 0 &&
                        sm_star_positive(&c->sm, sp->v, c->sm.m->xyz + 3 * (size_t)sp->v);
@@ -596,11 +626,16 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
             return 0;
     }
     if (!sp->have)
-        star_pts_fill(c, sp);
+        star_pts_fill(c, sp, 1);
+    uint32_t failed;
+    int kept = sp->swept ? sm_swept_kept(c, v, p, &failed) : -1;
+    if (kept < 0 && sp->swept)
+        star_pts_fill(c, sp, 0);
     if (!sp->ok)
         return 0;
-    uint32_t failed;
-    if (!svertices_kept(c, v, p, sp->list, sp->n, sp->positive, &failed)) {
+    if (kept < 0)
+        kept = svertices_kept(c, v, p, sp->list, sp->n, sp->positive, &failed);
+    if (!kept) {
         if (c->blocker)
             c->blocker[v] = failed;   /* v's own slot: v's colour writes it */
         return 0;
@@ -823,7 +858,7 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
 static size_t rescue_pass(fit_ctx *c, double *dist)
 {
     size_t moves = 0;
-    star_pts sp = {NULL, 0, 0, 1, 0, 0, 0};
+    star_pts sp = {NULL, 0, 0, 1, 0, 0, 0, 0};
     for (int round = 0; round < RESCUE_ROUNDS; round++) {
         size_t moved = 0;
         for (size_t v = 0; v < c->sm.nv; v++)
@@ -1138,7 +1173,7 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
             #pragma omp parallel reduction(+ : moved, rejected, skipped) \
                 if (PAR_CHECKED(c.sm.col_off[col + 1] - c.sm.col_off[col]))
             {
-                star_pts sp = {NULL, 0, 0, 1, 0, 0, 0};
+                star_pts sp = {NULL, 0, 0, 1, 0, 0, 0, 0};
                 #pragma omp for schedule(dynamic, 4)
                 for (size_t j = c.sm.col_off[col]; j < c.sm.col_off[col + 1]; j++) {
                     fit_counts k = {0, 0, 0};

@@ -287,7 +287,7 @@ st_status sm_quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
             #pragma omp parallel reduction(+ : moved, rejected) \
                 if (PAR_CHECKED(sm->col_off[col + 1] - sm->col_off[col]))
             {
-                star_pts sp = {NULL, 0, 0, 1, 0, 0, 0};
+                star_pts sp = {NULL, 0, 0, 1, 0, 0, 0, 0};
                 #pragma omp for schedule(dynamic, 8)
                 for (size_t j = sm->col_off[col]; j < sm->col_off[col + 1]; j++) {
                     uint32_t v = sm->col_v[j];

@@ -96,6 +96,8 @@ typedef struct pgrid {
     size_t n[3];
     size_t *off;          /* bin -> points (CSR) */
     uint32_t *idx;
+    double *bpts;         /* the points in bin order: bpts + 3 j is
+                             pts + 3 idx[j] (fit_swept.c's scans) */
 } pgrid;
 
 typedef struct fit_ctx {
@@ -147,6 +149,7 @@ typedef struct star_pts {
     int have;        /* 1: list holds the star of v as it is */
     int positive;    /* the star as it is: every tet positive */
     uint32_t v;
+    int swept;       /* 1: no list; moves are checked by sm_swept_kept */
 } star_pts;
 
 /* Start the moves of v (the list of S vertices is filled when a move
@@ -154,6 +157,16 @@ typedef struct star_pts {
 void sm_star_pts_collect(const fit_ctx *c, uint32_t v, star_pts *sp);
 /* The whole invariant for moving v to p (fit.c's header comment). */
 int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp);
+/* The bin of coordinate x along axis a of the point grid. */
+size_t sm_pgrid_coord(const pgrid *g, double x, int a);
+/* 1 when sm_swept_kept may decide v's moves (at most as many boundary
+ * faces as it handles). */
+int sm_swept_applies(const fit_ctx *c, uint32_t v);
+/* For a boundary vertex v of a mesh with no face of three tets, whose star
+ * is positive with v where it is and with v at p: 1 when every S vertex in
+ * the closed star stays in it with v at p, else 0 with *failed a point grid
+ * index that would leave; -1 when it cannot tell (fit_swept.c). Exact. */
+int sm_swept_kept(const fit_ctx *c, uint32_t v, const double p[3], uint32_t *failed);
 /* The distance from p to S; closest (may be NULL) gets the nearest point. */
 double sm_dist_to_s(const fit_ctx *c, const double p[3], double closest[3]);
 

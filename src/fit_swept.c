@@ -1,0 +1,186 @@
+/*
+ * fit_swept.c - the fit invariant's point test for a boundary vertex,
+ * without gathering the star's points (issue 23): only the S vertices in
+ * the region the star's boundary faces sweep can leave the star.
+ *
+ * The claim. Let v be a boundary vertex of a mesh in which no face has
+ * more than two tets (fit_ctx.full_check 0), moving from x to p, its star
+ * positive at both (every tet orient3d < 0; sm_move_ok tests p, the caller
+ * x). R(y) is the closed star with v at y; L its faces not holding v (the
+ * link, which does not move); C(y) the boundary faces holding v, (y, a, b).
+ * Faces holding v shared by two star tets cancel in the boundary chain (two
+ * positive tets on one face lie on its two sides, so they induce opposite
+ * orientations), so the chain boundary of the star is L + C(y), and at a
+ * point off every face the count of star tets holding it (positive tets)
+ * is the winding number of L + C(y). The chain boundary of C(y) has no
+ * edge holding v (it is minus that of L), so C(x) - C(p) is the boundary
+ * of H = sum over the faces of the tets (x, p, a, b): the two counts differ
+ * only inside the union of those closed tets. A point q of R(x) \ R(p) has
+ * near it points inside a tet of R(x) and off R(p) (which is closed), off
+ * every face: there the counts are >= 1 and 0, so they lie in a tet of H,
+ * and so does q (finitely many closed tets). So every S vertex that leaves
+ * the star lies in some closed (x, p, a, b): testing those S vertices alone
+ * decides "every S vertex of R(x) is in R(p)" as the full list does, and
+ * fails on a point that leaves (the blocker only orders the work).
+ *
+ * The sweep is thin for a small move, so most S vertices near the faces
+ * are rejected by one plane test: q strictly on the other side of the plane
+ * (x, a, b) from p, or of (p, a, b) from x, is not in the closed tet (for a
+ * flat tet, p on the plane: q off it). The plane tests are orient3d's
+ * determinant with the face's two edge vectors and their cross products
+ * computed once per face and filtered by pred.c's error bound (the same six
+ * monomials through at most five roundings, here with a margin of 16 u
+ * instead of 9 u and 2^-1000 instead of 2^-1040 for underflow); a sign the
+ * filter cannot certify rejects nothing. What passes is decided exactly by
+ * st_point_in_tet and the star tests: no decision is taken in floating
+ * point.
+ */
+#include "smooth_internal.h"
+#include "fpenv.h"
+
+#include "souptet/isect.h"
+#include "souptet/pred.h"
+
+#include <math.h>
+#include <stddef.h>
+
+/* Boundary faces of a vertex handled here; a vertex with more (none in a
+ * lattice) takes the gathering path. */
+#define SWEPT_MAX_FACES 48
+/* The filter's relative and absolute margins (see the top). */
+#define SWEPT_REL (16.0 * 0x1p-53)
+#define SWEPT_ABS 0x1p-1000
+
+/* A plane through o with edge vectors e1, e2 from it: their rounded values,
+ * the three 2x2 minors of the cross product and the absolute sums the
+ * permanent takes, and the exact side (of det [e1; e2; r - o]) of the
+ * reference corner r, which the tet lies on. */
+typedef struct swept_plane {
+    const double *o;
+    double n[3], an[3];
+    int side;
+} swept_plane;
+
+static void plane_init(swept_plane *pl, const double *o, const double *a, const double *b,
+                       const double *r)
+{
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = a[k] - o[k];
+        e2[k] = b[k] - o[k];
+    }
+    double m[6] = {e1[1] * e2[2], e1[2] * e2[1], e1[2] * e2[0],
+                   e1[0] * e2[2], e1[0] * e2[1], e1[1] * e2[0]};
+    for (int k = 0; k < 3; k++) {
+        pl->n[k] = m[2 * k] - m[2 * k + 1];
+        pl->an[k] = fabs(m[2 * k]) + fabs(m[2 * k + 1]);
+    }
+    pl->o = o;
+    /* orient3d(o, a, b, r) = -det [a - o; b - o; r - o] */
+    double s = st_orient3d(o, a, b, r);
+    pl->side = s < 0 ? 1 : (s > 0 ? -1 : 0);
+}
+
+/* 1 when q is certainly outside the closed half-space (or, for side 0,
+ * the plane) the tet lies in; 0 when it may be inside or the filter cannot
+ * tell. */
+static int plane_rejects(const swept_plane *pl, const double q[3])
+{
+    double d0 = q[0] - pl->o[0], d1 = q[1] - pl->o[1], d2 = q[2] - pl->o[2];
+    double det = d0 * pl->n[0] + d1 * pl->n[1] + d2 * pl->n[2];
+    double a0 = fabs(d0), a1 = fabs(d1), a2 = fabs(d2);
+    double perm = a0 * pl->an[0] + a1 * pl->an[1] + a2 * pl->an[2];
+    double bound = SWEPT_REL * perm + (a0 + a1 + a2 + 1.0) * SWEPT_ABS;
+    if (det > bound)
+        return pl->side <= 0;
+    if (-det > bound)
+        return pl->side >= 0;
+    return 0;
+}
+
+/* 1 when q lies in the closed star of v with v at y. */
+static int in_closed_star(const sm_mesh *sm, uint32_t v, const double y[3], const double q[3])
+{
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
+        const uint32_t *c = sm->m->tets + 4 * (size_t)sm->vt[j];
+        const double *t[4];
+        for (int k = 0; k < 4; k++)
+            t[k] = c[k] == v ? y : sm->m->xyz + 3 * (size_t)c[k];
+        if (st_point_in_tet(q, t[0], t[1], t[2], t[3]) != ST_OUTSIDE)
+            return 1;
+    }
+    return 0;
+}
+
+int sm_swept_applies(const fit_ctx *c, uint32_t v)
+{
+    return c->sm.vf_off[v + 1] - c->sm.vf_off[v] <= SWEPT_MAX_FACES;
+}
+
+int sm_swept_kept(const fit_ctx *c, uint32_t v, const double p[3], uint32_t *failed)
+{
+    const sm_mesh *sm = &c->sm;
+    const pgrid *g = &c->pg;
+    const size_t nf = sm->vf_off[v + 1] - sm->vf_off[v];
+    if (nf > SWEPT_MAX_FACES)
+        return -1;
+    if (g->npts == 0 || nf == 0)
+        return 1;
+    const double *x = sm->m->xyz + 3 * (size_t)v;
+    swept_plane in[SWEPT_MAX_FACES], out[SWEPT_MAX_FACES];
+    double box[SWEPT_MAX_FACES][6];
+    const double *ab[SWEPT_MAX_FACES][2];
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = fmin(x[a], p[a]);
+        hi[a] = fmax(x[a], p[a]);
+    }
+    for (size_t i = 0; i < nf; i++) {
+        const uint32_t *k = sm->bf + 3 * (size_t)sm->vf[sm->vf_off[v] + i];
+        int n = 0;
+        for (int j = 0; j < 3; j++)
+            if (k[j] != v)
+                ab[i][n++] = sm->m->xyz + 3 * (size_t)k[j];
+        if (n != 2)
+            return -1;   /* not a face of v: leave it to the full test */
+        plane_init(&in[i], x, ab[i][0], ab[i][1], p);
+        plane_init(&out[i], p, ab[i][0], ab[i][1], x);
+        for (int a = 0; a < 3; a++) {
+            box[i][a] = fmin(fmin(x[a], p[a]), fmin(ab[i][0][a], ab[i][1][a]));
+            box[i][3 + a] = fmax(fmax(x[a], p[a]), fmax(ab[i][0][a], ab[i][1][a]));
+            lo[a] = fmin(lo[a], box[i][a]);
+            hi[a] = fmax(hi[a], box[i][3 + a]);
+        }
+    }
+    size_t a0[3], a1[3];
+    for (int a = 0; a < 3; a++) {
+        a0[a] = sm_pgrid_coord(g, lo[a], a);
+        a1[a] = sm_pgrid_coord(g, hi[a], a);
+    }
+    for (size_t iz = a0[2]; iz <= a1[2]; iz++)
+        for (size_t iy = a0[1]; iy <= a1[1]; iy++)
+            for (size_t ix = a0[0]; ix <= a1[0]; ix++) {
+                size_t b = ix + g->n[0] * (iy + g->n[1] * iz);
+                for (size_t j = g->off[b]; j < g->off[b + 1]; j++) {
+                    const double *q = g->bpts + 3 * j;
+                    if (q[0] < lo[0] || q[0] > hi[0] || q[1] < lo[1] || q[1] > hi[1] ||
+                        q[2] < lo[2] || q[2] > hi[2])
+                        continue;
+                    int swept = 0;
+                    for (size_t i = 0; i < nf && !swept; i++) {
+                        const double *bx = box[i];
+                        if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] || q[0] > bx[3] ||
+                            q[1] > bx[4] || q[2] > bx[5])
+                            continue;
+                        if (plane_rejects(&in[i], q) || plane_rejects(&out[i], q))
+                            continue;
+                        swept = st_point_in_tet(q, x, p, ab[i][0], ab[i][1]) != ST_OUTSIDE;
+                    }
+                    if (swept && in_closed_star(sm, v, x, q) && !in_closed_star(sm, v, p, q)) {
+                        *failed = g->idx[j];
+                        return 0;
+                    }
+                }
+            }
+    return 1;
+}
