@@ -187,6 +187,14 @@ static void print_json(FILE *f, const char *name, const char *sname,
         fputc('\n', f);                                                     \
     } while (0)
 
+/* The row of the stopping condition: how many are beyond R h of what. */
+static void beyond_row(FILE *f, double ratio, const char *what, size_t n)
+{
+    char lab[64];
+    snprintf(lab, sizeof lab, "beyond %.3g h (%s)", ratio, what);
+    ROW(lab, "%zu%s", n, n ? "   <- OFFSET NOT MET" : "   (met)");
+}
+
 static void print_table(FILE *f, const char *name, const char *sname,
                         const char *fname, const st_tetstat *r)
 {
@@ -247,23 +255,15 @@ static void print_table(FILE *f, const char *name, const char *sname,
             ROW("boundary -> S max / diag", "%.6f", r->dist_max / r->surface_diag);
             ROW("S -> boundary max / diag", "%.6f", r->surface_dist_max / r->surface_diag);
         }
-        if (r->has_offset) {
-            char lab[64];
-            snprintf(lab, sizeof lab, "beyond %.3g h (offset)", r->offset_ratio);
-            ROW(lab, "%zu%s", r->beyond_offset,
-                r->beyond_offset ? "   <- OFFSET NOT MET" : "   (met)");
-        }
+        if (r->has_offset)
+            beyond_row(f, r->offset_ratio, "offset", r->beyond_offset);
         if (r->has_fill) {
             ROW("fill (field, no S) faces", "%zu", r->fill_faces);
             ROW("boundary -> S|fill max", "%.9g", r->fill_dist_max);
             if (r->has_h && r->h > 0.0)
                 ROW("boundary -> S|fill max / h", "%.4f", r->fill_dist_max / r->h);
-            if (r->has_offset) {
-                char lab[64];
-                snprintf(lab, sizeof lab, "beyond %.3g h (S|fill)", r->offset_ratio);
-                ROW(lab, "%zu%s", r->beyond_offset_fill,
-                    r->beyond_offset_fill ? "   <- OFFSET NOT MET" : "   (met)");
-            }
+            if (r->has_offset)
+                beyond_row(f, r->offset_ratio, "S|fill", r->beyond_offset_fill);
         }
         if (r->surface_closed) {
             ROW("surface volume", "%.9g", r->surface_volume);
