@@ -17,11 +17,10 @@
  * Faces are visited in grid order, so the fill does not depend on the
  * thread count (it runs serially: only the sign changes query the BVH).
  */
+#include "fpenv.h"
 #include "souptet/pseudo.h"
-#include "souptet/mem.h"
 
-#include <math.h>
-#include <stdlib.h>
+#include <stdint.h>
 
 static st_status add_square(st_soup *f, const double c[3], int axis, double half,
                             st_error *err)
