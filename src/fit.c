@@ -72,6 +72,16 @@
  * CPU time. The clean corpus at --tries 8 is unchanged (its best
  * candidates have no tet below the goal), and so is `make demo`.
  *
+ * The fill (st_fit_params.fill; issue 18). Where the input has no surface
+ * (the far side of a one-sided scan, a large hole), the sculpted lattice
+ * keeps the pseudo volume's fill, and its boundary vertices there are far
+ * from S with nothing to pull them: measured against S alone they can
+ * never meet the condition (bunny-onesided, --tries 8: 44 of 570 beyond
+ * 0.4 h, up to 1.88 h). With a fill, every distance the fit takes (the
+ * condition, the pull's nearest point, the rescue, the quality pass's
+ * band) is to S or the fill, whichever is nearer (sm_nearest_d2): the
+ * fill counts as surface; the invariant is S's alone.
+ *
  * Not checked: that the boundary does not fold onto another part of the
  * mesh far from the moved star (a global self-intersection); small steps
  * and positive stars make it unlikely, tetstat would show it as overlap.
@@ -645,11 +655,29 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
     return 1;
 }
 
+double sm_nearest_d2(const fit_ctx *c, const double p[3], double max_d2,
+                     int64_t *found, double closest[3])
+{
+    double d2 = st_bvh_nearest(c->bvh, p, max_d2, found, closest);
+    if (c->fbvh) {
+        int64_t ft;
+        double fq[3];
+        double f2 = st_bvh_nearest(c->fbvh, p, d2, &ft, fq);
+        if (ft >= 0 && f2 < d2) {
+            d2 = f2;
+            *found = ft;
+            if (closest)
+                memcpy(closest, fq, sizeof fq);
+        }
+    }
+    return d2;
+}
+
 double sm_dist_to_s(const fit_ctx *c, const double p[3], double closest[3])
 {
     int64_t tri;
     double q[3];
-    double d2 = st_bvh_nearest(c->bvh, p, INFINITY, &tri, closest ? closest : q);
+    double d2 = sm_nearest_d2(c, p, INFINITY, &tri, closest ? closest : q);
     return sqrt(d2);
 }
 
@@ -717,7 +745,7 @@ dist_summary sm_boundary_distances(const fit_ctx *c, double *dist)
                              (x[2] - o[2]) * (x[2] - o[2]));
             double r = (dist[v] + mv) * (1.0 + 1e-9) + 1e-9 * c->h;
             int64_t tri;
-            double d2 = st_bvh_nearest(c->bvh, x, r * r, &tri, NULL);
+            double d2 = sm_nearest_d2(c, x, r * r, &tri, NULL);
             dist[v] = tri >= 0 ? sqrt(d2) : sm_dist_to_s(c, x, NULL);
         } else {
             dist[v] = sm_dist_to_s(c, x, NULL);
@@ -831,7 +859,7 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
                 for (int a = 0; a < 3; a++)
                     cd[nc][1 + a] = x[a] + st * dir[a];
                 int64_t tri;
-                double d2 = st_bvh_nearest(c->bvh, cd[nc] + 1, dd * dd, &tri, NULL);
+                double d2 = sm_nearest_d2(c, cd[nc] + 1, dd * dd, &tri, NULL);
                 cd[nc][0] = tri >= 0 ? sqrt(d2) : INFINITY;
                 cd[nc][4] = (double)nc;
             }
@@ -1118,7 +1146,7 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
     c.s = s;
     c.h = h;
     c.d_offset = p.offset_ratio * h;
-    st_bvh *own = NULL;
+    st_bvh *own = NULL, *fown = NULL;
     double *dist = NULL;
     dirty dy;
     memset(&dy, 0, sizeof dy);
@@ -1130,6 +1158,12 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
         bvh = own;
     }
     c.bvh = bvh;
+    if (p.fill && p.fill->ntris > 0) {
+        rc = st_bvh_build(&fown, p.fill, err);
+        if (rc)
+            goto done;
+        c.fbvh = fown;
+    }
     rc = sm_mesh_build(&c.sm, m, err);
     if (rc)
         goto done;
@@ -1285,6 +1319,7 @@ done:
     pgrid_free(&c.pg);
     sm_mesh_free(&c.sm);
     st_bvh_free(own);
+    st_bvh_free(fown);
     return rc;
 }
 

@@ -37,6 +37,7 @@ st_pipeline_params st_pipeline_params_default(void)
     p.max_bytes = 0;
     p.fill_holes = 1;
     p.closed_shells = 1;
+    p.fill_counts = 1;
     return p;
 }
 
@@ -151,8 +152,8 @@ static void relay_iter(void *ctx, const st_fit_iter *it)
 static st_status run_sculpt_candidate(st_tetmesh **out,
                                       st_pipeline_candidate *c, size_t k,
                                       const st_grid *g, const st_soup *s,
-                                      const st_bvh *bvh, double h,
-                                      const st_pipeline_params *p,
+                                      const st_bvh *bvh, const st_soup *fill,
+                                      double h, const st_pipeline_params *p,
                                       const st_progress *prog, st_error *err)
 {
     st_sculpt_params sp = st_sculpt_params_default();
@@ -188,6 +189,7 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
     fp.offset_ratio = p->offset_ratio;
     fp.cell_width = h;
     fp.quality = p->quality;
+    fp.fill = fill;
     if (p->fit_max_iters > 0)
         fp.max_iters = p->fit_max_iters;
     st_fit_stats fs;
@@ -364,6 +366,8 @@ static st_status set_meta(st_tetmesh *m, const st_pipeline_params *p,
         goto oom;
     if (st_meta_set(&m->meta, "encloses", st->encloses ? "yes" : "no"))
         goto oom;
+    if (p->density_rho <= 0 && st_meta_set(&m->meta, "offset_fill", p->fill_counts ? "yes" : "no"))
+        goto oom;
     if (p->density_rho > 0) {
         snprintf(buf, sizeof buf, "%.17g", p->density_rho);
         if (st_meta_set(&m->meta, "rho_min", buf))
@@ -420,6 +424,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     st_grid *g = NULL;
     st_bvh *bvh = NULL;
     st_tetmesh **meshes = NULL;
+    st_soup *fill = NULL;
     /* The pseudo volume (pseudo.h), as soupsign --surface gives it: the
      * field and its refinement see the hole caps; the mesh is fitted to,
      * and must enclose, the soup itself. */
@@ -471,6 +476,13 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         goto done;
     }
 
+    /* The fill (pseudo.h): the pseudo volume's boundary where the soup has
+     * none counts as surface for the fit's condition. */
+    if (p->density_rho <= 0 && p->fill_counts) {
+        rc = st_pseudo_fill(&fill, g, bvh, &st->fill_faces, err);
+        if (rc)
+            goto done;
+    }
     size_t K = p->tries;
     st->candidates = calloc(K, sizeof *st->candidates);
     meshes = calloc(K, sizeof *meshes);
@@ -497,7 +509,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         st_error_clear(&e);
         st_status r = p->density_rho > 0
             ? run_density_candidate(&meshes[k], c, g, s, bvh, h, p, &e)
-            : run_sculpt_candidate(&meshes[k], c, k, g, s, bvh, h, p,
+            : run_sculpt_candidate(&meshes[k], c, k, g, s, bvh, fill, h, p,
                                    K == 1 ? prog : NULL, &e);
         if (r) {
             c->failed = 1;
@@ -550,6 +562,7 @@ done:
         free(local.candidates);
     }
     st_bvh_free(bvh);
+    st_soup_free(fill);
     st_grid_free(g);
     return rc;
 }

@@ -239,7 +239,7 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
         const double *p = cand[i] + 1;
         if (sm->onb[v] && c->s) {
             int64_t tri;
-            double d2 = st_bvh_nearest(c->bvh, p, dmax * dmax, &tri, NULL);
+            double d2 = sm_nearest_d2(c, p, dmax * dmax, &tri, NULL);
             if (tri < 0 || sqrt(d2) > dmax)
                 continue;
         }

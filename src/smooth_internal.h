@@ -104,6 +104,8 @@ typedef struct fit_ctx {
     sm_mesh sm;
     const st_soup *s;
     const st_bvh *bvh;
+    const st_bvh *fbvh;  /* the fill's (st_fit_params.fill), or NULL:
+                            distances are to S or it (sm_nearest_d2) */
     pgrid pg;
     double *dpos;        /* per vertex: where its distance in dist[] was
                             taken (3 each; NaN: not yet) */
@@ -184,6 +186,12 @@ dist_summary sm_boundary_distances(const fit_ctx *c, double *dist);
 /* Tell p->on_iter (when set) how the fit stands. */
 void sm_fit_report(const st_fit_params *p, const fit_ctx *c, const char *phase,
                    int iter, const dist_summary *ds, const fit_counts *n, double t0);
+
+/* The squared distance from p to S or the fill, whichever is nearer,
+ * among those closer than sqrt(max_d2) (st_bvh_nearest's contract: max_d2
+ * and *found -1 when none is; else *found >= 0). closest may be NULL. */
+double sm_nearest_d2(const fit_ctx *c, const double p[3], double max_d2,
+                     int64_t *found, double closest[3]);
 
 /* The quality pass (quality.c) of st_fit on c (c->s NULL: no surface, as
  * sm_quality_interior/sm_quality_fair). ST_OK, or ST_ENOMEM (err set)

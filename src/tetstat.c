@@ -17,6 +17,7 @@
 #include "souptet/geom.h"
 #include "souptet/mem.h"
 #include "souptet/pred.h"
+#include "souptet/pseudo.h"
 #include "souptet/soupinfo.h"
 #include "souptet/tetqual.h"
 
@@ -657,6 +658,62 @@ st_status st_tetstat_surface_to_boundary(double *out, const st_tetmesh *m,
     st_bvh_free(bb);
     st_soup_free(bs);
     free(faces);
+    return st;
+}
+
+/* ---- against a surface and a field's fill ------------------------------- */
+
+st_status st_tetstat_fill(st_tetstat *out, const st_tetmesh *m,
+                          const st_soup *s, const st_grid *f, st_error *err)
+{
+    out->has_fill = 0;
+    out->fill_faces = 0;
+    out->fill_dist_max = NAN;
+    out->beyond_offset_fill = 0;
+    uint32_t *faces = NULL;
+    size_t nf = 0;
+    st_soup *bs = NULL, *fill = NULL;
+    st_bvh *sb = NULL, *fb = NULL;
+    unsigned char *mark = NULL;
+    st_status st = boundary_soup(&bs, m, &faces, &nf, err);
+    if (st || (st = st_bvh_build(&sb, s, err)) ||
+        (st = st_pseudo_fill(&fill, f, sb, &out->fill_faces, err)))
+        goto done;
+    if (fill->ntris && (st = st_bvh_build(&fb, fill, err)))
+        goto done;
+    if (!(mark = st_calloc_array(m->npoints ? m->npoints : 1, 1))) {
+        st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < 3 * nf; i++)
+        mark[faces[i]] = 1;
+    const double lim = out->has_offset ? out->offset_ratio * out->h : INFINITY;
+    double mx = 0.0;
+    size_t beyond = 0;
+    const long long n = (long long)m->npoints;
+#pragma omp parallel for schedule(dynamic, 64) reduction(max : mx) reduction(+ : beyond)
+    for (long long i = 0; i < n; i++) {
+        if (!mark[i])
+            continue;
+        const double *p = m->xyz + 3 * (size_t)i;
+        int64_t tri;
+        double d2 = st_bvh_nearest(sb, p, INFINITY, &tri, NULL);
+        if (fb)
+            d2 = st_bvh_nearest(fb, p, d2, &tri, NULL);
+        double d = sqrt(d2);
+        mx = fmax(mx, d);
+        beyond += d > lim;
+    }
+    out->has_fill = 1;
+    out->fill_dist_max = nf ? mx : NAN;
+    out->beyond_offset_fill = beyond;
+done:
+    st_bvh_free(sb);
+    st_bvh_free(fb);
+    st_soup_free(bs);
+    st_soup_free(fill);
+    free(faces);
+    free(mark);
     return st;
 }
 

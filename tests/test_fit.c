@@ -568,6 +568,58 @@ static void test_peel(void)
     st_soup_free(s);
 }
 
+/* The fill (st_fit_params.fill): S is the sphere's upper half, the fill
+ * its lower half. Alone, S leaves the lower boundary vertices far from
+ * it; with the fill counting as surface every boundary vertex gets within
+ * d_offset of S or the fill, and the mesh still encloses S (brute force). */
+static void split_z(const st_soup *s, st_soup *up, st_soup *down)
+{
+    for (size_t t = 0; t < s->ntris; t++) {
+        const uint32_t *v = s->tris + 3 * t;
+        double cz = 0.0;
+        for (int k = 0; k < 3; k++)
+            cz += s->xyz[3 * (size_t)v[k] + 2] / 3.0;
+        st_soup *d = cz > 0.0 ? up : down;
+        size_t b = d->nverts;
+        for (int k = 0; k < 3; k++) {
+            const double *x = s->xyz + 3 * (size_t)v[k];
+            st_soup_add_vertex(d, x[0], x[1], x[2], NULL);
+        }
+        st_soup_add_triangle(d, (uint32_t)b, (uint32_t)b + 1, (uint32_t)b + 2, NULL);
+    }
+}
+
+static void test_fill(void)
+{
+    st_soup *full = st_soup_new(), *up = st_soup_new(), *down = st_soup_new();
+    add_sphere(full, 1.0, 2.0);
+    split_z(full, up, down);
+    st_fit_stats st[2];
+    for (int k = 0; k < 2; k++) {
+        st_tetmesh *m = ball_mesh(0.5, 1.6);
+        st_fit_params p = st_fit_params_default();
+        p.fill = k ? down : NULL;
+        st_error err;
+        st_status rc = st_fit(m, up, NULL, &p, &st[k], NULL, &err);
+        brute b = brute_check(m, up);
+        TAP_CHECK(rc == ST_OK && b.outside == 0 && b.crossing == 0 && b.inverted == 0,
+                  "%s: the mesh encloses the half sphere, nothing inverted",
+                  k ? "with the fill" : "without a fill");
+        st_tetmesh_free(m);
+    }
+    TAP_CHECK(!st[0].converged && st[0].max_distance > 2 * st[0].d_offset,
+              "without a fill the lower boundary stays far from S: %zu beyond, %.3f > 2 d_offset",
+              st[0].beyond_offset, st[0].max_distance);
+    TAP_CHECK(st[1].converged && st[1].beyond_offset == 0 && st[1].max_distance <= st[1].d_offset,
+              "with it every boundary vertex is within d_offset of S or the fill (max %.4f <= %.3g)",
+              st[1].max_distance, st[1].d_offset);
+    TAP_CHECK(st[1].min_dihedral_after > 20.0, "angles %.2f..%.2f", st[1].min_dihedral_after,
+              st[1].max_dihedral_after);
+    st_soup_free(full);
+    st_soup_free(up);
+    st_soup_free(down);
+}
+
 int main(void)
 {
     test_sphere();
@@ -577,5 +629,6 @@ int main(void)
     test_bvh_query_tri();
     test_band_edge();
     test_peel();
+    test_fill();
     return tap_done();
 }

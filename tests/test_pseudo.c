@@ -589,6 +589,62 @@ static void test_shells_shortcut(void)
     st_soup_free(s);
 }
 
+/* The fill (st_pseudo_fill): a box without its top face signs as the
+ * full box; the pseudo volume's boundary the soup does not explain is the
+ * top, less a rim a voxel wide: voxel squares within half a voxel of the
+ * plane z = 1, inside the top's square. The closed box has none; an
+ * unsigned field is refused. */
+static void test_fill(void)
+{
+    const st_pseudo_params pp = st_pseudo_params_default();
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = 40;
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    for (int closed = 0; closed < 2; closed++) {
+        st_soup *s = st_soup_new(), *f = NULL;
+        if (closed)
+            add_box_oriented(s, lo, hi);
+        else
+            add_box_faces(s, lo, hi, 2, top_face, 0);
+        st_grid *g = NULL;
+        st_bvh *bvh = NULL;
+        st_error err;
+        size_t faces = 0;
+        int ok = !st_pseudo_volume_bvh(&g, s, &dp, &pp, NULL, NULL, &bvh, &err) &&
+                 !st_pseudo_fill(&f, g, bvh, &faces, &err);
+        TAP_CHECK(ok && f->ntris == 2 * faces, "%s box: the fill runs (%zu squares)",
+                  closed ? "closed" : "open", faces);
+        if (closed) {
+            TAP_CHECK(ok && faces == 0, "the closed box has no fill");
+        } else {
+            const double v = ok ? g->voxel : 0, n = 1.0 / (v > 0 ? v : 1);
+            int near = ok && faces > 0;
+            for (size_t i = 0; near && i < f->nverts; i++) {
+                const double *p = f->xyz + 3 * i;
+                near = fabs(p[2] - 1.0) <= 0.5 * v + 1e-12 && p[0] >= -v && p[0] <= 1 + v &&
+                       p[1] >= -v && p[1] <= 1 + v;
+            }
+            TAP_CHECK(near, "the open box's fill lies on its missing top (voxel %g)", v);
+            TAP_CHECK(ok && (double)faces >= 0.6 * n * n && (double)faces <= n * n + 1,
+                      "and covers most of it: %zu squares of about %.0f", faces, n * n);
+        }
+        if (ok) {
+            /* an unsigned field has no pseudo volume */
+            st_grid *d = NULL;
+            st_soup *f2 = NULL;
+            int refused = !st_dist_field(&d, s, &dp, NULL, &err) &&
+                          st_pseudo_fill(&f2, d, bvh, NULL, &err) == ST_EINPUT && !f2;
+            if (!closed)
+                TAP_CHECK(refused, "an unsigned field is refused");
+            st_grid_free(d);
+        }
+        st_soup_free(f);
+        st_bvh_free(bvh);
+        st_grid_free(g);
+        st_soup_free(s);
+    }
+}
+
 int main(void)
 {
     test_entry_point();
@@ -599,5 +655,6 @@ int main(void)
     test_sides_orientation();
     test_shared_tables();
     test_shells_shortcut();
+    test_fill();
     return tap_done();
 }

@@ -16,7 +16,8 @@
  *   1. enclosing before not enclosing (no soup vertex outside the mesh, no
  *      soup triangle meeting the boundary, counted exactly);
  *   2. the fit's stopping condition met (every boundary vertex within
- *      offset_ratio * h of the soup) before not met;
+ *      offset_ratio * h of the soup, or of the fill with fill_counts)
+ *      before not met;
  *   3. larger minimum dihedral angle;
  *   4. smaller maximum dihedral angle;
  *   5. smaller k.
@@ -109,6 +110,12 @@ typedef struct st_pipeline_params {
                               (holes.h) (1) */
     int closed_shells;     /* the soup's closed pieces sign their solid
                               exactly (shells.h) (1) */
+    int fill_counts;       /* the fill counts as surface for the fit's
+                              stopping condition (2. below, and the pull):
+                              the pseudo volume's boundary where the soup
+                              has none (st_pseudo_fill, st_fit_params.fill);
+                              the mesh still encloses the soup alone. 0:
+                              the soup alone (1) */
     st_pipeline_event_fn on_event;   /* may be NULL (NULL) */
     void *on_event_ctx;
 } st_pipeline_params;
@@ -151,6 +158,8 @@ typedef struct st_pipeline_stats {
     int shells_only;                     /* the pseudo volume's signs are
                                             its closed shells' alone
                                             (pseudo.h, the shortcut) */
+    size_t fill_faces;                   /* voxel squares of the fill (0
+                                            with fill_counts 0) */
 } st_pipeline_stats;
 
 /* The lattice cell width p gives for s: p->h, or the width of p->cells
@@ -171,7 +180,8 @@ double st_pipeline_lattice_bytes(const st_soup *s, double h, size_t tries,
                                  double *tets, double *at_once);
 
 /* Mesh soup s. *out gets the chosen candidate's mesh, with meta "h",
- * "lattice", "seed", "offset_ratio", "candidates", "encloses". stats may
+ * "lattice", "seed", "offset_ratio", "offset_fill" (yes or no; not with density_rho),
+ * "candidates", "encloses". stats may
  * be NULL; when given, stats->candidates must be freed by the caller even
  * on failure (it is NULL when nothing was allocated). Fails when the
  * soup is empty or every candidate failed (the first candidate's message

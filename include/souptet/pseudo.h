@@ -122,6 +122,17 @@ st_status st_pseudo_volume_bvh(st_grid **out, const st_soup *s, const st_dist_pa
                                const st_pseudo_params *p, st_pseudo_stats *stats,
                                const st_progress *progress, st_bvh **bvh, st_error *err);
 
+/* The fill of signed field g (pseudo_fill.c): the faces between an
+ * inside and an outside voxel whose center is farther than one voxel from
+ * every triangle of the soup bvh was built over - where the pseudo volume
+ * has a boundary and the soup has no surface (the far side of a one-sided
+ * scan, a large hole's cap) - as a soup of voxel squares, two triangles
+ * each. Empty (no triangles) when the soup explains every sign change.
+ * *faces (may be NULL) gets the squares. ST_EINPUT for a field that is not
+ * signed (an unknown kind is taken as signed), ST_ENOMEM, ST_ELIMIT. */
+st_status st_pseudo_fill(st_soup **out, const st_grid *g, const st_bvh *bvh,
+                         size_t *faces, st_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -126,6 +126,13 @@ typedef struct st_fit_params {
                               tets scoring below quality_goal that hold no
                               part of S, where the boundary stays a manifold
                               (fit.c); the tet count may drop (default 1) */
+    const st_soup *fill;   /* where the surface S has none, what counts as
+                              surface for the stopping condition and the
+                              pull: the distance of a boundary vertex is to
+                              S or the fill, whichever is nearer (the
+                              pseudo volume's fill, st_pseudo_fill). The
+                              mesh still encloses S alone. NULL: none
+                              (default NULL) */
     st_fit_iter_fn on_iter;   /* called after every iteration; may be NULL */
     void *on_iter_ctx;
 } st_fit_params;

@@ -107,6 +107,14 @@ typedef struct st_tetstat {
                                      counts and 0 here the answer is
                                      "unverified", not "encloses" */
 
+    /* against a surface and the fill of a signed field (has_fill,
+       st_tetstat_fill): boundary vertices -> S or the fill, whichever is
+       nearer, as soupmesh's condition measures them */
+    int has_fill;
+    size_t fill_faces;            /* voxel squares of the fill */
+    double fill_dist_max;         /* boundary vertices -> S or the fill */
+    size_t beyond_offset_fill;    /* of them farther than R h (has_offset) */
+
     /* against a signed field (has_field) */
     int has_field;
     size_t field_voxels, field_inside, mesh_voxels, both_voxels;
@@ -128,6 +136,15 @@ st_status st_tetstat_surface(st_tetstat *out, const st_tetmesh *m,
  * alone: S's vertices and ST_TETSTAT_TRI_SAMPLES points per triangle). */
 st_status st_tetstat_surface_to_boundary(double *out, const st_tetmesh *m,
                                          const st_soup *s, st_error *err);
+
+/* The fill part of *out: the fill of the signed field f against s
+ * (st_pseudo_fill: where f's pseudo volume has a boundary and s no
+ * surface) and the boundary vertices' distances to s or the fill,
+ * whichever is nearer - the distance soupmesh's stopping condition takes
+ * (pipeline.h, fill_counts); beyond_offset_fill counts them against R h
+ * when has_offset (call st_tetstat_surface first). */
+st_status st_tetstat_fill(st_tetstat *out, const st_tetmesh *m,
+                          const st_soup *s, const st_grid *f, st_error *err);
 
 /* Fill the field part of *out for a signed field f. */
 st_status st_tetstat_field(st_tetstat *out, const st_tetmesh *m,

@@ -65,6 +65,9 @@ TOOL_HELP_TETFORMAT
 "                       with -q) and exit status 4\n"
 "      --offset-best-effort  keep a mesh that misses --offset with exit\n"
 "                       status 0 and a warning\n"
+"      --offset-fill on|off  on (default): where the soup has no surface,\n"
+"                       the pseudo volume's boundary (its fill) counts as\n"
+"                       surface for --offset; off: the soup alone\n"
 "      --tries K        candidates with randomly rotated and offset lattices,\n"
 "                       run in parallel; the best enclosing one is kept\n"
 "                       (default 1)\n"
@@ -101,7 +104,7 @@ TOOL_HELP_TETFORMAT
 
 enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
        OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY,
-       OPT_BEST_EFFORT };
+       OPT_BEST_EFFORT, OPT_OFFSET_FILL };
 
 /* -v: a line as each stage, sculpt, fit iteration and candidate ends, so a
  * long run is never silent (pipeline.h, st_pipeline_event). */
@@ -133,6 +136,9 @@ static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
 {
     tool_say(t, 2, "field %zux%zux%zu, voxel %.6g; lattice cell h %.6g",
              st->field_dims[0], st->field_dims[1], st->field_dims[2], st->voxel, st->h);
+    if (st->fill_faces)
+        tool_say(t, 2, "fill: %zu voxel faces of the pseudo volume's boundary where the "
+                 "input has no surface count as surface for --offset", st->fill_faces);
     tool_say(t, 2, "distance %.3f s, signs %.3f s%s, %zu candidate%s %.3f s",
              st->seconds_dist, st->seconds_sign,
              st->shells_only ? " (the closed shells' solid: no caps, vote or refinement)" : "",
@@ -229,6 +235,7 @@ static const struct option longopts[] = {
     {"dry-run", no_argument, NULL, OPT_DRY_RUN},
     {"offset", required_argument, NULL, OPT_OFFSET},
     {"offset-best-effort", no_argument, NULL, OPT_BEST_EFFORT},
+    {"offset-fill", required_argument, NULL, OPT_OFFSET_FILL},
     {"tries", required_argument, NULL, OPT_TRIES},
     {"seed", required_argument, NULL, OPT_SEED},
     {"density", required_argument, NULL, OPT_DENSITY},
@@ -294,6 +301,10 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         break;
     case OPT_NO_QUALITY:
         s->pipeline.quality = 0;
+        break;
+    case OPT_OFFSET_FILL:
+        if (tool_parse_switch(t, "--offset-fill", arg, &s->pipeline.fill_counts))
+            return TOOL_EXIT_USAGE;
         break;
     case TOOL_OPT_FILL_HOLES:
     case TOOL_OPT_SHELLS:
@@ -484,8 +495,9 @@ static int run(tool_ctx *t, void *settings)
             rc = tool_fail(t, &err);
             goto done;
         }
-        tool_say(t, 2, "boundary -> input max %.4f h (%.6f diag), input -> boundary max "
+        tool_say(t, 2, "boundary -> input%s max %.4f h (%.6f diag), input -> boundary max "
                  "%.4f h (%.6f diag); %zu of %zu boundary vertices beyond %.3g h",
+                 st.fill_faces ? " or fill" : "",
                  b->max_distance / st.h, b->max_distance / diag, sb / st.h, sb / diag,
                  b->beyond_offset, b->boundary_vertices, p->offset_ratio);
     }
@@ -504,10 +516,10 @@ static int run(tool_ctx *t, void *settings)
          * the exit status unless the user settles for less. */
         tool_say(t, s->best_effort ? 1 : 0,
                  "%s: %s: %zu of %zu boundary vertices stay farther than %.3g h from the "
-                 "input, the farthest %.4g h (%.4g); best of %zu candidates%s",
+                 "input%s, the farthest %.4g h (%.4g); best of %zu candidates%s",
                  in_name, s->best_effort ? "warning" : "error",
                  b->beyond_offset, b->boundary_vertices, p->offset_ratio,
-                 b->max_distance / st.h, b->max_distance, st.ncandidates,
+                 st.fill_faces ? " or its fill" : "", b->max_distance / st.h, b->max_distance, st.ncandidates,
                  s->best_effort ? "" : "; try more --tries or --cells, or --offset-best-effort");
         if (!s->best_effort && rc == TOOL_EXIT_OK)
             rc = TOOL_EXIT_OFFSET_NOT_MET;

@@ -12,6 +12,8 @@
 #define _GNU_SOURCE
 #include "../cli/tool.h"
 #include "souptet/bvh.h"
+#include "souptet/gridio.h"
+#include "souptet/pseudo.h"
 #include "souptet/outfile.h"
 #include "souptet/smooth.h"
 #include "souptet/soup.h"
@@ -28,7 +30,7 @@ static void usage(void)
 {
     printf(
 "Usage: tetsmooth --fair [--iters N] [OPTION]... [MESH]\n"
-"       tetsmooth --fit --surface S [--offset R] [--step T] [--max-iters N]\n"
+"       tetsmooth --fit --surface S [--field F] [--offset R] [--step T] [--max-iters N]\n"
 "                 [--no-quality] [OPTION]... [MESH]\n"
 "Move the vertices of a tet mesh (.vtu; '-' or none reads stdin).\n"
 "\n"
@@ -48,6 +50,9 @@ static void usage(void)
 "      --surface S      the surface to enclose (.obj .off .ply .stl .gltf .glb); required\n"
 "      --offset R       stop when every boundary vertex is within R*h of S\n"
 "                       (default 0.4)\n"
+"      --field F        the signed field the mesh was sculpted from: where S\n"
+"                       has no surface, its pseudo volume's boundary (the fill)\n"
+"                       counts as surface for --offset, as in soupmesh\n"
 "      --offset-best-effort  keep a mesh that misses --offset with exit\n"
 "                       status 0 and a warning (default: an error, exit 4)\n"
 "      --cell-width H   the lattice cell width h when the mesh does not record\n"
@@ -80,7 +85,8 @@ TOOL_HELP_TETFORMAT
 }
 
 enum { OPT_FAIR = TOOL_OPT_FIRST, OPT_FIT, OPT_ITERS, OPT_LAMBDA, OPT_MINANGLE, OPT_SURFACE, OPT_OFFSET,
-       OPT_CELL, OPT_STEP, OPT_MAXIT, OPT_QROUNDS, OPT_NOQ, OPT_INTQ, OPT_BEST_EFFORT };
+       OPT_CELL, OPT_STEP, OPT_MAXIT, OPT_QROUNDS, OPT_NOQ, OPT_INTQ, OPT_BEST_EFFORT,
+       OPT_FIELD };
 
 typedef struct iter_ctx {
     tool_ctx *t;
@@ -101,7 +107,7 @@ typedef struct tetsmooth_settings {
     tool_common co;
     st_fair_params fair;
     st_fit_params fit;
-    const char *in, *surface;
+    const char *in, *surface, *field;
     int mode; /* 1 fair, 2 fit */
     int fair_only, fit_only, noq, best_effort;
 } tetsmooth_settings;
@@ -114,6 +120,7 @@ static const struct option longopts[] = {
     {"min-angle", required_argument, NULL, OPT_MINANGLE},
     {"interior-quality", no_argument, NULL, OPT_INTQ},
     {"surface", required_argument, NULL, OPT_SURFACE},
+    {"field", required_argument, NULL, OPT_FIELD},
     {"offset", required_argument, NULL, OPT_OFFSET},
     {"offset-best-effort", no_argument, NULL, OPT_BEST_EFFORT},
     {"cell-width", required_argument, NULL, OPT_CELL},
@@ -154,6 +161,10 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         break;
     case OPT_SURFACE:
         s->surface = arg;
+        s->fit_only = 1;
+        break;
+    case OPT_FIELD:
+        s->field = arg;
         s->fit_only = 1;
         break;
     case OPT_OFFSET:
@@ -206,7 +217,7 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
     if (!s->mode)
         return tool_usage_error(t, "say what to do: --fair or --fit --surface S");
     if (s->mode == 1 && s->fit_only)
-        return tool_usage_error(t, "--surface, --offset, --offset-best-effort, --cell-width, "
+        return tool_usage_error(t, "--surface, --field, --offset, --offset-best-effort, --cell-width, "
                                    "--step and --max-iters go with --fit");
     if (s->mode == 2 && s->fair_only)
         return tool_usage_error(t, "--iters, --lambda, --min-angle and --interior-quality go with --fair");
@@ -214,6 +225,8 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
         s->fair.quality_rounds = 0;   /* whatever the order of the options */
     if (s->mode == 2 && !s->surface)
         return tool_usage_error(t, "--fit needs --surface S (the surface to enclose)");
+    if (s->field && strcmp(s->field, "-") == 0)
+        return tool_usage_error(t, "--field reads a file, not standard input");
     TOOL_TRY(tool_one_input(t, argc, argv, "input mesh", "-", &s->in));
     TOOL_TRY(tool_refuse_terminal(t, s->in, STDIN_FILENO, "no input: give a mesh or pipe one "
                                   "in (latticetet ... | tetsmooth ...)"));
@@ -232,7 +245,7 @@ static int run(tool_ctx *t, void *settings)
     st_error err;
     st_error_clear(&err);
     st_tetmesh *m = NULL;
-    st_soup *soup = NULL;
+    st_soup *soup = NULL, *fill = NULL;
     st_bvh *bvh = NULL;
     int rc = TOOL_EXIT_FAIL;
     int not_enclosing = 0;
@@ -274,6 +287,24 @@ static int run(tool_ctx *t, void *settings)
             rc = tool_fail(t, &err);
             goto done;
         }
+        if (s->field) {
+            /* the fill of the field's pseudo volume (pseudo.h) */
+            st_grid *g = NULL;
+            size_t nfill = 0;
+            if (st_grid_read(&g, s->field, s->co.max_bytes, &err) ||
+                st_pseudo_fill(&fill, g, bvh, &nfill, &err)) {
+                if (g && g->kind == ST_GRID_DISTANCE)
+                    st_error_set(&err, ST_EINPUT, tool_in_name(s->field), 0,
+                                 "the field is distance, not signed (run soupsign first)");
+                st_grid_free(g);
+                rc = tool_fail(t, &err);
+                goto done;
+            }
+            st_grid_free(g);
+            s->fit.fill = fill;
+            tool_say(t, 2, "fill: %zu voxel faces of the pseudo volume's boundary where S has "
+                     "no surface count as surface for --offset", nfill);
+        }
         iter_ctx ic = {t};
         if (t->verbosity >= 2) {
             s->fit.on_iter = on_iter;
@@ -297,9 +328,10 @@ static int run(tool_ctx *t, void *settings)
         tool_say(t, 2, "enclosure: S vertices outside %zu -> %zu, S triangles crossing "
                         "%zu -> %zu",
                  st.outside_before, st.outside_after, st.crossing_before, st.crossing_after);
-        tool_say(t, 2, "boundary: %zu of %zu vertices within %.6g of S; distance mean %.4g, "
+        tool_say(t, 2, "boundary: %zu of %zu vertices within %.6g of S%s; distance mean %.4g, "
                         "max %.4g",
-                 st.within_offset, st.boundary_vertices, st.d_offset, st.mean_distance,
+                 st.within_offset, st.boundary_vertices, st.d_offset,
+                 fill && fill->ntris ? " or the fill" : "", st.mean_distance,
                  st.max_distance);
         not_enclosing = st.outside_after || st.crossing_after;
         fst = st;
@@ -342,6 +374,7 @@ static int run(tool_ctx *t, void *settings)
     }
 done:
     st_bvh_free(bvh);
+    st_soup_free(fill);
     st_soup_free(soup);
     st_tetmesh_free(m);
     return rc;

@@ -85,7 +85,7 @@ static const char *enclosure_word(const st_tetstat *r)
 static void print_json(FILE *f, const char *name, const char *sname,
                        const char *fname, const st_tetstat *r)
 {
-    char b[12][32];
+    char b[15][32];
     fprintf(f, "{\"file\": ");
     tool_json_string(f, name);
     fprintf(f,
@@ -142,10 +142,20 @@ static void print_json(FILE *f, const char *name, const char *sname,
         if (r->has_offset)
             fprintf(f, ",\n    \"offset_ratio\": %s, \"beyond_offset\": %zu, \"offset_met\": %s",
                     tool_json_number(b[11], r->offset_ratio), r->beyond_offset,
-                    yesno(r->beyond_offset == 0));
+                    yesno((r->has_fill ? r->beyond_offset_fill : r->beyond_offset) == 0));
         else
             fprintf(f, ",\n    \"offset_ratio\": null, \"beyond_offset\": null, "
                        "\"offset_met\": null");
+        if (r->has_fill)
+            fprintf(f, ",\n    \"fill_faces\": %zu, \"fill_dist_max\": %s, "
+                       "\"fill_dist_max_h\": %s, \"beyond_offset_fill\": %s",
+                    r->fill_faces, tool_json_number(b[12], r->fill_dist_max),
+                    hh ? tool_json_number(b[13], r->fill_dist_max / r->h) : "null",
+                    r->has_offset ? tool_json_number(b[14], (double)r->beyond_offset_fill)
+                                  : "null");
+        else
+            fprintf(f, ",\n    \"fill_faces\": null, \"fill_dist_max\": null, "
+                       "\"fill_dist_max_h\": null, \"beyond_offset_fill\": null");
         if (r->has_enclosure)
             fprintf(f,
                     ",\n    \"vertices_inside\": %zu, \"fraction_inside\": "
@@ -176,6 +186,14 @@ static void print_json(FILE *f, const char *name, const char *sname,
         fprintf(f, __VA_ARGS__);                                            \
         fputc('\n', f);                                                     \
     } while (0)
+
+/* The row of the stopping condition: how many are beyond R h of what. */
+static void beyond_row(FILE *f, double ratio, const char *what, size_t n)
+{
+    char lab[64];
+    snprintf(lab, sizeof lab, "beyond %.3g h (%s)", ratio, what);
+    ROW(lab, "%zu%s", n, n ? "   <- OFFSET NOT MET" : "   (met)");
+}
 
 static void print_table(FILE *f, const char *name, const char *sname,
                         const char *fname, const st_tetstat *r)
@@ -237,11 +255,15 @@ static void print_table(FILE *f, const char *name, const char *sname,
             ROW("boundary -> S max / diag", "%.6f", r->dist_max / r->surface_diag);
             ROW("S -> boundary max / diag", "%.6f", r->surface_dist_max / r->surface_diag);
         }
-        if (r->has_offset) {
-            char lab[64];
-            snprintf(lab, sizeof lab, "beyond %.3g h (offset)", r->offset_ratio);
-            ROW(lab, "%zu%s", r->beyond_offset,
-                r->beyond_offset ? "   <- OFFSET NOT MET" : "   (met)");
+        if (r->has_offset)
+            beyond_row(f, r->offset_ratio, "offset", r->beyond_offset);
+        if (r->has_fill) {
+            ROW("fill (field, no S) faces", "%zu", r->fill_faces);
+            ROW("boundary -> S|fill max", "%.9g", r->fill_dist_max);
+            if (r->has_h && r->h > 0.0)
+                ROW("boundary -> S|fill max / h", "%.4f", r->fill_dist_max / r->h);
+            if (r->has_offset)
+                beyond_row(f, r->offset_ratio, "S|fill", r->beyond_offset_fill);
         }
         if (r->surface_closed) {
             ROW("surface volume", "%.9g", r->surface_volume);
@@ -384,6 +406,9 @@ static int run(tool_ctx *t, void *settings)
     double t3 = tool_now();
     if (g && st_tetstat_field(&r, m, g, &err))
         goto failed;
+    /* both: the fill counts as surface, as soupmesh's condition takes it */
+    if (soup && g && st_tetstat_fill(&r, m, soup, g, &err))
+        goto failed;
     double t4 = tool_now();
     tool_say(t, 2, "read %.3f s, mesh %.3f s, surface %.3f s, field %.3f s",
              t1 - t0, t2 - t1, t3 - t2, t4 - t3);
@@ -423,7 +448,11 @@ static int run(tool_ctx *t, void *settings)
     if (s->offset > 0.0 && !r.has_h)
         tool_say(t, 1, "%s: warning: no cell width h in the mesh (meta \"h\"): "
                  "--offset not reported", name);
-    if (r.has_surface && r.has_offset && r.beyond_offset)
+    if (r.has_fill && r.has_offset && r.beyond_offset_fill)
+        tool_say(t, 1, "%s: warning: %zu boundary vertices farther than %.3g h from %s "
+                 "and the fill of %s (up to %.4g h)", name, r.beyond_offset_fill,
+                 r.offset_ratio, sname, fname, r.fill_dist_max / r.h);
+    else if (!r.has_fill && r.has_surface && r.has_offset && r.beyond_offset)
         tool_say(t, 1, "%s: warning: %zu boundary vertices farther than %.3g h from %s "
                  "(up to %.4g h)", name, r.beyond_offset, r.offset_ratio, sname,
                  r.dist_max / r.h);

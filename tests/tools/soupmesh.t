@@ -117,4 +117,44 @@ check "a holed bunny meshes with its hole capped" sh -c "soupmesh -v -o hc.vtu h
 check "--fill-holes off meshes it too" sh -c "soupmesh -v --fill-holes off -o ho.vtu holed.obj 2>&1 | grep -q 'encloses the input'"
 expect_fail "bad --fill-holes" 2 "--fill-holes is on or off" soupmesh --fill-holes 2 holed.obj
 
+# A one-sided scan (issue 18): the bunny's triangles facing +z alone. The
+# pseudo volume closes its far side; that fill counts as surface for
+# --offset (--offset-fill on, the default), so every boundary vertex gets
+# within 0.4 h of the input or the fill; against the input alone they
+# cannot (the fill's vertices are far from it): --offset-fill off misses
+# with exit 4. tetstat with the same field (soupdist | soupsign --surface)
+# counts as soupmesh does.
+/usr/bin/python3 - "$BUNNY" onesided.obj <<'PY'
+import sys
+v, f = [], []
+for line in open(sys.argv[1]):
+    t = line.split()
+    if t and t[0] == "v": v.append([float(x) for x in t[1:4]])
+    elif t and t[0] == "f": f.append([int(x.split("/")[0]) for x in t[1:]])
+def nz(t):
+    a, b, c = (v[k - 1] for k in t)
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+with open(sys.argv[2], "w") as o:
+    for p in v: o.write("v %r %r %r\n" % tuple(p))
+    for t in f:
+        if nz(t) > 0: o.write("f %d %d %d\n" % tuple(t))
+PY
+check "one-sided: the fill counts, every boundary vertex within 0.4 h of it or the input, min dihedral >= 30" \
+    sh -c "soupmesh -v --cells 6 -o os.vtu onesided.obj 2> os.err && grep -Eq 'fill: [1-9][0-9]* voxel faces' os.err && grep -q 'boundary -> input or fill max' os.err && grep -q ' 0 of [0-9]* boundary vertices beyond 0.4 h' os.err && tetstat --json os.vtu | python3 -c 'import json,sys; assert json.load(sys.stdin)[\"min_dihedral\"] >= 30'"
+check "one-sided: --offset-fill off measures the input alone and misses (exit 4)" \
+    sh -c "soupmesh -q --cells 6 --offset-fill off -o osoff.vtu onesided.obj 2> osoff.err; test \$? -eq 4 && grep -q 'farther than 0.4 h from the input, the farthest' osoff.err"
+check "one-sided: tetstat --surface --field counts the fill as soupmesh does" \
+    sh -c "soupdist onesided.obj | soupsign --surface onesided.obj -o os.vti && tetstat --json --surface onesided.obj --field os.vti os.vtu > os.json && n=\$(sed -n 's/.*fill: \\([0-9]*\\) voxel faces.*/\\1/p' os.err) && python3 -c 'import json,sys; d=json.load(open(\"os.json\"))[\"surface\"]; assert d[\"fill_faces\"] == int(sys.argv[1]) and d[\"beyond_offset_fill\"] == 0 and d[\"offset_met\"] and d[\"beyond_offset\"] > 0 and d[\"fill_dist_max_h\"] <= 0.4 < d[\"dist_max_h\"], d' \$n"
+cat > samemesh.py <<'PY'
+import sys, vtk
+from vtk.util.numpy_support import vtk_to_numpy as n
+def rd(f):
+    r = vtk.vtkXMLUnstructuredGridReader(); r.SetFileName(f); r.Update(); g = r.GetOutput()
+    return n(g.GetPoints().GetData()).tolist(), n(g.GetCells().GetConnectivityArray()).tolist()
+assert rd(sys.argv[1]) == rd(sys.argv[2]), "the meshes differ"
+PY
+check "one-sided: the pipe with tetsmooth --field makes soupmesh's mesh, bit for bit" \
+    sh -c "soupdist onesided.obj | soupsign -o osf.vti && latticetet --sculpt --surface onesided.obj --cells 6 osf.vti | tetsmooth --fit --surface onesided.obj --field osf.vti -o pipe.vtu && /usr/bin/python3 samemesh.py pipe.vtu os.vtu"
+expect_fail "bad --offset-fill" 2 "--offset-fill is on or off" soupmesh --offset-fill 2 onesided.obj
+
 done_testing

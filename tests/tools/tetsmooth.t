@@ -105,6 +105,8 @@ check "fair --min-angle 25 --no-quality" sh -c "tetsmooth -v --fair --min-angle 
 
 expect_fail "no mode" 2 "--fair or --fit" tetsmooth b6.vtu
 expect_fail "--fit without --surface" 2 "needs --surface" tetsmooth --fit -o x.vtu b6.vtu
+expect_fail "--field with --fair" 2 "go with --fit" tetsmooth --fair --field f.vti -o x.vtu b6.vtu
+expect_fail "--field from standard input" 2 "reads a file" tetsmooth --fit --surface "$BUNNY" --field - -o x.vtu b6.vtu
 expect_fail "--fair with --surface" 2 "go with --fit" tetsmooth --fair --surface "$BUNNY" -o x.vtu b6.vtu
 expect_fail "--fit with --iters" 2 "go with --fair" tetsmooth --fit --surface "$BUNNY" --iters 3 -o x.vtu b6.vtu
 expect_fail "bad --step" 2 "step" tetsmooth --fit --surface "$BUNNY" --step 2 -o x.vtu b6.vtu
