@@ -200,6 +200,20 @@ static double least_bend(const double *const *pts, const double *const *side, si
     return area;
 }
 
+/* least_area and least_bend as st_holes_fill (holes_internal.h) */
+static double fill_area(const double *const *pts, const double *const *side, size_t n,
+                        uint32_t *tri)
+{
+    (void)side;
+    return least_area(pts, n, tri);
+}
+
+static double fill_bend(const double *const *pts, const double *const *side, size_t n,
+                        uint32_t *tri)
+{
+    return least_bend(pts, side, n, tri);
+}
+
 /* The bend along the loop of the cap tri[3 (n - 2)] (local indices, as
  * least_bend's): the sum over the loop's edges of length times the
  * dihedral between the cap's triangle on it and the soup's. */
@@ -773,7 +787,27 @@ st_status st_soup_hole_caps_shared(st_soup **caps, const st_soup *s,
              * points (a flat hole's cap continues them exactly) */
             int coned = 0;
             const double below = CONE_BETTER * rim_bend(pts, side, n, tri);
-            if ((rc = st_holes_planes_cap(out, &coned, pts, side, n, below, err)))
+            /* the cone from one corner, with planes 2 the fans from
+             * several too: whichever continues the faces better */
+            double cb, fb = INFINITY;
+            int fanned = 0;
+            st_soup *cone = st_soup_new(), *fans = p->planes == 2 ? st_soup_new() : NULL;
+            if (!cone || (p->planes == 2 && !fans)) {
+                st_soup_free(cone);
+                st_soup_free(fans);
+                rc = ST_ENOMEM;
+                goto done;
+            }
+            rc = st_holes_planes_cap(cone, &coned, pts, side, n, below, &cb, err);
+            if (!rc && fans)
+                rc = st_holes_planes_fans(fans, &fanned, pts, side, n, below,
+                                          p->bend ? fill_bend : fill_area, &fb, err);
+            if (!rc && (coned || fanned))
+                rc = st_soup_append(out, fanned && (!coned || fb < cb) ? fans : cone, err);
+            coned |= fanned;
+            st_soup_free(cone);
+            st_soup_free(fans);
+            if (rc)
                 goto fail;
             if (coned) {
                 st0.filled++;

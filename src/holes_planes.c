@@ -108,9 +108,10 @@ static int meet2(double *x, const plane *a, const plane *b, const double *o)
 
 st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
                               const double *const *side, size_t n, double below,
-                              st_error *err)
+                              double *bent, st_error *err)
 {
     *done = 0;
+    *bent = INFINITY;
     double *rim = malloc(3 * n * sizeof *rim), *tn = malloc(3 * n * sizeof *tn);
     plane *pl = malloc(n * sizeof *pl);
     st_status rc = ST_OK;
@@ -203,7 +204,314 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
                                        (uint32_t)(base + n), err)))
             goto out;
     *done = 1;
+    *bent = best;
 out:
     free(rim), free(tn), free(pl);
+    return rc;
+}
+
+/* ---- several corners per loop: fans to the points where the planes meet */
+
+/* An apex continues loop edge i when the triangle (p_i, p_i+1, apex) lies
+ * in the plane of the soup's triangle there, on the hole's side: its bend
+ * below FAN_FLAT radians. */
+#define FAN_FLAT 1e-6
+/* At most MAX_APEX apexes per loop. */
+#define MAX_APEX 16
+
+/* One vertex of a loop being capped: its point, the third point of the
+ * triangle beyond its outgoing edge (the soup's or a fan's), and the
+ * original loop edge that outgoing edge is (-1: a new one, to an apex). */
+typedef struct fan_v {
+    const double *p, *side;
+    long orig;
+} fan_v;
+
+/* The planes of the loop's edges, once each, the longest MAX_PLANES first;
+ * rim[3 n] gets each edge's unit normal. Returns how many. */
+static size_t loop_planes(plane *pl, double *rim, const fan_v *v, size_t n, double ext)
+{
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        const double *a = v[i].p, *b = v[(i + 1) % n].p;
+        unit_normal(rim + 3 * i, a, v[i].side, b);
+        const double *nn = rim + 3 * i;
+        if (st_dot3(nn, nn) == 0.0)
+            continue;
+        const double d = st_dot3(nn, a), len = dist3(a, b);
+        size_t j = 0;
+        for (; j < m; j++) {
+            const double sg = st_dot3(nn, pl[j].n) < 0.0 ? -1.0 : 1.0;
+            double dn = 0.0;
+            for (int k = 0; k < 3; k++)
+                dn += fabs(sg * nn[k] - pl[j].n[k]);
+            if (dn <= SAME && fabs(sg * d - pl[j].d) <= SAME * ext)
+                break;
+        }
+        if (j < m) {
+            pl[j].len += len;
+            continue;
+        }
+        memcpy(pl[m].n, nn, sizeof pl[m].n);
+        pl[m].d = d;
+        pl[m].len = len;
+        m++;
+    }
+    for (size_t i = 1; i < m; i++)
+        for (size_t j = i; j > 0 && pl[j].len > pl[j - 1].len; j--) {
+            plane t = pl[j];
+            pl[j] = pl[j - 1];
+            pl[j - 1] = t;
+        }
+    return m > MAX_PLANES ? MAX_PLANES : m;
+}
+
+/* The length of the loop's edges apex continues (FAN_FLAT). */
+static double fan_gain(const double *apex, const fan_v *v, const double *rim, size_t n)
+{
+    double g = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double t[3];
+        const double *a = v[i].p, *b = v[(i + 1) % n].p;
+        unit_normal(t, a, b, apex);
+        if (bend(t, rim + 3 * i) < FAN_FLAT)
+            g += dist3(a, b);
+    }
+    return g;
+}
+
+typedef struct fan_out {
+    const double **tri;     /* 3 points a triangle */
+    long *orig;             /* per triangle edge: the original loop edge or -1 */
+    size_t nt, cap;
+} fan_out;
+
+static int fan_push(fan_out *o, const double *a, const double *b, const double *c, long oa,
+                    long ob, long oc)
+{
+    if (o->nt == o->cap) {
+        size_t nc = o->cap ? 2 * o->cap : 64;
+        const double **t = realloc(o->tri, 3 * nc * sizeof *t);
+        if (!t)
+            return -1;
+        o->tri = t;
+        long *g = realloc(o->orig, 3 * nc * sizeof *g);
+        if (!g)
+            return -1;
+        o->orig = g;
+        o->cap = nc;
+    }
+    o->tri[3 * o->nt] = a, o->tri[3 * o->nt + 1] = b, o->tri[3 * o->nt + 2] = c;
+    o->orig[3 * o->nt] = oa, o->orig[3 * o->nt + 1] = ob, o->orig[3 * o->nt + 2] = oc;
+    o->nt++;
+    return 0;
+}
+
+st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts,
+                               const double *const *side, size_t n, double below,
+                               st_holes_fill fill, double *bent, st_error *err)
+{
+    *done = 0;
+    *bent = INFINITY;
+    const size_t maxv = n + 2 * MAX_APEX + 2;
+    /* the loops still to cap, one after another in stk (each led by its
+     * length), and the scratch of one */
+    fan_v *stk = malloc(2 * maxv * (MAX_APEX + 2) * sizeof *stk), *cur = malloc(maxv * sizeof *cur),
+          *nxt = malloc(2 * maxv * sizeof *nxt);
+    size_t *lens = malloc(maxv * sizeof *lens);
+    double *rim = malloc(3 * maxv * sizeof *rim);
+    plane *pl = malloc(maxv * sizeof *pl);
+    const double **lp = malloc(maxv * sizeof *lp), **ls = malloc(maxv * sizeof *ls);
+    uint32_t *tri = malloc(3 * maxv * sizeof *tri);
+    double (*apx)[3] = malloc(MAX_APEX * sizeof *apx);
+    fan_out fo = {NULL, NULL, 0, 0};
+    st_status rc = ST_OK;
+    if (!stk || !cur || !nxt || !lens || !rim || !pl || !lp || !ls || !tri || !apx)
+        goto oom;
+    double lo[3], hi[3], ext = 0.0;
+    for (int k = 0; k < 3; k++)
+        lo[k] = hi[k] = pts[0][k];
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], pts[i][k]);
+            hi[k] = fmax(hi[k], pts[i][k]);
+        }
+    for (int k = 0; k < 3; k++)
+        ext = fmax(ext, hi[k] - lo[k]);
+    for (int k = 0; k < 3; k++) {
+        lo[k] -= REACH * ext;
+        hi[k] += REACH * ext;
+    }
+    size_t nloops = 1, napex = 0, top = 0;
+    for (size_t i = 0; i < n; i++) {
+        stk[i].p = pts[i];
+        stk[i].side = side[i];
+        stk[i].orig = (long)i;
+    }
+    lens[0] = n;
+    top = n;
+    while (nloops) {
+        /* pop the last loop */
+        const size_t m = lens[--nloops];
+        top -= m;
+        memcpy(cur, stk + top, m * sizeof *cur);
+        if (m < 3)
+            continue;
+        double o[3] = {0, 0, 0};
+        for (size_t i = 0; i < m; i++)
+            for (int k = 0; k < 3; k++)
+                o[k] += cur[i].p[k] / (double)m;
+        const size_t np = loop_planes(pl, rim, cur, m, ext);
+        double best = 0.0, ax[3] = {0, 0, 0};
+        if (napex < MAX_APEX)
+            for (size_t a = 0; a < np; a++)
+                for (size_t b = a + 1; b < np; b++)
+                    for (size_t c = b; c < np; c++) {
+                        double x[3];
+                        if (!(c == b ? meet2(x, &pl[a], &pl[b], o)
+                                     : meet3(x, &pl[a], &pl[b], &pl[c])))
+                            continue;
+                        int inside = 1;
+                        for (int k = 0; k < 3; k++)
+                            inside &= x[k] >= lo[k] && x[k] <= hi[k];
+                        if (!inside)
+                            continue;
+                        const double g = fan_gain(x, cur, rim, m);
+                        if (g > best) {
+                            best = g;
+                            memcpy(ax, x, sizeof ax);
+                        }
+                    }
+        /* which edges the apex continues */
+        size_t ncont = 0;
+        if (best > 0.0)
+            for (size_t i = 0; i < m; i++) {
+                double t[3];
+                unit_normal(t, cur[i].p, cur[(i + 1) % m].p, ax);
+                ncont += bend(t, rim + 3 * i) < FAN_FLAT;
+            }
+        if (ncont < 2) {
+            /* no apex: the loop's own triangulation */
+            for (size_t i = 0; i < m; i++) {
+                lp[i] = cur[i].p;
+                ls[i] = cur[i].side;
+            }
+            if (fill((const double *const *)lp, (const double *const *)ls, m, tri) < 0)
+                goto oom;
+            for (size_t t = 0; t + 2 < m; t++) {
+                const uint32_t *c = tri + 3 * t;
+                long og[3];
+                for (int e = 0; e < 3; e++) {
+                    const size_t u = c[e], w = c[(e + 1) % 3];
+                    og[e] = (u + 1) % m == w ? cur[u].orig : (w + 1) % m == u ? cur[w].orig : -1;
+                }
+                if (fan_push(&fo, lp[c[0]], lp[c[1]], lp[c[2]], og[0], og[1], og[2]))
+                    goto oom;
+            }
+            continue;
+        }
+        memcpy(apx[napex], ax, sizeof ax);
+        const double *A = apx[napex++];
+        /* start at an edge the apex does not continue (all: the cone) */
+        size_t s0 = 0;
+        int *flag = malloc(m * sizeof *flag);
+        if (!flag)
+            goto oom;
+        for (size_t i = 0; i < m; i++) {
+            double t[3];
+            unit_normal(t, cur[i].p, cur[(i + 1) % m].p, A);
+            flag[i] = bend(t, rim + 3 * i) < FAN_FLAT;
+        }
+        while (s0 < m && flag[s0])
+            s0++;
+        /* the fans, and the loop with each run of continued edges replaced
+         * by the apex */
+        size_t k = 0;
+        for (size_t r = 0; r < m; r++) {
+            const size_t i = (s0 + r) % m;
+            const fan_v *vi = cur + i, *vj = cur + (i + 1) % m;
+            if (!flag[i]) {
+                nxt[k++] = *vi;
+                continue;
+            }
+            if (fan_push(&fo, vi->p, vj->p, A, vi->orig, -1, -1)) {
+                free(flag);
+                goto oom;
+            }
+            const int first = r == 0 || !flag[(i + m - 1) % m];
+            const int last = r + 1 == m || !flag[(i + 1) % m];
+            if (first && s0 < m) {      /* vi stays, its edge now to the apex */
+                nxt[k].p = vi->p;
+                nxt[k].side = vj->p;
+                nxt[k].orig = -1;
+                k++;
+            }
+            if (last) {
+                nxt[k].p = A;
+                nxt[k].side = vi->p;
+                nxt[k].orig = -1;
+                k++;
+            }
+        }
+        free(flag);
+        if (s0 == m)
+            continue;           /* a cone over the whole loop */
+        /* split where the loop meets the apex more than once */
+        size_t firstA = 0;
+        while (nxt[firstA].p != A)
+            firstA++;
+        /* rotate so the loop starts at the apex, then cut before each
+         * later occurrence of it */
+        for (size_t i = 0; i < k; i++)
+            nxt[k + i] = nxt[(firstA + i) % k];
+        size_t st = k;
+        for (size_t i = k + 1; i <= 2 * k; i++)
+            if (i == 2 * k || nxt[i].p == A) {
+                const size_t len = i - st;
+                if (len >= 3) {
+                    if (nloops == maxv || top + len > 2 * maxv * (MAX_APEX + 2))
+                        goto out;   /* (never on a loop of this size) */
+                    memcpy(stk + top, nxt + st, len * sizeof *stk);
+                    top += len;
+                    lens[nloops++] = len;
+                }
+                st = i;
+            }
+    }
+    /* the caps' bend along the original loop */
+    double rb = 0.0;
+    for (size_t t = 0; t < fo.nt; t++) {
+        double nt[3], nr[3];
+        const double **c = fo.tri + 3 * t;
+        unit_normal(nt, c[0], c[1], c[2]);
+        for (int e = 0; e < 3; e++) {
+            const long i = fo.orig[3 * t + e];
+            if (i < 0)
+                continue;
+            unit_normal(nr, pts[i], side[i], pts[((size_t)i + 1) % n]);
+            rb += dist3(pts[i], pts[((size_t)i + 1) % n]) * bend(nt, nr);
+        }
+    }
+    if (napex == 0 || !(rb < below))
+        goto out;
+    for (size_t t = 0; t < fo.nt; t++) {
+        const size_t base = out->nverts;
+        for (int c = 0; c < 3; c++) {
+            const double *q = fo.tri[3 * t + c];
+            if ((rc = st_soup_add_vertex(out, q[0], q[1], q[2], err)))
+                goto out;
+        }
+        if ((rc = st_soup_add_triangle(out, (uint32_t)base, (uint32_t)(base + 1),
+                                       (uint32_t)(base + 2), err)))
+            goto out;
+    }
+    *done = 1;
+    *bent = rb;
+    goto out;
+oom:
+    rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
+out:
+    free(stk), free(cur), free(nxt), free(lens), free(rim), free(pl), free(lp), free(ls);
+    free(tri), free(apx), free(fo.tri), free(fo.orig);
     return rc;
 }
