@@ -791,8 +791,8 @@ st_status st_soup_hole_caps_shared(st_soup **caps, const st_soup *s,
              * several too: whichever continues the faces better */
             double cb, fb = INFINITY;
             int fanned = 0;
-            st_soup *cone = st_soup_new(), *fans = p->planes == 2 ? st_soup_new() : NULL;
-            if (!cone || (p->planes == 2 && !fans)) {
+            st_soup *cone = st_soup_new(), *fans = p->planes ? st_soup_new() : NULL;
+            if (!cone || (p->planes && !fans)) {
                 st_soup_free(cone);
                 st_soup_free(fans);
                 rc = ST_ENOMEM;

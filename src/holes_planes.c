@@ -266,15 +266,20 @@ static size_t loop_planes(plane *pl, double *rim, const fan_v *v, size_t n, doub
     return m > MAX_PLANES ? MAX_PLANES : m;
 }
 
-/* The length of the loop's edges apex continues (FAN_FLAT). */
-static double fan_gain(const double *apex, const fan_v *v, const double *rim, size_t n)
+/* Which of the loop's edges apex continues (FAN_FLAT): flag[n]. Returns
+ * their length. (Fanning only the longest run of them, when it spans two
+ * planes: core IoU on the corpus's largeholes 0.842 -> 0.824, rotor
+ * 0.936 -> 0.851; only the runs that span two planes: 0.828.) */
+static double fan_flags(const double *apex, const fan_v *v, const double *rim, size_t n,
+                        int *flag)
 {
     double g = 0.0;
     for (size_t i = 0; i < n; i++) {
         double t[3];
         const double *a = v[i].p, *b = v[(i + 1) % n].p;
         unit_normal(t, a, b, apex);
-        if (bend(t, rim + 3 * i) < FAN_FLAT)
+        flag[i] = bend(t, rim + 3 * i) < FAN_FLAT;
+        if (flag[i])
             g += dist3(a, b);
     }
     return g;
@@ -324,9 +329,10 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
     const double **lp = malloc(maxv * sizeof *lp), **ls = malloc(maxv * sizeof *ls);
     uint32_t *tri = malloc(3 * maxv * sizeof *tri);
     double (*apx)[3] = malloc(MAX_APEX * sizeof *apx);
+    int *flag = malloc(maxv * sizeof *flag);
     fan_out fo = {NULL, NULL, 0, 0};
     st_status rc = ST_OK;
-    if (!stk || !cur || !nxt || !lens || !rim || !pl || !lp || !ls || !tri || !apx)
+    if (!flag || !stk || !cur || !nxt || !lens || !rim || !pl || !lp || !ls || !tri || !apx)
         goto oom;
     double lo[3], hi[3], ext = 0.0;
     for (int k = 0; k < 3; k++)
@@ -376,7 +382,7 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
                             inside &= x[k] >= lo[k] && x[k] <= hi[k];
                         if (!inside)
                             continue;
-                        const double g = fan_gain(x, cur, rim, m);
+                        const double g = fan_flags(x, cur, rim, m, flag);
                         if (g > best) {
                             best = g;
                             memcpy(ax, x, sizeof ax);
@@ -384,12 +390,11 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
                     }
         /* which edges the apex continues */
         size_t ncont = 0;
-        if (best > 0.0)
-            for (size_t i = 0; i < m; i++) {
-                double t[3];
-                unit_normal(t, cur[i].p, cur[(i + 1) % m].p, ax);
-                ncont += bend(t, rim + 3 * i) < FAN_FLAT;
-            }
+        if (best > 0.0) {
+            fan_flags(ax, cur, rim, m, flag);
+            for (size_t i = 0; i < m; i++)
+                ncont += (size_t)flag[i];
+        }
         if (ncont < 2) {
             /* no apex: the loop's own triangulation */
             for (size_t i = 0; i < m; i++) {
@@ -414,14 +419,6 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
         const double *A = apx[napex++];
         /* start at an edge the apex does not continue (all: the cone) */
         size_t s0 = 0;
-        int *flag = malloc(m * sizeof *flag);
-        if (!flag)
-            goto oom;
-        for (size_t i = 0; i < m; i++) {
-            double t[3];
-            unit_normal(t, cur[i].p, cur[(i + 1) % m].p, A);
-            flag[i] = bend(t, rim + 3 * i) < FAN_FLAT;
-        }
         while (s0 < m && flag[s0])
             s0++;
         /* the fans, and the loop with each run of continued edges replaced
@@ -434,10 +431,8 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
                 nxt[k++] = *vi;
                 continue;
             }
-            if (fan_push(&fo, vi->p, vj->p, A, vi->orig, -1, -1)) {
-                free(flag);
+            if (fan_push(&fo, vi->p, vj->p, A, vi->orig, -1, -1))
                 goto oom;
-            }
             const int first = r == 0 || !flag[(i + m - 1) % m];
             const int last = r + 1 == m || !flag[(i + 1) % m];
             if (first && s0 < m) {      /* vi stays, its edge now to the apex */
@@ -453,7 +448,6 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
                 k++;
             }
         }
-        free(flag);
         if (s0 == m)
             continue;           /* a cone over the whole loop */
         /* split where the loop meets the apex more than once */
@@ -512,6 +506,6 @@ oom:
     rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
 out:
     free(stk), free(cur), free(nxt), free(lens), free(rim), free(pl), free(lp), free(ls);
-    free(tri), free(apx), free(fo.tri), free(fo.orig);
+    free(tri), free(apx), free(fo.tri), free(fo.orig), free(flag);
     return rc;
 }

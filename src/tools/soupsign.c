@@ -365,8 +365,6 @@ static int run(tool_ctx *t, void *settings)
     pp.fill_holes = s->fill_holes;
     pp.holes.bend = s->bend_caps & 1;
     pp.holes.planes = (s->bend_caps & 2) != 0;
-    if (pp.holes.planes && getenv("LH_FANS") && *getenv("LH_FANS"))
-        pp.holes.planes = 2;
     pp.closed_shells = s->use_shells;
     pp.sides = s->use_sides;
     pp.sides_params.past_caps = s->past_caps;
