@@ -43,11 +43,15 @@ st_holes_params st_holes_params_default(void)
     /* 0.25: a hole's cap is at most a quarter of the surface around it (on
      * the corpus, holes of 3 rings of faces on models of 3 000 faces and
      * up: under 0.15); an open patch's own loop spans about its area. */
-    /* planes 0: a cone from a rebuilt corner recovers more of the large
-     * holes (core IoU 0.743 -> 0.819, worst 0.584 -> 0.685; with bend
-     * 0.834) and of the holes class, but loses on one-sided scans
-     * (elephant onesided 0.801 -> 0.551 at CONE_BETTER 0.999) and on
-     * deleted50 pinion (0.999 -> 0.993). */
+    /* planes 0: rebuilt corners (a cone from one, or fans from several)
+     * recover more of the large holes (core IoU at 128^3, mean / worst:
+     * 0.743 / 0.584 -> 0.842 / 0.685; with bend 0.876 / 0.803; the cone
+     * alone 0.819 / 0.685) and of the holes class (cheese 0.896 ->
+     * 0.922), but lose on deleted faces and one-sided scans: deleted50
+     * cheese 0.980 -> 0.925, pinion 0.999 -> 0.996, rotor 0.989 ->
+     * 0.986; onesided cheese 0.845 -> 0.813, rotor 0.883 -> 0.871, anchor
+     * 1.000 -> 0.995 (elephant onesided 0.801 -> 0.551 at CONE_BETTER
+     * 0.999). */
     /* bend 0: the least-area caps; the caps that bend least recover more
      * of a CAD part's large holes (issue 17, the corpus's largeholes:
      * core IoU 0.743 -> 0.829) and of its small ones, but extend a face's

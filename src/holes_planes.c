@@ -23,12 +23,24 @@
  * spokes too) is the cap when it does better than the caller's bound
  * (the cap of the loop's own points, which chamfers a lost corner: a
  * box's bends along all its loop by 55 degrees, the corner's cone by 0).
+ *
+ * A large hole spans several corners (a lost edge and both its ends, a
+ * wing of a part): no one point continues all of its loop.
+ * st_holes_planes_fans takes the point that continues the most of it
+ * exactly (its triangle over an edge within FAN_FLAT of the soup's
+ * plane there, on the hole's side), fans from it over the edges it
+ * continues, and replaces each run of them by the point; the loop left
+ * (split into several where it meets the point more than once) is capped
+ * the same way, and one that no point continues along two edges by the
+ * caller's triangulation of its own points. The caller keeps the fans or
+ * the single cone, whichever continues the soup along the loop better.
  */
 #include "holes_internal.h"
 #include "fpenv.h"
 #include "souptet/geom.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
