@@ -118,22 +118,14 @@ static int meet2(double *x, const plane *a, const plane *b, const double *o)
     return meet3(x, a, b, &c);
 }
 
-st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
-                              const double *const *side, size_t n, double below,
-                              double *bent, st_error *err)
+/* The loop's box grown by REACH times its extent each way (lo, hi), its
+ * centroid o and its extent. */
+static void reach_box(double *lo, double *hi, double *o, double *ext, const double *const *pts,
+                      size_t n)
 {
-    *done = 0;
-    *bent = INFINITY;
-    double *rim = malloc(3 * n * sizeof *rim), *tn = malloc(3 * n * sizeof *tn);
-    plane *pl = malloc(n * sizeof *pl);
-    st_status rc = ST_OK;
-    if (!rim || !tn || !pl) {
-        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
-        goto out;
-    }
-    double lo[3], hi[3], o[3] = {0, 0, 0}, ext = 0.0;
+    *ext = 0.0;
     for (int k = 0; k < 3; k++)
-        lo[k] = hi[k] = pts[0][k];
+        lo[k] = hi[k] = pts[0][k], o[k] = 0.0;
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) {
             lo[k] = fmin(lo[k], pts[i][k]);
@@ -141,12 +133,20 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
             o[k] += pts[i][k] / (double)n;
         }
     for (int k = 0; k < 3; k++)
-        ext = fmax(ext, hi[k] - lo[k]);
+        *ext = fmax(*ext, hi[k] - lo[k]);
     for (int k = 0; k < 3; k++) {
-        lo[k] -= REACH * ext;
-        hi[k] += REACH * ext;
+        lo[k] -= REACH * *ext;
+        hi[k] += REACH * *ext;
     }
-    /* the planes, once each (either orientation), by the length on them */
+}
+
+/* The planes of the soup's triangles along the loop, once each (either
+ * orientation), the MAX_PLANES with the most loop length on them first
+ * (ties by order along the loop); rim[3 n] gets each loop edge's unit
+ * normal. Returns how many (pl holds n). */
+static size_t loop_planes(plane *pl, double *rim, const double *const *pts,
+                          const double *const *side, size_t n, double ext)
+{
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
         unit_normal(rim + 3 * i, pts[i], side[i], pts[(i + 1) % n]);
@@ -172,29 +172,52 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
         pl[m].len = len;
         m++;
     }
-    /* the longest MAX_PLANES (insertion sort, ties by order along the loop) */
-    for (size_t i = 1; i < m; i++)
+    for (size_t i = 1; i < m; i++)      /* insertion sort */
         for (size_t j = i; j > 0 && pl[j].len > pl[j - 1].len; j--) {
             plane t = pl[j];
             pl[j] = pl[j - 1];
             pl[j - 1] = t;
         }
-    if (m > MAX_PLANES)
-        m = MAX_PLANES;
+    return m > MAX_PLANES ? MAX_PLANES : m;
+}
+
+/* The apex where planes a, b and c meet (c == b: the point of the line of
+ * a and b nearest o), when they meet within [lo, hi]. */
+static int candidate(double *x, const plane *pl, size_t a, size_t b, size_t c, const double *o,
+                     const double *lo, const double *hi)
+{
+    if (!(c == b ? meet2(x, &pl[a], &pl[b], o) : meet3(x, &pl[a], &pl[b], &pl[c])))
+        return 0;
+    int inside = 1;
+    for (int k = 0; k < 3; k++)
+        inside &= x[k] >= lo[k] && x[k] <= hi[k];
+    return inside;
+}
+
+st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
+                              const double *const *side, size_t n, double below,
+                              double *bent, st_error *err)
+{
+    *done = 0;
+    *bent = INFINITY;
+    double *rim = malloc(3 * n * sizeof *rim), *tn = malloc(3 * n * sizeof *tn);
+    plane *pl = malloc(n * sizeof *pl);
+    st_status rc = ST_OK;
+    if (!rim || !tn || !pl) {
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
+        goto out;
+    }
+    double lo[3], hi[3], o[3], ext;
+    reach_box(lo, hi, o, &ext, pts, n);
+    const size_t m = loop_planes(pl, rim, pts, side, n, ext);
     double best = below, best_total = INFINITY, apex[3] = {0, 0, 0};
     int found = 0;
     for (size_t a = 0; a < m; a++)
         for (size_t b = a + 1; b < m; b++)
             for (size_t c = b; c < m; c++) {    /* c == b: the line of a and b */
-                double x[3];
-                if (!(c == b ? meet2(x, &pl[a], &pl[b], o) : meet3(x, &pl[a], &pl[b], &pl[c])))
+                double x[3], rb;
+                if (!candidate(x, pl, a, b, c, o, lo, hi))
                     continue;
-                int inside = 1;
-                for (int k = 0; k < 3; k++)
-                    inside &= x[k] >= lo[k] && x[k] <= hi[k];
-                if (!inside)
-                    continue;
-                double rb;
                 const double cb = cone_bend(x, pts, rim, n, tn, &rb);
                 if (rb < best || (rb == best && cb < best_total)) {
                     best = rb;
@@ -238,45 +261,6 @@ typedef struct fan_v {
     const double *p, *side;
     long orig;
 } fan_v;
-
-/* The planes of the loop's edges, once each, the longest MAX_PLANES first;
- * rim[3 n] gets each edge's unit normal. Returns how many. */
-static size_t loop_planes(plane *pl, double *rim, const fan_v *v, size_t n, double ext)
-{
-    size_t m = 0;
-    for (size_t i = 0; i < n; i++) {
-        const double *a = v[i].p, *b = v[(i + 1) % n].p;
-        unit_normal(rim + 3 * i, a, v[i].side, b);
-        const double *nn = rim + 3 * i;
-        if (st_dot3(nn, nn) == 0.0)
-            continue;
-        const double d = st_dot3(nn, a), len = dist3(a, b);
-        size_t j = 0;
-        for (; j < m; j++) {
-            const double sg = st_dot3(nn, pl[j].n) < 0.0 ? -1.0 : 1.0;
-            double dn = 0.0;
-            for (int k = 0; k < 3; k++)
-                dn += fabs(sg * nn[k] - pl[j].n[k]);
-            if (dn <= SAME && fabs(sg * d - pl[j].d) <= SAME * ext)
-                break;
-        }
-        if (j < m) {
-            pl[j].len += len;
-            continue;
-        }
-        memcpy(pl[m].n, nn, sizeof pl[m].n);
-        pl[m].d = d;
-        pl[m].len = len;
-        m++;
-    }
-    for (size_t i = 1; i < m; i++)
-        for (size_t j = i; j > 0 && pl[j].len > pl[j - 1].len; j--) {
-            plane t = pl[j];
-            pl[j] = pl[j - 1];
-            pl[j - 1] = t;
-        }
-    return m > MAX_PLANES ? MAX_PLANES : m;
-}
 
 /* Which of the loop's edges apex continues (FAN_FLAT): flag[n]. Returns
  * their length. (Fanning only the longest run of them, when it spans two
@@ -346,20 +330,8 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
     st_status rc = ST_OK;
     if (!flag || !stk || !cur || !nxt || !lens || !rim || !pl || !lp || !ls || !tri || !apx)
         goto oom;
-    double lo[3], hi[3], ext = 0.0;
-    for (int k = 0; k < 3; k++)
-        lo[k] = hi[k] = pts[0][k];
-    for (size_t i = 0; i < n; i++)
-        for (int k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], pts[i][k]);
-            hi[k] = fmax(hi[k], pts[i][k]);
-        }
-    for (int k = 0; k < 3; k++)
-        ext = fmax(ext, hi[k] - lo[k]);
-    for (int k = 0; k < 3; k++) {
-        lo[k] -= REACH * ext;
-        hi[k] += REACH * ext;
-    }
+    double lo[3], hi[3], o0[3], ext;
+    reach_box(lo, hi, o0, &ext, pts, n);
     size_t nloops = 1, napex = 0, top = 0;
     for (size_t i = 0; i < n; i++) {
         stk[i].p = pts[i];
@@ -379,20 +351,19 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
         for (size_t i = 0; i < m; i++)
             for (int k = 0; k < 3; k++)
                 o[k] += cur[i].p[k] / (double)m;
-        const size_t np = loop_planes(pl, rim, cur, m, ext);
+        for (size_t i = 0; i < m; i++) {
+            lp[i] = cur[i].p;
+            ls[i] = cur[i].side;
+        }
+        const size_t np = loop_planes(pl, rim, (const double *const *)lp,
+                                      (const double *const *)ls, m, ext);
         double best = 0.0, ax[3] = {0, 0, 0};
         if (napex < MAX_APEX)
             for (size_t a = 0; a < np; a++)
                 for (size_t b = a + 1; b < np; b++)
                     for (size_t c = b; c < np; c++) {
                         double x[3];
-                        if (!(c == b ? meet2(x, &pl[a], &pl[b], o)
-                                     : meet3(x, &pl[a], &pl[b], &pl[c])))
-                            continue;
-                        int inside = 1;
-                        for (int k = 0; k < 3; k++)
-                            inside &= x[k] >= lo[k] && x[k] <= hi[k];
-                        if (!inside)
+                        if (!candidate(x, pl, a, b, c, o, lo, hi))
                             continue;
                         const double g = fan_flags(x, cur, rim, m, flag);
                         if (g > best) {
@@ -409,10 +380,6 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
         }
         if (ncont < 2) {
             /* no apex: the loop's own triangulation */
-            for (size_t i = 0; i < m; i++) {
-                lp[i] = cur[i].p;
-                ls[i] = cur[i].side;
-            }
             if (fill((const double *const *)lp, (const double *const *)ls, m, tri) < 0)
                 goto oom;
             for (size_t t = 0; t + 2 < m; t++) {
