@@ -6,6 +6,7 @@
 #define SOUPTET_HOLES_INTERNAL_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include <math.h>
 #include "souptet/err.h"
 #include "souptet/geom.h"
@@ -54,6 +55,22 @@ static inline double bend(const double *a, const double *b)
  * to 1; else out is left as it was and *done is 0. ST_ENOMEM, ST_ELIMIT. */
 st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
                               const double *const *side, size_t n, double below,
-                              st_error *err);
+                              double *bent, st_error *err);
+
+/* A triangulation of the loop pts[0..n) (side as above): fills
+ * tri[3 (n - 2)] with local indices; < 0 when out of memory. */
+typedef double (*st_holes_fill)(const double *const *pts, const double *const *side, size_t n,
+                                uint32_t *tri);
+
+/* The cap of the loop from several rebuilt corners: the point where planes
+ * along the loop meet that continues most of its length, fans from it over
+ * the edges it continues, the rest of the loop (split where it meets the
+ * point more than once) capped the same way, and what no such point
+ * continues by fill (see holes_planes.c). Appended to out with *done 1 when
+ * it bends along the loop less than `below`; else out is left as it was.
+ * ST_ENOMEM, ST_ELIMIT. */
+st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts,
+                               const double *const *side, size_t n, double below,
+                               st_holes_fill fill, double *bent, st_error *err);
 
 #endif

@@ -23,12 +23,24 @@
  * spokes too) is the cap when it does better than the caller's bound
  * (the cap of the loop's own points, which chamfers a lost corner: a
  * box's bends along all its loop by 55 degrees, the corner's cone by 0).
+ *
+ * A large hole spans several corners (a lost edge and both its ends, a
+ * wing of a part): no one point continues all of its loop.
+ * st_holes_planes_fans takes the point that continues the most of it
+ * exactly (its triangle over an edge within FAN_FLAT of the soup's
+ * plane there, on the hole's side), fans from it over the edges it
+ * continues, and replaces each run of them by the point; the loop left
+ * (split into several where it meets the point more than once) is capped
+ * the same way, and one that no point continues along two edges by the
+ * caller's triangulation of its own points. The caller keeps the fans or
+ * the single cone, whichever continues the soup along the loop better.
  */
 #include "holes_internal.h"
 #include "fpenv.h"
 #include "souptet/geom.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -106,21 +118,14 @@ static int meet2(double *x, const plane *a, const plane *b, const double *o)
     return meet3(x, a, b, &c);
 }
 
-st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
-                              const double *const *side, size_t n, double below,
-                              st_error *err)
+/* The loop's box grown by REACH times its extent each way (lo, hi), its
+ * centroid o and its extent. */
+static void reach_box(double *lo, double *hi, double *o, double *ext, const double *const *pts,
+                      size_t n)
 {
-    *done = 0;
-    double *rim = malloc(3 * n * sizeof *rim), *tn = malloc(3 * n * sizeof *tn);
-    plane *pl = malloc(n * sizeof *pl);
-    st_status rc = ST_OK;
-    if (!rim || !tn || !pl) {
-        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
-        goto out;
-    }
-    double lo[3], hi[3], o[3] = {0, 0, 0}, ext = 0.0;
+    *ext = 0.0;
     for (int k = 0; k < 3; k++)
-        lo[k] = hi[k] = pts[0][k];
+        lo[k] = hi[k] = pts[0][k], o[k] = 0.0;
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) {
             lo[k] = fmin(lo[k], pts[i][k]);
@@ -128,12 +133,20 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
             o[k] += pts[i][k] / (double)n;
         }
     for (int k = 0; k < 3; k++)
-        ext = fmax(ext, hi[k] - lo[k]);
+        *ext = fmax(*ext, hi[k] - lo[k]);
     for (int k = 0; k < 3; k++) {
-        lo[k] -= REACH * ext;
-        hi[k] += REACH * ext;
+        lo[k] -= REACH * *ext;
+        hi[k] += REACH * *ext;
     }
-    /* the planes, once each (either orientation), by the length on them */
+}
+
+/* The planes of the soup's triangles along the loop, once each (either
+ * orientation), the MAX_PLANES with the most loop length on them first
+ * (ties by order along the loop); rim[3 n] gets each loop edge's unit
+ * normal. Returns how many (pl holds n). */
+static size_t loop_planes(plane *pl, double *rim, const double *const *pts,
+                          const double *const *side, size_t n, double ext)
+{
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
         unit_normal(rim + 3 * i, pts[i], side[i], pts[(i + 1) % n]);
@@ -159,29 +172,52 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
         pl[m].len = len;
         m++;
     }
-    /* the longest MAX_PLANES (insertion sort, ties by order along the loop) */
-    for (size_t i = 1; i < m; i++)
+    for (size_t i = 1; i < m; i++)      /* insertion sort */
         for (size_t j = i; j > 0 && pl[j].len > pl[j - 1].len; j--) {
             plane t = pl[j];
             pl[j] = pl[j - 1];
             pl[j - 1] = t;
         }
-    if (m > MAX_PLANES)
-        m = MAX_PLANES;
+    return m > MAX_PLANES ? MAX_PLANES : m;
+}
+
+/* The apex where planes a, b and c meet (c == b: the point of the line of
+ * a and b nearest o), when they meet within [lo, hi]. */
+static int candidate(double *x, const plane *pl, size_t a, size_t b, size_t c, const double *o,
+                     const double *lo, const double *hi)
+{
+    if (!(c == b ? meet2(x, &pl[a], &pl[b], o) : meet3(x, &pl[a], &pl[b], &pl[c])))
+        return 0;
+    int inside = 1;
+    for (int k = 0; k < 3; k++)
+        inside &= x[k] >= lo[k] && x[k] <= hi[k];
+    return inside;
+}
+
+st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
+                              const double *const *side, size_t n, double below,
+                              double *bent, st_error *err)
+{
+    *done = 0;
+    *bent = INFINITY;
+    double *rim = malloc(3 * n * sizeof *rim), *tn = malloc(3 * n * sizeof *tn);
+    plane *pl = malloc(n * sizeof *pl);
+    st_status rc = ST_OK;
+    if (!rim || !tn || !pl) {
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
+        goto out;
+    }
+    double lo[3], hi[3], o[3], ext;
+    reach_box(lo, hi, o, &ext, pts, n);
+    const size_t m = loop_planes(pl, rim, pts, side, n, ext);
     double best = below, best_total = INFINITY, apex[3] = {0, 0, 0};
     int found = 0;
     for (size_t a = 0; a < m; a++)
         for (size_t b = a + 1; b < m; b++)
             for (size_t c = b; c < m; c++) {    /* c == b: the line of a and b */
-                double x[3];
-                if (!(c == b ? meet2(x, &pl[a], &pl[b], o) : meet3(x, &pl[a], &pl[b], &pl[c])))
+                double x[3], rb;
+                if (!candidate(x, pl, a, b, c, o, lo, hi))
                     continue;
-                int inside = 1;
-                for (int k = 0; k < 3; k++)
-                    inside &= x[k] >= lo[k] && x[k] <= hi[k];
-                if (!inside)
-                    continue;
-                double rb;
                 const double cb = cone_bend(x, pts, rim, n, tn, &rb);
                 if (rb < best || (rb == best && cb < best_total)) {
                     best = rb;
@@ -203,7 +239,252 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
                                        (uint32_t)(base + n), err)))
             goto out;
     *done = 1;
+    *bent = best;
 out:
     free(rim), free(tn), free(pl);
+    return rc;
+}
+
+/* ---- several corners per loop: fans to the points where the planes meet */
+
+/* An apex continues loop edge i when the triangle (p_i, p_i+1, apex) lies
+ * in the plane of the soup's triangle there, on the hole's side: its bend
+ * below FAN_FLAT radians. */
+#define FAN_FLAT 1e-6
+/* At most MAX_APEX apexes per loop. */
+#define MAX_APEX 16
+
+/* One vertex of a loop being capped: its point, the third point of the
+ * triangle beyond its outgoing edge (the soup's or a fan's), and the
+ * original loop edge that outgoing edge is (-1: a new one, to an apex). */
+typedef struct fan_v {
+    const double *p, *side;
+    long orig;
+} fan_v;
+
+/* Which of the loop's edges apex continues (FAN_FLAT): flag[n]. Returns
+ * their length. (Fanning only the longest run of them, when it spans two
+ * planes: core IoU on the corpus's largeholes 0.842 -> 0.824, rotor
+ * 0.936 -> 0.851; only the runs that span two planes: 0.828.) */
+static double fan_flags(const double *apex, const fan_v *v, const double *rim, size_t n,
+                        int *flag)
+{
+    double g = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double t[3];
+        const double *a = v[i].p, *b = v[(i + 1) % n].p;
+        unit_normal(t, a, b, apex);
+        flag[i] = bend(t, rim + 3 * i) < FAN_FLAT;
+        if (flag[i])
+            g += dist3(a, b);
+    }
+    return g;
+}
+
+typedef struct fan_out {
+    const double **tri;     /* 3 points a triangle */
+    long *orig;             /* per triangle edge: the original loop edge or -1 */
+    size_t nt, cap;
+} fan_out;
+
+static int fan_push(fan_out *o, const double *a, const double *b, const double *c, long oa,
+                    long ob, long oc)
+{
+    if (o->nt == o->cap) {
+        size_t nc = o->cap ? 2 * o->cap : 64;
+        const double **t = realloc(o->tri, 3 * nc * sizeof *t);
+        if (!t)
+            return -1;
+        o->tri = t;
+        long *g = realloc(o->orig, 3 * nc * sizeof *g);
+        if (!g)
+            return -1;
+        o->orig = g;
+        o->cap = nc;
+    }
+    o->tri[3 * o->nt] = a, o->tri[3 * o->nt + 1] = b, o->tri[3 * o->nt + 2] = c;
+    o->orig[3 * o->nt] = oa, o->orig[3 * o->nt + 1] = ob, o->orig[3 * o->nt + 2] = oc;
+    o->nt++;
+    return 0;
+}
+
+st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts,
+                               const double *const *side, size_t n, double below,
+                               st_holes_fill fill, double *bent, st_error *err)
+{
+    *done = 0;
+    *bent = INFINITY;
+    const size_t maxv = n + 2 * MAX_APEX + 2;
+    /* the loops still to cap, one after another in stk (each led by its
+     * length), and the scratch of one */
+    fan_v *stk = malloc(2 * maxv * (MAX_APEX + 2) * sizeof *stk), *cur = malloc(maxv * sizeof *cur),
+          *nxt = malloc(2 * maxv * sizeof *nxt);
+    size_t *lens = malloc(maxv * sizeof *lens);
+    double *rim = malloc(3 * maxv * sizeof *rim);
+    plane *pl = malloc(maxv * sizeof *pl);
+    const double **lp = malloc(maxv * sizeof *lp), **ls = malloc(maxv * sizeof *ls);
+    uint32_t *tri = malloc(3 * maxv * sizeof *tri);
+    double (*apx)[3] = malloc(MAX_APEX * sizeof *apx);
+    int *flag = malloc(maxv * sizeof *flag);
+    fan_out fo = {NULL, NULL, 0, 0};
+    st_status rc = ST_OK;
+    if (!flag || !stk || !cur || !nxt || !lens || !rim || !pl || !lp || !ls || !tri || !apx)
+        goto oom;
+    double lo[3], hi[3], o0[3], ext;
+    reach_box(lo, hi, o0, &ext, pts, n);
+    size_t nloops = 1, napex = 0, top = 0;
+    for (size_t i = 0; i < n; i++) {
+        stk[i].p = pts[i];
+        stk[i].side = side[i];
+        stk[i].orig = (long)i;
+    }
+    lens[0] = n;
+    top = n;
+    while (nloops) {
+        /* pop the last loop */
+        const size_t m = lens[--nloops];
+        top -= m;
+        memcpy(cur, stk + top, m * sizeof *cur);
+        if (m < 3)
+            continue;
+        double o[3] = {0, 0, 0};
+        for (size_t i = 0; i < m; i++)
+            for (int k = 0; k < 3; k++)
+                o[k] += cur[i].p[k] / (double)m;
+        for (size_t i = 0; i < m; i++) {
+            lp[i] = cur[i].p;
+            ls[i] = cur[i].side;
+        }
+        const size_t np = loop_planes(pl, rim, (const double *const *)lp,
+                                      (const double *const *)ls, m, ext);
+        double best = 0.0, ax[3] = {0, 0, 0};
+        if (napex < MAX_APEX)
+            for (size_t a = 0; a < np; a++)
+                for (size_t b = a + 1; b < np; b++)
+                    for (size_t c = b; c < np; c++) {
+                        double x[3];
+                        if (!candidate(x, pl, a, b, c, o, lo, hi))
+                            continue;
+                        const double g = fan_flags(x, cur, rim, m, flag);
+                        if (g > best) {
+                            best = g;
+                            memcpy(ax, x, sizeof ax);
+                        }
+                    }
+        /* which edges the apex continues */
+        size_t ncont = 0;
+        if (best > 0.0) {
+            fan_flags(ax, cur, rim, m, flag);
+            for (size_t i = 0; i < m; i++)
+                ncont += (size_t)flag[i];
+        }
+        if (ncont < 2) {
+            /* no apex: the loop's own triangulation */
+            if (fill((const double *const *)lp, (const double *const *)ls, m, tri) < 0)
+                goto oom;
+            for (size_t t = 0; t + 2 < m; t++) {
+                const uint32_t *c = tri + 3 * t;
+                long og[3];
+                for (int e = 0; e < 3; e++) {
+                    const size_t u = c[e], w = c[(e + 1) % 3];
+                    og[e] = (u + 1) % m == w ? cur[u].orig : (w + 1) % m == u ? cur[w].orig : -1;
+                }
+                if (fan_push(&fo, lp[c[0]], lp[c[1]], lp[c[2]], og[0], og[1], og[2]))
+                    goto oom;
+            }
+            continue;
+        }
+        memcpy(apx[napex], ax, sizeof ax);
+        const double *A = apx[napex++];
+        /* start at an edge the apex does not continue (all: the cone) */
+        size_t s0 = 0;
+        while (s0 < m && flag[s0])
+            s0++;
+        /* the fans, and the loop with each run of continued edges replaced
+         * by the apex */
+        size_t k = 0;
+        for (size_t r = 0; r < m; r++) {
+            const size_t i = (s0 + r) % m;
+            const fan_v *vi = cur + i, *vj = cur + (i + 1) % m;
+            if (!flag[i]) {
+                nxt[k++] = *vi;
+                continue;
+            }
+            if (fan_push(&fo, vi->p, vj->p, A, vi->orig, -1, -1))
+                goto oom;
+            const int first = r == 0 || !flag[(i + m - 1) % m];
+            const int last = r + 1 == m || !flag[(i + 1) % m];
+            if (first && s0 < m) {      /* vi stays, its edge now to the apex */
+                nxt[k].p = vi->p;
+                nxt[k].side = vj->p;
+                nxt[k].orig = -1;
+                k++;
+            }
+            if (last) {
+                nxt[k].p = A;
+                nxt[k].side = vi->p;
+                nxt[k].orig = -1;
+                k++;
+            }
+        }
+        if (s0 == m)
+            continue;           /* a cone over the whole loop */
+        /* split where the loop meets the apex more than once */
+        size_t firstA = 0;
+        while (nxt[firstA].p != A)
+            firstA++;
+        /* rotate so the loop starts at the apex, then cut before each
+         * later occurrence of it */
+        for (size_t i = 0; i < k; i++)
+            nxt[k + i] = nxt[(firstA + i) % k];
+        size_t st = k;
+        for (size_t i = k + 1; i <= 2 * k; i++)
+            if (i == 2 * k || nxt[i].p == A) {
+                const size_t len = i - st;
+                if (len >= 3) {
+                    if (nloops == maxv || top + len > 2 * maxv * (MAX_APEX + 2))
+                        goto out;   /* (never on a loop of this size) */
+                    memcpy(stk + top, nxt + st, len * sizeof *stk);
+                    top += len;
+                    lens[nloops++] = len;
+                }
+                st = i;
+            }
+    }
+    /* the caps' bend along the original loop */
+    double rb = 0.0;
+    for (size_t t = 0; t < fo.nt; t++) {
+        double nt[3], nr[3];
+        const double **c = fo.tri + 3 * t;
+        unit_normal(nt, c[0], c[1], c[2]);
+        for (int e = 0; e < 3; e++) {
+            const long i = fo.orig[3 * t + e];
+            if (i < 0)
+                continue;
+            unit_normal(nr, pts[i], side[i], pts[((size_t)i + 1) % n]);
+            rb += dist3(pts[i], pts[((size_t)i + 1) % n]) * bend(nt, nr);
+        }
+    }
+    if (napex == 0 || !(rb < below))
+        goto out;
+    for (size_t t = 0; t < fo.nt; t++) {
+        const size_t base = out->nverts;
+        for (int c = 0; c < 3; c++) {
+            const double *q = fo.tri[3 * t + c];
+            if ((rc = st_soup_add_vertex(out, q[0], q[1], q[2], err)))
+                goto out;
+        }
+        if ((rc = st_soup_add_triangle(out, (uint32_t)base, (uint32_t)(base + 1),
+                                       (uint32_t)(base + 2), err)))
+            goto out;
+    }
+    *done = 1;
+    *bent = rb;
+    goto out;
+oom:
+    rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
+out:
+    free(stk), free(cur), free(nxt), free(lens), free(rim), free(pl), free(lp), free(ls);
+    free(tri), free(apx), free(fo.tri), free(fo.orig), free(flag);
     return rc;
 }

@@ -449,6 +449,65 @@ static int corner_keep(int corner, int axis, int side, int a, int b, const doubl
     return !(corner && side && near);
 }
 
+/* The unit box on a grid of spacing 0.1; with edge, the triangles of its
+ * surface within 0.3 of its edge y = z = 1 (both ends' corners with it)
+ * are missing: the loop runs over four faces and two corners are lost. */
+static int edge_keep(int edge, int axis, int side, int a, int b, const double q[4][3],
+                     int second)
+{
+    (void)axis, (void)side, (void)a, (void)b, (void)second;
+    return !(edge && (q[0][1] + q[2][1]) / 2 > 0.7 && (q[0][2] + q[2][2]) / 2 > 0.7);
+}
+
+/* The rectangle o + [0, 1] u + [0, 1] w as two triangles per cell of an
+ * n x m grid, those whose centroids lie within 0.3 of the line y = 0.5,
+ * (x, z) = (1, 1) over |y - 0.5| < 0.2 left out when hole is set. */
+static void l_rect(st_soup *s, const double o[3], const double u[3], const double w[3], int n,
+                   int m, int hole)
+{
+    for (int a = 0; a < n; a++)
+        for (int b = 0; b < m; b++) {
+            double q[4][3];
+            for (int c = 0; c < 4; c++) {
+                const double da = (double)(a + (c == 1 || c == 2)) / n, db = (double)(b + (c >= 2)) / m;
+                for (int k = 0; k < 3; k++)
+                    q[c][k] = o[k] + da * u[k] + db * w[k];
+            }
+            for (int t = 0; t < 2; t++) {
+                const double *p0 = q[0], *p1 = q[t ? 2 : 1], *p2 = q[t ? 3 : 2];
+                double cx = (p0[0] + p1[0] + p2[0]) / 3, cy = (p0[1] + p1[1] + p2[1]) / 3,
+                       cz = (p0[2] + p1[2] + p2[2]) / 3;
+                if (hole && fabs(cx - 1) < 0.3 && fabs(cz - 1) < 0.3 && fabs(cy - 0.5) < 0.2)
+                    continue;
+                add_tri(s, p0, p1, p2, t);
+            }
+        }
+}
+
+/* An L-shaped block, [0, 2] x [0, 1] x [0, 1] and [0, 1] x [0, 1] x [1, 2],
+ * on a grid of spacing 0.1; with hole, a hole 0.6 across and 0.4 long
+ * over its concave crease x = z = 1. */
+static st_soup *l_block(int hole)
+{
+    st_soup *s = st_soup_new();
+    static const double R[][4][3] = {
+        /* origin, u, w, (cells u, cells w) */
+        {{0, 0, 0}, {2, 0, 0}, {0, 1, 0}, {20, 10, 0}},    /* bottom z = 0 */
+        {{2, 0, 0}, {0, 1, 0}, {0, 0, 1}, {10, 10, 0}},    /* right x = 2 */
+        {{1, 0, 1}, {1, 0, 0}, {0, 1, 0}, {10, 10, 0}},    /* step z = 1 */
+        {{1, 0, 1}, {0, 1, 0}, {0, 0, 1}, {10, 10, 0}},    /* wall x = 1 */
+        {{0, 0, 2}, {1, 0, 0}, {0, 1, 0}, {10, 10, 0}},    /* top z = 2 */
+        {{0, 0, 0}, {0, 1, 0}, {0, 0, 2}, {10, 20, 0}},    /* left x = 0 */
+        {{0, 0, 0}, {2, 0, 0}, {0, 0, 1}, {20, 10, 0}},    /* front y = 0, low */
+        {{0, 0, 1}, {1, 0, 0}, {0, 0, 1}, {10, 10, 0}},    /* front, high */
+        {{0, 1, 0}, {2, 0, 0}, {0, 0, 1}, {20, 10, 0}},    /* back y = 1, low */
+        {{0, 1, 1}, {1, 0, 0}, {0, 0, 1}, {10, 10, 0}},    /* back, high */
+    };
+    for (size_t r = 0; r < sizeof R / sizeof R[0]; r++)
+        l_rect(s, R[r][0], R[r][1], R[r][2], (int)R[r][3][0], (int)R[r][3][1], hole);
+    return s;
+}
+
 /* corner_keep's box with 2: its face x = 1 missing; plate_keep's plate
  * with 2: the half x > 1 of its top face missing. */
 static int face_keep(int which, int axis, int side, int a, int b, const double q[4][3],
@@ -499,6 +558,58 @@ static void test_corner(void)
     TAP_CHECK(iou >= iou_whole - 1e-9 && iou_area < iou_whole - 0.002,
               "the box without its corner signs as the whole box: IoU %.4f (the whole box %.4f, "
               "with the least-area cap %.4f)", iou, iou_whole, iou_area);
+    st_soup_free(cut);
+    st_soup_free(whole);
+
+    /* a lost edge with its two corners (issue 17's large holes span
+     * several corners): fans from one corner rebuild the faces that meet
+     * there, the rest of the loop is a cone from the other */
+    static const double ehi[3] = {1, 1, 1};
+    static const int en[3] = {10, 10, 10};
+    whole = gridded_box(ehi, en, edge_keep, 0);
+    cut = gridded_box(ehi, en, edge_keep, 1);
+    hp = st_holes_params_default();
+    hp.planes = 1;
+    ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err);
+    TAP_CHECK(ok && hs.loops == 1 && hs.rebuilt == 1,
+              "a box without an edge: one loop, rebuilt from the planes (%zu loops, %zu rebuilt)",
+              hs.loops, hs.rebuilt);
+    if (ok) {
+        TAP_NEAR(soup_area(caps), 2 * 0.3 + 2 * 0.3 * 0.3, 1e-12,
+                 "the cap is the lost strips of its four faces");
+        int at = 0;
+        for (size_t v = 0; v < caps->nverts; v++)
+            at |= (caps->xyz[3 * v] == 0.0 ? 1 : caps->xyz[3 * v] == 1.0 ? 2 : 0) *
+                  (caps->xyz[3 * v + 1] == 1.0 && caps->xyz[3 * v + 2] == 1.0);
+        TAP_CHECK(at == 3, "it has both lost corners (0, 1, 1) and (1, 1, 1) exactly");
+    }
+    st_soup_free(caps);
+    caps = NULL;
+    const double edge_whole = capped_iou(whole, whole, 1, &nt);
+    const double iou_edge = capped_iou(cut, whole, 3, &nt);
+    TAP_CHECK(iou_edge >= edge_whole - 1e-9,
+              "the box without its edge signs as the whole box: IoU %.4f (%.4f)", iou_edge,
+              edge_whole);
+    st_soup_free(cut);
+    st_soup_free(whole);
+
+    /* a hole across a concave crease: the planes of its two faces meet
+     * along it, and the cone from a point of it brings both back */
+    whole = l_block(0);
+    cut = l_block(1);
+    ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err);
+    TAP_CHECK(ok && hs.loops == 1 && hs.rebuilt == 1,
+              "an L-shaped block with a hole across its concave crease: one loop, rebuilt "
+              "(%zu loops, %zu rebuilt)", hs.loops, hs.rebuilt);
+    if (ok)
+        TAP_NEAR(soup_area(caps), 2 * 0.3 * 0.4, 1e-12, "the cap is the two faces' lost parts");
+    st_soup_free(caps);
+    caps = NULL;
+    const double l_whole = capped_iou(whole, whole, 1, &nt);
+    const double l_area = capped_iou(cut, whole, 1, &nt), l_iou = capped_iou(cut, whole, 3, &nt);
+    TAP_CHECK(l_iou >= l_whole - 1e-9,
+              "it signs as the whole block: IoU %.4f (%.4f, with the least-area cap %.4f)", l_iou,
+              l_whole, l_area);
     st_soup_free(cut);
     st_soup_free(whole);
 

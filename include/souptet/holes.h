@@ -37,8 +37,15 @@
  * loop replaces the cap when its triangles continue the soup's along the
  * loop clearly better (the sum over the loop's edges of length times
  * dihedral angle below half the cap's): a box's lost corner comes back
- * whole. Not the default either: it helps the large holes of CAD parts
- * but loses on one-sided scans.
+ * whole. Where a hole spans several corners, such a point of the planes
+ * may continue only part of the loop: the fans from it over the edges it
+ * continues replace them, and the rest of the loop (split where it meets
+ * the point more than once) is capped the same way, at most 16 points per
+ * loop, what none continues by the cap of its own points; the fans or the
+ * single cone, whichever continues the soup along the loop better: a
+ * box's lost edge comes back with both its corners. Not the default
+ * either: it helps the large holes of CAD parts but loses on one-sided
+ * scans and some deleted faces (numbers at st_holes_params_default).
  *
  * Not every loop is a hole: an open patch (a panel of a CAD part, one of a
  * teapot's patches, a sheet) has a loop around itself, and capping it would
