@@ -112,8 +112,12 @@ static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_soup_edg
     st_status rc = votes && evidence ? ST_OK
                  : st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the sides");
     st_sides_params sp = p->sides_params;
-    if (sp.past_caps && !edges && !sp.seen_triangles)   /* s: the soup, then its caps */
-        sp.seen_triangles = st->cap_triangles ? s->ntris - st->cap_triangles : 0;
+    /* s: the soup, then its caps */
+    const size_t seen = !edges && st->cap_triangles ? s->ntris - st->cap_triangles : 0;
+    if (sp.past_caps && !sp.seen_triangles)
+        sp.seen_triangles = seen;
+    if (!sp.column_seen)
+        sp.column_seen = seen;
     /* voxels the cut takes as the votes say get no evidence (mincut.h) */
     const int decided = st_mincut_params_default().fixed_evidence;
     rc = rc ? rc : st_sign_votes(g, &p->sign, votes, err);
@@ -121,6 +125,8 @@ static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_soup_edg
                                            &st->sides, err);
     rc = rc ? rc : st_sign_field_evidence(g, &p->sign, evidence, votes, progress, err);
     rc = rc ? rc : st_sides_mirror(g, s, sp.seen_triangles, &st->sides, &st->mirrored, err);
+    rc = rc ? rc : st_sides_columns(g, s, sp.column_seen, &st->sides, p->refine.band_voxels,
+                                    &st->columned, err);
     free(votes);
     free(evidence);
     return rc;

@@ -7,6 +7,7 @@
 #include "souptet/bvh.h"
 #include "souptet/edges.h"
 #include "souptet/mem.h"
+#include "souptet/pred.h"
 #include "souptet/sign.h"
 
 #include <math.h>
@@ -26,7 +27,10 @@ st_sides_params st_sides_params_default(void)
      * (mincut.h), so the votes and the cut's area still have a say. */
     /* one-sided below 0.25: the corpus's one-sided scans read 0.00-0.16,
      * its soups with holes and deleted faces 0.41 and up, closed ones 1 */
-    st_sides_params p = {2.5, 3.0, 24.0, 9, 0.25, 0, 1e-3, 0.25, 0};
+    /* the column rule below 0.02 along an axis: the corpus's one-sided
+     * scans read 0.000-0.001 (their faces facing down were deleted), its
+     * other damaged soups 0.4 and up */
+    st_sides_params p = {2.5, 3.0, 24.0, 9, 0.25, 0, 1e-3, 0.25, 0, 0.02, 0};
     return p;
 }
 
@@ -477,6 +481,8 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
             goto done;
     size_t nview = 0;
     const size_t seen = p->seen_triangles && p->seen_triangles < nt ? p->seen_triangles : nt;
+    const size_t cseen = p->column_seen && p->column_seen < nt ? p->column_seen : nt;
+    double axis_area[3][2] = {{0.0}};   /* [axis][0: facing +, 1: facing -] */
     for (size_t t = 0; t < nt; t++) {
         if (!E.kept[t])
             continue;
@@ -494,7 +500,27 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
         const uint32_t *v = s->tris + 3 * t;
         if ((rc = st_soup_add_triangle(o, v[0], back ? v[2] : v[1], back ? v[1] : v[2], err)))
             goto done;
+        if (t < cseen) {
+            double an[3];
+            tri_normal(o, o->ntris - 1, an);
+            for (int k = 0; k < 3; k++)
+                axis_area[k][an[k] < 0.0] += fabs(an[k]);
+        }
     }
+    /* the column rule's direction: the axis direction the seen soup faces
+     * most exclusively */
+    st->column_back_front = INFINITY;
+    for (int k = 0; k < 3; k++)
+        for (int d = 0; d < 2; d++) {
+            const double front = axis_area[k][d], back = axis_area[k][1 - d];
+            const double r = front > 0.0 ? back / front : INFINITY;
+            if (r < st->column_back_front) {
+                st->column_back_front = r;
+                st->column_axis = k;
+                st->column_dir = d ? -1 : 1;
+            }
+        }
+    st->columns = st->column_back_front < p->column_ratio;
     if (o->ntris == 0)
         goto done;
     if ((rc = st_bvh_build(&bvh, o, err)))
@@ -540,5 +566,176 @@ done:
     free(region);
     free(queue);
     free(score);
+    return rc;
+}
+
+typedef struct col_hit {
+    double h;       /* dir * the coordinate along the axis, voxel units */
+    uint32_t t;     /* the triangle */
+} col_hit;
+
+static int cmp_hit_desc(const void *a, const void *b)
+{
+    const col_hit *x = a, *y = b;
+    return (x->h < y->h) - (x->h > y->h) ? (x->h < y->h) - (x->h > y->h)
+                                         : (x->t > y->t) - (x->t < y->t);
+}
+
+/* Where the line of lattice point (i, j) (voxel units, axes a and b)
+ * crosses triangle (A, B, C) (voxel units): 1 and *h its coordinate along
+ * axis k, when the point is in the closed projected triangle (exact signs;
+ * a projection of zero area crosses nothing). */
+static int line_crosses(const double A[3], const double B[3], const double C[3], int k,
+                        double i, double j, double *h)
+{
+    const int a = (k + 1) % 3, b = (k + 2) % 3;
+    const double pa[2] = {A[a], A[b]}, pb[2] = {B[a], B[b]}, pc[2] = {C[a], C[b]};
+    const double q[2] = {i, j};
+    const int s = st_sign(st_orient2d(pa, pb, pc));
+    if (!s)
+        return 0;
+    const double w0 = st_orient2d(pb, pc, q), w1 = st_orient2d(pc, pa, q),
+                 w2 = st_orient2d(pa, pb, q);
+    if (st_sign(w0) == -s || st_sign(w1) == -s || st_sign(w2) == -s)
+        return 0;
+    /* the depth by barycentric weights (a position, not a decision) */
+    const double area = (pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0]);
+    const double l1 = ((pc[0] - pb[0]) * (q[1] - pb[1]) - (pc[1] - pb[1]) * (q[0] - pb[0])) / area;
+    const double l2 = ((pa[0] - pc[0]) * (q[1] - pc[1]) - (pa[1] - pc[1]) * (q[0] - pc[0])) / area;
+    *h = l1 * A[k] + l2 * B[k] + (1.0 - l1 - l2) * C[k];
+    return 1;
+}
+
+st_status st_sides_columns(st_grid *g, const st_soup *s, size_t seen, const st_sides_stats *st,
+                           double band_voxels, size_t *changed, st_error *err)
+{
+    *changed = 0;
+    if (!st->columns || !s)
+        return ST_OK;
+    const int k = st->column_axis, a = (k + 1) % 3, b = (k + 2) % 3, dir = st->column_dir;
+    const size_t dims[3] = {g->nx, g->ny, g->nz};
+    const size_t na = dims[a], nb = dims[b], nk = dims[k];
+    const size_t nt = seen && seen < s->ntris ? seen : s->ntris;
+    const size_t ncol = na * nb;
+    size_t *start = st_calloc_array(ncol + 1, sizeof *start);
+    size_t *fill = st_calloc_array(ncol + 1, sizeof *fill);
+    col_hit *hit = NULL;
+    st_status rc = ST_OK;
+    if (!start || !fill) {
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the columns");
+        goto done;
+    }
+    /* the seen triangles' crossings of each line along axis k, in voxel
+     * coordinates: counted, then stored (pass 0, 1) */
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t t = 0; t < nt; t++) {
+            double P[3][3], lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+            for (int v = 0; v < 3; v++)
+                for (int c = 0; c < 3; c++)
+                    P[v][c] = (s->xyz[3 * (size_t)s->tris[3 * t + v] + c] - g->origin[c]) /
+                              g->voxel;
+            for (int v = 0; v < 3; v++) {
+                lo[0] = fmin(lo[0], P[v][a]);
+                hi[0] = fmax(hi[0], P[v][a]);
+                lo[1] = fmin(lo[1], P[v][b]);
+                hi[1] = fmax(hi[1], P[v][b]);
+            }
+            const double i0 = fmax(ceil(lo[0]), 0.0), i1 = fmin(floor(hi[0]), (double)na - 1);
+            const double j0 = fmax(ceil(lo[1]), 0.0), j1 = fmin(floor(hi[1]), (double)nb - 1);
+            for (double j = j0; j <= j1; j++)
+                for (double i = i0; i <= i1; i++) {
+                    double h;
+                    if (!line_crosses(P[0], P[1], P[2], k, i, j, &h))
+                        continue;
+                    const size_t col = (size_t)i + na * (size_t)j;
+                    if (pass) {
+                        col_hit *x = &hit[start[col] + fill[col]++];
+                        x->h = dir * h;
+                        x->t = (uint32_t)t;
+                    } else {
+                        start[col + 1]++;
+                    }
+                }
+        }
+        if (pass)
+            break;
+        for (size_t c = 0; c < ncol; c++)
+            start[c + 1] += start[c];
+        hit = st_malloc_array(start[ncol] + 1, sizeof *hit);
+        if (!hit) {
+            rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the columns");
+            goto done;
+        }
+    }
+    const float band = (float)(band_voxels * g->voxel);
+    size_t count = 0;
+    int oom = 0;
+    #pragma omp parallel for schedule(dynamic, 64) reduction(+ : count) reduction(| : oom)
+    for (size_t col = 0; col < ncol; col++) {
+        const size_t ci = col % na, cj = col / na;
+        col_hit *h = hit + start[col];
+        size_t n = start[col + 1] - start[col];
+        /* from the viewer: the greatest dir * coordinate first */
+        qsort(h, n, sizeof *h, cmp_hit_desc);
+        /* crossings within half a voxel are one (an edge or vertex on the
+         * line, or a sliver) */
+        size_t u = 0;
+        for (size_t m = 0; m < n; m++)
+            if (u == 0 || h[u - 1].h - h[m].h > 0.5)
+                h[u++] = h[m];
+        n = u;
+        size_t *line = malloc((nk + 1) * sizeof *line);
+        if (!line) {
+            oom = 1;
+            continue;
+        }
+        for (size_t step = 0; step < nk; step++) {
+            const size_t m = dir > 0 ? nk - 1 - step : step;
+            size_t ijk[3];
+            ijk[k] = m;
+            ijk[a] = ci;
+            ijk[b] = cj;
+            line[step] = st_grid_index(g, ijk[0], ijk[1], ijk[2]);
+        }
+        /* each segment: nothing before the first crossing; after one, the
+         * solid it enters and then nothing: the step (inside, then
+         * outside) that the confident voxels (|d| >= band) agree with
+         * most, its end not below the cut; only made outside */
+        size_t first = 0;
+        for (size_t seg = 0; seg <= n; seg++) {
+            size_t end = first;   /* the segment: line[first..end) */
+            while (end < nk && (seg == n || dir * (double)(dir > 0 ? nk - 1 - end : end) > h[seg].h))
+                end++;
+            size_t split = first;   /* inside before split */
+            if (seg > 0) {
+                long score = 0, best = 0;
+                for (size_t i = first; i < end; i++) {
+                    const float d = g->data[line[i]];
+                    if (fabsf(d) >= band)
+                        score += d < 0.0f ? 1 : -1;
+                    if (score >= best) {
+                        best = score;
+                        split = i + 1;
+                    }
+                }
+            }
+            for (size_t i = split; i < end; i++) {
+                float *d = &g->data[line[i]];
+                if (*d < 0.0f) {
+                    *d = st_grid_signed_value(*d, 0);
+                    count++;
+                }
+            }
+            first = end;
+        }
+        free(line);
+    }
+    *changed = count;
+    if (oom)
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the columns");
+done:
+    free(start);
+    free(fill);
+    free(hit);
     return rc;
 }

@@ -13,7 +13,9 @@
  *   3. the vote (sign.h, st_sign_field, the rule in p->sign), its cut
  *      also given the side of the soup's oriented walls that each voxel
  *      near them is on (sides.h: the soup and its caps, each orientable
- *      region turned the way the plain majority of the votes reads it);
+ *      region turned the way the plain majority of the votes reads it;
+ *      a one-sided scan's far side mirrored, and for one seen along an
+ *      axis the column rule, st_sides_columns);
  *   4. the near-surface refinement against s and its caps (sign.h,
  *      st_sign_refine);
  *   5. the shells' solid (st_shells_sign).
@@ -83,6 +85,7 @@ typedef struct st_pseudo_stats {
     size_t cap_triangles;
     st_sides_stats sides;
     size_t mirrored;                /* voxels a one-sided view's mirror added */
+    size_t columned;                /* voxels the column rule made outside */
     size_t refined;                 /* signs the refinement changed */
     size_t shells;                  /* closed shells */
     size_t shell_open_triangles;    /* triangles in none */

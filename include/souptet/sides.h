@@ -34,6 +34,9 @@
  *      reweighted least absolute cosines, so walls along v outweigh the
  *      faces that meet an unseen one at a sharp edge; the mean normal when
  *      that is over 45 degrees from it).
+ *   5. whether the seen soup (without its caps) is a one-sided view along
+ *      an axis (columns; st_sides_columns then drops what the cut put
+ *      where no seen surface is above it along that axis).
  * So the cut (mincut.h) has, on each side of every surviving wall, the
  * side it is on, and spans the holes between walls by the least area.
  *
@@ -70,6 +73,10 @@ typedef struct st_sides_params {
     double walls_ratio;     /* mirrored below this walls' share of the rim */
     int past_caps;          /* the view of the seen soup alone, and the
                                mirror past its caps (0; see st_sides_mirror) */
+    double column_ratio;    /* the column rule below this back/front ratio
+                               along an axis (0: never; st_sides_columns) */
+    size_t column_seen;     /* the column rule reads the first this many
+                               triangles (the seen surface); 0: all */
 } st_sides_params;
 
 st_sides_params st_sides_params_default(void);
@@ -91,6 +98,10 @@ typedef struct st_sides_stats {
     double far;             /* without past_caps: the soup's farthest point
                                along the step (-INFINITY with it) */
     int step[3];            /* the lattice step nearest view */
+    double column_back_front;   /* the least back/front of the seen soup
+                                   along an axis direction */
+    int column_axis, column_dir;    /* that direction: +-1 along axis 0..2 */
+    int columns;            /* column_back_front < column_ratio */
 } st_sides_stats;
 
 /* evidence (n bytes) gets each voxel's evidence (0 where none). g: the
@@ -131,6 +142,29 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
  * ST_ENOMEM. */
 st_status st_sides_mirror(st_grid *g, const st_soup *s, size_t seen_triangles,
                           const st_sides_stats *stats, size_t *changed, st_error *err);
+
+/* The column rule, for a scan seen along an axis (stats->columns:
+ * the oriented seen soup's faces facing away from the axis direction
+ * column_dir * e_column_axis add up, in projected area, to under
+ * column_ratio of those facing it; nothing otherwise). Seen from there,
+ * every surface a line along the axis enters the solid through faces the
+ * viewer, so it was seen, and every one it leaves through faces away, so
+ * it was not: along each line of voxel centers (from the viewer), the
+ * solid is nothing before the first crossing of the seen soup (s's first
+ * `seen` triangles; 0: all), and after each crossing one run of inside
+ * (the solid it enters) and then nothing up to the next crossing. Each
+ * such segment keeps the step (inside, then outside) that the voxels of g
+ * at least band_voxels from the soup agree with most (ties: the longer
+ * inside run); the voxels after it are made outside, none made inside. A
+ * line that crosses nothing seen is empty (the bore of a part seen along
+ * it). Where a segment's solid ends is the field's (the cut, the caps, the
+ * mirror): the rule adds no depth prior. Crossings: each lattice line
+ * against each triangle's projection, exact orient2d signs (a closed
+ * triangle; crossings within half a voxel of each other are one).
+ * *changed gets the voxels made outside. Deterministic: each line is one
+ * thread's. ST_ENOMEM. */
+st_status st_sides_columns(st_grid *g, const st_soup *s, size_t seen, const st_sides_stats *st,
+                           double band_voxels, size_t *changed, st_error *err);
 
 #ifdef __cplusplus
 }

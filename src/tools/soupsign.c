@@ -93,6 +93,10 @@ static void usage(void)
 "                       the surface alone (not its caps), mirrors only where\n"
 "                       its rim folds (not walls along the view) and past\n"
 "                       caps and the surface's lowest point (default plain)\n"
+"      --columns on|off  with --sides on: a scan seen along an axis (no\n"
+"                       face of it faces away) is nothing before the first\n"
+"                       surface on each line along the axis, and between two\n"
+"                       of its surfaces leaves the solid (default on)\n"
 "      --refine-band D  refine voxels nearer than D voxels (default 1.5)\n"
 "      --refine-radius R  neighbours within R voxels per axis (default 2)\n"
 "      --refine-answers A  neighbours' answers combined per voxel (default 6)\n"
@@ -161,7 +165,7 @@ static int recorded_surface(tool_ctx *t, const st_grid *g, st_soup **soup, st_er
 }
 
 enum { OPT_BAND = TOOL_OPT_FIRST, OPT_RAYS, OPT_TOGGLE, OPT_ODD, OPT_NESTED, OPT_RUNS, OPT_CUT,
-       OPT_CAPS, OPT_SIDES, OPT_ONESIDED, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS,
+       OPT_CAPS, OPT_SIDES, OPT_ONESIDED, OPT_COLUMNS, OPT_RULE, OPT_SURFACE, OPT_REFINE_BAND, OPT_REFINE_RADIUS,
        OPT_REFINE_ANSWERS };
 
 static const struct option longopts[] = {
@@ -176,6 +180,7 @@ static const struct option longopts[] = {
     {"caps", required_argument, NULL, OPT_CAPS},
     {"sides", required_argument, NULL, OPT_SIDES},
     {"onesided", required_argument, NULL, OPT_ONESIDED},
+    {"columns", required_argument, NULL, OPT_COLUMNS},
     {"rule", required_argument, NULL, OPT_RULE},
     {"surface", required_argument, NULL, OPT_SURFACE},
     {"refine-band", required_argument, NULL, OPT_REFINE_BAND},
@@ -190,7 +195,7 @@ typedef struct soupsign_settings {
     st_sign_params sign;
     st_sign_refine_params refine;
     const char *in, *surface;
-    int paper, fill_holes, bend_caps, use_shells, use_sides, past_caps, no_surface;
+    int paper, fill_holes, bend_caps, use_shells, use_sides, past_caps, columns, no_surface;
 } soupsign_settings;
 
 static int option(tool_ctx *t, int c, const char *arg, void *settings)
@@ -280,6 +285,10 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         else
             return tool_usage_error(t, "--onesided is plain or past-caps, not '%s'", arg);
         break;
+    case OPT_COLUMNS:
+        if (tool_parse_switch(t, "--columns", arg, &s->columns))
+            return TOOL_EXIT_USAGE;
+        break;
     case OPT_RULE:
         if (st_sign_params_named(&s->sign, arg))
             return tool_usage_error(t, "unknown rule '%s' (paper, parity, default)", arg);
@@ -368,6 +377,8 @@ static int run(tool_ctx *t, void *settings)
     pp.closed_shells = s->use_shells;
     pp.sides = s->use_sides;
     pp.sides_params.past_caps = s->past_caps;
+    if (!s->columns)
+        pp.sides_params.column_ratio = 0.0;
     st_progress prog = tool_progress(t);
     const double c0 = cpu_now();
     if (st_pseudo_sign(g, soup, &pp, &ps, &prog, &err)) {
@@ -415,6 +426,11 @@ static int run(tool_ctx *t, void *settings)
     if (surface && s->use_sides && p->cut && voted && ps.sides.fold)
         tool_say(t, 2, "far side mirrored along step (%d %d %d): %zu voxels",
                  ps.sides.step[0], ps.sides.step[1], ps.sides.step[2], ps.mirrored);
+    if (surface && s->use_sides && p->cut && voted)
+        tool_say(t, 2, "columns: back/front %.3f along %c%c: %s, %zu voxels made outside",
+                 ps.sides.column_back_front, ps.sides.column_dir > 0 ? '+' : '-',
+                 "xyz"[ps.sides.column_axis], ps.sides.columns ? "one-sided" : "not one-sided",
+                 ps.columned);
     if (surface && voted)
         tool_say(t, 2, "refinement (band %g voxels): %zu signs changed, %.3f s",
                  s->refine.band_voxels, ps.refined, ps.seconds_refine);
@@ -438,6 +454,7 @@ int main(int argc, char *argv[])
 {
     soupsign_settings s = {.sign = st_sign_params_default(),
                            .refine = st_sign_refine_params_default(), .fill_holes = 1,
-                           .use_shells = 1, .use_sides = 1};
+                           .use_shells = 1, .use_sides = 1,
+                           .columns = 1};
     return tool_main(&spec, argc, argv, &s, &s.co);
 }
