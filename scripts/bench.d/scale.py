@@ -112,7 +112,7 @@ def mesh_row(bench, build, path, cells, out):
            "encloses": r.returncode == 0}
     m = re.search(r"(\d+) vertices, (\d+) triangles", e)
     row["triangles"] = int(m.group(2))
-    m = re.search(r"distance ([0-9.]+) s, signs ([0-9.]+) s, \d+ candidates? ([0-9.]+) s", e)
+    m = re.search(r"distance ([0-9.]+) s, signs ([0-9.]+) s(?: \([^)]*\))?, \d+ candidates? ([0-9.]+) s", e)
     if m:
         row["distance_s"], row["signs_s"], row["candidates_s"] = (float(x) for x in m.groups())
     m = re.search(r"field (\d+)x(\d+)x(\d+)", e)
