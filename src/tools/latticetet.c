@@ -377,12 +377,17 @@ static int run(tool_ctx *t, void *settings)
             tool_say(t, 1, "warning: the boundary is not manifold at %zu "
                      "vertices", ss.nonmanifold_vertices_left);
     }
-    if (m->ntets == 0)
-        tool_say(t, 1, thin_parts
-                 ? "%s: warning: no tets kept: the pseudo volume is thinner than this "
-                   "lattice holds (the --cells above would hold it)"
-                 : "%s: warning: no tets kept: the pseudo volume is empty (a field "
-                   "soupsign made has its inside negative)", in_name);
+    /* An empty mesh is no mesh: say why and write nothing (a pipe after
+     * latticetet would mesh nothing without a word). */
+    if (m->ntets == 0) {
+        st_error_set(&err, ST_EINPUT, in_name, 0, thin_parts
+                     ? "no tets kept: the pseudo volume is thinner than this lattice "
+                       "holds (the --cells above would hold it); nothing written"
+                     : "no tets kept: the pseudo volume is empty (a field soupsign "
+                       "made has its inside negative); nothing written");
+        rc = tool_fail(t, &err);
+        goto done;
+    }
     /* The field's metadata (source, history) carries over; the lattice's
      * own keys win. */
     if (st_meta_inherit(&m->meta, &g->meta) != ST_OK ||

@@ -122,11 +122,12 @@ f 4 5 8
 OBJ
 soupdist -r 96 plate.obj 2>/dev/null | soupsign -o plate.vdb
 check "a thin plate at 6 cells: the warning says where, how thin, which --cells" \
-    sh -c "latticetet --density 0.5 --cells 6 -o plate6.vtu plate.vdb 2> plate6.log &&
+    sh -c "latticetet --density 0.5 --cells 6 -o plate6.vtu plate.vdb 2> plate6.log;
            grep -q '^latticetet: plate.vdb: warning: a part of the pseudo volume is too thin.* thick, .*--cells [0-9]* would hold it' plate6.log"
-check "the plate at 3 cells: no tets, and it says the plate is too thin, not empty" \
-    sh -c "latticetet --density 0.5 --cells 3 -o plate3.vtu plate.vdb 2> plate3.log &&
-           grep -q '^latticetet: plate.vdb: warning: no tets kept: the pseudo volume is thinner than this lattice holds' plate3.log &&
+check "the plate at 3 cells: no tets, exit 1, nothing written, and it says the plate is too thin, not empty" \
+    sh -c "rm -f plate3.vtu; latticetet --density 0.5 --cells 3 -o plate3.vtu plate.vdb 2> plate3.log;
+           test \$? -eq 1 && test ! -e plate3.vtu &&
+           grep -q '^latticetet: plate.vdb: no tets kept: the pseudo volume is thinner than this lattice holds' plate3.log &&
            ! grep -q 'is empty' plate3.log"
 cells=$(sed -n 's/.*--cells \([0-9]*\) would hold it.*/\1/p' plate6.log | head -1)
 check "the plate at the suggested --cells ($cells): no warning, one piece" \
