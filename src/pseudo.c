@@ -125,7 +125,7 @@ static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_soup_edg
                                            &st->sides, err);
     rc = rc ? rc : st_sign_field_evidence(g, &p->sign, evidence, votes, progress, err);
     rc = rc ? rc : st_sides_mirror(g, s, sp.seen_triangles, &st->sides, &st->mirrored, err);
-    rc = rc ? rc : st_sides_columns(g, s, sp.column_seen, &st->sides, p->refine.band_voxels,
+    rc = rc ? rc : st_sides_columns(g, s, &sp, &st->sides, p->refine.band_voxels,
                                     &st->columned, err);
     free(votes);
     free(evidence);

@@ -30,7 +30,7 @@ st_sides_params st_sides_params_default(void)
     /* the column rule below 0.02 along an axis: the corpus's one-sided
      * scans read 0.000-0.001 (their faces facing down were deleted), its
      * other damaged soups 0.4 and up */
-    st_sides_params p = {2.5, 3.0, 24.0, 9, 0.25, 0, 1e-3, 0.25, 0, 0.02, 0};
+    st_sides_params p = {2.5, 3.0, 24.0, 9, 0.25, 0, 1e-3, 0.25, 0, 0.02, 0, 1};
     return p;
 }
 
@@ -606,8 +606,99 @@ static int line_crosses(const double A[3], const double B[3], const double C[3],
     return 1;
 }
 
-st_status st_sides_columns(st_grid *g, const st_soup *s, size_t seen, const st_sides_stats *st,
-                           double band_voxels, size_t *changed, st_error *err)
+/* For the caps of s (its triangles from the first nt on): *away gets 1
+ * for each that faces away from the viewer (direction dir along axis k)
+ * when oriented as the seen soup around it: each seen triangle faces the
+ * viewer (walls square to the axis are left to their neighbours), and
+ * that is carried across the edges of two triangles, breadth first from
+ * the seen triangles in order (a conflict keeps the first). *top gets the
+ * highest point along dir of its piece (the caps joined across their
+ * edges of two; model units). Both hold s->ntris entries. */
+static st_status exit_caps(uint8_t **away, double **top, const st_soup *s, size_t nt, int k,
+                           int dir, st_error *err)
+{
+    const size_t n = s->ntris;
+    st_soup_edges E;
+    st_status rc = st_soup_edges_build(&E, s, err);
+    if (rc)
+        return rc;
+    uint32_t *nbr = st_malloc_array(3 * n + 1, sizeof *nbr);
+    uint8_t *same = st_malloc_array(3 * n + 1, 1);
+    uint8_t *flip = st_malloc_array(n + 1, 1);
+    uint32_t *queue = st_malloc_array(n + 1, sizeof *queue);
+    *away = st_calloc_array(n + 1, 1);
+    *top = st_calloc_array(n + 1, sizeof **top);
+    if (!nbr || !same || !flip || !queue || !*away || !*top) {
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the columns");
+        goto done;
+    }
+    st_soup_edges_neighbours(&E, s, nbr, same, NULL);
+    memset(flip, 2, n);
+    size_t qt = 0;
+    for (size_t t = 0; t < nt; t++) {
+        double nrm[3];
+        tri_normal(s, t, nrm);
+        if (!E.kept[t] || nrm[k] == 0.0)
+            continue;
+        flip[t] = dir * nrm[k] < 0.0;
+        queue[qt++] = (uint32_t)t;
+    }
+    for (size_t qh = 0; qh < qt; qh++) {
+        const uint32_t t = queue[qh];
+        for (size_t slot = 3 * (size_t)t; slot < 3 * (size_t)t + 3; slot++) {
+            const uint32_t q = nbr[slot];
+            if (q == ST_EDGES_NONE || flip[q] != 2)
+                continue;
+            flip[q] = (uint8_t)(flip[t] ^ same[slot]);
+            queue[qt++] = q;
+        }
+    }
+    /* the caps' pieces: bit 2 of *away marks a cap reached */
+    for (size_t t0 = nt; t0 < n; t0++) {
+        if (!E.kept[t0] || (*away)[t0] & 2)
+            continue;
+        size_t qh = 0, q1 = 0;
+        double hi = -INFINITY;
+        (*away)[t0] = 2;
+        queue[q1++] = (uint32_t)t0;
+        while (qh < q1) {
+            const uint32_t t = queue[qh++];
+            for (int c = 0; c < 3; c++)
+                hi = fmax(hi, dir * s->xyz[3 * (size_t)s->tris[3 * (size_t)t + c] + k]);
+            for (size_t slot = 3 * (size_t)t; slot < 3 * (size_t)t + 3; slot++) {
+                const uint32_t q = nbr[slot];
+                if (q != ST_EDGES_NONE && q >= nt && !((*away)[q] & 2)) {
+                    (*away)[q] = 2;
+                    queue[q1++] = q;
+                }
+            }
+        }
+        for (size_t i = 0; i < q1; i++) {
+            const uint32_t t = queue[i];
+            double nrm[3];
+            tri_normal(s, t, nrm);
+            (*away)[t] = (uint8_t)(2 | (flip[t] != 2 && dir * nrm[k] * (flip[t] ? -1.0 : 1.0) < 0.0));
+            (*top)[t] = hi;
+        }
+    }
+done:
+    if (rc) {
+        free(*away);
+        free(*top);
+        *away = NULL;
+        *top = NULL;
+    }
+    st_soup_edges_free(&E);
+    free(nbr);
+    free(same);
+    free(flip);
+    free(queue);
+    return rc;
+}
+
+st_status st_sides_columns(st_grid *g, const st_soup *s, const st_sides_params *p,
+                           const st_sides_stats *st, double band_voxels, size_t *changed,
+                           st_error *err)
 {
     *changed = 0;
     if (!st->columns || !s)
@@ -615,20 +706,30 @@ st_status st_sides_columns(st_grid *g, const st_soup *s, size_t seen, const st_s
     const int k = st->column_axis, a = (k + 1) % 3, b = (k + 2) % 3, dir = st->column_dir;
     const size_t dims[3] = {g->nx, g->ny, g->nz};
     const size_t na = dims[a], nb = dims[b], nk = dims[k];
+    const size_t seen = p->column_seen;
     const size_t nt = seen && seen < s->ntris ? seen : s->ntris;
+    /* the crossings of the caps that face away too (not past a fold,
+     * where the mirror has continued the solid past them) */
+    const size_t nall = p->column_caps && !st->fold ? s->ntris : nt;
     const size_t ncol = na * nb;
     size_t *start = st_calloc_array(ncol + 1, sizeof *start);
     size_t *fill = st_calloc_array(ncol + 1, sizeof *fill);
     col_hit *hit = NULL;
+    uint8_t *exits = NULL;
+    double *ctop = NULL;
     st_status rc = ST_OK;
     if (!start || !fill) {
         rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the columns");
         goto done;
     }
+    if (nall > nt && (rc = exit_caps(&exits, &ctop, s, nt, k, dir, err)))
+        goto done;
     /* the seen triangles' crossings of each line along axis k, in voxel
      * coordinates: counted, then stored (pass 0, 1) */
     for (int pass = 0; pass < 2; pass++) {
-        for (size_t t = 0; t < nt; t++) {
+        for (size_t t = 0; t < nall; t++) {
+            if (t >= nt && !(exits[t] & 1))
+                continue;
             double P[3][3], lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
             for (int v = 0; v < 3; v++)
                 for (int c = 0; c < 3; c++)
@@ -677,18 +778,24 @@ st_status st_sides_columns(st_grid *g, const st_soup *s, size_t seen, const st_s
         size_t n = start[col + 1] - start[col];
         /* from the viewer: the greatest dir * coordinate first */
         qsort(h, n, sizeof *h, cmp_hit_desc);
-        /* crossings within half a voxel are one (an edge or vertex on the
-         * line, or a sliver) */
-        size_t u = 0;
-        for (size_t m = 0; m < n; m++)
-            if (u == 0 || h[u - 1].h - h[m].h > 0.5)
-                h[u++] = h[m];
-        n = u;
+        /* the caps' crossings apart (in order); the seen soup's: within
+         * half a voxel are one (an edge or vertex on the line, or a
+         * sliver) */
+        col_hit *cap = malloc((n + 1) * sizeof *cap);
         size_t *line = malloc((nk + 1) * sizeof *line);
-        if (!line) {
+        if (!line || !cap) {
+            free(line);
+            free(cap);
             oom = 1;
             continue;
         }
+        size_t u = 0, ncap = 0;
+        for (size_t m = 0; m < n; m++)
+            if (h[m].t >= nt)
+                cap[ncap++] = h[m];
+            else if (u == 0 || h[u - 1].h - h[m].h > 0.5)
+                h[u++] = h[m];
+        n = u;
         for (size_t step = 0; step < nk; step++) {
             const size_t m = dir > 0 ? nk - 1 - step : step;
             size_t ijk[3];
@@ -719,6 +826,31 @@ st_status st_sides_columns(st_grid *g, const st_soup *s, size_t seen, const st_s
                     }
                 }
             }
+            /* the first cap that faces away below the entry (half a voxel
+             * clear of it and of the next): where its piece rises less
+             * than a voxel above the crossing (flat: the lost face, a
+             * pocket's ceiling), the solid ends there at the latest; else,
+             * where the segment's solid ends at it or below, the air run
+             * from it down to the next entry is mirrored above it (a
+             * bore's lower half seen, its cap across the middle: the upper
+             * half), where that leaves solid below the entry */
+            const double top = seg > 0 ? h[seg - 1].h - 0.5 : INFINITY;
+            const double bottom = seg < n ? h[seg].h + 0.5 : -INFINITY;
+            for (size_t c = 0; c < ncap && seg > 0; c++) {
+                if (!(cap[c].h < top && cap[c].h > bottom) || !(exits[cap[c].t] & 1))
+                    continue;
+                size_t capi = first;   /* the first voxel below the cap */
+                while (capi < end && dir * (double)(dir > 0 ? nk - 1 - capi : capi) > cap[c].h)
+                    capi++;
+                const double rise = ((ctop[cap[c].t] - dir * g->origin[k]) / g->voxel) - cap[c].h;
+                const size_t air = end - capi;
+                if (rise < 1.0 && capi < split)
+                    split = capi;
+                if (seg < n && split + 1 >= capi && rise >= 1.0 && air > 0 && air < capi - first &&
+                    capi - air < split)
+                    split = capi - air;
+                break;
+            }
             for (size_t i = split; i < end; i++) {
                 float *d = &g->data[line[i]];
                 if (*d < 0.0f) {
@@ -729,6 +861,7 @@ st_status st_sides_columns(st_grid *g, const st_soup *s, size_t seen, const st_s
             first = end;
         }
         free(line);
+        free(cap);
     }
     *changed = count;
     if (oom)
@@ -737,5 +870,7 @@ done:
     free(start);
     free(fill);
     free(hit);
+    free(exits);
+    free(ctop);
     return rc;
 }

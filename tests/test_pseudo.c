@@ -4,7 +4,7 @@
  * one by one, and large holes close: a box with a whole face missing (of
  * any size), a thin plate with half of one face gone, a one-sided
  * hemisphere shell, a one-sided scan of a ball whose horizon is not
- * flat; an unoriented soup gives what an oriented one gives; the steps
+ * flat, a block with a bore scanned from above; an unoriented soup gives what an oriented one gives; the steps
  * given the soup's edge table and BVH give what they give alone.
  */
 #include "souptet/pseudo.h"
@@ -186,9 +186,13 @@ static void test_hemisphere(void)
     }
     const st_pseudo_params pp = st_pseudo_params_default();
     /* t is closed but not consistently oriented: compare by parity */
-    const double iou = iou_by(s, t, 64, &pp, ST_SOLID_PARITY);
+    st_pseudo_stats st;
+    const double iou = iou_stats(s, t, 64, &pp, ST_SOLID_PARITY, &st);
     TAP_CHECK(iou >= 0.98, "a one-sided hemisphere shell closes across its rim (IoU %.4f)",
               iou);
+    /* and the column rule reads it as a scan from below */
+    TAP_CHECK(st.sides.columns && st.sides.column_axis == 2 && st.sides.column_dir == -1,
+              "it is a scan along -z (back/front %.3f)", st.sides.column_back_front);
     st_soup_free(s);
     st_soup_free(t);
 }
@@ -393,6 +397,51 @@ static size_t inside_in_box(const st_grid *g, const double lo[3], const double h
     return n;
 }
 
+/* A rule on and off (off turns it off in the params), on the pseudo
+ * volume of s at 64 cells: the voxels inside the box (lo, hi) and the IoU
+ * against truth's solid by rule, each way; st: the stats with it on. */
+typedef struct on_off {
+    int ok;
+    st_pseudo_stats st;
+    size_t in, in0;
+    double with, without;
+} on_off;
+
+static on_off rule_on_off(const st_soup *s, const st_soup *truth, const double lo[3],
+                          const double hi[3], void (*off)(st_pseudo_params *),
+                          st_solid_rule rule)
+{
+    on_off r;
+    memset(&r, 0, sizeof r);
+    st_pseudo_params pp = st_pseudo_params_default();
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = 64;
+    st_grid *g = NULL, *g0 = NULL;
+    st_error err;
+    r.ok = !st_pseudo_volume(&g, s, &dp, &pp, &r.st, NULL, &err);
+    off(&pp);
+    r.ok = r.ok && !st_pseudo_volume(&g0, s, &dp, &pp, NULL, NULL, &err);
+    r.in = r.ok ? inside_in_box(g, lo, hi) : 1;
+    r.in0 = r.ok ? inside_in_box(g0, lo, hi) : 0;
+    pp = st_pseudo_params_default();
+    r.with = iou_by(s, truth, 64, &pp, rule);
+    off(&pp);
+    r.without = iou_by(s, truth, 64, &pp, rule);
+    st_grid_free(g);
+    st_grid_free(g0);
+    return r;
+}
+
+static void columns_off(st_pseudo_params *pp)
+{
+    pp->sides_params.column_ratio = 0.0;
+}
+
+static void column_caps_off(st_pseudo_params *pp)
+{
+    pp->sides_params.column_caps = 0;
+}
+
 static void test_columns(void)
 {
     /* A one-sided scan of a counterbored block, from above: the lines
@@ -403,30 +452,100 @@ static void test_columns(void)
     st_soup *s = st_soup_new(), *t = st_soup_new();
     add_counterbored(s, 1);
     add_counterbored(t, -1);
-    st_pseudo_params pp = st_pseudo_params_default();
-    st_dist_params dp = st_dist_params_default();
-    dp.cells = 64;
-    st_pseudo_stats st;
-    st_grid *g = NULL, *g0 = NULL;
-    st_error err;
-    int ok = !st_pseudo_volume(&g, s, &dp, &pp, &st, NULL, &err);
-    pp.sides_params.column_ratio = 0.0;
-    ok = ok && !st_pseudo_volume(&g0, s, &dp, &pp, NULL, NULL, &err);
-    TAP_CHECK(ok && st.sides.columns && st.sides.column_axis == 2 && st.sides.column_dir == 1 &&
-                  st.columned > 0,
-              "a counterbored block scanned from above is one-sided along +z (back/front "
-              "%.3f, %zu voxels made outside)", st.sides.column_back_front, st.columned);
     const double lo[3] = {0.42, 0.42, 0.02}, hi[3] = {0.58, 0.58, 0.48};
-    const size_t in = ok ? inside_in_box(g, lo, hi) : 1, in0 = ok ? inside_in_box(g0, lo, hi) : 0;
-    TAP_CHECK(ok && in == 0 && in0 > 100, "its bore is empty (%zu voxels inside, %zu without "
-              "the column rule)", in, in0);
-    pp = st_pseudo_params_default();
-    const double with = iou_by(s, t, 64, &pp, ST_SOLID_PARITY);
-    pp.sides_params.column_ratio = 0.0;
-    const double without = iou_by(s, t, 64, &pp, ST_SOLID_PARITY);
-    TAP_CHECK(with > without + 0.01, "and its IoU gains (%.4f, %.4f without)", with, without);
-    st_grid_free(g);
-    st_grid_free(g0);
+    const on_off r = rule_on_off(s, t, lo, hi, columns_off, ST_SOLID_PARITY);
+    TAP_CHECK(r.ok && r.st.sides.columns && r.st.sides.column_axis == 2 &&
+                  r.st.sides.column_dir == 1 && r.st.columned > 0,
+              "a counterbored block scanned from above is one-sided along +z (back/front "
+              "%.3f, %zu voxels made outside)", r.st.sides.column_back_front, r.st.columned);
+    TAP_CHECK(r.ok && r.in == 0 && r.in0 > 100, "its bore is empty (%zu voxels inside, %zu "
+              "without the column rule)", r.in, r.in0);
+    TAP_CHECK(r.with > r.without + 0.01, "and its IoU gains (%.4f, %.4f without)", r.with,
+              r.without);
+    st_soup_free(s);
+    st_soup_free(t);
+}
+
+/* Triangle (a, b, c) turned so that its normal has a positive component
+ * along hint; left out when skip_down and it then faces down (z). */
+static void add_tri_facing(st_soup *s, const double a[3], const double b[3], const double c[3],
+                           const double hint[3], int skip_down)
+{
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                         u[0] * w[1] - u[1] * w[0]};
+    const int flip = n[0] * hint[0] + n[1] * hint[1] + n[2] * hint[2] < 0.0;
+    if (skip_down && (flip ? -n[2] : n[2]) < 0.0)
+        return;
+    add_tri(s, a, b, c, flip);
+}
+
+/* A point of the bore's circle (r 0) or of the block's square around it
+ * (r 1) at angle t about the x axis, at x. */
+static void bored_point(double x, int r, double t, double p[3])
+{
+    const double c = cos(t), sn = sin(t);
+    const double m = r ? 0.5 / fmax(fabs(c), fabs(sn)) : 0.2;
+    p[0] = x;
+    p[1] = m * c;
+    p[2] = m * sn;
+}
+
+/* A block along x (x in [-1, 1], y and z in [-0.5, 0.5]) with a bore of
+ * radius 0.2 along the x axis, outward: all of it (up < 0), or its faces
+ * that do not face down (up > 0: a scan from above; the ends, which face
+ * along x, stay). */
+static void add_bored_block(st_soup *s, int up)
+{
+    const int nu = 32;   /* a multiple of 8: the square's corners are points */
+    for (int j = 0; j < nu; j++) {
+        const double t0 = 2 * M_PI * j / nu, t1 = 2 * M_PI * (j + 1) / nu;
+        const double tm = 0.5 * (t0 + t1);
+        for (int r = 0; r < 2; r++) {
+            /* the walls: outward on the square, inward in the bore */
+            const double sg = r ? 1.0 : -1.0, hint[3] = {0, sg * cos(tm), sg * sin(tm)};
+            double a[3], b[3], c[3], d[3];
+            bored_point(-1, r, t0, a);
+            bored_point(1, r, t0, b);
+            bored_point(1, r, t1, c);
+            bored_point(-1, r, t1, d);
+            add_tri_facing(s, a, b, c, hint, up > 0);
+            add_tri_facing(s, a, c, d, hint, up > 0);
+        }
+        for (int e = 0; e < 2; e++) {   /* the ends */
+            const double x = e ? 1.0 : -1.0, hint[3] = {x, 0, 0};
+            double a[3], b[3], c[3], d[3];
+            bored_point(x, 0, t0, a);
+            bored_point(x, 1, t0, b);
+            bored_point(x, 1, t1, c);
+            bored_point(x, 0, t1, d);
+            add_tri_facing(s, a, b, c, hint, 0);
+            add_tri_facing(s, a, c, d, hint, 0);
+        }
+    }
+}
+
+static void test_columns_caps(void)
+{
+    /* A block with a bore along x, scanned from above: the bore's lower
+     * half is seen, its upper half is not; the least-area cap of the
+     * bore's loop runs flat across its middle (and up the ends' half
+     * circles), and the cut fills the bore's upper half. The column
+     * rule reads the caps that face away: this one rises above the lines'
+     * crossings, so the air run below it is mirrored above it and the
+     * bore is empty again. */
+    st_soup *s = st_soup_new(), *t = st_soup_new();
+    add_bored_block(s, 1);
+    add_bored_block(t, -1);
+    const double lo[3] = {-0.8, -0.1, 0.03}, hi[3] = {0.8, 0.1, 0.16};
+    const on_off r = rule_on_off(s, t, lo, hi, column_caps_off, ST_SOLID_NONZERO);
+    TAP_CHECK(r.ok && r.st.sides.columns && r.st.sides.column_axis == 2 && r.in == 0 &&
+                  r.in0 > 100,
+              "a bored block scanned from above: its bore's upper half is empty (%zu voxels "
+              "inside, %zu without the caps in the column rule)", r.in, r.in0);
+    TAP_CHECK(r.with >= 0.9 && r.with > r.without + 0.05,
+              "and its IoU gains (%.4f, %.4f without)", r.with, r.without);
     st_soup_free(s);
     st_soup_free(t);
 }
@@ -768,6 +887,7 @@ int main(void)
     test_onesided();
     test_onesided_caps();
     test_columns();
+    test_columns_caps();
     test_sides_orientation();
     test_shared_tables();
     test_shells_shortcut();

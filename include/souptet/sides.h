@@ -36,7 +36,8 @@
  *      that is over 45 degrees from it).
  *   5. whether the seen soup (without its caps) is a one-sided view along
  *      an axis (columns; st_sides_columns then drops what the cut put
- *      where no seen surface is above it along that axis).
+ *      where no seen surface is above it along that axis, and reads the
+ *      caps that face away from the viewer).
  * So the cut (mincut.h) has, on each side of every surviving wall, the
  * side it is on, and spans the holes between walls by the least area.
  *
@@ -77,6 +78,8 @@ typedef struct st_sides_params {
                                along an axis (0: never; st_sides_columns) */
     size_t column_seen;     /* the column rule reads the first this many
                                triangles (the seen surface); 0: all */
+    int column_caps;        /* the column rule reads the caps that face
+                               away too (1; st_sides_columns) */
 } st_sides_params;
 
 st_sides_params st_sides_params_default(void);
@@ -151,20 +154,35 @@ st_status st_sides_mirror(st_grid *g, const st_soup *s, size_t seen_triangles,
  * viewer, so it was seen, and every one it leaves through faces away, so
  * it was not: along each line of voxel centers (from the viewer), the
  * solid is nothing before the first crossing of the seen soup (s's first
- * `seen` triangles; 0: all), and after each crossing one run of inside
+ * p->column_seen triangles; 0: all), and after each crossing one run of inside
  * (the solid it enters) and then nothing up to the next crossing. Each
  * such segment keeps the step (inside, then outside) that the voxels of g
  * at least band_voxels from the soup agree with most (ties: the longer
  * inside run); the voxels after it are made outside, none made inside. A
  * line that crosses nothing seen is empty (the bore of a part seen along
  * it). Where a segment's solid ends is the field's (the cut, the caps, the
- * mirror): the rule adds no depth prior. Crossings: each lattice line
- * against each triangle's projection, exact orient2d signs (a closed
- * triangle; crossings within half a voxel of each other are one).
+ * mirror), but for the caps the lines read when p->column_caps is set and
+ * the scan is not mirrored (!stats->fold): s's triangles after the first
+ * p->column_seen, oriented as the seen soup around them (each seen
+ * triangle facing the viewer, carried across edges of two triangles,
+ * breadth first), those that face away. The first such cap a segment
+ * crosses (half a voxel clear of its ends) ends its solid there at the
+ * latest when the cap's piece (its caps joined across edges) rises less
+ * than a voxel above the crossing, toward the viewer: a flat cap is the
+ * lost face (a pocket's ceiling). Otherwise, when the segment's step is at
+ * or below the cap and a next crossing follows, the air from the cap down
+ * to it is mirrored above the cap, if solid is left after the first
+ * crossing: a bore seen along a line square to it shows its lower half,
+ * and its least-area cap runs across the middle (rising up the half
+ * circles at its ends), so the upper half is the lower one mirrored.
+ * Crossings: each lattice line against each triangle's projection, exact
+ * orient2d signs (a closed triangle; the seen soup's crossings within half
+ * a voxel of each other are one).
  * *changed gets the voxels made outside. Deterministic: each line is one
  * thread's. ST_ENOMEM. */
-st_status st_sides_columns(st_grid *g, const st_soup *s, size_t seen, const st_sides_stats *st,
-                           double band_voxels, size_t *changed, st_error *err);
+st_status st_sides_columns(st_grid *g, const st_soup *s, const st_sides_params *p,
+                           const st_sides_stats *st, double band_voxels, size_t *changed,
+                           st_error *err);
 
 #ifdef __cplusplus
 }
