@@ -51,7 +51,18 @@ st_holes_params st_holes_params_default(void)
      * cheese 0.980 -> 0.925, pinion 0.999 -> 0.996, rotor 0.989 ->
      * 0.986; onesided cheese 0.845 -> 0.813, rotor 0.883 -> 0.871, anchor
      * 1.000 -> 0.995 (elephant onesided 0.801 -> 0.551 at CONE_BETTER
-     * 0.999). */
+     * 0.999). A plane support bound does not make it the default: a
+     * rebuilt corner's triangles on a face's plane at most k times the
+     * area left of that face (the soup's triangles joined across edges
+     * where they lie exactly in one plane, st_orient3d), largeholes 0.842
+     * -> 0.784 (k 1), 0.821 (k 2; rotor 0.936 -> 0.829, fandisk 0.964 ->
+     * 0.944), 0.831 (k 4), while deleted50 cheese 0.925 -> 0.945 (k 2; not
+     * the 0.980 without planes, its loss is recall) and anchor 0.998 ->
+     * 0.923 (0.911 without planes): on a CAD part's curved faces a face is
+     * one facet, and a face that lost most of itself bears fans larger
+     * than what is left of it. planes also costs soupsign 2.4 times the
+     * user time on the armadillo's deleted faces at 256^3 (2.3 s -> 5.5 s;
+     * its holes 1.4 s -> 1.5 s). */
     /* bend 0: the least-area caps; the caps that bend least recover more
      * of a CAD part's large holes (issue 17, the corpus's largeholes:
      * core IoU 0.743 -> 0.829) and of its small ones, but extend a face's
