@@ -41,6 +41,7 @@ st_dist_params st_dist_params_default(void)
     p.pad = -1;
     p.band = ST_DIST_DEFAULT_BAND;
     p.max_bytes = 0;
+    p.nearest = ST_DIST_AUTO;
     return p;
 }
 
@@ -623,6 +624,348 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
     return ST_OK;
 }
 
+/* Query path (fine soups: many triangles per voxel). A triangle scattered
+ * over the bricks of its band costs the band's volume whatever its size,
+ * so a soup of sub-voxel triangles pays that volume per triangle. Here each
+ * triangle goes only into the cells (one per voxel, centered on it) that
+ * its bounding box meets, and each voxel near the surface asks for its
+ * nearest triangle: it visits cells in the order of their distance from
+ * it and stops once that distance reaches its best so far. It measures
+ * with the same setup and the same pruning as the brick pass, so it finds
+ * the same minimum (the value stored), not necessarily the same nearest
+ * triangle among equals: band fields only (the full field's propagation
+ * needs the brick pass's nearest). */
+
+/* A row of cells along x at offset (dy, dz) from a voxel's, with a lower
+ * bound (voxels) on the distance from the voxel's center to any point of
+ * the row's cells: the cells of a row are consecutive, and so are their
+ * triangles in the lists, so a voxel visits a row's stretch as one run. */
+typedef struct row_off {
+    double lb;
+    int d[2];
+} row_off;
+
+/* How far a cell |d| cells away along an axis is from a voxel's center, at
+ * least (voxels): the half cell less a millionth, so a triangle rounding
+ * puts in the next cell is still found. */
+static double cell_gap(int d)
+{
+    double x = fabs((double)d) - 0.5 - 1e-6;
+    return x > 0.0 ? x : 0.0;
+}
+
+static int row_off_cmp(const void *a, const void *b)
+{
+    const row_off *x = a, *y = b;
+    if (x->lb != y->lb)
+        return x->lb < y->lb ? -1 : 1;
+    for (int q = 0; q < 2; q++)
+        if (x->d[q] != y->d[q])
+            return x->d[q] < y->d[q] ? -1 : 1;
+    return 0;
+}
+
+/* The rows within Bv voxels of a voxel center, nearest first; *D gets the
+ * largest offset along any axis. */
+static row_off *row_offsets(double Bv, int *D, size_t *count)
+{
+    int R = (int)ceil(Bv + 0.5) + 1;
+    row_off *o = st_malloc_array((size_t)(2 * R + 1) * (size_t)(2 * R + 1), sizeof *o);
+    if (!o)
+        return NULL;
+    size_t n = 0;
+    int dmax = 0;
+    for (int k = -R; k <= R; k++)
+        for (int j = -R; j <= R; j++) {
+            const double lb = sqrt(cell_gap(j) * cell_gap(j) + cell_gap(k) * cell_gap(k));
+            if (!(lb < Bv))
+                continue;
+            o[n].lb = lb;
+            o[n].d[0] = j;
+            o[n].d[1] = k;
+            dmax = abs(j) > dmax ? abs(j) : dmax;
+            dmax = abs(k) > dmax ? abs(k) : dmax;
+            n++;
+        }
+    for (int i = 0; cell_gap(i) < Bv; i++)
+        dmax = i > dmax ? i : dmax;
+    qsort(o, n, sizeof *o, row_off_cmp);
+    *D = dmax;
+    *count = n;
+    return o;
+}
+
+/* The cells triangle t's bounding box meets, clamped to the grid. */
+static void triangle_cells(const st_grid *g, const st_soup *s, size_t t,
+                           size_t lo[3], size_t hi[3])
+{
+    const size_t n[3] = {g->nx, g->ny, g->nz};
+    const double *v[3];
+    for (int k = 0; k < 3; k++)
+        v[k] = s->xyz + 3 * (size_t)s->tris[3 * t + k];
+    for (int a = 0; a < 3; a++) {
+        double mn = MIN2(v[0][a], MIN2(v[1][a], v[2][a]));
+        double mx = MAX2(v[0][a], MAX2(v[1][a], v[2][a]));
+        double l = floor((mn - g->origin[a]) / g->voxel + 0.5);
+        double u = floor((mx - g->origin[a]) / g->voxel + 0.5);
+        l = l < 0.0 ? 0.0 : l > (double)(n[a] - 1) ? (double)(n[a] - 1) : l;
+        u = u < 0.0 ? 0.0 : u > (double)(n[a] - 1) ? (double)(n[a] - 1) : u;
+        lo[a] = (size_t)l;
+        hi[a] = (size_t)u;
+    }
+}
+
+/* Cells of the triangles' bounding boxes summed over the soup: the query
+ * path's list length, and with ntris the measure of fineness. */
+static size_t cell_entries(const st_grid *g, const st_soup *s)
+{
+    size_t total = 0;
+    #pragma omp parallel for reduction(+ : total) schedule(static)
+    for (size_t t = 0; t < s->ntris; t++) {
+        size_t lo[3], hi[3];
+        triangle_cells(g, s, t, lo, hi);
+        total += (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+    }
+    return total;
+}
+
+/* Setups cached per thread, direct mapped by triangle index. */
+#define SETUP_CACHE 4096
+
+/* Measure triangle t from p as the brick pass does (its setup, its plane
+ * bound), lowering *cur (squared) and *curd, and setting *best, when t is
+ * nearer. */
+static inline void measure(const st_soup *s, const uint32_t *orig, uint32_t t,
+                           const double p[3],
+                           tri_setup *setups, uint32_t *tag, double *cur,
+                           double *curd, uint32_t *best)
+{
+    tri_setup *ts = &setups[t % SETUP_CACHE];
+    if (tag[t % SETUP_CACHE] != t) {
+        tag[t % SETUP_CACHE] = t;
+        setup_triangle(ts, s, orig[t]);
+    }
+    double pd = 0.0;
+    if (!ts->degenerate) {
+        double v0p[3];
+        st_sub3(v0p, p, ts->v[0]);
+        pd = st_dot3(v0p, ts->nu);
+        if (pd * pd >= *cur)
+            return;   /* its plane is too far */
+    }
+    double d2 = tri_dist2(ts, p, pd);
+    if (d2 < *cur) {
+        *cur = d2;
+        *curd = sqrt(d2);
+        *best = t;
+    }
+}
+
+static st_status band_pass_query(st_grid *g, const st_soup *s, double B,
+                                 const st_progress *progress, st_error *err)
+{
+    const size_t nx = g->nx, ny = g->ny, nz = g->nz;
+    const size_t ncells = nx * ny * nz;
+    const double h = g->voxel;
+    int D;
+    size_t noff;
+    row_off *offs = row_offsets(B / h, &D, &noff);
+    uint32_t *start = st_calloc_array(ncells + 1, sizeof(uint32_t));
+    tri_ball *balls = st_malloc_array(s->ntris ? s->ntris : 1, sizeof *balls);
+    if (!offs || !start || !balls) {
+        free(offs);
+        free(start);
+        free(balls);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    #pragma omp parallel for schedule(static)
+    for (size_t t = 0; t < s->ntris; t++)
+        triangle_ball(&balls[t], s, t);
+    /* Counting sort of (cell, triangle) pairs. The order within a cell
+     * changes the work only, never the minimum. */
+    for (size_t t = 0; t < s->ntris; t++) {
+        size_t lo[3], hi[3];
+        triangle_cells(g, s, t, lo, hi);
+        for (size_t k = lo[2]; k <= hi[2]; k++)
+            for (size_t j = lo[1]; j <= hi[1]; j++)
+                for (size_t i = lo[0]; i <= hi[0]; i++)
+                    start[i + nx * (j + ny * k) + 1]++;
+    }
+    for (size_t c = 0; c < ncells; c++)
+        start[c + 1] += start[c];
+    uint32_t *list = st_malloc_array(start[ncells] ? start[ncells] : 1,
+                                     sizeof(uint32_t));
+    uint32_t *fill = st_malloc_array(ncells, sizeof(uint32_t));
+    const size_t nbx = (nx + BRICK - 1) / BRICK, nby = (ny + BRICK - 1) / BRICK,
+                 nbz = (nz + BRICK - 1) / BRICK, nb = nbx * nby * nbz;
+    uint8_t *near_brick = st_calloc_array(nb, 1);
+    if (!list || !fill || !near_brick) {
+        free(list);
+        free(fill);
+        free(near_brick);
+        free(offs);
+        free(start);
+        free(balls);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    memcpy(fill, start, ncells * sizeof *fill);
+    for (size_t t = 0; t < s->ntris; t++) {
+        size_t lo[3], hi[3];
+        triangle_cells(g, s, t, lo, hi);
+        for (size_t k = lo[2]; k <= hi[2]; k++)
+            for (size_t j = lo[1]; j <= hi[1]; j++)
+                for (size_t i = lo[0]; i <= hi[0]; i++)
+                    list[fill[i + nx * (j + ny * k)]++] = (uint32_t)t;
+    }
+    free(fill);
+    /* Renumber the triangles in the order the lists first name them, so
+     * the balls a voxel reads lie together in memory; orig[] maps back. */
+    uint32_t *renum = st_malloc_array(s->ntris ? s->ntris : 1, sizeof *renum);
+    uint32_t *orig = st_malloc_array(s->ntris ? s->ntris : 1, sizeof *orig);
+    tri_ball *sorted = st_malloc_array(s->ntris ? s->ntris : 1, sizeof *sorted);
+    if (!renum || !orig || !sorted) {
+        free(renum);
+        free(orig);
+        free(sorted);
+        free(list);
+        free(near_brick);
+        free(offs);
+        free(start);
+        free(balls);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    memset(renum, 0xff, s->ntris * sizeof *renum);
+    uint32_t nnew = 0;
+    for (size_t e = 0; e < start[ncells]; e++) {
+        const uint32_t t = list[e];
+        if (renum[t] == UINT32_MAX) {
+            renum[t] = nnew;
+            orig[nnew] = t;
+            sorted[nnew] = balls[t];
+            nnew++;
+        }
+        list[e] = renum[t];
+    }
+    free(renum);
+    free(balls);
+    balls = sorted;
+    /* Bricks holding a voxel within D cells of a nonempty cell: the only
+     * ones whose voxels can be in the band. */
+    const size_t Rb = ((size_t)D + BRICK - 1) / BRICK;
+    for (size_t k = 0; k < nz; k++)
+        for (size_t j = 0; j < ny; j++)
+            for (size_t i = 0; i < nx; i++) {
+                const size_t c = i + nx * (j + ny * k);
+                if (start[c] == start[c + 1])
+                    continue;
+                const size_t b[3] = {i / BRICK, j / BRICK, k / BRICK};
+                const size_t bn[3] = {nbx, nby, nbz};
+                size_t lo[3], hi[3];
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = b[a] > Rb ? b[a] - Rb : 0;
+                    hi[a] = b[a] + Rb < bn[a] - 1 ? b[a] + Rb : bn[a] - 1;
+                }
+                for (size_t z = lo[2]; z <= hi[2]; z++)
+                    for (size_t y = lo[1]; y <= hi[1]; y++)
+                        for (size_t x = lo[0]; x <= hi[0]; x++)
+                            near_brick[x + nbx * (y + nby * z)] = 1;
+            }
+
+    const float Bf = (float)B;
+    const double B2 = B * B;
+    int oom = 0;
+    size_t done = 0;
+    #pragma omp parallel
+    {
+        uint32_t seed = UINT32_MAX;
+        uint32_t *tag = st_malloc_array(SETUP_CACHE, sizeof *tag);
+        tri_setup *setups = st_malloc_array(SETUP_CACHE, sizeof *setups);
+        if (!tag || !setups) {
+            #pragma omp atomic write
+            oom = 1;
+        } else {
+            for (size_t q = 0; q < SETUP_CACHE; q++)
+                tag[q] = UINT32_MAX;
+        }
+        #pragma omp for schedule(dynamic, 16)
+        for (size_t bi = 0; bi < nb; bi++) {
+            const size_t b[3] = {bi % nbx, (bi / nbx) % nby, bi / (nbx * nby)};
+            size_t lo[3], hi[3];
+            const size_t n[3] = {nx, ny, nz};
+            for (int a = 0; a < 3; a++) {
+                lo[a] = b[a] * BRICK;
+                hi[a] = lo[a] + BRICK < n[a] ? lo[a] + BRICK : n[a];
+            }
+            for (size_t k = lo[2]; k < hi[2]; k++)
+                for (size_t j = lo[1]; j < hi[1]; j++)
+                    for (size_t i = lo[0]; i < hi[0]; i++) {
+                        float *out = g->data + st_grid_index(g, i, j, k);
+                        if (!near_brick[bi] || !tag) {
+                            *out = Bf;
+                            continue;
+                        }
+                        const double p[3] = {g->origin[0] + h * (double)i,
+                                             g->origin[1] + h * (double)j,
+                                             g->origin[2] + h * (double)k};
+                        double cur = B2, curd = B;
+                        /* The last voxel's nearest first: it is often
+                         * this one's, and a close first bound prunes. */
+                        if (seed != UINT32_MAX)
+                            measure(s, orig, seed, p, setups, tag, &cur, &curd, &seed);
+                        for (size_t o = 0; o < noff; o++) {
+                            const double lb = offs[o].lb * h;
+                            if (lb >= curd)
+                                break;   /* no later row comes closer */
+                            const long cj = (long)j + offs[o].d[0],
+                                       ck = (long)k + offs[o].d[1];
+                            if (cj < 0 || cj >= (long)ny || ck < 0 || ck >= (long)nz)
+                                continue;
+                            /* the row's cells within curd: |di| < q + 1/2 */
+                            const double c = curd / h, l = offs[o].lb;
+                            const double q = sqrt(c * c - l * l > 0.0 ? c * c - l * l : 0.0);
+                            long r = (long)floor(q + 0.5 + 1e-6);
+                            r = r > D ? D : r;
+                            const long c0 = (long)i - r < 0 ? 0 : (long)i - r;
+                            const long c1 = (long)i + r >= (long)nx ? (long)nx - 1 : (long)i + r;
+                            const size_t row = nx * ((size_t)cj + ny * (size_t)ck);
+                            const uint32_t e1 = start[row + (size_t)c1 + 1];
+                            for (uint32_t e = start[row + (size_t)c0]; e < e1; e++) {
+                                const uint32_t t = list[e];
+                                const tri_ball *tb = &balls[t];
+                                double w[3];
+                                st_sub3(w, p, tb->c);
+                                double reach = curd + tb->r;
+                                if (st_dot3(w, w) >= reach * reach)
+                                    continue;   /* its ball is too far */
+                                measure(s, orig, t, p, setups, tag, &cur, &curd, &seed);
+                            }
+                        }
+                        *out = cur >= B2 ? Bf : (float)curd;
+                    }
+            size_t now;
+            #pragma omp atomic capture
+            now = ++done;
+#ifdef _OPENMP
+            if (omp_get_thread_num() == 0 && (now & 1023) == 0)
+#endif
+                st_progress_report(progress, "distance band",
+                                   (double)now / (double)nb);
+        }
+        free(tag);
+        free(setups);
+    }
+    free(near_brick);
+    free(list);
+    free(start);
+    free(balls);
+    free(orig);
+    free(offs);
+    if (oom)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    st_progress_report(progress, "distance band", 1.0);
+    return ST_OK;
+}
+
 /* Distance from p to triangle t of s, squared. */
 static double soup_tri_dist2(const st_soup *s, int32_t t, const double p[3])
 {
@@ -751,7 +1094,14 @@ st_status st_dist_field(st_grid **out, const st_soup *s,
         return st_error_set(err, ST_ENOMEM, NULL, 0,
                             "out of memory for the nearest-triangle map");
     }
-    st = band_pass(g, near, s, B, progress, err);
+    int query = 0;
+    if (!near && p->nearest != ST_DIST_SCATTER) {
+        const size_t entries = cell_entries(g, s);
+        query = entries < UINT32_MAX && s->ntris <= UINT32_MAX &&
+                (p->nearest == ST_DIST_QUERY || getenv("SOUPTET_DIST_QUERY"));
+    }
+    st = query ? band_pass_query(g, s, B, progress, err)
+               : band_pass(g, near, s, B, progress, err);
     if (!st && full)
         st = full_pass(g, near, s, B, progress, err);
     free(near);
