@@ -362,102 +362,6 @@ static void test_threads_identical(void)
 #endif
 }
 
-/* A fine soup (many triangles per voxel, a few large and degenerate ones
- * among them): the per-voxel query and the brick scatter give the same
- * band field, bit for bit, with the default padding and with none (cells
- * at the grid's sides), at 1 and 3 threads; and it equals brute force. */
-static st_soup *fine_soup(size_t n)
-{
-    st_soup *s = st_soup_new();
-    for (size_t t = 0; t < n; t++) {
-        /* points near a sphere: a closed-looking surface of tiny triangles */
-        double c[3], r2 = 0.0;
-        for (int a = 0; a < 3; a++) {
-            c[a] = urand() - 0.5;
-            r2 += c[a] * c[a];
-        }
-        const double f = 0.4 / sqrt(r2 > 1e-12 ? r2 : 1e-12);
-        const double size = t % 97 == 0 ? 0.3 : 0.004 + 0.01 * urand();
-        for (int k = 0; k < 3; k++) {
-            double x = c[0] * f + size * (urand() - 0.5);
-            double y = c[1] * f + size * (urand() - 0.5);
-            double z = c[2] * f + size * (urand() - 0.5);
-            if (t % 13 == 0 && k == 2) {   /* collinear: degenerate */
-                const double *a = s->xyz + 3 * (s->nverts - 2);
-                const double *b = s->xyz + 3 * (s->nverts - 1);
-                x = 2 * b[0] - a[0];
-                y = 2 * b[1] - a[1];
-                z = 2 * b[2] - a[2];
-            }
-            st_soup_add_vertex(s, x, y, z, NULL);
-        }
-        uint32_t v = (uint32_t)(3 * t);
-        st_soup_add_triangle(s, v, v + 1, v + 2, NULL);
-    }
-    return s;
-}
-
-static void test_query_equals_scatter(void)
-{
-    st_soup *s = fine_soup(20000);
-    st_error err;
-    for (int pad = -1; pad <= 0; pad++) {
-        st_dist_params p = st_dist_params_default();
-        p.cells = 40;
-        p.pad = pad;
-        p.band = pad < 0 ? 3.0 : 4.5;
-        st_grid *a = NULL, *b = NULL, *c = NULL;
-        p.nearest = ST_DIST_SCATTER;
-        st_status sa = st_dist_field(&a, s, &p, NULL, &err);
-        p.nearest = ST_DIST_QUERY;
-#ifdef _OPENMP
-        omp_set_num_threads(1);
-#endif
-        st_status sb = st_dist_field(&b, s, &p, NULL, &err);
-#ifdef _OPENMP
-        omp_set_num_threads(3);
-#endif
-        st_status sc = st_dist_field(&c, s, &p, NULL, &err);
-        TAP_CHECK(!sa && !sb && !sc, "pad %d: fields by scatter and by query", pad);
-        if (sa || sb || sc)
-            break;
-        const size_t n = st_grid_count(a);
-        size_t inband = 0;
-        for (size_t i = 0; i < n; i++)
-            inband += a->data[i] < (float)a->band;
-        TAP_CHECK(memcmp(a->data, b->data, n * sizeof(float)) == 0 &&
-                      memcmp(a->data, c->data, n * sizeof(float)) == 0 && inband > 1000,
-                  "pad %d: query gives the scatter's field bit for bit at 1 and 3 threads "
-                  "(%zu band voxels)", pad, inband);
-        if (pad == 0) {
-            st_bvh *bvh = NULL;
-            size_t bad = 0;
-            if (st_bvh_build(&bvh, s, &err) != ST_OK) {
-                TAP_CHECK(0, "bvh of the fine soup: %s", err.msg);
-            } else {
-                #pragma omp parallel for reduction(+ : bad) schedule(dynamic, 256)
-                for (size_t idx = 0; idx < n; idx++) {
-                    size_t i = idx % b->nx, j = (idx / b->nx) % b->ny,
-                           k = idx / (b->nx * b->ny);
-                    double q[3];
-                    st_grid_center(b, i, j, k, q);
-                    double ref = true_dist(s, bvh, q);
-                    double want = ref < b->band ? ref : b->band;
-                    if (fabs(b->data[idx] - want) > 1e-6 * fmax(want, b->voxel))
-                        bad++;
-                }
-                TAP_CHECK(bad == 0, "pad 0: the query's field is the true distance "
-                          "(%zu bad)", bad);
-            }
-            st_bvh_free(bvh);
-        }
-        st_grid_free(a);
-        st_grid_free(b);
-        st_grid_free(c);
-    }
-    st_soup_free(s);
-}
-
 /* A real model: sampled voxels against brute force. */
 static void test_real_model(void)
 {
@@ -510,7 +414,6 @@ int main(void)
     test_bvh_nearest();
     test_bvh_parallel_layout();
     test_threads_identical();
-    test_query_equals_scatter();
     test_real_model();
     return tap_done();
 }

@@ -42,22 +42,12 @@ extern "C" {
 #define ST_DIST_MIN_BAND 3.0
 #define ST_DIST_DEFAULT_CELLS 128
 
-/* The band pass's two ways to the same values (dist.c): triangles
- * scattered over the bricks their band reaches, or a query per voxel near
- * the surface through a cell grid of triangles (faster where triangles are
- * much smaller than voxels). AUTO picks by the triangles' size; a full
- * field always scatters (its propagation needs the scatter's choice among
- * equally near triangles). */
-enum { ST_DIST_AUTO = 0, ST_DIST_SCATTER = 1, ST_DIST_QUERY = 2 };
-
 typedef struct st_dist_params {
     size_t cells;       /* voxels along the longest side; used if voxel == 0 */
     double voxel;       /* voxel size in model units; 0: from cells */
     long pad;           /* voxels of padding per side; < 0: the default */
     double band;        /* band in voxels (>= ST_DIST_MIN_BAND) or INFINITY */
     size_t max_bytes;   /* limit for the grid; 0: none */
-    int nearest;        /* how band voxels find their nearest triangle:
-                           ST_DIST_AUTO, ST_DIST_SCATTER or ST_DIST_QUERY */
 } st_dist_params;
 
 /* Parameters with every default filled in. */
