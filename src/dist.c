@@ -7,9 +7,11 @@
  * band and not its bounding box). Bricks are processed in parallel, each
  * writing only its own voxels. A brick sorts its candidates by a lower
  * bound on their distance (from the brick's center, less the triangle's
- * radius and the brick's half diagonal); each voxel then walks that list
- * and stops at the first candidate whose bound is not below its best so
- * far. Candidates that survive a per-voxel ball bound and a plane bound are
+ * radius and the brick's half diagonal); each of its eight octants keeps
+ * the candidates that can come within the band of one of its voxels (in
+ * the same order), and each voxel walks its octant's list and stops at
+ * the first candidate whose bound is not below its best so far.
+ * Candidates that survive a per-voxel ball bound and a plane bound are
  * measured exactly. The minimum is the same whatever the order, so the
  * pruning changes the work, never the answer.
  *
@@ -143,18 +145,31 @@ static void setup_triangle(tri_setup *t, const st_soup *s, size_t tri)
     for (int k = 0; k < 3; k++)
         memcpy(t->v[k], s->xyz + 3 * (size_t)s->tris[3 * tri + k],
                3 * sizeof(double));
-    double emax = 0.0;
+    double eemax = 0.0;
     for (int i = 0; i < 3; i++) {
         st_sub3(t->e[i], t->v[(i + 1) % 3], t->v[i]);
         double ee = st_dot3(t->e[i], t->e[i]);
         t->inv_ee[i] = ee > 0.0 ? 1.0 / ee : 0.0;
-        emax = fmax(emax, st_norm3(t->e[i]));
+        eemax = MAX2(eemax, ee);
     }
     double n[3];
     st_cross3(n, t->e[0], t->e[1]);
     double nl = st_norm3(n);
-    /* Same rule as st_point_triangle_dist2 (geom.h explains the ratio). */
-    t->degenerate = !(nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
+    /* Same rule as st_point_triangle_dist2 (geom.h explains the ratio),
+     * with the longest edge squared as st_norm3 gives it. The plain square
+     * eemax is that within a few ulps, so unless nl is within a 1e-12 of
+     * the threshold (or eemax near the exponent range's ends) it decides
+     * the same way without the three scaled norms. */
+    const double thr = ST_DEGENERATE_AREA_RATIO * eemax;
+    if (eemax > 1e-280 && eemax < 1e280 && nl > thr * (1.0 + 1e-12))
+        t->degenerate = 0;
+    else if (eemax > 1e-280 && eemax < 1e280 && nl < thr * (1.0 - 1e-12))
+        t->degenerate = 1;
+    else {
+        const double emax = fmax(st_norm3(t->e[0]),
+                                 fmax(st_norm3(t->e[1]), st_norm3(t->e[2])));
+        t->degenerate = !(nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
+    }
     t->dom = 0;
     if (t->degenerate) {
         memset(t->nu, 0, sizeof t->nu);
@@ -380,6 +395,7 @@ typedef struct brick_scratch {
     cand *cands;
     tri_setup *setups;
     cand_key *keys;    /* 2 * cap: the keys and the merge's scratch */
+    uint32_t *oct;     /* an octant's candidates (positions in cands) */
     size_t cap;
 } brick_scratch;
 
@@ -400,6 +416,10 @@ static int scratch_reserve(brick_scratch *sc, size_t m)
     if (!k)
         return -1;
     sc->keys = k;
+    uint32_t *o = st_realloc_array(sc->oct, cap, sizeof *o);
+    if (!o)
+        return -1;
+    sc->oct = o;
     sc->cap = cap;
     return 0;
 }
@@ -453,55 +473,91 @@ static void process_brick(st_grid *g, int32_t *near, const st_soup *s,
         cs[q].slot = UINT32_MAX;
     }
     uint32_t nsetup = 0;
-    double p[3];
-    for (size_t k = lo[2]; k < hi[2]; k++) {
-        p[2] = g->origin[2] + g->voxel * (double)k;
-        for (size_t j = lo[1]; j < hi[1]; j++) {
-            p[1] = g->origin[1] + g->voxel * (double)j;
-            for (size_t i = lo[0]; i < hi[0]; i++) {
-                p[0] = g->origin[0] + g->voxel * (double)i;
-                double off[3];
-                st_sub3(off, p, bc);
-                /* |p - c| - r >= key - |p - bc|: once that reaches the best
-                 * distance so far, no later candidate can improve it. The
-                 * relative shave keeps rounding on the safe side. */
-                const double offset = sqrt(st_dot3(off, off)) * (1.0 + 1e-9) +
-                                      1e-12 * g->voxel;
-                double cur = B2, curd = B;
-                int32_t best = -1;
-                for (size_t q = 0; q < m; q++) {
-                    if (cs[q].key - offset >= curd)
-                        break;          /* sorted: no later one is closer */
-                    const tri_ball *tb = &cs[q].ball;
-                    double w[3];
-                    st_sub3(w, p, tb->c);
-                    double reach = curd + tb->r;
-                    if (st_dot3(w, w) >= reach * reach)
-                        continue;       /* its ball is too far */
-                    if (cs[q].slot == UINT32_MAX) {
-                        cs[q].slot = nsetup++;
-                        setup_triangle(&sc->setups[cs[q].slot], s, cs[q].tri);
+    const double h = g->voxel;
+    /* The brick's octants (2^3 voxels, fewer at the grid's sides), each
+     * with the candidates that can come within B of one of its voxels:
+     * those whose ball is within B of the octant's box of voxel centers,
+     * tested from its center. The list keeps the brick's order, so the
+     * walk below may stop as it did; a candidate left out cannot come
+     * below B, so it could never be a voxel's value or nearest. */
+    for (int o = 0; o < 8; o++) {
+        size_t olo[3], ohi[3];
+        int empty = 0;
+        double oc[3], hd2 = 0.0;
+        for (int a = 0; a < 3; a++) {
+            olo[a] = lo[a] + (size_t)((o >> a) & 1) * (BRICK / 2);
+            ohi[a] = olo[a] + BRICK / 2 < hi[a] ? olo[a] + BRICK / 2 : hi[a];
+            if (olo[a] >= ohi[a]) {
+                empty = 1;
+                break;
+            }
+            oc[a] = g->origin[a] + h * 0.5 * (double)(olo[a] + ohi[a] - 1);
+            const double ext = 0.5 * h * (double)(ohi[a] - 1 - olo[a]);
+            hd2 += ext * ext;
+        }
+        if (empty)
+            continue;
+        const double oreach = (B + sqrt(hd2)) * (1.0 + 1e-9) + 1e-12 * h;
+        uint32_t *idx = sc->oct;
+        size_t mo = 0;
+        for (size_t q = 0; q < m; q++) {
+            double w[3];
+            st_sub3(w, oc, cs[q].ball.c);
+            const double r = oreach + cs[q].ball.r;
+            if (st_dot3(w, w) < r * r)
+                idx[mo++] = (uint32_t)q;
+        }
+        double p[3];
+        for (size_t k = olo[2]; k < ohi[2]; k++) {
+            p[2] = g->origin[2] + g->voxel * (double)k;
+            for (size_t j = olo[1]; j < ohi[1]; j++) {
+                p[1] = g->origin[1] + g->voxel * (double)j;
+                for (size_t i = olo[0]; i < ohi[0]; i++) {
+                    p[0] = g->origin[0] + g->voxel * (double)i;
+                    double off[3];
+                    st_sub3(off, p, bc);
+                    /* |p - c| - r >= key - |p - bc|: once that reaches the best
+                     * distance so far, no later candidate can improve it. The
+                     * relative shave keeps rounding on the safe side. */
+                    const double offset = sqrt(st_dot3(off, off)) * (1.0 + 1e-9) +
+                                          1e-12 * g->voxel;
+                    double cur = B2, curd = B;
+                    int32_t best = -1;
+                    for (size_t x = 0; x < mo; x++) {
+                        const size_t q = idx[x];
+                        if (cs[q].key - offset >= curd)
+                            break;          /* sorted: no later one is closer */
+                        const tri_ball *tb = &cs[q].ball;
+                        double w[3];
+                        st_sub3(w, p, tb->c);
+                        double reach = curd + tb->r;
+                        if (st_dot3(w, w) >= reach * reach)
+                            continue;       /* its ball is too far */
+                        if (cs[q].slot == UINT32_MAX) {
+                            cs[q].slot = nsetup++;
+                            setup_triangle(&sc->setups[cs[q].slot], s, cs[q].tri);
+                        }
+                        const tri_setup *t = &sc->setups[cs[q].slot];
+                        double pd = 0.0;
+                        if (!t->degenerate) {
+                            double v0p[3];
+                            st_sub3(v0p, p, t->v[0]);
+                            pd = st_dot3(v0p, t->nu);
+                            if (pd * pd >= cur)
+                                continue;   /* its plane is too far */
+                        }
+                        double d2 = tri_dist2(t, p, pd);
+                        if (d2 < cur) {
+                            cur = d2;
+                            curd = sqrt(d2);
+                            best = (int32_t)cs[q].tri;
+                        }
                     }
-                    const tri_setup *t = &sc->setups[cs[q].slot];
-                    double pd = 0.0;
-                    if (!t->degenerate) {
-                        double v0p[3];
-                        st_sub3(v0p, p, t->v[0]);
-                        pd = st_dot3(v0p, t->nu);
-                        if (pd * pd >= cur)
-                            continue;   /* its plane is too far */
-                    }
-                    double d2 = tri_dist2(t, p, pd);
-                    if (d2 < cur) {
-                        cur = d2;
-                        curd = sqrt(d2);
-                        best = (int32_t)cs[q].tri;
-                    }
+                    g->data[st_grid_index(g, i, j, k)] =
+                        cur >= B2 ? Bf : (float)curd;
+                    if (near)
+                        near[st_grid_index(g, i, j, k)] = cur >= B2 ? -1 : best;
                 }
-                g->data[st_grid_index(g, i, j, k)] =
-                    cur >= B2 ? Bf : (float)curd;
-                if (near)
-                    near[st_grid_index(g, i, j, k)] = cur >= B2 ? -1 : best;
             }
         }
     }
@@ -590,7 +646,7 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
     size_t done = 0;
     #pragma omp parallel
     {
-        brick_scratch sc = {NULL, NULL, NULL, 0};
+        brick_scratch sc = {NULL, NULL, NULL, NULL, 0};
         #pragma omp for schedule(dynamic, 16)
         for (size_t b = 0; b < nb; b++) {
             size_t m = start[b + 1] - start[b];
@@ -613,6 +669,7 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
         free(sc.cands);
         free(sc.setups);
         free(sc.keys);
+        free(sc.oct);
     }
     free(list);
     free(start);
