@@ -277,18 +277,26 @@ static void triangle_bricks(const st_grid *g, const brick_grid *bg,
         lo[a] /= BRICK;
         hi[a] /= BRICK;
     }
-    double e1[3], e2[3], nrm[3];
+    double e1[3], e2[3], e3[3], nrm[3];
     st_sub3(e1, v[1], v[0]);
     st_sub3(e2, v[2], v[0]);
+    st_sub3(e3, v[2], v[1]);
     st_cross3(nrm, e1, e2);
     double nl = st_norm3(nrm);
-    int use_plane = nl > 0.0;
+    const double ee = MAX2(st_dot3(e1, e1), MAX2(st_dot3(e2, e2), st_dot3(e3, e3)));
+    /* The plane only for a triangle far from collinear: the rounding in
+     * the normal of a sliver (or of a collinear triangle, whose normal is
+     * rounding alone) tilts it by about 1e-16 * ee / nl radians, so the
+     * triangle's far end leaves that plane; here the tilt is below 1e-9
+     * of the longest edge, which the plane's slack covers. */
+    int use_plane = nl > 1e-6 * ee && isfinite(ee);
     if (use_plane)
         for (int a = 0; a < 3; a++)
             nrm[a] /= nl;
     /* Small slack: these tests only prune, so erring wide is safe. */
     const double reach = (B + bg->half_diag) * (1.0 + 1e-9) + 1e-12 * h;
     const double reach_ball = reach + ball->r;
+    const double reach_plane = reach + 1e-9 * sqrt(ee);
     size_t b[3];
     double c[3];    /* brick b's center, each axis set where b[a] moves */
     for (b[2] = lo[2]; b[2] <= hi[2]; b[2]++) {
@@ -303,7 +311,7 @@ static void triangle_bricks(const st_grid *g, const brick_grid *bg,
                     continue;
                 if (use_plane) {
                     st_sub3(w, c, v[0]);
-                    if (fabs(st_dot3(w, nrm)) > reach)
+                    if (fabs(st_dot3(w, nrm)) > reach_plane)
                         continue;
                 }
                 visit(b[0] + bg->n[0] * (b[1] + bg->n[1] * b[2]), ctx);
