@@ -7,11 +7,9 @@
  * band and not its bounding box). Bricks are processed in parallel, each
  * writing only its own voxels. A brick sorts its candidates by a lower
  * bound on their distance (from the brick's center, less the triangle's
- * radius and the brick's half diagonal); each of its eight octants keeps
- * the candidates that can come within the band of one of its voxels (in
- * the same order), and each voxel walks its octant's list and stops at
- * the first candidate whose bound is not below its best so far.
- * Candidates that survive a per-voxel ball bound and a plane bound are
+ * radius and the brick's half diagonal); each voxel then walks that list
+ * and stops at the first candidate whose bound is not below its best so
+ * far. Candidates that survive a per-voxel ball bound and a plane bound are
  * measured exactly. The minimum is the same whatever the order, so the
  * pruning changes the work, never the answer.
  *
@@ -403,7 +401,6 @@ typedef struct brick_scratch {
     cand *cands;
     tri_setup *setups;
     cand_key *keys;    /* 2 * cap: the keys and the merge's scratch */
-    uint32_t *oct;     /* an octant's candidates (positions in cands) */
     size_t cap;
 } brick_scratch;
 
@@ -424,10 +421,6 @@ static int scratch_reserve(brick_scratch *sc, size_t m)
     if (!k)
         return -1;
     sc->keys = k;
-    uint32_t *o = st_realloc_array(sc->oct, cap, sizeof *o);
-    if (!o)
-        return -1;
-    sc->oct = o;
     sc->cap = cap;
     return 0;
 }
@@ -481,91 +474,55 @@ static void process_brick(st_grid *g, int32_t *near, const st_soup *s,
         cs[q].slot = UINT32_MAX;
     }
     uint32_t nsetup = 0;
-    const double h = g->voxel;
-    /* The brick's octants (2^3 voxels, fewer at the grid's sides), each
-     * with the candidates that can come within B of one of its voxels:
-     * those whose ball is within B of the octant's box of voxel centers,
-     * tested from its center. The list keeps the brick's order, so the
-     * walk below may stop as it did; a candidate left out cannot come
-     * below B, so it could never be a voxel's value or nearest. */
-    for (int o = 0; o < 8; o++) {
-        size_t olo[3], ohi[3];
-        int empty = 0;
-        double oc[3], hd2 = 0.0;
-        for (int a = 0; a < 3; a++) {
-            olo[a] = lo[a] + (size_t)((o >> a) & 1) * (BRICK / 2);
-            ohi[a] = olo[a] + BRICK / 2 < hi[a] ? olo[a] + BRICK / 2 : hi[a];
-            if (olo[a] >= ohi[a]) {
-                empty = 1;
-                break;
-            }
-            oc[a] = g->origin[a] + h * 0.5 * (double)(olo[a] + ohi[a] - 1);
-            const double ext = 0.5 * h * (double)(ohi[a] - 1 - olo[a]);
-            hd2 += ext * ext;
-        }
-        if (empty)
-            continue;
-        const double oreach = (B + sqrt(hd2)) * (1.0 + 1e-9) + 1e-12 * h;
-        uint32_t *idx = sc->oct;
-        size_t mo = 0;
-        for (size_t q = 0; q < m; q++) {
-            double w[3];
-            st_sub3(w, oc, cs[q].ball.c);
-            const double r = oreach + cs[q].ball.r;
-            if (st_dot3(w, w) < r * r)
-                idx[mo++] = (uint32_t)q;
-        }
-        double p[3];
-        for (size_t k = olo[2]; k < ohi[2]; k++) {
-            p[2] = g->origin[2] + g->voxel * (double)k;
-            for (size_t j = olo[1]; j < ohi[1]; j++) {
-                p[1] = g->origin[1] + g->voxel * (double)j;
-                for (size_t i = olo[0]; i < ohi[0]; i++) {
-                    p[0] = g->origin[0] + g->voxel * (double)i;
-                    double off[3];
-                    st_sub3(off, p, bc);
-                    /* |p - c| - r >= key - |p - bc|: once that reaches the best
-                     * distance so far, no later candidate can improve it. The
-                     * relative shave keeps rounding on the safe side. */
-                    const double offset = sqrt(st_dot3(off, off)) * (1.0 + 1e-9) +
-                                          1e-12 * g->voxel;
-                    double cur = B2, curd = B;
-                    int32_t best = -1;
-                    for (size_t x = 0; x < mo; x++) {
-                        const size_t q = idx[x];
-                        if (cs[q].key - offset >= curd)
-                            break;          /* sorted: no later one is closer */
-                        const tri_ball *tb = &cs[q].ball;
-                        double w[3];
-                        st_sub3(w, p, tb->c);
-                        double reach = curd + tb->r;
-                        if (st_dot3(w, w) >= reach * reach)
-                            continue;       /* its ball is too far */
-                        if (cs[q].slot == UINT32_MAX) {
-                            cs[q].slot = nsetup++;
-                            setup_triangle(&sc->setups[cs[q].slot], s, cs[q].tri);
-                        }
-                        const tri_setup *t = &sc->setups[cs[q].slot];
-                        double pd = 0.0;
-                        if (!t->degenerate) {
-                            double v0p[3];
-                            st_sub3(v0p, p, t->v[0]);
-                            pd = st_dot3(v0p, t->nu);
-                            if (pd * pd >= cur)
-                                continue;   /* its plane is too far */
-                        }
-                        double d2 = tri_dist2(t, p, pd);
-                        if (d2 < cur) {
-                            cur = d2;
-                            curd = sqrt(d2);
-                            best = (int32_t)cs[q].tri;
-                        }
+    double p[3];
+    for (size_t k = lo[2]; k < hi[2]; k++) {
+        p[2] = g->origin[2] + g->voxel * (double)k;
+        for (size_t j = lo[1]; j < hi[1]; j++) {
+            p[1] = g->origin[1] + g->voxel * (double)j;
+            for (size_t i = lo[0]; i < hi[0]; i++) {
+                p[0] = g->origin[0] + g->voxel * (double)i;
+                double off[3];
+                st_sub3(off, p, bc);
+                /* |p - c| - r >= key - |p - bc|: once that reaches the best
+                 * distance so far, no later candidate can improve it. The
+                 * relative shave keeps rounding on the safe side. */
+                const double offset = sqrt(st_dot3(off, off)) * (1.0 + 1e-9) +
+                                      1e-12 * g->voxel;
+                double cur = B2, curd = B;
+                int32_t best = -1;
+                for (size_t q = 0; q < m; q++) {
+                    if (cs[q].key - offset >= curd)
+                        break;          /* sorted: no later one is closer */
+                    const tri_ball *tb = &cs[q].ball;
+                    double w[3];
+                    st_sub3(w, p, tb->c);
+                    double reach = curd + tb->r;
+                    if (st_dot3(w, w) >= reach * reach)
+                        continue;       /* its ball is too far */
+                    if (cs[q].slot == UINT32_MAX) {
+                        cs[q].slot = nsetup++;
+                        setup_triangle(&sc->setups[cs[q].slot], s, cs[q].tri);
                     }
-                    g->data[st_grid_index(g, i, j, k)] =
-                        cur >= B2 ? Bf : (float)curd;
-                    if (near)
-                        near[st_grid_index(g, i, j, k)] = cur >= B2 ? -1 : best;
+                    const tri_setup *t = &sc->setups[cs[q].slot];
+                    double pd = 0.0;
+                    if (!t->degenerate) {
+                        double v0p[3];
+                        st_sub3(v0p, p, t->v[0]);
+                        pd = st_dot3(v0p, t->nu);
+                        if (pd * pd >= cur)
+                            continue;   /* its plane is too far */
+                    }
+                    double d2 = tri_dist2(t, p, pd);
+                    if (d2 < cur) {
+                        cur = d2;
+                        curd = sqrt(d2);
+                        best = (int32_t)cs[q].tri;
+                    }
                 }
+                g->data[st_grid_index(g, i, j, k)] =
+                    cur >= B2 ? Bf : (float)curd;
+                if (near)
+                    near[st_grid_index(g, i, j, k)] = cur >= B2 ? -1 : best;
             }
         }
     }
@@ -654,7 +611,7 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
     size_t done = 0;
     #pragma omp parallel
     {
-        brick_scratch sc = {NULL, NULL, NULL, NULL, 0};
+        brick_scratch sc = {NULL, NULL, NULL, 0};
         #pragma omp for schedule(dynamic, 16)
         for (size_t b = 0; b < nb; b++) {
             size_t m = start[b + 1] - start[b];
@@ -677,7 +634,6 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
         free(sc.cands);
         free(sc.setups);
         free(sc.keys);
-        free(sc.oct);
     }
     free(list);
     free(start);

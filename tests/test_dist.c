@@ -44,6 +44,27 @@ static double urand(void)
     return (double)((rng >> 8) & 0xffffff) / 16777216.0;
 }
 
+/* A random triangle of the given size around c appended to s; with
+ * `collinear`, its third vertex continues the first two (degenerate). */
+static void add_random_triangle(st_soup *s, const double c[3], double size, int collinear)
+{
+    for (int k = 0; k < 3; k++) {
+        double x = c[0] + size * (urand() - 0.5);
+        double y = c[1] + size * (urand() - 0.5);
+        double z = c[2] + size * (urand() - 0.5);
+        if (collinear && k == 2) {
+            const double *a = s->xyz + 3 * (s->nverts - 2);
+            const double *b = s->xyz + 3 * (s->nverts - 1);
+            x = 2 * b[0] - a[0];
+            y = 2 * b[1] - a[1];
+            z = 2 * b[2] - a[2];
+        }
+        st_soup_add_vertex(s, x, y, z, NULL);
+    }
+    uint32_t v = (uint32_t)(s->nverts - 3);
+    st_soup_add_triangle(s, v, v + 1, v + 2, NULL);
+}
+
 /* Random triangles of all sizes and orientations, some degenerate. */
 static st_soup *random_soup(size_t n)
 {
@@ -51,21 +72,7 @@ static st_soup *random_soup(size_t n)
     for (size_t t = 0; t < n; t++) {
         double c[3] = {urand(), urand(), urand()};
         double size = t % 7 == 0 ? 0.8 : 0.05 + 0.1 * urand();
-        for (int k = 0; k < 3; k++) {
-            double x = c[0] + size * (urand() - 0.5);
-            double y = c[1] + size * (urand() - 0.5);
-            double z = c[2] + size * (urand() - 0.5);
-            if (t % 11 == 0 && k == 2) {   /* collinear: degenerate */
-                const double *a = s->xyz + 3 * (s->nverts - 2);
-                const double *b = s->xyz + 3 * (s->nverts - 1);
-                x = 2 * b[0] - a[0];
-                y = 2 * b[1] - a[1];
-                z = 2 * b[2] - a[2];
-            }
-            st_soup_add_vertex(s, x, y, z, NULL);
-        }
-        uint32_t v = (uint32_t)(3 * t);
-        st_soup_add_triangle(s, v, v + 1, v + 2, NULL);
+        add_random_triangle(s, c, size, t % 11 == 0);
     }
     return s;
 }
@@ -375,29 +382,16 @@ static st_soup *fine_soup(size_t n)
         }
         const double f = 0.4 / sqrt(r2 > 1e-12 ? r2 : 1e-12);
         const double size = t % 97 == 0 ? 0.3 : 0.004 + 0.01 * urand();
-        for (int k = 0; k < 3; k++) {
-            double x = c[0] * f + size * (urand() - 0.5);
-            double y = c[1] * f + size * (urand() - 0.5);
-            double z = c[2] * f + size * (urand() - 0.5);
-            if (t % 13 == 0 && k == 2) {   /* collinear: degenerate */
-                const double *a = s->xyz + 3 * (s->nverts - 2);
-                const double *b = s->xyz + 3 * (s->nverts - 1);
-                x = 2 * b[0] - a[0];
-                y = 2 * b[1] - a[1];
-                z = 2 * b[2] - a[2];
-            }
-            st_soup_add_vertex(s, x, y, z, NULL);
-        }
-        uint32_t v = (uint32_t)(3 * t);
-        st_soup_add_triangle(s, v, v + 1, v + 2, NULL);
+        const double on[3] = {c[0] * f, c[1] * f, c[2] * f};
+        add_random_triangle(s, on, size, t % 13 == 0);
     }
     return s;
 }
 
-/* The band pass on a fine soup (each brick's octants walk their own
- * candidate lists): every voxel is the true distance, with the default
- * padding and with none (bricks cut by the grid's sides, odd octants),
- * for bands of 3 and 4.5 voxels. */
+/* The band pass on a fine soup (many candidates per brick, large
+ * collinear triangles whose normal is rounding noise): every voxel is the
+ * true distance, with the default padding and with none (bricks cut by the
+ * grid's sides), for bands of 3 and 4.5 voxels. */
 static void test_fine_soup_exact(void)
 {
     st_soup *s = fine_soup(20000);
