@@ -143,18 +143,31 @@ static void setup_triangle(tri_setup *t, const st_soup *s, size_t tri)
     for (int k = 0; k < 3; k++)
         memcpy(t->v[k], s->xyz + 3 * (size_t)s->tris[3 * tri + k],
                3 * sizeof(double));
-    double emax = 0.0;
+    double eemax = 0.0;
     for (int i = 0; i < 3; i++) {
         st_sub3(t->e[i], t->v[(i + 1) % 3], t->v[i]);
         double ee = st_dot3(t->e[i], t->e[i]);
         t->inv_ee[i] = ee > 0.0 ? 1.0 / ee : 0.0;
-        emax = fmax(emax, st_norm3(t->e[i]));
+        eemax = MAX2(eemax, ee);
     }
     double n[3];
     st_cross3(n, t->e[0], t->e[1]);
     double nl = st_norm3(n);
-    /* Same rule as st_point_triangle_dist2 (geom.h explains the ratio). */
-    t->degenerate = !(nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
+    /* Same rule as st_point_triangle_dist2 (geom.h explains the ratio),
+     * with the longest edge squared as st_norm3 gives it. The plain square
+     * eemax is that within a few ulps, so unless nl is within a 1e-12 of
+     * the threshold (or eemax near the exponent range's ends) it decides
+     * the same way without the three scaled norms. */
+    const double thr = ST_DEGENERATE_AREA_RATIO * eemax;
+    if (eemax > 1e-280 && eemax < 1e280 && nl > thr * (1.0 + 1e-12))
+        t->degenerate = 0;
+    else if (eemax > 1e-280 && eemax < 1e280 && nl < thr * (1.0 - 1e-12))
+        t->degenerate = 1;
+    else {
+        const double emax = fmax(st_norm3(t->e[0]),
+                                 fmax(st_norm3(t->e[1]), st_norm3(t->e[2])));
+        t->degenerate = !(nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
+    }
     t->dom = 0;
     if (t->degenerate) {
         memset(t->nu, 0, sizeof t->nu);
@@ -262,18 +275,26 @@ static void triangle_bricks(const st_grid *g, const brick_grid *bg,
         lo[a] /= BRICK;
         hi[a] /= BRICK;
     }
-    double e1[3], e2[3], nrm[3];
+    double e1[3], e2[3], e3[3], nrm[3];
     st_sub3(e1, v[1], v[0]);
     st_sub3(e2, v[2], v[0]);
+    st_sub3(e3, v[2], v[1]);
     st_cross3(nrm, e1, e2);
     double nl = st_norm3(nrm);
-    int use_plane = nl > 0.0;
+    const double ee = MAX2(st_dot3(e1, e1), MAX2(st_dot3(e2, e2), st_dot3(e3, e3)));
+    /* The plane only for a triangle far from collinear: the rounding in
+     * the normal of a sliver (or of a collinear triangle, whose normal is
+     * rounding alone) tilts it by about 1e-16 * ee / nl radians, so the
+     * triangle's far end leaves that plane; here the tilt is below 1e-9
+     * of the longest edge, which the plane's slack covers. */
+    int use_plane = nl > 1e-6 * ee && isfinite(ee);
     if (use_plane)
         for (int a = 0; a < 3; a++)
             nrm[a] /= nl;
     /* Small slack: these tests only prune, so erring wide is safe. */
     const double reach = (B + bg->half_diag) * (1.0 + 1e-9) + 1e-12 * h;
     const double reach_ball = reach + ball->r;
+    const double reach_plane = reach + 1e-9 * sqrt(ee);
     size_t b[3];
     double c[3];    /* brick b's center, each axis set where b[a] moves */
     for (b[2] = lo[2]; b[2] <= hi[2]; b[2]++) {
@@ -288,7 +309,7 @@ static void triangle_bricks(const st_grid *g, const brick_grid *bg,
                     continue;
                 if (use_plane) {
                     st_sub3(w, c, v[0]);
-                    if (fabs(st_dot3(w, nrm)) > reach)
+                    if (fabs(st_dot3(w, nrm)) > reach_plane)
                         continue;
                 }
                 visit(b[0] + bg->n[0] * (b[1] + bg->n[1] * b[2]), ctx);

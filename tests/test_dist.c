@@ -44,6 +44,27 @@ static double urand(void)
     return (double)((rng >> 8) & 0xffffff) / 16777216.0;
 }
 
+/* A random triangle of the given size around c appended to s; with
+ * `collinear`, its third vertex continues the first two (degenerate). */
+static void add_random_triangle(st_soup *s, const double c[3], double size, int collinear)
+{
+    for (int k = 0; k < 3; k++) {
+        double x = c[0] + size * (urand() - 0.5);
+        double y = c[1] + size * (urand() - 0.5);
+        double z = c[2] + size * (urand() - 0.5);
+        if (collinear && k == 2) {
+            const double *a = s->xyz + 3 * (s->nverts - 2);
+            const double *b = s->xyz + 3 * (s->nverts - 1);
+            x = 2 * b[0] - a[0];
+            y = 2 * b[1] - a[1];
+            z = 2 * b[2] - a[2];
+        }
+        st_soup_add_vertex(s, x, y, z, NULL);
+    }
+    uint32_t v = (uint32_t)(s->nverts - 3);
+    st_soup_add_triangle(s, v, v + 1, v + 2, NULL);
+}
+
 /* Random triangles of all sizes and orientations, some degenerate. */
 static st_soup *random_soup(size_t n)
 {
@@ -51,21 +72,7 @@ static st_soup *random_soup(size_t n)
     for (size_t t = 0; t < n; t++) {
         double c[3] = {urand(), urand(), urand()};
         double size = t % 7 == 0 ? 0.8 : 0.05 + 0.1 * urand();
-        for (int k = 0; k < 3; k++) {
-            double x = c[0] + size * (urand() - 0.5);
-            double y = c[1] + size * (urand() - 0.5);
-            double z = c[2] + size * (urand() - 0.5);
-            if (t % 11 == 0 && k == 2) {   /* collinear: degenerate */
-                const double *a = s->xyz + 3 * (s->nverts - 2);
-                const double *b = s->xyz + 3 * (s->nverts - 1);
-                x = 2 * b[0] - a[0];
-                y = 2 * b[1] - a[1];
-                z = 2 * b[2] - a[2];
-            }
-            st_soup_add_vertex(s, x, y, z, NULL);
-        }
-        uint32_t v = (uint32_t)(3 * t);
-        st_soup_add_triangle(s, v, v + 1, v + 2, NULL);
+        add_random_triangle(s, c, size, t % 11 == 0);
     }
     return s;
 }
@@ -362,6 +369,70 @@ static void test_threads_identical(void)
 #endif
 }
 
+/* A fine soup: many triangles per voxel near a sphere, a few large and
+ * degenerate ones among them. */
+static st_soup *fine_soup(size_t n)
+{
+    st_soup *s = st_soup_new();
+    for (size_t t = 0; t < n; t++) {
+        double c[3], r2 = 0.0;
+        for (int a = 0; a < 3; a++) {
+            c[a] = urand() - 0.5;
+            r2 += c[a] * c[a];
+        }
+        const double f = 0.4 / sqrt(r2 > 1e-12 ? r2 : 1e-12);
+        const double size = t % 97 == 0 ? 0.3 : 0.004 + 0.01 * urand();
+        const double on[3] = {c[0] * f, c[1] * f, c[2] * f};
+        add_random_triangle(s, on, size, t % 13 == 0);
+    }
+    return s;
+}
+
+/* The band pass on a fine soup (many candidates per brick, large
+ * collinear triangles whose normal is rounding noise): every voxel is the
+ * true distance, with the default padding and with none (bricks cut by the
+ * grid's sides), for bands of 3 and 4.5 voxels. */
+static void test_fine_soup_exact(void)
+{
+    st_soup *s = fine_soup(20000);
+    st_error err;
+    st_bvh *bvh = NULL;
+    if (st_bvh_build(&bvh, s, &err) != ST_OK) {
+        TAP_CHECK(0, "bvh of the fine soup: %s", err.msg);
+        st_soup_free(s);
+        return;
+    }
+    for (int pad = -1; pad <= 0; pad++) {
+        st_dist_params p = st_dist_params_default();
+        p.cells = 41;
+        p.pad = pad;
+        p.band = pad < 0 ? 3.0 : 4.5;
+        st_grid *g = NULL;
+        if (st_dist_field(&g, s, &p, NULL, &err) != ST_OK) {
+            TAP_CHECK(0, "fine soup field: %s", err.msg);
+            continue;
+        }
+        const size_t n = st_grid_count(g);
+        size_t bad = 0, inband = 0;
+        #pragma omp parallel for reduction(+ : bad, inband) schedule(dynamic, 256)
+        for (size_t idx = 0; idx < n; idx++) {
+            size_t i = idx % g->nx, j = (idx / g->nx) % g->ny, k = idx / (g->nx * g->ny);
+            double q[3];
+            st_grid_center(g, i, j, k, q);
+            double ref = true_dist(s, bvh, q);
+            double want = ref < g->band ? ref : g->band;
+            inband += ref < g->band;
+            if (fabs(g->data[idx] - want) > 1e-6 * fmax(want, g->voxel))
+                bad++;
+        }
+        TAP_CHECK(bad == 0 && inband > 1000, "fine soup, pad %d, band %g: every voxel is the "
+                  "true distance (%zu bad, %zu in band)", pad, p.band, bad, inband);
+        st_grid_free(g);
+    }
+    st_bvh_free(bvh);
+    st_soup_free(s);
+}
+
 /* A real model: sampled voxels against brute force. */
 static void test_real_model(void)
 {
@@ -414,6 +485,7 @@ int main(void)
     test_bvh_nearest();
     test_bvh_parallel_layout();
     test_threads_identical();
+    test_fine_soup_exact();
     test_real_model();
     return tap_done();
 }
