@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <math.h>
+#include "souptet/bvh.h"
 #include "souptet/err.h"
 #include "souptet/geom.h"
 #include "souptet/soup.h"
@@ -47,15 +48,24 @@ static inline double bend(const double *a, const double *b)
     return atan2(st_norm3(c), st_dot3(a, b));
 }
 
+/* The surviving soup a rebuilt corner's triangles may not pierce
+ * (st_tri_tri_cross; touching it is no crossing): its BVH and which of
+ * its triangles count (edges.h's kept). NULL or bvh NULL: no test. */
+typedef struct st_holes_guard {
+    const st_bvh *bvh;
+    const uint8_t *kept;
+} st_holes_guard;
+
 /* The cap of the loop pts[0..n) (n >= 3) from a corner rebuilt from the
  * planes of the soup's triangles along it (side[i]: the third point of
  * the triangle on edge pts[i] -> pts[i + 1 mod n]; see holes_planes.c):
- * the cone from the apex that bends least, when it bends less than
+ * the cone from the apex that bends least (of those whose cone pierces
+ * no triangle of guard's soup), when it bends less than
  * `below`, is appended to out (n + 1 vertices, n triangles) and *done set
  * to 1; else out is left as it was and *done is 0. ST_ENOMEM, ST_ELIMIT. */
 st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
                               const double *const *side, size_t n, double below,
-                              double *bent, st_error *err);
+                              const st_holes_guard *guard, double *bent, st_error *err);
 
 /* A triangulation of the loop pts[0..n) (side as above): fills
  * tri[3 (n - 2)] with local indices; < 0 when out of memory. */
@@ -64,13 +74,15 @@ typedef double (*st_holes_fill)(const double *const *pts, const double *const *s
 
 /* The cap of the loop from several rebuilt corners: the point where planes
  * along the loop meet that continues most of its length, fans from it over
- * the edges it continues, the rest of the loop (split where it meets the
+ * the edges it continues (where its fan pierces none of guard's soup),
+ * the rest of the loop (split where it meets the
  * point more than once) capped the same way, and what no such point
  * continues by fill (see holes_planes.c). Appended to out with *done 1 when
  * it bends along the loop less than `below`; else out is left as it was.
  * ST_ENOMEM, ST_ELIMIT. */
 st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts,
                                const double *const *side, size_t n, double below,
-                               st_holes_fill fill, double *bent, st_error *err);
+                               st_holes_fill fill, const st_holes_guard *guard, double *bent,
+                               st_error *err);
 
 #endif

@@ -319,6 +319,45 @@ int st_tri_tri_intersect(const double a0[3], const double a1[3],
     return tri_tri_core(A, B, NULL);
 }
 
+/* 1 when signs s[0..3) hold both a +1 and a -1. */
+static int straddles(const int *s)
+{
+    return (s[0] > 0 || s[1] > 0 || s[2] > 0) && (s[0] < 0 || s[1] < 0 || s[2] < 0);
+}
+
+int st_tri_tri_cross(const double a0[3], const double a1[3], const double a2[3],
+                     const double b0[3], const double b1[3], const double b2[3])
+{
+    const double *A[3] = {a0, a1, a2}, *B[3] = {b0, b1, b2};
+    if (boxes_apart(A, 3, B, 3))
+        return 0;
+    int sa[3], sb[3];
+    for (int j = 0; j < 3; j++)
+        sb[j] = o3(a0, a1, a2, B[j]);
+    if (!straddles(sb))
+        return 0;
+    for (int j = 0; j < 3; j++)
+        sa[j] = o3(b0, b1, b2, A[j]);
+    if (!straddles(sa))
+        return 0;
+    /* both proper, not coplanar; a common vertex is on both planes, so
+     * there is at most one (a second would leave the third alone on one
+     * side) */
+    int ia = -1, ib = -1;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (same_point(A[i], B[j]))
+                ia = i, ib = j;
+    if (ia < 0)
+        return tri_tri_core(A, B, sa);
+    /* A n B is a segment of the line where the planes meet, from the
+     * common vertex; its far end lies on the edge of A or of B opposite
+     * that vertex (an edge at the vertex is off the line, the other
+     * vertices straddling) */
+    return st_segment_tri_intersect(A[(ia + 1) % 3], A[(ia + 2) % 3], b0, b1, b2) ||
+           st_segment_tri_intersect(B[(ib + 1) % 3], B[(ib + 2) % 3], a0, a1, a2);
+}
+
 /* The faces of tet t, ordered so that orient3d(F[i][0], F[i][1], F[i][2], v)
  * equals orient3d of the tet with corner i replaced by v. */
 static void tet_faces(const double *const t[4], const double *F[4][3])

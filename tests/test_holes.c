@@ -4,6 +4,7 @@
  */
 #include "souptet/dist.h"
 #include "souptet/holes.h"
+#include "souptet/isect.h"
 #include "souptet/sign.h"
 #include "souptet/solid.h"
 #include "shapes.h"
@@ -636,11 +637,60 @@ static void test_corner(void)
     st_soup_free(whole);
 }
 
+/* How many triangles of caps pierce triangle (a, b, c). */
+static size_t piercing(const st_soup *caps, const double *a, const double *b, const double *c)
+{
+    size_t k = 0;
+    for (size_t t = 0; t < caps->ntris; t++) {
+        const uint32_t *v = caps->tris + 3 * t;
+        k += (size_t)st_tri_tri_cross(caps->xyz + 3 * (size_t)v[0], caps->xyz + 3 * (size_t)v[1],
+                                      caps->xyz + 3 * (size_t)v[2], a, b, c);
+    }
+    return k;
+}
+
+/* A rebuilt corner whose cone would pierce a surviving face: the box
+ * without its corner, and a small triangle of the soup standing through
+ * the lost square on the face x = 1 near the corner. The cone from
+ * (1, 1, 1) crosses it; the cap may not (the cone is rejected, and the
+ * fans from the corner over the edges it pierces). (Not every such
+ * crossing is kept out: where the loop the fans leave, through the
+ * corner, is capped over the standing triangle, nothing tests that cap.) */
+static void test_corner_pierced(void)
+{
+    static const double pin[3][3] = {{0.9, 0.95, 0.8}, {1.1, 0.95, 0.8}, {1.0, 0.95, 0.9}};
+    st_soup *cut = cornered_box(1), *caps = NULL;
+    st_holes_params hp = st_holes_params_default();
+    hp.planes = 1;
+    st_holes_stats hs;
+    st_error err;
+    int ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err);
+    const size_t before = ok ? piercing(caps, pin[0], pin[1], pin[2]) : 0;
+    TAP_CHECK(ok && hs.rebuilt == 1 && before > 0,
+              "without the standing triangle the corner's cone crosses where it stands "
+              "(%zu triangles)", before);
+    st_soup_free(caps);
+    caps = NULL;
+    const size_t base = cut->nverts;
+    for (int i = 0; i < 3; i++)
+        st_soup_add_vertex(cut, pin[i][0], pin[i][1], pin[i][2], NULL);
+    st_soup_add_triangle(cut, (uint32_t)base, (uint32_t)base + 1, (uint32_t)base + 2, NULL);
+    ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err);
+    const size_t after = ok ? piercing(caps, pin[0], pin[1], pin[2]) : 1;
+    TAP_CHECK(ok && hs.loops == 2 && hs.filled == 1 && after == 0,
+              "with it (a loop of its own, open), the box's is capped and no cap pierces it "
+              "(%zu loops, %zu capped, %zu rebuilt, %zu piercing)",
+              hs.loops, hs.filled, hs.rebuilt, after);
+    st_soup_free(caps);
+    st_soup_free(cut);
+}
+
 int main(void)
 {
     test_which_loops();
     test_pseudo_volume();
     test_bend();
     test_corner();
+    test_corner_pierced();
     return tap_done();
 }

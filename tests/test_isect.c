@@ -740,9 +740,39 @@ static void test_bvh_query_box(void)
     st_soup_free(s);
 }
 
+/* st_tri_tri_cross: piercing, not touching, either way round. */
+static void test_tri_tri_cross(void)
+{
+    static const double A[3][3] = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+    static const struct {
+        double b[3][3];
+        int cross, meet;
+        const char *what;
+    } c[] = {
+        {{{0.5, 0.5, -1}, {0.5, 0.5, 1}, {0.6, 0.7, 1}}, 1, 1, "one through the other"},
+        {{{0.5, 0.5, 0}, {0.9, 0.5, 0}, {0.5, 0.5, 1}}, 0, 1, "an edge lying on the other"},
+        {{{0.5, 0.5, 0}, {0.5, 0.6, 1}, {0.7, 0.5, 1}}, 0, 1, "a vertex on the other"},
+        {{{0.5, 0.5, 0}, {3, 0.5, 0}, {0.5, 3, 0}}, 0, 1, "coplanar, overlapping"},
+        {{{0, 0, 0}, {1, 1, -1}, {1, 1, 1}}, 1, 1, "a common vertex, piercing beyond it"},
+        {{{0, 0, 0}, {-1, -1, -1}, {-1, -1, 1}}, 0, 1, "a common vertex, meeting only there"},
+        {{{0, 0, 0}, {2, 0, 0}, {1, -1, 1}}, 0, 1, "a common edge"},
+        {{{0, 0, 0}, {2, 0, 0}, {1, 0.5, 0}}, 0, 1, "a common edge, folded onto it"},
+        {{{3, 3, -1}, {3, 3, 1}, {4, 3, 0}}, 0, 0, "apart"},
+    };
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        const double(*b)[3] = c[i].b;
+        const int r = st_tri_tri_cross(A[0], A[1], A[2], b[0], b[1], b[2]);
+        const int s = st_tri_tri_cross(b[2], b[0], b[1], A[1], A[2], A[0]);
+        const int m = st_tri_tri_intersect(A[0], A[1], A[2], b[0], b[1], b[2]);
+        TAP_CHECK(r == c[i].cross && s == r && m == c[i].meet,
+                  "tri_tri_cross: %s: %d / %d (meet %d)", c[i].what, r, s, m);
+    }
+}
+
 int main(void)
 {
     test_point_in_tet();
+    test_tri_tri_cross();
     test_point_in_tri();
     test_segment_tri();
     test_tri_tri();

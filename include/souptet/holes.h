@@ -36,10 +36,11 @@
  * centroid), within the loop's box grown by 0.75 of its extent, over the
  * loop replaces the cap when its triangles continue the soup's along the
  * loop clearly better (the sum over the loop's edges of length times
- * dihedral angle below half the cap's): a box's lost corner comes back
+ * dihedral angle below half the cap's) and none of its triangles pierces
+ * the soup (isect.h's st_tri_tri_cross): a box's lost corner comes back
  * whole. Where a hole spans several corners, such a point of the planes
  * may continue only part of the loop: the fans from it over the edges it
- * continues replace them, and the rest of the loop (split where it meets
+ * continues (but those that pierce the soup) replace them, and the rest of the loop (split where it meets
  * the point more than once) is capped the same way, at most 16 points per
  * loop, what none continues by the cap of its own points; the fans or the
  * single cone, whichever continues the soup along the loop better: a

@@ -35,6 +35,16 @@ int st_tri_tri_intersect(const double a0[3], const double a1[3],
                          const double a2[3], const double b0[3],
                          const double b1[3], const double b2[3]);
 
+/* 1 when the closed triangles (a0 a1 a2) and (b0 b1 b2) pierce each
+ * other: each has vertices strictly on both sides of the other's plane,
+ * and they share a point beyond the vertex they may have in common (equal
+ * positions). Triangles that only touch (a vertex or an edge on the
+ * other's plane, a common edge), coplanar and degenerate ones do not
+ * cross (0). For a patch across a hole: does it pierce the surface whose
+ * rim it meets? */
+int st_tri_tri_cross(const double a0[3], const double a1[3], const double a2[3],
+                     const double b0[3], const double b1[3], const double b2[3]);
+
 /* 1 when the closed segment [p, q] and the closed triangle (a b c) share
  * a point, else 0. */
 int st_segment_tri_intersect(const double p[3], const double q[3],
