@@ -511,7 +511,8 @@ def previous_rows(bench):
         return {}
     out = {}
     for r in old.get("rows", []):
-        if r.get("mesher") == "souptet" and r.get("tries") == 1 and r.get("status") == "ok":
+        if (r.get("mesher") == "souptet" and r.get("tries") == 1 and r.get("status") == "ok"
+                and r.get("offset") is None):
             out[(r["model"], r["damage"])] = r
     return out
 
@@ -539,8 +540,10 @@ def _encloses_ok(r):
 
 
 def fill_rows(rows):
-    """souptet's --tries 1 rows, clean and damaged, in run order."""
-    return [r for r in rows if r.get("mesher") == "souptet" and r.get("tries") == 1]
+    """souptet's --tries 1 rows at the default offset, clean and damaged, in
+    run order (the rows at --offset OFFSET_TIGHT carry no fill measurement)."""
+    return [r for r in rows if r.get("mesher") == "souptet" and r.get("tries") == 1
+            and r.get("offset") is None]
 
 
 def fill_markdown(rows, previous):
