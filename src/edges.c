@@ -14,6 +14,7 @@
 #include "souptet/edges.h"
 #include "souptet/mem.h"
 #include "souptet/weld.h"
+#include "radix.h"
 #include "unionfind.h"
 
 #include <stdlib.h>
@@ -23,36 +24,6 @@ typedef struct tri_key {
     uint32_t k[3];      /* sorted welded corners */
     uint32_t t;
 } tri_key;
-
-/* Stable least-significant-digit radix sort of n elements of `size` bytes
- * (at most 16) by `passes` 16-bit digits, digit(x, 0) the least
- * significant; tmp holds n elements. A pass whose digit is the same for
- * every element moves nothing. Both orders below are total (ties by
- * triangle), so this is qsort's order with its comparator, without its
- * comparisons (issue 23: qsort was a third of the dragon's edge table). */
-static void radix_sort(void *a, void *tmp, size_t n, size_t size, int passes,
-                       uint32_t (*digit)(const void *x, int pass, unsigned bits),
-                       unsigned bits, size_t *count)
-{
-    unsigned char *src = a, *dst = tmp;
-    for (int pass = 0; pass < passes; pass++) {
-        memset(count, 0, 65537 * sizeof *count);
-        for (size_t i = 0; i < n; i++)
-            count[digit(src + i * size, pass, bits) + 1]++;
-        if (n == 0 || count[digit(src, pass, bits) + 1] == n)
-            continue;
-        for (size_t d = 0; d < 65536; d++)
-            count[d + 1] += count[d];
-        for (size_t i = 0; i < n; i++)
-            memcpy(dst + size * count[digit(src + i * size, pass, bits)]++, src + i * size,
-                   size);
-        unsigned char *x = src;
-        src = dst;
-        dst = x;
-    }
-    if (src != a)
-        memcpy(a, src, n * size);
-}
 
 /* (k[0], k[1], k[2]) from the least significant 16 bits; the keys are
  * made in triangle order, so the stable passes leave ties by t */
@@ -151,7 +122,7 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
         nk++;
     }
     _Static_assert(sizeof(tri_key) <= sizeof(st_half_edge), "the scratch holds the keys");
-    radix_sort(keys, tmp, nk, sizeof *keys, 6, tri_digit, 0, count);
+    st_radix_sort(keys, tmp, nk, sizeof *keys, 6, tri_digit, 0, count);
 
     /* 2. half-edges of the kept triangles (with ST_EDGES_DUPLICATES, of
      * every non-degenerate one), made in triangle order */
@@ -182,7 +153,7 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
     unsigned bits = 0;
     while (bits < 32 && (e->nweld - 1) >> bits)
         bits++;
-    radix_sort(e->he, tmp, nh, sizeof *e->he, (int)((2 * bits + 15) / 16), half_digit, bits,
+    st_radix_sort(e->he, tmp, nh, sizeof *e->he, (int)((2 * bits + 15) / 16), half_digit, bits,
                count);
     free(tmp);
     free(count);

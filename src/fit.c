@@ -118,6 +118,8 @@
 #include "souptet/enclose.h"
 #include "souptet/tetqual.h"
 
+#include "radix.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -154,6 +156,7 @@ st_fit_params st_fit_params_default(void)
     p.quality_rounds = 40;
     p.quality_goal = 35.0;
     p.peel = 1;
+    p.count_before = 1;
     return p;
 }
 
@@ -167,6 +170,15 @@ static int cmp_pt(const void *a, const void *b)
         if (x[k] != y[k])
             return x[k] < y[k] ? -1 : 1;
     return 0;
+}
+
+/* Digit `pass` of the point's key (x, y, z), z's lowest 16 bits first:
+ * cmp_pt's order, sorted stably as qsort's merge sort did */
+static uint32_t pt_digit(const void *x, int pass, unsigned bits)
+{
+    const double *p = x;
+    (void)bits;
+    return (uint32_t)(st_radix_double_key(p[2 - pass / 4]) >> (16 * (pass & 3))) & 0xffffu;
 }
 
 static void pgrid_free(pgrid *g)
@@ -217,7 +229,16 @@ static st_status pgrid_build(pgrid *g, const st_soup *s, double cell)
         if (used[v])
             memcpy(g->pts + 3 * i++, s->xyz + 3 * v, 3 * sizeof(double));
     free(used);
-    qsort(g->pts, n, 3 * sizeof(double), cmp_pt);
+    double *tmp = st_malloc_array(n ? n : 1, 3 * sizeof *tmp);
+    size_t *count = st_malloc_array(65537, sizeof *count);
+    if (!tmp || !count) {
+        free(tmp);
+        free(count);
+        return ST_ENOMEM;
+    }
+    st_radix_sort(g->pts, tmp, n, 3 * sizeof(double), 12, pt_digit, 0, count);
+    free(tmp);
+    free(count);
     size_t k = 0;
     for (size_t i = 0; i < n; i++)
         if (k == 0 || cmp_pt(g->pts + 3 * (k - 1), g->pts + 3 * i) != 0) {
@@ -737,7 +758,9 @@ dist_summary sm_boundary_distances(const fit_ctx *c, double *dist)
         }
         const double *x = sm->m->xyz + 3 * v;
         double *o = c->dpos ? c->dpos + 3 * v : NULL;
-        if (o && !isnan(o[0])) {
+        if (o && o[0] == x[0] && o[1] == x[1] && o[2] == x[2]) {
+            /* not moved since dist[v] was found: the same distance */
+        } else if (o && !isnan(o[0])) {
             /* the distance changed by at most the way the vertex moved:
              * a search bounded by that (with room for rounding) finds the
              * same nearest distance faster; unbounded if it finds none */
@@ -1211,8 +1234,8 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
         c.dpos[3 * v] = NAN;
     }
     sm_dihedral_range(m, &st.min_dihedral_before, &st.max_dihedral_before);
-    rc = st_enclosure_count(m, s, bvh, &st.outside_before, &st.crossing_before, err);
-    if (rc)
+    if (p.count_before &&
+        (rc = st_enclosure_count(m, s, bvh, &st.outside_before, &st.crossing_before, err)))
         goto done;
 
     dist_summary ds = sm_boundary_distances(&c, dist);

@@ -190,6 +190,7 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
     fp.cell_width = h;
     fp.quality = p->quality;
     fp.fill = fill;
+    fp.count_before = 0;   /* only the count after is reported */
     if (p->fit_max_iters > 0)
         fp.max_iters = p->fit_max_iters;
     st_fit_stats fs;

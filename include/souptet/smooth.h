@@ -133,6 +133,12 @@ typedef struct st_fit_params {
                               pseudo volume's fill, st_pseudo_fill). The
                               mesh still encloses S alone. NULL: none
                               (default NULL) */
+    int count_before;      /* 1: count the enclosure on entry into the
+                              stats' *_before (an exact pass over S, as
+                              long as the one after); 0: skip it, the
+                              counts read 0 (the pipeline's sculpted
+                              meshes, checked after the fit anyway)
+                              (default 1) */
     st_fit_iter_fn on_iter;   /* called after every iteration; may be NULL */
     void *on_iter_ctx;
 } st_fit_params;
@@ -158,8 +164,9 @@ typedef struct st_fit_stats {
     double min_dihedral_before, max_dihedral_before;   /* the input */
     double min_dihedral_fit, max_dihedral_fit;         /* after the fit */
     double min_dihedral_after, max_dihedral_after;     /* after quality */
-    /* Enclosure of S, counted over the whole mesh before and after (exact):
-     * S vertices outside the mesh, S triangles meeting a boundary face. */
+    /* Enclosure of S, counted over the whole mesh before (unless
+     * !count_before) and after (exact): S vertices outside the mesh, S
+     * triangles meeting a boundary face. */
     size_t outside_before, crossing_before;
     size_t outside_after, crossing_after;
     double seconds_fit, seconds_quality;
