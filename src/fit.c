@@ -172,13 +172,36 @@ static int cmp_pt(const void *a, const void *b)
     return 0;
 }
 
-/* Digit `pass` of the point's key (x, y, z), z's lowest 16 bits first:
- * cmp_pt's order, sorted stably as qsort's merge sort did */
-static uint32_t pt_digit(const void *x, int pass, unsigned bits)
+/* Digit `pass` of the point's x key (st_radix_double_key) */
+static uint32_t pt_x_digit(const void *x, int pass, unsigned bits)
 {
     const double *p = x;
     (void)bits;
-    return (uint32_t)(st_radix_double_key(p[2 - pass / 4]) >> (16 * (pass & 3))) & 0xffffu;
+    return (uint32_t)(st_radix_double_key(p[0]) >> (16 * pass)) & 0xffffu;
+}
+
+/* The n points at pts in cmp_pt's order, stably (as qsort's merge sort
+ * did): a stable radix sort by x, then each run of equal x by cmp_pt
+ * (glibc's qsort is a stable merge sort at these sizes). */
+static st_status sort_points(double *pts, size_t n)
+{
+    double *tmp = st_malloc_array(n ? n : 1, 3 * sizeof *tmp);
+    size_t *count = st_malloc_array(65537, sizeof *count);
+    if (!tmp || !count) {
+        free(tmp);
+        free(count);
+        return ST_ENOMEM;
+    }
+    st_radix_sort(pts, tmp, n, 3 * sizeof(double), 4, pt_x_digit, 0, count);
+    free(tmp);
+    free(count);
+    for (size_t i = 0, j; i < n; i = j) {
+        for (j = i + 1; j < n && pts[3 * j] == pts[3 * i]; j++)
+            ;
+        if (j - i > 1)
+            qsort(pts + 3 * i, j - i, 3 * sizeof(double), cmp_pt);
+    }
+    return ST_OK;
 }
 
 static void pgrid_free(pgrid *g)
@@ -229,16 +252,8 @@ static st_status pgrid_build(pgrid *g, const st_soup *s, double cell)
         if (used[v])
             memcpy(g->pts + 3 * i++, s->xyz + 3 * v, 3 * sizeof(double));
     free(used);
-    double *tmp = st_malloc_array(n ? n : 1, 3 * sizeof *tmp);
-    size_t *count = st_malloc_array(65537, sizeof *count);
-    if (!tmp || !count) {
-        free(tmp);
-        free(count);
+    if (sort_points(g->pts, n))
         return ST_ENOMEM;
-    }
-    st_radix_sort(g->pts, tmp, n, 3 * sizeof(double), 12, pt_digit, 0, count);
-    free(tmp);
-    free(count);
     size_t k = 0;
     for (size_t i = 0; i < n; i++)
         if (k == 0 || cmp_pt(g->pts + 3 * (k - 1), g->pts + 3 * i) != 0) {

@@ -1,5 +1,6 @@
 /*
- * radix.h - a stable least-significant-digit radix sort (private).
+ * radix.h - a stable least-significant-digit radix sort (private, header
+ * only: each caller gets a copy with its digit function inlined).
  *
  * For sorts whose order is total and whose keys are short: qsort's
  * comparisons and indirect calls were a third of the dragon's edge table
@@ -10,6 +11,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 /* The 16-bit digit number `pass` of element x (pass 0 the least
  * significant); bits is the caller's, passed through. */
@@ -19,8 +21,28 @@ typedef uint32_t (*st_radix_digit)(const void *x, int pass, unsigned bits);
  * elements with equal digits keep their order. tmp holds n elements,
  * count 65537 size_t. A pass whose digit is the same for every element
  * moves nothing. */
-void st_radix_sort(void *a, void *tmp, size_t n, size_t size, int passes,
-                   st_radix_digit digit, unsigned bits, size_t *count);
+static inline void st_radix_sort(void *a, void *tmp, size_t n, size_t size, int passes,
+                                 st_radix_digit digit, unsigned bits, size_t *count)
+{
+    unsigned char *src = a, *dst = tmp;
+    for (int pass = 0; pass < passes; pass++) {
+        memset(count, 0, 65537 * sizeof *count);
+        for (size_t i = 0; i < n; i++)
+            count[digit(src + i * size, pass, bits) + 1]++;
+        if (n == 0 || count[digit(src, pass, bits) + 1] == n)
+            continue;
+        for (size_t d = 0; d < 65536; d++)
+            count[d + 1] += count[d];
+        for (size_t i = 0; i < n; i++)
+            memcpy(dst + size * count[digit(src + i * size, pass, bits)]++, src + i * size,
+                   size);
+        unsigned char *x = src;
+        src = dst;
+        dst = x;
+    }
+    if (src != a)
+        memcpy(a, src, n * size);
+}
 
 /* An unsigned key with the order of the double x: -0.0 and 0.0 get the
  * same key, as they compare equal (x not a NaN). */
