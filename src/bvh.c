@@ -24,6 +24,7 @@
 #include "souptet/geom.h"
 #include "souptet/isect.h"
 #include "souptet/mem.h"
+#include "souptet/pred.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -441,6 +442,80 @@ int st_bvh_query_tri(const st_bvh *b, const double a[3], const double bb[3],
         if (node_meets_tri(&b->nodes[r], q, lo, hi))
             stack[sp++] = r;
         if (node_meets_tri(&b->nodes[l], q, lo, hi))
+            stack[sp++] = l;
+    }
+    return 0;
+}
+
+/* 1 when the closed box [lo, hi] certainly lies strictly outside the tet
+ * whose face planes (each with the opposite corner as reference) are pl:
+ * one plane rejects all eight corners. The corner furthest toward the
+ * tet's side of a plane (by the rounded normal) is tried first: for a box
+ * the plane does not reject, that one test usually says so. */
+static int box_outside_tet(const st_plane_filter pl[4], const double lo[3], const double hi[3])
+{
+    for (int f = 0; f < 4; f++) {
+        int first = 0;
+        for (int k = 0; k < 3; k++)
+            if (pl[f].n[k] * (double)pl[f].side > 0.0)
+                first |= 1 << k;
+        int all = 1;
+        for (int c = 0; c < 8 && all; c++) {
+            const int corner = c ^ first;
+            const double q[3] = {corner & 1 ? hi[0] : lo[0], corner & 2 ? hi[1] : lo[1],
+                                 corner & 4 ? hi[2] : lo[2]};
+            all = st_plane_filter_rejects(&pl[f], q);
+        }
+        if (all)
+            return 1;
+    }
+    return 0;
+}
+
+int st_bvh_query_tet(const st_bvh *b, const double *const p[4],
+                     int (*visit)(void *ctx, uint32_t tri), void *ctx)
+{
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = hi[a] = p[0][a];
+        for (int c = 1; c < 4; c++) {
+            lo[a] = p[c][a] < lo[a] ? p[c][a] : lo[a];
+            hi[a] = p[c][a] > hi[a] ? p[c][a] : hi[a];
+        }
+    }
+    st_plane_filter pl[4];
+    for (int f = 0; f < 4; f++) {
+        const double *q[3];
+        for (int c = 0, n = 0; c < 4; c++)
+            if (c != f)
+                q[n++] = p[c];
+        st_plane_filter_init(&pl[f], q[0], q[1], q[2], p[f]);
+    }
+    uint32_t stack[STACK_DEPTH];
+    int sp = 0;
+    if (b->nnodes == 0 || !boxes_meet(b->nodes[0].lo, b->nodes[0].hi, lo, hi))
+        return 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const st_bvh_node *n = &b->nodes[stack[--sp]];
+        if (box_outside_tet(pl, n->lo, n->hi))
+            continue;
+        if (n->count) {
+            for (uint32_t i = 0; i < n->count; i++) {
+                const double *tb = b->tbox + 6 * (size_t)(n->start + i);
+                if (boxes_meet(tb, tb + 3, lo, hi) && !box_outside_tet(pl, tb, tb + 3)) {
+                    int r = visit(ctx, b->order[n->start + i]);
+                    if (r)
+                        return r;
+                }
+            }
+            continue;
+        }
+        uint32_t l = n->start, r = n->start + 1;
+        /* Right pushed first so the left is visited first. */
+        if (boxes_meet(b->nodes[r].lo, b->nodes[r].hi, lo, hi))
+            stack[sp++] = r;
+        if (boxes_meet(b->nodes[l].lo, b->nodes[l].hi, lo, hi))
             stack[sp++] = l;
     }
     return 0;

@@ -26,12 +26,11 @@
  * The sweep is thin for a small move, so most S vertices near the faces
  * are rejected by one plane test: q strictly on the other side of the plane
  * (x, a, b) from p, or of (p, a, b) from x, is not in the closed tet (for a
- * flat tet, p on the plane: q off it). The plane tests are orient3d's
- * determinant with the face's two edge vectors and their cross products
- * computed once per face and filtered by pred.c's error bound (the same six
- * monomials through at most five roundings, here with a margin of 16 u
- * instead of 9 u and 2^-1000 instead of 2^-1040 for underflow); a sign the
- * filter cannot certify rejects nothing. What passes is decided exactly by
+ * flat tet, p on the plane: q off it). The plane tests are pred.h's
+ * st_plane_filter (orient3d's determinant with the face's two edge vectors
+ * and their cross products computed once per face, filtered by orient3d's
+ * error bound with a margin); a sign the filter cannot certify rejects
+ * nothing. What passes is decided exactly by
  * st_point_in_tet and the star tests: no decision is taken in floating
  * point.
  */
@@ -47,57 +46,6 @@
 /* Boundary faces of a vertex handled here; a vertex with more (none in a
  * lattice) takes the gathering path. */
 #define SWEPT_MAX_FACES 48
-/* The filter's relative and absolute margins (see the top). */
-#define SWEPT_REL (16.0 * 0x1p-53)
-#define SWEPT_ABS 0x1p-1000
-
-/* A plane through o with edge vectors e1, e2 from it: their rounded values,
- * the three 2x2 minors of the cross product and the absolute sums the
- * permanent takes, and the exact side (of det [e1; e2; r - o]) of the
- * reference corner r, which the tet lies on. */
-typedef struct swept_plane {
-    const double *o;
-    double n[3], an[3];
-    int side;
-} swept_plane;
-
-static void plane_init(swept_plane *pl, const double *o, const double *a, const double *b,
-                       const double *r)
-{
-    double e1[3], e2[3];
-    for (int k = 0; k < 3; k++) {
-        e1[k] = a[k] - o[k];
-        e2[k] = b[k] - o[k];
-    }
-    double m[6] = {e1[1] * e2[2], e1[2] * e2[1], e1[2] * e2[0],
-                   e1[0] * e2[2], e1[0] * e2[1], e1[1] * e2[0]};
-    for (int k = 0; k < 3; k++) {
-        pl->n[k] = m[2 * k] - m[2 * k + 1];
-        pl->an[k] = fabs(m[2 * k]) + fabs(m[2 * k + 1]);
-    }
-    pl->o = o;
-    /* orient3d(o, a, b, r) = -det [a - o; b - o; r - o] */
-    double s = st_orient3d(o, a, b, r);
-    pl->side = s < 0 ? 1 : (s > 0 ? -1 : 0);
-}
-
-/* 1 when q is certainly outside the closed half-space (or, for side 0,
- * the plane) the tet lies in; 0 when it may be inside or the filter cannot
- * tell. */
-static int plane_rejects(const swept_plane *pl, const double q[3])
-{
-    double d0 = q[0] - pl->o[0], d1 = q[1] - pl->o[1], d2 = q[2] - pl->o[2];
-    double det = d0 * pl->n[0] + d1 * pl->n[1] + d2 * pl->n[2];
-    double a0 = fabs(d0), a1 = fabs(d1), a2 = fabs(d2);
-    double perm = a0 * pl->an[0] + a1 * pl->an[1] + a2 * pl->an[2];
-    double bound = SWEPT_REL * perm + (a0 + a1 + a2 + 1.0) * SWEPT_ABS;
-    if (det > bound)
-        return pl->side <= 0;
-    if (-det > bound)
-        return pl->side >= 0;
-    return 0;
-}
-
 /* 1 when q lies in the closed star of v with v at y. */
 static int in_closed_star(const sm_mesh *sm, uint32_t v, const double y[3], const double q[3])
 {
@@ -127,7 +75,7 @@ int sm_swept_kept(const fit_ctx *c, uint32_t v, const double p[3], uint32_t *fai
     if (g->npts == 0 || nf == 0)
         return 1;
     const double *x = sm->m->xyz + 3 * (size_t)v;
-    swept_plane in[SWEPT_MAX_FACES], out[SWEPT_MAX_FACES];
+    st_plane_filter in[SWEPT_MAX_FACES], out[SWEPT_MAX_FACES];
     double box[SWEPT_MAX_FACES][6];
     const double *ab[SWEPT_MAX_FACES][2];
     double lo[3], hi[3];
@@ -143,8 +91,8 @@ int sm_swept_kept(const fit_ctx *c, uint32_t v, const double p[3], uint32_t *fai
                 ab[i][n++] = sm->m->xyz + 3 * (size_t)k[j];
         if (n != 2)
             return -1;   /* not a face of v: leave it to the full test */
-        plane_init(&in[i], x, ab[i][0], ab[i][1], p);
-        plane_init(&out[i], p, ab[i][0], ab[i][1], x);
+        st_plane_filter_init(&in[i], x, ab[i][0], ab[i][1], p);
+        st_plane_filter_init(&out[i], p, ab[i][0], ab[i][1], x);
         for (int a = 0; a < 3; a++) {
             box[i][a] = fmin(fmin(x[a], p[a]), fmin(ab[i][0][a], ab[i][1][a]));
             box[i][3 + a] = fmax(fmax(x[a], p[a]), fmax(ab[i][0][a], ab[i][1][a]));
@@ -172,7 +120,7 @@ int sm_swept_kept(const fit_ctx *c, uint32_t v, const double p[3], uint32_t *fai
                         if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] || q[0] > bx[3] ||
                             q[1] > bx[4] || q[2] > bx[5])
                             continue;
-                        if (plane_rejects(&in[i], q) || plane_rejects(&out[i], q))
+                        if (st_plane_filter_rejects(&in[i], q) || st_plane_filter_rejects(&out[i], q))
                             continue;
                         swept = st_point_in_tet(q, x, p, ab[i][0], ab[i][1]) != ST_OUTSIDE;
                     }

@@ -430,3 +430,23 @@ double st_orient3d(const double a[3], const double b[3], const double c[3],
         return 0.0;
     return orient3d_exact(a, b, c, d);
 }
+
+void st_plane_filter_init(st_plane_filter *pl, const double o[3], const double a[3],
+                          const double b[3], const double r[3])
+{
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = a[k] - o[k];
+        e2[k] = b[k] - o[k];
+    }
+    double m[6] = {e1[1] * e2[2], e1[2] * e2[1], e1[2] * e2[0],
+                   e1[0] * e2[2], e1[0] * e2[1], e1[1] * e2[0]};
+    for (int k = 0; k < 3; k++) {
+        pl->n[k] = m[2 * k] - m[2 * k + 1];
+        pl->an[k] = fabs(m[2 * k]) + fabs(m[2 * k + 1]);
+    }
+    pl->o = o;
+    /* orient3d(o, a, b, r) = -det [a - o; b - o; r - o] */
+    double s = st_orient3d(o, a, b, r);
+    pl->side = s < 0 ? 1 : (s > 0 ? -1 : 0);
+}

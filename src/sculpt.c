@@ -138,16 +138,11 @@ st_status st_sculpt_classify(unsigned char *keep, st_sculpt_stats *stats,
             k = ST_SCULPT_VOLUME;
             nvol++;
         } else if (bvh) {
-            double lo[3], hi[3];
-            for (int a = 0; a < 3; a++) {
-                lo[a] = fmin(fmin(p[0][a], p[1][a]), fmin(p[2][a], p[3][a]));
-                hi[a] = fmax(fmax(p[0][a], p[1][a]), fmax(p[2][a], p[3][a]));
-            }
             tri_ctx ctx;
             ctx.s = s;
             for (int c = 0; c < 4; c++)
                 ctx.p[c] = p[c];
-            if (st_bvh_query_box(bvh, lo, hi, visit_tri, &ctx)) {
+            if (st_bvh_query_tet(bvh, p, visit_tri, &ctx)) {
                 k = ST_SCULPT_SURFACE;
                 nsurf++;
             }

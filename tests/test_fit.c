@@ -366,6 +366,82 @@ static void test_bvh_query_tri(void)
     st_soup_free(s);
 }
 
+typedef struct tet_seen {
+    size_t visited;
+    unsigned char *seen;
+} tet_seen;
+
+static int tet_visit(void *ctx, uint32_t t)
+{
+    tet_seen *h = ctx;
+    h->visited++;
+    h->seen[t] = 1;
+    return 0;
+}
+
+/* st_bvh_query_tet against brute force (the sculpting's test): every
+ * sphere triangle that meets a tet (random ones, large and small; ones with
+ * a corner on a sphere vertex; ones with a face on a sphere triangle) is
+ * visited; and it visits far fewer than the box query of the tet's box. */
+static void test_bvh_query_tet(void)
+{
+    st_soup *s = st_soup_new();
+    add_sphere(s, 1.0, 2.0);
+    st_bvh *b = NULL;
+    st_error err;
+    TAP_CHECK(st_bvh_build(&b, s, &err) == ST_OK, "bvh over the sphere");
+    tet_seen h = {0, calloc(s->ntris, 1)};
+    size_t missed = 0, meeting = 0, boxed = 0;
+    unsigned rng = 4242u;
+    for (int k = 0; k < 300; k++) {
+        double p[4][3];
+        const double size = k % 3 == 0 ? 0.3 : 2.0;
+        double c[3];
+        for (int a = 0; a < 3; a++) {
+            rng = rng * 1103515245u + 12345u;
+            c[a] = -1.2 + 2.4 * (double)(rng >> 8) / (double)(1u << 24);
+        }
+        for (int i = 0; i < 4; i++)
+            for (int a = 0; a < 3; a++) {
+                rng = rng * 1103515245u + 12345u;
+                p[i][a] = c[a] + size * ((double)(rng >> 8) / (double)(1u << 24) - 0.5);
+            }
+        const uint32_t *tv = s->tris + 3 * (size_t)(k % s->ntris);
+        if (k % 10 == 1)   /* a corner exactly on a sphere vertex */
+            memcpy(p[0], s->xyz + 3 * (size_t)tv[0], sizeof p[0]);
+        if (k % 10 == 2)   /* a face exactly on a sphere triangle */
+            for (int i = 0; i < 3; i++)
+                memcpy(p[i], s->xyz + 3 * (size_t)tv[i], sizeof p[i]);
+        if (st_orient3d(p[0], p[1], p[2], p[3]) == 0.0)
+            continue;
+        const double *q[4] = {p[0], p[1], p[2], p[3]};
+        memset(h.seen, 0, s->ntris);
+        st_bvh_query_tet(b, q, tet_visit, &h);
+        for (size_t t = 0; t < s->ntris; t++) {
+            const uint32_t *v = s->tris + 3 * t;
+            if (st_tri_tet_intersect(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
+                                     s->xyz + 3 * (size_t)v[2], p[0], p[1], p[2], p[3])) {
+                meeting++;
+                missed += !h.seen[t];
+            }
+        }
+        double lo[3], hi[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(fmin(p[0][a], p[1][a]), fmin(p[2][a], p[3][a]));
+            hi[a] = fmax(fmax(p[0][a], p[1][a]), fmax(p[2][a], p[3][a]));
+        }
+        st_bvh_query_box(b, lo, hi, box_visit, &boxed);
+    }
+    TAP_CHECK(missed == 0 && meeting > 0,
+              "the tet query visits every triangle that meets the tet (%zu meet, %zu missed)",
+              meeting, missed);
+    TAP_CHECK(2 * h.visited < boxed, "and visits fewer than half of the box query's (%zu vs %zu)",
+              h.visited, boxed);
+    free(h.seen);
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
 typedef struct band_watch {
     st_tetmesh *m;
     const st_bvh *b;
@@ -627,6 +703,7 @@ int main(void)
     test_not_enclosing();
     test_refusals();
     test_bvh_query_tri();
+    test_bvh_query_tet();
     test_band_edge();
     test_peel();
     test_fill();

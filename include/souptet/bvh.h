@@ -62,6 +62,17 @@ int st_bvh_query_tri(const st_bvh *b, const double a[3], const double bb[3],
                      const double c[3], int (*visit)(void *ctx, uint32_t tri),
                      void *ctx);
 
+/* Call visit(ctx, tri) for every triangle whose bounding box meets the
+ * box of the tet (p[0], p[1], p[2], p[3]) and is not certainly outside the
+ * closed tet, in a node whose box is not (pred.h's st_plane_filter on the
+ * tet's face planes, all eight corners): a superset of the triangles that
+ * meet the closed tet, much smaller than st_bvh_query_box's where the
+ * triangles are dense around a large tet (the coarse lattice of a 10 M
+ * triangle soup). Stops at the first nonzero return of visit and returns
+ * it. The visiting order is fixed for a given tree and tet. Thread-safe. */
+int st_bvh_query_tet(const st_bvh *b, const double *const p[4],
+                     int (*visit)(void *ctx, uint32_t tri), void *ctx);
+
 #ifdef __cplusplus
 }
 #endif
