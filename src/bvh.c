@@ -37,8 +37,9 @@
 
 typedef struct build_ctx {
     const st_soup *s;
-    double *cent;          /* 3 per triangle */
-    double *box;           /* 6 per triangle: lo, hi */
+    double *cent;          /* 3 per position of order: the centroid of
+                              triangle order[i] at cent + 3 i, swapped
+                              with it (the scans read it in sequence) */
     uint32_t *order;
     st_bvh_node *nodes;
     size_t nnodes;
@@ -67,22 +68,28 @@ static void select_median(build_ctx *c, size_t lo, size_t hi, size_t mid,
                           int axis)
 {
     uint32_t *o = c->order;
+    double *ce = c->cent;
     ptrdiff_t l = (ptrdiff_t)lo, r = (ptrdiff_t)hi - 1, m = (ptrdiff_t)mid;
     while (l < r) {
-        double pivot = c->cent[3 * (size_t)o[l + (r - l) / 2] + axis];
+        double pivot = ce[3 * (size_t)(l + (r - l) / 2) + axis];
         ptrdiff_t i = l - 1, j = r + 1;
         for (;;) {
             do
                 i++;
-            while (c->cent[3 * (size_t)o[i] + axis] < pivot);
+            while (ce[3 * (size_t)i + axis] < pivot);
             do
                 j--;
-            while (c->cent[3 * (size_t)o[j] + axis] > pivot);
+            while (ce[3 * (size_t)j + axis] > pivot);
             if (i >= j)
                 break;
             uint32_t t = o[i];
             o[i] = o[j];
             o[j] = t;
+            for (int k = 0; k < 3; k++) {
+                double x = ce[3 * (size_t)i + k];
+                ce[3 * (size_t)i + k] = ce[3 * (size_t)j + k];
+                ce[3 * (size_t)j + k] = x;
+            }
         }
         /* [l, j] <= pivot <= [j+1, r], with l <= j < r */
         if (m <= j)
@@ -92,26 +99,21 @@ static void select_median(build_ctx *c, size_t lo, size_t hi, size_t mid,
     }
 }
 
-/* Set n's box to that of the triangles order[lo..hi); return the axis
- * along which their centroids spread widest (the split axis). */
-static int node_bounds(const build_ctx *c, st_bvh_node *n, size_t lo,
-                       size_t hi)
+/* Subtrees this large are built as tasks of their own (and node and
+ * triangle arrays this long are swept in parallel). */
+#define PARALLEL_MIN 32768
+
+/* The axis along which the centroids of the triangles order[lo..hi)
+ * spread widest (the split axis). The node's box is set after the build
+ * (node_boxes). */
+static int split_axis(const build_ctx *c, size_t lo, size_t hi)
 {
     double clo[3] = {INFINITY, INFINITY, INFINITY};
     double chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int k = 0; k < 3; k++) {
-        n->lo[k] = INFINITY;
-        n->hi[k] = -INFINITY;
-    }
     for (size_t i = lo; i < hi; i++) {
-        const double *tb = c->box + 6 * (size_t)c->order[i];
-        const double *ce = c->cent + 3 * (size_t)c->order[i];
+        const double *ce = c->cent + 3 * i;
         for (int k = 0; k < 3; k++) {
             /* plain comparisons: coordinates are finite (soup.h) */
-            if (tb[k] < n->lo[k])
-                n->lo[k] = tb[k];
-            if (tb[3 + k] > n->hi[k])
-                n->hi[k] = tb[3 + k];
             if (ce[k] < clo[k])
                 clo[k] = ce[k];
             if (ce[k] > chi[k])
@@ -123,6 +125,44 @@ static int node_bounds(const build_ctx *c, st_bvh_node *n, size_t lo,
         if (chi[k] - clo[k] > chi[axis] - clo[axis])
             axis = k;
     return axis;
+}
+
+/* Every node's box: a leaf's from its triangles' boxes (tbox, in order),
+ * then, children being numbered after their parent, each inner node's as
+ * the union of its children's, from the last node back. The same exact
+ * minima and maxima as a scan of each node's triangles, without log n
+ * passes over all of them. */
+static void node_boxes(st_bvh_node *nodes, size_t nnodes, const double *tbox)
+{
+    #pragma omp parallel for schedule(static) if (nnodes >= PARALLEL_MIN)
+    for (size_t i = 0; i < nnodes; i++) {
+        st_bvh_node *n = &nodes[i];
+        if (!n->count)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            n->lo[k] = INFINITY;
+            n->hi[k] = -INFINITY;
+        }
+        for (uint32_t j = 0; j < n->count; j++) {
+            const double *tb = tbox + 6 * (size_t)(n->start + j);
+            for (int k = 0; k < 3; k++) {
+                if (tb[k] < n->lo[k])
+                    n->lo[k] = tb[k];
+                if (tb[3 + k] > n->hi[k])
+                    n->hi[k] = tb[3 + k];
+            }
+        }
+    }
+    for (size_t i = nnodes; i-- > 0;) {
+        st_bvh_node *n = &nodes[i];
+        if (n->count)
+            continue;
+        const st_bvh_node *l = &nodes[n->start], *r = &nodes[n->start + 1];
+        for (int k = 0; k < 3; k++) {
+            n->lo[k] = l->lo[k] < r->lo[k] ? l->lo[k] : r->lo[k];
+            n->hi[k] = l->hi[k] > r->hi[k] ? l->hi[k] : r->hi[k];
+        }
+    }
 }
 
 /* The subtree of `node` over order[lo..hi), its nodes numbered from
@@ -142,7 +182,7 @@ static void build_serial(build_ctx *c, size_t node, size_t lo, size_t hi,
         sp--;
         size_t nd = stack[sp][0], a = stack[sp][1], b = stack[sp][2];
         st_bvh_node *n = &c->nodes[nd];
-        int axis = node_bounds(c, n, a, b);
+        int axis = split_axis(c, a, b);
         if (b - a <= ST_BVH_LEAF) {
             n->start = (uint32_t)a;
             n->count = (uint32_t)(b - a);
@@ -193,8 +233,6 @@ static size_t subtree_nodes(size_t n)
     return 2 * (l - 1);
 }
 
-/* Subtrees this large are built as tasks of their own. */
-#define PARALLEL_MIN 32768
 
 /* build_serial's tree, node for node, with the two halves of large
  * subtrees built in parallel: each child's numbering starts where the
@@ -209,7 +247,7 @@ static void build_parallel(build_ctx *c, size_t node, size_t lo, size_t hi,
         return;
     }
     st_bvh_node *n = &c->nodes[node];
-    int axis = node_bounds(c, n, lo, hi);
+    int axis = split_axis(c, lo, hi);
     size_t mid = lo + (hi - lo) / 2;
     select_median(c, lo, hi, mid, axis);
     size_t left = next;
@@ -237,14 +275,12 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
     c.cent = st_malloc_array(s->ntris, 3 * sizeof(double));
     c.order = st_malloc_array(s->ntris, sizeof(uint32_t));
     c.nodes = st_malloc_array(2 * s->ntris, sizeof(st_bvh_node));
-    c.box = st_malloc_array(s->ntris, 6 * sizeof(double));
     double *tbox = st_malloc_array(s->ntris, 6 * sizeof(double));
-    if (!b || !c.cent || !c.order || !c.nodes || !c.box || !tbox) {
+    if (!b || !c.cent || !c.order || !c.nodes || !tbox) {
         free(b);
         free(c.cent);
         free(c.order);
         free(c.nodes);
-        free(c.box);
         free(tbox);
         return st_error_set(err, ST_ENOMEM, NULL, 0,
                             "out of memory for a BVH over %zu triangles",
@@ -259,7 +295,6 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
                 sum += s->xyz[3 * (size_t)s->tris[3 * t + k] + a];
             c.cent[3 * t + a] = sum / 3.0;
         }
-        tri_box(s, (uint32_t)t, c.box + 6 * t, c.box + 6 * t + 3);
     }
     c.nnodes = 1 + subtree_nodes(s->ntris);
     if (s->ntris < PARALLEL_MIN)
@@ -271,9 +306,9 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
     }
     #pragma omp parallel for schedule(static) if (s->ntris >= PARALLEL_MIN)
     for (size_t i = 0; i < s->ntris; i++)
-        memcpy(tbox + 6 * i, c.box + 6 * (size_t)c.order[i], 6 * sizeof(double));
+        tri_box(s, c.order[i], tbox + 6 * i, tbox + 6 * i + 3);
+    node_boxes(c.nodes, c.nnodes, tbox);
     free(c.cent);
-    free(c.box);
     b->tbox = tbox;
     b->soup = s;
     b->nodes = c.nodes;
