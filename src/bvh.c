@@ -401,8 +401,13 @@ static int boxes_meet(const double alo[3], const double ahi[3],
  * coordinates, so no triangle whose box meets the query box is pruned; in
  * a leaf each triangle's own box is checked, so exactly those triangles
  * are visited. */
-int st_bvh_query_box(const st_bvh *b, const double lo[3], const double hi[3],
-                     int (*visit)(void *ctx, uint32_t tri), void *ctx)
+static int box_outside_tet(const st_plane_filter pl[4], const double lo[3], const double hi[3]);
+
+/* st_bvh_query_box, and with pl (not NULL) st_bvh_query_tet: nodes and
+ * triangles whose boxes miss [lo, hi], or that the tet's face planes pl
+ * certainly exclude, are skipped. */
+static int query_box(const st_bvh *b, const double lo[3], const double hi[3],
+                     const st_plane_filter *pl, int (*visit)(void *ctx, uint32_t tri), void *ctx)
 {
     uint32_t stack[STACK_DEPTH];
     int sp = 0;
@@ -411,10 +416,12 @@ int st_bvh_query_box(const st_bvh *b, const double lo[3], const double hi[3],
     stack[sp++] = 0;
     while (sp > 0) {
         const st_bvh_node *n = &b->nodes[stack[--sp]];
+        if (pl && box_outside_tet(pl, n->lo, n->hi))
+            continue;
         if (n->count) {
             for (uint32_t i = 0; i < n->count; i++) {
                 const double *tb = b->tbox + 6 * (size_t)(n->start + i);
-                if (boxes_meet(tb, tb + 3, lo, hi)) {
+                if (boxes_meet(tb, tb + 3, lo, hi) && !(pl && box_outside_tet(pl, tb, tb + 3))) {
                     int r = visit(ctx, b->order[n->start + i]);
                     if (r)
                         return r;
@@ -430,6 +437,12 @@ int st_bvh_query_box(const st_bvh *b, const double lo[3], const double hi[3],
             stack[sp++] = l;
     }
     return 0;
+}
+
+int st_bvh_query_box(const st_bvh *b, const double lo[3], const double hi[3],
+                     int (*visit)(void *ctx, uint32_t tri), void *ctx)
+{
+    return query_box(b, lo, hi, NULL, visit, ctx);
 }
 
 /* Node boxes are exact, and st_tri_box_intersect is exact for closed sets,
@@ -526,32 +539,5 @@ int st_bvh_query_tet(const st_bvh *b, const double *const p[4],
                 q[n++] = p[c];
         st_plane_filter_init(&pl[f], q[0], q[1], q[2], p[f]);
     }
-    uint32_t stack[STACK_DEPTH];
-    int sp = 0;
-    if (b->nnodes == 0 || !boxes_meet(b->nodes[0].lo, b->nodes[0].hi, lo, hi))
-        return 0;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        const st_bvh_node *n = &b->nodes[stack[--sp]];
-        if (box_outside_tet(pl, n->lo, n->hi))
-            continue;
-        if (n->count) {
-            for (uint32_t i = 0; i < n->count; i++) {
-                const double *tb = b->tbox + 6 * (size_t)(n->start + i);
-                if (boxes_meet(tb, tb + 3, lo, hi) && !box_outside_tet(pl, tb, tb + 3)) {
-                    int r = visit(ctx, b->order[n->start + i]);
-                    if (r)
-                        return r;
-                }
-            }
-            continue;
-        }
-        uint32_t l = n->start, r = n->start + 1;
-        /* Right pushed first so the left is visited first. */
-        if (boxes_meet(b->nodes[r].lo, b->nodes[r].hi, lo, hi))
-            stack[sp++] = r;
-        if (boxes_meet(b->nodes[l].lo, b->nodes[l].hi, lo, hi))
-            stack[sp++] = l;
-    }
-    return 0;
+    return query_box(b, lo, hi, pl, visit, ctx);
 }
