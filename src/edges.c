@@ -102,16 +102,14 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
     e->he = st_malloc_array(3 * nt + 1, sizeof *e->he);
     e->piece = st_malloc_array(nt ? nt : 1, sizeof *e->piece);
     size_t *uf = st_malloc_array(nt ? nt : 1, sizeof *uf);
-    /* the radix sorts' scratch: the half-edges, and the digits' counts */
+    /* the radix sorts' scratch: the half-edges */
     st_half_edge *tmp = st_malloc_array(3 * nt + 1, sizeof *tmp);
-    size_t *count = st_malloc_array(65537, sizeof *count);
     long long nw = -1;
-    if (!keys || !e->weld || !e->kept || !e->he || !e->piece || !uf || !tmp || !count ||
+    if (!keys || !e->weld || !e->kept || !e->he || !e->piece || !uf || !tmp ||
         (nw = st_weld_vertices(e->weld, s)) < 0) {
         free(keys);
         free(uf);
         free(tmp);
-        free(count);
         st_soup_edges_free(e);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
     }
@@ -136,8 +134,14 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
     unsigned bits = 0;   /* every welded index is below 2^bits */
     while (bits < 32 && (e->nweld - 1) >> bits)
         bits++;
-    st_radix_sort(keys, tmp, nk, sizeof *keys, (int)((3 * bits + 15) / 16), tri_digit, bits,
-                  count);
+    if (st_radix_sort(keys, tmp, nk, sizeof *keys, (int)((3 * bits + 15) / 16), tri_digit,
+                      bits)) {
+        free(keys);
+        free(uf);
+        free(tmp);
+        st_soup_edges_free(e);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
+    }
 
     /* 2. half-edges of the kept triangles (with ST_EDGES_DUPLICATES, of
      * every non-degenerate one), made in triangle order */
@@ -165,10 +169,14 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
             nh++;
         }
     }
-    st_radix_sort(e->he, tmp, nh, sizeof *e->he, (int)((2 * bits + 15) / 16), half_digit, bits,
-               count);
+    const int sorted = st_radix_sort(e->he, tmp, nh, sizeof *e->he, (int)((2 * bits + 15) / 16),
+                                     half_digit, bits);
     free(tmp);
-    free(count);
+    if (sorted) {
+        free(uf);
+        st_soup_edges_free(e);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
+    }
     e->nhalf = nh;
 
     /* 3. pieces */

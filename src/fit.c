@@ -186,15 +186,11 @@ static uint32_t pt_x_digit(const void *x, int pass, unsigned bits)
 static st_status sort_points(double *pts, size_t n)
 {
     double *tmp = st_malloc_array(n ? n : 1, 3 * sizeof *tmp);
-    size_t *count = st_malloc_array(65537, sizeof *count);
-    if (!tmp || !count) {
+    if (!tmp || st_radix_sort(pts, tmp, n, 3 * sizeof(double), 4, pt_x_digit, 0)) {
         free(tmp);
-        free(count);
         return ST_ENOMEM;
     }
-    st_radix_sort(pts, tmp, n, 3 * sizeof(double), 4, pt_x_digit, 0, count);
     free(tmp);
-    free(count);
     for (size_t i = 0, j; i < n; i = j) {
         for (j = i + 1; j < n && pts[3 * j] == pts[3 * i]; j++)
             ;

@@ -9,39 +9,77 @@
 #ifndef SOUPTET_RADIX_H
 #define SOUPTET_RADIX_H
 
+#include <omp.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* The 16-bit digit number `pass` of element x (pass 0 the least
  * significant); bits is the caller's, passed through. */
 typedef uint32_t (*st_radix_digit)(const void *x, int pass, unsigned bits);
 
+/* Arrays at least this long are counted and scattered in parallel. */
+#define ST_RADIX_PARALLEL_MIN 65536
+
 /* Sort the n elements of `size` bytes at a by `passes` digits, stably:
- * elements with equal digits keep their order. tmp holds n elements,
- * count 65537 size_t. A pass whose digit is the same for every element
- * moves nothing. */
-static inline void st_radix_sort(void *a, void *tmp, size_t n, size_t size, int passes,
-                                 st_radix_digit digit, unsigned bits, size_t *count)
+ * elements with equal digits keep their order. tmp holds n elements. A
+ * pass whose digit is the same for every element moves nothing. Long
+ * arrays are cut into one chunk per thread, each counted and scattered by
+ * one thread, the chunks' slots for a digit in chunk order: the sort is
+ * the same for any number of threads (a stable sort's result is unique).
+ * Returns 0, or -1 when out of memory (a untouched). */
+static inline int st_radix_sort(void *a, void *tmp, size_t n, size_t size, int passes,
+                                st_radix_digit digit, unsigned bits)
 {
+    size_t nc = 1;
+    if (n >= ST_RADIX_PARALLEL_MIN) {
+        int t = omp_get_max_threads();
+        nc = t > 1 ? (size_t)t : 1;
+    }
+    size_t *hist = malloc(nc * 65536 * sizeof *hist);
+    if (!hist)
+        return -1;
     unsigned char *src = a, *dst = tmp;
-    for (int pass = 0; pass < passes; pass++) {
-        memset(count, 0, 65537 * sizeof *count);
-        for (size_t i = 0; i < n; i++)
-            count[digit(src + i * size, pass, bits) + 1]++;
-        if (n == 0 || count[digit(src, pass, bits) + 1] == n)
+    const long long lnc = (long long)nc;
+    for (int pass = 0; pass < passes && n > 0; pass++) {
+        #pragma omp parallel for schedule(static) if (nc > 1)
+        for (long long c = 0; c < lnc; c++) {
+            size_t *h = hist + 65536 * (size_t)c;
+            memset(h, 0, 65536 * sizeof *h);
+            const size_t lo = n * (size_t)c / nc, hi = n * (size_t)(c + 1) / nc;
+            for (size_t i = lo; i < hi; i++)
+                h[digit(src + i * size, pass, bits)]++;
+        }
+        const uint32_t d0 = digit(src, pass, bits);
+        size_t same = 0;
+        for (size_t c = 0; c < nc; c++)
+            same += hist[65536 * c + d0];
+        if (same == n)
             continue;
+        size_t run = 0;   /* each chunk's first slot for each digit */
         for (size_t d = 0; d < 65536; d++)
-            count[d + 1] += count[d];
-        for (size_t i = 0; i < n; i++)
-            memcpy(dst + size * count[digit(src + i * size, pass, bits)]++, src + i * size,
-                   size);
+            for (size_t c = 0; c < nc; c++) {
+                size_t k = hist[65536 * c + d];
+                hist[65536 * c + d] = run;
+                run += k;
+            }
+        #pragma omp parallel for schedule(static) if (nc > 1)
+        for (long long c = 0; c < lnc; c++) {
+            size_t *h = hist + 65536 * (size_t)c;
+            const size_t lo = n * (size_t)c / nc, hi = n * (size_t)(c + 1) / nc;
+            for (size_t i = lo; i < hi; i++)
+                memcpy(dst + size * h[digit(src + i * size, pass, bits)]++, src + i * size,
+                       size);
+        }
         unsigned char *x = src;
         src = dst;
         dst = x;
     }
+    free(hist);
     if (src != a)
         memcpy(a, src, n * size);
+    return 0;
 }
 
 /* An unsigned key with the order of the double x: -0.0 and 0.0 get the
