@@ -230,6 +230,7 @@ static inline double tri_dist2(const tri_setup *t, const double p[3],
 typedef struct brick_grid {
     size_t n[3];        /* bricks per axis */
     double half_diag;   /* from a brick's center to its farthest voxel center */
+    double *center[3];  /* the centers of the bricks' voxels along each axis */
 } brick_grid;
 
 /* The center of brick b's voxels along axis a. */
@@ -289,24 +290,28 @@ static void triangle_bricks(const st_grid *g, const brick_grid *bg,
     const double reach = (B + bg->half_diag) * (1.0 + 1e-9) + 1e-12 * h;
     const double reach_ball = reach + ball->r;
     const double reach_plane = reach + 1e-9 * sqrt(ee);
-    size_t b[3];
-    double c[3];    /* brick b's center, each axis set where b[a] moves */
-    for (b[2] = lo[2]; b[2] <= hi[2]; b[2]++) {
-        c[2] = brick_center_axis(g, 2, b[2]);
-        for (b[1] = lo[1]; b[1] <= hi[1]; b[1]++) {
-            c[1] = brick_center_axis(g, 1, b[1]);
-            for (b[0] = lo[0]; b[0] <= hi[0]; b[0]++) {
-                double w[3];
-                c[0] = brick_center_axis(g, 0, b[0]);
-                st_sub3(w, c, ball->c);
-                if (st_dot3(w, w) > reach_ball * reach_ball)
+    /* The sums over the axes are kept as each loop's axis moves: the
+     * tests round a little differently from a dot product, far inside the
+     * slack. */
+    const double rb2 = reach_ball * reach_ball;
+    for (size_t bz = lo[2]; bz <= hi[2]; bz++) {
+        const double cz = bg->center[2][bz];
+        const double bz2 = (cz - ball->c[2]) * (cz - ball->c[2]);
+        const double pz = (cz - v[0][2]) * nrm[2];
+        for (size_t by = lo[1]; by <= hi[1]; by++) {
+            const double cy = bg->center[1][by];
+            const double byz2 = (cy - ball->c[1]) * (cy - ball->c[1]) + bz2;
+            if (byz2 > rb2)
+                continue;
+            const double pyz = (cy - v[0][1]) * nrm[1] + pz;
+            const size_t row = bg->n[0] * (by + bg->n[1] * bz);
+            for (size_t bx = lo[0]; bx <= hi[0]; bx++) {
+                const double cx = bg->center[0][bx];
+                if ((cx - ball->c[0]) * (cx - ball->c[0]) + byz2 > rb2)
                     continue;
-                if (use_plane) {
-                    st_sub3(w, c, v[0]);
-                    if (fabs(st_dot3(w, nrm)) > reach_plane)
-                        continue;
-                }
-                visit(b[0] + bg->n[0] * (b[1] + bg->n[1] * b[2]), ctx);
+                if (use_plane && fabs((cx - v[0][0]) * nrm[0] + pyz) > reach_plane)
+                    continue;
+                visit(bx + row, ctx);
             }
         }
     }
@@ -723,10 +728,17 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
 
     tri_ball *balls = st_malloc_array(s->ntris, sizeof *balls);
     size_t *start = st_calloc_array(nb + 1, sizeof(size_t));
-    if (!balls || !start) {
+    double *centers = st_malloc_array(bg.n[0] + bg.n[1] + bg.n[2], sizeof(double));
+    if (!balls || !start || !centers) {
         free(balls);
+        free(centers);
         free(start);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    for (int a = 0; a < 3; a++) {
+        bg.center[a] = centers + (a > 0 ? bg.n[0] : 0) + (a > 1 ? bg.n[1] : 0);
+        for (size_t b = 0; b < bg.n[a]; b++)
+            bg.center[a][b] = brick_center_axis(g, a, b);
     }
     #pragma omp parallel for schedule(static)
     for (size_t t = 0; t < s->ntris; t++)
@@ -742,6 +754,7 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
     size_t *cnt = st_calloc_array((size_t)chunks * (nb + 1), sizeof(size_t));
     if (!cnt) {
         free(balls);
+        free(centers);
         free(start);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     }
@@ -770,6 +783,7 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
     if (!list) {
         free(cnt);
         free(balls);
+        free(centers);
         free(start);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for "
                             "%zu brick candidates", npairs);
@@ -816,6 +830,7 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
     free(list);
     free(start);
     free(balls);
+    free(centers);
     if (oom)
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     st_progress_report(progress, "distance band", 1.0);
