@@ -5,13 +5,17 @@
  * binned into the bricks its band may reach (near its bounding ball and,
  * for a large CAD triangle, near its plane, so it costs its area times the
  * band and not its bounding box). Bricks are processed in parallel, each
- * writing only its own voxels. A brick sorts its candidates by a lower
- * bound on their distance (from the brick's center, less the triangle's
- * radius and the brick's half diagonal); each voxel then walks that list
- * and stops at the first candidate whose bound is not below its best so
- * far. Candidates that survive a per-voxel ball bound and a plane bound are
+ * writing only its own voxels. A brick's voxels are walked in 2x2x2
+ * groups: a group keeps the brick's candidates whose ball comes within the
+ * band of one of its voxels, in buckets by a lower bound on their distance
+ * from the group's center (less the triangle's radius); each voxel then
+ * walks the buckets in order and stops at the first whose bound, less the
+ * voxel's offset from the center, is not below its best so far.
+ * Candidates that survive a per-voxel ball bound and a plane bound are
  * measured exactly. The minimum is the same whatever the order, so the
- * pruning changes the work, never the answer.
+ * pruning changes the work, never the answer. A full field also keeps
+ * each voxel's nearest triangle, the first of any ties in a fixed order,
+ * so its bricks walk their candidates whole, sorted by (bound, index).
  *
  * Full field. Beyond the band, a vector distance transform over
  * triangles: four raster sweeps hand each voxel the nearest of the
