@@ -390,8 +390,9 @@ static st_soup *fine_soup(size_t n)
 
 /* The band pass on a fine soup (many candidates per brick, large
  * collinear triangles whose normal is rounding noise): every voxel is the
- * true distance, with the default padding and with none (bricks cut by the
- * grid's sides), for bands of 3 and 4.5 voxels. */
+ * true distance, with the default padding and with none (bricks, and the
+ * 2x2x2 groups a brick is walked in, cut by the grid's sides to 1, 2 or 3
+ * voxels), for bands of 3 to 7.5 voxels. */
 static void test_fine_soup_exact(void)
 {
     st_soup *s = fine_soup(20000);
@@ -402,11 +403,14 @@ static void test_fine_soup_exact(void)
         st_soup_free(s);
         return;
     }
-    for (int pad = -1; pad <= 0; pad++) {
+    static const struct { long pad; size_t cells; double band; } run[] = {
+        {-1, 41, 3.0}, {0, 41, 4.5}, {0, 42, 3.0}, {0, 43, 7.5}};
+    for (size_t r = 0; r < sizeof run / sizeof run[0]; r++) {
         st_dist_params p = st_dist_params_default();
-        p.cells = 41;
-        p.pad = pad;
-        p.band = pad < 0 ? 3.0 : 4.5;
+        p.cells = run[r].cells;
+        p.pad = run[r].pad;
+        p.band = run[r].band;
+        const long pad = p.pad;
         st_grid *g = NULL;
         if (st_dist_field(&g, s, &p, NULL, &err) != ST_OK) {
             TAP_CHECK(0, "fine soup field: %s", err.msg);
@@ -425,8 +429,9 @@ static void test_fine_soup_exact(void)
             if (fabs(g->data[idx] - want) > 1e-6 * fmax(want, g->voxel))
                 bad++;
         }
-        TAP_CHECK(bad == 0 && inband > 1000, "fine soup, pad %d, band %g: every voxel is the "
-                  "true distance (%zu bad, %zu in band)", pad, p.band, bad, inband);
+        TAP_CHECK(bad == 0 && inband > 1000, "fine soup, %zu cells, pad %ld, band %g: every "
+                  "voxel is the true distance (%zu bad, %zu in band, grid %zux%zux%zu)",
+                  p.cells, pad, p.band, bad, inband, g->nx, g->ny, g->nz);
         st_grid_free(g);
     }
     st_bvh_free(bvh);
