@@ -113,6 +113,8 @@ typedef struct fit_ctx {
                             move (a point grid index), or UINT32_MAX */
     double h, d_offset;
     int full_check;   /* non-conforming faces: test S vertices everywhere */
+    int joint;           /* rescue_pass also moves a held vertex's boundary
+                            neighbours first (fit.c, rescue_joint) */
     int cube_steps;      /* the quality pass also tries the 26 cube
                             directions (quality.c; st_fit's last pass) */
     int fair_boundary;   /* no S (after fairing): boundary vertices move in
