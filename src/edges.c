@@ -55,6 +55,9 @@ static uint32_t half_digit(const void *x, int pass, unsigned bits)
     return (uint32_t)(packed >> (16 * pass)) & 0xffffu;
 }
 
+ST_RADIX_SORT_DEFINE(sort_tri_keys, sizeof(tri_key), tri_digit)
+ST_RADIX_SORT_DEFINE(sort_half_edges, sizeof(st_half_edge), half_digit)
+
 void st_soup_edges_free(st_soup_edges *e)
 {
     if (!e)
@@ -134,8 +137,7 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
     unsigned bits = 0;   /* every welded index is below 2^bits */
     while (bits < 32 && (e->nweld - 1) >> bits)
         bits++;
-    if (st_radix_sort(keys, tmp, nk, sizeof *keys, (int)((3 * bits + 15) / 16), tri_digit,
-                      bits)) {
+    if (sort_tri_keys(keys, tmp, nk, (int)((3 * bits + 15) / 16), bits)) {
         free(keys);
         free(uf);
         free(tmp);
@@ -169,8 +171,7 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
             nh++;
         }
     }
-    const int sorted = st_radix_sort(e->he, tmp, nh, sizeof *e->he, (int)((2 * bits + 15) / 16),
-                                     half_digit, bits);
+    const int sorted = sort_half_edges(e->he, tmp, nh, (int)((2 * bits + 15) / 16), bits);
     free(tmp);
     if (sorted) {
         free(uf);

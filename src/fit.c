@@ -193,13 +193,15 @@ static uint32_t pt_x_digit(const void *x, int pass, unsigned bits)
     return (uint32_t)(st_radix_double_key(p[0]) >> (16 * pass)) & 0xffffu;
 }
 
+ST_RADIX_SORT_DEFINE(sort_by_x, 3 * sizeof(double), pt_x_digit)
+
 /* The n points at pts in cmp_pt's order, stably (as qsort's merge sort
  * did): a stable radix sort by x, then each run of equal x by cmp_pt
  * (glibc's qsort is a stable merge sort at these sizes). */
 static st_status sort_points(double *pts, size_t n)
 {
     double *tmp = st_malloc_array(n ? n : 1, 3 * sizeof *tmp);
-    if (!tmp || st_radix_sort(pts, tmp, n, 3 * sizeof(double), 4, pt_x_digit, 0)) {
+    if (!tmp || sort_by_x(pts, tmp, n, 4, 0)) {
         free(tmp);
         return ST_ENOMEM;
     }
