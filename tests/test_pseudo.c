@@ -102,6 +102,18 @@ static int half_top(int axis, int side, const double c[3])
 {
     return axis == 2 && side == 1 && c[0] < 1.0;
 }
+/* every other quad of the faces (a checkerboard) */
+static int checker(int axis, int side, const double c[3])
+{
+    const int u = (int)floor(c[(axis + 1) % 3] * 4.0), w = (int)floor(c[(axis + 2) % 3] * 4.0);
+    return (u + w + side) & 1;
+}
+/* the three faces' quads at the corner (0, 0, 0) of a box of side 2 cut
+ * into 4 x 4 */
+static int corner_quads(int axis, int side, const double c[3])
+{
+    return side == 0 && c[(axis + 1) % 3] < 0.5 && c[(axis + 2) % 3] < 0.5;
+}
 
 static void test_entry_point(void)
 {
@@ -163,6 +175,39 @@ static void test_large_holes(void)
         add_box_oriented(t, lo, hi);
         const double iou = iou_of(s, t, 96, &pp);
         TAP_CHECK(iou >= 0.99, "a thin plate with half of one face missing (IoU %.4f)", iou);
+        st_soup_free(s);
+        st_soup_free(t);
+    }
+    /* a box without the corner of its three faces at (0, 0, 0): the hole's
+     * loop is not flat, and its least-area cap cuts the corner off across
+     * the loop; the cap that bends least continues each face along its
+     * L-shaped edge and cuts off only the lost corner's tip (a 1/48 of the
+     * quads' cube: IoU 0.9974) */
+    {
+        const double lo[3] = {0, 0, 0}, hi[3] = {2, 2, 2};
+        st_soup *s = st_soup_new(), *t = st_soup_new();
+        add_box_faces(s, lo, hi, 4, corner_quads, 0);
+        add_box_oriented(t, lo, hi);
+        st_pseudo_params area = pp;
+        area.holes.bend = area.holes.planes = 0;
+        st_pseudo_stats st;
+        const double iou = iou_stats(s, t, 64, &pp, ST_SOLID_NONZERO, &st);
+        const double least = iou_of(s, t, 64, &area);
+        TAP_CHECK(iou >= 0.995 && iou > least && st.holes.continued,
+                  "a box without a corner: its faces continued by default (IoU %.4f, rim %.3f "
+                  "of the area; %.4f with the least-area cap)",
+                  iou, st.holes.rim_share, least);
+        st_soup_free(s);
+        s = st_soup_new();
+        /* every other quad gone: all that is left is rim, whose fragments'
+         * planes say little: the least-area caps (as the deleted faces of
+         * the corpus, where the bent caps lose) */
+        add_box_faces(s, lo, hi, 8, checker, 0);
+        const double frag = iou_stats(s, t, 64, &pp, ST_SOLID_NONZERO, &st);
+        const double frag_area = iou_of(s, t, 64, &area);
+        TAP_CHECK(!st.holes.continued && st.holes.rim_share > pp.holes.intact && frag == frag_area,
+                  "a box with every other face quad gone keeps the least-area caps (rim %.3f "
+                  "of the area, IoU %.4f)", st.holes.rim_share, frag);
         st_soup_free(s);
         st_soup_free(t);
     }
@@ -462,6 +507,12 @@ static void test_columns(void)
               "without the column rule)", r.in, r.in0);
     TAP_CHECK(r.with > r.without + 0.01, "and its IoU gains (%.4f, %.4f without)", r.with,
               r.without);
+    /* its loops are the horizon, not lost faces: not continued (the bent
+     * caps would carry its walls past the far side) */
+    TAP_CHECK(r.ok && !r.st.holes.continued && r.st.holes.one_sided < 0.02 &&
+                  r.st.holes.rim_share < 0.5,
+              "its caps are the least-area ones: one-sided along an axis (%.3f), though its "
+              "rim is %.3f of the area", r.st.holes.one_sided, r.st.holes.rim_share);
     st_soup_free(s);
     st_soup_free(t);
 }

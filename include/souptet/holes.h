@@ -28,8 +28,8 @@
  * solid. Lost corners (points of the part inside the hole) stay lost: the
  * cap has the loop's points only; where such a corner was concave (a
  * notch) the cap that bends least extends the faces across it, and on a
- * one-sided scan it continues the walls past the far side: not the
- * default (the numbers at st_holes_params_default in holes.c). With
+ * one-sided scan it continues the walls past the far side (the numbers at
+ * st_holes_params_default in holes.c). With
  * planes, a lost corner is rebuilt where the planes of the soup's
  * triangles along the loop meet: the cone from the point where three of
  * them meet (or from the line where two meet, nearest the loop's
@@ -44,9 +44,19 @@
  * the point more than once) is capped the same way, at most 16 points per
  * loop, what none continues by the cap of its own points; the fans or the
  * single cone, whichever continues the soup along the loop better: a
- * box's lost edge comes back with both its corners. Not the default
- * either: it helps the large holes of CAD parts but loses on one-sided
- * scans and some deleted faces (numbers at st_holes_params_default).
+ * box's lost edge comes back with both its corners.
+ *
+ * Where the soup around its holes is intact: bend and planes (the
+ * default) apply only where the rim, the kept triangles on a boundary
+ * edge, is at most `intact` of the soup's area (where faces were deleted
+ * at random nearly everything left touches a hole, the fragments' planes
+ * say little and a bent cap fills lost notches), and, with `onesided`,
+ * where the soup is not a scan seen from one side along an axis (each
+ * orientable region, propagated across edges of two triangles, turned the
+ * way it faces most along the axis: the projected area facing away under
+ * `onesided` of that facing it; its loops are the horizon, not lost faces,
+ * and a bent cap would carry its walls past the far side). Elsewhere every
+ * cap is the least-area one.
  *
  * Not every loop is a hole: an open patch (a panel of a CAD part, one of a
  * teapot's patches, a sheet) has a loop around itself, and capping it would
@@ -95,6 +105,13 @@ typedef struct st_holes_params {
     int planes;             /* 1: the cap rebuilt from the planes along
                              * the loop where they agree on one, else as
                              * bend says */
+    double intact;          /* bend and planes only where the rim (the
+                             * triangles on a hole's edge) is at most this
+                             * share of the soup's area (1: always) */
+    double onesided;        /* and only where the soup is not seen from one
+                             * side along an axis: its least back/front
+                             * ratio (axis_one_sided in holes.c) at least
+                             * this (0: always) */
 } st_holes_params;
 
 typedef struct st_holes_stats {
@@ -106,6 +123,10 @@ typedef struct st_holes_stats {
     size_t too_long;        /* more than max_loop edges */
     size_t pinched;         /* boundary edges on paths through a vertex
                              * whose edges could not be paired: left open */
+    double rim_share;       /* the rim's share of the soup's area */
+    double one_sided;       /* that ratio (-1 when not needed) */
+    int continued;          /* bend or planes applied (rim_share at most
+                             * intact, one_sided at least onesided) */
 } st_holes_stats;
 
 st_holes_params st_holes_params_default(void);

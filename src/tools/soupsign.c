@@ -73,13 +73,17 @@ static void usage(void)
 "                       boundary edges, by the triangulation of least area,\n"
 "                       when small beside the surface around them) before\n"
 "                       voting (default on)\n"
-"      --caps area|bend|planes|planes-bend  with --fill-holes: each cap is the\n"
-"                       loop's triangulation of least area (default) or the\n"
-"                       one that bends least; planes: lost corners rebuilt\n"
-"                       where the faces' planes along the loop meet (one\n"
-"                       cone, or fans from several), when that continues\n"
-"                       them better, else the least-area cap\n"
-"                       (planes-bend: else the one that bends least)\n"
+"      --caps auto|area|bend|planes|planes-bend  with --fill-holes: each cap is\n"
+"                       the loop's triangulation of least area (area) or the\n"
+"                       one that bends least (bend); planes: lost corners\n"
+"                       rebuilt where the faces' planes along the loop meet\n"
+"                       (one cone, or fans from several), when that continues\n"
+"                       them better, else the least-area cap (planes-bend:\n"
+"                       else the one that bends least); auto (default):\n"
+"                       planes-bend where the soup around its holes is\n"
+"                       intact (the triangles on a hole's edge at most half\n"
+"                       its area, and not seen from one side along an axis),\n"
+"                       else area\n"
 "      --shells on|off  with --surface: the surface's closed pieces (every edge\n"
 "                       shared by two faces) bound their solid exactly: inside\n"
 "                       them is inside, and when the surface is nothing else\n"
@@ -264,7 +268,9 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
     case TOOL_OPT_SHELLS:
         return tool_pseudo_option(t, c, arg, &s->fill_holes, &s->use_shells);
     case OPT_CAPS:
-        if (strcmp(arg, "area") == 0)
+        if (strcmp(arg, "auto") == 0)
+            s->bend_caps = -1;
+        else if (strcmp(arg, "area") == 0)
             s->bend_caps = 0;
         else if (strcmp(arg, "bend") == 0)
             s->bend_caps = 1;
@@ -273,7 +279,7 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         else if (strcmp(arg, "planes-bend") == 0)
             s->bend_caps = 3;
         else
-            return tool_usage_error(t, "--caps is area, bend, planes or planes-bend, not '%s'",
+            return tool_usage_error(t, "--caps is auto, area, bend, planes or planes-bend, not '%s'",
                                     arg);
         break;
     case OPT_SIDES:
@@ -375,8 +381,12 @@ static int run(tool_ctx *t, void *settings)
     pp.sign = *p;
     pp.refine = s->refine;
     pp.fill_holes = s->fill_holes;
-    pp.holes.bend = s->bend_caps & 1;
-    pp.holes.planes = (s->bend_caps & 2) != 0;
+    if (s->bend_caps >= 0) {     /* chosen: on every soup */
+        pp.holes.bend = s->bend_caps & 1;
+        pp.holes.planes = (s->bend_caps & 2) != 0;
+        pp.holes.intact = 1.0;
+        pp.holes.onesided = 0.0;
+    }
     pp.closed_shells = s->use_shells;
     pp.sides = s->use_sides;
     pp.sides_params.past_caps = s->past_caps;
@@ -417,6 +427,16 @@ static int run(tool_ctx *t, void *settings)
                  "%zu edges left open where holes touch unpaired), %.3f s",
                  ps.holes.filled, ps.holes.loops, ps.holes.too_large, ps.holes.too_long,
                  ps.holes.pinched, ps.seconds_holes);
+    if (surface && s->fill_holes && ps.holes.loops && !ps.shells_only) {
+        char axis[64] = "";
+        if (ps.holes.one_sided >= 0.0)
+            snprintf(axis, sizeof axis, "; along an axis its back/front is %.3f",
+                     ps.holes.one_sided);
+        tool_say(t, 2, "caps: %s (the rim is %.3f of the soup's area%s)",
+                 ps.holes.continued ? "continuing the faces (planes, else the least bend)"
+                                    : "least area",
+                 ps.holes.rim_share, axis);
+    }
     const int voted = !ps.shells_only;
     if (surface && s->use_sides && p->cut && voted)
         tool_say(t, 2, "sides: %zu orientable regions (%zu turned to the votes, %zu edges "
@@ -457,6 +477,7 @@ int main(int argc, char *argv[])
 {
     soupsign_settings s = {.sign = st_sign_params_default(),
                            .refine = st_sign_refine_params_default(), .fill_holes = 1,
+                           .bend_caps = -1,
                            .use_shells = 1, .use_sides = 1,
                            .columns = 1};
     return tool_main(&spec, argc, argv, &s, &s.co);
