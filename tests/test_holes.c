@@ -58,9 +58,21 @@ static double soup_area(const st_soup *s)
     return a;
 }
 
-static void test_which_loops(void)
+/* The least-area caps, and bend or planes when a test sets them, on every
+ * soup (the default continues the faces only where the soup around its
+ * holes is intact). */
+static st_holes_params area_params(void)
 {
     st_holes_params p = st_holes_params_default();
+    p.bend = p.planes = 0;
+    p.intact = 1.0;
+    p.onesided = 0.0;
+    return p;
+}
+
+static void test_which_loops(void)
+{
+    st_holes_params p = area_params();
     st_holes_stats hs;
     st_soup *caps;
     st_error err;
@@ -297,7 +309,7 @@ static double capped_iou(const st_soup *s, const st_soup *whole, int capped, siz
     st_error err;
     double iou = -1, prec, rec;
     uint8_t *truth = NULL;
-    st_holes_params hp = st_holes_params_default();
+    st_holes_params hp = area_params();
     hp.bend = capped == 2;
     hp.planes = capped == 3;
     st_sign_params sp = st_sign_params_default();
@@ -338,7 +350,7 @@ static void test_pseudo_volume(void)
      * it leave two gaps, which pair its four boundary edges; each hole is
      * capped by the triangle that was there. */
     st_soup *pinched = slotted_box(2), *caps = NULL;
-    st_holes_params hp = st_holes_params_default();
+    st_holes_params hp = area_params();
     st_holes_stats hs;
     st_error err;
     int ok = !st_soup_hole_caps(&caps, pinched, &hp, &hs, &err);
@@ -374,12 +386,16 @@ static void test_pseudo_volume(void)
  * cap whose edges bend least follows the missing faces. */
 static void test_bend(void)
 {
-    st_holes_params hp = st_holes_params_default();
+    st_holes_params hp = area_params();
     st_holes_stats hs;
     st_soup *caps = NULL;
     st_error err;
     size_t nt = 0;
-    TAP_CHECK(hp.bend == 0, "the caps are of least area by default");
+    const st_holes_params def = st_holes_params_default();
+    TAP_CHECK(def.bend && def.planes && def.intact > 0.0 && def.intact < 1.0 && def.onesided > 0.0,
+              "by default the caps continue the faces, where the soup around its holes is "
+              "intact (the rim at most %g of its area) and not one-sided (%g)", def.intact,
+              def.onesided);
     hp.bend = 1;
 
     /* Three of a long 16-gon prism's side facets missing: a loop of two
@@ -534,11 +550,10 @@ static st_soup *cornered_box(int corner)
 static void test_corner(void)
 {
     st_soup *whole = cornered_box(0), *cut = cornered_box(1), *caps = NULL;
-    st_holes_params hp = st_holes_params_default();
+    st_holes_params hp = area_params();
     st_holes_stats hs;
     st_error err;
     size_t nt = 0;
-    TAP_CHECK(hp.planes == 0, "corners are not rebuilt by default");
     hp.planes = 1;
     int ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err);
     TAP_CHECK(ok && hs.loops == 1 && hs.filled == 1 && hs.rebuilt == 1 && caps->ntris == 24,
@@ -569,7 +584,7 @@ static void test_corner(void)
     static const int en[3] = {10, 10, 10};
     whole = gridded_box(ehi, en, edge_keep, 0);
     cut = gridded_box(ehi, en, edge_keep, 1);
-    hp = st_holes_params_default();
+    hp = area_params();
     hp.planes = 1;
     ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err);
     TAP_CHECK(ok && hs.loops == 1 && hs.rebuilt == 1,
@@ -660,7 +675,7 @@ static void test_corner_pierced(void)
 {
     static const double pin[3][3] = {{0.9, 0.95, 0.8}, {1.1, 0.95, 0.8}, {1.0, 0.95, 0.9}};
     st_soup *cut = cornered_box(1), *caps = NULL;
-    st_holes_params hp = st_holes_params_default();
+    st_holes_params hp = area_params();
     hp.planes = 1;
     st_holes_stats hs;
     st_error err;

@@ -72,7 +72,9 @@ soupsign -v --fill-holes off --surface holed.obj -o h2.vdb h.vdb 2> h2.log
 check "--fill-holes off: no caps" sh -c "test -s h2.vdb && ! grep -q 'holes:' h2.log && ! grep -aq 'hole_caps' h2.vdb"
 check "--caps bend caps the hole too" sh -c "soupsign -v --caps bend --surface holed.obj -o h3.vdb h.vdb 2>&1 | grep -q 'holes: 1 of 1 boundary loops capped'"
 check "--caps planes caps the hole too" sh -c "soupsign -v --caps planes --surface holed.obj -o h4.vdb h.vdb 2>&1 | grep -q 'holes: 1 of 1 boundary loops capped'"
-expect_fail "bad --caps" 2 "--caps is area, bend, planes or planes-bend" soupsign --caps least d.vdb
+check "-v says which caps the hole got, and why" sh -c "soupsign -v --surface holed.obj -o h5.vdb h.vdb 2>&1 | grep -q 'caps: continuing the faces (planes, else the least bend) (the rim is 0\\.[0-9]* of the soup.s area; along an axis'"
+check "--caps area: the least-area caps" sh -c "soupsign -v --caps area --surface holed.obj -o h6.vdb h.vdb 2>&1 | grep -q 'caps: least area (the rim is'"
+expect_fail "bad --caps" 2 "--caps is auto, area, bend, planes or planes-bend" soupsign --caps least d.vdb
 
 # Closed shells (--shells): two interpenetrating cubes, each closed.
 cat > cubes.obj <<'OBJ'
