@@ -232,3 +232,41 @@ void st_soup_edges_neighbours(const st_soup_edges *e, const st_soup *s, uint32_t
         }
     }
 }
+
+size_t st_soup_edges_orient(const st_soup_edges *e, const st_soup *s, const uint32_t *nbr,
+                            const uint8_t *same, uint8_t *flip, uint32_t *region,
+                            uint32_t *queue, size_t *nkept)
+{
+    const size_t nt = s->ntris;
+    size_t conflicts = 0, qt = 0;
+    memset(flip, 2, nt);
+    for (size_t t0 = 0; t0 < nt; t0++) {
+        if (!e->kept[t0] || flip[t0] != 2)
+            continue;
+        size_t qh = qt;
+        flip[t0] = 0;
+        if (region)
+            region[t0] = (uint32_t)t0;
+        queue[qt++] = (uint32_t)t0;
+        while (qh < qt) {
+            const uint32_t t = queue[qh++];
+            for (size_t slot = 3 * (size_t)t; slot < 3 * (size_t)t + 3; slot++) {
+                const uint32_t q = nbr[slot];
+                if (q == ST_EDGES_NONE)
+                    continue;
+                const uint8_t want = (uint8_t)(flip[t] ^ same[slot]);
+                if (flip[q] == 2) {
+                    flip[q] = want;
+                    if (region)
+                        region[q] = (uint32_t)t0;
+                    queue[qt++] = q;
+                } else if (flip[q] != want) {
+                    conflicts++;
+                }
+            }
+        }
+    }
+    if (nkept)
+        *nkept = qt;
+    return conflicts;
+}

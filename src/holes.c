@@ -469,45 +469,35 @@ static double axis_one_sided(const st_soup *s, const st_soup_edges *E)
     uint8_t *same = st_malloc_array(3 * nt + 1, 1);
     uint8_t *flip = st_malloc_array(nt + 1, 1);
     uint32_t *queue = st_malloc_array(nt + 1, sizeof *queue);
+    uint32_t *region = st_malloc_array(nt + 1, sizeof *region);
     double ratio = -1.0;
-    if (!nbr || !same || !flip || !queue)
+    if (!nbr || !same || !flip || !queue || !region)
         goto done;
     st_soup_edges_neighbours(E, s, nbr, same, NULL);
-    memset(flip, 2, nt);
+    size_t nq = 0;
+    st_soup_edges_orient(E, s, nbr, same, flip, region, queue, &nq);
     double back[3] = {0.0, 0.0, 0.0}, front[3] = {0.0, 0.0, 0.0};
-    for (size_t t0 = 0; t0 < nt; t0++) {
-        if (!E->kept[t0] || flip[t0] != 2)
-            continue;
-        double pos[3] = {0.0, 0.0, 0.0}, neg[3] = {0.0, 0.0, 0.0};
-        size_t qh = 0, qt = 0;
-        flip[t0] = 0;
-        queue[qt++] = (uint32_t)t0;
-        while (qh < qt) {
-            const uint32_t t = queue[qh++];
-            const uint32_t *v = s->tris + 3 * (size_t)t;
-            double u[3], w[3], n[3];
-            st_sub3(u, s->xyz + 3 * (size_t)v[1], s->xyz + 3 * (size_t)v[0]);
-            st_sub3(w, s->xyz + 3 * (size_t)v[2], s->xyz + 3 * (size_t)v[0]);
-            st_cross3(n, u, w);
-            for (int k = 0; k < 3; k++) {
-                const double a = flip[t] ? -n[k] : n[k];
-                if (a > 0.0)
-                    pos[k] += a;
-                else
-                    neg[k] -= a;
-            }
-            for (size_t slot = 3 * (size_t)t; slot < 3 * (size_t)t + 3; slot++) {
-                const uint32_t q = nbr[slot];
-                if (q != ST_EDGES_NONE && flip[q] == 2) {
-                    flip[q] = (uint8_t)(flip[t] ^ same[slot]);
-                    queue[qt++] = q;
-                }
-            }
-        }
+    double pos[3] = {0.0, 0.0, 0.0}, neg[3] = {0.0, 0.0, 0.0};
+    for (size_t i = 0; i < nq; i++) {   /* region by region */
+        const uint32_t t = queue[i];
+        const uint32_t *v = s->tris + 3 * (size_t)t;
+        double u[3], w[3], n[3];
+        st_sub3(u, s->xyz + 3 * (size_t)v[1], s->xyz + 3 * (size_t)v[0]);
+        st_sub3(w, s->xyz + 3 * (size_t)v[2], s->xyz + 3 * (size_t)v[0]);
+        st_cross3(n, u, w);
         for (int k = 0; k < 3; k++) {
-            back[k] += fmin(pos[k], neg[k]);
-            front[k] += fmax(pos[k], neg[k]);
+            const double a = flip[t] ? -n[k] : n[k];
+            if (a > 0.0)
+                pos[k] += a;
+            else
+                neg[k] -= a;
         }
+        if (i + 1 == nq || region[queue[i + 1]] != region[t])
+            for (int k = 0; k < 3; k++) {
+                back[k] += fmin(pos[k], neg[k]);
+                front[k] += fmax(pos[k], neg[k]);
+                pos[k] = neg[k] = 0.0;
+            }
     }
     ratio = INFINITY;
     for (int k = 0; k < 3; k++)
@@ -518,6 +508,7 @@ done:
     free(same);
     free(flip);
     free(queue);
+    free(region);
     return ratio;
 }
 

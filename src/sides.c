@@ -416,32 +416,9 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
     st_soup_edges_neighbours(&E, s, nbr, same, NULL);
 
     /* 1. orientable regions, by propagation */
-    memset(flip, 2, nt);
-    for (size_t t0 = 0; t0 < nt; t0++) {
-        if (!E.kept[t0] || flip[t0] != 2)
-            continue;
-        size_t qh = 0, qt = 0;
-        flip[t0] = 0;
-        region[t0] = (uint32_t)t0;
-        queue[qt++] = (uint32_t)t0;
-        st->regions++;
-        while (qh < qt) {
-            const uint32_t t = queue[qh++];
-            for (size_t slot = 3 * (size_t)t; slot < 3 * (size_t)t + 3; slot++) {
-                const uint32_t q = nbr[slot];
-                if (q == ST_EDGES_NONE)
-                    continue;
-                const uint8_t want = (uint8_t)(flip[t] ^ same[slot]);
-                if (flip[q] == 2) {
-                    flip[q] = want;
-                    region[q] = (uint32_t)t0;
-                    queue[qt++] = q;
-                } else if (flip[q] != want) {
-                    st->conflicts++;
-                }
-            }
-        }
-    }
+    st->conflicts = st_soup_edges_orient(&E, s, nbr, same, flip, region, queue, NULL);
+    for (size_t t = 0; t < nt; t++)
+        st->regions += E.kept[t] && region[t] == t;
 
     /* 2. each region turned to the votes' reading */
     const double off = 1.5 * g->voxel;

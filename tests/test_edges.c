@@ -92,6 +92,20 @@ static void test_closed_box(void)
     TAP_CHECK(nnone == 0 && nsame > 0 && nsame % 2 == 0,
               "box: every triangle has 3 neighbours, %zu slots run the same way", nsame);
     TAP_CHECK(open[0] == 0, "box: the piece is not open");
+    /* orientation by propagation: one region, no conflict, and every
+     * triangle turned where add_box flipped it relative to triangle 0 */
+    uint8_t flip[12];
+    uint32_t region[12], queue[12];
+    size_t nq = 0;
+    const size_t conflicts = st_soup_edges_orient(&e, s, nbr, same, flip, region, queue, &nq);
+    int consistent = 1, one = 1;
+    for (size_t t = 0; t < 12; t++) {
+        consistent &= flip[t] == (uint8_t)((t & 1) != 0);
+        one &= region[t] == 0;
+    }
+    TAP_CHECK(conflicts == 0 && nq == 12 && one && queue[0] == 0 && consistent,
+              "box: one orientable region, the flipped triangles turned (%zu conflicts)",
+              conflicts);
     free(nbr);
     free(same);
     st_soup_edges_free(&e);

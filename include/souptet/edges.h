@@ -85,6 +85,19 @@ int st_soup_edges_forward(const st_soup_edges *e, const st_soup *s, uint32_t t,
 void st_soup_edges_neighbours(const st_soup_edges *e, const st_soup *s, uint32_t *nbr,
                               uint8_t *same, uint8_t *open);
 
+/* Orientable regions by propagation over nbr and same (from
+ * st_soup_edges_neighbours): breadth first from each kept triangle not
+ * yet reached, in index order, flip[t] (0 or 1: t is to be turned) such
+ * that neighbours agree; a conflict (an edge the propagation already
+ * oriented the other way) is left where it is found. region[t] (may be
+ * NULL) gets the first triangle of t's region; queue (ntris) gets the
+ * kept triangles region by region, each region's contiguous, in the
+ * order reached. flip[t] is 2 for triangles not kept. Returns the number
+ * of conflicts; *nkept (may be NULL) gets the kept triangles in queue. */
+size_t st_soup_edges_orient(const st_soup_edges *e, const st_soup *s, const uint32_t *nbr,
+                            const uint8_t *same, uint8_t *flip, uint32_t *region,
+                            uint32_t *queue, size_t *nkept);
+
 #ifdef __cplusplus
 }
 #endif
