@@ -43,7 +43,8 @@ st_holes_params st_holes_params_default(void)
     /* 0.25: a hole's cap is at most a quarter of the surface around it (on
      * the corpus, holes of 3 rings of faces on models of 3 000 faces and
      * up: under 0.15); an open patch's own loop spans about its area. */
-    /* planes 0: rebuilt corners (a cone from one, or fans from several)
+    /* History (the measurements that led here). planes on every soup:
+     * rebuilt corners (a cone from one, or fans from several)
      * recover more of the large holes (core IoU at 128^3, mean / worst:
      * 0.743 / 0.584 -> 0.842 / 0.685; with bend 0.876 / 0.803; the cone
      * alone 0.819 / 0.685) and of the holes class (cheese 0.896 ->
@@ -68,7 +69,7 @@ st_holes_params st_holes_params_default(void)
      * 0.8461, largeholes 0.838, but deleted50 cheese 0.971 (0.980
      * without planes), onesided cheese 0.879 (0.905), and 3.2 times the
      * user time on the armadillo's deleted faces (1.9 s -> 6.2 s). */
-    /* bend 0: the least-area caps; the caps that bend least recover more
+    /* bend on every soup: the caps that bend least recover more
      * of a CAD part's large holes (issue 17, the corpus's largeholes:
      * core IoU 0.743 -> 0.829) and of its small ones, but extend a face's
      * plane across a lost concave corner and continue a one-sided scan's
@@ -77,7 +78,7 @@ st_holes_params st_holes_params_default(void)
     /* bend and planes where the soup is intact (issue 17): the rim at
      * most half the soup's area and not one-sided along an axis below
      * 0.02. On the corpus the rim reads 0.76-0.87 where faces were deleted
-     * at random and 0.03-0.15 for the holes, large holes and one-sided
+     * at random and 0.003-0.15 for the holes, large holes and one-sided
      * scans; along an axis the one-sided scans read 0.000 and every other
      * soup with holes 0.39 and up. Core IoU at 128^3 against the least-area
      * caps everywhere (mean / worst): large holes 0.743 / 0.584 -> 0.875 /
@@ -452,7 +453,6 @@ static void pair_by_sides(const st_soup *s, const uint32_t *weld, const uint32_t
     for (size_t i = 0; i < k; i++)
         set_partner(be_a, pa, pb, ev[i], v, ev[mate[i]]);
 }
-
 
 /* How one-sided along an axis the kept triangles of s are: for each axis,
  * each orientable region (triangles oriented to agree across every edge of

@@ -70,7 +70,7 @@ static void usage(void)
 "                       hash); else the vote alone, with a note. none: the vote\n"
 "                       alone (as is --rule paper)\n"
 "      --fill-holes on|off  with --surface: cap the surface's holes (loops of\n"
-"                       boundary edges, by the triangulation of least area,\n"
+"                       boundary edges, by the caps --caps says,\n"
 "                       when small beside the surface around them) before\n"
 "                       voting (default on)\n"
 "      --caps auto|area|bend|planes|planes-bend  with --fill-holes: each cap is\n"
