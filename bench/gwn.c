@@ -15,7 +15,9 @@
  * triangle (no hierarchy), so it is evaluated at every S-th voxel center
  * along each axis (default 4) of the FIELDs' grid; the truth is the
  * shells' winding number (solid.h), as in bench/iou, and every FIELD's IoU
- * is measured at the same samples. One JSON object per line on stdout:
+ * is measured at the same samples, as IoU and as core IoU (the samples
+ * whose six neighbouring voxels all have the sample's own true side, as in
+ * bench/iou: the metric of issue 17's targets). One JSON object per line on stdout:
  * the peer's first ("field": "gwn"), then one per FIELD.
  */
 #include "souptet/gridio.h"
@@ -52,12 +54,29 @@ static double solid_angle(const double p[3], const double *a, const double *b, c
     return 2.0 * atan2(det, den);
 }
 
-static void print_iou(const char *name, size_t both, size_t t, size_t f)
+/* Whether voxel (i, j, k)'s six neighbours all have its own true side
+ * (bench/iou's core: the voxels within a voxel of the true boundary are
+ * left out of the core IoU). */
+static int core_voxel(const uint8_t *truth, const st_grid *g, size_t i, size_t j, size_t k)
+{
+    const size_t id = st_grid_index(g, i, j, k), sx = 1, sy = g->nx, sz = g->nx * g->ny;
+    const uint8_t t = truth[id] != 0;
+    if ((i > 0 && (truth[id - sx] != 0) != t) || (i + 1 < g->nx && (truth[id + sx] != 0) != t) ||
+        (j > 0 && (truth[id - sy] != 0) != t) || (j + 1 < g->ny && (truth[id + sy] != 0) != t) ||
+        (k > 0 && (truth[id - sz] != 0) != t) || (k + 1 < g->nz && (truth[id + sz] != 0) != t))
+        return 0;
+    return 1;
+}
+
+static void print_iou(const char *name, size_t both, size_t t, size_t f, size_t core_both,
+                      size_t core_either)
 {
     const size_t uni = t + f - both;
-    printf("{\"field\": \"%s\", \"iou\": %.6f, \"precision\": %.6f, \"recall\": %.6f}\n", name,
-           uni ? (double)both / (double)uni : 1.0, f ? (double)both / (double)f : 1.0,
-           t ? (double)both / (double)t : 1.0);
+    printf("{\"field\": \"%s\", \"iou\": %.6f, \"precision\": %.6f, \"recall\": %.6f, "
+           "\"core_iou\": %.6f}\n",
+           name, uni ? (double)both / (double)uni : 1.0, f ? (double)both / (double)f : 1.0,
+           t ? (double)both / (double)t : 1.0,
+           core_either ? (double)core_both / (double)core_either : 1.0);
 }
 
 int main(int argc, char **argv)
@@ -131,7 +150,7 @@ int main(int argc, char **argv)
         peer[q] = fabs(w) / (4.0 * M_PI) >= 0.5;
     }
     for (int f = -1; f < nfield; f++) {
-        size_t both = 0, t = 0, in = 0;
+        size_t both = 0, t = 0, in = 0, core_both = 0, core_either = 0;
         for (size_t q = 0; q < ns; q++) {
             const size_t i = step * (q % sx), j = step * (q / sx % sy), k = step * (q / (sx * sy));
             const size_t id = st_grid_index(g, i, j, k);
@@ -139,8 +158,12 @@ int main(int argc, char **argv)
             both += (size_t)(a & b);
             t += (size_t)a;
             in += (size_t)b;
+            if (core_voxel(truth, g, i, j, k)) {
+                core_both += (size_t)(a & b);
+                core_either += (size_t)(a | b);
+            }
         }
-        print_iou(f < 0 ? "gwn" : argv[sep2 + 1 + f], both, t, in);
+        print_iou(f < 0 ? "gwn" : argv[sep2 + 1 + f], both, t, in, core_both, core_either);
     }
     return 0;
 fail:

@@ -473,7 +473,8 @@ def fill_measure(bench, build, mesh, truth, own=None):
     the truth itself (a clean model), which then needs no second run."""
     if own is not None and own.get("vertices_inside") is not None:
         return {"undamaged_inside": own["vertices_inside"],
-                "undamaged_vertices": own.get("surface_vertices")}
+                "undamaged_vertices": own.get("surface_vertices"),
+                "undamaged_short_h": own.get("surface_dist_max_h")}
     if not truth:
         return {"fill_error": "no ground truth"}
     inside = total = 0
@@ -497,6 +498,12 @@ def fill_measure(bench, build, mesh, truth, own=None):
         # --offset), and this is shown beside the misses.
         out["undamaged_beyond"] = m.get("beyond_offset")
         out["undamaged_dist_max_h"] = m.get("dist_max_h")
+        # How far short of the solid a mesh that misses it falls: the
+        # undamaged surface's farthest point from the mesh's boundary, in
+        # h (S->dM at vertices and samples inside each triangle). A mesh a fraction of a cell
+        # short of a lost face reads under 1 h, however many of that
+        # face's vertices lie outside; a hollow one reads its depth.
+        out["undamaged_short_h"] = m.get("surface_dist_max_h")
     return out
 
 
@@ -557,24 +564,28 @@ def fill_markdown(rows, previous):
           " the undamaged model at the same options (for *interpenetrating*: of the model"
           " alone, so the part of shell 2 outside it adds to the ratio, and the volume target"
           " is not applied: the mesh of the undamaged union would be the mesh of the input"
-          " itself). *encloses input*:"
+          " itself). *S→∂M*: the undamaged surface's farthest point from the mesh's"
+          " boundary, in h (tetstat's surface_dist_max_h): how far short of the solid a mesh"
+          " falls where vertices are outside (the clean model's own row is the reference)."
+          " *encloses input*:"
           " every input vertex inside and no input triangle crossing the boundary (tetstat,"
           " exact).", "",
           "| model | damage | tets | min ° | max ° | encloses input | undamaged inside"
-          " | undamaged inside % | mesh volume | volume ratio |",
-          "|---|---|--:|--:|--:|---|--:|--:|--:|--:|"]
+          " | undamaged inside % | S→∂M (h) | mesh volume | volume ratio |",
+          "|---|---|--:|--:|--:|---|--:|--:|--:|--:|--:|"]
     for r in fr:
         clean = r["damage"] in ("closed", "as is")
         if r.get("status") != "ok":
-            md.append("| %s | %s | %s ||||||||" % (r["model"], r["damage"], r["status"]))
+            md.append("| %s | %s | %s |||||||||" % (r["model"], r["damage"], r["status"]))
             continue
         inside = ("%d / %d" % (r["undamaged_inside"], r["undamaged_vertices"])
                   if r.get("undamaged_inside") is not None else r.get("fill_error", "-"))
         vr = r.get("volume_vs_undamaged")
-        md.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+        md.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
             r["model"], r["damage"], _f(r.get("tets"), "%d"), _f(r.get("min_dihedral")),
             _f(r.get("max_dihedral")), "yes" if _encloses_ok(r) else "**no**", inside,
-            _pct(_inside_frac(r)), _f(r.get("volume"), "%.6g"),
+            _pct(_inside_frac(r)), _f(r.get("undamaged_short_h"), "%.2f"),
+            _f(r.get("volume"), "%.6g"),
             "1 (reference)" if clean else _f(vr, "%.3f")))
     # per damage
     order = []
@@ -589,9 +600,9 @@ def fill_markdown(rows, previous):
            " previous run of this stage on the same inputs (bench/results/mesh.json before"
            " this run; met within %.0f°; '-' without one). A failed mesh misses every"
            " target." % (100 * FILL_DEFAULT, FILL_VOLUME[0], FILL_VOLUME[1], QUALITY_SLACK), "",
-           "| damage | inputs | inside: worst (input) | target | | volume ratio: range"
+           "| damage | inputs | inside: worst (input) | target | | S→∂M: worst (h) | volume ratio: range"
            " | target | | enclosed | | min ° / max ° (previous) | |",
-           "|---|--:|---|--:|---|---|---|---|--:|---|---|---|"]
+           "|---|--:|---|--:|---|--:|---|---|---|--:|---|---|---|"]
     summary = []
     for dmg in order:
         sub = [r for r in fr if r["damage"] == dmg]
@@ -607,6 +618,8 @@ def fill_markdown(rows, previous):
         vol_met = (not failed and len(kr) == len(ok) and
                    all(FILL_VOLUME[0] <= x <= FILL_VOLUME[1] for x in kr))
         vol_na = dmg in FILL_VOLUME_NA
+        shorts = [r["undamaged_short_h"] for r in ok if r.get("undamaged_short_h") is not None]
+        short = max(shorts) if shorts else None
         enc = sum(1 for r in ok if _encloses_ok(r))
         enc_met = not failed and enc == len(sub)
         mn = min((r["min_dihedral"] for r in ok if r.get("min_dihedral") is not None), default=None)
@@ -620,11 +633,11 @@ def fill_markdown(rows, previous):
             q = "met" if (not failed and mn >= pmn - QUALITY_SLACK
                           and mx <= pmx + QUALITY_SLACK) else "**missed**"
         mark = lambda b: "met" if b else "**missed**"
-        md.append("| %s | %d%s | %s | %s | %s | %s | %s | %s | %d / %d | %s | %s / %s (%s / %s) | %s |" % (
+        md.append("| %s | %d%s | %s | %s | %s | %s | %s | %s | %s | %d / %d | %s | %s / %s (%s / %s) | %s |" % (
             dmg, len(sub), " (%d failed)" % failed if failed else "",
             ("%s (%s)" % (_pct(worst[0]), worst[1] if worst[0] < 1.0 else "all")) if worst else "-",
             "%g%%" % (100 * want),
-            mark(inside_met),
+            mark(inside_met), _f(short, "%.2f"),
             "%.3f-%.3f" % (min(kr), max(kr)) if kr else "-",
             "%.2f-%.2f" % FILL_VOLUME if not vol_na else "n/a (union)",
             mark(vol_met) if not vol_na else "-", enc, len(sub), mark(enc_met),
@@ -632,10 +645,10 @@ def fill_markdown(rows, previous):
         vol_target = ("target %.2f-%.2f) %s" % (FILL_VOLUME[0], FILL_VOLUME[1],
                                                  "met" if vol_met else "MISSED")
                       if not vol_na else "to the model alone; target n/a: the union is larger)")
-        summary.append("fill %s: inside %s (target %s) %s; volume %s (%s;"
+        summary.append("fill %s: inside %s (target %s) %s, S->dM up to %s h; volume %s (%s;"
                        " enclosed %d/%d %s; dihedral %s..%s%s" % (
                            dmg, _pct(worst[0]) if worst else "-", "%g%%" % (100 * want),
-                           "met" if inside_met else "MISSED",
+                           "met" if inside_met else "MISSED", _f(short, "%.2f"),
                            "%.3f-%.3f" % (min(kr), max(kr)) if kr else "-", vol_target, enc, len(sub),
                            "met" if enc_met else "MISSED", _f(mn), _f(mx),
                            "" if q == "-" else " (previous %s..%s) %s" % (
