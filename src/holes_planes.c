@@ -71,7 +71,13 @@
 
 /* Apexes within the loop's box grown by REACH times its extent each way:
  * a lost corner lies near the loop's box (a box's lost corner at a corner
- * of it), a point where nearly parallel planes meet far beyond. */
+ * of it), a point where nearly parallel planes meet far beyond. Not kept:
+ * that box cut to the kept soup's box (a lost corner lies within the
+ * part's surviving extent). It removes the spike that pinion's large
+ * holes send out a gear's length past its teeth, but the apexes the
+ * loops take next are worse elsewhere (core IoU at 128^3, planes-bend:
+ * pinion 0.803 -> 0.830, rotor 0.950 -> 0.879, joint 0.803 -> 0.782; the
+ * soup's box grown by a tenth of its extent: rotor 0.950, joint 0.659). */
 #define REACH 0.75
 /* Planes whose offsets and normals differ by less than SAME (relative to
  * the loop's extent) are one face's (its triangles' rounding). */
