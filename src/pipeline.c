@@ -478,11 +478,21 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     }
 
     /* The fill (pseudo.h): the pseudo volume's boundary where the soup has
-     * none counts as surface for the fit's condition. */
-    if (p->density_rho <= 0 && p->fill_counts) {
-        rc = st_pseudo_fill(&fill, g, bvh, &st->fill_faces, err);
+     * none. It counts as surface for the fit's condition (fill_counts),
+     * and how much of the boundary it is, how far from the soup, says how
+     * much of the solid is a guess (the closed shells' alone: none). */
+    if (!st->shells_only) {
+        size_t nfill = 0;
+        rc = st_pseudo_fill(&fill, g, bvh, &nfill, err);
         if (rc)
             goto done;
+        st_pseudo_guess_measure(&st->guess, g, fill, bvh);
+        if (p->density_rho <= 0 && p->fill_counts) {
+            st->fill_faces = nfill;
+        } else {
+            st_soup_free(fill);
+            fill = NULL;
+        }
     }
     size_t K = p->tries;
     st->candidates = calloc(K, sizeof *st->candidates);

@@ -20,6 +20,7 @@
 #include "fpenv.h"
 #include "souptet/pseudo.h"
 
+#include <math.h>
 #include <stdint.h>
 
 static st_status add_square(st_soup *f, const double c[3], int axis, double half,
@@ -86,4 +87,41 @@ st_status st_pseudo_fill(st_soup **out, const st_grid *g, const st_bvh *bvh,
         *faces = count;
     *out = f;
     return ST_OK;
+}
+
+void st_pseudo_guess_measure(st_pseudo_guess *out, const st_grid *g, const st_soup *fill,
+                             const st_bvh *bvh)
+{
+    size_t all = 0;
+    const long long nz = (long long)g->nz;
+    #pragma omp parallel for schedule(static) reduction(+ : all)
+    for (long long kk = 0; kk < nz; kk++) {
+        const size_t k = (size_t)kk;
+        for (size_t j = 0; j < g->ny; j++)
+            for (size_t i = 0; i < g->nx; i++) {
+                const int in = g->data[st_grid_index(g, i, j, k)] < 0.0f;
+                if (i + 1 < g->nx)
+                    all += (g->data[st_grid_index(g, i + 1, j, k)] < 0.0f) != in;
+                if (j + 1 < g->ny)
+                    all += (g->data[st_grid_index(g, i, j + 1, k)] < 0.0f) != in;
+                if (k + 1 < g->nz)
+                    all += (g->data[st_grid_index(g, i, j, k + 1)] < 0.0f) != in;
+            }
+    }
+    /* a square's two triangles are (b, b+1, b+2) and (b, b+2, b+3)
+     * (add_square): b and b+2 are opposite corners */
+    const long long nsq = fill && bvh ? (long long)(fill->ntris / 2) : 0;
+    double depth2 = 0.0;
+    #pragma omp parallel for schedule(dynamic, 256) reduction(max : depth2)
+    for (long long q = 0; q < nsq; q++) {
+        const uint32_t *t = fill->tris + 6 * (size_t)q;
+        const double *a = fill->xyz + 3 * (size_t)t[0], *c = fill->xyz + 3 * (size_t)t[2];
+        const double m[3] = {0.5 * (a[0] + c[0]), 0.5 * (a[1] + c[1]), 0.5 * (a[2] + c[2])};
+        int64_t tri;
+        const double d2 = st_bvh_nearest(bvh, m, INFINITY, &tri, NULL);
+        depth2 = d2 > depth2 ? d2 : depth2;
+    }
+    out->boundary_faces = all;
+    out->fill_faces = (size_t)nsq;
+    out->depth = sqrt(depth2);
 }

@@ -913,6 +913,23 @@ static void test_fill(void)
             TAP_CHECK(ok && (double)faces >= 0.6 * n * n && (double)faces <= n * n + 1,
                       "and covers most of it: %zu squares of about %.0f", faces, n * n);
         }
+        /* how much of the boundary is a guess: the top's share of a cube's
+         * boundary faces, about 1/6 (less the rim within a voxel of the
+         * walls), as far from the soup as its middle from the walls' top
+         * edges (1/2) */
+        st_pseudo_guess gs = {0, 0, -1.0};
+        if (ok)
+            st_pseudo_guess_measure(&gs, g, f, bvh);
+        const double share = gs.boundary_faces ? (double)gs.fill_faces / gs.boundary_faces : -1;
+        const double v = ok ? g->voxel : 0;
+        if (closed)
+            TAP_CHECK(ok && gs.fill_faces == 0 && gs.depth == 0.0 && gs.boundary_faces > 0,
+                      "the closed box: nothing guessed (%zu boundary faces)", gs.boundary_faces);
+        else
+            TAP_CHECK(ok && gs.fill_faces == faces && share >= 0.1 && share <= 1.0 / 6 + 0.01 &&
+                      fabs(gs.depth - 0.5) <= v,
+                      "the open box: its top is the guess, %.3f of the boundary, up to %.4f "
+                      "from the soup (voxel %g)", share, gs.depth, v);
         if (ok) {
             /* an unsigned field has no pseudo volume */
             st_grid *d = NULL;

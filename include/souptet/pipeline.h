@@ -36,6 +36,7 @@
 #include <stdint.h>
 
 #include "souptet/err.h"
+#include "souptet/pseudo.h"
 #include "souptet/progress.h"
 #include "souptet/smooth.h"
 #include "souptet/soup.h"
@@ -160,6 +161,10 @@ typedef struct st_pipeline_stats {
                                             (pseudo.h, the shortcut) */
     size_t fill_faces;                   /* voxel squares of the fill (0
                                             with fill_counts 0) */
+    st_pseudo_guess guess;               /* how much of the pseudo volume's
+                                            boundary is fill, and how far
+                                            from the input (pseudo.h; all 0
+                                            for closed shells alone) */
 } st_pipeline_stats;
 
 /* The lattice cell width p gives for s: p->h, or the width of p->cells

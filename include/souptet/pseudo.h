@@ -136,6 +136,21 @@ st_status st_pseudo_volume_bvh(st_grid **out, const st_soup *s, const st_dist_pa
 st_status st_pseudo_fill(st_soup **out, const st_grid *g, const st_bvh *bvh,
                          size_t *faces, st_error *err);
 
+/* How much of the pseudo volume's boundary is a guess rather than the
+ * soup: the faces of signed field g's boundary (between an inside and an
+ * outside voxel), of them the fill's (fill: st_pseudo_fill's output for g
+ * and bvh; NULL: none), and the fill's farthest point from the soup (bvh:
+ * the soup's; each fill square's center; model units, 0 without fill).
+ * A hole's cap, a one-sided view's far side or a large hole's rebuilt
+ * face are fill; the soup's own surface is not. */
+typedef struct st_pseudo_guess {
+    size_t boundary_faces;
+    size_t fill_faces;
+    double depth;
+} st_pseudo_guess;
+void st_pseudo_guess_measure(st_pseudo_guess *out, const st_grid *g, const st_soup *fill,
+                             const st_bvh *bvh);
+
 #ifdef __cplusplus
 }
 #endif

@@ -132,6 +132,20 @@ static void on_event(void *ctx, const st_pipeline_event *ev)
                  ev->candidate->failed ? " (failed)" : "");
 }
 
+/* The diagonal of the box of the points s's triangles use. */
+static double box_diagonal(const st_soup *s)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < 3 * s->ntris; i++)
+        for (int a = 0; a < 3; a++) {
+            const double x = s->xyz[3 * (size_t)s->tris[i] + (size_t)a];
+            lo[a] = fmin(lo[a], x);
+            hi[a] = fmax(hi[a], x);
+        }
+    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
 static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
 {
     tool_say(t, 2, "field %zux%zux%zu, voxel %.6g; lattice cell h %.6g",
@@ -479,18 +493,23 @@ static int run(tool_ctx *t, void *settings)
              b->tets, b->points, b->min_dihedral, b->max_dihedral,
              st.encloses ? "encloses the input" : "DOES NOT enclose the input",
              b->verts_outside, b->tris_crossing, tool_now() - t0);
+    const double diag = box_diagonal(soup);
+    if (st.guess.fill_faces) {
+        /* The solid where the input has no surface is the pseudo volume's
+         * guess (caps, a one-sided view's far side): said by default when
+         * it reaches past a lattice cell from the input, where the mesh
+         * resolves it (its volume, a simulation's mass, rest on it). */
+        const double depth_h = st.guess.depth / st.h;
+        tool_say(t, depth_h > 1.0 ? 1 : 2,
+                 "note: %.1f%% of the solid's boundary is not on the input but guessed "
+                 "(hole caps, a one-sided view's far side), up to %.2f h (%.3f of the "
+                 "diagonal) from it; the mesh's volume there rests on that guess",
+                 100.0 * (double)st.guess.fill_faces / (double)st.guess.boundary_faces,
+                 depth_h, st.guess.depth / diag);
+    }
     if (t->verbosity >= 2 && p->density_rho <= 0) {
         /* both directions, in h and per the input's box diagonal */
-        double sb = NAN, lo[3] = {INFINITY, INFINITY, INFINITY},
-               hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (size_t i = 0; i < 3 * soup->ntris; i++)
-            for (int a = 0; a < 3; a++) {
-                double x = soup->xyz[3 * (size_t)soup->tris[i] + (size_t)a];
-                lo[a] = fmin(lo[a], x);
-                hi[a] = fmax(hi[a], x);
-            }
-        double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                           (hi[2] - lo[2]) * (hi[2] - lo[2]));
+        double sb = NAN;
         if (st_tetstat_surface_to_boundary(&sb, m, soup, &err)) {
             rc = tool_fail(t, &err);
             goto done;

@@ -353,6 +353,7 @@ static int run(tool_ctx *t, void *settings)
     st_error_clear(&err);
     st_grid *g = NULL;
     st_soup *soup = NULL;
+    st_bvh *bvh = NULL;   /* -v with the soup: for the fill's report */
     st_pseudo_stats ps;
     memset(&ps, 0, sizeof ps);
     int rc = TOOL_EXIT_FAIL;
@@ -394,7 +395,10 @@ static int run(tool_ctx *t, void *settings)
         pp.sides_params.column_ratio = 0.0;
     st_progress prog = tool_progress(t);
     const double c0 = cpu_now();
-    if (st_pseudo_sign(g, soup, &pp, &ps, &prog, &err)) {
+    /* -v with the soup: its BVH too, for how much of the boundary is a
+     * guess (st_pseudo_guess_measure) */
+    if (st_pseudo_sign_bvh(g, soup, &pp, &ps, &prog,
+                           soup && t->verbosity >= 2 ? &bvh : NULL, &err)) {
         tool_progress_end(t);
         rc = tool_fail_file(t, &err, surface && ps.failed_step &&
                                          strcmp(ps.failed_step, "vote") != 0 ? surface
@@ -462,10 +466,27 @@ static int run(tool_ctx *t, void *settings)
                  "%.3f s", ps.shells, ps.shell_open_triangles,
                  ps.shells && !ps.shell_open_triangles ? ": the signs are their solid" : "",
                  ps.shell_changed, ps.seconds_shells);
+    if (bvh && voted) {
+        st_soup *fill = NULL;
+        st_pseudo_guess gs;
+        if (st_pseudo_fill(&fill, g, bvh, NULL, &err)) {
+            rc = tool_fail(t, &err);
+            goto done;
+        }
+        st_pseudo_guess_measure(&gs, g, fill, bvh);
+        st_soup_free(fill);
+        tool_say(t, 2, "fill: %zu of %zu boundary faces (%.1f%%) have no soup within a voxel "
+                 "(caps, a far side), up to %.3g voxels (%.6g) from it", gs.fill_faces,
+                 gs.boundary_faces,
+                 gs.boundary_faces ? 100.0 * (double)gs.fill_faces / (double)gs.boundary_faces
+                                   : 0.0,
+                 gs.depth / g->voxel, gs.depth);
+    }
     tool_say(t, 2, "read %.3f s, signs %.3f s (CPU %.3f s, all threads), write %.3f s",
              t1 - t0, voted ? ps.seconds_vote : ps.seconds_shells, cpu_sign, t3 - t2);
     rc = TOOL_EXIT_OK;
 done:
+    st_bvh_free(bvh);
     st_grid_free(g);
     st_soup_free(soup);
     return rc;

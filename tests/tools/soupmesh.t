@@ -156,5 +156,15 @@ PY
 check "one-sided: the pipe with tetsmooth --field makes soupmesh's mesh, bit for bit" \
     sh -c "soupdist onesided.obj | soupsign -o osf.vti && latticetet --sculpt --surface onesided.obj --cells 6 osf.vti | tetsmooth --fit --surface onesided.obj --field osf.vti -o pipe.vtu && /usr/bin/python3 samemesh.py pipe.vtu os.vtu"
 expect_fail "bad --offset-fill" 2 "--offset-fill is on or off" soupmesh --offset-fill 2 onesided.obj
+# How much of the solid is a guess (issue 17): said by default where the
+# fill reaches past a lattice cell from the input (the one-sided bunny's
+# far side), under -v only where it does not (the holed bunny's small
+# cap), never for a closed input.
+check "one-sided: the default output says how much of the solid is guessed, and how far" sh -c \
+    "soupmesh --cells 6 -o osn.vtu onesided.obj 2>&1 | grep -Eq 'note: [0-9.]+% of the solid.s boundary is not on the input but guessed .*, up to [0-9.]+ h \\([0-9.]+ of the diagonal\\)'"
+check "a small cap: the note only under -v" sh -c \
+    "soupmesh -o hn.vtu holed.obj 2> hn.log && grep -q 'encloses the input' hn.log && ! grep -q 'guessed' hn.log && soupmesh -v -o hn.vtu holed.obj 2>&1 | grep -q 'guessed'"
+check "the closed bunny: nothing guessed, even under -v" sh -c \
+    "soupmesh -v --cells 6 -o bn.vtu '$BUNNY' 2> bn.log && grep -q 'encloses the input' bn.log && ! grep -q 'guessed' bn.log"
 
 done_testing

@@ -152,6 +152,10 @@ check "the holed bunny runs every step" sh -c \
     "soupsign -v --surface holed.obj -o h4.vdb h.vdb 2>&1 | grep -q 'refinement (band' && grep -aq sign_refine h4.vdb"
 check "the holed bunny has none" sh -c "soupsign -v --surface holed.obj -o h3.vdb h.vdb 2>&1 | grep -q 'closed shells: 0 ('"
 expect_fail "bad --shells" 2 "--shells is on or off" soupsign --shells 1 d.vdb
+check "-v: how much of the holed bunny's boundary is fill (its cap), and how far from the soup" sh -c \
+    "soupsign -v --surface holed.obj -o h5.vdb h.vdb 2>&1 | grep -Eq 'fill: [1-9][0-9]* of [0-9]+ boundary faces \\([0-9.]+%\\) have no soup within a voxel .*, up to [0-9.e+-]+ voxels'"
+check "-v: the closed bunny's signs are its shells', with no fill line" sh -c \
+    "soupsign -v --surface '$BUNNY' -o h6.vdb d.vdb 2> h6.log && grep -q 'every triangle is in a closed shell' h6.log && ! grep -q 'fill:' h6.log"
 
 # The pipe carries its surface (issue 17): soupdist records the soup (path,
 # size, content hash) and soupsign uses it as --surface when it is unchanged.
