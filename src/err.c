@@ -83,6 +83,7 @@ const char *st_status_name(st_status status)
     case ST_ENOMEM: return "out of memory";
     case ST_ELIMIT: return "over limit";
     case ST_EINTERNAL: return "internal error";
+    case ST_ECANCELLED: return "cancelled";
     }
     return "unknown status";
 }

@@ -25,7 +25,8 @@ typedef enum st_status {
     ST_EIO,       /* the operating system refused: open, read, write */
     ST_ENOMEM,    /* allocation failed or a size overflowed */
     ST_ELIMIT,    /* a size exceeds a configured limit */
-    ST_EINTERNAL  /* a bug: an invariant did not hold */
+    ST_EINTERNAL, /* a bug: an invariant did not hold */
+    ST_ECANCELLED /* the caller asked to stop (progress.h's cancel flag) */
 } st_status;
 
 typedef struct st_error {
