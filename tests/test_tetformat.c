@@ -92,7 +92,7 @@ static int write_samples(const char *dir)
     for (size_t i = 0; i < NVARIANTS; i++) {
         char path[4096];
         snprintf(path, sizeof path, "%s/%s", dir, k_variants[i].file);
-        st_tetformat_opts o = {k_variants[i].version, k_variants[i].binary};
+        st_tetformat_opts o = {.msh_version = k_variants[i].version, .binary = k_variants[i].binary};
         st_error e;
         if (st_tetmesh_save(m, path, &o, &e)) {
             char buf[1100];
@@ -117,7 +117,7 @@ static void test_round_trips(void)
         const variant *v = &k_variants[i];
         char path[256];
         snprintf(path, sizeof path, "%s/%s", g_dir, v->file);
-        st_tetformat_opts o = {v->version, v->binary};
+        st_tetformat_opts o = {.msh_version = v->version, .binary = v->binary};
         st_error e;
         st_status s = st_tetmesh_save(m, path, &o, &e);
         TAP_CHECK(s == ST_OK, "%s: written", v->file);
@@ -224,8 +224,7 @@ static void test_written_text(void)
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char path[256];
         snprintf(path, sizeof path, "%s/%s", g_dir, cases[i].file);
-        st_tetformat_opts o = {cases[i].version > 0 ? cases[i].version : 0,
-                               0};
+        st_tetformat_opts o = {.msh_version = cases[i].version > 0 ? cases[i].version : 0};
         st_error e;
         if (cases[i].version >= 0)
             st_tetmesh_save(m, path, &o, &e);
