@@ -18,6 +18,14 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 int st_points_are_float32(const double *xyz, size_t n)
 {
@@ -114,6 +122,7 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
     if (!st)
         st = &local;
     memset(st, 0, sizeof *st);
+    const double t0 = now_seconds();
     if (bvh && bvh->soup != s)
         return st_error_set(err, ST_EINPUT, NULL, 0,
                             "float32 rounding: the BVH is not over this soup");
@@ -301,6 +310,7 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
         }
     }
 out:
+    st->seconds = now_seconds() - t0;
     if (rc && copied && np)
         memcpy(m->xyz, orig, np * 3 * sizeof *orig);   /* as it was */
     st_locator_free(loc);

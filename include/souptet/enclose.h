@@ -165,6 +165,7 @@ typedef struct st_float32_stats {
     int encloses;               /* the three above are 0 */
     size_t input_not_float32;   /* soup vertices (used by a triangle) with a
                                    coordinate that is not a float */
+    double seconds;             /* the call's wall-clock time */
 } st_float32_stats;
 
 st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,

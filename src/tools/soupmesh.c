@@ -443,11 +443,11 @@ static int run(tool_ctx *t, void *settings)
         const st_float32_stats *f = &st.float32;
         tool_say(t, 2, "float32%s: %zu of %zu points moved (%zu on the boundary, %zu of "
                  "them pushed, up to %u ulps further out), the farthest by %.3g (%.3g h); "
-                 "%d exact check%s: %s (%zu vertices outside, %zu triangles crossing, "
-                 "%zu inverted tets)",
+                 "%d exact check%s, %.3f s: %s (%zu vertices outside, %zu triangles "
+                 "crossing, %zu inverted tets)",
                  s->float32_by_stl ? " (for the .stl boundary)" : "", f->points_moved,
                  m->npoints, f->boundary_points, f->pushed, f->max_push, f->max_move,
-                 f->max_move / st.h, f->rounds, f->rounds == 1 ? "" : "s",
+                 f->max_move / st.h, f->rounds, f->rounds == 1 ? "" : "s", f->seconds,
                  f->encloses ? "encloses the input" : "DOES NOT enclose the input",
                  f->verts_outside, f->tris_crossing, f->inverted);
         if (f->input_not_float32)
