@@ -59,14 +59,17 @@ static double float_side(double x, int dir, unsigned steps)
 /* Point v's rounding at push level `level`: interior points (nfaces 0)
  * to the nearest float; boundary points to the corner of the box of
  * floats around them that goes farthest out by the worst of their faces'
- * unit outward normals (normals: 3 per face; adj: the faces around v). */
-static void round_point(double out[3], const double x[3], unsigned level,
-                        const uint32_t *adj, size_t nadj, const double *normals)
+ * unit outward normals (normals: 3 per face; adj: the faces around v).
+ * Returns that worst (displacement . normal) of the corner chosen: > 0
+ * when the point moved out of every face around it (0 for interior
+ * points). */
+static double round_point(double out[3], const double x[3], unsigned level,
+                          const uint32_t *adj, size_t nadj, const double *normals)
 {
     if (nadj == 0) {
         for (int a = 0; a < 3; a++)
             out[a] = (double)(float)x[a];
-        return;
+        return 0.0;
     }
     double side[3][2];
     for (int a = 0; a < 3; a++) {
@@ -95,6 +98,7 @@ static void round_point(double out[3], const double x[3], unsigned level,
     }
     for (int a = 0; a < 3; a++)
         out[a] = side[a][(best >> a) & 1];
+    return best_score;
 }
 
 typedef struct face_ctx {
@@ -151,6 +155,8 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
     size_t *aoff = NULL;
     uint32_t *adj = NULL;
     unsigned *level = NULL;
+    double *score = NULL, *best_xyz = NULL;
+    unsigned *best_level = NULL;
     unsigned char *vin = NULL, *hit = NULL, *mark = NULL, *fmark = NULL;
     st_bvh *own = NULL;
     st_locator *loc = NULL;
@@ -164,11 +170,15 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
     aoff = st_calloc_array(np + 1, sizeof *aoff);
     adj = st_malloc_array(nf ? 3 * nf : 1, sizeof *adj);
     level = st_calloc_array(np ? np : 1, sizeof *level);
+    score = st_malloc_array(np ? np : 1, sizeof *score);
+    best_xyz = st_malloc_array(np ? np : 1, 3 * sizeof *best_xyz);
+    best_level = st_malloc_array(np ? np : 1, sizeof *best_level);
     mark = st_calloc_array(np ? np : 1, 1);
     fmark = st_calloc_array(nf ? nf : 1, 1);
     vin = st_malloc_array(s->nverts ? s->nverts : 1, 1);
     hit = st_malloc_array(s->ntris ? s->ntris : 1, 1);
-    if (!orig || !normals || !aoff || !adj || !level || !mark || !fmark || !vin || !hit) {
+    if (!orig || !normals || !aoff || !adj || !level || !score || !best_xyz || !best_level || !mark ||
+        !fmark || !vin || !hit) {
         rc = st_error_set(err, ST_ENOMEM, NULL, 0,
                           "out of memory rounding %zu points to float32", np);
         goto out;
@@ -220,10 +230,14 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
     before = *m;
     before.xyz = orig;
 
+    /* The best rounding tried (fewest failures: vertices outside, then
+     * triangles crossing, then inverted tets) is the one kept. */
+    st_float32_stats best = *st;
+    int have_best = 0;
     for (int round = 1; round <= ST_FLOAT32_MAX_ROUNDS; round++) {
         for (size_t v = 0; v < np; v++)
-            round_point(m->xyz + 3 * v, orig + 3 * v, level[v], adj + aoff[v],
-                        aoff[v + 1] - aoff[v], normals);
+            score[v] = round_point(m->xyz + 3 * v, orig + 3 * v, level[v], adj + aoff[v],
+                                   aoff[v + 1] - aoff[v], normals);
         st->rounds = round;
         st_enclosure e;
         if ((rc = st_enclosure_compute(&e, m, s, bvh, vin, hit, err)))
@@ -240,6 +254,17 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
         st->tris_crossing = e.crossing_triangles;
         st->inverted = inverted;
         st->encloses = e.encloses && inverted == 0;
+        if (!have_best || st->verts_outside < best.verts_outside ||
+            (st->verts_outside == best.verts_outside &&
+             (st->tris_crossing < best.tris_crossing ||
+              (st->tris_crossing == best.tris_crossing && st->inverted < best.inverted)))) {
+            best = *st;
+            have_best = 1;
+            if (np) {
+                memcpy(best_xyz, m->xyz, np * 3 * sizeof *best_xyz);
+                memcpy(best_level, level, np * sizeof *best_level);
+            }
+        }
         if (st->encloses || round == ST_FLOAT32_MAX_ROUNDS)
             break;
         if (e.encloses)
@@ -285,14 +310,28 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
                     for (int k = 0; k < 3; k++)
                         mark[faces[3 * f + (size_t)k]] = 1;
         }
-        size_t named = 0;
+        /* A point whose float is not outward for every face around it
+         * (score <= 0: faces around it facing nearly opposite ways, a
+         * knife edge) would only go farther in by some face: it stays;
+         * its neighbours go out. */
+        size_t bumped = 0;
         for (size_t v = 0; v < np; v++)
-            named += mark[v];
-        if (named == 0)
-            all = 1;
-        for (size_t v = 0; v < np; v++)
-            if ((all || mark[v]) && aoff[v + 1] > aoff[v])
+            if ((all || mark[v]) && aoff[v + 1] > aoff[v] && score[v] > 0) {
                 level[v]++;
+                bumped++;
+            }
+        if (bumped == 0)
+            break;   /* nothing left to try */
+    }
+    if (!st->encloses && have_best) {
+        /* Keep the best rounding tried, with its counts. */
+        int rounds = st->rounds;
+        *st = best;
+        st->rounds = rounds;
+        if (np) {
+            memcpy(m->xyz, best_xyz, np * 3 * sizeof *best_xyz);
+            memcpy(level, best_level, np * sizeof *level);
+        }
     }
     for (size_t v = 0; v < np; v++) {
         const double *a = orig + 3 * v, *b = m->xyz + 3 * v;
@@ -321,6 +360,9 @@ out:
     free(aoff);
     free(adj);
     free(level);
+    free(score);
+    free(best_xyz);
+    free(best_level);
     free(mark);
     free(fmark);
     free(vin);

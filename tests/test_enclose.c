@@ -578,6 +578,76 @@ static void test_float32_rotated(void)
     st_soup_free(s);
 }
 
+/* A flat tet (height 1e-3 over a base of side 1, coordinates near 20 and
+ * about half an ulp from floats) with input vertices 0.1..0.4 ulp inside each of its faces near
+ * every corner: at a corner the faces' outward normals point nearly
+ * opposite ways, so no float around it is outward for all of them and the
+ * first rounding may fail; whatever the rounds give, what is reported is
+ * what an independent exact count finds on the mesh left behind. */
+static void test_float32_knife(void)
+{
+    st_tetmesh *m = st_tetmesh_new();
+    const double u = 0x1p-19;   /* heights mid-way between floats */
+    add_point(m, 20.0 + 0.3 * u, 20.0 + 0.6 * u, 20.0 + 0.5 * u);
+    add_point(m, 21.0 + 0.4 * u, 20.1 + 0.2 * u, 20.0 + 0.45 * u);
+    add_point(m, 20.3 - 0.5 * u, 21.0 + 0.5 * u, 20.0 + 0.55 * u);
+    add_point(m, 20.4 + 0.5 * u, 20.4 - 0.5 * u, 20.001 + 0.5 * u);
+    add_tet_pos(m, 0, 1, 2, 3);
+    uint32_t *faces = NULL;
+    size_t nf = 0;
+    st_tetmesh_boundary(m, &faces, NULL, &nf, NULL);
+    st_soup *s = st_soup_new();
+    const double ulp = 0x1p-19;
+    double cen[3] = {0, 0, 0};
+    for (int k = 0; k < 4; k++)
+        for (int a = 0; a < 3; a++)
+            cen[a] += m->xyz[3 * k + a] / 4;
+    for (size_t f = 0; f < nf; f++)
+        for (int c = 0; c < 3; c++) {
+            const uint32_t *q = faces + 3 * f;
+            const double *a = m->xyz + 3 * q[c], *b = m->xyz + 3 * q[(c + 1) % 3],
+                         *d = m->xyz + 3 * q[(c + 2) % 3];
+            double e1[3], e2[3], n[3], p[3];
+            for (int i = 0; i < 3; i++) {
+                e1[i] = b[i] - a[i];
+                e2[i] = d[i] - a[i];
+            }
+            n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            double depth = (0.1 + 0.1 * (double)c) * ulp;
+            for (int i = 0; i < 3; i++)
+                p[i] = 0.9 * a[i] + 0.05 * b[i] + 0.05 * d[i] - depth * n[i] / len;
+            uint32_t base = (uint32_t)s->nverts;
+            st_soup_add_vertex(s, p[0], p[1], p[2], NULL);
+            st_soup_add_vertex(s, 0.5 * (p[0] + cen[0]), 0.5 * (p[1] + cen[1]),
+                               0.5 * (p[2] + cen[2]), NULL);
+            st_soup_add_vertex(s, cen[0], cen[1], cen[2], NULL);
+            st_soup_add_triangle(s, base, base + 1, base + 2, NULL);
+        }
+    free(faces);
+    size_t out = 9, cross = 9;
+    st_enclosure_count(m, s, NULL, &out, &cross, NULL);
+    TAP_CHECK(out == 0 && cross == 0, "float32 knife: the double tet encloses its 12 "
+              "near-face triangles (%zu, %zu)", out, cross);
+    st_float32_stats fs;
+    st_status rc = st_enclosure_round_float32(m, s, NULL, &fs, NULL);
+    st_enclosure_count(m, s, NULL, &out, &cross, NULL);
+    size_t inv = not_positive(m);
+    TAP_CHECK(rc == ST_OK && fs.rounds >= 1 && fs.rounds <= ST_FLOAT32_MAX_ROUNDS &&
+              st_points_are_float32(m->xyz, m->npoints),
+              "float32 knife: rounded to floats in %d checks (%zu pushed, up to %u ulps)",
+              fs.rounds, fs.pushed, fs.max_push);
+    TAP_CHECK(fs.verts_outside == out && fs.tris_crossing == cross && fs.inverted == inv &&
+              fs.encloses == (out == 0 && cross == 0 && inv == 0),
+              "float32 knife: the report is the result's (%s: %zu outside, %zu crossing, "
+              "%zu inverted)", fs.encloses ? "encloses" : "does not enclose", out, cross,
+              inv);
+    st_tetmesh_free(m);
+    st_soup_free(s);
+}
+
 int main(void)
 {
     test_cube_encloses_small_soup();
@@ -589,5 +659,6 @@ int main(void)
     test_threads_and_speed();
     test_float32_face();
     test_float32_rotated();
+    test_float32_knife();
     return tap_done();
 }
