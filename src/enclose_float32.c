@@ -310,13 +310,14 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
                     for (int k = 0; k < 3; k++)
                         mark[faces[3 * f + (size_t)k]] = 1;
         }
-        /* A point whose float is not outward for every face around it
-         * (score <= 0: faces around it facing nearly opposite ways, a
-         * knife edge) would only go farther in by some face: it stays;
-         * its neighbours go out. */
+        /* A point whose float goes inward by some face around it (score
+         * < 0: faces around it facing nearly opposite ways, a knife edge)
+         * would only go farther in by it: it stays; the other points
+         * named go out. (Score 0: a point on the float grid under a face
+         * along it; one ulp out is outward.) */
         size_t bumped = 0;
         for (size_t v = 0; v < np; v++)
-            if ((all || mark[v]) && aoff[v + 1] > aoff[v] && score[v] > 0) {
+            if ((all || mark[v]) && aoff[v + 1] > aoff[v] && score[v] >= 0) {
                 level[v]++;
                 bumped++;
             }

@@ -134,9 +134,9 @@ st_status st_enclosure_count(const st_tetmesh *m, const st_soup *s,
  *     none; the corners of boundary faces that meet a crossing soup
  *     triangle) go one float ulp further out, and the check is made
  *     again, at most ST_FLOAT32_MAX_ROUNDS checks in all. A point whose
- *     chosen float is not outward for every face around it (faces facing
+ *     chosen float goes inward by some face around it (faces facing
  *     nearly opposite ways: a knife edge, a flat tet) is not pushed: that
- *     would take it farther in by some face; its neighbours are. The
+ *     would take it farther in by that face; the other points named are. The
  *     rounds stop when nothing is left to push (a soup vertex outside the
  *     mesh before rounding names nothing). When no rounding encloses, the
  *     best tried (fewest vertices outside, then triangles crossing, then
