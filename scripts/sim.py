@@ -5,8 +5,14 @@ elasticity measures of a tet mesh (stable time step, stiffness matrix,
 conjugate gradients).
 
 Imported by Debian's /usr/bin/python3 (numpy, scipy, meshio, SfePy from
-python3-sfepy). SfePy is imported only by solve_sag, so the rest works
-without it.
+python3-sfepy). SfePy is imported only by read_cage_sfepy and solve_sag,
+so the rest works without it.
+
+The demo and the tests load the cage as a SfePy user would, with SfePy's
+own Mesh.from_file (read_cage_sfepy): that wants the tets alone (its
+FEDomain refuses "meshes with several cell kinds"), so the cage is written
+with soupmesh --volume-only (.mesh or .msh). read_cage reads any file
+meshio reads (the bench's peers' meshes too).
 
 The embedding is soupmesh --embed's text sidecar (embed.h): one line per
 surface vertex, "tet b0 b1 b2 b3", tets numbered from 0 in the mesh file's
@@ -40,6 +46,25 @@ def read_cage(path):
         raise ValueError("%s: no tetrahedra" % path)
     return np.asarray(m.points, dtype=np.float64)[:, :3], \
         np.concatenate(tets).astype(np.int64)
+
+
+def read_cage_sfepy(path):
+    """(SfePy Mesh, points n x 3 float64, tets m x 4 int64) of a tet mesh
+    file loaded by SfePy's own Mesh.from_file (.mesh, .msh, .vtk, ...), as
+    a SfePy user would load it. The file must hold the tets alone
+    (soupmesh --volume-only): with the boundary triangles too, SfePy loads
+    two cell kinds and its FEDomain refuses them, which is raised here as
+    a ValueError naming the option."""
+    from sfepy.base.base import output
+    from sfepy.discrete.fem import Mesh
+    output.set_output(quiet=True)
+    mesh = Mesh.from_file(path)
+    if list(mesh.descs) != ["3_4"]:
+        raise ValueError("%s: SfePy loads the cell kinds %s; its FEDomain takes one"
+                         " (write the mesh with soupmesh --volume-only)"
+                         % (path, list(mesh.descs)))
+    return mesh, np.array(mesh.coors, dtype=np.float64)[:, :3], \
+        np.asarray(mesh.get_conn("3_4"), dtype=np.int64)
 
 
 def read_obj(path):
@@ -345,14 +370,17 @@ def pcg_jacobi(k, f, tol=1e-8, maxit=100000):
 # ------------------------------------------------------------------ SfePy
 
 def solve_sag(points, tets, load, steps=4, up=1, fraction=0.08, young=YOUNG,
-              poisson=POISSON, quiet=True):
+              poisson=POISSON, quiet=True, mesh=None):
     """A compressible Neo-Hookean body (total Lagrangian: SfePy's
     dw_tl_he_neohook + dw_tl_bulk_penalty, mu and bulk modulus K from
     Young's modulus and Poisson's ratio) sagging under its weight `load`
     (force per volume, along -up), the base nodes (base_nodes) held fixed,
     the load applied in `steps` equal increments, Newton at each. Returns
     (displacement n x 3, [Newton iterations per step], converged). Only the
-    mesh's points used by tets are in the problem; the others get 0."""
+    mesh's points used by tets are in the problem; the others get 0.
+    mesh: the SfePy Mesh these points and tets came from (read_cage_sfepy),
+    solved as loaded when every point is used; None: one is made from the
+    arrays (Mesh.from_data)."""
     from sfepy.base.base import output, IndexedStruct
     from sfepy.discrete import (FieldVariable, Material, Integral, Function,
                                 Equation, Equations, Problem)
@@ -368,9 +396,10 @@ def solve_sag(points, tets, load, steps=4, up=1, fraction=0.08, young=YOUNG,
     remap = np.full(len(points), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
     coors = points[used]
-    conn = remap[tets].astype(np.int32)
-    mesh = Mesh.from_data("cage", coors, None, [conn],
-                          [np.zeros(len(conn), dtype=np.int32)], ["3_4"])
+    if mesh is None or len(used) != len(points):
+        conn = remap[tets].astype(np.int32)
+        mesh = Mesh.from_data("cage", coors, None, [conn],
+                              [np.zeros(len(conn), dtype=np.int32)], ["3_4"])
     domain = FEDomain("domain", mesh)
     omega = domain.create_region("Omega", "all")
     y = coors[:, up]

@@ -38,6 +38,7 @@ st_pipeline_params st_pipeline_params_default(void)
     p.fill_holes = 1;
     p.closed_shells = 1;
     p.fill_counts = 1;
+    p.float32 = 0;
     return p;
 }
 
@@ -371,6 +372,8 @@ static st_status set_meta(st_tetmesh *m, const st_pipeline_params *p,
         goto oom;
     if (st_meta_set(&m->meta, "encloses", st->encloses ? "yes" : "no"))
         goto oom;
+    if (p->float32 && st_meta_set(&m->meta, "float32", "yes"))
+        goto oom;
     if (p->density_rho <= 0 && st_meta_set(&m->meta, "offset_fill", p->fill_counts ? "yes" : "no"))
         goto oom;
     if (p->density_rho > 0) {
@@ -574,6 +577,18 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     st->best = best;
     st->encloses = st->candidates[best].verts_outside == 0 &&
                    st->candidates[best].tris_crossing == 0;
+    if (p->float32) {
+        /* The chosen mesh as a float32 consumer will hold it: its counts,
+         * angles and enclosure are then the rounded mesh's. */
+        st_pipeline_candidate *c = &st->candidates[best];
+        rc = st_enclosure_round_float32(meshes[best], s, bvh, &st->float32, err);
+        if (rc)
+            goto done;
+        c->verts_outside = st->float32.verts_outside;
+        c->tris_crossing = st->float32.tris_crossing;
+        dihedral_range(meshes[best], &c->min_dihedral, &c->max_dihedral);
+        st->encloses = st->float32.encloses;
+    }
     rc = set_meta(meshes[best], p, st, err);
     if (rc)
         goto done;

@@ -225,7 +225,7 @@ FILE *st_tf_open_out(const char *path, st_error *err)
 st_status st_tf_save(const st_tetmesh *m, st_tetformat f, const char *path,
                      const st_tetformat_opts *opts, st_error *err)
 {
-    st_tetformat_opts o = {0, 0};
+    st_tetformat_opts o = {0};
     if (opts)
         o = *opts;
     if (!path || st_path_is_stdio(path))
@@ -244,7 +244,7 @@ st_status st_tf_save(const st_tetmesh *m, st_tetformat f, const char *path,
         return s;
     uint32_t *faces = NULL;
     size_t nfaces = 0;
-    if (f != ST_TETFORMAT_TETGEN &&
+    if (f != ST_TETFORMAT_TETGEN && !o.volume_only &&
         (s = st_tf_boundary(m, &faces, &nfaces, path, err)))
         return s;
     char *names[2] = {NULL, NULL};
@@ -269,7 +269,7 @@ st_status st_tf_save(const st_tetmesh *m, st_tetformat f, const char *path,
     if (!s) {
         if (f == ST_TETFORMAT_MSH)
             st_tf_write_msh_fp(out[0].fp, m, version, o.binary ? 1 : 0,
-                               faces, nfaces);
+                               o.volume_only, faces, nfaces);
         else if (f == ST_TETFORMAT_MEDIT)
             st_tf_write_medit_fp(out[0].fp, m, faces, nfaces);
         else {

@@ -356,13 +356,23 @@ st_status st_tf_check_writable(const st_tetmesh *m, st_tetformat f,
 st_status st_tf_boundary(const st_tetmesh *m, uint32_t **faces,
                          size_t *nfaces, const char *path, st_error *err);
 FILE *st_tf_open_out(const char *path, st_error *err);
+/* st_tetmesh_write_msh and st_tetmesh_write_medit with the option
+ * volume_only (st_tetformat_opts): the tets alone. */
+st_status st_tf_write_msh_path(const st_tetmesh *m, const char *path,
+                               int version, int binary, int volume_only,
+                               st_error *err);
+st_status st_tf_write_medit_path(const st_tetmesh *m, const char *path,
+                                 int volume_only, st_error *err);
 st_status st_tf_close_written(FILE *fp, const char *path, st_error *err);
 
 /* The writers on an open stream (tetformat_msh.c, tetformat_tetgen.c,
  * tetformat_medit.c); errors show in ferror(fp). The .msh and .mesh
- * writers also write the nfaces boundary triangles faces (st_tf_boundary). */
+ * writers also write the nfaces boundary triangles faces (st_tf_boundary).
+ * The .msh writer with volume_only writes the volume's physical group and
+ * entity alone (no "boundary" group, no surface entity; faces unused). */
 void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
-                        int binary, const uint32_t *faces, size_t nfaces);
+                        int binary, int volume_only, const uint32_t *faces,
+                        size_t nfaces);
 void st_tf_write_node_fp(FILE *fp, const st_tetmesh *m);
 void st_tf_write_ele_fp(FILE *fp, const st_tetmesh *m);
 void st_tf_write_medit_fp(FILE *fp, const st_tetmesh *m,

@@ -187,9 +187,15 @@ void st_tf_write_medit_fp(FILE *fp, const st_tetmesh *m,
 st_status st_tetmesh_write_medit(const st_tetmesh *m, const char *path,
                                  st_error *err)
 {
+    return st_tf_write_medit_path(m, path, 0, err);
+}
+
+st_status st_tf_write_medit_path(const st_tetmesh *m, const char *path,
+                                 int volume_only, st_error *err)
+{
     uint32_t *faces = NULL;
     size_t nfaces = 0;
-    st_status s = st_tf_boundary(m, &faces, &nfaces, path, err);
+    st_status s = volume_only ? ST_OK : st_tf_boundary(m, &faces, &nfaces, path, err);
     if (s)
         return s;
     FILE *fp = st_tf_open_out(path, err);

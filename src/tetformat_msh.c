@@ -603,10 +603,14 @@ static void put_f64(FILE *fp, double v) { fwrite(&v, sizeof v, 1, fp); }
 #define MSH_VOLUME 1
 #define MSH_BOUNDARY 2
 
-static void msh_physical_names(FILE *fp)
+static void msh_physical_names(FILE *fp, int volume_only)
 {
-    fprintf(fp, "$PhysicalNames\n2\n2 %d \"boundary\"\n3 %d \"volume\"\n"
-            "$EndPhysicalNames\n", MSH_BOUNDARY, MSH_VOLUME);
+    if (volume_only)
+        fprintf(fp, "$PhysicalNames\n1\n3 %d \"volume\"\n$EndPhysicalNames\n",
+                MSH_VOLUME);
+    else
+        fprintf(fp, "$PhysicalNames\n2\n2 %d \"boundary\"\n3 %d \"volume\"\n"
+                "$EndPhysicalNames\n", MSH_BOUNDARY, MSH_VOLUME);
 }
 
 static void msh22_elements(FILE *fp, const st_tetmesh *m, int binary,
@@ -681,8 +685,11 @@ static void msh41_entity(FILE *fp, int binary, int tag, const double lo[3],
 }
 
 void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
-                        int binary, const uint32_t *faces, size_t nf)
+                        int binary, int volume_only, const uint32_t *faces,
+                        size_t nf)
 {
+    if (volume_only)
+        nf = 0;
     size_t np = m->npoints, nt = m->ntets;
     fprintf(fp, "$MeshFormat\n%s %d 8\n", version == 22 ? "2.2" : "4.1",
             binary);
@@ -691,7 +698,7 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
         fputc('\n', fp);
     }
     fputs("$EndMeshFormat\n", fp);
-    msh_physical_names(fp);
+    msh_physical_names(fp, volume_only);
     if (m->meta.count) {
         fputs("$Comments\n", fp);
         st_tf_put_meta(fp, &m->meta, "");
@@ -726,16 +733,18 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
                 hi[k] = x;
         }
     fputs("$Entities\n", fp);
+    const int nsurf = volume_only ? 0 : 1;
     if (binary) {
         put_u64(fp, 0);
         put_u64(fp, 0);
-        put_u64(fp, 1);
+        put_u64(fp, (uint64_t)nsurf);
         put_u64(fp, 1);
     } else {
-        fputs("0 0 1 1\n", fp);
+        fprintf(fp, "0 0 %d 1\n", nsurf);
     }
-    msh41_entity(fp, binary, MSH_BOUNDARY, lo, hi, 0);
-    msh41_entity(fp, binary, MSH_VOLUME, lo, hi, MSH_BOUNDARY);
+    if (nsurf)
+        msh41_entity(fp, binary, MSH_BOUNDARY, lo, hi, 0);
+    msh41_entity(fp, binary, MSH_VOLUME, lo, hi, nsurf ? MSH_BOUNDARY : 0);
     if (binary)
         fputc('\n', fp);
     fputs("$EndEntities\n$Nodes\n", fp);
@@ -829,6 +838,13 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
 st_status st_tetmesh_write_msh(const st_tetmesh *m, const char *path,
                                int version, int binary, st_error *err)
 {
+    return st_tf_write_msh_path(m, path, version, binary, 0, err);
+}
+
+st_status st_tf_write_msh_path(const st_tetmesh *m, const char *path,
+                               int version, int binary, int volume_only,
+                               st_error *err)
+{
     version = st_tf_msh_version(version);
     st_status s = st_tf_check_writable(m, ST_TETFORMAT_MSH, version, binary, path,
                                  err);
@@ -836,14 +852,14 @@ st_status st_tetmesh_write_msh(const st_tetmesh *m, const char *path,
         return s;
     uint32_t *faces = NULL;
     size_t nfaces = 0;
-    if ((s = st_tf_boundary(m, &faces, &nfaces, path, err)))
+    if (!volume_only && (s = st_tf_boundary(m, &faces, &nfaces, path, err)))
         return s;
     FILE *fp = st_tf_open_out(path, err);
     if (!fp) {
         free(faces);
         return err ? err->status : ST_EIO;
     }
-    st_tf_write_msh_fp(fp, m, version, binary ? 1 : 0, faces, nfaces);
+    st_tf_write_msh_fp(fp, m, version, binary ? 1 : 0, volume_only, faces, nfaces);
     free(faces);
     return st_tf_close_written(fp, path, err);
 }

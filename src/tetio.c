@@ -32,7 +32,7 @@ st_status st_tetmesh_write_mem(unsigned char **data, size_t *size,
 st_status st_tetmesh_write(const st_tetmesh *m, const char *path,
                            const st_tetformat_opts *opts, st_error *err)
 {
-    st_tetformat_opts o = {0, 0};
+    st_tetformat_opts o = {0};
     if (opts)
         o = *opts;
     if (st_path_is_stdio(path)) {
@@ -54,9 +54,9 @@ st_status st_tetmesh_write(const st_tetmesh *m, const char *path,
     switch (st_tetformat_from_path(path)) {
     case ST_TETFORMAT_VTU: return st_tetio_write_vtu_file(m, path, err);
     case ST_TETFORMAT_MSH:
-        return st_tetmesh_write_msh(m, path, o.msh_version, o.binary, err);
+        return st_tf_write_msh_path(m, path, o.msh_version, o.binary, o.volume_only, err);
     case ST_TETFORMAT_TETGEN: return st_tetmesh_write_tetgen(m, path, err);
-    case ST_TETFORMAT_MEDIT: return st_tetmesh_write_medit(m, path, err);
+    case ST_TETFORMAT_MEDIT: return st_tf_write_medit_path(m, path, o.volume_only, err);
     case ST_TETFORMAT_NONE: break;
     }
     return st_error_set(err, ST_EINPUT, path, 0, UNKNOWN_FORMAT);

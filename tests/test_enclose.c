@@ -1,7 +1,9 @@
 /* test_enclose.c - exact point location in tet meshes and the enclosure
  * counts: known answers on a cube of five tets, touching contacts, inverted
  * and flat tets, agreement with brute force, thread-count independence and
- * the speed on a 70K-triangle soup. */
+ * the speed on a 70K-triangle soup; the rounding to float32 that keeps the
+ * enclosure (st_enclosure_round_float32) where rounding to nearest loses
+ * it. */
 #include "souptet/enclose.h"
 #include "souptet/pred.h"
 #include "shapes.h"
@@ -387,6 +389,265 @@ static void test_threads_and_speed(void)
     st_soup_free(s);
 }
 
+/* ---- float32 ------------------------------------------------------------ */
+
+static void round_nearest(st_tetmesh *m)
+{
+    for (size_t i = 0; i < 3 * m->npoints; i++)
+        m->xyz[i] = (double)(float)m->xyz[i];
+}
+
+/* The points through float and back, as a float32 file holds them: a
+ * new mesh whose enclosure of s is counted again. */
+static int encloses_as_floats(const st_tetmesh *m, const st_soup *s)
+{
+    st_tetmesh *c = NULL;
+    if (st_tetmesh_copy(&c, m, NULL))
+        return 0;
+    float *f = malloc(3 * m->npoints * sizeof *f);
+    for (size_t i = 0; i < 3 * m->npoints; i++)
+        f[i] = (float)m->xyz[i];
+    for (size_t i = 0; i < 3 * m->npoints; i++)
+        c->xyz[i] = (double)f[i];
+    free(f);
+    size_t out = 1, cross = 1;
+    st_enclosure_count(c, s, NULL, &out, &cross, NULL);
+    st_tetmesh_free(c);
+    return out == 0 && cross == 0;
+}
+
+static size_t not_positive(const st_tetmesh *m)
+{
+    size_t n = 0;
+    for (size_t t = 0; t < m->ntets; t++) {
+        const uint32_t *q = m->tets + 4 * t;
+        n += st_orient3d(m->xyz + 3 * q[0], m->xyz + 3 * q[1], m->xyz + 3 * q[2],
+                         m->xyz + 3 * q[3]) >= 0;
+    }
+    return n;
+}
+
+/* An axis-aligned face x = hi a quarter of a float ulp above the float
+ * 20.5 (ulp 2^-19 at 20), and an input vertex 0.1 ulp above 20.5: inside
+ * in double, outside once hi goes to its nearest float 20.5; the rounding
+ * outward takes hi to 20.5 + 1 ulp and keeps it. */
+static void test_float32_face(void)
+{
+    const double ulp = 0x1p-19, f0 = 20.5, hi = f0 + 0.25 * ulp;
+    st_tetmesh *m = cube5(18.25, hi);
+    st_soup *s = st_soup_new();
+    const double v = f0 + 0.1 * ulp;
+    st_soup_add_vertex(s, v, 19.0, 19.5, NULL);
+    st_soup_add_vertex(s, 19.0, 19.25, 19.5, NULL);
+    st_soup_add_vertex(s, 19.0, 19.0, 19.875, NULL);
+    st_soup_add_triangle(s, 0, 1, 2, NULL);
+    size_t out = 9, cross = 9;
+    st_enclosure_count(m, s, NULL, &out, &cross, NULL);
+    TAP_CHECK(out == 0 && cross == 0, "float32 face: the double mesh encloses the vertex "
+              "0.15 float ulp inside its face");
+    st_tetmesh *n = NULL;
+    st_tetmesh_copy(&n, m, NULL);
+    round_nearest(n);
+    st_enclosure_count(n, s, NULL, &out, &cross, NULL);
+    TAP_CHECK(out == 1, "float32 face: rounded to nearest, the vertex is outside (%zu)", out);
+    st_tetmesh_free(n);
+
+    st_float32_stats fs;
+    st_status rc = st_enclosure_round_float32(m, s, NULL, &fs, NULL);
+    TAP_CHECK(rc == ST_OK && fs.encloses && fs.rounds == 1 && fs.inverted == 0,
+              "float32 face: rounded outward it encloses, exactly, at the first check "
+              "(rc %d, encloses %d, rounds %d)", (int)rc, fs.encloses, fs.rounds);
+    TAP_CHECK(st_points_are_float32(m->xyz, m->npoints), "float32 face: every coordinate "
+              "is a float");
+    TAP_CHECK(m->xyz[3 * 1] == f0 + ulp && m->xyz[0] == 18.25,
+              "float32 face: the face went one ulp out (%.17g), the far side stayed (%.17g)",
+              m->xyz[3], m->xyz[0]);
+    TAP_CHECK(encloses_as_floats(m, s), "float32 face: through float and back, it encloses");
+    TAP_CHECK(fs.boundary_points == 8 && fs.points_moved == 7 && fs.input_not_float32 == 1,
+              "float32 face: 8 boundary points, 7 moved (those with a coordinate hi), 1 "
+              "input vertex not a float "
+              "(%zu, %zu, %zu)", fs.boundary_points, fs.points_moved, fs.input_not_float32);
+
+    /* Already floats and enclosing: nothing moves. */
+    double before[24];
+    memcpy(before, m->xyz, sizeof before);
+    rc = st_enclosure_round_float32(m, s, NULL, &fs, NULL);
+    TAP_CHECK(rc == ST_OK && fs.encloses && fs.rounds == 1 && fs.points_moved == 0 &&
+              memcmp(before, m->xyz, sizeof before) == 0,
+              "float32: a float mesh that encloses is left as it is");
+    st_tetmesh_free(m);
+
+    /* Past the float range: refused, the mesh unchanged. */
+    m = cube5(0.0, 1e39);
+    memcpy(before, m->xyz, sizeof before);
+    rc = st_enclosure_round_float32(m, s, NULL, &fs, NULL);
+    TAP_CHECK(rc == ST_ELIMIT && memcmp(before, m->xyz, sizeof before) == 0,
+              "float32: a coordinate past FLT_MAX is refused (ST_ELIMIT), nothing changed");
+    st_tetmesh_free(m);
+
+    /* A soup the mesh never enclosed: no error, not enclosing, bounded. */
+    m = cube5(18.25, 19.0);
+    rc = st_enclosure_round_float32(m, s, NULL, &fs, NULL);
+    TAP_CHECK(rc == ST_OK && !fs.encloses && fs.verts_outside >= 1 &&
+              fs.rounds >= 1 && fs.rounds <= ST_FLOAT32_MAX_ROUNDS,
+              "float32: a soup outside from the start is reported, not an error "
+              "(rounds %d, %zu outside)", fs.rounds, fs.verts_outside);
+    st_tetmesh_free(m);
+    st_soup_free(s);
+}
+
+/* A rotated lattice near (20, 21, 19), not in floats, and 400 input
+ * vertices each 0.05..0.45 float ulp inside a random boundary face
+ * (each on a small triangle reaching inward): plain rounding to nearest
+ * loses some of them, the outward rounding none, and no tet inverts. */
+static void test_float32_rotated(void)
+{
+    const double o[3] = {0, 0, 0};
+    st_tetmesh *m = kuhn_lattice(o, 1.0, 3, 3, 3);
+    const double ax[3] = {0.48, -0.6, 0.64};   /* unit */
+    const double ang = 0.7, c = cos(ang), sn = sin(ang), C = 1 - c;
+    const double R[3][3] = {
+        {c + ax[0] * ax[0] * C, ax[0] * ax[1] * C - ax[2] * sn, ax[0] * ax[2] * C + ax[1] * sn},
+        {ax[1] * ax[0] * C + ax[2] * sn, c + ax[1] * ax[1] * C, ax[1] * ax[2] * C - ax[0] * sn},
+        {ax[2] * ax[0] * C - ax[1] * sn, ax[2] * ax[1] * C + ax[0] * sn, c + ax[2] * ax[2] * C}};
+    const double shift[3] = {20.0 + 1e-9, 21.0 - 3e-9, 19.0 + 7e-10};
+    for (size_t i = 0; i < m->npoints; i++) {
+        double *p = m->xyz + 3 * i, q[3];
+        for (int a = 0; a < 3; a++)
+            q[a] = R[a][0] * (p[0] - 1.5) + R[a][1] * (p[1] - 1.5) + R[a][2] * (p[2] - 1.5) +
+                   shift[a];
+        memcpy(p, q, sizeof q);
+    }
+    TAP_CHECK(not_positive(m) == 0, "float32 rotated: the lattice's tets are positive");
+    uint32_t *faces = NULL;
+    size_t nf = 0;
+    st_tetmesh_boundary(m, &faces, NULL, &nf, NULL);
+    st_soup *s = st_soup_new();
+    const double ulp = 0x1p-19;   /* of floats in [16, 32) */
+    for (int k = 0; k < 400; k++) {
+        const uint32_t *q = faces + 3 * (size_t)(rng_next() % nf);
+        const double *a = m->xyz + 3 * q[0], *b = m->xyz + 3 * q[1], *d = m->xyz + 3 * q[2];
+        double u = rng_unif(0.05, 1), v = rng_unif(0.05, 1), w = rng_unif(0.05, 1);
+        double sum = u + v + w, n[3], e1[3], e2[3], p[3];
+        for (int i = 0; i < 3; i++) {
+            e1[i] = b[i] - a[i];
+            e2[i] = d[i] - a[i];
+        }
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        double depth = rng_unif(0.05, 0.45) * ulp;
+        for (int i = 0; i < 3; i++)
+            p[i] = (u * a[i] + v * b[i] + w * d[i]) / sum - depth * n[i] / len;
+        uint32_t base = (uint32_t)s->nverts;
+        st_soup_add_vertex(s, p[0], p[1], p[2], NULL);
+        st_soup_add_vertex(s, p[0] - 0.2 * n[0] / len, p[1] - 0.2 * n[1] / len,
+                           p[2] - 0.2 * n[2] / len, NULL);
+        double g[3];   /* toward the face's centroid: over the face */
+        for (int i = 0; i < 3; i++)
+            g[i] = 0.3 * ((a[i] + b[i] + d[i]) / 3 - p[i]);
+        st_soup_add_vertex(s, p[0] - 0.2 * n[0] / len + g[0], p[1] - 0.2 * n[1] / len + g[1],
+                           p[2] - 0.2 * n[2] / len + g[2], NULL);
+        st_soup_add_triangle(s, base, base + 1, base + 2, NULL);
+    }
+    free(faces);
+    size_t out = 9, cross = 9;
+    st_enclosure_count(m, s, NULL, &out, &cross, NULL);
+    TAP_CHECK(out == 0 && cross == 0, "float32 rotated: the double mesh encloses the "
+              "400 near-boundary triangles (%zu, %zu)", out, cross);
+    st_tetmesh *n = NULL;
+    st_tetmesh_copy(&n, m, NULL);
+    round_nearest(n);
+    st_enclosure_count(n, s, NULL, &out, &cross, NULL);
+    TAP_CHECK(out > 0, "float32 rotated: rounded to nearest, %zu input vertices fall "
+              "outside (%zu triangles crossing)", out, cross);
+    st_tetmesh_free(n);
+    st_float32_stats fs;
+    st_status rc = st_enclosure_round_float32(m, s, NULL, &fs, NULL);
+    TAP_CHECK(rc == ST_OK && fs.encloses && fs.inverted == 0 && not_positive(m) == 0,
+              "float32 rotated: rounded outward it encloses, exactly, no tet inverted "
+              "(%d checks, %zu pushed up to %u ulps, largest move %.3g)", fs.rounds,
+              fs.pushed, fs.max_push, fs.max_move);
+    TAP_CHECK(st_points_are_float32(m->xyz, m->npoints) && encloses_as_floats(m, s),
+              "float32 rotated: every coordinate a float; through float and back it "
+              "encloses");
+    TAP_CHECK(fs.max_move < 4 * ulp, "float32 rotated: no point moved 4 ulps (%.3g ulp)",
+              fs.max_move / ulp);
+    st_tetmesh_free(m);
+    st_soup_free(s);
+}
+
+/* A flat tet (height 1e-3 over a base of side 1, coordinates near 20 and
+ * about half an ulp from floats) with input vertices 0.1..0.4 ulp inside each of its faces near
+ * every corner: at a corner the faces' outward normals point nearly
+ * opposite ways, so no float around it is outward for all of them and the
+ * first rounding may fail; whatever the rounds give, what is reported is
+ * what an independent exact count finds on the mesh left behind. */
+static void test_float32_knife(void)
+{
+    st_tetmesh *m = st_tetmesh_new();
+    const double u = 0x1p-19;   /* heights mid-way between floats */
+    add_point(m, 20.0 + 0.3 * u, 20.0 + 0.6 * u, 20.0 + 0.5 * u);
+    add_point(m, 21.0 + 0.4 * u, 20.1 + 0.2 * u, 20.0 + 0.45 * u);
+    add_point(m, 20.3 - 0.5 * u, 21.0 + 0.5 * u, 20.0 + 0.55 * u);
+    add_point(m, 20.4 + 0.5 * u, 20.4 - 0.5 * u, 20.001 + 0.5 * u);
+    add_tet_pos(m, 0, 1, 2, 3);
+    uint32_t *faces = NULL;
+    size_t nf = 0;
+    st_tetmesh_boundary(m, &faces, NULL, &nf, NULL);
+    st_soup *s = st_soup_new();
+    const double ulp = 0x1p-19;
+    double cen[3] = {0, 0, 0};
+    for (int k = 0; k < 4; k++)
+        for (int a = 0; a < 3; a++)
+            cen[a] += m->xyz[3 * k + a] / 4;
+    for (size_t f = 0; f < nf; f++)
+        for (int c = 0; c < 3; c++) {
+            const uint32_t *q = faces + 3 * f;
+            const double *a = m->xyz + 3 * q[c], *b = m->xyz + 3 * q[(c + 1) % 3],
+                         *d = m->xyz + 3 * q[(c + 2) % 3];
+            double e1[3], e2[3], n[3], p[3];
+            for (int i = 0; i < 3; i++) {
+                e1[i] = b[i] - a[i];
+                e2[i] = d[i] - a[i];
+            }
+            n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            double depth = (0.1 + 0.1 * (double)c) * ulp;
+            for (int i = 0; i < 3; i++)
+                p[i] = 0.9 * a[i] + 0.05 * b[i] + 0.05 * d[i] - depth * n[i] / len;
+            uint32_t base = (uint32_t)s->nverts;
+            st_soup_add_vertex(s, p[0], p[1], p[2], NULL);
+            st_soup_add_vertex(s, 0.5 * (p[0] + cen[0]), 0.5 * (p[1] + cen[1]),
+                               0.5 * (p[2] + cen[2]), NULL);
+            st_soup_add_vertex(s, cen[0], cen[1], cen[2], NULL);
+            st_soup_add_triangle(s, base, base + 1, base + 2, NULL);
+        }
+    free(faces);
+    size_t out = 9, cross = 9;
+    st_enclosure_count(m, s, NULL, &out, &cross, NULL);
+    TAP_CHECK(out == 0 && cross == 0, "float32 knife: the double tet encloses its 12 "
+              "near-face triangles (%zu, %zu)", out, cross);
+    st_float32_stats fs;
+    st_status rc = st_enclosure_round_float32(m, s, NULL, &fs, NULL);
+    st_enclosure_count(m, s, NULL, &out, &cross, NULL);
+    size_t inv = not_positive(m);
+    TAP_CHECK(rc == ST_OK && fs.rounds >= 1 && fs.rounds <= ST_FLOAT32_MAX_ROUNDS &&
+              st_points_are_float32(m->xyz, m->npoints),
+              "float32 knife: rounded to floats in %d checks (%zu pushed, up to %u ulps)",
+              fs.rounds, fs.pushed, fs.max_push);
+    TAP_CHECK(fs.verts_outside == out && fs.tris_crossing == cross && fs.inverted == inv &&
+              fs.encloses == (out == 0 && cross == 0 && inv == 0),
+              "float32 knife: the report is the result's (%s: %zu outside, %zu crossing, "
+              "%zu inverted)", fs.encloses ? "encloses" : "does not enclose", out, cross,
+              inv);
+    st_tetmesh_free(m);
+    st_soup_free(s);
+}
+
 int main(void)
 {
     test_cube_encloses_small_soup();
@@ -396,5 +657,8 @@ int main(void)
     test_empty_mesh();
     test_locator_brute_force();
     test_threads_and_speed();
+    test_float32_face();
+    test_float32_rotated();
+    test_float32_knife();
     return tap_done();
 }

@@ -113,6 +113,48 @@ int main(void)
     p.dry_run = 0;
     p.on_event = NULL;
 
+    /* float32: the same candidate, its points rounded to floats, still
+     * enclosing; the stats and meta say so. The sphere moved off the
+     * float grid (centre 20 + 1e-9) so every point has to move. */
+    {
+        st_soup *f = st_soup_new();
+        add_sphere(f, 1.0, 2.0);
+        for (size_t i = 0; i < f->nverts; i++)
+            for (int a = 0; a < 3; a++)
+                f->xyz[3 * i + (size_t)a] += 20.0 + 1e-9 * (a + 1);
+        st_tetmesh *md = NULL, *mf = NULL;
+        st_pipeline_stats sd, sf;
+        p.tries = 1;
+        st_status rd = st_pipeline_run(&md, &sd, f, &p, NULL, &err);
+        p.float32 = 1;
+        st_status rf = st_pipeline_run(&mf, &sf, f, &p, NULL, &err);
+        p.float32 = 0;
+        TAP_CHECK(rd == ST_OK && rf == ST_OK && md && mf && md->ntets == mf->ntets &&
+                  memcmp(md->tets, mf->tets, 4 * md->ntets * sizeof *md->tets) == 0,
+                  "float32: the same tets as without");
+        TAP_CHECK(mf && st_points_are_float32(mf->xyz, mf->npoints) &&
+                  md && !st_points_are_float32(md->xyz, md->npoints),
+                  "float32: every coordinate a float (without: not)");
+        size_t out = 9, cross = 9;
+        if (mf)
+            st_enclosure_count(mf, f, NULL, &out, &cross, &err);
+        TAP_CHECK(sf.encloses && sf.float32.encloses && out == 0 && cross == 0 &&
+                  sf.float32.rounds >= 1 && sf.float32.points_moved == mf->npoints &&
+                  sf.candidates[sf.best].verts_outside == 0,
+                  "float32: encloses, counted again on the result (%d checks, %zu moved, "
+                  "farthest %.3g)", sf.float32.rounds, sf.float32.points_moved,
+                  sf.float32.max_move);
+        const char *yes = mf ? st_meta_get(&mf->meta, "float32") : NULL;
+        TAP_CHECK(yes && strcmp(yes, "yes") == 0 && md && !st_meta_get(&md->meta, "float32") &&
+                  sd.float32.rounds == 0,
+                  "float32: meta float32 yes; without it, no meta and no rounding");
+        free(sd.candidates);
+        free(sf.candidates);
+        st_tetmesh_free(md);
+        st_tetmesh_free(mf);
+        st_soup_free(f);
+    }
+
     p.tries = 0;
     TAP_CHECK(st_pipeline_run(&m2, NULL, s, &p, NULL, &err) == ST_EINPUT && !m2,
               "tries 0: refused");

@@ -92,7 +92,7 @@ static int write_samples(const char *dir)
     for (size_t i = 0; i < NVARIANTS; i++) {
         char path[4096];
         snprintf(path, sizeof path, "%s/%s", dir, k_variants[i].file);
-        st_tetformat_opts o = {k_variants[i].version, k_variants[i].binary};
+        st_tetformat_opts o = {.msh_version = k_variants[i].version, .binary = k_variants[i].binary};
         st_error e;
         if (st_tetmesh_save(m, path, &o, &e)) {
             char buf[1100];
@@ -117,7 +117,7 @@ static void test_round_trips(void)
         const variant *v = &k_variants[i];
         char path[256];
         snprintf(path, sizeof path, "%s/%s", g_dir, v->file);
-        st_tetformat_opts o = {v->version, v->binary};
+        st_tetformat_opts o = {.msh_version = v->version, .binary = v->binary};
         st_error e;
         st_status s = st_tetmesh_save(m, path, &o, &e);
         TAP_CHECK(s == ST_OK, "%s: written", v->file);
@@ -224,8 +224,7 @@ static void test_written_text(void)
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char path[256];
         snprintf(path, sizeof path, "%s/%s", g_dir, cases[i].file);
-        st_tetformat_opts o = {cases[i].version > 0 ? cases[i].version : 0,
-                               0};
+        st_tetformat_opts o = {.msh_version = cases[i].version > 0 ? cases[i].version : 0};
         st_error e;
         if (cases[i].version >= 0)
             st_tetmesh_save(m, path, &o, &e);
@@ -717,6 +716,63 @@ out:
     return rc;
 }
 
+/* volume_only: the tets alone in every .msh variant and .mesh (no
+ * triangles, no "boundary" group or surface entity); they read back the
+ * same; st_tetmesh_write (not atomic) honours it too. */
+static int file_has(const char *path, const char *needle)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return -1;
+    static char buf[1 << 20];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    size_t k = strlen(needle);
+    for (size_t i = 0; i + k <= n; i++)
+        if (memcmp(buf + i, needle, k) == 0)
+            return 1;
+    return 0;
+}
+
+static void test_volume_only(void)
+{
+    st_tetmesh *m = sample_mesh(3);
+    for (size_t i = 0; i < NVARIANTS; i++) {
+        const variant *v = &k_variants[i];
+        char path[256], path2[256];
+        snprintf(path, sizeof path, "%s/vo-%s", g_dir, v->file);
+        snprintf(path2, sizeof path2, "%s/vw-%s", g_dir, v->file);
+        st_tetformat_opts o = {.msh_version = v->version, .binary = v->binary,
+                               .volume_only = 1};
+        st_error e;
+        st_status s = st_tetmesh_save(m, path, &o, &e);
+        st_status s2 = st_tetmesh_write(m, path2, &o, &e);
+        st_tetmesh *r = NULL, *r2 = NULL;
+        if (!s)
+            s = st_tetmesh_read(&r, path, 0, &e);
+        if (!s2)
+            s2 = st_tetmesh_read(&r2, path2, 0, &e);
+        TAP_CHECK(!s && !s2 && same_mesh(m, r) && same_mesh(m, r2),
+                  "volume_only %s: written (save and write) and read back the same", v->file);
+        if (strstr(v->file, ".msh"))
+            TAP_CHECK(file_has(path, "boundary") == 0 && file_has(path2, "boundary") == 0 &&
+                      file_has(path, "\"volume\"") == 1,
+                      "volume_only %s: the \"volume\" group alone", v->file);
+        if (strstr(v->file, ".mesh"))
+            TAP_CHECK(file_has(path, "Triangles") == 0 && file_has(path2, "Triangles") == 0,
+                      "volume_only %s: no Triangles", v->file);
+        st_tetmesh_free(r);
+        st_tetmesh_free(r2);
+    }
+    /* The default keeps them. */
+    char path[256];
+    snprintf(path, sizeof path, "%s/def.mesh", g_dir);
+    st_error e;
+    TAP_CHECK(st_tetmesh_save(m, path, NULL, &e) == ST_OK && file_has(path, "Triangles") == 1,
+              "the default .mesh has its Triangles");
+    st_tetmesh_free(m);
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 3 && strcmp(argv[1], "--write") == 0)
@@ -733,6 +789,7 @@ int main(int argc, char **argv)
     }
     test_paths();
     test_round_trips();
+    test_volume_only();
     test_written_text();
     test_foreign_files();
     test_malformed();

@@ -107,6 +107,86 @@ st_status st_enclosure_count(const st_tetmesh *m, const st_soup *s,
                              const st_bvh *bvh, size_t *verts_outside,
                              size_t *tris_crossing, st_error *err);
 
+/* ---- float32: enclosing after the points are rounded to float ----------
+ *
+ * Blender, glTF, STL, game engines and PhysX store float32. A mesh that
+ * encloses a soup in double can lose it when its points are rounded to
+ * float (an input vertex a fraction of a float ulp inside a boundary face
+ * is outside once the face's corners move). st_enclosure_round_float32
+ * rounds every point of m to a float32 value (stored back as the double
+ * of that float, so every writer keeps it exactly and (double)(float)x ==
+ * x for every coordinate afterwards) such that the rounded mesh still
+ * encloses s, checked exactly:
+ *   - a point on no boundary face goes to the nearest float;
+ *   - a boundary point goes "outward": of the 8 floats around it (the
+ *     largest float <= x or the smallest >= x, per coordinate; at push
+ *     level k, k more float ulps beyond those) the one maximising the
+ *     smallest of (displacement . unit outward normal) over the boundary
+ *     faces around it (ties: the shorter displacement, then the lower
+ *     corner index). The choice is a heuristic in floating point; the
+ *     guarantee is the exact check that follows.
+ *   - check: st_enclosure_compute of s by the rounded mesh (exact), and
+ *     the orientation of every tet (st_orient3d, exact: a tet that is no
+ *     longer positively oriented counts as inverted, flat included);
+ *   - when the check fails, the boundary points near the failure (the
+ *     boundary corners of the tet of the original mesh that held a soup
+ *     vertex now outside, or every boundary point when that tet has
+ *     none; the corners of boundary faces that meet a crossing soup
+ *     triangle) go one float ulp further out, and the check is made
+ *     again, at most ST_FLOAT32_MAX_ROUNDS checks in all. A point whose
+ *     chosen float goes inward by some face around it (faces facing
+ *     nearly opposite ways: a knife edge, a flat tet) is not pushed: that
+ *     would take it farther in by that face; the other points named are. The
+ *     rounds stop when nothing is left to push (a soup vertex outside the
+ *     mesh before rounding names nothing). When no rounding encloses, the
+ *     best tried (fewest vertices outside, then triangles crossing, then
+ *     inverted tets) is the one kept and reported.
+ * Why it usually holds at the first check: when every boundary point
+ * moves out of every boundary face around it, each face moves outward at
+ * each of its points (a convex combination of its corners' moves), so a
+ * soup point behind it stays behind it (measured: soupmesh.1, --float32).
+ * The guarantee is about s as given (in double) against the rounded mesh.
+ * When s itself is not float32 (input_not_float32 > 0), a consumer that
+ * rounds the soup too moves it by up to half an ulp, which this does not
+ * cover.
+ * On return m holds the last rounding tried, whether it holds or not:
+ * st->encloses says (with verts_outside, tris_crossing and inverted of
+ * that mesh); a rounding that does not enclose is not an error. Points
+ * whose float would overflow (|x| > FLT_MAX) fail with ST_ELIMIT and leave
+ * m unchanged. bvh over s may be NULL (one is built). A mesh already in
+ * float32 that encloses s is left unchanged (1 round, 0 points moved).
+ * Deterministic; the enclosure check runs OpenMP loops. Errors: ST_ENOMEM,
+ * ST_ELIMIT, those of st_enclosure_compute. */
+
+/* Exact checks at most (the first rounding and the pushes after it). */
+#define ST_FLOAT32_MAX_ROUNDS 8
+
+typedef struct st_float32_stats {
+    int rounds;                 /* exact checks made (1: the first rounding
+                                   held) */
+    size_t points_moved;        /* points with some coordinate changed */
+    size_t boundary_points;     /* points on a boundary face */
+    size_t pushed;              /* boundary points pushed past the floats
+                                   around them (push level > 0) */
+    unsigned max_push;          /* the largest push level (float ulps) */
+    double max_move;            /* the largest distance a point moved */
+    size_t verts_outside;       /* of the last rounding, exact */
+    size_t tris_crossing;
+    size_t inverted;            /* tets not positively oriented */
+    int encloses;               /* the three above are 0 */
+    size_t input_not_float32;   /* soup vertices (used by a triangle) with a
+                                   coordinate that is not a float */
+    double seconds;             /* the call's wall-clock time */
+} st_float32_stats;
+
+st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
+                                     const st_bvh *bvh, st_float32_stats *st,
+                                     st_error *err);
+
+/* 1 when every coordinate of the n points xyz is a float32 value
+ * ((double)(float)x == x); 0 otherwise. */
+int st_points_are_float32(const double *xyz, size_t n);
+
 #ifdef __cplusplus
 }
 #endif

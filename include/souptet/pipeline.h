@@ -35,6 +35,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "souptet/enclose.h"
 #include "souptet/err.h"
 #include "souptet/pseudo.h"
 #include "souptet/progress.h"
@@ -117,6 +118,24 @@ typedef struct st_pipeline_params {
                               has none (st_pseudo_fill, st_fit_params.fill);
                               the mesh still encloses the soup alone. 0:
                               the soup alone (1) */
+    int float32;           /* 1: the chosen mesh's points are rounded to
+                              float32 so that it encloses the soup once
+                              stored as float (Blender, glTF, STL, game
+                              engines, PhysX): st_enclosure_round_float32
+                              (enclose.h) on the chosen candidate, after
+                              the choice; its enclosure counts (and the
+                              dihedral range) are then the rounded mesh's,
+                              checked exactly, and so are stats->encloses
+                              and meta "encloses"; meta "float32" is
+                              "yes"; stats->float32 says what it took.
+                              Every coordinate x of *out then has
+                              (double)(float)x == x. The fit's distances
+                              and its stopping condition (max_distance,
+                              converged, beyond_offset) are measured
+                              before the rounding, which moves a point by
+                              at most stats->float32.max_move (float ulps).
+                              0: the points as the fit left them, in
+                              double, and no meta "float32" (0) */
     st_pipeline_event_fn on_event;   /* may be NULL (NULL) */
     void *on_event_ctx;
 } st_pipeline_params;
@@ -161,6 +180,8 @@ typedef struct st_pipeline_stats {
                                             (pseudo.h, the shortcut) */
     size_t fill_faces;                   /* voxel squares of the fill (0
                                             with fill_counts 0) */
+    st_float32_stats float32;            /* with p->float32: the rounding
+                                            (enclose.h; all 0 without) */
     st_pseudo_guess guess;               /* how much of the pseudo volume's
                                             boundary is fill, and how far
                                             from the input (pseudo.h; all 0
@@ -186,7 +207,7 @@ double st_pipeline_lattice_bytes(const st_soup *s, double h, size_t tries,
 
 /* Mesh soup s. *out gets the chosen candidate's mesh, with meta "h",
  * "lattice", "seed", "offset_ratio", "offset_fill" (yes or no; not with density_rho),
- * "candidates", "encloses". stats may
+ * "candidates", "encloses", and "float32" ("yes") with p->float32. stats may
  * be NULL; when given, stats->candidates must be freed by the caller even
  * on failure (it is NULL when nothing was allocated). Fails when the
  * soup is empty or every candidate failed (the first candidate's message

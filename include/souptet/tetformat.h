@@ -17,7 +17,7 @@
  * arrays are not written (use .vtu for per-cell quality).
  *
  * What is written.
- *  - The boundary faces (st_tetmesh_boundary's, each turned outward by
+ *  - Unless volume_only (st_tetformat_opts): the boundary faces (st_tetmesh_boundary's, each turned outward by
  *    the exact orientation of its tet, so also for an inverted tet) go
  *    into .msh and .mesh as triangles, after the tets.
  *  - .msh 4.1: $MeshFormat, $PhysicalNames (3-D 1 "volume", 2-D 2
@@ -71,10 +71,19 @@ typedef enum st_tetformat {
 } st_tetformat;
 
 /* Writer options; a zeroed struct (or NULL where one is taken) means the
- * defaults. Only .msh has any. */
+ * defaults. */
 typedef struct st_tetformat_opts {
     int msh_version;  /* 41 (default, also 0 and 4) or 22 (also 2) */
     int binary;       /* msh only: 0 ASCII (default), 1 binary */
+    int volume_only;  /* 1: .msh and .mesh hold the tets alone: no boundary
+                         triangles, and in .msh no "boundary" physical group
+                         or surface entity (the "volume" group stays). For
+                         readers that take one cell kind only: SfePy's
+                         Mesh.from_file gives a mesh its FEDomain refuses
+                         ("meshes with several cell kinds are not
+                         supported!") when the triangles are there. .vtu
+                         and TetGen hold the tets alone anyway: no effect
+                         there. 0: the boundary too, as below (default) */
 } st_tetformat_opts;
 
 /* The format of a path's extension (case-insensitive): .vtu, .msh,

@@ -338,6 +338,10 @@ int tool_tetformat_option(const tool_ctx *t, int c, const char *arg,
         o->binary = 1;
         return 0;
     }
+    if (c == TOOL_OPT_VOLUME_ONLY) {
+        o->volume_only = 1;
+        return 0;
+    }
     if (tool_parse_size(t, "--msh-version", arg, 2, 41, &v))
         return -1;
     if (v != 2 && v != 4 && v != 22 && v != 41) {
@@ -626,7 +630,8 @@ int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
            (c = getopt_long(argc, argv, spec->shortopts, spec->longopts, NULL)) != -1) {
         if (c == 'o')
             co->out = optarg;
-        else if (c == TOOL_OPT_MSH_VERSION || c == TOOL_OPT_MSH_BINARY)
+        else if (c == TOOL_OPT_MSH_VERSION || c == TOOL_OPT_MSH_BINARY ||
+                 c == TOOL_OPT_VOLUME_ONLY)
             rc = tool_tetformat_option(&t, c, optarg, &co->tetformat) ? TOOL_EXIT_USAGE
                                                                        : TOOL_CONTINUE;
         else if (c == 'q' || c == 'v' || c == ':' || c == '?' || c == TOOL_OPT_THREADS ||

@@ -216,7 +216,7 @@ int tool_output_check(tool_ctx *t, const char *out);
  * shared codes to tool_common_option (below). */
 enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION,
        TOOL_OPT_MSH_VERSION, TOOL_OPT_MSH_BINARY, TOOL_OPT_FILL_HOLES, TOOL_OPT_SHELLS,
-       TOOL_OPT_FIRST = 1100 };
+       TOOL_OPT_VOLUME_ONLY, TOOL_OPT_FIRST = 1100 };
 #define TOOL_LONG_OPTIONS_BASIC                              \
     {"quiet", no_argument, NULL, 'q'},                       \
     {"verbose", no_argument, NULL, 'v'},                     \
@@ -247,14 +247,20 @@ int tool_pseudo_option(const tool_ctx *t, int c, const char *arg, int *fill_hole
 /* The tet-mesh format options of every tool that writes a tet mesh
  * (soupmesh, latticetet, tetsmooth): their table entries, their --help
  * lines, and their handling: for c TOOL_OPT_MSH_VERSION (2, 4, 22 or 41
- * into o->msh_version) or TOOL_OPT_MSH_BINARY (o->binary = 1). Returns 0,
- * or -1 after a usage error (printed). */
+ * into o->msh_version), TOOL_OPT_MSH_BINARY (o->binary = 1) or
+ * TOOL_OPT_VOLUME_ONLY (o->volume_only = 1: the tets alone in .msh and
+ * .mesh, for SfePy's Mesh.from_file; no effect on .vtu and TetGen, which
+ * hold nothing else). Returns 0, or -1 after a usage error (printed). */
 #define TOOL_LONG_OPTIONS_TETFORMAT                                \
     {"msh-version", required_argument, NULL, TOOL_OPT_MSH_VERSION}, \
-    {"msh-binary", no_argument, NULL, TOOL_OPT_MSH_BINARY}
+    {"msh-binary", no_argument, NULL, TOOL_OPT_MSH_BINARY},        \
+    {"volume-only", no_argument, NULL, TOOL_OPT_VOLUME_ONLY}
 #define TOOL_HELP_TETFORMAT                                               \
     "      --msh-version V  Gmsh format 4 (4.1, default) or 2 (2.2)\n"   \
-    "      --msh-binary     binary .msh instead of ASCII\n"
+    "      --msh-binary     binary .msh instead of ASCII\n"              \
+    "      --volume-only    .msh and .mesh: the tets alone, without the boundary\n" \
+    "                       triangles and their group (SfePy's Mesh.from_file\n" \
+    "                       wants one cell kind); .vtu, TetGen: no change\n"
 int tool_tetformat_option(const tool_ctx *t, int c, const char *arg,
                           st_tetformat_opts *o);
 

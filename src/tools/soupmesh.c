@@ -50,6 +50,11 @@ TOOL_HELP_TETFORMAT
 "                       point arrays embed_tet, embed_bary)\n"
 "      --boundary FILE  also write the mesh's boundary surface (closed, normals\n"
 "                       outward; a collision proxy) as .obj, .off, .ply or .stl\n"
+"                       (.stl holds floats: it turns on --float32)\n"
+"      --float32        round the mesh's points to float32 values (outward on the\n"
+"                       boundary, pushed further when needed) so that it still\n"
+"                       encloses the input once stored as float (Blender, glTF,\n"
+"                       STL, game engines), checked exactly\n"
 "      --cells N        BCC lattice cells along the longest side of the\n"
 "                       model's box (default 10; more cells, more tets)\n"
 "  -h, --size H         the lattice cell width in model units, instead of\n"
@@ -105,7 +110,7 @@ TOOL_HELP_TETFORMAT
 
 enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
        OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY,
-       OPT_BEST_EFFORT, OPT_OFFSET_FILL };
+       OPT_BEST_EFFORT, OPT_OFFSET_FILL, OPT_FLOAT32 };
 
 /* -v: a line as each stage, sculpt, fit iteration and candidate ends, so a
  * long run is never silent (pipeline.h, st_pipeline_event). */
@@ -239,6 +244,7 @@ typedef struct soupmesh_settings {
     st_pipeline_params pipeline;
     const char *in, *embed, *boundary;
     int have_cells, best_effort;
+    int float32_by_stl;        /* --boundary .stl turned --float32 on */
     int embed_text;            /* --embed FILE.txt, else .vtu */
     st_soup_format boundary_format;
 } soupmesh_settings;
@@ -261,6 +267,7 @@ static const struct option longopts[] = {
     TOOL_LONG_OPTIONS_TETFORMAT,
     {"embed", required_argument, NULL, OPT_EMBED},
     {"boundary", required_argument, NULL, OPT_BOUNDARY},
+    {"float32", no_argument, NULL, OPT_FLOAT32},
     TOOL_LONG_OPTIONS_OUTPUT,
     TOOL_LONG_OPTIONS_END};
 
@@ -331,6 +338,9 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
     case OPT_BOUNDARY:
         s->boundary = arg;
         break;
+    case OPT_FLOAT32:
+        s->pipeline.float32 = 1;
+        break;
     }
     return TOOL_CONTINUE;
 }
@@ -362,6 +372,12 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
                                 boundary);
     if (boundary && p->density_rho > 0)
         return tool_usage_error(t, "--boundary goes with the enclosing mesh, not --density");
+    /* Binary STL holds floats: the surface written there must enclose
+     * the input as floats, so the mesh it bounds is rounded (--float32). */
+    if (boundary && s->boundary_format == ST_SOUP_STL) {
+        s->float32_by_stl = !s->pipeline.float32;
+        s->pipeline.float32 = 1;
+    }
     if (tool_output_unwritable(t, s->co.out) || tool_output_unwritable(t, embed) ||
         tool_output_unwritable(t, boundary))
         return TOOL_EXIT_FAIL;
@@ -423,6 +439,22 @@ static int run(tool_ctx *t, void *settings)
         tool_say(t, 2, "h %.6g for about %zu tets: %zu sculpts, %.2f s", st.h,
                  p->target_tets, st.sculpts, st.seconds_size);
     report(t, &st, p->density_rho > 0);
+    if (p->float32) {
+        const st_float32_stats *f = &st.float32;
+        tool_say(t, 2, "float32%s: %zu of %zu points moved (%zu on the boundary, %zu of "
+                 "them pushed, up to %u ulps further out), the farthest by %.3g (%.3g h); "
+                 "%d exact check%s, %.3f s: %s (%zu vertices outside, %zu triangles "
+                 "crossing, %zu inverted tets)",
+                 s->float32_by_stl ? " (for the .stl boundary)" : "", f->points_moved,
+                 m->npoints, f->boundary_points, f->pushed, f->max_push, f->max_move,
+                 f->max_move / st.h, f->rounds, f->rounds == 1 ? "" : "s", f->seconds,
+                 f->encloses ? "encloses the input" : "DOES NOT enclose the input",
+                 f->verts_outside, f->tris_crossing, f->inverted);
+        if (f->input_not_float32)
+            tool_say(t, 1, "note: %zu input vertices are not float32 values: the mesh "
+                     "in float32 encloses the input as given (in double); rounding the "
+                     "input too moves it by up to half a float ulp", f->input_not_float32);
+    }
     if (st_meta_set(&m->meta, "source", in_name) ||
         st_meta_history_append(&m->meta, tool_command(t))) {
         rc = tool_fail_nomem(t, &err);
@@ -524,9 +556,14 @@ static int run(tool_ctx *t, void *settings)
     rc = TOOL_EXIT_OK;
     if (!st.encloses && p->density_rho <= 0) {
         /* Level 0: printed even with -q, and the exit status says it. */
-        tool_say(t, 0, "%s: error: the mesh written to %s does not enclose the input "
+        if (p->float32 && st.float32.inverted)
+            tool_say(t, 0, "%s: error: the mesh written to %s has %zu inverted tets once "
+                     "rounded to float32 (--float32)", in_name, tool_out_name(out),
+                     st.float32.inverted);
+        tool_say(t, 0, "%s: error: the mesh written to %s does not enclose the input%s "
                  "(%zu vertices outside, %zu triangles crossing; best of %zu candidates); "
                  "try more --cells or --tries", in_name, tool_out_name(out),
+                 p->float32 ? " once rounded to float32" : "",
                  b->verts_outside, b->tris_crossing, st.ncandidates);
         rc = TOOL_EXIT_NOT_ENCLOSING;
     }
