@@ -436,7 +436,7 @@ static void progress_draw(void *ctx, const char *stage, double fraction)
 
 st_progress tool_progress(tool_ctx *t)
 {
-    st_progress p = {NULL, NULL};
+    st_progress p = {NULL, NULL, NULL};
     if (t->verbosity >= 1 && isatty(STDERR_FILENO)) {
         p.fn = progress_draw;
         p.ctx = t;
