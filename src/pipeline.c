@@ -15,6 +15,7 @@
 #include "souptet/smooth.h"
 #include "souptet/tetqual.h"
 
+#include <errno.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -360,10 +361,30 @@ static int better(const st_pipeline_candidate *a, size_t ka,
     return ka < kb;
 }
 
+/* The field and the pseudo volume's settings a run uses (voxels along the
+ * longest side of the soup's box, its hole caps and closed shells): one
+ * place for st_pipeline_run and st_pipeline_field_of_mesh. */
+static void field_params(st_dist_params *dp, st_pseudo_params *pp, size_t voxels,
+                         size_t max_bytes, int fill_holes, int closed_shells)
+{
+    *dp = st_dist_params_default();
+    dp->cells = voxels;
+    dp->max_bytes = max_bytes;
+    *pp = st_pseudo_params_default();
+    pp->fill_holes = fill_holes;
+    pp->closed_shells = closed_shells;
+}
+
 static st_status set_meta(st_tetmesh *m, const st_pipeline_params *p,
-                          const st_pipeline_stats *st, st_error *err)
+                          const st_pipeline_stats *st, size_t field_voxels, st_error *err)
 {
     char buf[64];
+    /* what the fill (offset_fill) was made from: st_pipeline_field_of_mesh */
+    snprintf(buf, sizeof buf, "%zu", field_voxels);
+    if (st_meta_set(&m->meta, "field_voxels", buf) ||
+        st_meta_set(&m->meta, "fill_holes", p->fill_holes ? "yes" : "no") ||
+        st_meta_set(&m->meta, "closed_shells", p->closed_shells ? "yes" : "no"))
+        goto oom;
     snprintf(buf, sizeof buf, "%.17g", p->offset_ratio);
     if (st_meta_set(&m->meta, "offset_ratio", buf))
         goto oom;
@@ -425,10 +446,10 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                                 p->h, n, ST_PIPELINE_MAX_CELLS);
         cells = n < 1 ? 1 : (size_t)n;
     }
-    st_dist_params dp = st_dist_params_default();
-    dp.cells = p->field_cells ? p->field_cells
-                              : (cells * 8 > 128 ? cells * 8 : 128);
-    dp.max_bytes = p->max_bytes;
+    st_dist_params dp;
+    st_pseudo_params pp;
+    field_params(&dp, &pp, p->field_cells ? p->field_cells : (cells * 8 > 128 ? cells * 8 : 128),
+                 p->max_bytes, p->fill_holes, p->closed_shells);
     st_grid *g = NULL;
     st_bvh *bvh = NULL;
     st_tetmesh **meshes = NULL;
@@ -436,9 +457,6 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     /* The pseudo volume (pseudo.h), as soupsign --surface gives it: the
      * field and its refinement see the hole caps; the mesh is fitted to,
      * and must enclose, the soup itself. */
-    st_pseudo_params pp = st_pseudo_params_default();
-    pp.fill_holes = p->fill_holes;
-    pp.closed_shells = p->closed_shells;
     st_pseudo_stats ps;
     /* the soup's BVH from the pseudo volume (the caps and the refinement
      * used it): the fit's, the sculpting's and the checks' */
@@ -589,7 +607,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         dihedral_range(meshes[best], &c->min_dihedral, &c->max_dihedral);
         st->encloses = st->float32.encloses;
     }
-    rc = set_meta(meshes[best], p, st, err);
+    rc = set_meta(meshes[best], p, st, dp.cells, err);
     if (rc)
         goto done;
     *out = meshes[best];
@@ -607,4 +625,30 @@ done:
     st_soup_free(fill);
     st_grid_free(g);
     return rc;
+}
+
+/* yes or no in m's meta: 1, 0, or -1 when absent or neither. */
+static int meta_yes(const st_tetmesh *m, const char *key)
+{
+    const char *v = st_meta_get(&m->meta, key);
+    return !v ? -1 : strcmp(v, "yes") == 0 ? 1 : strcmp(v, "no") == 0 ? 0 : -1;
+}
+
+st_status st_pipeline_field_of_mesh(st_grid **out, const st_tetmesh *m, const st_soup *s,
+                                    size_t max_bytes, const st_progress *prog, st_error *err)
+{
+    *out = NULL;
+    const char *v = st_meta_get(&m->meta, "field_voxels");
+    const int holes = meta_yes(m, "fill_holes"), shells = meta_yes(m, "closed_shells");
+    char *end = NULL;
+    errno = 0;
+    const unsigned long long n = v ? strtoull(v, &end, 10) : 0;
+    if (!v || !*v || *end || errno || n < 1 || n > 65536 || holes < 0 || shells < 0)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "the mesh does not say what field it was fitted against (meta "
+                            "field_voxels, fill_holes, closed_shells: a soupmesh mesh does)");
+    st_dist_params dp;
+    st_pseudo_params pp;
+    field_params(&dp, &pp, (size_t)n, max_bytes, holes, shells);
+    return st_pseudo_volume(out, s, &dp, &pp, NULL, prog, err);
 }

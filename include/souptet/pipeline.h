@@ -221,6 +221,15 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                           const st_soup *s, const st_pipeline_params *p,
                           const st_progress *prog, st_error *err);
 
+/* The pseudo volume a mesh of st_pipeline_run was fitted against: the
+ * same field over s (its meta "field_voxels", "fill_holes",
+ * "closed_shells"), so that a check of the fit's condition against the
+ * soup and its fill (st_tetstat_fill with offset_fill yes) measures what
+ * the run measured. ST_EINPUT when the meta does not say (a mesh from the
+ * pipe of tools or elsewhere). */
+st_status st_pipeline_field_of_mesh(st_grid **out, const st_tetmesh *m, const st_soup *s,
+                                    size_t max_bytes, const st_progress *prog, st_error *err);
+
 #ifdef __cplusplus
 }
 #endif

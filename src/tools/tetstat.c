@@ -13,6 +13,7 @@
 #define _GNU_SOURCE
 #include "../cli/tool.h"
 #include "souptet/gridio.h"
+#include "souptet/pipeline.h"
 #include "souptet/soup.h"
 #include "souptet/tetio.h"
 #include "souptet/tetstat.h"
@@ -255,8 +256,14 @@ static void print_table(FILE *f, const char *name, const char *sname,
             ROW("boundary -> S max / diag", "%.6f", r->dist_max / r->surface_diag);
             ROW("S -> boundary max / diag", "%.6f", r->surface_dist_max / r->surface_diag);
         }
-        if (r->has_offset)
+        if (r->has_offset && r->has_fill) {
+            /* the condition is the next row's: this one only informs */
+            char lab[64];
+            snprintf(lab, sizeof lab, "beyond %.3g h (S alone)", r->offset_ratio);
+            ROW(lab, "%zu   (the condition counts the fill too)", r->beyond_offset);
+        } else if (r->has_offset) {
             beyond_row(f, r->offset_ratio, "offset", r->beyond_offset);
+        }
         if (r->has_fill) {
             ROW("fill (field, no S) faces", "%zu", r->fill_faces);
             ROW("boundary -> S|fill max", "%.9g", r->fill_dist_max);
@@ -409,12 +416,31 @@ static int run(tool_ctx *t, void *settings)
     /* both: the fill counts as surface, as soupmesh's condition takes it */
     if (soup && g && st_tetstat_fill(&r, m, soup, g, &err))
         goto failed;
+    /* A soupmesh mesh whose condition counted the fill (meta offset_fill
+     * yes) and no field given: the same fill, rebuilt from the soup as the
+     * run made it (pipeline.h), so tetstat reports the condition soupmesh
+     * reported. A mesh that does not say how: the soup alone, as before. */
+    int rebuilt = 0;
+    const char *of = st_meta_get(&m->meta, "offset_fill");
+    if (soup && !g && of && strcmp(of, "yes") == 0 && st_meta_get(&m->meta, "field_voxels")) {
+        st_grid *fg = NULL;
+        st_progress prog = tool_progress(t);
+        st_status fs = st_pipeline_field_of_mesh(&fg, m, soup, s->co.max_bytes, &prog, &err);
+        tool_progress_end(t);
+        if (!fs)
+            fs = st_tetstat_fill(&r, m, soup, fg, &err);
+        st_grid_free(fg);
+        if (fs)
+            goto failed;
+        rebuilt = 1;
+    }
     double t4 = tool_now();
     tool_say(t, 2, "read %.3f s, mesh %.3f s, surface %.3f s, field %.3f s",
              t1 - t0, t2 - t1, t3 - t2, t4 - t3);
 
     const char *sname = surface ? tool_in_name(surface) : "<stdin>";
-    const char *fname = field ? tool_in_name(field) : "<stdin>";
+    const char *fname = rebuilt ? "the mesh's field (rebuilt from its meta)"
+                        : field ? tool_in_name(field) : "<stdin>";
     if (s->json)
         print_json(stdout, name, sname, fname, &r);
     else
