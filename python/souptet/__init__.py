@@ -23,7 +23,7 @@ __all__ = ["read", "mesh", "pseudo_volume", "distance", "wrap", "Error",
 __version__ = _core.version
 
 
-def _io():
+def _load_io():
     try:
         from . import _io as io
     except ImportError as e:
@@ -95,7 +95,7 @@ class MeshResult:
         p = os.fspath(path)
         ext = (p.decode() if isinstance(p, bytes) else p).lower()
         if ext.endswith(".vtu"):
-            _io().write_vtu(self._mesh, p)
+            _load_io().write_vtu(self._mesh, p)
         else:
             _core.write(self._mesh, p, msh_version, binary)
 
@@ -203,4 +203,4 @@ def wrap(V, F, resolution=128):
                 as soupwrap -r)
     Returns (V2, F2): float64 (n, 3) (float-representable) and int64 (m, 3).
     """
-    return _io().wrap(V, F, resolution)
+    return _load_io().wrap(V, F, resolution)
