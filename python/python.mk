@@ -44,16 +44,51 @@ $(PY_OUT)/%: python/souptet/%
 	@mkdir -p $(dir $@)
 	cp $< $@
 
-# Until the shared libraries exist: the static library, built with -fPIC.
-$(PY_CORE): $(BUILD)/python-obj/_core.o $(LIBA)
-	@mkdir -p $(dir $@)
-	$(CC) -shared $(LDFLAGS_ALL) $< $(LIBA) -lxxhash $(OMPLIB) -lm -o $@
-$(PY_IO): $(BUILD)/python-obj/_io.o $(LIBA)
-	@mkdir -p $(dir $@)
-	$(CXX) -shared $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
+# The extensions link the shared libraries (_core libsouptet.so only, _io
+# libsouptet-io.so too), found through RUNPATH: $ORIGIN/../.. in the
+# build tree (build/python/souptet -> build/), $(PREFIX)/lib when
+# installed (relinked into $(BUILD)/python-install). A Makefile without
+# the shared libraries: the static library instead (built with -fPIC).
+PY_SHARED := $(shell grep -q 'libsouptet-io\.so' Makefile 2>/dev/null && echo yes)
+ifeq ($(PY_SHARED),yes)
+PY_CORE_DEPS := $(BUILD)/libsouptet.so
+PY_IO_DEPS := $(BUILD)/libsouptet-io.so $(BUILD)/libsouptet.so
+PY_CORE_LINK = $(CC) -shared $(LDFLAGS_ALL) $< -L$(BUILD) -lsouptet -Wl,-rpath,'$(1)' -o $@
+PY_IO_LINK = $(CC) -shared $(LDFLAGS_ALL) $< -L$(BUILD) -lsouptet-io -lsouptet -Wl,-rpath,'$(1)' -o $@
+else
+PY_CORE_DEPS := $(LIBA)
+PY_IO_DEPS := $(LIBA)
+PY_CORE_LINK = $(CC) -shared $(LDFLAGS_ALL) $< $(LIBA) -lxxhash $(OMPLIB) -lm -o $@
+PY_IO_LINK = $(CXX) -shared $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
+endif
+PY_INST := $(BUILD)/python-install
+PY_INST_SO := $(PY_INST)/_core$(PY_EXT) $(PY_INST)/_io$(PY_EXT)
 
-install-python: python
+$(PY_CORE): $(BUILD)/python-obj/_core.o $(PY_CORE_DEPS)
+	@mkdir -p $(dir $@)
+	$(call PY_CORE_LINK,$$ORIGIN/../..)
+$(PY_IO): $(BUILD)/python-obj/_io.o $(PY_IO_DEPS)
+	@mkdir -p $(dir $@)
+	$(call PY_IO_LINK,$$ORIGIN/../..)
+$(PY_INST)/_core$(PY_EXT): $(BUILD)/python-obj/_core.o $(PY_CORE_DEPS)
+	@mkdir -p $(dir $@)
+	$(call PY_CORE_LINK,$(PREFIX)/lib)
+$(PY_INST)/_io$(PY_EXT): $(BUILD)/python-obj/_io.o $(PY_IO_DEPS)
+	@mkdir -p $(dir $@)
+	$(call PY_IO_LINK,$(PREFIX)/lib)
+
+ifeq ($(PY_ENABLED),yes)
+install-python: python $(PY_INST_SO)
 	install -d $(DESTDIR)$(PY_SITE)/souptet
 	install -m 644 $(PY_PURE) $(DESTDIR)$(PY_SITE)/souptet/
-	install -m 755 $(PY_CORE) $(PY_IO) $(DESTDIR)$(PY_SITE)/souptet/
+	install -m 755 $(PY_INST_SO) $(DESTDIR)$(PY_SITE)/souptet/
+else
+install-python:
+	@echo "not installing souptet's Python module (no python3-dev or python3-numpy)"
+endif
 install: install-python
+
+.PHONY: uninstall-python
+uninstall-python:
+	rm -rf $(DESTDIR)$(PY_SITE)/souptet
+uninstall: uninstall-python
