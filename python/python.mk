@@ -56,6 +56,10 @@ PY_IO_DEPS := $(BUILD)/libsouptet-io.so $(BUILD)/libsouptet.so
 PY_CORE_LINK = $(CC) -shared $(LDFLAGS_ALL) $< -L$(BUILD) -lsouptet -Wl,-rpath,'$(1)' -o $@
 PY_IO_LINK = $(CC) -shared $(LDFLAGS_ALL) $< -L$(BUILD) -lsouptet-io -lsouptet -Wl,-rpath,'$(1)' -o $@
 else
+ifeq ($(PY_ENABLED),yes)
+CFLAGS_ALL += -fPIC
+CXXFLAGS_ALL += -fPIC
+endif
 PY_CORE_DEPS := $(LIBA)
 PY_IO_DEPS := $(LIBA)
 PY_CORE_LINK = $(CC) -shared $(LDFLAGS_ALL) $< $(LIBA) -lxxhash $(OMPLIB) -lm -o $@

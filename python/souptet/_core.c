@@ -397,7 +397,17 @@ static PyObject *py_mesh(PyObject *self, PyObject *args, PyObject *kw)
         py_raise(&e, NULL);
         goto done;
     }
-    if (st_meta_history_append(&m->meta, "python3: souptet.mesh()")) {
+    char hist[256];
+    if (p.h > 0)
+        snprintf(hist, sizeof hist, "python3: souptet.mesh(size=%.17g", p.h);
+    else
+        snprintf(hist, sizeof hist, "python3: souptet.mesh(cells=%zu", p.cells);
+    if (p.target_tets)
+        snprintf(hist + strlen(hist), sizeof hist - strlen(hist), ", tets=%zu", p.target_tets);
+    snprintf(hist + strlen(hist), sizeof hist - strlen(hist),
+             ", tries=%zu, seed=%llu, offset=%.17g)", p.tries, (unsigned long long)p.seed,
+             p.offset_ratio);
+    if (st_meta_history_append(&m->meta, hist)) {
         PyErr_NoMemory();
         goto done;
     }
