@@ -405,7 +405,7 @@ static PyObject *py_mesh(PyObject *self, PyObject *args, PyObject *kw)
     if (p.target_tets)
         snprintf(hist + strlen(hist), sizeof hist - strlen(hist), ", tets=%zu", p.target_tets);
     snprintf(hist + strlen(hist), sizeof hist - strlen(hist),
-             ", tries=%zu, seed=%llu, offset=%.17g)", p.tries, (unsigned long long)p.seed,
+             ", tries=%zu, seed=%llu, offset=%.15g)", p.tries, (unsigned long long)p.seed,
              p.offset_ratio);
     if (st_meta_history_append(&m->meta, hist)) {
         PyErr_NoMemory();
