@@ -47,24 +47,11 @@ $(PY_OUT)/%: python/souptet/%
 # The extensions link the shared libraries (_core libsouptet.so only, _io
 # libsouptet-io.so too), found through RUNPATH: $ORIGIN/../.. in the
 # build tree (build/python/souptet -> build/), $(PREFIX)/lib when
-# installed (relinked into $(BUILD)/python-install). A Makefile without
-# the shared libraries: the static library instead (built with -fPIC).
-PY_SHARED := $(shell grep -q 'libsouptet-io\.so' Makefile 2>/dev/null && echo yes)
-ifeq ($(PY_SHARED),yes)
-PY_CORE_DEPS := $(BUILD)/libsouptet.so
-PY_IO_DEPS := $(BUILD)/libsouptet-io.so $(BUILD)/libsouptet.so
+# installed (relinked into $(BUILD)/python-install).
+PY_CORE_DEPS := $(LIBSO_CORE)
+PY_IO_DEPS := $(LIBSO_IO) $(LIBSO_CORE)
 PY_CORE_LINK = $(CC) -shared $(LDFLAGS_ALL) $< -L$(BUILD) -lsouptet -Wl,-rpath,'$(1)' -o $@
 PY_IO_LINK = $(CC) -shared $(LDFLAGS_ALL) $< -L$(BUILD) -lsouptet-io -lsouptet -Wl,-rpath,'$(1)' -o $@
-else
-ifeq ($(PY_ENABLED),yes)
-CFLAGS_ALL += -fPIC
-CXXFLAGS_ALL += -fPIC
-endif
-PY_CORE_DEPS := $(LIBA)
-PY_IO_DEPS := $(LIBA)
-PY_CORE_LINK = $(CC) -shared $(LDFLAGS_ALL) $< $(LIBA) -lxxhash $(OMPLIB) -lm -o $@
-PY_IO_LINK = $(CXX) -shared $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
-endif
 PY_INST := $(BUILD)/python-install
 PY_INST_SO := $(PY_INST)/_core$(PY_EXT) $(PY_INST)/_io$(PY_EXT)
 
@@ -96,3 +83,7 @@ install: install-python
 uninstall-python:
 	rm -rf $(DESTDIR)$(PY_SITE)/souptet
 uninstall: uninstall-python
+
+# Relinked on every install (PREFIX may differ from the last one).
+.PHONY: py-force
+$(PY_INST_SO): py-force

@@ -99,5 +99,5 @@ def test_ctrl_c(call):
     rest = p.stdout.read()
     p.wait(timeout=60)
     assert line == "interrupted", line
-    assert dt <= 1.5, dt
+    assert dt <= 1.5, (dt, line, rest)
     assert "again" in rest and p.returncode == 0
