@@ -117,3 +117,31 @@ def test_next_call_works_after_errors():
             souptet.mesh(*make())
     m = souptet.mesh(V0, F0, cells=3, tries=1)
     assert m.encloses and len(m.tets) > 0
+
+
+def test_out_of_memory_is_memoryerror():
+    # under a 1 GiB address-space limit a 2 GiB field cannot be had
+    import subprocess
+    import sys
+    from conftest import BUNNY, PYDIR
+    code = """
+import resource, sys
+sys.path.insert(0, %r)
+import souptet
+V, F = souptet.read(%r)
+resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30))
+try:
+    souptet.distance(V, F, resolution=900)
+    print('no error')
+except MemoryError as e:
+    print('MemoryError', e)
+print(len(souptet.mesh(V, F, cells=3, tries=1).tets) > 0)
+""" % (PYDIR, BUNNY)
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.stdout.startswith("MemoryError out of memory"), (r.stdout, r.stderr)
+    assert r.stdout.strip().endswith("True")
+
+
+def test_lattice_over_memory_is_error():
+    with pytest.raises(souptet.Error, match="over 80% of this machine's memory"):
+        souptet.mesh(V0, F0, cells=4096, tries=1024)
