@@ -31,8 +31,9 @@ def test_other_threads_run_during_mesh(bunny):
     elapsed = time.monotonic() - t0
     t.join()
     assert out["m"].encloses
-    # at least a third of the 1 ms ticks the run's length allows
-    assert elapsed > 0.2 and ticks > elapsed * 1000 / 3 / 2, (ticks, elapsed)
+    # a tick every 50 ms at least (a loaded machine's sleeps are long; with
+    # the GIL held through the run there would be one or two in all)
+    assert elapsed > 0.2 and ticks > elapsed * 20, (ticks, elapsed)
 
 
 def test_progress_from_threads_with_gil(bunny):
