@@ -64,7 +64,9 @@ def test_two_threads_mesh_at_once(bunny, bunny_mesh):
 
 
 CHILD = textwrap.dedent("""
-    import sys, time
+    import signal, sys, time
+    # as an interactive python3 has it, even when started with SIGINT ignored
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     sys.path.insert(0, %(pydir)r)
     import souptet
     V, F = souptet.read(%(bunny)r)
