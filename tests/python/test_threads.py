@@ -75,7 +75,7 @@ CHILD = textwrap.dedent("""
     t0 = time.monotonic()
     try:
         if call == "mesh":
-            souptet.mesh(V, F, cells=24, tries=2)
+            souptet.mesh(V, F, cells=20, tries=1)
         elif call == "pseudo_volume":
             souptet.pseudo_volume(V, F, resolution=520)
         else:
