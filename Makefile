@@ -276,4 +276,6 @@ uninstall:
 clean:
 	rm -rf build build-debug build-sanitize build-fuzz build-tsan
 
+include python/python.mk
+
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -1,0 +1,605 @@
+/*
+ * _core.c - souptet's Python module over libsouptet (the C core: no VTK,
+ * no OpenVDB). The public API is souptet/__init__.py's; this module
+ * gives it plain values (arrays, dicts, a capsule holding the mesh).
+ *
+ *   read(path) -> (V, F)
+ *   mesh(V, F, cells, size, tets, tries, seed, offset, threads, progress)
+ *       -> dict (points, tets, boundary, embed_tet, embed_bary, ...,
+ *          "_mesh": capsule "souptet.tetmesh")
+ *   pseudo_volume(V, F, resolution) / distance(V, F, resolution, band)
+ *       -> dict (values, origin, voxel, dims)
+ *   write(capsule, path, msh_version, binary)   .msh .node/.ele .mesh
+ *
+ * The GIL is released while the library works; Ctrl-C cancels through
+ * the library's cancel flag (common.h).
+ */
+#include "common.h"
+
+#include "souptet/dist.h"
+#include "souptet/embed.h"
+#include "souptet/grid.h"
+#include "souptet/meta.h"
+#include "souptet/outfile.h"
+#include "souptet/pipeline.h"
+#include "souptet/pseudo.h"
+#include "souptet/tetformat.h"
+#include "souptet/tetmesh.h"
+
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#define CAPSULE_NAME "souptet.tetmesh"
+
+/* ---- read ------------------------------------------------------------- */
+
+static PyObject *soup_arrays(const st_soup *s)
+{
+    npy_intp dv[2] = {(npy_intp)s->nverts, 3}, df[2] = {(npy_intp)s->ntris, 3};
+    PyArrayObject *V = (PyArrayObject *)PyArray_SimpleNew(2, dv, NPY_FLOAT64);
+    PyArrayObject *F = (PyArrayObject *)PyArray_SimpleNew(2, df, NPY_INT64);
+    if (!V || !F) {
+        Py_XDECREF(V);
+        Py_XDECREF(F);
+        return NULL;
+    }
+    memcpy(PyArray_DATA(V), s->xyz, 3 * s->nverts * sizeof(double));
+    int64_t *f = PyArray_DATA(F);
+    for (size_t i = 0; i < 3 * s->ntris; i++)
+        f[i] = s->tris[i];
+    return Py_BuildValue("(NN)", V, F);
+}
+
+static PyObject *py_read(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *path = NULL;
+    if (!PyArg_ParseTuple(args, "O&:read", PyUnicode_FSConverter, &path))
+        return NULL;
+    const char *p = PyBytes_AS_STRING(path);
+    st_soup *s = NULL;
+    st_soup_warnings w;
+    st_error e;
+    st_error_clear(&e);
+    st_status rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = st_soup_read_warn(&s, p, &w, &e);
+    Py_END_ALLOW_THREADS
+    PyObject *res = NULL;
+    if (rc) {
+        py_raise(&e, p);
+    } else {
+        res = soup_arrays(s);
+        if (res && w.count) {
+            char buf[1200];
+            st_error_format(&w.first, buf, sizeof buf);
+            if (PyErr_WarnFormat(PyExc_UserWarning, 1, "%s (%zu note%s from the reader)",
+                                 buf, w.count, w.count == 1 ? "" : "s") < 0)
+                Py_CLEAR(res);
+        }
+    }
+    st_soup_free(s);
+    Py_DECREF(path);
+    return res;
+}
+
+/* ---- progress ------------------------------------------------------------ */
+
+/* What the library's callbacks share; every field is touched with the GIL
+ * held. */
+typedef struct py_prog {
+    PyObject *fn;             /* the progress callable, or NULL */
+    volatile int cancel;      /* the library's cancel flag */
+    int failed;               /* the callable raised: exc_* hold it */
+    PyObject *exc_type, *exc_value, *exc_tb;
+    const char *stage;        /* the latest st_progress report */
+    double fraction;
+    const char *sent_stage;   /* the latest one passed on */
+    double sent_fraction;
+} py_prog;
+
+static int set_item(PyObject *d, const char *key, PyObject *v)
+{
+    if (!v)
+        return -1;
+    int rc = PyDict_SetItemString(d, key, v);
+    Py_DECREF(v);
+    return rc;
+}
+
+/* Call the callable with an event dict (GIL held); on an exception keep
+ * it and cancel the run. */
+static void prog_send(py_prog *pp, PyObject *d)
+{
+    if (!d || set_item(d, "stage", pp->stage ? PyUnicode_FromString(pp->stage)
+                                             : (Py_INCREF(Py_None), Py_None)) ||
+        set_item(d, "fraction", PyFloat_FromDouble(pp->fraction))) {
+        Py_XDECREF(d);
+        goto fail;
+    }
+    PyObject *r = PyObject_CallOneArg(pp->fn, d);
+    Py_DECREF(d);
+    if (r) {
+        Py_DECREF(r);
+        return;
+    }
+fail:
+    pp->failed = 1;
+    PyErr_Fetch(&pp->exc_type, &pp->exc_value, &pp->exc_tb);
+    st_progress_cancel(&pp->cancel);
+}
+
+static void on_progress(void *ctx, const char *stage, double fraction)
+{
+    py_prog *pp = ctx;
+    PyGILState_STATE g = PyGILState_Ensure();
+    pp->stage = stage;
+    pp->fraction = fraction;
+    /* at most every 1% of a stage, so the callable does not slow the run */
+    if (pp->fn && !pp->failed &&
+        (stage != pp->sent_stage || fraction >= pp->sent_fraction + 0.01 || fraction >= 1.0 ||
+         fraction < pp->sent_fraction)) {
+        pp->sent_stage = stage;
+        pp->sent_fraction = fraction;
+        PyObject *d = PyDict_New();
+        if (d && set_item(d, "what", PyUnicode_FromString("progress"))) {
+            Py_CLEAR(d);
+        }
+        prog_send(pp, d);
+    }
+    PyGILState_Release(g);
+}
+
+static void on_event(void *ctx, const st_pipeline_event *ev)
+{
+    py_prog *pp = ctx;
+    PyGILState_STATE g = PyGILState_Ensure();
+    if (pp->fn && !pp->failed) {
+        PyObject *d = PyDict_New();
+        int bad = !d || set_item(d, "what", PyUnicode_FromString(ev->what)) ||
+                  set_item(d, "k", PyLong_FromSize_t(ev->k)) ||
+                  set_item(d, "h", PyFloat_FromDouble(ev->h)) ||
+                  set_item(d, "tets", PyLong_FromSize_t(ev->tets)) ||
+                  set_item(d, "seconds", PyFloat_FromDouble(ev->seconds)) ||
+                  set_item(d, "voxel", PyFloat_FromDouble(ev->voxel)) ||
+                  set_item(d, "field_dims", Py_BuildValue("(nnn)", (Py_ssize_t)ev->field_dims[0],
+                                                          (Py_ssize_t)ev->field_dims[1],
+                                                          (Py_ssize_t)ev->field_dims[2]));
+        if (!bad && ev->fit)
+            bad = set_item(d, "phase", PyUnicode_FromString(ev->fit->phase)) ||
+                  set_item(d, "iteration", PyLong_FromLong(ev->fit->iter)) ||
+                  set_item(d, "min_dihedral", PyFloat_FromDouble(ev->fit->min_dihedral)) ||
+                  set_item(d, "max_dihedral", PyFloat_FromDouble(ev->fit->max_dihedral)) ||
+                  set_item(d, "max_distance", PyFloat_FromDouble(ev->fit->max_distance));
+        if (!bad && ev->candidate)
+            bad = set_item(d, "failed", PyBool_FromLong(ev->candidate->failed));
+        if (bad)
+            Py_CLEAR(d);
+        prog_send(pp, d);
+    }
+    PyGILState_Release(g);
+}
+
+/* After the call: the callable's exception, if it raised (returns -1). */
+static int prog_finish(py_prog *pp)
+{
+    if (!pp->failed)
+        return 0;
+    PyErr_Restore(pp->exc_type, pp->exc_value, pp->exc_tb);
+    pp->exc_type = pp->exc_value = pp->exc_tb = NULL;
+    return -1;
+}
+
+/* ---- mesh --------------------------------------------------------------- */
+
+static void capsule_free(PyObject *cap)
+{
+    st_tetmesh_free(PyCapsule_GetPointer(cap, CAPSULE_NAME));
+}
+
+static PyObject *mesh_result(st_tetmesh *m, const st_pipeline_stats *st, const int64_t *et,
+                             const double *eb, size_t nv)
+{
+    st_error e;
+    st_error_clear(&e);
+    uint32_t *faces = NULL;
+    size_t nfaces = 0;
+    if (st_tetmesh_boundary(m, &faces, NULL, &nfaces, &e))
+        return py_raise(&e, NULL);
+    npy_intp dp[2] = {(npy_intp)m->npoints, 3}, dt[2] = {(npy_intp)m->ntets, 4},
+             db[2] = {(npy_intp)nfaces, 3}, de[1] = {(npy_intp)nv}, dbary[2] = {(npy_intp)nv, 4};
+    PyArrayObject *P = (PyArrayObject *)PyArray_SimpleNew(2, dp, NPY_FLOAT64);
+    PyArrayObject *T = (PyArrayObject *)PyArray_SimpleNew(2, dt, NPY_INT64);
+    PyArrayObject *B = (PyArrayObject *)PyArray_SimpleNew(2, db, NPY_INT64);
+    PyArrayObject *ET = (PyArrayObject *)PyArray_SimpleNew(1, de, NPY_INT64);
+    PyArrayObject *EB = (PyArrayObject *)PyArray_SimpleNew(2, dbary, NPY_FLOAT64);
+    PyObject *d = PyDict_New();
+    PyObject *res = NULL;
+    if (!P || !T || !B || !ET || !EB || !d)
+        goto done;
+    memcpy(PyArray_DATA(P), m->xyz, 3 * m->npoints * sizeof(double));
+    int64_t *t = PyArray_DATA(T);
+    for (size_t i = 0; i < 4 * m->ntets; i++)
+        t[i] = m->tets[i];
+    int64_t *b = PyArray_DATA(B);
+    for (size_t i = 0; i < 3 * nfaces; i++)
+        b[i] = faces[i];
+    memcpy(PyArray_DATA(ET), et, nv * sizeof(int64_t));
+    memcpy(PyArray_DATA(EB), eb, 4 * nv * sizeof(double));
+    const st_pipeline_candidate *c = &st->candidates[st->best];
+    if (set_item(d, "points", (Py_INCREF(P), (PyObject *)P)) ||
+        set_item(d, "tets", (Py_INCREF(T), (PyObject *)T)) ||
+        set_item(d, "boundary", (Py_INCREF(B), (PyObject *)B)) ||
+        set_item(d, "embed_tet", (Py_INCREF(ET), (PyObject *)ET)) ||
+        set_item(d, "embed_bary", (Py_INCREF(EB), (PyObject *)EB)) ||
+        set_item(d, "min_dihedral", PyFloat_FromDouble(c->min_dihedral)) ||
+        set_item(d, "max_dihedral", PyFloat_FromDouble(c->max_dihedral)) ||
+        set_item(d, "encloses", PyBool_FromLong(st->encloses)) ||
+        set_item(d, "converged", PyBool_FromLong(c->converged)) ||
+        set_item(d, "h", PyFloat_FromDouble(st->h)) ||
+        set_item(d, "seed", PyLong_FromUnsignedLongLong(c->seed)) ||
+        set_item(d, "candidates", PyLong_FromSize_t(st->ncandidates)) ||
+        set_item(d, "max_distance", PyFloat_FromDouble(c->max_distance)) ||
+        set_item(d, "guessed", PyFloat_FromDouble(
+                     st->guess.boundary_faces
+                         ? (double)st->guess.fill_faces / (double)st->guess.boundary_faces
+                         : 0.0)) ||
+        set_item(d, "seconds", PyFloat_FromDouble(st->seconds_total)))
+        goto done;
+    PyObject *cap = PyCapsule_New(m, CAPSULE_NAME, capsule_free);
+    if (!cap)
+        goto done;
+    if (set_item(d, "_mesh", cap))   /* the capsule owns m from here */
+        goto done;
+    res = d;
+    d = NULL;
+done:
+    free(faces);
+    Py_XDECREF(P);
+    Py_XDECREF(T);
+    Py_XDECREF(B);
+    Py_XDECREF(ET);
+    Py_XDECREF(EB);
+    Py_XDECREF(d);
+    return res;
+}
+
+static int opt_double(PyObject *o, const char *name, double *out)
+{
+    if (o == Py_None)
+        return 0;
+    if (PyBool_Check(o) || !PyNumber_Check(o)) {
+        py_fail("%s must be a number or None", name);
+        return -1;
+    }
+    *out = PyFloat_AsDouble(o);
+    return *out == -1.0 && PyErr_Occurred() ? -1 : 0;
+}
+
+static int opt_size(PyObject *o, const char *name, size_t lo, size_t hi, size_t *out)
+{
+    if (o == Py_None)
+        return 0;
+    if (PyBool_Check(o) || !PyLong_Check(o)) {
+        py_fail("%s must be an integer", name);
+        return -1;
+    }
+    int overflow = 0;
+    long long v = PyLong_AsLongLongAndOverflow(o, &overflow);
+    if (v == -1 && PyErr_Occurred())
+        return -1;
+    if (overflow || v < (long long)lo || (unsigned long long)v > hi) {
+        py_fail("%s must be in %zu..%zu", name, lo, hi);
+        return -1;
+    }
+    *out = (size_t)v;
+    return 0;
+}
+
+static PyObject *py_mesh(PyObject *self, PyObject *args, PyObject *kw)
+{
+    (void)self;
+    static char *kwlist[] = {"V", "F", "cells", "size", "tets", "tries", "seed",
+                             "offset", "threads", "progress", "float32", NULL};
+    PyObject *V, *F, *cells_o = NULL, *size_o = Py_None, *tets_o = Py_None, *tries_o = NULL,
+                     *seed_o = NULL, *offset_o = NULL, *threads_o = NULL, *progress = Py_None,
+                     *f32_o = Py_False;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|$OOOOOOOOO:mesh", kwlist, &V, &F, &cells_o,
+                                     &size_o, &tets_o, &tries_o, &seed_o, &offset_o,
+                                     &threads_o, &progress, &f32_o))
+        return NULL;
+    st_pipeline_params p = st_pipeline_params_default();
+    size_t threads = 0, seed = (size_t)p.seed;
+    if (cells_o && opt_size(cells_o, "cells", 1, ST_PIPELINE_MAX_CELLS, &p.cells))
+        return NULL;
+    if (opt_double(size_o, "size", &p.h))
+        return NULL;
+    if (size_o != Py_None && !(p.h >= 1e-300 && p.h <= 1e300))
+        return py_fail("size must be a positive cell width in model units, not %g", p.h);
+    if (opt_size(tets_o, "tets", 10, 100000000, &p.target_tets))
+        return NULL;
+    if (tries_o && opt_size(tries_o, "tries", 1, ST_PIPELINE_MAX_TRIES, &p.tries))
+        return NULL;
+    if (seed_o && opt_size(seed_o, "seed", 0, SIZE_MAX, &seed))
+        return NULL;
+    p.seed = seed;
+    if (offset_o && opt_double(offset_o, "offset", &p.offset_ratio))
+        return NULL;
+    if (!(p.offset_ratio >= 1e-3 && p.offset_ratio <= 10.0))
+        return py_fail("offset must be in 0.001..10 (cell widths), not %g", p.offset_ratio);
+    if (threads_o && opt_size(threads_o, "threads", 0, 4096, &threads))
+        return NULL;
+    if (progress != Py_None && !PyCallable_Check(progress)) {
+        PyErr_SetString(PyExc_TypeError, "progress must be callable or None");
+        return NULL;
+    }
+    int f32 = PyObject_IsTrue(f32_o);
+    if (f32 < 0)
+        return NULL;
+    if (f32)
+        return py_fail("float32=True needs a library with st_pipeline_params.float32 "
+                       "(not in this build)");
+    st_soup *soup = NULL;
+    if (py_soup(V, F, &soup))
+        return NULL;
+
+    st_error e;
+    st_error_clear(&e);
+    p.max_bytes = py_max_bytes();
+    py_prog pp;
+    memset(&pp, 0, sizeof pp);
+    pp.fn = progress != Py_None ? progress : NULL;
+    pp.sent_fraction = -1.0;
+    p.on_event = on_event;
+    p.on_event_ctx = &pp;
+    st_progress prog = {on_progress, &pp, &pp.cancel};
+    st_pipeline_stats st;
+    memset(&st, 0, sizeof st);
+    st_tetmesh *m = NULL;
+    int64_t *et = NULL;
+    double *eb = NULL;
+    PyObject *res = NULL;
+    size_t nout = 0;
+
+    /* soupmesh refuses lattices over its memory limit before laying any */
+    double h = st_pipeline_cell_width(soup, &p), ltets, at_once;
+    double need = st_pipeline_lattice_bytes(soup, h, p.tries, &ltets, &at_once);
+    if (p.max_bytes && need > (double)p.max_bytes) {
+        py_fail("cell width %g lays lattices of up to %.0f tets (%.0f at a time), about "
+                "%.1f MiB, over 80%% of this machine's memory (%.1f MiB): use fewer cells or "
+                "tries, or a larger size", h, ltets, at_once, need / 1048576.0,
+                (double)p.max_bytes / 1048576.0);
+        goto done;
+    }
+    et = malloc(soup->nverts * sizeof *et);
+    eb = malloc(soup->nverts * 4 * sizeof *eb);
+    if (!et || !eb) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    int sig = py_sig_begin(&pp.cancel);
+    st_status rc;
+    Py_BEGIN_ALLOW_THREADS
+    int old_threads = omp_get_max_threads();
+    if (threads)
+        omp_set_num_threads((int)threads);
+    rc = st_pipeline_run(&m, &st, soup, &p, &prog, &e);
+    if (!rc && !pp.cancel)
+        rc = st_embed_compute(et, eb, &nout, NULL, m, soup, &e);
+    else if (!rc)
+        rc = st_error_set(&e, ST_ECANCELLED, NULL, 0, "cancelled");
+    omp_set_num_threads(old_threads);
+    Py_END_ALLOW_THREADS
+    if (py_sig_end(sig) || prog_finish(&pp))
+        goto done;
+    if (rc) {
+        py_raise(&e, NULL);
+        goto done;
+    }
+    char hist[256];
+    if (p.h > 0)
+        snprintf(hist, sizeof hist, "python3: souptet.mesh(size=%.17g", p.h);
+    else
+        snprintf(hist, sizeof hist, "python3: souptet.mesh(cells=%zu", p.cells);
+    if (p.target_tets)
+        snprintf(hist + strlen(hist), sizeof hist - strlen(hist), ", tets=%zu", p.target_tets);
+    snprintf(hist + strlen(hist), sizeof hist - strlen(hist),
+             ", tries=%zu, seed=%llu, offset=%.15g)", p.tries, (unsigned long long)p.seed,
+             p.offset_ratio);
+    if (st_meta_history_append(&m->meta, hist)) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    res = mesh_result(m, &st, et, eb, soup->nverts);
+    if (res)
+        m = NULL;   /* the capsule has it */
+done:
+    Py_XDECREF(pp.exc_type);
+    Py_XDECREF(pp.exc_value);
+    Py_XDECREF(pp.exc_tb);
+    free(et);
+    free(eb);
+    free(st.candidates);
+    st_tetmesh_free(m);
+    st_soup_free(soup);
+    return res;
+}
+
+/* ---- fields --------------------------------------------------------------- */
+
+/* A grid's values as a float32 (nx, ny, nz) array indexed [i, j, k] (Fortran
+ * order over the library's x-fastest storage), with origin, voxel, dims. */
+static PyObject *grid_result(const st_grid *g)
+{
+    npy_intp dims[3] = {(npy_intp)g->nx, (npy_intp)g->ny, (npy_intp)g->nz};
+    PyArrayObject *a = (PyArrayObject *)PyArray_New(&PyArray_Type, 3, dims, NPY_FLOAT32, NULL,
+                                                    NULL, 0, NPY_ARRAY_F_CONTIGUOUS, NULL);
+    if (!a)
+        return NULL;
+    memcpy(PyArray_DATA(a), g->data, st_grid_count(g) * sizeof(float));
+    return Py_BuildValue("{s:N,s:(ddd),s:d,s:d}", "values", a, "origin", g->origin[0],
+                         g->origin[1], g->origin[2], "voxel", g->voxel, "band", g->band);
+}
+
+static PyObject *field_call(PyObject *args, PyObject *kw, int signs)
+{
+    static char *kwlist_d[] = {"V", "F", "resolution", "band", NULL};
+    static char *kwlist_s[] = {"V", "F", "resolution", NULL};
+    PyObject *V, *F, *res_o = NULL, *band_o = NULL;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, signs ? "OO|O:pseudo_volume" : "OO|OO:distance",
+                                     signs ? kwlist_s : kwlist_d, &V, &F, &res_o, &band_o))
+        return NULL;
+    st_dist_params dp = st_dist_params_default();
+    dp.cells = ST_DIST_DEFAULT_CELLS;
+    if (res_o && opt_size(res_o, "resolution", 1, 65536, &dp.cells))
+        return NULL;
+    if (band_o && opt_double(band_o, "band", &dp.band))
+        return NULL;
+    if (!(dp.band >= ST_DIST_MIN_BAND))
+        return py_fail("band must be at least %g voxels (or math.inf), not %g",
+                       ST_DIST_MIN_BAND, dp.band);
+    if (isfinite(dp.band) && dp.band > 1e6)
+        return py_fail("band must be at most 1e6 voxels (or math.inf)");
+    dp.max_bytes = py_max_bytes();
+    st_soup *soup = NULL;
+    if (py_soup(V, F, &soup))
+        return NULL;
+    volatile int cancel = 0;
+    st_progress prog = {NULL, NULL, &cancel};
+    st_pseudo_params pp = st_pseudo_params_default();
+    st_grid *g = NULL;
+    st_error e;
+    st_error_clear(&e);
+    st_status rc;
+    PyObject *res = NULL;
+    int sig = py_sig_begin(&cancel);
+    Py_BEGIN_ALLOW_THREADS
+    rc = signs ? st_pseudo_volume(&g, soup, &dp, &pp, NULL, &prog, &e)
+               : st_dist_field(&g, soup, &dp, &prog, &e);
+    if (!rc && cancel)
+        rc = st_error_set(&e, ST_ECANCELLED, NULL, 0, "cancelled");
+    Py_END_ALLOW_THREADS
+    if (!py_sig_end(sig)) {
+        if (rc)
+            py_raise(&e, NULL);
+        else
+            res = grid_result(g);
+    }
+    st_grid_free(g);
+    st_soup_free(soup);
+    return res;
+}
+
+static PyObject *py_distance(PyObject *self, PyObject *args, PyObject *kw)
+{
+    (void)self;
+    return field_call(args, kw, 0);
+}
+
+static PyObject *py_pseudo_volume(PyObject *self, PyObject *args, PyObject *kw)
+{
+    (void)self;
+    return field_call(args, kw, 1);
+}
+
+/* ---- write ---------------------------------------------------------------- */
+
+static PyObject *py_write(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *cap, *path = NULL;
+    int version = 41, binary = 0;
+    if (!PyArg_ParseTuple(args, "OO&|ip:write", &cap, PyUnicode_FSConverter, &path, &version,
+                          &binary))
+        return NULL;
+    const st_tetmesh *m = PyCapsule_GetPointer(cap, CAPSULE_NAME);
+    if (!m) {
+        Py_DECREF(path);
+        return NULL;
+    }
+    const char *p = PyBytes_AS_STRING(path);
+    st_error e;
+    st_error_clear(&e);
+    st_status rc = ST_OK;
+    st_tetformat f = st_tetformat_from_path(p);
+    if (version != 41 && version != 22 && version != 4 && version != 2) {
+        Py_DECREF(path);
+        return py_fail("msh_version must be 41 or 22, not %d", version);
+    }
+    if (f != ST_TETFORMAT_MSH && f != ST_TETFORMAT_TETGEN && f != ST_TETFORMAT_MEDIT) {
+        Py_DECREF(path);
+        return py_fail("'%s': not a .msh, .node, .ele or .mesh path", p);
+    }
+    Py_BEGIN_ALLOW_THREADS
+    if (f == ST_TETFORMAT_TETGEN) {
+        rc = st_tetmesh_write_tetgen(m, p, &e);
+    } else {
+        /* to a temporary file beside the target, renamed when complete */
+        st_outfile o;
+        rc = st_outfile_begin(&o, p, 0, &e);
+        if (!rc) {
+            rc = f == ST_TETFORMAT_MSH ? st_tetmesh_write_msh(m, o.tmp, version, binary, &e)
+                                       : st_tetmesh_write_medit(m, o.tmp, &e);
+            if (rc) {
+                if (strcmp(e.file, o.tmp) == 0)
+                    snprintf(e.file, sizeof e.file, "%s", p);
+                st_outfile_abort(&o);
+            } else {
+                rc = st_outfile_commit(&o, &e);
+            }
+        }
+    }
+    Py_END_ALLOW_THREADS
+    PyObject *res = rc ? py_raise(&e, p) : (Py_INCREF(Py_None), Py_None);
+    Py_DECREF(path);
+    return res;
+}
+
+/* ---- module --------------------------------------------------------------- */
+
+static PyObject *py_defaults(PyObject *self, PyObject *noargs)
+{
+    (void)self;
+    (void)noargs;
+    st_pipeline_params p = st_pipeline_params_default();
+    return Py_BuildValue("{s:n,s:n,s:K,s:d,s:n}", "cells", (Py_ssize_t)p.cells, "tries",
+                         (Py_ssize_t)p.tries, "seed", (unsigned long long)p.seed, "offset",
+                         p.offset_ratio, "resolution", (Py_ssize_t)ST_DIST_DEFAULT_CELLS);
+}
+
+static PyMethodDef methods[] = {
+    {"read", py_read, METH_VARARGS, "read(path) -> (V, F)"},
+    {"mesh", (PyCFunction)(void (*)(void))py_mesh, METH_VARARGS | METH_KEYWORDS,
+     "mesh(V, F, **params) -> dict"},
+    {"distance", (PyCFunction)(void (*)(void))py_distance, METH_VARARGS | METH_KEYWORDS,
+     "distance(V, F, resolution, band) -> dict"},
+    {"pseudo_volume", (PyCFunction)(void (*)(void))py_pseudo_volume,
+     METH_VARARGS | METH_KEYWORDS, "pseudo_volume(V, F, resolution) -> dict"},
+    {"write", py_write, METH_VARARGS, "write(mesh_capsule, path, msh_version, binary)"},
+    {"library_defaults", py_defaults, METH_NOARGS,
+     "the library's pipeline defaults (st_pipeline_params_default)"},
+    {NULL, NULL, 0, NULL}};
+
+static struct PyModuleDef moddef = {PyModuleDef_HEAD_INIT, "souptet._core",
+                                    "souptet's C core (libsouptet).", -1, methods,
+                                    NULL, NULL, NULL, NULL};
+
+PyMODINIT_FUNC PyInit__core(void)
+{
+    import_array();
+    PyObject *mod = PyModule_Create(&moddef);
+    if (!mod)
+        return NULL;
+    py_error = PyErr_NewExceptionWithDoc(
+        "souptet.Error",
+        "What the souptet library refused or could not do, with its message (a ValueError).\n"
+        "Attributes: status (the library's status name), file and line (or None).",
+        PyExc_ValueError, NULL);
+    if (!py_error || PyModule_AddObject(mod, "Error", (Py_INCREF(py_error), py_error)) ||
+        PyModule_AddStringConstant(mod, "version", SOUPTET_VERSION)) {
+        Py_DECREF(mod);
+        return NULL;
+    }
+    return mod;
+}
