@@ -209,3 +209,4 @@ clean:
 	rm -rf build build-debug build-sanitize build-fuzz build-tsan
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
+include blender/blender.mk
