@@ -197,17 +197,15 @@ def write_tetmesh(r, filepath):
         os.makedirs(d, exist_ok=True)
     try:
         r.write(path)
-    except souptet.Error as e:
-        # .vtu needs souptet's VTK part, which the zip leaves out: the
-        # points and tets as plain VTK XML instead.
-        if not path.lower().endswith(".vtu"):
+    except Exception as e:
+        # .vtu needs souptet's VTK part (souptet._io), which the zip leaves
+        # out: then the points and tets as plain VTK XML.
+        if not path.lower().endswith(".vtu") or isinstance(e, OSError):
             raise CageError("cannot write %s: %s" % (path, e))
         try:
             write_vtu(path, r.points, r.tets)
         except OSError as e2:
             raise CageError("cannot write %s: %s" % (path, e2))
-    except OSError as e:
-        raise CageError("cannot write %s: %s" % (path, e))
     tet = np.asarray(r.embed_tet)
     bary = np.asarray(r.embed_bary, dtype=np.float64)
     epath = os.path.splitext(path)[0] + ".embed.txt"
