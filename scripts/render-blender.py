@@ -4,12 +4,13 @@
 # same bunny after the cage's top was pulled up and twisted: Mesh Deform
 # carries the mesh along.
 #
-#   xvfb-run -a blender -b --factory-startup --python scripts/render-blender.py -- \
+#   blender -b --factory-startup --python scripts/render-blender.py -- \
 #       ADDON BUNNY.obj OUT.png
 # ADDON: the zip make blender-addon builds (installed into the user
 # scripts directory: point BLENDER_USER_SCRIPTS at a scratch one), or the
 # add-on's folder (souptet must then be on Blender's Python path).
-# Workbench needs an OpenGL context, hence xvfb-run without a display.
+# Workbench needs an OpenGL context: Blender 3.4 falls back to surfaceless
+# EGL without a display; where that fails, run it under xvfb-run -a.
 import math
 import os
 import sys
@@ -58,13 +59,15 @@ def bunny(name, x):
 
 
 def wire(cage, color):
-    """Render the cage's edges: a thin Wireframe modifier on it."""
-    w = cage.modifiers.new("edges", 'WIREFRAME')
+    """Render the cage's edges: a second object on the cage's mesh with a
+    thin Wireframe modifier (not on the cage itself: Mesh Deform reads the
+    cage's evaluated mesh, and the modifier changes its vertex count)."""
+    ob = bpy.data.objects.new(cage.name + "_edges", cage.data)
+    bpy.context.scene.collection.objects.link(ob)
+    w = ob.modifiers.new("edges", 'WIREFRAME')
     w.thickness = 0.012
     w.use_relative_offset = False
-    cage.display_type = 'TEXTURED'
-    cage.hide_render = False
-    cage.color = color
+    ob.color = color
 
 
 rest = bunny("bunny", -1.25)
@@ -84,11 +87,11 @@ co = co.reshape(-1, 3).astype(np.float64)
 c = co.mean(axis=0)
 z0, z1 = co[:, 2].min(), co[:, 2].max()
 t = np.clip((co[:, 2] - z0) / (z1 - z0), 0, 1) ** 2
-a = 0.6 * t
+a = 0.8 * t
 x, y = co[:, 0] - c[0], co[:, 1] - c[1]
 co[:, 0] = c[0] + x * np.cos(a) - y * np.sin(a)
 co[:, 1] = c[1] + x * np.sin(a) + y * np.cos(a)
-co[:, 2] += 0.35 * t
+co[:, 2] += 0.45 * t
 me.vertices.foreach_set("co", co.astype(np.float32).ravel())
 me.update()
 wire(cage, (0.55, 0.1, 0.1, 1))
@@ -117,4 +120,13 @@ cam.location = Vector((0.6, -8.0, 2.2))
 cam.rotation_euler = (target - cam.location).to_track_quat('-Z', 'Y').to_euler()
 scene.render.filepath = os.path.abspath(OUT)
 bpy.ops.render.render(write_still=True)
-print("wrote", OUT)
+# 128 colours: a third of the bytes, no visible change (python3-pil, when
+# Blender's Python has it).
+try:
+    from PIL import Image
+    im = Image.open(OUT).convert("RGB")
+    im.quantize(colors=128, method=Image.Quantize.MEDIANCUT,
+                dither=Image.Dither.NONE).save(OUT, optimize=True)
+except ImportError:
+    pass
+print("wrote", OUT, os.path.getsize(OUT), "bytes")
