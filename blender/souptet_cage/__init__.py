@@ -28,12 +28,17 @@ bl_info = {
 import os
 import sys
 import threading
+import time
 
 import bpy
 import numpy as np
 from bpy.props import BoolProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 MODIFIER_NAME = "souptet cage"
+# Seconds the UI waits after Esc for souptet to stop before it lets go.
+CANCEL_WAIT = 2.0
+# Objects whose cage a modal run (invoke) is making now.
+RUNNING = set()
 
 
 # ---- the souptet module ------------------------------------------------------
@@ -381,6 +386,9 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
         except CageError as e:
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}
+        if obj.name in RUNNING:
+            self.report({'ERROR'}, "the cage of %s is being made" % obj.name)
+            return {'CANCELLED'}
         self._obj_name = obj.name
         self._progress = Progress()
         self._result = None
@@ -395,6 +403,7 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
             except BaseException as e:   # handed to the main thread
                 self._error = e
 
+        self._cancel_time = 0.0
         self._thread = threading.Thread(target=work, name="souptet", daemon=True)
         wm = context.window_manager
         wm.progress_begin(0, 100)
@@ -404,9 +413,11 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
             context.workspace.status_text_set("souptet: making the cage of %s (Esc cancels)"
                                               % obj.name)
         self._thread.start()
+        RUNNING.add(obj.name)
         return {'RUNNING_MODAL'}
 
     def _finish(self, context):
+        RUNNING.discard(self._obj_name)
         wm = context.window_manager
         wm.event_timer_remove(self._timer)
         wm.progress_end()
@@ -414,10 +425,14 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
             context.workspace.status_text_set(None)
 
     def modal(self, context, event):
-        if event.type == 'ESC':
-            self._progress.cancel = True
+        if event.type == 'ESC' and event.value == 'PRESS':
+            if not self._progress.cancel:
+                self._progress.cancel = True
+                self._cancel_time = time.monotonic()
             return {'RUNNING_MODAL'}
         if event.type != 'TIMER':
+            # Input waits for the cage (views may still move); TIMER events
+            # pass on below: others' timers must reach them.
             if event.type in {'MOUSEMOVE', 'INBETWEEN_MOUSEMOVE', 'MIDDLEMOUSE',
                               'WHEELUPMOUSE', 'WHEELDOWNMOUSE', 'TRACKPADPAN',
                               'TRACKPADZOOM'}:
@@ -426,11 +441,21 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
         context.window_manager.progress_update(int(100 * self._progress.fraction))
         if context.workspace is not None:
             context.workspace.status_text_set(
-                "souptet: the cage of %s, %s %d%% (Esc cancels)"
+                "souptet: the cage of %s, %s %d%% (%s)"
                 % (self._obj_name, self._progress.stage or "starting",
-                   int(100 * self._progress.fraction)))
+                   int(100 * self._progress.fraction),
+                   "cancelling" if self._progress.cancel else "Esc cancels"))
         if self._thread.is_alive():
-            return {'RUNNING_MODAL'}
+            if not (self._progress.cancel and
+                    time.monotonic() - self._cancel_time > CANCEL_WAIT):
+                return {'PASS_THROUGH'}
+            # souptet has not stopped yet (a stage that does not look at
+            # the cancel flag): let the thread run out on its own; what it
+            # makes is dropped (run_mesh sees the flag and raises).
+            self._finish(context)
+            self.report({'WARNING'}, "cancelled (souptet finishes its current stage "
+                                     "in the background; its result is dropped)")
+            return {'CANCELLED'}
         self._finish(context)
         err = self._error
         if isinstance(err, Cancelled) or (err is not None and self._progress.cancel):

@@ -7,8 +7,10 @@
 # loose vertices; each rotated and non-uniformly scaled): the cage is
 # closed, outward, encloses every world-space vertex (an independent
 # winding-number check in numpy), binds with Mesh Deform and carries the
-# mesh along; refusals leave nothing behind. Its TAP lines are renumbered
-# after ours. Skipped in the sanitizer, fuzz and tsan builds (the Python
+# mesh along; refusals leave nothing behind. Then, in a window under
+# xvfb-run (tests/blender/test_modal.py), the operator as the panel's button
+# runs it: in a thread under a modal timer, cancelled by a simulated Esc.
+# Their TAP lines are renumbered after ours. Skipped in the sanitizer, fuzz and tsan builds (the Python
 # module is not built there, and an ASan library cannot load into Blender).
 . "$(dirname "$0")/lib.sh"
 cd "$WORK" || exit 1
@@ -38,17 +40,32 @@ check "the zip carries the add-on, the module and its core library, no VTK part"
 # A user scripts directory of our own: the add-on installs there, not
 # into ~/.config/blender. No souptet on the path but the bundled one.
 mkdir -p scripts config
-BLENDER_USER_SCRIPTS=$WORK/scripts BLENDER_USER_CONFIG=$WORK/config PYTHONPATH= \
-  blender -b --factory-startup --python-exit-code 1 \
+export BLENDER_USER_SCRIPTS="$WORK/scripts" BLENDER_USER_CONFIG="$WORK/config" PYTHONPATH=
+
+# run_tap NAME OUT ERR RC: OUT's TAP lines renumbered after ours, then
+# checks that it ran to its plan and exited 0.
+run_tap() {
+    grep -E '^(not )?ok [0-9]+|^#' "$2" |
+      awk -v n="$TAP_N" '/^(not )?ok [0-9]+/ { n++; sub(/ok [0-9]+/, "ok " n) } { print }'
+    TAP_N=$((TAP_N + $(grep -Ec '^(not )?ok [0-9]+' "$2")))
+    TAP_FAILED=$((TAP_FAILED + $(grep -Ec '^not ok [0-9]+' "$2")))
+    grep -q '^1\.\.[0-9]' "$2"
+    ok $? "$1 ran to its end"
+    ok "$4" "$1: blender exited 0"
+    [ "$4" -eq 0 ] || { sed 's/^/#   /' "$3" | tail -15
+                        grep -v -E '^(not )?ok |^#|^1\.\.' "$2" | sed 's/^/#   /' | tail -15; }
+}
+
+blender -b --factory-startup --python-exit-code 1 \
   --python "$ROOT/tests/blender/test_cage.py" -- "$ZIP" "$ROOT/corpus/bunny.obj" "$WORK" \
-  >blender.out 2>blender.err
-rc=$?
-grep -E '^(not )?ok [0-9]+|^#' blender.out |
-  awk -v n="$TAP_N" '/^(not )?ok [0-9]+/ { n++; sub(/ok [0-9]+/, "ok " n) } { print }'
-TAP_N=$((TAP_N + $(grep -Ec '^(not )?ok [0-9]+' blender.out)))
-TAP_FAILED=$((TAP_FAILED + $(grep -Ec '^not ok [0-9]+' blender.out)))
-grep -q '^1\.\.[0-9]' blender.out
-ok $? "test_cage.py ran to its end"
-ok $rc "blender exited 0"
-[ $rc -eq 0 ] || { sed 's/^/#   /' blender.err | tail -15; grep -v -E '^(not )?ok |^#|^1\.\.' blender.out | sed 's/^/#   /' | tail -15; }
+  >cage.out 2>cage.err
+run_tap test_cage.py cage.out cage.err $?
+
+# The interactive path (invoke, the modal timer, Esc) needs a window:
+# Blender under xvfb-run with its event simulation.
+timeout 300 xvfb-run -a -s "-screen 0 1280x800x24" \
+  blender --factory-startup --enable-event-simulate \
+  --python "$ROOT/tests/blender/test_modal.py" -- "$ZIP" "$ROOT/corpus/bunny.obj" \
+  >modal.out 2>modal.err
+run_tap test_modal.py modal.out modal.err $?
 done_testing
