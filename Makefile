@@ -64,25 +64,58 @@ CFLAGS_ALL := -std=c11 -D_POSIX_C_SOURCE=200809L $(OPT) $(WARN) -Wstrict-prototy
 CXXFLAGS_ALL := -std=c++17 $(OPT) -Wall -Wextra -fopenmp -Iinclude \
                 -I/usr/include/vtk-9.1 -MMD -MP -DSOUPTET_VERSION='"$(VERSION)"' $(CXXFLAGS) \
                 $(FP_EXACT)
-LIBS := -lopenvdb -ltbb -lImath-3_1 \
-        -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
-        -lvtkCommonDataModel-9.1 -lvtkCommonMath-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1 \
-        -lxxhash $(OMPLIB) -lpthread -lm
+LIBS = $(IO_LIBS) $(CORE_LIBS) -lpthread
 LDFLAGS_ALL := $(OPT) -fopenmp $(LDFLAGS)
 
-LIB_C   := $(sort $(wildcard src/*.c))
-LIB_CXX := $(sort $(wildcard src/adapters/*.cpp))
+# Two libraries. libsouptet: the C core (soups, fields, signs, lattices,
+# fit, embedding, the .msh/.node/.ele/.mesh formats), needing libgomp,
+# libxxhash and libm alone: what the Python module and the Blender add-on
+# link. libsouptet-io: what needs OpenVDB or VTK (.vdb/.vti fields, the
+# .vtu front door, the wrap's volumeToMesh), on top of the core: what the
+# tools link too. Each as a static archive (the tools and tests) and a
+# shared library with a soname, exporting only the names its public
+# headers declare (scripts/exports writes the version scripts).
+IO_C     := src/gridio.c src/tetio.c src/vtkxml.c src/wrap.c
+CORE_C   := $(filter-out $(IO_C),$(sort $(wildcard src/*.c)))
+LIB_CXX  := $(sort $(wildcard src/adapters/*.cpp))
 TOOLS   := $(basename $(notdir $(sort $(wildcard src/tools/*.c))))
 TESTS_C := $(basename $(notdir $(sort $(wildcard tests/test_*.c))))
 
-LIB_OBJ := $(LIB_C:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/obj/%.o)
+CORE_OBJ := $(CORE_C:src/%.c=$(BUILD)/obj/%.o)
+IO_OBJ   := $(IO_C:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/obj/%.o)
+LIB_OBJ  := $(CORE_OBJ) $(IO_OBJ)
 CLI_OBJ := $(patsubst src/%.c,$(BUILD)/obj/%.o,$(sort $(wildcard src/cli/*.c)))
-LIBA    := $(BUILD)/libsouptet.a
+LIBA_CORE := $(BUILD)/libsouptet.a
+LIBA_IO   := $(BUILD)/libsouptet-io.a
+LIBA      := $(LIBA_IO) $(LIBA_CORE)
+SOVERSION := 0
+LIBSO_CORE := $(BUILD)/libsouptet.so.$(VERSION)
+LIBSO_IO   := $(BUILD)/libsouptet-io.so.$(VERSION)
+CORE_LIBS := -lxxhash $(OMPLIB) -lm
+IO_LIBS   := -lopenvdb -ltbb -lImath-3_1 \
+        -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
+        -lvtkCommonDataModel-9.1 -lvtkCommonMath-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1
 TOOL_BIN := $(TOOLS:%=$(BUILD)/bin/%)
 TEST_BIN := $(TESTS_C:%=$(BUILD)/tests/%)
 
 .PHONY: all check test demo demo-sim bench setup install uninstall clean fuzz
-all: $(LIBA) $(TOOL_BIN) $(TEST_BIN)
+all: $(LIBA) $(LIBSO_CORE) $(LIBSO_IO) $(TOOL_BIN) $(TEST_BIN)
+
+# The library's objects are position-independent (they go into the shared
+# libraries too); the tools' and tests' are not.
+$(LIB_OBJ): CFLAGS_ALL += -fPIC
+$(LIB_OBJ): CXXFLAGS_ALL += -fPIC
+
+# The flags a build was made with, in $(BUILD)/flags: rewritten when they
+# change (other CFLAGS, a new compiler), and every object depends on it,
+# so a changed flag rebuilds what it touches instead of being silently
+# ignored on a built tree.
+FLAGS_NOW := $(CC) $(CXX) | $(CFLAGS_ALL) | $(CXXFLAGS_ALL) | $(LDFLAGS_ALL) | library -fPIC
+ifneq ($(FLAGS_NOW),$(file < $(BUILD)/flags))
+  $(shell mkdir -p $(BUILD))
+  $(file > $(BUILD)/flags,$(FLAGS_NOW))
+endif
+$(LIB_OBJ) $(CLI_OBJ): $(BUILD)/flags
 
 $(BUILD)/obj/%.o: src/%.c
 	@mkdir -p $(dir $@)
@@ -93,17 +126,43 @@ $(BUILD)/obj/%.o: src/%.cpp
 $(BUILD)/obj/cli/%.o: src/cli/%.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -c $< -o $@
-$(BUILD)/obj/tools/%.o: src/tools/%.c
+$(BUILD)/obj/tools/%.o: src/tools/%.c $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -c $< -o $@
-$(BUILD)/obj/tests/%.o: tests/%.c
+$(BUILD)/obj/tests/%.o: tests/%.c $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -Itests -c $< -o $@
 
-$(LIBA): $(LIB_OBJ)
+$(LIBA_CORE): $(CORE_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@
 	ar rcs $@ $^
+$(LIBA_IO): $(IO_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@
+	ar rcs $@ $^
+
+# Shared libraries: libNAME.so.VERSION, its soname libNAME.so.0 and the
+# development link libNAME.so beside it. Undefined symbols are an error,
+# except under the sanitizers (whose runtime the executable brings).
+ifneq ($(filter release debug,$(config)),)
+  SO_LDFLAGS := -Wl,--no-undefined
+endif
+$(BUILD)/libsouptet.map: $(CORE_OBJ) $(IO_OBJ) scripts/exports $(wildcard include/souptet/*.h)
+	scripts/exports SOUPTET_0 $(CORE_OBJ) -- $(IO_OBJ) > $@.tmp && mv $@.tmp $@
+$(BUILD)/libsouptet-io.map: $(IO_OBJ) scripts/exports $(wildcard include/souptet/*.h)
+	scripts/exports SOUPTET_IO_0 $(IO_OBJ) -- > $@.tmp && mv $@.tmp $@
+$(LIBSO_CORE): $(CORE_OBJ) $(BUILD)/libsouptet.map
+	$(CC) -shared $(LDFLAGS_ALL) $(SO_LDFLAGS) -Wl,-soname,libsouptet.so.$(SOVERSION) \
+	  -Wl,--version-script=$(BUILD)/libsouptet.map $(CORE_OBJ) $(CORE_LIBS) -o $@
+	ln -sf $(notdir $@) $(BUILD)/libsouptet.so.$(SOVERSION)
+	ln -sf libsouptet.so.$(SOVERSION) $(BUILD)/libsouptet.so
+$(LIBSO_IO): $(IO_OBJ) $(LIBSO_CORE) $(BUILD)/libsouptet-io.map
+	$(CXX) -shared $(LDFLAGS_ALL) $(SO_LDFLAGS) -Wl,-soname,libsouptet-io.so.$(SOVERSION) \
+	  -Wl,--version-script=$(BUILD)/libsouptet-io.map $(IO_OBJ) -L$(BUILD) -lsouptet \
+	  $(IO_LIBS) $(CORE_LIBS) -o $@
+	ln -sf $(notdir $@) $(BUILD)/libsouptet-io.so.$(SOVERSION)
+	ln -sf libsouptet-io.so.$(SOVERSION) $(BUILD)/libsouptet-io.so
 
 # Tools and tests link with the C++ driver: the adapters need libstdc++.
 $(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(CLI_OBJ) $(LIBA)
@@ -154,7 +213,7 @@ setup:
 # TAP shell scripts; prove runs them all and prints the count.
 # The unit tests of the modules with OpenMP loops, run under TSan with 3
 # threads (more than the 2 cores, so threads interleave), Archer loaded.
-TSAN_TESTS := test_dist test_sign test_holes test_shells test_mincut test_lattice \
+TSAN_TESTS := test_cancel test_dist test_sign test_holes test_shells test_mincut test_lattice \
               test_sculpt test_fair test_fit test_enclose test_embed test_tetstat \
               test_tetmesh test_solid test_soupinfo test_wrap
 ifeq ($(config),tsan)
@@ -193,15 +252,24 @@ install: all
 	  $(DESTDIR)$(PREFIX)/share/man/man7
 	install -m 755 $(TOOL_BIN) $(DESTDIR)$(PREFIX)/bin/
 	install -m 644 $(LIBA) $(DESTDIR)$(PREFIX)/lib/
+	install -m 755 $(LIBSO_CORE) $(LIBSO_IO) $(DESTDIR)$(PREFIX)/lib/
+	for l in libsouptet libsouptet-io; do \
+	  ln -sf $$l.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/$$l.so.$(SOVERSION) && \
+	  ln -sf $$l.so.$(SOVERSION) $(DESTDIR)$(PREFIX)/lib/$$l.so || exit 1; done
 	install -m 644 include/souptet/*.h $(DESTDIR)$(PREFIX)/include/souptet/
 	install -m 644 man/man1/*.1 $(DESTDIR)$(PREFIX)/share/man/man1/
 	install -m 644 man/man7/*.7 $(DESTDIR)$(PREFIX)/share/man/man7/
 	sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@VERSION@|$(VERSION)|g' \
-	    -e 's|@LIBS@|$(LIBS)|g' souptet.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/souptet.pc
+	    -e 's|@LIBS@|$(CORE_LIBS)|g' souptet.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/souptet.pc
+	sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@VERSION@|$(VERSION)|g' \
+	    -e 's|@LIBS@|$(IO_LIBS) -lstdc++|g' souptet-io.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/souptet-io.pc
+	-[ -z "$(DESTDIR)" ] && command -v ldconfig >/dev/null && ldconfig
 
 uninstall:
 	rm -f $(TOOLS:%=$(DESTDIR)$(PREFIX)/bin/%) $(DESTDIR)$(PREFIX)/lib/libsouptet.a \
-	  $(DESTDIR)$(PREFIX)/lib/pkgconfig/souptet.pc
+	  $(DESTDIR)$(PREFIX)/lib/libsouptet-io.a $(DESTDIR)$(PREFIX)/lib/libsouptet.so* \
+	  $(DESTDIR)$(PREFIX)/lib/libsouptet-io.so* \
+	  $(DESTDIR)$(PREFIX)/lib/pkgconfig/souptet.pc $(DESTDIR)$(PREFIX)/lib/pkgconfig/souptet-io.pc
 	rm -rf $(DESTDIR)$(PREFIX)/include/souptet
 	rm -f $(TOOLS:%=$(DESTDIR)$(PREFIX)/share/man/man1/%.1) $(DESTDIR)$(PREFIX)/share/man/man7/souptet.7
 

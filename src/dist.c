@@ -767,8 +767,18 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
         const size_t t0 = s->ntris * (size_t)c / (size_t)chunks;
         const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)chunks;
         bin_ctx cc = {cnt + (size_t)c * (nb + 1), NULL, NULL, 0};
-        for (size_t t = t0; t < t1; t++)
+        for (size_t t = t0; t < t1; t++) {
+            if ((t & 4095) == 0 && st_progress_cancelled(progress))
+                break;
             triangle_bricks(g, &bg, s, t, &balls[t], B, count_visit, &cc);
+        }
+    }
+    if (st_progress_cancelled(progress)) {
+        free(cnt);
+        free(balls);
+        free(centers);
+        free(start);
+        return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
     }
     /* start[b]: brick b's first slot; cnt[c][b + 1] becomes run c's */
     size_t at = 0;
@@ -798,6 +808,8 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
         const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)chunks;
         bin_ctx cc = {NULL, cnt + (size_t)c * (nb + 1) + 1, list, 0};
         for (size_t t = t0; t < t1; t++) {
+            if ((t & 4095) == 0 && st_progress_cancelled(progress))
+                break;
             cc.tri = (uint32_t)t;
             triangle_bricks(g, &bg, s, t, &balls[t], B, fill_visit, &cc);
         }
@@ -806,12 +818,17 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
 
     int oom = 0;
     size_t done = 0;
-    #pragma omp parallel
+    /* A cancelled run skips the bricks left (a brick is well under a
+     * millisecond of work). */
+    const int stopped = st_progress_cancelled(progress);
+    #pragma omp parallel if (!stopped)
     {
         brick_scratch sc;
         memset(&sc, 0, sizeof sc);
         #pragma omp for schedule(dynamic, 16)
         for (size_t b = 0; b < nb; b++) {
+            if (st_progress_cancelled(progress))
+                continue;
             size_t m = start[b + 1] - start[b];
             if (scratch_reserve(&sc, m)) {
                 #pragma omp atomic write
@@ -837,6 +854,8 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
     free(centers);
     if (oom)
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    if (st_progress_cancelled(progress))
+        return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
     st_progress_report(progress, "distance band", 1.0);
     return ST_OK;
 }
@@ -853,8 +872,8 @@ static double soup_tri_dist2(const st_soup *s, int32_t t, const double p[3])
 /* One raster sweep (forward: dir = +1, backward: -1) over the voxels the
  * band did not fix: each takes the nearest of the triangles its 13
  * already-swept neighbours found, measured exactly. */
-static void sweep(st_grid *g, int32_t *near, const uint8_t *fixed,
-                  const st_soup *s, int dir)
+static int sweep(st_grid *g, int32_t *near, const uint8_t *fixed,
+                 const st_soup *s, int dir, const st_progress *progress)
 {
     const long nx = (long)g->nx, ny = (long)g->ny, nz = (long)g->nz;
     /* The 13 neighbours that precede a voxel in raster order. */
@@ -865,6 +884,8 @@ static void sweep(st_grid *g, int32_t *near, const uint8_t *fixed,
         {-1, 1, -1}, {0, 1, -1}, {1, 1, -1}};
     for (long kk = 0; kk < nz; kk++) {
         long k = dir > 0 ? kk : nz - 1 - kk;
+        if (st_progress_cancelled(progress))
+            return 0;
         for (long jj = 0; jj < ny; jj++) {
             long j = dir > 0 ? jj : ny - 1 - jj;
             for (long ii = 0; ii < nx; ii++) {
@@ -905,6 +926,7 @@ static void sweep(st_grid *g, int32_t *near, const uint8_t *fixed,
             }
         }
     }
+    return 1;
 }
 
 /* Beyond the band: a vector distance transform over triangles. The band
@@ -932,7 +954,10 @@ static st_status full_pass(st_grid *g, int32_t *near, const st_soup *s,
     static const char *stage = "distance beyond the band";
     st_progress_report(progress, stage, 0.0);
     for (int pass = 0; pass < SWEEPS; pass++) {
-        sweep(g, near, fixed, s, pass % 2 ? -1 : +1);
+        if (!sweep(g, near, fixed, s, pass % 2 ? -1 : +1, progress)) {
+            free(fixed);
+            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        }
         st_progress_report(progress, stage, (double)(pass + 1) / SWEEPS);
     }
     free(fixed);

@@ -1298,6 +1298,7 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
         bvh = own;
     }
     c.bvh = bvh;
+    c.prog = prog;
     if (p.fill && p.fill->ntris > 0) {
         rc = st_bvh_build(&fown, p.fill, err);
         if (rc)
@@ -1342,6 +1343,10 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
     size_t best_within = ds.within;
     int since_best = 0;
     for (int it = 0; it < p.max_iters && ds.within < c.sm.nbv; it++) {
+        if (st_progress_cancelled(prog)) {
+            rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+            goto done;
+        }
         st_progress_report(prog, "fit", (double)ds.within / (double)(c.sm.nbv ? c.sm.nbv : 1));
         fit_counts n = {0, 0, 0};
         for (size_t col = 0; col < c.sm.ncolours; col++) {

@@ -224,7 +224,7 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
 static st_status choose_h(double *h, st_pipeline_stats *st, const st_grid *g,
                           const st_soup *s, const st_bvh *bvh,
                           const st_pipeline_params *p, const double lo[3],
-                          const double hi[3], st_error *err)
+                          const double hi[3], const st_progress *prog, st_error *err)
 {
     const double target = p->target_tets ? (double)p->target_tets : 0;
     double d2 = 0;
@@ -234,6 +234,8 @@ static st_status choose_h(double *h, st_pipeline_stats *st, const st_grid *g,
     double best_h = hk, best_err = INFINITY;
     size_t best_n = 0;
     for (int it = 0; it < ST_PIPELINE_SIZE_STEPS; it++) {
+        if (st_progress_cancelled(prog))
+            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
         double cells = lattice_cells_bound(d2, hk);
         if (p->max_bytes &&
             12.0 * cells * cells * cells * ST_LATTICE_BYTES_PER_TET > (double)p->max_bytes)
@@ -466,7 +468,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     double h = p->h > 0 ? p->h : st_lattice_h_for_cells(lo, hi, p->cells);
     if (p->density_rho <= 0 && (p->target_tets || p->dry_run)) {
         double t_size = now_seconds();
-        rc = choose_h(&h, st, g, s, bvh, p, lo, hi, err);
+        rc = choose_h(&h, st, g, s, bvh, p, lo, hi, prog, err);
         st->seconds_size = now_seconds() - t_size;
         if (rc)
             goto done;
@@ -481,6 +483,10 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
      * none. It counts as surface for the fit's condition (fill_counts),
      * and how much of the boundary it is, how far from the soup, says how
      * much of the solid is a guess (the closed shells' alone: none). */
+    if (st_progress_cancelled(prog)) {
+        rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        goto done;
+    }
     if (!st->shells_only) {
         size_t nfill = 0;
         rc = st_pseudo_fill(&fill, g, bvh, &nfill, err);
@@ -510,6 +516,8 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
      * (several report only as each one finishes: the reporter is not
      * called from two threads at once). */
     size_t finished = 0;
+    /* several candidates: their fits see the cancel flag alone */
+    st_progress cancel_only = {NULL, NULL, prog ? prog->cancel : NULL};
     int nthreads = K > 1 ? omp_get_max_threads() : 1;
     if ((size_t)nthreads > K)
         nthreads = (int)K;
@@ -518,10 +526,12 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         st_pipeline_candidate *c = &st->candidates[k];
         st_error e;
         st_error_clear(&e);
+        if (st_progress_cancelled(prog))
+            continue;
         st_status r = p->density_rho > 0
             ? run_density_candidate(&meshes[k], c, g, s, bvh, h, p, &e)
             : run_sculpt_candidate(&meshes[k], c, k, g, s, bvh, fill, h, p,
-                                   K == 1 ? prog : NULL, &e);
+                                   K == 1 ? prog : &cancel_only, &e);
         if (r) {
             c->failed = 1;
             st_error_format(&e, c->message, sizeof c->message);
@@ -545,6 +555,10 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         }
     }
     st->seconds_candidates = now_seconds() - t_cand;
+    if (st_progress_cancelled(prog)) {
+        rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        goto done;
+    }
 
     size_t best = 0;
     for (size_t k = 1; k < K; k++)

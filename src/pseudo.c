@@ -120,7 +120,7 @@ static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_soup_edg
         sp.column_seen = seen;
     /* voxels the cut takes as the votes say get no evidence (mincut.h) */
     const int decided = st_mincut_params_default().fixed_evidence;
-    rc = rc ? rc : st_sign_votes(g, &p->sign, votes, err);
+    rc = rc ? rc : st_sign_votes_progress(g, &p->sign, votes, progress, err);
     rc = rc ? rc : st_sides_evidence_edges(evidence, g, votes, decided, s, edges, &sp,
                                            &st->sides, err);
     rc = rc ? rc : st_sign_field_evidence(g, &p->sign, evidence, votes, progress, err);
@@ -138,6 +138,15 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
 {
     return st_pseudo_sign_bvh(g, s, p, stats, progress, NULL, err);
 }
+
+/* Between the steps: a caller that asked to stop gets ST_ECANCELLED. */
+#define STOP_IF_CANCELLED()                                                    \
+    do {                                                                       \
+        if (st_progress_cancelled(progress)) {                                 \
+            rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");       \
+            goto done;                                                         \
+        }                                                                      \
+    } while (0)
 
 st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_params *p,
                              st_pseudo_stats *stats, const st_progress *progress,
@@ -161,6 +170,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     st_bvh *bvh = NULL;
     st_status rc = ST_OK;
     double t0 = now_seconds();
+    STOP_IF_CANCELLED();
     if (s && (p->closed_shells || p->fill_holes || (p->sides && p->sign.cut))) {
         st->failed_step = p->closed_shells ? "shells" : p->fill_holes ? "holes" : "vote";
         if ((rc = st_soup_edges_build(&edges, s, err)))
@@ -184,6 +194,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
             goto count_inside;
         }
     }
+    STOP_IF_CANCELLED();
     double t1 = now_seconds();
     st->seconds_shells = t1 - t0;
     st->failed_step = "holes";
@@ -192,6 +203,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
             (rc = add_caps(g, s, &edges, bvh, p, st, &with_caps, err)))
             goto done;
     }
+    STOP_IF_CANCELLED();
     double t2 = now_seconds();
     st->seconds_holes = t2 - t1;
     st->failed_step = "vote";
@@ -206,6 +218,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
         st_soup_edges_free(&edges);
         have_edges = 0;
     }
+    STOP_IF_CANCELLED();
     double t3 = now_seconds();
     st->seconds_vote = t3 - t2;
     st->failed_step = "refine";
@@ -217,6 +230,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
         if (rc)
             goto done;
     }
+    STOP_IF_CANCELLED();
     double t4 = now_seconds();
     st->seconds_refine = t4 - t3;
     st->failed_step = "shells";

@@ -267,6 +267,11 @@ st_status sm_quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
                             "out of memory for the quality pass (%zu vertices)", sm->nv);
     }
     for (int round = 0; round < p->quality_rounds; round++) {
+        if (st_progress_cancelled(c->prog)) {
+            free(mark);
+            sm_dirty_free(&dy);
+            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        }
         memset(mark, 0, sm->nv);
         size_t nbad = 0;
         for (size_t t = 0; t < m->ntets; t++) {

@@ -905,6 +905,8 @@ static st_status vote_all(const st_grid *g, const st_sign_params *p, uint8_t *v,
     sweep_init(&w, (st_grid *)g, p, g->data, v, (float)t);
     st_status st = ST_OK;
     for (int d = 0; d < 13 && !st; d++) {
+        if (st_progress_cancelled(progress))
+            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
         /* Every direction is walked forward in memory (see DIRS). */
         const ptrdiff_t stride = (ptrdiff_t)DIRS[d][0] +
             (ptrdiff_t)g->nx * ((ptrdiff_t)DIRS[d][1] + (ptrdiff_t)g->ny * (ptrdiff_t)DIRS[d][2]);
@@ -924,9 +926,15 @@ static st_status vote_all(const st_grid *g, const st_sign_params *p, uint8_t *v,
 st_status st_sign_votes(const st_grid *g, const st_sign_params *p, uint8_t *votes,
                         st_error *err)
 {
+    return st_sign_votes_progress(g, p, votes, NULL, err);
+}
+
+st_status st_sign_votes_progress(const st_grid *g, const st_sign_params *p, uint8_t *votes,
+                                 const st_progress *progress, st_error *err)
+{
     const size_t n = st_grid_count(g);
     memset(votes, 0, n);
-    st_status st = vote_all(g, p, votes, NULL, err);
+    st_status st = vote_all(g, p, votes, progress, err);
     if (st)
         return st;
     #pragma omp parallel for schedule(static)

@@ -119,6 +119,8 @@ typedef struct fit_ctx {
                             directions (quality.c; st_fit's last pass) */
     int fair_boundary;   /* no S (after fairing): boundary vertices move in
                             their tangent plane only (sm_quality_fair) */
+    const st_progress *prog;   /* its cancel flag stops the fit between
+                                  iterations and rounds (may be NULL) */
 } fit_ctx;
 
 /* Which vertices can be skipped: a vertex move is a deterministic function

@@ -114,6 +114,30 @@ static st_status read_face(st_soup *s, st_text *t, fwd_ref *fwd,
     return ST_OK;
 }
 
+/* A file that gave no triangles: when it is not OBJ text at all (a
+ * binary file, another format renamed .obj), say so rather than "no
+ * triangles". Text is what an OBJ may hold: printable bytes, tabs, line
+ * ends, form feeds, and UTF-8 (bytes >= 0x80, in comments and names);
+ * a NUL or another control byte in the first 64 KiB says binary. A text
+ * with no v or f record also is not an OBJ. Returns ST_OK when the file
+ * is an OBJ without faces (the caller's "no triangles"). */
+static st_status not_obj_text(const unsigned char *data, size_t size, size_t nverts,
+                              const char *name, st_error *err)
+{
+    const size_t n = size < 65536 ? size : 65536;
+    for (size_t i = 0; i < n; i++) {
+        const unsigned char c = data[i];
+        if (c < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\f' && c != '\v')
+            return st_error_set_offset(err, ST_EINPUT, name, (long long)i,
+                                       "not OBJ text: a binary byte, 0x%02x (a mesh in "
+                                       "another format renamed .obj?)", c);
+    }
+    if (nverts == 0)
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "not an OBJ file: no 'v' or 'f' record");
+    return ST_OK;
+}
+
 st_status st_soup__parse_obj(st_soup *s, const unsigned char *data,
                              size_t size, const char *name, st_error *err)
 {
@@ -136,5 +160,7 @@ st_status st_soup__parse_obj(st_soup *s, const unsigned char *data,
         return st_error_set(err, ST_EINPUT, name, fwd.line,
                             "face index %lld out of range (file has %zu "
                             "vertices)", fwd.max, s->nverts);
+    if (s->ntris == 0)
+        return not_obj_text(data, size, s->nverts, name, err);
     return ST_OK;
 }

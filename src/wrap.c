@@ -977,6 +977,8 @@ st_status st_wrap_field(st_soup **out, const st_grid *g,
     mesh m = {0};
     st_wrap_check chk;
     for (;;) {
+        if (st_progress_cancelled(progress))
+            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
         st_progress_report(progress, "extract", 0.0);
         st_wrap_polys P;
         st_status st = st_wrap_polys_vdb(&P, g, p->iso, A, err);
@@ -1034,7 +1036,12 @@ st_status st_wrap_field(st_soup **out, const st_grid *g,
         for (int step = 0; step < p->smooth; step++) {
             st_progress_report(progress, "smooth",
                                (double)step / (double)p->smooth);
-            st_status st;
+            st_status st = ST_OK;
+            if (st_progress_cancelled(progress)) {
+                adj_free(&a);
+                st_soup_free(m.s);
+                return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+            }
             if ((st = taubin_half(m.s, &a, ST_WRAP_TAUBIN_LAMBDA,
                                   &stats->smooth_reverted, err)) ||
                 (st = taubin_half(m.s, &a, ST_WRAP_TAUBIN_MU,

@@ -559,9 +559,17 @@ static void test_obj(void)
                       "face index 7 out of range (file has 3 vertices)");
     static const unsigned char garbage[] = {0x00, 0xff, 0x13, 0x37, 0x0a,
                                             0x80, 0x7f, 'f', 0x01, 0x0a};
-    expect_bin_error("obj error: binary garbage has no triangles",
+    expect_bin_error("obj error: binary garbage is not OBJ text (at its first binary byte)",
                      ST_SOUP_OBJ, garbage, sizeof garbage, "g.obj", ST_EINPUT,
-                     -1, "no triangles");
+                     0, "not OBJ text: a binary byte, 0x00");
+    static const unsigned char stl_head[] = {'s', 'o', 'l', 'i', 'd', ' ', 'x', '\n',
+                                             0x02, 0x00, 0x00, 0x00};
+    expect_bin_error("obj error: a binary STL renamed .obj is not OBJ text",
+                     ST_SOUP_OBJ, stl_head, sizeof stl_head, "s.obj", ST_EINPUT,
+                     8, "not OBJ text: a binary byte, 0x02");
+    expect_text_error("obj error: text without a v or f record is not an OBJ", ST_SOUP_OBJ,
+                      "hello\nworld\n", "e.obj", ST_EINPUT, 0,
+                      "not an OBJ file: no 'v' or 'f' record");
 }
 
 /* Numbers: the fast path must agree with strtod bit for bit. */
@@ -1338,6 +1346,7 @@ static int robust_one(st_soup_format f, const unsigned char *d, size_t n,
         ok = s == NULL && err.status == st && strcmp(err.file, name) == 0 &&
              (err.line > 0 || err.offset >= 0 ||
               strstr(err.msg, "no triangles") || strstr(err.msg, "empty") ||
+              strstr(err.msg, "not an OBJ file") ||
               st == ST_ENOMEM || st == ST_ELIMIT);
     if (!ok)
         note_error(&err);

@@ -191,7 +191,11 @@ double st_pipeline_lattice_bytes(const st_soup *s, double h, size_t tries,
  * on failure (it is NULL when nothing was allocated). Fails when the
  * soup is empty or every candidate failed (the first candidate's message
  * is reported). Not enclosing is not a failure: stats say it, and meta
- * "encloses" is "no". With p->dry_run, *out stays NULL on success. */
+ * "encloses" is "no". With p->dry_run, *out stays NULL on success. prog may be
+ * NULL; its cancel flag (progress.h), once set, stops the run within
+ * about 0.1 s of work (the field, the signs, between the fit's
+ * iterations, the candidates not yet started): ST_ECANCELLED, *out NULL,
+ * everything freed but stats->candidates. */
 st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                           const st_soup *s, const st_pipeline_params *p,
                           const st_progress *prog, st_error *err);

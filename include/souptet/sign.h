@@ -133,6 +133,10 @@ st_status st_sign_field_evidence(st_grid *g, const st_sign_params *p, const int8
 #define ST_SIGN_VOTES_INSIDE 0x80u
 st_status st_sign_votes(const st_grid *g, const st_sign_params *p, uint8_t *votes,
                         st_error *err);
+/* The same, reporting "signs" to progress and stopping on its cancel flag
+ * between the 13 sweeps (ST_ECANCELLED). */
+st_status st_sign_votes_progress(const st_grid *g, const st_sign_params *p, uint8_t *votes,
+                                 const st_progress *progress, st_error *err);
 
 /* The rule on one line of samples (for tests and for reading the rule):
  * d[0..n) are the distances along the line, t the event distance; adds the

@@ -122,6 +122,10 @@ EOF2
     [ $rc -eq 1 ] && grep -q '^victim .*FAILED' ktable && [ "$(grep -c ' ok$' ktable)" -eq 2 ] &&
         grep -q 'soupmesh failed' kout/victim.log
     ok $? "soupmesh killed by SIGKILL on one model: that model failed, the two others meshed"
+    grep -Eq '^2 meshed, 0 cached, 1 failed, in [0-9.]+ s' kmsg
+    ok $? "the closing count says 2 meshed and 1 failed (it said 3 models meshed)"
+    [ ! -e kout/joblog ]
+    ok $? "no undocumented joblog in the output folder"
     [ $rc -eq 1 ] || { echo "#   exit $rc"; sed 's/^/#   /' kmsg ktable | head; }
     left=$(cd kout && ls -A | grep '^\.')
     n=$(printf '%s\n' "$left" | grep -c .)

@@ -1,0 +1,129 @@
+#!/bin/sh
+# tests/tools/library.t - the shared libraries: libsouptet.so (the C core)
+# and libsouptet-io.so (OpenVDB, VTK). Sonames; the core needs no C++,
+# OpenVDB or VTK; each exports the names its public headers declare and
+# nothing else (the core's few private functions that the io library
+# calls only under SOUPTET_PRIVATE_0); a program on the public headers,
+# linked against the core alone, meshes the bunny and cancels a run; and
+# `make install` into a staging directory gives a pkg-config that builds
+# the same program.
+. "$(dirname "$0")/lib.sh"
+BUILD=$(cd "$SOUPTET_BIN/.." && pwd)
+cd "$WORK" || exit 1
+
+core="$BUILD/libsouptet.so.0"
+io="$BUILD/libsouptet-io.so.0"
+[ -f "$core" ] && [ -f "$io" ]
+ok $? "build/ has libsouptet.so.0 and libsouptet-io.so.0"
+
+readelf -d "$core" | grep -q 'Library soname: \[libsouptet.so.0\]'
+ok $? "libsouptet.so's soname is libsouptet.so.0"
+readelf -d "$io" | grep -q 'Library soname: \[libsouptet-io.so.0\]'
+ok $? "libsouptet-io.so's soname is libsouptet-io.so.0"
+
+readelf -d "$core" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' > needed.txt
+! grep -Eq 'vtk|openvdb|tbb|stdc\+\+|Imath' needed.txt
+ok $? "the core needs no VTK, OpenVDB, TBB or C++ runtime ($(tr '\n' ' ' < needed.txt))"
+readelf -d "$io" | grep -q 'Shared library: \[libsouptet.so.0\]'
+ok $? "the io library stands on the core (NEEDED libsouptet.so.0)"
+
+# Exports: every defined dynamic symbol is a public name (declared in
+# include/souptet/*.h) or one of the core's private ones the io library
+# needs, versioned SOUPTET_PRIVATE_0.
+grep -ohw 'st_[A-Za-z0-9_]*' "$ROOT"/include/souptet/*.h | LC_ALL=C sort -u > public.txt
+nm -D --defined-only --with-symbol-versions "$core" | awk '{print $3}' | grep -v '^SOUPTET' > core-syms.txt
+sed 's/@.*//' core-syms.txt | LC_ALL=C sort -u > core-names.txt
+grep '@@SOUPTET_PRIVATE_0' core-syms.txt | sed 's/@.*//' | LC_ALL=C sort -u > core-private.txt
+LC_ALL=C comm -23 core-names.txt public.txt > not-public.txt
+cmp -s not-public.txt core-private.txt
+ok $? "the core exports only public names, and private ones under SOUPTET_PRIVATE_0 ($(wc -l < core-names.txt) symbols, $(wc -l < core-private.txt) private)"
+sed 's/^/#   not public: /' not-public.txt | head -5
+for f in st_pipeline_run st_soup_read st_tetmesh_write_msh st_dist_field st_pseudo_volume st_embed_points; do
+    grep -qx "$f" core-names.txt || echo "$f" >> missing.txt
+done
+[ ! -s missing.txt ]
+ok $? "the core exports the pipeline, the readers, the formats, the field, the pseudo volume, the embedding"
+sed 's/^/#   missing: /' missing.txt 2>/dev/null
+# st_tf_boundary: tetformat's private boundary finder, used by no io file
+! grep -qx 'st_tf_boundary' core-names.txt
+ok $? "a private function the io library does not call stays local (st_tf_boundary)"
+nm -D --defined-only "$io" | awk '{print $3}' | grep -v '^SOUPTET' | sed 's/@.*//' | LC_ALL=C sort -u > io-names.txt
+LC_ALL=C comm -23 io-names.txt public.txt > io-not-public.txt
+[ ! -s io-not-public.txt ] && grep -qx st_tetmesh_save io-names.txt && grep -qx st_wrap_field io-names.txt
+ok $? "the io library exports only public names (st_tetmesh_save, st_wrap_field, ...: $(wc -l < io-names.txt))"
+sed 's/^/#   not public: /' io-not-public.txt | head -5
+
+case "$BUILD" in
+*build-sanitize|*build-tsan|*build-fuzz)
+    echo "# the rest links a plain program against the library: release and debug builds only"
+    done_testing ;;
+esac
+
+cat > prog.c <<'EOF'
+/* A user's program: the public headers and the core library alone. */
+#include <souptet/pipeline.h>
+#include <souptet/tetformat.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+int main(int argc, char **argv)
+{
+    st_error err;
+    st_soup *s = NULL;
+    if (argc < 3 || st_soup_read(&s, argv[1], &err)) {
+        fprintf(stderr, "read: %s\n", argc < 3 ? "usage" : err.msg);
+        return 1;
+    }
+    st_pipeline_params p = st_pipeline_params_default();
+    p.cells = 5;
+    st_tetmesh *m = NULL;
+    st_pipeline_stats st;
+    if (st_pipeline_run(&m, &st, s, &p, NULL, &err) ||
+        st_tetmesh_write_msh(m, argv[2], 0, 0, &err)) {
+        fprintf(stderr, "mesh: %s\n", err.msg);
+        return 1;
+    }
+    printf("%zu tets, encloses %d\n", m->ntets, st.encloses);
+    free(st.candidates);
+    st_tetmesh_free(m);
+    /* a run cancelled before it starts */
+    volatile int stop = 1;
+    st_progress prog = {NULL, NULL, &stop};
+    st_status rc = st_pipeline_run(&m, &st, s, &p, &prog, &err);
+    printf("cancelled: %s\n", rc == ST_ECANCELLED && !m ? "yes" : "no");
+    free(st.candidates);
+    st_soup_free(s);
+    return 0;
+}
+EOF
+cc -std=c11 -I"$ROOT/include" prog.c -L"$BUILD" -lsouptet -Wl,-rpath,"$BUILD" -Wall -Werror -o prog 2> cc.err
+ok $? "a C program on the public headers links against -lsouptet alone"
+sed 's/^/#   /' cc.err | head -5
+readelf -d prog | grep -q 'Shared library: \[libsouptet.so.0\]' &&
+    ! readelf -d prog | grep -q 'libsouptet-io'
+ok $? "it needs libsouptet.so.0 and not the io library"
+./prog "$ROOT/corpus/bunny.obj" bunny.msh > prog.out 2> prog.err
+ok $? "it meshes the bunny"
+sed 's/^/#   /' prog.out prog.err | head -5
+grep -q 'encloses 1' prog.out && grep -q 'cancelled: yes' prog.out
+ok $? "the mesh encloses, and a cancelled run returns ST_ECANCELLED"
+gmsh -check bunny.msh > gmsh.out 2>&1
+ok $? "gmsh reads the program's .msh"
+
+# make install into a staging directory; pkg-config builds the program.
+make -C "$ROOT" --no-print-directory -s install PREFIX=/usr DESTDIR="$WORK/stage" > install.out 2>&1
+ok $? "make install PREFIX=/usr DESTDIR=stage"
+sed 's/^/#   /' install.out | tail -5
+lib="$WORK/stage/usr/lib"
+[ -f "$lib/libsouptet.so.0" ] && [ -L "$lib/libsouptet.so" ] && [ -f "$lib/libsouptet-io.so.0" ] &&
+    [ -f "$lib/pkgconfig/souptet.pc" ] && [ -f "$lib/pkgconfig/souptet-io.pc" ]
+ok $? "it installs both libraries, their sonames and links, and souptet.pc, souptet-io.pc"
+flags=$(PKG_CONFIG_SYSROOT_DIR="$WORK/stage" PKG_CONFIG_LIBDIR="$lib/pkgconfig" \
+        pkg-config --cflags --libs souptet)
+ok $? "pkg-config --cflags --libs souptet: $flags"
+# shellcheck disable=SC2086
+cc -std=c11 prog.c $flags -Wl,-rpath,"$lib" -o prog2 2> cc2.err && ./prog2 "$ROOT/corpus/bunny.obj" b2.msh > prog2.out
+ok $? "the program builds from the installed headers and library through pkg-config"
+sed 's/^/#   /' cc2.err | head -5
+
+done_testing
