@@ -65,6 +65,15 @@ if souptet_cage.souptet is None:
     print("1..%d" % N)
     sys.exit(1)
 note("souptet from %s" % souptet_cage.souptet.__file__)
+if ADDON.endswith(".zip"):
+    # The extension links libsouptet.so.0: the zip's copy is the one loaded.
+    libs = {l.split()[-1] for l in open("/proc/self/maps") if "libsouptet" in l}
+    here = os.path.dirname(souptet_cage.__file__)
+    ok(souptet_cage.souptet.__file__.startswith(here)
+       and all(x.startswith(here) for x in libs),
+       "the module and libsouptet come from the zip (%s)"
+       % (", ".join(sorted(os.path.basename(x) for x in libs)) or "the library linked in"),
+       sorted(libs))
 ok(hasattr(bpy.ops.object, "souptet_cage") and hasattr(bpy.types, "VIEW3D_PT_souptet_cage"),
    "the operator and the sidebar panel are registered")
 
