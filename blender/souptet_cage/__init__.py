@@ -37,8 +37,8 @@ from bpy.props import BoolProperty, FloatProperty, IntProperty, PointerProperty,
 MODIFIER_NAME = "souptet cage"
 # Seconds the UI waits after Esc for souptet to stop before it lets go.
 CANCEL_WAIT = 2.0
-# Objects whose cage a modal run (invoke) is making now.
-RUNNING = set()
+# Objects whose cage a modal run (invoke) is making now: name -> its thread.
+RUNNING = {}
 
 
 # ---- the souptet module ------------------------------------------------------
@@ -413,11 +413,11 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
             context.workspace.status_text_set("souptet: making the cage of %s (Esc cancels)"
                                               % obj.name)
         self._thread.start()
-        RUNNING.add(obj.name)
+        RUNNING[obj.name] = self._thread
         return {'RUNNING_MODAL'}
 
     def _finish(self, context):
-        RUNNING.discard(self._obj_name)
+        RUNNING.pop(self._obj_name, None)
         wm = context.window_manager
         wm.event_timer_remove(self._timer)
         wm.progress_end()

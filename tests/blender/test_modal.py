@@ -102,7 +102,8 @@ def steps():
     r = invoke(cells=40, tries=1)
     ok(r == {'RUNNING_MODAL'}, "a large run starts", r)
     yield 1.0
-    ok("bunny" in souptet_cage.RUNNING, "it is still running after 1 s")
+    th = souptet_cage.RUNNING.get("bunny")
+    ok(th is not None and th.is_alive(), "it is still running after 1 s")
     win = bpy.context.window_manager.windows[0]
     win.event_simulate(type='ESC', value='PRESS')
     win.event_simulate(type='ESC', value='RELEASE')
@@ -113,6 +114,13 @@ def steps():
     ok("bunny" not in souptet_cage.RUNNING and waited < souptet_cage.CANCEL_WAIT + 8,
        "Esc ends the run (%.1f s)" % waited)
     ok(snapshot() == before, "a cancelled run leaves nothing behind", snapshot())
+    # souptet itself stopped (the library looks at the cancel flag), not
+    # only the operator letting go of it.
+    t = time.monotonic()
+    while th is not None and th.is_alive() and time.monotonic() - t < 5:
+        yield 0.2
+    ok(th is not None and not th.is_alive(),
+       "souptet stopped: its thread ended %.1f s after the operator" % (time.monotonic() - t))
     yield None
 
 
