@@ -509,7 +509,8 @@ class VIEW3D_PT_souptet_cage(bpy.types.Panel):
         col.prop(s, "tries")
         col.prop(s, "offset")
         layout.prop(s, "bind")
-        layout.prop(s, "filepath")
+        layout.label(text="Tet mesh to write (optional):")
+        layout.prop(s, "filepath", text="")
         obj = context.active_object
         row = layout.row()
         row.enabled = obj is not None and obj.type == 'MESH'

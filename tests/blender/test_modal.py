@@ -80,7 +80,31 @@ def finish():
 st = {"t0": time.monotonic()}
 
 
+# The sidebar panel: the same panel in the sidebar's first tab (Item; 3.4
+# cannot switch tabs from Python), drawn once the sidebar shows.
+drawn = []
+
+
+class PanelInItem(souptet_cage.VIEW3D_PT_souptet_cage):
+    bl_idname = "VIEW3D_PT_souptet_cage_item"
+    bl_category = "Item"
+
+    def draw(self, context):
+        super().draw(context)
+        drawn.append(1)
+
+
+bpy.utils.register_class(PanelInItem)
+
+
 def steps():
+    win = bpy.context.window_manager.windows[0]
+    area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
+    area.spaces[0].show_region_ui = True
+    area.tag_redraw()
+    yield 1.0
+    ok(len(drawn) > 0, "the sidebar panel draws (its settings and Make cage)")
+    bpy.utils.unregister_class(PanelInItem)
     # 1. a small cage made through invoke: the modal run ends with the cage
     #    bound, and the status bar is left clean.
     r = invoke(cells=6, tries=1)
