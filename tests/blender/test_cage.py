@@ -263,11 +263,13 @@ for ob in cases:
 
 # Running again replaces the cage and rebinds (no NAME_cage.001, one modifier).
 make_active(clean)
-res = bpy.ops.object.souptet_cage(cells=5, tries=1, bind=True)
+ntri = len(bpy.data.objects["clean_cage"].data.polygons)
+res = bpy.ops.object.souptet_cage(cells=5, tets=600, tries=1, bind=True)
 mods = [m for m in clean.modifiers if m.type == 'MESH_DEFORM']
 ok(res == {'FINISHED'} and "clean_cage.001" not in bpy.data.objects and len(mods) == 1
-   and mods[0].is_bound and mods[0].object == bpy.data.objects["clean_cage"],
-   "running again replaces the cage and rebinds its one modifier")
+   and mods[0].is_bound and mods[0].object == bpy.data.objects["clean_cage"]
+   and len(bpy.data.objects["clean_cage"].data.polygons) != ntri,
+   "running again (tets=600) replaces the cage and rebinds its one modifier")
 w = winding_numbers(world_vertices(clean), *[np.array(x) if i else x for i, x in
                                              enumerate(cage_arrays(bpy.data.objects["clean_cage"]))])
 ok(w.min() > 0.5, "the new cage encloses the mesh (min winding number %.6f)" % w.min())
@@ -318,6 +320,18 @@ except RuntimeError as e:
     res, msg = {'CANCELLED'}, str(e)
 ok(res == {'CANCELLED'} and "not a mesh" in msg and snapshot() == before,
    "a non-mesh object (an empty) is refused, nothing left behind", msg)
+
+# souptet refusing the parameters (cells past its 4096): its message, and
+# nothing left behind.
+make_active(flipped)
+before = snapshot()
+try:
+    res = bpy.ops.object.souptet_cage(cells=5000, tries=TRIES)
+    msg = ""
+except RuntimeError as e:
+    res, msg = {'CANCELLED'}, str(e)
+ok(res == {'CANCELLED'} and "souptet:" in msg and snapshot() == before,
+   "souptet.Error is reported, nothing left behind", msg)
 
 # Cancelling: the progress callback raises once cancel is set; souptet stops
 # and nothing is made.
