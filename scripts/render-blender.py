@@ -17,7 +17,7 @@ import sys
 
 import bpy
 import numpy as np
-from mathutils import Matrix, Vector
+from mathutils import Vector
 
 ADDON, BUNNY, OUT = sys.argv[sys.argv.index("--") + 1:][:3]
 if ADDON.endswith(".zip"):

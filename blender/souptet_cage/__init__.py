@@ -146,6 +146,7 @@ class Progress:
         self.stage = ""
         self.stages = 0
         self.cancel = False
+        self.on_main = None   # called with the fraction, on the main thread only
 
     def __call__(self, *args, **kwargs):
         self.calls += 1
@@ -161,6 +162,8 @@ class Progress:
         else:
             done = self.calls / (self.calls + 50.0)
         self.fraction = max(self.fraction, min(1.0, done))
+        if self.on_main is not None and threading.current_thread() is threading.main_thread():
+            self.on_main(self.fraction)
         if self.cancel:
             raise Cancelled()
 
@@ -312,6 +315,27 @@ def build_cage(context, obj, r, bind):
     return cage
 
 
+def _settings():
+    """The operator's settings, also the panel's (scene.souptet_cage)."""
+    return {
+        "cells": IntProperty(name="Cells", default=10, min=1, soft_max=100,
+                             description="Lattice cells along the object's longest side"),
+        "tets": IntProperty(name="Tets", default=0, min=0,
+                            description="About this many tets (0: from cells)"),
+        "tries": IntProperty(name="Tries", default=4, min=1, soft_max=16,
+                             description="Candidate lattices; the best is kept"),
+        "offset": FloatProperty(name="Offset", default=0.4, min=0.001, max=10.0, soft_max=1.0,
+                                description="How far the cage may stay from the surface, "
+                                            "in cells"),
+        "bind": BoolProperty(name="Bind", default=True,
+                             description="Add a Mesh Deform modifier targeting the cage "
+                                         "and bind it"),
+        "filepath": StringProperty(name="Tet mesh", default="", subtype='FILE_PATH',
+                                   description="Also write the tet mesh (.vtu, .msh, .node, "
+                                               ".mesh) and its embedding (FILE.embed.txt)"),
+    }
+
+
 # ---- the operator -------------------------------------------------------------
 
 class OBJECT_OT_souptet_cage(bpy.types.Operator):
@@ -322,19 +346,7 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
     bl_label = "Make cage"
     bl_options = {'REGISTER', 'UNDO'}
 
-    cells: IntProperty(name="Cells", default=10, min=1, soft_max=100,
-                       description="Lattice cells along the object's longest side")
-    tets: IntProperty(name="Tets", default=0, min=0,
-                      description="About this many tets (0: from cells)")
-    tries: IntProperty(name="Tries", default=4, min=1, soft_max=16,
-                       description="Candidate lattices; the best is kept")
-    offset: FloatProperty(name="Offset", default=0.4, min=0.01, soft_max=1.0,
-                          description="How far the cage may stay from the surface, in cells")
-    bind: BoolProperty(name="Bind", default=True,
-                       description="Add a Mesh Deform modifier targeting the cage and bind it")
-    filepath: StringProperty(name="Tet mesh", default="", subtype='FILE_PATH',
-                             description="Also write the tet mesh (.vtu, .msh, .node, .mesh) "
-                                         "and its embedding (FILE.embed.txt)")
+    __annotations__ = _settings()
 
     @classmethod
     def poll(cls, context):
@@ -355,7 +367,8 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
         self.report({'INFO'}, msg)
         return {'FINISHED'}
 
-    # Scripts (and -b): blocking, the status bar as far as there is one.
+    # Scripts (and -b): blocking; the progress shows on the cursor when the
+    # callback comes on this thread.
     def execute(self, context):
         obj = context.active_object
         wm = context.window_manager
@@ -363,6 +376,7 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
         try:
             V, F = soup_of(context, obj)
             wm.progress_begin(0, 100)
+            prog.on_main = lambda f: wm.progress_update(int(100 * f))
             try:
                 r = run_mesh(V, F, progress=prog, filepath=self.filepath, **self._params())
             finally:
@@ -477,19 +491,7 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
 # ---- the panel ----------------------------------------------------------------
 
 class SouptetCageSettings(bpy.types.PropertyGroup):
-    cells: IntProperty(name="Cells", default=10, min=1, soft_max=100,
-                       description="Lattice cells along the object's longest side")
-    tets: IntProperty(name="Tets", default=0, min=0,
-                      description="About this many tets (0: from cells)")
-    tries: IntProperty(name="Tries", default=4, min=1, soft_max=16,
-                       description="Candidate lattices; the best is kept")
-    offset: FloatProperty(name="Offset", default=0.4, min=0.01, soft_max=1.0,
-                          description="How far the cage may stay from the surface, in cells")
-    bind: BoolProperty(name="Bind", default=True,
-                       description="Add a Mesh Deform modifier targeting the cage and bind it")
-    filepath: StringProperty(name="Tet mesh", default="", subtype='FILE_PATH',
-                             description="Also write the tet mesh (.vtu, .msh, .node, .mesh) "
-                                         "and its embedding (FILE.embed.txt)")
+    __annotations__ = _settings()
 
 
 class VIEW3D_PT_souptet_cage(bpy.types.Panel):

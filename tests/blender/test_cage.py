@@ -20,7 +20,6 @@
 import os
 import sys
 import time
-import traceback
 
 import bpy
 import numpy as np
