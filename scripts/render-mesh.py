@@ -93,6 +93,28 @@ def mesh_actor(grid, opacity, table):
     return a
 
 
+def scalar_bar(table, title):
+    """A vertical colour bar filling its renderer: title on top, labels
+    beside the bar, black text of one size."""
+    bar = vtk.vtkScalarBarActor()
+    bar.SetLookupTable(table)
+    bar.SetTitle(title)
+    bar.SetNumberOfLabels(5)
+    bar.SetPosition(0.05, 0.15)
+    bar.SetWidth(0.9)
+    bar.SetHeight(0.7)
+    bar.SetBarRatio(0.25)
+    bar.SetTitleRatio(0.5)
+    bar.SetVerticalTitleSeparation(12)
+    bar.UnconstrainedFontSizeOn()
+    for tp, size in ((bar.GetTitleTextProperty(), 16), (bar.GetLabelTextProperty(), 14)):
+        tp.SetColor(0, 0, 0)
+        tp.SetFontSize(size)
+        tp.ItalicOff()
+        tp.ShadowOff()
+    return bar
+
+
 def main():
     if len(sys.argv) < 3:
         sys.exit(__doc__)
@@ -113,14 +135,26 @@ def main():
     if surface:
         left.AddActor(surface_actor(surface, 1.0))
 
+    # The view first: the cut-away's plane faces the camera, so its cut is
+    # seen face-on from any model's orientation (a fixed z plane was seen
+    # edge-on on models whose z is the view's up).
+    left.ResetCamera(grid.GetBounds())
+    cam = left.GetActiveCamera()
+    cam.Azimuth(30)
+    cam.Elevation(20)
+    cam.OrthogonalizeViewUp()
+    left.ResetCamera(grid.GetBounds())
+
     # Right: the tets wholly on the far side of a plane through the middle
     # (whole cells, so the interior tets show as they are), and the input
     # clipped at the plane: it shows where the removed tets crossing the
-    # plane held it.
+    # plane held it. vtkPlane's inside is behind its normal: the normal
+    # points at the camera, so the near half goes.
     b = grid.GetBounds()
+    d = cam.GetDirectionOfProjection()
     plane = vtk.vtkPlane()
     plane.SetOrigin(0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5]))
-    plane.SetNormal(0, 0, 1)
+    plane.SetNormal(-d[0], -d[1], -d[2])
     keep = vtk.vtkExtractGeometry()
     keep.SetInputData(grid)
     keep.SetImplicitFunction(plane)
@@ -128,7 +162,7 @@ def main():
     keep.ExtractBoundaryCellsOff()
     keep.Update()
     right = vtk.vtkRenderer()
-    right.SetViewport(0.5, 0.0, 1.0, 1.0)
+    right.SetViewport(0.5, 0.0, 0.9, 1.0)
     right.AddActor(mesh_actor(keep.GetOutput(), 1.0, table))
     if surface:
         clip = vtk.vtkClipPolyData()
@@ -137,29 +171,21 @@ def main():
         clip.InsideOutOn()
         clip.Update()
         right.AddActor(surface_actor(clip.GetOutput(), 1.0))
+    right.SetActiveCamera(cam)
+    left.SetViewport(0.0, 0.0, 0.5, 1.0)
 
-    bar = vtk.vtkScalarBarActor()
-    bar.SetLookupTable(table)
-    bar.SetTitle("min dihedral")
-    bar.SetNumberOfLabels(4)
-    bar.SetWidth(0.08)
-    bar.SetHeight(0.5)
-    bar.GetTitleTextProperty().SetColor(0, 0, 0)
-    bar.GetLabelTextProperty().SetColor(0, 0, 0)
-    right.AddActor2D(bar)
+    # The colour bar in a strip of its own, so it covers no mesh; its
+    # title above the bar, clear of the labels.
+    legend = vtk.vtkRenderer()
+    legend.SetViewport(0.9, 0.0, 1.0, 1.0)
+    legend.AddActor2D(scalar_bar(table, "min dihedral\n(degrees)"))
 
     win = vtk.vtkRenderWindow()
     win.SetOffScreenRendering(1)
     win.SetSize(1600, 800)
-    for ren in (left, right):
+    for ren in (left, right, legend):
         ren.SetBackground(1, 1, 1)
         win.AddRenderer(ren)
-    cam = left.GetActiveCamera()
-    left.ResetCamera()
-    cam.Azimuth(30)
-    cam.Elevation(20)
-    left.ResetCamera()
-    right.SetActiveCamera(cam)
     win.Render()
     grab = vtk.vtkWindowToImageFilter()
     grab.SetInput(win)

@@ -160,6 +160,7 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
     sp.kind = ST_LATTICE_BCC;
     sp.h = h;
     sp.seed = c->seed;
+    sp.cancel = prog ? prog->cancel : NULL;
     st_sculpt_stats ss;
     memset(&ss, 0, sizeof ss);
     double t0 = now_seconds();
@@ -247,6 +248,7 @@ static st_status choose_h(double *h, st_pipeline_stats *st, const st_grid *g,
         sp.kind = ST_LATTICE_BCC;
         sp.h = hk;
         sp.seed = st_pipeline_candidate_seed(p->seed, 0);
+        sp.cancel = prog ? prog->cancel : NULL;
         st_sculpt_stats ss;
         memset(&ss, 0, sizeof ss);
         st_tetmesh *m = NULL;

@@ -55,6 +55,7 @@
 #include "fpenv.h"
 #include "souptet/isect.h"
 #include "souptet/mem.h"
+#include "souptet/progress.h"
 
 #include <math.h>
 #include <omp.h>
@@ -74,6 +75,7 @@ st_sculpt_params st_sculpt_params_default(void)
     p.repair_manifold = 1;
     p.cluster_max = 64;
     p.search_budget = (size_t)1 << 20;
+    p.cancel = NULL;
     return p;
 }
 
@@ -94,11 +96,27 @@ static int visit_tri(void *ctx, uint32_t tri)
     return st_tri_tet_intersect(a, b, d, c->p[0], c->p[1], c->p[2], c->p[3]);
 }
 
+static st_status classify(unsigned char *keep, st_sculpt_stats *stats,
+                          const st_lattice *L, const st_grid *g,
+                          const st_soup *s, const st_bvh *bvh,
+                          volatile int *cancel, st_error *err);
+
 st_status st_sculpt_classify(unsigned char *keep, st_sculpt_stats *stats,
                              const st_lattice *L, const st_grid *g,
                              const st_soup *s, const st_bvh *bvh,
                              st_error *err)
 {
+    return classify(keep, stats, L, g, s, bvh, NULL, err);
+}
+
+/* st_sculpt_classify; a set cancel flag leaves the tets not yet classified
+ * (keep 0) and returns ST_ECANCELLED. */
+static st_status classify(unsigned char *keep, st_sculpt_stats *stats,
+                          const st_lattice *L, const st_grid *g,
+                          const st_soup *s, const st_bvh *bvh,
+                          volatile int *cancel, st_error *err)
+{
+    const st_progress stop = {NULL, NULL, cancel};
     if (g->kind != ST_GRID_SIGNED)
         return st_error_set(err, ST_EINPUT, NULL, 0,
                             "the field is not signed (run soupsign first)");
@@ -119,6 +137,10 @@ st_status st_sculpt_classify(unsigned char *keep, st_sculpt_stats *stats,
     long long nt = (long long)L->ntets;
 #pragma omp parallel for schedule(dynamic, 256) reduction(+ : nvol, nsurf)
     for (long long t = 0; t < nt; t++) {
+        if ((t & 255) == 0 && st_progress_cancelled(&stop)) {
+            keep[t] = ST_SCULPT_REMOVED;
+            continue;
+        }
         const uint32_t *v = L->tets + 4 * (size_t)t;
         const double *p[4];
         for (int c = 0; c < 4; c++)
@@ -151,6 +173,8 @@ st_status st_sculpt_classify(unsigned char *keep, st_sculpt_stats *stats,
     }
     st_voxel_summary_free(sum);
     st_bvh_free(own);
+    if (st_progress_cancelled(&stop))
+        return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
     if (stats) {
         stats->lattice_tets = L->ntets;
         stats->kept_volume = nvol;
@@ -697,8 +721,11 @@ st_status st_sculpt(st_tetmesh **out, st_sculpt_stats *stats,
         st_lattice_free(L);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     }
-    st = st_sculpt_classify(keep, &ss, L, g, s, bvh, err);
+    const st_progress stop = {NULL, NULL, p->cancel};
+    st = classify(keep, &ss, L, g, s, bvh, p->cancel, err);
     double t2 = omp_get_wtime();
+    if (!st && st_progress_cancelled(&stop))
+        st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
     if (!st && p->repair_bombs)
         st = st_sculpt_repair_bombs(keep, &ss, L, p, err);
     else if (!st) {
@@ -707,6 +734,8 @@ st_status st_sculpt(st_tetmesh **out, st_sculpt_stats *stats,
         ss.bombs_3faces = hist[3];
         ss.bombs_4faces = hist[4];
     }
+    if (!st && st_progress_cancelled(&stop))
+        st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
     if (!st && p->repair_manifold)
         st = st_sculpt_repair_manifold(keep, &ss, L, err);
     else if (!st) {

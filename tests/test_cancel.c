@@ -11,6 +11,7 @@
  */
 #include "souptet/pipeline.h"
 #include "souptet/pseudo.h"
+#include "souptet/sculpt.h"
 #include "tap.h"
 
 #include <omp.h>
@@ -115,6 +116,26 @@ int main(void)
         st_status rc = st_pseudo_volume(&g, s, &dp, &pp, NULL, &prog, &err);
         TAP_CHECK(rc == ST_ECANCELLED && g == NULL, "the pseudo volume: cancelled in the "
                   "signs, no grid (%.3f s after the flag)", now() - k.t_set);
+    }
+
+    /* the sculpt alone, the flag set: nothing classified, no mesh */
+    {
+        st_dist_params dp = st_dist_params_default();
+        st_pseudo_params pp = st_pseudo_params_default();
+        st_grid *g = NULL;
+        st_status rc = st_pseudo_volume(&g, s, &dp, &pp, NULL, NULL, &err);
+        st_sculpt_params sp = st_sculpt_params_default();
+        double lo[3], hi[3];
+        st_soup_bounds(s, lo, hi, &err);
+        sp.h = (hi[0] - lo[0]) / 30;
+        volatile int flag = 1;
+        sp.cancel = &flag;
+        st_tetmesh *m = NULL;
+        double t0 = now();
+        st_status r2 = rc ? rc : st_sculpt(&m, NULL, g, s, NULL, &sp, &err);
+        TAP_CHECK(rc == ST_OK && r2 == ST_ECANCELLED && m == NULL,
+                  "the sculpt at 30 cells, flag set: ST_ECANCELLED, no mesh (%.3f s)", now() - t0);
+        st_grid_free(g);
     }
 
     /* the next call, flag cleared, is an ordinary run */

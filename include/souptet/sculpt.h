@@ -73,6 +73,10 @@ typedef struct st_sculpt_params {
     int repair_manifold;      /* 1: add snowflakes at pinched vertices */
     size_t cluster_max;       /* bombs per cluster searched at all (64) */
     size_t search_budget;     /* search nodes per cluster (1 << 20) */
+    volatile int *cancel;     /* NULL, or a caller's flag (progress.h):
+                                 once nonzero, st_sculpt stops between
+                                 its steps and within the classification,
+                                 returning ST_ECANCELLED (NULL) */
 } st_sculpt_params;
 
 /* BCC, h 1, seed 0, pad ST_LATTICE_PAD_DEFAULT, repairs on. */

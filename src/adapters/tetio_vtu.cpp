@@ -14,7 +14,9 @@
  *              then the mesh's own per-cell arrays; point data: the mesh's
  *              per-point arrays. All vtkDoubleArray.
  *   field data every st_meta entry (source, h, lattice, parameters,
- *              history, ...) named by its key, in st_meta order: a value
+ *              history, ...) named by its key, in st_meta order: a
+ *              canonical non-negative integer (seed, candidates) as a
+ *              one-value vtkTypeUInt64Array (meta_integer), another value
  *              that is a number exactly as %.17g prints it as a one-value
  *              vtkDoubleArray, any other as a vtkUnsignedCharArray of its
  *              bytes (meshio cannot read VTK's String arrays; see
@@ -62,6 +64,7 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkStringArray.h>
+#include <vtkTypeUInt64Array.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridReader.h>
@@ -108,6 +111,28 @@ bool meta_number(const char *v, double *x)
     if (std::strcmp(buf, v) != 0)
         return false;
     *x = d;
+    return true;
+}
+
+/* A canonical decimal integer ("0", or digits without a leading zero)
+ * that fits 64 bits unsigned: seeds, counts, resolutions. Such a value is
+ * written as a one-value UInt64 array whatever its size (a seed above
+ * 2^53 is no exact double, and one key keeps one type: meshio gives
+ * numpy.uint64 for every seed), and read back with %llu. */
+bool meta_integer(const char *v, unsigned long long *x)
+{
+    const size_t n = std::strlen(v);
+    if (n == 0 || n > 20 || (v[0] == '0' && n > 1))
+        return false;
+    for (size_t i = 0; i < n; i++)
+        if (v[i] < '0' || v[i] > '9')
+            return false;
+    errno = 0;
+    char *end;
+    const unsigned long long u = std::strtoull(v, &end, 10);
+    if (*end || errno)
+        return false;
+    *x = u;
     return true;
 }
 
@@ -200,7 +225,13 @@ st_status build_grid(vtkUnstructuredGrid *ug, const st_tetmesh *m,
         const char *val = m->meta.entries[i].value ? m->meta.entries[i].value
                                                    : "";
         double x;
-        if (meta_number(val, &x)) {
+        unsigned long long u;
+        if (meta_integer(val, &u)) {
+            vtkNew<vtkTypeUInt64Array> d;
+            d->SetName(key);
+            d->InsertNextValue(vtkTypeUInt64(u));
+            fd->AddArray(d);
+        } else if (meta_number(val, &x)) {
             vtkNew<vtkDoubleArray> d;
             d->SetName(key);
             d->InsertNextValue(x);
@@ -493,6 +524,15 @@ st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
                     break;   // a C string ends there
                 v.push_back(char(c));
             }
+        } else if (d && d->GetNumberOfComponents() == 1 && d->GetNumberOfTuples() == 1 &&
+                   d->GetDataTypeSize() == 8 &&
+                   (type == VTK_UNSIGNED_LONG || type == VTK_UNSIGNED_LONG_LONG ||
+                    type == VTK_TYPE_UINT64)) {
+            // (the reader makes a vtkUnsignedLongArray, not the typed one)
+            char buf[32];
+            std::snprintf(buf, sizeof buf, "%llu",
+                          (unsigned long long)a->GetVariantValue(0).ToTypeUInt64());
+            v = buf;
         } else if (d && d->GetNumberOfComponents() == 1 &&
                    d->GetNumberOfTuples() == 1) {
             char buf[64];

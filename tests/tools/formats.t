@@ -243,7 +243,9 @@ for f in sys.argv[1:]:
     # Numbers are numbers; text is bytes that decode as UTF-8.
     text = {k: bytes(v.astype(np.uint8)).decode() for k, v in fd.items()
             if v.dtype == np.uint8}
-    nums = {k: float(v[0]) for k, v in fd.items() if v.dtype == np.float64}
+    nums = {k: float(v[0]) for k, v in fd.items() if v.dtype in (np.float64, np.uint64)}
+    if "seed" in fd and fd["seed"].dtype != np.uint64:
+        print("#   %s: seed is %s, not uint64" % (f, fd["seed"].dtype)); bad = 1
     print("%s %s %d %s %s" % (f, ",".join(types), n,
           "history" in text, ",".join(sorted(nums))))
     for k, v in m.cell_data.items():
