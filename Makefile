@@ -279,3 +279,4 @@ clean:
 include python/python.mk
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
+include blender/blender.mk
