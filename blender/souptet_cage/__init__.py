@@ -137,8 +137,10 @@ class Progress:
     here: a dict with the library's stage and that stage's fraction done is
     used when there is one, else the count of calls. The fraction shown
     grows through each new stage (half of what is left, stage by stage) and
-    never goes back. Raises Cancelled once cancel is set (from any thread):
-    souptet then stops and raises it back out of mesh()."""
+    never goes back. request_cancel() (from any thread) sets souptet's
+    own cancel flag (a souptet.Cancel given to mesh()), which the library
+    polls itself: it stops within about 0.1 s of work, not at the next
+    event; the callable also raises Cancelled once cancel is set."""
 
     def __init__(self):
         self.calls = 0
@@ -146,7 +148,13 @@ class Progress:
         self.stage = ""
         self.stages = 0
         self.cancel = False
+        self.handle = souptet.Cancel() if souptet is not None else None
         self.on_main = None   # called with the fraction, on the main thread only
+
+    def request_cancel(self):
+        self.cancel = True
+        if self.handle is not None:
+            self.handle.set()
 
     def __call__(self, *args, **kwargs):
         self.calls += 1
@@ -174,13 +182,14 @@ def run_mesh(V, F, cells, tets, tries, offset, progress=None, filepath=""):
     if souptet is None:
         raise CageError(_SOUPTET_ERROR)
     kw = dict(cells=int(cells), tries=int(tries), offset=float(offset),
-              float32=True, progress=progress)
+              float32=True, progress=progress,
+              cancel=progress.handle if progress is not None else None)
     if tets > 0:
         kw["tets"] = int(tets)
     try:
         r = souptet.mesh(V, F, **kw)
-    except Cancelled:
-        raise
+    except (Cancelled, souptet.Cancelled):
+        raise Cancelled()
     except souptet.Error as e:
         if progress is not None and progress.cancel:
             raise Cancelled()
@@ -441,7 +450,7 @@ class OBJECT_OT_souptet_cage(bpy.types.Operator):
     def modal(self, context, event):
         if event.type == 'ESC' and event.value == 'PRESS':
             if not self._progress.cancel:
-                self._progress.cancel = True
+                self._progress.request_cancel()
                 self._cancel_time = time.monotonic()
             return {'RUNNING_MODAL'}
         if event.type != 'TIMER':

@@ -16,10 +16,10 @@ KeyboardInterrupt.
 """
 
 from . import _core
-from ._core import Error
+from ._core import Cancel, Cancelled, Error
 
 __all__ = ["read", "mesh", "pseudo_volume", "distance", "wrap", "Error",
-           "MeshResult", "Field"]
+           "Cancel", "Cancelled", "MeshResult", "Field"]
 __version__ = _core.version
 
 
@@ -101,7 +101,7 @@ class MeshResult:
 
 
 def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
-         threads=0, progress=None, float32=False):
+         threads=0, progress=None, float32=False, cancel=None):
     """Mesh a triangle soup into a coarse tet mesh that encloses it (soupmesh).
 
     V         (n, 3) numbers, the vertices in model units (finite)
@@ -134,13 +134,18 @@ def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
               on another thread, never two at once; an exception raised in
               it stops the run and propagates.
     float32   bool, the mesh encloses the input after its points are rounded
-              to float32 (default False); needs a library that has it
+              to float32, checked exactly on the rounded points (default
+              False; soupmesh --float32): for Blender, glTF, STL, game
+              engines, anything that stores float32
+    cancel    souptet.Cancel or None: another thread's c.set() stops the
+              run within about 0.1 s of work (the library polls the flag
+              itself) and mesh() raises souptet.Cancelled (default None)
     Returns a MeshResult. Not enclosing is not an error: see .encloses.
     Raises souptet.Error for bad input or parameters, MemoryError.
     """
     return MeshResult(_core.mesh(V, F, cells=cells, size=size, tets=tets, tries=tries,
                                  seed=seed, offset=offset, threads=threads,
-                                 progress=progress, float32=float32))
+                                 progress=progress, float32=float32, cancel=cancel))
 
 
 class Field:

@@ -332,10 +332,10 @@ except RuntimeError as e:
 ok(res == {'CANCELLED'} and "souptet:" in msg and snapshot() == before,
    "souptet.Error is reported, nothing left behind", msg)
 
-# Cancelling: the progress callback raises once cancel is set; souptet stops
+# Cancelling: request_cancel() sets souptet.Cancel (and the callback raises); souptet stops
 # and nothing is made.
 prog = souptet_cage.Progress()
-prog.cancel = True
+prog.request_cancel()
 make_active(clean)
 V, F = souptet_cage.soup_of(bpy.context, clean)
 try:

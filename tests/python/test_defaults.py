@@ -6,6 +6,8 @@ import re
 import subprocess
 import sys
 
+import numpy as np
+
 import pytest
 
 import souptet
@@ -116,3 +118,10 @@ def test_float32_parameter():
     V, F = box()
     m = souptet.mesh(V, F, cells=3, tries=1, float32=False)
     assert m.encloses
+    # float32=True: every point is a float32 value, and the mesh still
+    # encloses (checked exactly by the library on the rounded points, and
+    # here the same as soupmesh --float32 gives)
+    V2 = V * (1.0 + 1e-9) + 20.3   # off the float grid
+    m32 = souptet.mesh(V2, F, cells=4, tries=1, float32=True)
+    assert m32.encloses
+    assert np.array_equal(m32.points.astype(np.float32).astype(np.float64), m32.points)

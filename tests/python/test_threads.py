@@ -104,3 +104,42 @@ def test_ctrl_c(call):
     assert line == "interrupted", line
     assert dt <= 1.5, (dt, line, rest)
     assert "again" in rest and p.returncode == 0
+
+
+def test_cancel_object_stops_a_run_from_another_thread(bunny):
+    # a UI's event loop sets souptet.Cancel while mesh() runs in a worker
+    # thread: the library polls the flag itself (progress.h)
+    c = souptet.Cancel()
+    assert not c.is_set()
+    out = {}
+
+    def work():
+        try:
+            souptet.mesh(*bunny, cells=30, tries=2, cancel=c)
+            out["r"] = "finished"
+        except souptet.Cancelled:
+            out["r"] = "cancelled"
+        out["t"] = time.monotonic()
+    t = threading.Thread(target=work)
+    t.start()
+    time.sleep(1.5)
+    t_set = time.monotonic()
+    c.set()
+    t.join(30)
+    assert out.get("r") == "cancelled", out
+    # about 0.1 s of work; a loaded machine gets slack (1-1.5 s measured at
+    # worst, in the signs' cut of a 240^3 field)
+    assert out["t"] - t_set < 3.0, out["t"] - t_set
+    assert c.is_set()
+    c.clear()
+    m = souptet.mesh(*bunny, cells=5, tries=1, cancel=c)
+    assert m.encloses and not c.is_set()
+
+
+def test_cancel_set_before_the_call(bunny):
+    c = souptet.Cancel()
+    c.set()
+    with pytest.raises(souptet.Cancelled):
+        souptet.mesh(*bunny, cells=5, tries=1, cancel=c)
+    with pytest.raises(TypeError):
+        souptet.mesh(*bunny, cells=5, tries=1, cancel=True)
