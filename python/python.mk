@@ -3,7 +3,7 @@
 #   make                 also builds build/python/souptet (release and debug
 #                        configs, when python3-dev and python3-numpy are
 #                        there): PYTHONPATH=build/python python3 -c 'import souptet'
-#   make install         also installs it into $(PREFIX)/lib/python3/dist-packages
+#   make install         also installs it where Debian's python3 finds it (PY_SITE)
 #
 # _core links only the C core (libsouptet); _io (wrap, .vtu) also links
 # libsouptet-io (OpenVDB, VTK), and is imported only when used.
@@ -12,7 +12,11 @@ PYTHON ?= /usr/bin/python3
 PY_INC := $(shell $(PYTHON) -c 'import sysconfig; print(sysconfig.get_paths()["include"])' 2>/dev/null)
 PY_NUMPY_INC := $(shell $(PYTHON) -c 'import numpy; print(numpy.get_include())' 2>/dev/null)
 PY_EXT := $(shell $(PYTHON) -c 'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))' 2>/dev/null)
-PY_SITE := $(PREFIX)/lib/python3/dist-packages
+# Where Debian's python3 looks: /usr/lib/python3/dist-packages for
+# PREFIX=/usr, $(PREFIX)/lib/python3.X/dist-packages otherwise (on its
+# sys.path for /usr/local).
+PY_VER := $(shell $(PYTHON) -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null)
+PY_SITE := $(if $(filter /usr,$(PREFIX)),/usr/lib/python3/dist-packages,$(PREFIX)/lib/python$(PY_VER)/dist-packages)
 
 PY_OUT := $(BUILD)/python/souptet
 PY_CORE := $(PY_OUT)/_core$(PY_EXT)

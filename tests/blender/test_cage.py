@@ -332,19 +332,25 @@ except RuntimeError as e:
 ok(res == {'CANCELLED'} and "souptet:" in msg and snapshot() == before,
    "souptet.Error is reported, nothing left behind", msg)
 
-# Cancelling: request_cancel() sets souptet.Cancel (and the callback raises); souptet stops
-# and nothing is made.
-prog = souptet_cage.Progress()
-prog.request_cancel()
+# Cancelling, two ways; souptet stops and nothing is made: the callback
+# raises once cancel is set (at its first call), and request_cancel() (what
+# Esc calls) sets the run's souptet.Cancel, which the library polls itself
+# (set before the run: it stops before any event).
 make_active(clean)
 V, F = souptet_cage.soup_of(bpy.context, clean)
-try:
-    souptet_cage.run_mesh(V, F, CELLS, 0, TRIES, 0.4, progress=prog)
-    cancelled = False
-except souptet_cage.Cancelled:
-    cancelled = True
-ok(cancelled and prog.calls >= 1, "a cancel through the progress callback stops souptet (%d call)"
-   % prog.calls)
+for way in ("callback", "souptet.Cancel"):
+    prog = souptet_cage.Progress()
+    if way == "callback":
+        prog.cancel = True
+    else:
+        prog.request_cancel()
+    try:
+        souptet_cage.run_mesh(V, F, CELLS, 0, TRIES, 0.4, progress=prog)
+        cancelled = False
+    except souptet_cage.Cancelled:
+        cancelled = True
+    ok(cancelled and (prog.calls >= 1 if way == "callback" else prog.handle.is_set()),
+       "a cancel through the %s stops souptet (%d call)" % (way, prog.calls))
 
 prog = souptet_cage.Progress()
 souptet_cage.run_mesh(V, F, CELLS, 0, TRIES, 0.4, progress=prog)

@@ -127,4 +127,18 @@ cc -std=c11 prog.c $flags -Wl,-rpath,"$lib" -o prog2 2> cc2.err && ./prog2 "$ROO
 ok $? "the program builds from the installed headers and library through pkg-config"
 sed 's/^/#   /' cc2.err | head -5
 
+# The Python module: where Debian's python3 looks for PREFIX=/usr, and it
+# imports from there (the staged libraries through LD_LIBRARY_PATH, as
+# they would be in /usr/lib).
+site="$WORK/stage/usr/lib/python3/dist-packages"
+if [ -d "$BUILD/python/souptet" ]; then
+    (cd "$WORK" && PYTHONPATH="$site" LD_LIBRARY_PATH="$lib" /usr/bin/python3 -c \
+        'import souptet, sys; m = souptet.mesh(*souptet.read(sys.argv[1]), cells=4, tries=1); assert m.encloses; print(souptet.__file__)' \
+        "$ROOT/corpus/bunny.obj") > py.out 2>&1 && grep -q "^$site/souptet/__init__.py" py.out
+    ok $? "make install PREFIX=/usr puts the Python module in /usr/lib/python3/dist-packages, and it meshes from there"
+    sed 's/^/#   /' py.out | tail -3
+    /usr/bin/python3 -c 'import sys; sys.exit(0 if "/usr/local/lib/python%d.%d/dist-packages" % sys.version_info[:2] in sys.path else 1)'
+    ok $? "and PREFIX=/usr/local's place (/usr/local/lib/python3.X/dist-packages) is on Debian's python3 path"
+fi
+
 done_testing
