@@ -256,7 +256,7 @@ static void print_table(FILE *f, const char *name, const char *sname,
             ROW("boundary -> S max / diag", "%.6f", r->dist_max / r->surface_diag);
             ROW("S -> boundary max / diag", "%.6f", r->surface_dist_max / r->surface_diag);
         }
-        if (r->has_offset && r->has_fill) {
+        if (r->has_offset && r->has_fill && r->fill_faces > 0) {
             /* the condition is the next row's: this one only informs */
             char lab[64];
             snprintf(lab, sizeof lab, "beyond %.3g h (S alone)", r->offset_ratio);
