@@ -17,6 +17,7 @@
 #include "fpenv.h"
 #include "souptet/isect.h"
 #include "souptet/mem.h"
+#include "souptet/progress.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -53,6 +54,7 @@ st_lattice_params st_lattice_params_default(void)
     p.seed = 0;
     p.pad = ST_LATTICE_PAD_DEFAULT;
     p.max_tets = 0;
+    p.cancel = NULL;
     return p;
 }
 
@@ -202,7 +204,7 @@ void st_lattice_free(st_lattice *L)
 }
 
 /* Face adjacency by buckets of the smallest vertex id; star CSR. */
-static st_status build_topology(st_lattice *L, st_error *err)
+static st_status build_topology(st_lattice *L, const st_progress *stop, st_error *err)
 {
     size_t nv = L->nverts, nt = L->ntets, nf = 4 * nt;
     size_t *off = st_calloc_array(nv + 1, sizeof *off);
@@ -256,7 +258,11 @@ static st_status build_topology(st_lattice *L, st_error *err)
     for (size_t f = 0; f < nf; f++)
         L->nbr[f] = -1;
     st_status st = ST_OK;
-    for (size_t v = 0; v < nv && st == ST_OK; v++)
+    for (size_t v = 0; v < nv && st == ST_OK; v++) {
+        if ((v & 4095) == 0 && st_progress_cancelled(stop)) {
+            st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+            break;
+        }
         for (size_t a = off[v]; a < off[v + 1]; a++) {
             uint32_t sa[3];
             size_t ta = (size_t)(slot[a] / 4);
@@ -279,6 +285,7 @@ static st_status build_topology(st_lattice *L, st_error *err)
                 L->nbr[slot[b]] = (int64_t)ta;
             }
         }
+    }
 #undef FACE_SORTED
     free(off);
     free(slot);
@@ -391,7 +398,12 @@ st_status st_lattice_build(st_lattice **out, const double lo[3],
     }
     size_t nt = 0;
     const size_t *n = L->n;
-    for (size_t k = 0; k < n[2]; k++)
+    const st_progress stop = {NULL, NULL, p->cancel};
+    for (size_t k = 0; k < n[2]; k++) {
+        if (st_progress_cancelled(&stop)) {
+            st_lattice_free(L);
+            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        }
         for (size_t j = 0; j < n[1]; j++)
             for (size_t i = 0; i < n[0]; i++) {
                 if (p->kind == ST_LATTICE_CUBIC5) {
@@ -444,8 +456,9 @@ st_status st_lattice_build(st_lattice **out, const double lo[3],
                     }
                 }
             }
+    }
     L->ntets = nt;
-    st_status st = build_topology(L, err);
+    st_status st = build_topology(L, &stop, err);
     if (st) {
         st_lattice_free(L);
         return st;

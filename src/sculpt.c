@@ -711,6 +711,7 @@ st_status st_sculpt(st_tetmesh **out, st_sculpt_stats *stats,
     lp.seed = p->seed;
     lp.pad = p->pad;
     lp.max_tets = p->max_tets;
+    lp.cancel = p->cancel;
     st_lattice *L = NULL;
     st_status st = st_lattice_build(&L, lo, hi, &lp, err);
     if (st)

@@ -76,6 +76,10 @@ typedef struct st_lattice_params {
     uint64_t seed;       /* 0: axis-aligned at the box's low corner */
     int pad;             /* cells of padding on every side, >= 0 */
     size_t max_tets;     /* ST_ELIMIT beyond this many tets (0: none) */
+    volatile int *cancel;   /* NULL, or a caller's flag (progress.h):
+                               once nonzero the build stops (between
+                               slices of cells and in the face matching)
+                               with ST_ECANCELLED (NULL) */
 } st_lattice_params;
 
 /* kind cubic5, h 1, seed 0, pad ST_LATTICE_PAD_DEFAULT, no limit. */
