@@ -118,6 +118,153 @@ static int face_visit(void *ctx, uint32_t tri)
                                 c->s->xyz + 3 * (size_t)v[1], c->s->xyz + 3 * (size_t)v[2]);
 }
 
+/* How many of s's used vertices are not float32 values (*n); 1 when out
+ * of memory. */
+static int input_not_float32(const st_soup *s, size_t *n)
+{
+    unsigned char *used = st_calloc_array(s->nverts ? s->nverts : 1, 1);
+    if (!used)
+        return 1;
+    for (size_t i = 0; i < 3 * s->ntris; i++)
+        used[s->tris[i]] = 1;
+    for (size_t v = 0; v < s->nverts; v++)
+        if (used[v] && !st_points_are_float32(s->xyz + 3 * v, 1))
+            (*n)++;
+    free(used);
+    return 0;
+}
+
+/* The boundary faces around each point (CSR: aoff, np + 1 zeroed slots;
+ * adj, 3 nf) and each face's unit outward normal (st_tetmesh_boundary
+ * turns them out of positive tets), at the points xyz. 1 when out of
+ * memory. */
+static int boundary_stars(const uint32_t *faces, size_t nf, const double *xyz, size_t np,
+                          double *normals, size_t *aoff, uint32_t *adj)
+{
+    for (size_t f = 0; f < nf; f++) {
+        const uint32_t *q = faces + 3 * f;
+        for (int k = 0; k < 3; k++)
+            aoff[q[k] + 1]++;
+        const double *a = xyz + 3 * (size_t)q[0], *b = xyz + 3 * (size_t)q[1],
+                     *c = xyz + 3 * (size_t)q[2];
+        double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        double *n = normals + 3 * f;
+        n[0] = u[1] * w[2] - u[2] * w[1];
+        n[1] = u[2] * w[0] - u[0] * w[2];
+        n[2] = u[0] * w[1] - u[1] * w[0];
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int k = 0; k < 3; k++)
+            n[k] = len > 0 ? n[k] / len : 0.0;
+    }
+    for (size_t v = 0; v < np; v++)
+        aoff[v + 1] += aoff[v];
+    size_t *fill = st_malloc_array(np ? np : 1, sizeof *fill);
+    if (!fill)
+        return 1;
+    if (np)
+        memcpy(fill, aoff, np * sizeof *fill);
+    for (size_t f = 0; f < nf; f++)
+        for (int k = 0; k < 3; k++)
+            adj[fill[faces[3 * f + (size_t)k]]++] = (uint32_t)f;
+    free(fill);
+    return 0;
+}
+
+/* Tets of m that are not positively oriented (exact). */
+static size_t count_not_positive(const st_tetmesh *m)
+{
+    size_t inverted = 0;
+    const long long nt = (long long)m->ntets;
+#pragma omp parallel for reduction(+ : inverted) schedule(static)
+    for (long long t = 0; t < nt; t++) {
+        const uint32_t *q = m->tets + 4 * (size_t)t;
+        inverted += st_orient3d(m->xyz + 3 * (size_t)q[0], m->xyz + 3 * (size_t)q[1],
+                                m->xyz + 3 * (size_t)q[2], m->xyz + 3 * (size_t)q[3]) >= 0;
+    }
+    return inverted;
+}
+
+/* What the rounding did: points moved, the farthest move, points pushed
+ * and the most ulps. */
+static void move_stats(st_float32_stats *st, const double *orig, const double *xyz,
+                       const unsigned *level, size_t np)
+{
+    for (size_t v = 0; v < np; v++) {
+        const double *a = orig + 3 * v, *b = xyz + 3 * v;
+        double d2 = 0;
+        for (int k = 0; k < 3; k++)
+            d2 += (b[k] - a[k]) * (b[k] - a[k]);
+        if (a[0] != b[0] || a[1] != b[1] || a[2] != b[2])
+            st->points_moved++;
+        if (sqrt(d2) > st->max_move)
+            st->max_move = sqrt(d2);
+        if (level[v]) {
+            st->pushed++;
+            if (level[v] > st->max_push)
+                st->max_push = level[v];
+        }
+    }
+}
+
+/* The boundary points of the rounded mesh m near where its enclosure
+ * failed (e from st_enclosure_compute, vin and hit its per-vertex and
+ * per-triangle results): the points of the tet (in m_before, found by
+ * *loc, made here once) that held each soup vertex now outside, and the
+ * corners of the boundary faces that meet a crossing triangle. mark gets
+ * 1 at them (np bytes, zeroed here; fmark: nf bytes of scratch); *all
+ * becomes 1 when a vertex's tet has no boundary point to push. */
+static st_status mark_failures(unsigned char *mark, unsigned char *fmark, int *all,
+                               st_locator **loc, const st_tetmesh *m_before,
+                               const st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
+                               const uint32_t *faces, size_t nf, const size_t *aoff,
+                               const st_enclosure *e, const unsigned char *vin,
+                               unsigned char *hit, st_error *err)
+{
+    memset(mark, 0, m->npoints);
+    *all = 0;
+    st_status rc;
+    if (e->vertices_outside) {
+        if (!*loc && (rc = st_locator_new(loc, m_before, err)))
+            return rc;
+        for (size_t i = 0; i < s->nverts && !*all; i++) {
+            if (vin[i] != 0)
+                continue;
+            int64_t t = st_locator_find(*loc, s->xyz + 3 * i, NULL);
+            if (t < 0)
+                continue;   /* outside before rounding too */
+            int named = 0;
+            for (int k = 0; k < 4; k++) {
+                uint32_t v = m->tets[4 * (size_t)t + (size_t)k];
+                if (aoff[v + 1] > aoff[v]) {
+                    mark[v] = 1;
+                    named = 1;
+                }
+            }
+            if (!named)
+                *all = 1;
+        }
+    }
+    if (e->crossing_triangles && !*all) {
+        const long long n = (long long)nf;
+#pragma omp parallel for schedule(dynamic, 64)
+        for (long long f = 0; f < n; f++) {
+            face_ctx c;
+            c.s = s;
+            c.crossing = hit;
+            for (int k = 0; k < 3; k++)
+                c.f[k] = m->xyz + 3 * (size_t)faces[3 * (size_t)f + (size_t)k];
+            fmark[f] = (unsigned char)(st_bvh_query_tri(bvh, c.f[0], c.f[1], c.f[2],
+                                                        face_visit, &c) != 0);
+        }
+        for (size_t f = 0; f < nf; f++)
+            if (fmark[f])
+                for (int k = 0; k < 3; k++)
+                    mark[faces[3 * f + (size_t)k]] = 1;
+    }
+    return ST_OK;
+}
+
 st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
                                      const st_bvh *bvh, st_float32_stats *st,
                                      st_error *err)
@@ -136,17 +283,8 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
             return st_error_set(err, ST_ELIMIT, NULL, 0,
                                 "a mesh coordinate (%g) is beyond the float32 range",
                                 m->xyz[i]);
-    {
-        unsigned char *used = st_calloc_array(s->nverts ? s->nverts : 1, 1);
-        if (!used)
-            return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
-        for (size_t i = 0; i < 3 * s->ntris; i++)
-            used[s->tris[i]] = 1;
-        for (size_t v = 0; v < s->nverts; v++)
-            if (used[v] && !st_points_are_float32(s->xyz + 3 * v, 1))
-                st->input_not_float32++;
-        free(used);
-    }
+    if (input_not_float32(s, &st->input_not_float32))
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
 
     st_status rc = ST_OK;
     uint32_t *faces = NULL;
@@ -186,38 +324,9 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
     if (np)
         memcpy(orig, m->xyz, np * 3 * sizeof *orig);
     copied = 1;
-    /* The faces around each point (CSR) and each face's unit outward
-     * normal (st_tetmesh_boundary turns them out of positive tets). */
-    for (size_t f = 0; f < nf; f++) {
-        const uint32_t *q = faces + 3 * f;
-        for (int k = 0; k < 3; k++)
-            aoff[q[k] + 1]++;
-        const double *a = orig + 3 * (size_t)q[0], *b = orig + 3 * (size_t)q[1],
-                     *c = orig + 3 * (size_t)q[2];
-        double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-        double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        double *n = normals + 3 * f;
-        n[0] = u[1] * w[2] - u[2] * w[1];
-        n[1] = u[2] * w[0] - u[0] * w[2];
-        n[2] = u[0] * w[1] - u[1] * w[0];
-        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        for (int k = 0; k < 3; k++)
-            n[k] = len > 0 ? n[k] / len : 0.0;
-    }
-    for (size_t v = 0; v < np; v++)
-        aoff[v + 1] += aoff[v];
-    {
-        size_t *fill = st_malloc_array(np ? np : 1, sizeof *fill);
-        if (!fill) {
-            rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
-            goto out;
-        }
-        if (np)
-            memcpy(fill, aoff, np * sizeof *fill);
-        for (size_t f = 0; f < nf; f++)
-            for (int k = 0; k < 3; k++)
-                adj[fill[faces[3 * f + (size_t)k]]++] = (uint32_t)f;
-        free(fill);
+    if (boundary_stars(faces, nf, orig, np, normals, aoff, adj)) {
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        goto out;
     }
     for (size_t v = 0; v < np; v++)
         st->boundary_points += aoff[v + 1] > aoff[v];
@@ -242,14 +351,7 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
         st_enclosure e;
         if ((rc = st_enclosure_compute(&e, m, s, bvh, vin, hit, err)))
             goto out;
-        size_t inverted = 0;
-        const long long nt = (long long)m->ntets;
-#pragma omp parallel for reduction(+ : inverted) schedule(static)
-        for (long long t = 0; t < nt; t++) {
-            const uint32_t *q = m->tets + 4 * (size_t)t;
-            inverted += st_orient3d(m->xyz + 3 * (size_t)q[0], m->xyz + 3 * (size_t)q[1],
-                                    m->xyz + 3 * (size_t)q[2], m->xyz + 3 * (size_t)q[3]) >= 0;
-        }
+        const size_t inverted = count_not_positive(m);
         st->verts_outside = e.vertices_outside;
         st->tris_crossing = e.crossing_triangles;
         st->inverted = inverted;
@@ -270,46 +372,10 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
         if (e.encloses)
             break;   /* only inversions: pushing out is no cure */
         /* Name the boundary points near the failure. */
-        memset(mark, 0, np);
         int all = 0;
-        if (e.vertices_outside) {
-            if (!loc && (rc = st_locator_new(&loc, &before, err)))
-                goto out;
-            for (size_t i = 0; i < s->nverts && !all; i++) {
-                if (vin[i] != 0)
-                    continue;
-                int64_t t = st_locator_find(loc, s->xyz + 3 * i, NULL);
-                if (t < 0)
-                    continue;   /* outside before rounding too */
-                int named = 0;
-                for (int k = 0; k < 4; k++) {
-                    uint32_t v = m->tets[4 * (size_t)t + (size_t)k];
-                    if (aoff[v + 1] > aoff[v]) {
-                        mark[v] = 1;
-                        named = 1;
-                    }
-                }
-                if (!named)
-                    all = 1;
-            }
-        }
-        if (e.crossing_triangles && !all) {
-            const long long n = (long long)nf;
-#pragma omp parallel for schedule(dynamic, 64)
-            for (long long f = 0; f < n; f++) {
-                face_ctx c;
-                c.s = s;
-                c.crossing = hit;
-                for (int k = 0; k < 3; k++)
-                    c.f[k] = m->xyz + 3 * (size_t)faces[3 * (size_t)f + (size_t)k];
-                fmark[f] = (unsigned char)(st_bvh_query_tri(bvh, c.f[0], c.f[1], c.f[2],
-                                                            face_visit, &c) != 0);
-            }
-            for (size_t f = 0; f < nf; f++)
-                if (fmark[f])
-                    for (int k = 0; k < 3; k++)
-                        mark[faces[3 * f + (size_t)k]] = 1;
-        }
+        if ((rc = mark_failures(mark, fmark, &all, &loc, &before, m, s, bvh, faces, nf, aoff,
+                                &e, vin, hit, err)))
+            goto out;
         /* A point whose float goes inward by some face around it (score
          * < 0: faces around it facing nearly opposite ways, a knife edge)
          * would only go farther in by it: it stays; the other points
@@ -334,21 +400,7 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
             memcpy(level, best_level, np * sizeof *level);
         }
     }
-    for (size_t v = 0; v < np; v++) {
-        const double *a = orig + 3 * v, *b = m->xyz + 3 * v;
-        double d2 = 0;
-        for (int k = 0; k < 3; k++)
-            d2 += (b[k] - a[k]) * (b[k] - a[k]);
-        if (a[0] != b[0] || a[1] != b[1] || a[2] != b[2])
-            st->points_moved++;
-        if (sqrt(d2) > st->max_move)
-            st->max_move = sqrt(d2);
-        if (level[v]) {
-            st->pushed++;
-            if (level[v] > st->max_push)
-                st->max_push = level[v];
-        }
-    }
+    move_stats(st, orig, m->xyz, level, np);
 out:
     st->seconds = now_seconds() - t0;
     if (rc && copied && np)
