@@ -10,6 +10,8 @@ import sys
 
 import vtk
 
+from render_bar import scalar_bar
+
 
 def main():
     if len(sys.argv) < 3:
@@ -56,21 +58,8 @@ def main():
 
     # The slice's colours, in a strip of their own beside the picture.
     signed = lo < 0.0
-    bar = vtk.vtkScalarBarActor()
-    bar.SetLookupTable(smap.GetLookupTable())
-    bar.SetTitle("signed\ndistance" if signed else "distance")
-    bar.SetNumberOfLabels(5)
-    bar.SetPosition(0.05, 0.15)
-    bar.SetWidth(0.9)
-    bar.SetHeight(0.7)
-    bar.SetBarRatio(0.25)
-    bar.SetVerticalTitleSeparation(10)
-    bar.UnconstrainedFontSizeOn()
-    for tp, size in ((bar.GetTitleTextProperty(), 14), (bar.GetLabelTextProperty(), 12)):
-        tp.SetColor(0, 0, 0)
-        tp.SetFontSize(size)
-        tp.ItalicOff()
-        tp.ShadowOff()
+    bar = scalar_bar(smap.GetLookupTable(), "signed\ndistance" if signed else "distance",
+                     14, 12)
     legend = vtk.vtkRenderer()
     legend.SetBackground(1, 1, 1)
     legend.SetViewport(0.82, 0.0, 1.0, 1.0)

@@ -16,6 +16,8 @@ import sys
 
 import vtk
 
+from render_bar import scalar_bar
+
 
 def read_surface(path):
     ext = os.path.splitext(path)[1].lower()
@@ -92,27 +94,6 @@ def mesh_actor(grid, opacity, table):
     a.GetProperty().SetOpacity(opacity)
     return a
 
-
-def scalar_bar(table, title):
-    """A vertical colour bar filling its renderer: title on top, labels
-    beside the bar, black text of one size."""
-    bar = vtk.vtkScalarBarActor()
-    bar.SetLookupTable(table)
-    bar.SetTitle(title)
-    bar.SetNumberOfLabels(5)
-    bar.SetPosition(0.05, 0.15)
-    bar.SetWidth(0.9)
-    bar.SetHeight(0.7)
-    bar.SetBarRatio(0.25)
-    bar.SetTitleRatio(0.5)
-    bar.SetVerticalTitleSeparation(12)
-    bar.UnconstrainedFontSizeOn()
-    for tp, size in ((bar.GetTitleTextProperty(), 16), (bar.GetLabelTextProperty(), 14)):
-        tp.SetColor(0, 0, 0)
-        tp.SetFontSize(size)
-        tp.ItalicOff()
-        tp.ShadowOff()
-    return bar
 
 
 def main():
