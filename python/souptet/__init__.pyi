@@ -59,6 +59,7 @@ def mesh(
     progress: Optional[Callable[[Dict[str, Any]], object]] = ...,
     float32: bool = ...,
     cancel: Optional[Cancel] = ...,
+    try_all: bool = ...,
 ) -> MeshResult: ...
 
 class Field:
