@@ -453,7 +453,7 @@ static int node_meets_tri(const st_bvh_node *n, const double *q[3],
                           const double qlo[3], const double qhi[3])
 {
     return boxes_meet(n->lo, n->hi, qlo, qhi) &&
-           st_tri_box_intersect(q[0], q[1], q[2], n->lo, n->hi);
+           st_tri_box_maybe(q[0], q[1], q[2], n->lo, n->hi);
 }
 
 int st_bvh_query_tri(const st_bvh *b, const double a[3], const double bb[3],

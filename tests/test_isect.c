@@ -548,6 +548,77 @@ static void test_tri_box(void)
               n, hits, bad);
 }
 
+/* st_tri_box_maybe never parts what meets (the exact test's 1 is its 1),
+ * at every scale and far from the origin, on touching cases built to be
+ * exact (a box corner on a vertex, a box face through a vertex); and it
+ * parts most of what the exact test parts, or it would not be a filter. */
+static double unit_rand(uint64_t *st)
+{
+    *st = *st * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(*st >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static void test_tri_box_maybe(void)
+{
+    int missed = 0, n = 0, exact_apart = 0, maybe_apart = 0;
+    for (int it = 0; it < 60000; it++) {
+        double a[3], b[3], c[3], blo[3], bhi[3];
+        rand_pt(a, 3);
+        rand_pt(b, 3);
+        rand_pt(c, 3);
+        for (int k = 0; k < 3; k++) {
+            double u = (double)rng_int(2), v = (double)rng_int(2);
+            if (u == v)
+                v = u + 1;
+            blo[k] = fmin(u, v);
+            bhi[k] = fmax(u, v);
+        }
+        int ex = st_tri_box_intersect(a, b, c, blo, bhi);
+        int mb = st_tri_box_maybe(a, b, c, blo, bhi);
+        n++;
+        missed += ex && !mb;
+    }
+    static const double scale[] = {1e-9, 1e-3, 1.0, 1e3, 1e9};
+    static const double shift[] = {0.0, 1.0, 1e5};
+    uint64_t st = 12345;
+    for (int si = 0; si < 5; si++)
+        for (int hi_ = 0; hi_ < 3; hi_++)
+            for (int it = 0; it < 4000; it++) {
+                const double S = scale[si], T = shift[hi_] * S;
+                double v[3][3], lo[3], hi[3];
+                for (int i = 0; i < 3; i++)
+                    for (int k = 0; k < 3; k++)
+                        v[i][k] = T + S * unit_rand(&st);
+                /* a small box near the triangle: its corner on vertex 0
+                 * (touching), or moved off it by a little (mostly apart) */
+                const int touch = it % 2 == 0;
+                for (int k = 0; k < 3; k++) {
+                    double w = 0.05 * S * unit_rand(&st);
+                    double off = touch ? 0.0 : 0.02 * S * (unit_rand(&st) - 0.5);
+                    if ((it / 2) % 2) {
+                        lo[k] = v[0][k] + off;
+                        hi[k] = lo[k] + w;
+                    } else {
+                        hi[k] = v[0][k] + off;
+                        lo[k] = hi[k] - w;
+                    }
+                }
+                if (touch && it % 8 == 0)   /* a box face through vertex 0 */
+                    lo[1] = hi[1] = v[0][1];
+                int ex = st_tri_box_intersect(v[0], v[1], v[2], lo, hi);
+                int mb = st_tri_box_maybe(v[0], v[1], v[2], lo, hi);
+                n++;
+                missed += ex && !mb;
+                exact_apart += !ex;
+                maybe_apart += !mb;
+            }
+    TAP_CHECK(missed == 0, "tri-box filter: no meeting pair parted (%d cases, %d missed)",
+              n, missed);
+    TAP_CHECK(exact_apart > 1000 && maybe_apart * 10 >= exact_apart * 9,
+              "tri-box filter: parts %d of the %d pairs the exact test parts", maybe_apart,
+              exact_apart);
+}
+
 /* ---- speed --------------------------------------------------------------------- */
 
 /* M calls/s of each test on pairs of small random triangles / tets / boxes
@@ -778,6 +849,7 @@ int main(void)
     test_tri_tri();
     test_tri_tet();
     test_tri_box();
+    test_tri_box_maybe();
     test_bvh_query_box();
     test_speed();
     return tap_done();

@@ -70,6 +70,14 @@ int st_tri_box_intersect(const double a[3], const double b[3],
                          const double c[3], const double lo[3],
                          const double hi[3]);
 
+/* 0 only when the closed triangle (a b c) certainly misses the closed box
+ * [lo, hi]; 1 when it may meet it: a floating-point filter with a proven
+ * slack (isect.c), for culling (a BVH walk whose visits must be a superset
+ * of the triangles that meet), several times cheaper than
+ * st_tri_box_intersect. Non-finite input: 1. */
+int st_tri_box_maybe(const double a[3], const double b[3], const double c[3],
+                     const double lo[3], const double hi[3]);
+
 /* 1 when p lies in the closed triangle (a b c) of any shape (collinear:
  * its segment; coincident: its point), else 0. (Added by isect.c's
  * author; not part of the original contract.) */
