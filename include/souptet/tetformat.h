@@ -1,13 +1,14 @@
 /*
  * tetformat.h - the tet-mesh formats: their one enum and writer options,
  * and the simulator formats themselves, plain C, no library: Gmsh .msh
- * (4.1 and 2.2, ASCII and binary), TetGen .node/.ele and Medit .mesh.
- * .vtu is the VTK adapter's. Tools and library callers read and write
+ * (4.1 and 2.2, ASCII and binary), TetGen .node/.ele and Medit .mesh,
+ * and the writing of .vtu (src/tetformat_vtu.c; reading .vtu is the VTK
+ * adapter's). Tools and library callers read and write
  * every format through one front door, tetio.h (st_tetmesh_read,
  * st_tetmesh_save, st_tetmesh_write), which dispatches here; the
  * per-format functions below are for tests, fuzzers and callers that
  * hold the bytes. (One file per format: src/tetformat_msh.c,
- * tetformat_tetgen.c, tetformat_medit.c.)
+ * tetformat_tetgen.c, tetformat_medit.c, tetformat_vtu.c.)
  *
  * What is kept. Points and tets, exactly (coordinates are written with 17
  * significant digits or as raw doubles, so a round trip is bit-exact), and

@@ -1,13 +1,15 @@
 /*
  * tetio.h - tet meshes on disk and on pipes: the one front door for
  * reading and writing every tet-mesh format (tetformat.h names them:
- * .vtu here, in the VTK adapter src/adapters/tetio_vtu.cpp; .msh,
- * .node/.ele and .mesh in tetformat_*.c).
+ * .msh, .node/.ele and .mesh in tetformat_*.c; .vtu written by
+ * tetformat_vtu.c in C, read by the VTK adapter src/adapters/tetio_vtu.cpp).
  *
  * .vtu: VTK XML UnstructuredGrid, binary, zlib-compressed, VTK_TETRA
  * cells. The writer adds per-cell arrays min_dihedral, max_dihedral and
  * volume (degrees, model units^3) and stores the mesh's meta entries
- * (source, h, lattice, parameters, history, ...) as string field data,
+ * (source, h, lattice, parameters, history, ...) as field data (a
+ * UInt64 for a canonical integer, a Float64 for an exact %.17g number,
+ * else UInt8 bytes),
  * plus the mesh's own named arrays. The reader restores all of it; cells
  * that are not tetrahedra are refused with a message.
  *
