@@ -37,6 +37,7 @@
 
 #include "souptet/enclose.h"
 #include "souptet/err.h"
+#include "souptet/parts.h"
 #include "souptet/pseudo.h"
 #include "souptet/progress.h"
 #include "souptet/smooth.h"
@@ -138,6 +139,12 @@ typedef struct st_pipeline_params {
                               double, and no meta "float32" (0) */
     st_pipeline_event_fn on_event;   /* may be NULL (NULL) */
     void *on_event_ctx;
+    const st_parts *parts; /* the soup's parts (st_parts_split of the
+                              soup given to st_pipeline_run): the chosen
+                              mesh is tagged (st_parts_tag, on the run's
+                              field grid and pseudo-volume settings), and
+                              stats->parts says how. NULL: no parts, and
+                              the output is as without them (NULL) */
 } st_pipeline_params;
 
 st_pipeline_params st_pipeline_params_default(void);
@@ -186,6 +193,10 @@ typedef struct st_pipeline_stats {
                                             boundary is fill, and how far
                                             from the input (pseudo.h; all 0
                                             for closed shells alone) */
+    st_parts_tag_stats parts;            /* with p->parts: per part (the
+                                            caller frees it with
+                                            st_parts_tag_stats_free, also
+                                            on failure; all 0 without) */
 } st_pipeline_stats;
 
 /* The lattice cell width p gives for s: p->h, or the width of p->cells

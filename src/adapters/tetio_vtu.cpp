@@ -12,7 +12,8 @@
  *              model units^3), computed at every write (min_dihedral is
  *              the active scalars, so ParaView colours by it at once),
  *              then the mesh's own per-cell arrays; point data: the mesh's
- *              per-point arrays. All vtkDoubleArray.
+ *              per-point arrays. All vtkDoubleArray but "part" (the
+ *              part index, parts.h), a vtkIntArray (Int32).
  *   field data every st_meta entry (source, h, lattice, parameters,
  *              history, ...) named by its key, in st_meta order: a
  *              canonical non-negative integer (seed, candidates) as a
@@ -57,6 +58,7 @@
 #include <vtkCellType.h>
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
+#include <vtkIntArray.h>
 #include <vtkErrorCode.h>
 #include <vtkFieldData.h>
 #include <vtkIdTypeArray.h>
@@ -208,6 +210,19 @@ st_status build_grid(vtkUnstructuredGrid *ug, const st_tetmesh *m,
             return st_error_set(err, ST_EINTERNAL, name, 0,
                                 "mesh array '%s' has %d components",
                                 arr->name, arr->ncomp);
+        if (std::strcmp(arr->name, "part") == 0 && arr->ncomp == 1) {
+            // the part index (parts.h): Int32, as simulators read tags
+            vtkNew<vtkIntArray> a;
+            a->SetName(arr->name);
+            a->SetNumberOfValues(vtkIdType(n));
+            for (size_t k = 0; k < n; k++)
+                a->SetValue(vtkIdType(k), int(arr->values[k]));
+            if (on_cells)
+                cd->AddArray(a);
+            else
+                ug->GetPointData()->AddArray(a);
+            continue;
+        }
         vtkNew<vtkDoubleArray> a;
         a->SetName(arr->name);
         a->SetNumberOfComponents(arr->ncomp);
