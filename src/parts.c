@@ -577,7 +577,8 @@ static void tag_tet(const st_tetmesh *m, size_t t, const st_grid *g, const uint1
     *share = (double)best_n / (double)n;
 }
 
-static st_status set_part_meta(st_tetmesh *m, const st_parts *p, st_error *err)
+static st_status set_part_meta(st_tetmesh *m, const st_parts *p, const double *pv,
+                               st_error *err)
 {
     char key[48], buf[32];
     snprintf(buf, sizeof buf, "%zu", p->nparts);
@@ -586,6 +587,12 @@ static st_status set_part_meta(st_tetmesh *m, const st_parts *p, st_error *err)
     for (size_t k = 0; k < p->nparts; k++) {
         snprintf(key, sizeof key, "part_name_%zu", k);
         if (st_meta_set(&m->meta, key, p->names[k]))
+            return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    for (size_t k = 0; k < p->nparts; k++) {
+        snprintf(key, sizeof key, "part_pseudo_volume_%zu", k);
+        snprintf(buf, sizeof buf, "%.17g", pv[k]);
+        if (st_meta_set(&m->meta, key, buf))
             return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     }
     return ST_OK;
@@ -658,7 +665,7 @@ st_status st_parts_tag(st_tetmesh *m, const st_soup *s, const st_parts *p,
         sts->volume[part[t]] += vol[t];
         sts->uncovered += share[t] == 0;
     }
-    st = set_part_meta(m, p, err);
+    st = set_part_meta(m, p, sts->pseudo_volume, err);
 out:
     st_bvh_free(bvh);
     free(own);
@@ -693,5 +700,55 @@ st_status st_parts_of_mesh(const char ***names, size_t *count, const st_tetmesh 
     }
     *names = nm;
     *count = (size_t)n;
+    return ST_OK;
+}
+
+st_status st_parts_measure(st_parts_tag_stats *out, const st_tetmesh *m, st_error *err)
+{
+    memset(out, 0, sizeof *out);
+    const st_tet_array *pa = st_tetmesh_find_array(m, "part", ST_ON_CELLS);
+    const st_tet_array *sa = st_tetmesh_find_array(m, "part_share", ST_ON_CELLS);
+    if (!pa || pa->ncomp != 1 || m->ntets == 0)
+        return ST_OK;
+    const char **names = NULL;
+    size_t n = 0;
+    st_status st = st_parts_of_mesh(&names, &n, m, err);
+    free((void *)names);
+    if (st)
+        return st;
+    for (size_t t = 0; t < m->ntets; t++) {
+        const double x = pa->values[t];
+        if (x >= 0 && x < ST_PARTS_MAX && x == floor(x) && (size_t)x >= n)
+            n = (size_t)x + 1;
+    }
+    if (n == 0)
+        return ST_OK;
+    out->nparts = n;
+    out->pseudo_volume = st_realloc_array(NULL, n, sizeof *out->pseudo_volume);
+    out->tets = calloc(n, sizeof *out->tets);
+    out->volume = calloc(n, sizeof *out->volume);
+    double *vol = st_realloc_array(NULL, m->ntets, sizeof *vol);
+    if (!out->pseudo_volume || !out->tets || !out->volume || !vol) {
+        free(vol);
+        st_parts_tag_stats_free(out);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    for (size_t k = 0; k < n; k++) {
+        char key[48];
+        snprintf(key, sizeof key, "part_pseudo_volume_%zu", k);
+        const char *v = st_meta_get(&m->meta, key);
+        char *end = NULL;
+        const double x = v ? strtod(v, &end) : NAN;
+        out->pseudo_volume[k] = v && *v && !*end ? x : NAN;
+    }
+    st_tetmesh_quality(m, NULL, NULL, vol);
+    for (size_t t = 0; t < m->ntets; t++) {
+        const double x = pa->values[t];
+        const size_t k = x >= 0 && x < (double)n && x == floor(x) ? (size_t)x : 0;
+        out->tets[k]++;
+        out->volume[k] += vol[t];
+        out->uncovered += sa && sa->ncomp == 1 && sa->values[t] == 0;
+    }
+    free(vol);
     return ST_OK;
 }

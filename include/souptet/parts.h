@@ -101,11 +101,20 @@ void st_parts_tag_stats_free(st_parts_tag_stats *st);
  * read), each part's pseudo volume made with pp (st_pseudo_params). Adds
  * the cell arrays "part" (the part index) and "part_share" (0..1), and
  * meta "parts" (the count) and "part_name_K" for each part K. stats may be
- * NULL. prog's cancel flag is polled between parts. */
+ * NULL. prog's cancel flag is polled between parts. Meta
+ * "part_pseudo_volume_K" keeps each part's pseudo volume (%.17g). */
 st_status st_parts_tag(st_tetmesh *m, const st_soup *s, const st_parts *p,
                        const st_grid *g, const st_pseudo_params *pp,
                        st_parts_tag_stats *stats, const st_progress *prog,
                        st_error *err);
+
+/* What a tagged mesh says of its parts (tetstat): per part, from the
+ * cell arrays "part" and "part_share" and the meta, the tets and their
+ * volume (st_tetmesh_quality's, signed), the pseudo volume st_parts_tag
+ * recorded (meta "part_pseudo_volume_K"; NAN where missing), and the
+ * tets no part covered (share 0) in uncovered. out->nparts is 0 for a
+ * mesh without parts (ST_OK). ST_ENOMEM. */
+st_status st_parts_measure(st_parts_tag_stats *out, const st_tetmesh *m, st_error *err);
 
 /* The parts a mesh's meta names (st_parts_tag's "parts", "part_name_K"):
  * *count, and names[K] borrowed from m's meta (NULL where missing); 0 and

@@ -105,6 +105,18 @@ check "nested boxes: >= 90% of tets in the bone tagged bone, >= 90% of the other
     $PY nested_check.py nested.vtu
 sed 's/^/#   /' "$WORK/.out"
 
+check "tetstat: tets and volume per part, and the pseudo volume" sh -c \
+    "tetstat nested.vtu | grep -Eq '^  1 +bone +[0-9]+ tets, volume [0-9.]+, its pseudo volume [0-9.]+ \(ratio 0\.[89]|^  1 +bone .*\(ratio 1\.[01]'"
+check "tetstat --json: the parts" sh -c "tetstat --json nested.vtu | $PY -c '
+import json, sys
+d = json.load(sys.stdin)
+p = d[\"parts\"]
+assert [x[\"name\"] for x in p] == [\"flesh\", \"bone\"], p
+assert sum(x[\"tets\"] for x in p) == d[\"tets\"], p
+assert 0.5 < p[1][\"volume_ratio\"] < 2, p'"
+check "tetstat: no parts section without parts" sh -c \
+    "soupmesh -q --cells 6 -o p6.vtu nested.obj && ! tetstat p6.vtu | grep -q '^parts'"
+
 # ---- the formats -------------------------------------------------------------
 check "nested boxes: .msh" soupmesh -q --parts names --cells 12 -o nested.msh nested.obj
 cat >msh_check.py <<'PY'
