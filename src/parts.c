@@ -340,6 +340,40 @@ out:
     return st;
 }
 
+st_status st_parts_from_indices(st_parts *out, const uint32_t *part, size_t ntris,
+                                const char *const *names, size_t nnames, st_error *err)
+{
+    memset(out, 0, sizeof *out);
+    size_t n = 0;
+    for (size_t t = 0; t < ntris; t++) {
+        if (part[t] >= ST_PARTS_MAX)
+            return st_error_set(err, ST_EINPUT, NULL, 0,
+                                "triangle %zu: part %lu, past the %d parts allowed", t,
+                                (unsigned long)part[t], ST_PARTS_MAX);
+        if (part[t] >= n)
+            n = (size_t)part[t] + 1;
+    }
+    if (n == 0)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "no triangles");
+    st_status st = alloc_split(out, ntris, n, err);
+    for (size_t t = 0; t < ntris && !st; t++) {
+        out->tri_part[t] = (uint16_t)part[t];
+        out->tris_of[part[t]]++;
+    }
+    for (size_t k = 0; k < n && !st; k++) {
+        if (!(out->names[k] = part_name(out, names && k < nnames ? names[k] : NULL, k)))
+            st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        else
+            out->nparts = k + 1;
+    }
+    out->mode = ST_PARTS_NAMES;
+    if (!st)
+        st = unique_names(out, err);
+    if (st)
+        st_parts_free(out);
+    return st;
+}
+
 st_status st_parts_split(st_parts *out, const st_soup *s, st_parts_mode mode,
                          st_error *err)
 {
@@ -506,7 +540,9 @@ static st_status owner_grid(uint16_t **owner, const st_soup *s, const st_parts *
         if ((st = part_soup(&q, s, p, (uint16_t)k, map, err)))
             break;
         order[k].part = k;
-        st = part_voxels(&vox[k], &order[k].voxels, q, g, pp, prog, err);
+        order[k].voxels = 0;
+        if (q->ntris)   /* a caller's part may have no triangles: no solid */
+            st = part_voxels(&vox[k], &order[k].voxels, q, g, pp, prog, err);
         st_soup_free(q);
         if (!st && stats)
             stats->pseudo_volume[k] = (double)order[k].voxels * g->voxel * g->voxel * g->voxel;

@@ -65,7 +65,8 @@ typedef struct st_parts {
     uint16_t *tri_part;   /* ntris entries: each triangle's part */
     size_t ntris;
     char **names;         /* nparts unique UTF-8 names */
-    size_t *tris_of;      /* nparts: triangles per part (each >= 1) */
+    size_t *tris_of;      /* nparts: triangles per part (>= 1 from
+                             st_parts_split) */
     size_t nparts;
     st_parts_mode mode;   /* what was used: NAMES or PIECES */
     /* What was handled on the way (a tool says it): */
@@ -82,6 +83,15 @@ typedef struct st_parts {
 st_status st_parts_split(st_parts *out, const st_soup *s, st_parts_mode mode,
                          st_error *err);
 void st_parts_free(st_parts *p);   /* safe on NULL and on a zeroed one */
+
+/* The parts a caller gives: part[t] for each of ntris triangles (each <
+ * ST_PARTS_MAX; the parts are 0..max), names[k] for k < nnames (names may
+ * be NULL; a missing, empty or non-UTF-8 name becomes part_K, duplicates
+ * are suffixed, as st_parts_split does). A part no triangle names has
+ * tris_of 0 and no solid. mode is NAMES. ST_EINPUT for an index too large
+ * (naming the triangle), ST_ENOMEM. */
+st_status st_parts_from_indices(st_parts *out, const uint32_t *part, size_t ntris,
+                                const char *const *names, size_t nnames, st_error *err);
 
 /* What st_parts_tag measured: per part (nparts entries each, the caller
  * frees with st_parts_tag_stats_free) its pseudo volume (inside voxels
