@@ -156,6 +156,13 @@ import meshio, numpy as np
 m = meshio.read(\"emb.vtu\")
 assert list(m.point_data[\"part\"]) == [0] * 8 + [1] * 8, m.point_data[\"part\"]'"
 
+check "latticetet --sculpt --parts: the pipe of tools tags the tets too" sh -c \
+    "soupdist nested.obj | soupsign --surface nested.obj |
+     latticetet --sculpt --surface nested.obj --parts names --cells 8 |
+     tetsmooth --fit --surface nested.obj -o lt.vtu && tetstat lt.vtu | grep -Eq '^  1 +bone +[0-9]+ tets'"
+expect_fail "latticetet --parts without --sculpt: usage" 2 "--parts goes with --sculpt" \
+    latticetet --density 0.5 --parts names -o x.vtu nested.obj
+
 # ---- glTF nodes, groups, pieces ---------------------------------------------
 cat >gltf2.py <<'PY'
 import base64, json, struct
