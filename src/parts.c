@@ -267,8 +267,6 @@ static st_status split_names(st_parts *p, const st_soup *s, st_error *err)
         k++;
     }
     p->nparts = nparts;
-    /* the leading unnamed run of a file whose names start at once is not
-     * counted: only named runs and runs before them that hold faces are */
 out:
     free(start);
     free(nm);

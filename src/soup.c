@@ -126,8 +126,12 @@ st_status st_soup_add_triangle(st_soup *s, uint32_t a, uint32_t b, uint32_t c,
 st_status st_soup__push_name(st_soup *s, int level, const unsigned char *name,
                              size_t len)
 {
-    if (len > ST_SOUP_NAME_MAX)
+    if (len > ST_SOUP_NAME_MAX) {
+        /* cut before a UTF-8 sequence, not inside it */
         len = ST_SOUP_NAME_MAX;
+        while (len > 0 && (name[len] & 0xc0) == 0x80)
+            len--;
+    }
     if (grow((void **)&s->names, s->nnames, sizeof *s->names) != 0)
         return ST_ENOMEM;
     char *c = malloc(len + 1);

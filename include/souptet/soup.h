@@ -51,8 +51,9 @@ typedef enum st_soup_format {
  * derived from the counts. */
 /* One named run of triangles: from triangle `first` up to the next run
  * of the same level (or the end). level 1: an OBJ object (`o`), a glTF
- * mesh node, an STL solid; level 2: an OBJ group (`g`, the first name on
- * the line). name is the file's bytes up to the line's end, NUL-terminated
+ * mesh node, an STL solid; level 2: an OBJ group (`g`). name is the
+ * rest of the line (blanks at both ends trimmed; "g a b" is "a b"), or the
+ * glTF node's (else its mesh's) name: bytes, NUL-terminated, at most 255
  * (not checked as UTF-8; may be ""). */
 typedef struct st_soup_name {
     size_t first;

@@ -191,6 +191,15 @@ check "OFF without names, --parts auto: 25 pieces, 25 groups" sh -c \
     "soupmesh -q --parts auto --cells 10 -o cubes.msh cubes.off &&
      $PY msh_check.py cubes.msh $(seq -f 'piece_%g' 0 24 | tr '\n' ' ')"
 
+check "the tags do not depend on the thread count (1 and 2 threads)" sh -c \
+    "soupmesh -q --threads 1 --parts auto --cells 10 -o t1.vtu cubes.off &&
+     soupmesh -q --threads 2 --parts auto --cells 10 -o t2.vtu cubes.off && $PY -c '
+import meshio, numpy as np
+a, b = meshio.read(\"t1.vtu\"), meshio.read(\"t2.vtu\")
+assert np.array_equal(a.points, b.points)
+for k in (\"part\", \"part_share\"):
+    assert np.array_equal(a.cell_data[k][0], b.cell_data[k][0]), k'"
+
 # ---- bad input ---------------------------------------------------------------
 check "bad names: meshed" sh -c "soupmesh --parts names --cells 8 -o bad.msh bad.obj 2>bad.err"
 check "an object without faces is skipped, said" grep -q "bad.obj: warning: 1 named part without faces skipped (first: 'empty')" bad.err
