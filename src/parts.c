@@ -378,8 +378,13 @@ st_status st_parts_split(st_parts *out, const st_soup *s, st_parts_mode mode,
     memset(out, 0, sizeof *out);
     if (!s || s->ntris == 0)
         return st_error_set(err, ST_EINPUT, NULL, 0, "the soup has no triangles");
-    if (mode == ST_PARTS_AUTO)
-        mode = s->nnames ? ST_PARTS_NAMES : ST_PARTS_PIECES;
+    if (mode == ST_PARTS_AUTO) {
+        /* names where the file gives one (an STL's bare "solid" is none) */
+        mode = ST_PARTS_PIECES;
+        for (size_t i = 0; i < s->nnames; i++)
+            if (s->names[i].name[0])
+                mode = ST_PARTS_NAMES;
+    }
     st_status st;
     if (mode == ST_PARTS_NAMES)
         st = split_names(out, s, err);

@@ -93,6 +93,17 @@ static void test_groups_utf8_stl(void)
               "STL: solid names, an unnamed solid by index");
     st_parts_free(&p);
     st_soup_free(s);
+
+    /* a bare "solid" names nothing: auto takes the pieces */
+    s = parse(ST_SOUP_STL, "solid\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                           "vertex 0 1 0\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\n"
+                           "vertex 5 0 0\nvertex 6 0 0\nvertex 5 1 0\nendloop\nendfacet\n"
+                           "endsolid\n");
+    TAP_CHECK(s && st_parts_split(&p, s, ST_PARTS_AUTO, &err) == ST_OK &&
+                  p.mode == ST_PARTS_PIECES && p.nparts == 2,
+              "STL with a bare solid, auto: 2 pieces");
+    st_parts_free(&p);
+    st_soup_free(s);
 }
 
 /* Two disjoint tetrahedra's surfaces, and a degenerate triangle on one. */

@@ -52,7 +52,8 @@ extern "C" {
 
 typedef enum st_parts_mode {
     ST_PARTS_NONE = 0,
-    ST_PARTS_AUTO,       /* names where the file has them, else pieces */
+    ST_PARTS_AUTO,       /* names where the file has any (not empty),
+                            else pieces */
     ST_PARTS_NAMES,      /* the file's names (one part when it has none) */
     ST_PARTS_PIECES      /* edge-connected pieces */
 } st_parts_mode;
