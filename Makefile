@@ -76,7 +76,7 @@ LDFLAGS_ALL := $(OPT) -fopenmp $(LDFLAGS)
 # tools link too. Each as a static archive (the tools and tests) and a
 # shared library with a soname, exporting only the names its public
 # headers declare (scripts/exports writes the version scripts).
-IO_C     := src/gridio.c src/tetio.c src/vtkxml.c src/wrap.c
+IO_C     := src/gridio.c src/gridio_path.c src/tetio.c src/tetio_write.c src/vtkxml.c src/wrap.c
 CORE_C   := $(filter-out $(IO_C),$(sort $(wildcard src/*.c)))
 LIB_CXX  := $(sort $(wildcard src/adapters/*.cpp))
 TOOLS   := $(basename $(notdir $(sort $(wildcard src/tools/*.c))))
@@ -92,7 +92,7 @@ LIBA      := $(LIBA_IO) $(LIBA_CORE)
 SOVERSION := 0
 LIBSO_CORE := $(BUILD)/libsouptet.so.$(VERSION)
 LIBSO_IO   := $(BUILD)/libsouptet-io.so.$(VERSION)
-CORE_LIBS := -lxxhash $(OMPLIB) -lm
+CORE_LIBS := -lxxhash -lz $(OMPLIB) -lm
 IO_LIBS   := -lopenvdb -ltbb -lImath-3_1 \
         -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
         -lvtkCommonDataModel-9.1 -lvtkCommonMath-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1
@@ -166,9 +166,12 @@ $(LIBSO_IO): $(IO_OBJ) $(LIBSO_CORE) $(BUILD)/libsouptet-io.map
 	ln -sf libsouptet-io.so.$(SOVERSION) $(BUILD)/libsouptet-io.so
 
 # Tools and tests link with the C++ driver: the adapters need libstdc++.
+# A tool keeps only the libraries it calls (--as-needed): one that reads
+# and writes no field or .vtu input (soupmesh) then loads neither OpenVDB
+# nor VTK, whose relocations cost a process about 60 ms (issue 41).
 $(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(CLI_OBJ) $(LIBA)
 	@mkdir -p $(dir $@)
-	$(CXX) $(LDFLAGS_ALL) $< $(CLI_OBJ) $(LIBA) $(LIBS) -o $@
+	$(CXX) $(LDFLAGS_ALL) $< $(CLI_OBJ) $(LIBA) -Wl,--as-needed $(LIBS) -o $@
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA)
 	@mkdir -p $(dir $@)
 	$(CXX) $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@

@@ -19,16 +19,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-st_grid_format st_grid_format_from_path(const char *path)
-{
-    static const char *const ext[] = {"vdb", "vti"};
-    switch (st_path_ext_match(path, ext, 2, 0)) {
-    case 0: return ST_GRID_FMT_VDB;
-    case 1: return ST_GRID_FMT_VTI;
-    default: return ST_GRID_FMT_UNKNOWN;
-    }
-}
-
 st_status st_grid_write(const st_grid *g, const char *path, st_error *err)
 {
     if (st_path_is_stdio(path))

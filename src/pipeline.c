@@ -361,6 +361,50 @@ static int better(const st_pipeline_candidate *a, size_t ka,
     return ka < kb;
 }
 
+/* 1 when candidate c meets every goal: it encloses, meets the fit's
+ * stopping condition, and every tet scores at least the quality pass's
+ * goal (smooth.h: min dihedral >= 35 degrees, max <= 133.3 by default).
+ * A better one could only have larger angles within these. */
+static int meets_goals(const st_pipeline_candidate *c, const st_pipeline_params *p)
+{
+    const double goal = st_fit_params_default().quality_goal;
+    if (c->failed || c->verts_outside || c->tris_crossing || !c->converged)
+        return 0;
+    if (p->density_rho > 0)
+        return 0;   /* the Spillmann mesher has no such goal */
+    return c->min_dihedral >= goal && ST_FIT_MAX_WEIGHT * (180.0 - c->max_dihedral) >= goal;
+}
+
+/* Candidate k, start to end, its event included. */
+static void run_candidate(st_tetmesh **meshes, st_pipeline_stats *st, size_t k,
+                          const st_grid *g, const st_soup *s, const st_bvh *bvh,
+                          const st_soup *fill, double h, const st_pipeline_params *p,
+                          const st_progress *prog)
+{
+    st_pipeline_candidate *c = &st->candidates[k];
+    st_error e;
+    st_error_clear(&e);
+    st_status r = p->density_rho > 0
+        ? run_density_candidate(&meshes[k], c, g, s, bvh, h, p, &e)
+        : run_sculpt_candidate(&meshes[k], c, k, g, s, bvh, fill, h, p, prog, &e);
+    if (r) {
+        c->failed = 1;
+        st_error_format(&e, c->message, sizeof c->message);
+    } else {
+        c->tets = meshes[k]->ntets;
+        c->points = meshes[k]->npoints;
+        dihedral_range(meshes[k], &c->min_dihedral, &c->max_dihedral);
+    }
+    st_pipeline_event ev;
+    memset(&ev, 0, sizeof ev);
+    ev.what = "candidate";
+    ev.k = k;
+    ev.h = h;
+    ev.tets = c->tets;
+    ev.candidate = c;
+    emit(p, &ev);
+}
+
 /* The field and the pseudo volume's settings a run uses (voxels along the
  * longest side of the soup's box, its hole caps and closed shells): one
  * place for st_pipeline_run and st_pipeline_field_of_mesh. */
@@ -534,49 +578,41 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     for (size_t k = 0; k < K; k++)
         st->candidates[k].seed = st_pipeline_candidate_seed(p->seed, k);
 
-    /* One thread per candidate when there are several; a single candidate
-     * keeps all threads for its own loops, and reports the fit's progress
-     * (several report only as each one finishes: the reporter is not
-     * called from two threads at once). */
-    size_t finished = 0;
+    /* Batches of ST_PIPELINE_BATCH candidates in index order, one thread
+     * per candidate when a batch has several; a single candidate keeps all
+     * threads for its own loops, and reports the fit's progress (several
+     * report only as each one finishes: the reporter is not called from
+     * two threads at once). After each batch, a candidate that meets every
+     * goal ends the run (pipeline.h): the batches do not depend on the
+     * thread count, so neither does which candidates ran. */
+    size_t finished = 0, ran = 0;
     /* several candidates: their fits see the cancel flag alone */
     st_progress cancel_only = {NULL, NULL, prog ? prog->cancel : NULL};
-    int nthreads = K > 1 ? omp_get_max_threads() : 1;
-    if ((size_t)nthreads > K)
-        nthreads = (int)K;
-    #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
-    for (size_t k = 0; k < K; k++) {
-        st_pipeline_candidate *c = &st->candidates[k];
-        st_error e;
-        st_error_clear(&e);
-        if (st_progress_cancelled(prog))
-            continue;
-        st_status r = p->density_rho > 0
-            ? run_density_candidate(&meshes[k], c, g, s, bvh, h, p, &e)
-            : run_sculpt_candidate(&meshes[k], c, k, g, s, bvh, fill, h, p,
-                                   K == 1 ? prog : &cancel_only, &e);
-        if (r) {
-            c->failed = 1;
-            st_error_format(&e, c->message, sizeof c->message);
-        } else {
-            c->tets = meshes[k]->ntets;
-            c->points = meshes[k]->npoints;
-            dihedral_range(meshes[k], &c->min_dihedral, &c->max_dihedral);
+    for (size_t b0 = 0; b0 < K && !st->goal_met; b0 += ST_PIPELINE_BATCH) {
+        size_t b1 = b0 + ST_PIPELINE_BATCH < K ? b0 + ST_PIPELINE_BATCH : K;
+        int nthreads = b1 - b0 > 1 ? omp_get_max_threads() : 1;
+        if ((size_t)nthreads > b1 - b0)
+            nthreads = (int)(b1 - b0);
+        #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+        for (size_t k = b0; k < b1; k++) {
+            if (st_progress_cancelled(prog))
+                continue;
+            run_candidate(meshes, st, k, g, s, bvh, fill, h, p,
+                          K == 1 ? prog : &cancel_only);
+            #pragma omp critical(st_pipeline_progress)
+            {
+                finished++;
+                st_progress_report(prog, "candidates", (double)finished / (double)K);
+            }
         }
-        st_pipeline_event ev;
-        memset(&ev, 0, sizeof ev);
-        ev.what = "candidate";
-        ev.k = k;
-        ev.h = h;
-        ev.tets = c->tets;
-        ev.candidate = c;
-        emit(p, &ev);
-        #pragma omp critical(st_pipeline_progress)
-        {
-            finished++;
-            st_progress_report(prog, "candidates", (double)finished / (double)K);
-        }
+        ran = b1;
+        for (size_t k = b0; k < b1 && !p->try_all; k++)
+            if (meets_goals(&st->candidates[k], p))
+                st->goal_met = 1;
     }
+    st->ncandidates = ran;
+    if (ran < K)
+        st_progress_report(prog, "candidates", 1.0);
     st->seconds_candidates = now_seconds() - t_cand;
     if (st_progress_cancelled(prog)) {
         rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
@@ -584,7 +620,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     }
 
     size_t best = 0;
-    for (size_t k = 1; k < K; k++)
+    for (size_t k = 1; k < st->ncandidates; k++)
         if (better(&st->candidates[k], k, &st->candidates[best], best))
             best = k;
     if (st->candidates[best].failed) {

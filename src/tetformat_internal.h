@@ -390,6 +390,13 @@ void st_tf_write_ele_fp(FILE *fp, const st_tetmesh *m);
 void st_tf_write_medit_fp(FILE *fp, const st_tetmesh *m,
                           const uint32_t *faces, size_t nfaces);
 
+/* .vtu (tetformat_vtu.c): m as a VTK XML UnstructuredGrid document in a
+ * malloc'd buffer (name: for messages), or written to the file path
+ * (exactly there, no temporary). */
+st_status st_tf_write_vtu_mem(unsigned char **data, size_t *size, const st_tetmesh *m,
+                              const char *name, st_error *err);
+st_status st_tf_write_vtu_path(const st_tetmesh *m, const char *path, st_error *err);
+
 /* m to path in format f (NONE: by path; MSH, TETGEN or MEDIT) with opts
  * (NULL: defaults), atomically: every file (both of a TetGen pair) goes
  * to a temporary name beside its target and is renamed only when all

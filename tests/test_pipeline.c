@@ -53,6 +53,7 @@ int main(void)
     p.cells = 4;
     p.field_cells = 40;
     p.tries = 3;
+    p.try_all = 1;
     st_error err;
 
     TAP_CHECK(st_pipeline_candidate_seed(7, 0) == 7, "candidate 0 takes the seed itself");
@@ -96,6 +97,46 @@ int main(void)
               c.field, c.sculpted, c.candidate);
     TAP_CHECK(c.iteration >= 3 && !c.bad, "events: the fit's iterations, well formed (%zu)",
               c.iteration);
+
+    /* Without try_all: the first batch (ST_PIPELINE_BATCH) runs, and the
+     * rest only when none of it meets every goal; the same for any thread
+     * count, and the winner is the best of those that ran. */
+    {
+        p.try_all = 0;
+        size_t goal_k = SIZE_MAX;
+        for (size_t k = 0; k < ST_PIPELINE_BATCH && k < st1.ncandidates; k++) {
+            const st_pipeline_candidate *q = &st1.candidates[k];
+            if (!q->failed && !q->verts_outside && !q->tris_crossing && q->converged &&
+                q->min_dihedral >= 35.0 && 0.75 * (180.0 - q->max_dihedral) >= 35.0)
+                goal_k = k;
+        }
+        size_t want = goal_k != SIZE_MAX ? ST_PIPELINE_BATCH : 3;
+        st_tetmesh *m3 = NULL, *m4 = NULL;
+        st_pipeline_stats st3, st4;
+        omp_set_num_threads(1);
+        st_status r3 = st_pipeline_run(&m3, &st3, s, &p, NULL, &err);
+        omp_set_num_threads(2);
+        st_status r4 = st_pipeline_run(&m4, &st4, s, &p, NULL, &err);
+        TAP_CHECK(r3 == ST_OK && r4 == ST_OK && st3.ncandidates == want &&
+                  st4.ncandidates == want && st3.goal_met == (goal_k != SIZE_MAX) &&
+                  same_mesh(m3, m4),
+                  "without try_all: %zu of 3 candidates ran (goal met by %zu), "
+                  "the same for 1 and 2 threads", st3.ncandidates, goal_k);
+        size_t b = 0;
+        for (size_t k = 1; k < want; k++) {
+            const st_pipeline_candidate *x = &st1.candidates[k], *y = &st1.candidates[b];
+            if (x->min_dihedral > y->min_dihedral ||
+                (x->min_dihedral == y->min_dihedral && x->max_dihedral < y->max_dihedral))
+                b = k;
+        }
+        TAP_CHECK(r3 == ST_OK && st3.best == b &&
+                  st3.candidates[b].min_dihedral == st1.candidates[b].min_dihedral,
+                  "without try_all: the best of those that ran (%zu), as with try_all", b);
+        free(st3.candidates);
+        free(st4.candidates);
+        st_tetmesh_free(m3);
+        st_tetmesh_free(m4);
+    }
     free(st1.candidates);
     free(st2.candidates);
     st_tetmesh_free(m2);

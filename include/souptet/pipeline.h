@@ -10,9 +10,16 @@
  * Candidates (Stuart et al. 2013, section 3.4). Candidate k lays its
  * lattice with seed st_pipeline_candidate_seed(seed, k): a random rotation
  * and offset per candidate (seed 0 and k 0: the axis-aligned lattice). The
- * candidates run in parallel (one OpenMP thread each; each candidate's own
- * loops then run on one thread), and the winner is chosen by a total order
- * that does not depend on which finished first:
+ * candidates run in batches of ST_PIPELINE_BATCH in index order, the
+ * candidates of a batch in parallel (one OpenMP thread each; each
+ * candidate's own loops then run on one thread). Once a batch has ended
+ * with a candidate that meets every goal (it encloses, meets the fit's
+ * stopping condition, and every tet scores at least the quality pass's
+ * goal: min dihedral >= 35 and max <= 133.3 degrees by default, smooth.h),
+ * no further batch runs, unless try_all: stats->ncandidates says how many
+ * ran, stats->goal_met why. Which ran does not depend on the thread count.
+ * Of those that ran, the winner is chosen by a total order that does not
+ * depend on which finished first:
  *   1. enclosing before not enclosing (no soup vertex outside the mesh, no
  *      soup triangle meeting the boundary, counted exactly);
  *   2. the fit's stopping condition met (every boundary vertex within
@@ -52,6 +59,9 @@ extern "C" {
 #define ST_PIPELINE_MAX_TRIES 1024
 /* Most lattice cells along the longest side (as soupmesh --cells). */
 #define ST_PIPELINE_MAX_CELLS 4096
+/* Candidates per batch (see above): a fixed count, so that which
+ * candidates run does not depend on the thread count. */
+#define ST_PIPELINE_BATCH 2
 /* Sculpts at most when choosing h for target_tets. */
 #define ST_PIPELINE_SIZE_STEPS 10
 
@@ -139,6 +149,8 @@ typedef struct st_pipeline_params {
                               double, and no meta "float32" (0) */
     st_pipeline_event_fn on_event;   /* may be NULL (NULL) */
     void *on_event_ctx;
+    int try_all;           /* 1: run all tries candidates even once one
+                              meets every goal (0) */
     const st_parts *parts; /* the soup's parts (st_parts_split of the
                               soup given to st_pipeline_run): the chosen
                               mesh is tagged (st_parts_tag, on the run's
@@ -193,6 +205,9 @@ typedef struct st_pipeline_stats {
                                             boundary is fill, and how far
                                             from the input (pseudo.h; all 0
                                             for closed shells alone) */
+    int goal_met;                        /* 1: a candidate met every goal
+                                            and ended the run, maybe before
+                                            all tries (see above) */
     st_parts_tag_stats parts;            /* with p->parts: per part (the
                                             caller frees it with
                                             st_parts_tag_stats_free, also

@@ -119,8 +119,8 @@ def read_parts(path, mode="auto"):
 
 
 def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
-         threads=0, progress=None, float32=False, cancel=None, parts=None,
-         part_names=None):
+         threads=0, progress=None, float32=False, cancel=None, try_all=False,
+         parts=None, part_names=None):
     """Mesh a triangle soup into a coarse tet mesh that encloses it (soupmesh).
 
     V         (n, 3) numbers, the vertices in model units (finite)
@@ -132,8 +132,10 @@ def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
               of cells (soupmesh -h/--size; default None: from cells)
     tets      int or None, choose h for about this many tets, cells or size
               giving the first guess (soupmesh --tets; default None)
-    tries     int, candidates with randomly rotated and offset lattices, run
-              in parallel, the best enclosing one kept (default 4; NOTE:
+    tries     int, candidates with randomly rotated and offset lattices, at
+              most, two at a time in parallel, the best enclosing one kept;
+              no more start once one meets every goal (encloses, offset,
+              dihedral 35..133.3; soupmesh --tries) (default 4; NOTE:
               soupmesh's default is 1 - here 4, because the worst angle
               improves and a script rarely tunes it; tries=1 gives
               soupmesh's mesh bit for bit)
@@ -156,6 +158,8 @@ def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
               to float32, checked exactly on the rounded points (default
               False; soupmesh --float32): for Blender, glTF, STL, game
               engines, anything that stores float32
+    try_all   bool, run all tries candidates even once one meets every goal
+              (soupmesh --try-all; default False)
     cancel    souptet.Cancel or None: another thread's c.set() stops the
               run within about 0.1 s of work (the library polls the flag
               itself) and mesh() raises souptet.Cancelled (default None)
@@ -171,7 +175,7 @@ def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
     return MeshResult(_core.mesh(V, F, cells=cells, size=size, tets=tets, tries=tries,
                                  seed=seed, offset=offset, threads=threads,
                                  progress=progress, float32=float32, cancel=cancel,
-                                 parts=parts, part_names=part_names))
+                                 try_all=try_all, parts=parts, part_names=part_names))
 
 
 class Field:

@@ -63,6 +63,7 @@ def mesh(
     progress: Optional[Callable[[Dict[str, Any]], object]] = ...,
     float32: bool = ...,
     cancel: Optional[Cancel] = ...,
+    try_all: bool = ...,
     parts: Union[None, str, npt.ArrayLike] = ...,
     part_names: Optional[List[str]] = ...,
 ) -> MeshResult: ...

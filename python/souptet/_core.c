@@ -544,16 +544,16 @@ static PyObject *py_mesh(PyObject *self, PyObject *args, PyObject *kw)
 {
     (void)self;
     static char *kwlist[] = {"V", "F", "cells", "size", "tets", "tries", "seed",
-                             "offset", "threads", "progress", "float32", "cancel", "parts",
-                             "part_names", NULL};
+                             "offset", "threads", "progress", "float32", "cancel", "try_all",
+                             "parts", "part_names", NULL};
     PyObject *V, *F, *cells_o = NULL, *size_o = Py_None, *tets_o = Py_None, *tries_o = NULL,
                      *seed_o = NULL, *offset_o = NULL, *threads_o = NULL, *progress = Py_None,
-                     *f32_o = Py_False, *cancel_o = Py_None, *parts_o = Py_None,
-                     *pnames_o = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|$OOOOOOOOOOOO:mesh", kwlist, &V, &F, &cells_o,
+                     *f32_o = Py_False, *cancel_o = Py_None, *try_all_o = Py_False,
+                     *parts_o = Py_None, *pnames_o = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|$OOOOOOOOOOOOO:mesh", kwlist, &V, &F, &cells_o,
                                      &size_o, &tets_o, &tries_o, &seed_o, &offset_o,
-                                     &threads_o, &progress, &f32_o, &cancel_o, &parts_o,
-                                     &pnames_o))
+                                     &threads_o, &progress, &f32_o, &cancel_o, &try_all_o,
+                                     &parts_o, &pnames_o))
         return NULL;
     if (cancel_o != Py_None && !PyObject_TypeCheck(cancel_o, &CancelType)) {
         PyErr_SetString(PyExc_TypeError, "cancel must be a souptet.Cancel or None");
@@ -574,6 +574,10 @@ static PyObject *py_mesh(PyObject *self, PyObject *args, PyObject *kw)
     if (seed_o && opt_size(seed_o, "seed", 0, SIZE_MAX, &seed))
         return NULL;
     p.seed = seed;
+    int try_all = PyObject_IsTrue(try_all_o);
+    if (try_all < 0)
+        return NULL;
+    p.try_all = try_all;
     if (offset_o && opt_double(offset_o, "offset", &p.offset_ratio))
         return NULL;
     if (!(p.offset_ratio >= 1e-3 && p.offset_ratio <= 10.0))

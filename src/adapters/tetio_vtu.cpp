@@ -1,39 +1,18 @@
 /*
- * tetio_vtu.cpp - st_tetmesh <-> VTK XML UnstructuredGrid (.vtu), for
- * ParaView, simulators built on VTK, and the pipes between souptet's tools.
- *
- * Mapping (writing; reading inverts it):
- *
- *   points     one 3-component vtkDoubleArray (binary: exact).
- *   cells      VTK_TETRA only, connectivity in the mesh's own corner order
- *              (VTK's tetra has the same orientation convention as
- *              tetmesh.h: a positive tet has positive signed volume).
- *   cell data  min_dihedral, max_dihedral (degrees) and volume (signed,
- *              model units^3), computed at every write (min_dihedral is
- *              the active scalars, so ParaView colours by it at once),
- *              then the mesh's own per-cell arrays; point data: the mesh's
- *              per-point arrays. All vtkDoubleArray but "part" (the
- *              part index, parts.h), a vtkIntArray (Int32).
- *   field data every st_meta entry (source, h, lattice, parameters,
- *              history, ...) named by its key, in st_meta order: a
- *              canonical non-negative integer (seed, candidates) as a
- *              one-value vtkTypeUInt64Array (meta_integer), another value
- *              that is a number exactly as %.17g prints it as a one-value
- *              vtkDoubleArray, any other as a vtkUnsignedCharArray of its
- *              bytes (meshio cannot read VTK's String arrays; see
- *              meta_number).
- *   no tets    a points-only mesh (soupmesh --embed F.vtu) gets one
- *              VTK_VERTEX cell per point and no cell arrays, so ParaView
- *              draws it and meshio reads it.
- *   encoding   appended raw binary, zlib compression, UInt64 block headers
- *              and Int64 ids (meshes beyond 2^31 entries stay readable).
+ * tetio_vtu.cpp - reading VTK XML UnstructuredGrid (.vtu) into an
+ * st_tetmesh, for meshes from ParaView, simulators built on VTK and the
+ * pipes between souptet's tools. Writing is C (src/tetformat_vtu.c, whose
+ * comment gives the mapping; reading inverts it): a tool that only writes
+ * meshes need not load VTK.
  *
  * Reading accepts foreign files: float or double points, any numeric
  * point/cell arrays of 1..9 components (converted to double), string,
- * char and one-value numeric field data as meta, vertex cells i = point i
- * as a points-only mesh. The three quality arrays are derived data: they are
- * not read back (every write recomputes them from the geometry, which a
- * tool may have moved). Refused, with a message naming the file: input VTK
+ * char and one-value numeric field data as meta (numbers formatted back
+ * with %llu and %.17g, so souptet's meta round-trips exactly), vertex
+ * cells i = point i as a points-only mesh. The three quality arrays
+ * (min_dihedral, max_dihedral, volume) are derived data: they are not
+ * read back (every write recomputes them from the geometry, which a tool
+ * may have moved). Refused, with a message naming the file: input VTK
  * cannot parse, cells that are not tetrahedra, point indices out of range,
  * non-finite coordinates, arrays whose length does not match, more than
  * max_bytes of mesh. Before VTK sees a byte, every input (files by path
@@ -58,7 +37,6 @@
 #include <vtkCellType.h>
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
-#include <vtkIntArray.h>
 #include <vtkErrorCode.h>
 #include <vtkFieldData.h>
 #include <vtkIdTypeArray.h>
@@ -88,259 +66,6 @@ bool is_quality_name(const char *n)
     return n && (std::strcmp(n, "min_dihedral") == 0 ||
                  std::strcmp(n, "max_dihedral") == 0 ||
                  std::strcmp(n, "volume") == 0);
-}
-
-/* ---- metadata ---------------------------------------------------------- */
-
-/* A meta value VTK, ParaView and meshio all read (meshio 5-7 refuses VTK's
- * String arrays: its vtu reader has no "String" type and asserts on their
- * appended blocks). A value that is exactly the %.17g form of a finite
- * double (h, seed, offset_ratio, candidates, ...) becomes a one-value
- * Float64 array, so ParaView can compute with it; anything else (source,
- * history, lattice, ...) a UInt8 array of its bytes. Reading formats a
- * number with %.17g again, so the meta round-trips exactly. */
-bool meta_number(const char *v, double *x)
-{
-    if (!v[0] || v[0] == ' ' || v[0] == '\t' || v[0] == '\n')
-        return false;
-    char *end;
-    errno = 0;
-    const double d = std::strtod(v, &end);
-    if (*end || errno || !std::isfinite(d))
-        return false;
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.17g", d);
-    if (std::strcmp(buf, v) != 0)
-        return false;
-    *x = d;
-    return true;
-}
-
-/* A canonical decimal integer ("0", or digits without a leading zero)
- * that fits 64 bits unsigned: seeds, counts, resolutions. Such a value is
- * written as a one-value UInt64 array whatever its size (a seed above
- * 2^53 is no exact double, and one key keeps one type: meshio gives
- * numpy.uint64 for every seed), and read back with %llu. */
-bool meta_integer(const char *v, unsigned long long *x)
-{
-    const size_t n = std::strlen(v);
-    if (n == 0 || n > 20 || (v[0] == '0' && n > 1))
-        return false;
-    for (size_t i = 0; i < n; i++)
-        if (v[i] < '0' || v[i] > '9')
-            return false;
-    errno = 0;
-    char *end;
-    const unsigned long long u = std::strtoull(v, &end, 10);
-    if (*end || errno)
-        return false;
-    *x = u;
-    return true;
-}
-
-/* ---- writing ----------------------------------------------------------- */
-
-/* The grid for m. Points and the mesh's arrays are borrowed (the writer
- * only reads them); the grid must not outlive m. */
-st_status build_grid(vtkUnstructuredGrid *ug, const st_tetmesh *m,
-                     const char *name, st_error *err)
-{
-    vtkNew<vtkDoubleArray> xyz;
-    xyz->SetNumberOfComponents(3);
-    if (m->npoints)
-        xyz->SetArray(m->xyz, vtkIdType(3 * m->npoints), 1);
-    vtkNew<vtkPoints> pts;
-    pts->SetData(xyz);
-    ug->SetPoints(pts);
-
-    if (m->ntets == 0) {
-        // A points-only mesh (soupmesh --embed F.vtu): one VTK_VERTEX per
-        // point, so ParaView draws the points and meshio finds cells; no
-        // cell arrays (they would be empty).
-        const vtkIdType np = vtkIdType(m->npoints);
-        vtkNew<vtkIdTypeArray> offsets, conn;
-        offsets->SetNumberOfValues(np + 1);
-        conn->SetNumberOfValues(np);
-        for (vtkIdType i = 0; i <= np; i++)
-            offsets->SetValue(i, i);
-        for (vtkIdType i = 0; i < np; i++)
-            conn->SetValue(i, i);
-        vtkNew<vtkCellArray> cells;
-        cells->SetData(offsets, conn);
-        ug->SetCells(VTK_VERTEX, cells);
-    }
-    const vtkIdType nt = vtkIdType(m->ntets);
-    vtkNew<vtkIdTypeArray> offsets, conn;
-    offsets->SetNumberOfValues(nt + 1);
-    conn->SetNumberOfValues(4 * nt);
-    vtkIdType *o = offsets->GetPointer(0), *c = conn->GetPointer(0);
-    for (vtkIdType t = 0; t <= nt; t++)
-        o[t] = 4 * t;
-    for (vtkIdType i = 0; i < 4 * nt; i++)
-        c[i] = vtkIdType(m->tets[i]);
-    vtkCellData *cd = ug->GetCellData();
-    if (nt > 0 || m->npoints == 0) {
-        vtkNew<vtkCellArray> cells;
-        cells->SetData(offsets, conn);
-        ug->SetCells(VTK_TETRA, cells);
-    }
-    if (nt > 0) {
-        const char *qn[3] = {"min_dihedral", "max_dihedral", "volume"};
-        double *q[3];
-        for (int k = 0; k < 3; k++) {
-            vtkNew<vtkDoubleArray> a;
-            a->SetName(qn[k]);
-            a->SetNumberOfValues(nt);
-            q[k] = a->GetPointer(0);
-            cd->AddArray(a);
-        }
-        st_tetmesh_quality(m, q[0], q[1], q[2]);
-        cd->SetActiveScalars("min_dihedral");
-    }
-
-    for (size_t i = 0; i < m->narrays; i++) {
-        const st_tet_array *arr = &m->arrays[i];
-        const bool on_cells = arr->assoc == ST_ON_CELLS;
-        if (on_cells && is_quality_name(arr->name))
-            continue;   // recomputed above
-        const size_t n = on_cells ? m->ntets : m->npoints;
-        if (on_cells && n == 0)
-            continue;   // no tets: vertex cells, no empty tet arrays
-        if (arr->ncomp < 1 || arr->ncomp > 9)
-            return st_error_set(err, ST_EINTERNAL, name, 0,
-                                "mesh array '%s' has %d components",
-                                arr->name, arr->ncomp);
-        if (std::strcmp(arr->name, "part") == 0 && arr->ncomp == 1) {
-            // the part index (parts.h): Int32, as simulators read tags
-            vtkNew<vtkIntArray> a;
-            a->SetName(arr->name);
-            a->SetNumberOfValues(vtkIdType(n));
-            for (size_t k = 0; k < n; k++)
-                a->SetValue(vtkIdType(k), int(arr->values[k]));
-            if (on_cells)
-                cd->AddArray(a);
-            else
-                ug->GetPointData()->AddArray(a);
-            continue;
-        }
-        vtkNew<vtkDoubleArray> a;
-        a->SetName(arr->name);
-        a->SetNumberOfComponents(arr->ncomp);
-        if (n)
-            a->SetArray(arr->values, vtkIdType(n * size_t(arr->ncomp)), 1);
-        if (on_cells)
-            cd->AddArray(a);
-        else
-            ug->GetPointData()->AddArray(a);
-    }
-
-    vtkFieldData *fd = ug->GetFieldData();
-    for (size_t i = 0; i < m->meta.count; i++) {
-        const char *key = m->meta.entries[i].key;
-        const char *val = m->meta.entries[i].value ? m->meta.entries[i].value
-                                                   : "";
-        double x;
-        unsigned long long u;
-        if (meta_integer(val, &u)) {
-            vtkNew<vtkTypeUInt64Array> d;
-            d->SetName(key);
-            d->InsertNextValue(vtkTypeUInt64(u));
-            fd->AddArray(d);
-        } else if (meta_number(val, &x)) {
-            vtkNew<vtkDoubleArray> d;
-            d->SetName(key);
-            d->InsertNextValue(x);
-            fd->AddArray(d);
-        } else {
-            vtkNew<vtkUnsignedCharArray> b;
-            b->SetName(key);
-            const size_t len = std::strlen(val);
-            b->SetNumberOfValues(vtkIdType(len));
-            if (len)
-                std::memcpy(b->GetPointer(0), val, len);
-            fd->AddArray(b);
-        }
-    }
-    return ST_OK;
-}
-
-void configure(vtkXMLUnstructuredGridWriter *w)
-{
-    w->SetDataModeToAppended();
-    w->EncodeAppendedDataOff();   // raw binary, not base64
-    w->SetCompressorTypeToZLib();
-    w->SetHeaderTypeToUInt64();
-    w->SetIdTypeToInt64();
-}
-
-st_status check_mesh(const st_tetmesh *m, const char *name, st_error *err)
-{
-    if (!m)
-        return st_error_set(err, ST_EINTERNAL, name, 0, "no mesh to write");
-    for (size_t i = 0; i < 4 * m->ntets; i++)
-        if (m->tets[i] >= m->npoints)
-            return st_error_set(err, ST_EINTERNAL, name, 0,
-                                "tet %zu refers to point %lu of %zu", i / 4,
-                                (unsigned long)m->tets[i], m->npoints);
-    return ST_OK;
-}
-
-st_status write_file(const st_tetmesh *m, const char *path, st_error *err)
-{
-    if (st_status s = check_mesh(m, path, err))
-        return s;
-    vtkNew<vtkUnstructuredGrid> ug;
-    if (st_status s = build_grid(ug, m, path, err))
-        return s;
-    vtkNew<vtkXMLUnstructuredGridWriter> w;
-    w->SetInputData(ug);
-    w->SetFileName(path);
-    configure(w);
-    st_vtk::Capture cap;
-    errno = 0;
-    const int ok = w->Write();
-    const int e = errno;
-    if (!ok || st_vtk::failed() ||
-        w->GetErrorCode() != vtkErrorCode::NoError) {
-        std::string msg = st_vtk::message();
-        if (msg.empty() && e)
-            msg = std::strerror(e);
-        return st_error_set(err, ST_EIO, path, 0, "write failed%s%s",
-                            msg.empty() ? "" : ": ", msg.c_str());
-    }
-    return ST_OK;
-}
-
-st_status write_mem(unsigned char **data, size_t *size, const st_tetmesh *m,
-                    st_error *err)
-{
-    const char *name = ST_STDOUT_NAME;
-    if (st_status s = check_mesh(m, name, err))
-        return s;
-    vtkNew<vtkUnstructuredGrid> ug;
-    if (st_status s = build_grid(ug, m, name, err))
-        return s;
-    vtkNew<vtkXMLUnstructuredGridWriter> w;
-    w->SetInputData(ug);
-    w->WriteToOutputStringOn();
-    configure(w);
-    st_vtk::Capture cap;
-    const int ok = w->Write();
-    if (!ok || st_vtk::failed() ||
-        w->GetErrorCode() != vtkErrorCode::NoError) {
-        std::string msg = st_vtk::message();
-        return st_error_set(err, ST_EIO, name, 0, "write failed%s%s",
-                            msg.empty() ? "" : ": ", msg.c_str());
-    }
-    const std::string out = w->GetOutputString();
-    unsigned char *buf = static_cast<unsigned char *>(
-        std::malloc(out.size() ? out.size() : 1));
-    if (!buf)
-        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
-    std::memcpy(buf, out.data(), out.size());
-    *data = buf;
-    *size = out.size();
-    return ST_OK;
 }
 
 /* ---- reading ----------------------------------------------------------- */
@@ -603,22 +328,6 @@ st_status read_mem(st_tetmesh **out, const unsigned char *data, size_t size,
 } // namespace
 
 extern "C" {
-
-st_status st_tetio_write_vtu_file(const st_tetmesh *m, const char *path,
-                                  st_error *err)
-{
-    return st_vtk::guarded(path, "writing", err,
-                   [&] { return write_file(m, path, err); });
-}
-
-st_status st_tetio_write_vtu_mem(unsigned char **data, size_t *size,
-                                 const st_tetmesh *m, st_error *err)
-{
-    *data = nullptr;
-    *size = 0;
-    return st_vtk::guarded(ST_STDOUT_NAME, "writing", err,
-                   [&] { return write_mem(data, size, m, err); });
-}
 
 st_status st_tetio_read_vtu_mem(st_tetmesh **out, const unsigned char *data,
                                 size_t size, const char *name,

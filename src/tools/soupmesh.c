@@ -81,8 +81,11 @@ TOOL_HELP_TETFORMAT
 "                       the pseudo volume's boundary (its fill) counts as\n"
 "                       surface for --offset; off: the soup alone\n"
 "      --tries K        candidates with randomly rotated and offset lattices,\n"
-"                       run in parallel; the best enclosing one is kept\n"
+"                       at most, two at a time in parallel; the best\n"
+"                       enclosing one is kept; no more start once one meets\n"
+"                       every goal (encloses, --offset, dihedral 35..133.3)\n"
 "                       (default 1)\n"
+"      --try-all        run all --tries candidates even then\n"
 "      --seed S         seed of the first candidate's lattice (default 1;\n"
 "                       0: the axis-aligned lattice)\n"
 "      --density RHO    the Spillmann mesher instead: cubic lattice tets with\n"
@@ -115,7 +118,7 @@ TOOL_HELP_TETFORMAT
 "the input but some boundary vertex is farther than --offset R * h from it.\n");
 }
 
-enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
+enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_TRY_ALL, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
        OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY,
        OPT_BEST_EFFORT, OPT_OFFSET_FILL, OPT_FLOAT32, OPT_PARTS };
 
@@ -159,7 +162,7 @@ static double box_diagonal(const st_soup *s)
                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
 
-static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
+static void report(const tool_ctx *t, const st_pipeline_stats *st, size_t tries, int density)
 {
     tool_say(t, 2, "field %zux%zux%zu, voxel %.6g; lattice cell h %.6g",
              st->field_dims[0], st->field_dims[1], st->field_dims[2], st->voxel, st->h);
@@ -186,6 +189,10 @@ static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
                  density ? "" : ",", c->seconds_sculpt, c->seconds_fit,
                  k == st->best ? "  <- best" : "");
     }
+    if (st->goal_met && st->ncandidates < tries)
+        tool_say(t, 2, "candidate %zu met every goal (encloses, --offset, dihedral "
+                 "35..133.3): the other %zu of --tries %zu not run (--try-all runs them)",
+                 st->best, tries - st->ncandidates, tries);
 }
 
 /* The pipeline lays one lattice per candidate (pipeline.h), up to one per
@@ -315,6 +322,7 @@ static const struct option longopts[] = {
     {"offset-best-effort", no_argument, NULL, OPT_BEST_EFFORT},
     {"offset-fill", required_argument, NULL, OPT_OFFSET_FILL},
     {"tries", required_argument, NULL, OPT_TRIES},
+    {"try-all", no_argument, NULL, OPT_TRY_ALL},
     {"seed", required_argument, NULL, OPT_SEED},
     {"density", required_argument, NULL, OPT_DENSITY},
     {"field-cells", required_argument, NULL, OPT_FIELD_CELLS},
@@ -360,6 +368,9 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
     case OPT_TRIES:
         if (tool_parse_size(t, "--tries", arg, 1, ST_PIPELINE_MAX_TRIES, &s->pipeline.tries))
             return TOOL_EXIT_USAGE;
+        break;
+    case OPT_TRY_ALL:
+        s->pipeline.try_all = 1;
         break;
     case OPT_SEED:
         if (tool_parse_size(t, "--seed", arg, 0, SIZE_MAX, &n))
@@ -498,7 +509,7 @@ static int run(tool_ctx *t, void *settings)
         if (!err.file[0])
             snprintf(err.file, sizeof err.file, "%s", in_name);
         tool_limit_hint(&err, "use fewer --cells or --field-cells, or raise --max-memory");
-        report(t, &st, p->density_rho > 0);
+        report(t, &st, p->tries, p->density_rho > 0);
         rc = tool_fail(t, &err);
         goto done;
     }
@@ -510,7 +521,7 @@ static int run(tool_ctx *t, void *settings)
     if (p->target_tets)
         tool_say(t, 2, "h %.6g for about %zu tets: %zu sculpts, %.2f s", st.h,
                  p->target_tets, st.sculpts, st.seconds_size);
-    report(t, &st, p->density_rho > 0);
+    report(t, &st, p->tries, p->density_rho > 0);
     if (p->parts)
         report_parts(t, &parts, &st.parts);
     if (p->float32) {

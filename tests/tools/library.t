@@ -26,6 +26,11 @@ readelf -d "$core" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' > needed.txt
 ok $? "the core needs no VTK, OpenVDB, TBB or C++ runtime ($(tr '\n' ' ' < needed.txt))"
 readelf -d "$io" | grep -q 'Shared library: \[libsouptet.so.0\]'
 ok $? "the io library stands on the core (NEEDED libsouptet.so.0)"
+# soupmesh writes every mesh format in C and reads no field: it loads no
+# VTK or OpenVDB (whose relocations cost a process about 60 ms)
+readelf -d "$SOUPTET_BIN/soupmesh" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' > tool-needed.txt
+! grep -Eq 'vtk|openvdb|tbb|Imath' tool-needed.txt
+ok $? "soupmesh needs no VTK, OpenVDB or TBB ($(tr '\n' ' ' < tool-needed.txt))"
 
 # Exports: every defined dynamic symbol is a public name (declared in
 # include/souptet/*.h) or one of the core's private ones the io library
