@@ -4,6 +4,7 @@
 #   make check            install missing Debian packages, build, run all tests
 #   make demo             the main job on the bundled model
 #   make demo-sim         the bundled model's cage in a FEM solve (SfePy)
+#   make demo-sim-parts   two materials from soupmesh --parts in a FEM solve (SfePy)
 #   make bench            measurements against peers (bench/results/)
 #   make install PREFIX=/usr/local DESTDIR=
 #   make fuzz [FUZZ_SECONDS=60] [FUZZ_RUNS=N]  libFuzzer on every reader (build-fuzz/)
@@ -98,7 +99,7 @@ IO_LIBS   := -lopenvdb -ltbb -lImath-3_1 \
 TOOL_BIN := $(TOOLS:%=$(BUILD)/bin/%)
 TEST_BIN := $(TESTS_C:%=$(BUILD)/tests/%)
 
-.PHONY: all check test demo demo-sim bench setup install uninstall clean fuzz
+.PHONY: all check test demo demo-sim demo-sim-parts bench setup install uninstall clean fuzz
 all: $(LIBA) $(LIBSO_CORE) $(LIBSO_IO) $(TOOL_BIN) $(TEST_BIN)
 
 # The library's objects are position-independent (they go into the shared
@@ -243,6 +244,10 @@ demo: setup
 demo-sim: setup
 	$(MAKE) --no-print-directory all
 	scripts/simulate $(BUILD)/bin demo
+
+demo-sim-parts: setup
+	$(MAKE) --no-print-directory all
+	scripts/simulate-parts $(BUILD)/bin demo
 
 bench: setup
 	@scripts/setup --bench

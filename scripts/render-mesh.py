@@ -9,7 +9,9 @@ tets and the input surface inside them.
         scripts/render-mesh.py MESH.vtu OUT.png [SURFACE.obj|.ply|.stl|.off]
 
 Colours: blue-green-yellow-red = min dihedral 0..70 degrees (red is good);
-the input surface is grey. Uses Debian's python3-vtk9.
+a mesh tagged with parts (soupmesh --parts: cell data "part", field data
+part_name_K) is coloured by part instead, with the names in the legend.
+The input surface is grey. Uses Debian's python3-vtk9.
 """
 import os
 import sys
@@ -74,12 +76,48 @@ def surface_actor(surface, opacity):
     return a
 
 
-def mesh_actor(grid, opacity, table):
+def part_table(grid):
+    """(lookup table, names) for a mesh tagged with parts, or (None, None):
+    one colour a part (a qualitative palette), annotated with its name."""
+    arr = grid.GetCellData().GetArray("part")
+    if arr is None:
+        return None, None
+    fd = grid.GetFieldData()
+    n = int(arr.GetRange()[1]) + 1
+    names = []
+    for k in range(n):
+        a = fd.GetAbstractArray("part_name_%d" % k)
+        if a is not None and a.GetNumberOfTuples() > 0:
+            names.append(bytes(int(a.GetTuple1(i)) for i in range(a.GetNumberOfTuples()))
+                         .decode("utf-8", "replace"))
+        else:
+            names.append("part_%d" % k)
+    palette = [(0.89, 0.47, 0.20), (0.22, 0.42, 0.69), (0.30, 0.69, 0.29), (0.60, 0.31, 0.64),
+               (0.97, 0.82, 0.25), (0.65, 0.34, 0.16), (0.97, 0.51, 0.75), (0.40, 0.76, 0.65),
+               (0.55, 0.63, 0.80), (0.90, 0.10, 0.11)]
+    t = vtk.vtkLookupTable()
+    t.SetNumberOfTableValues(n)
+    t.SetTableRange(-0.5, n - 0.5)
+    for k in range(n):
+        t.SetTableValue(k, *palette[k % len(palette)], 1.0)
+        t.SetAnnotation(vtk.vtkVariant(k), names[k])
+    t.IndexedLookupOn()
+    t.Build()
+    return t, names
+
+
+def mesh_actor(grid, opacity, table, by_part=False):
     geo = vtk.vtkDataSetSurfaceFilter()
     geo.SetInputData(grid)
     m = vtk.vtkDataSetMapper()
     m.SetInputConnection(geo.GetOutputPort())
-    if grid.GetCellData().GetArray("min_dihedral") is not None:
+    if by_part:
+        m.SetScalarModeToUseCellFieldData()
+        m.SelectColorArray("part")
+        m.SetLookupTable(table)
+        m.UseLookupTableScalarRangeOn()
+        m.ScalarVisibilityOn()
+    elif grid.GetCellData().GetArray("min_dihedral") is not None:
         m.SetScalarModeToUseCellFieldData()
         m.SelectColorArray("min_dihedral")
         m.SetLookupTable(table)
@@ -107,12 +145,15 @@ def main():
     if grid.GetNumberOfCells() == 0:
         sys.exit("render-mesh.py: %s: no tets" % src)
     surface = read_surface(sys.argv[3]) if len(sys.argv) > 3 else None
-    table = lut()
+    table, names = part_table(grid)
+    by_part = table is not None
+    if not by_part:
+        table = lut()
 
     # Left: the whole mesh, half transparent, the input inside.
     left = vtk.vtkRenderer()
     left.SetViewport(0.0, 0.0, 0.5, 1.0)
-    left.AddActor(mesh_actor(grid, 0.55 if surface else 1.0, table))
+    left.AddActor(mesh_actor(grid, 0.55 if surface else 1.0, table, by_part))
     if surface:
         left.AddActor(surface_actor(surface, 1.0))
 
@@ -144,7 +185,7 @@ def main():
     keep.Update()
     right = vtk.vtkRenderer()
     right.SetViewport(0.5, 0.0, 0.9, 1.0)
-    right.AddActor(mesh_actor(keep.GetOutput(), 1.0, table))
+    right.AddActor(mesh_actor(keep.GetOutput(), 1.0, table, by_part))
     if surface:
         clip = vtk.vtkClipPolyData()
         clip.SetInputData(surface)
@@ -159,7 +200,20 @@ def main():
     # title above the bar, clear of the labels.
     legend = vtk.vtkRenderer()
     legend.SetViewport(0.9, 0.0, 1.0, 1.0)
-    legend.AddActor2D(scalar_bar(table, "min dihedral\n(degrees)"))
+    if by_part:
+        # each part's name in its colour, top down (the first 20)
+        for k, name in enumerate(names[:20]):
+            t = vtk.vtkTextActor()
+            t.SetInput(name if k < 19 or len(names) == 20 else "... %d more" % (len(names) - 19))
+            t.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+            t.SetPosition(0.08, 0.88 - 0.04 * k)
+            tp = t.GetTextProperty()
+            tp.SetFontSize(16)
+            tp.BoldOn()
+            tp.SetColor(*table.GetTableValue(k)[:3])
+            legend.AddActor2D(t)
+    else:
+        legend.AddActor2D(scalar_bar(table, "min dihedral\n(degrees)"))
 
     win = vtk.vtkRenderWindow()
     win.SetOffScreenRendering(1)

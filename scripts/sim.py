@@ -456,3 +456,55 @@ def _displacement(state, pb):
         return np.asarray(state.get_parts()["u"])
     except AttributeError:
         return np.asarray(state["u"].data[0] if hasattr(state["u"], "data") else state["u"]())
+
+
+
+def solve_cantilever_parts(mesh, load, young, poisson, clamp=0.6, up=1, quiet=True):
+    """A two-material (or more) cantilever in linear elasticity: the SfePy
+    mesh `mesh` (read by read_cage_sfepy from a .mesh whose tet references
+    are soupmesh --parts' part + 1, which SfePy loads as its cell groups),
+    Young's modulus young[g] and Poisson's ratio poisson[g] in cell group
+    g (one dw_lin_elastic term over the body, its stiffness per cell),
+    clamped where x is within `clamp` of its smallest value, under its
+    weight `load` (force per volume along -up). Returns (displacement of
+    the mesh's points n x 3, Newton iterations, converged)."""
+    from sfepy.base.base import output, IndexedStruct
+    from sfepy.discrete import (FieldVariable, Material, Integral, Function,
+                                Equation, Equations, Problem)
+    from sfepy.discrete.conditions import Conditions, EssentialBC
+    from sfepy.discrete.fem import FEDomain, Field
+    from sfepy.mechanics.matcoefs import stiffness_from_youngpoisson
+    from sfepy.solvers.ls import ScipyDirect
+    from sfepy.solvers.nls import Newton
+    from sfepy.terms import Term
+    output.set_output(quiet=quiet)
+    domain = FEDomain("domain", mesh)
+    omega = domain.create_region("Omega", "all")
+    x = mesh.coors[:, 0]
+    base = domain.create_region("Clamp", "vertices in (x < %.17g)" % (x.min() + clamp), "vertex")
+    field = Field.from_args("displacement", np.float64, "vector", omega, approx_order=1)
+    u = FieldVariable("u", "unknown", field)
+    v = FieldVariable("v", "test", field, primary_var_name="u")
+    integral = Integral("i", order=2)
+    groups = np.asarray(mesh.cmesh.cell_groups)
+    d_of = {g: stiffness_from_youngpoisson(3, young[g], poisson[g]) for g in young}
+    d_c = np.array([d_of[g] for g in groups], dtype=np.float64)
+
+    def params(ts, coors, mode=None, **kwargs):
+        if mode != "qp":
+            return None
+        nqp = coors.shape[0] // len(groups)    # quadrature points by cell
+        val = np.zeros((coors.shape[0], 3, 1))
+        val[:, up, 0] = -load
+        return {"D": np.repeat(d_c, nqp, axis=0), "val": val}
+    solid = Material("solid", function=Function("params", params))
+    terms = Term.new("dw_lin_elastic(solid.D, v, u)", integral, omega, solid=solid, v=v, u=u) \
+        - Term.new("dw_volume_lvf(solid.val, v)", integral, omega, solid=solid, v=v)
+    pb = Problem("cantilever", equations=Equations([Equation("balance", terms)]))
+    pb.set_bcs(ebcs=Conditions([EssentialBC("clamp", base, {"u.all": 0.0})]))
+    status = IndexedStruct()
+    nls = Newton({"i_max": 1, "eps_a": 1e-10, "eps_r": 1.0}, lin_solver=ScipyDirect({}),
+                 status=status)
+    pb.set_solver(nls)
+    state = pb.solve(save_results=False)
+    return _displacement(state, pb).reshape(-1, 3), int(status.n_iter), status.condition == 0

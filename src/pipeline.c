@@ -646,6 +646,8 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     rc = set_meta(meshes[best], p, st, dp.cells, err);
     if (rc)
         goto done;
+    if (p->parts && (rc = st_parts_tag(meshes[best], s, p->parts, g, &pp, &st->parts, prog, err)))
+        goto done;
     *out = meshes[best];
     meshes[best] = NULL;
     st->seconds_total = now_seconds() - t_start;

@@ -94,6 +94,9 @@ void st_soup_free(st_soup *s)
         return;
     free(s->xyz);
     free(s->tris);
+    for (size_t i = 0; i < s->nnames; i++)
+        free(s->names[i].name);
+    free(s->names);
     free(s);
 }
 
@@ -117,6 +120,42 @@ st_status st_soup_add_triangle(st_soup *s, uint32_t a, uint32_t b, uint32_t c,
     st_status st = st_soup__push_tri(s, a, b, c);
     if (st)
         return st_soup__push_failed(err, st, NULL, 0, -1);
+    return ST_OK;
+}
+
+st_status st_soup__push_name(st_soup *s, int level, const unsigned char *name,
+                             size_t len)
+{
+    if (len > ST_SOUP_NAME_MAX) {
+        /* cut before a UTF-8 sequence, not inside it */
+        len = ST_SOUP_NAME_MAX;
+        while (len > 0 && (name[len] & 0xc0) == 0x80)
+            len--;
+    }
+    if (grow((void **)&s->names, s->nnames, sizeof *s->names) != 0)
+        return ST_ENOMEM;
+    char *c = malloc(len + 1);
+    if (!c)
+        return ST_ENOMEM;
+    if (len)
+        memcpy(c, name, len);
+    c[len] = '\0';
+    /* A NUL inside a name would cut it short in every writer: make it '_'. */
+    for (size_t i = 0; i < len; i++)
+        if (c[i] == '\0')
+            c[i] = '_';
+    s->names[s->nnames].first = s->ntris;
+    s->names[s->nnames].name = c;
+    s->names[s->nnames].level = level;
+    s->nnames++;
+    return ST_OK;
+}
+
+st_status st_soup_add_name(st_soup *s, int level, const char *name, size_t len,
+                           st_error *err)
+{
+    if (st_soup__push_name(s, level, (const unsigned char *)name, len))
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     return ST_OK;
 }
 

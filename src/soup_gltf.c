@@ -1191,6 +1191,22 @@ static st_status add_mesh(gltf *g, size_t mi, const double M[16])
 /* Depth-first through the node trees under roots, with an explicit stack
  * (a chain of nodes may be as long as the file). A node reached twice is
  * a cycle or a node with two parents: both invalid glTF. */
+/* A mesh node is a part (parts.h): its name, else its mesh's, else "". */
+static st_status node_name(gltf *g, const jnode *nd, size_t mi)
+{
+    const jnode *nm = jget(&g->j, nd, "name");
+    if (!nm || nm->type != J_STR) {
+        const jnode *mesh = jat(&g->j, jget(&g->j, g->root, "meshes"), mi);
+        nm = mesh && mesh->type == J_OBJ ? jget(&g->j, mesh, "name") : NULL;
+    }
+    const int named = nm && nm->type == J_STR;
+    if (st_soup__push_name(g->s, 1,
+                           named ? (const unsigned char *)g->j.arena + nm->str : NULL,
+                           named ? nm->slen : 0))
+        return st_error_set(g->err, ST_ENOMEM, g->name, 0, "out of memory");
+    return ST_OK;
+}
+
 static st_status walk(gltf *g, const size_t *roots, size_t nroots)
 {
     const jnode *nodes = jget(&g->j, g->root, "nodes");
@@ -1237,6 +1253,7 @@ static st_status walk(gltf *g, const size_t *roots, size_t nroots)
                 size_t mi;
                 if ((st = get_index(g, nd, "mesh", -1, SIZE_MAX, "/nodes",
                                     f.node, &mi)) ||
+                    (st = node_name(g, nd, mi)) ||
                     (st = add_mesh(g, mi, W)))
                     break;
             }

@@ -2,9 +2,10 @@
  * soup_obj.c - the Wavefront OBJ reader.
  *
  * Takes `v x y z [w ...]` and `f` records (i, i/t, i//n, i/t/n, negative
- * relative indices, polygons fanned from their first vertex). Everything
- * else -- vn, vt, l, p, g, o, s, mtllib, usemtl, unknown statements,
- * comments -- is skipped, so all groups and objects form one soup. CRLF
+ * relative indices, polygons fanned from their first vertex). The names
+ * of `o` and `g` lines are noted as named runs (soup.h, st_soup_name);
+ * everything else -- vn, vt, l, p, s, mtllib, usemtl, unknown statements,
+ * comments -- is skipped, and all groups and objects form one soup. CRLF
  * line ends and backslash line continuations are handled by the st_text
  * cursor.
  */
@@ -152,6 +153,15 @@ st_status st_soup__parse_obj(st_soup *s, const unsigned char *data,
             st = read_vertex(s, &t, name, err);
         else if (n == 1 && kw[0] == 'f')
             st = read_face(s, &t, &fwd, name, err);
+        else if (n == 1 && (kw[0] == 'o' || kw[0] == 'g')) {
+            /* A part's name (parts.h): objects, or groups where the file
+             * has no objects. */
+            const unsigned char *nm;
+            size_t nl = st_text_rest(&t, &nm);
+            st = st_soup__push_name(s, kw[0] == 'o' ? 1 : 2, nm, nl);
+            if (st)
+                return st_soup__push_failed(err, st, name, t.line, -1);
+        }
         if (st)
             return st;
         st_text_next_line(&t);

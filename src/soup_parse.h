@@ -94,6 +94,23 @@ static inline size_t st_text_token(st_text *t, const unsigned char **tok)
     return (size_t)(t->p - s);
 }
 
+/* The rest of the current line as one name: blanks at both ends trimmed
+ * (a backslash continuation is not followed: names are one line). The
+ * cursor stays where it was. */
+static inline size_t st_text_rest(const st_text *t, const unsigned char **name)
+{
+    const unsigned char *p = t->p, *q;
+    while (p < t->end && *p != '\n' && st_text_blank(*p))
+        p++;
+    q = p;
+    while (q < t->end && *q != '\n')
+        q++;
+    while (q > p && st_text_blank(q[-1]))
+        q--;
+    *name = p;
+    return (size_t)(q - p);
+}
+
 /* Move to the start of the next line (or to the end). */
 static inline void st_text_next_line(st_text *t)
 {
@@ -177,6 +194,12 @@ const char *st_soup__quote(char *buf, size_t bufsize,
  * check the indices themselves. ST_ENOMEM or ST_ELIMIT, no message. */
 st_status st_soup__push_vertex(st_soup *s, double x, double y, double z);
 st_status st_soup__push_tri(st_soup *s, uint32_t a, uint32_t b, uint32_t c);
+/* Note a named run at the next triangle (soup.h, st_soup_name); a name is
+ * kept to ST_SOUP_NAME_MAX bytes (longer ones are cut: a part's name is a
+ * label, and gmsh's physical names are short). ST_ENOMEM. */
+#define ST_SOUP_NAME_MAX 255
+st_status st_soup__push_name(st_soup *s, int level, const unsigned char *name,
+                             size_t len);
 
 /* Fill err for a failed push at a text line (offset < 0) or byte offset. */
 st_status st_soup__push_failed(st_error *err, st_status st, const char *name,

@@ -181,7 +181,13 @@ static st_status parse_ascii(st_soup *s, const unsigned char *data,
         if (!inside) {
             if (!st_tok_ieq(tok, n, "solid"))
                 return asc_expected(&a, "'solid'", tok, n);
-            st_text_next_line(&a.t);    /* the solid's name */
+            /* The solid's name: a part (parts.h). */
+            const unsigned char *nm;
+            size_t nl = st_text_rest(&a.t, &nm);
+            st = st_soup__push_name(s, 1, nm, nl);
+            if (st)
+                return st_soup__push_failed(err, st, name, a.t.line, -1);
+            st_text_next_line(&a.t);
             inside = 1;
         } else if (st_tok_ieq(tok, n, "endsolid")) {
             st_text_next_line(&a.t);

@@ -27,6 +27,7 @@
 #include "tetformat_internal.h"
 #include "fileio.h"
 #include "souptet/pred.h"
+#include "souptet/parts.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -290,4 +291,43 @@ st_status st_tf_save(const st_tetmesh *m, st_tetformat f, const char *path,
     free(names[1]);
     free(faces);
     return s;
+}
+
+/* ---- parts (parts.h) ------------------------------------------------------ */
+
+size_t st_tf_parts(const st_tetmesh *m, const double **part)
+{
+    *part = NULL;
+    const st_tet_array *a = st_tetmesh_find_array(m, "part", ST_ON_CELLS);
+    if (!a || a->ncomp != 1 || m->ntets == 0)
+        return 0;
+    size_t n = 1;
+    const char *v = st_meta_get(&m->meta, "parts");
+    if (v) {
+        char *end = NULL;
+        unsigned long long c = strtoull(v, &end, 10);
+        if (*v && !*end && c >= 1 && c <= ST_PARTS_MAX)
+            n = (size_t)c;
+    }
+    for (size_t t = 0; t < m->ntets; t++) {
+        const double x = a->values[t];
+        if (x >= 0 && x < ST_PARTS_MAX && x == floor(x) && (size_t)x >= n)
+            n = (size_t)x + 1;
+    }
+    *part = a->values;
+    return n;
+}
+
+void st_tf_part_name(char *buf, size_t size, const st_tetmesh *m, size_t k)
+{
+    char key[48];
+    snprintf(key, sizeof key, "part_name_%zu", k);
+    const char *v = st_meta_get(&m->meta, key);
+    if (v && *v)
+        snprintf(buf, size, "%s", v);
+    else
+        snprintf(buf, size, "part_%zu", k);
+    for (char *c = buf; *c; c++)
+        if (*c == '"' || *c == '\\' || (unsigned char)*c < 0x20 || *c == 0x7f)
+            *c = '_';
 }

@@ -344,6 +344,18 @@ st_status st_tf_read_with(st_tf_parser parse, st_tetmesh **out,
  * the msh version normalised (41 or 22; -1: not one); what no file of
  * format f can hold; open a file for writing; flush, close and report. */
 void st_tf_put_meta(FILE *fp, const st_meta *meta, const char *prefix);
+/* The mesh's parts (parts.h: the cell array "part", meta "parts" and
+ * "part_name_K"): the count (0: no parts), and tet t's part through
+ * st_tf_tet_part (values not a part index in 0..count-1 read as 0). */
+size_t st_tf_parts(const st_tetmesh *m, const double **part);
+static inline size_t st_tf_tet_part(const double *part, size_t nparts, size_t t)
+{
+    const double v = part[t];
+    return v >= 0 && v < (double)nparts && v == floor(v) ? (size_t)v : 0;
+}
+/* Part k's name for a quoted field: meta part_name_k, else part_k, with '"',
+ * '\\' and control bytes as '_'. */
+void st_tf_part_name(char *buf, size_t size, const st_tetmesh *m, size_t k);
 int st_tf_msh_version(int v);
 st_status st_tf_check_writable(const st_tetmesh *m, st_tetformat f,
                                int version, int binary, const char *path,

@@ -165,12 +165,15 @@ void st_tf_write_medit_fp(FILE *fp, const st_tetmesh *m,
         const double *p = m->xyz + 3 * i;
         fprintf(fp, "%.17g %.17g %.17g 0\n", p[0], p[1], p[2]);
     }
+    /* The tets' reference: 1, or with parts (parts.h) part index + 1. */
+    const double *part;
+    const size_t nparts = st_tf_parts(m, &part);
     fprintf(fp, "\nTetrahedra\n%zu\n", m->ntets);
     for (size_t i = 0; i < m->ntets; i++) {
         const uint32_t *t = m->tets + 4 * i;
-        fprintf(fp, "%lu %lu %lu %lu 1\n", (unsigned long)t[0] + 1,
+        fprintf(fp, "%lu %lu %lu %lu %zu\n", (unsigned long)t[0] + 1,
                 (unsigned long)t[1] + 1, (unsigned long)t[2] + 1,
-                (unsigned long)t[3] + 1);
+                (unsigned long)t[3] + 1, nparts ? st_tf_tet_part(part, nparts, i) + 1 : 1);
     }
     /* The boundary, outward, with reference 2. */
     if (nfaces) {

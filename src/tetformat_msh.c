@@ -602,10 +602,29 @@ static void put_f64(FILE *fp, double v) { fwrite(&v, sizeof v, 1, fp); }
  * sees the right group. */
 #define MSH_VOLUME 1
 #define MSH_BOUNDARY 2
+/* With parts (parts.h), one volume group per part instead of "volume":
+ * part k is physical (and entity) tag MSH_PART + k, named by the part. */
+#define MSH_PART 3
 
-static void msh_physical_names(FILE *fp, int volume_only)
+/* The physical tag of tet t: the volume, or its part's. */
+static int32_t msh_tet_tag(const double *part, size_t nparts, size_t t)
 {
-    if (volume_only)
+    return nparts ? (int32_t)(MSH_PART + st_tf_tet_part(part, nparts, t)) : MSH_VOLUME;
+}
+
+static void msh_physical_names(FILE *fp, const st_tetmesh *m, size_t nparts, int volume_only)
+{
+    if (nparts) {
+        fprintf(fp, "$PhysicalNames\n%zu\n", nparts + (volume_only ? 0 : 1));
+        if (!volume_only)
+            fprintf(fp, "2 %d \"boundary\"\n", MSH_BOUNDARY);
+        for (size_t k = 0; k < nparts; k++) {
+            char nm[300];
+            st_tf_part_name(nm, sizeof nm, m, k);
+            fprintf(fp, "3 %zu \"%s\"\n", MSH_PART + k, nm);
+        }
+        fputs("$EndPhysicalNames\n", fp);
+    } else if (volume_only)
         fprintf(fp, "$PhysicalNames\n1\n3 %d \"volume\"\n$EndPhysicalNames\n",
                 MSH_VOLUME);
     else
@@ -617,6 +636,8 @@ static void msh22_elements(FILE *fp, const st_tetmesh *m, int binary,
                            const uint32_t *faces, size_t nf)
 {
     size_t nt = m->ntets;
+    const double *part;
+    const size_t nparts = st_tf_parts(m, &part);
     fprintf(fp, "$Elements\n%zu\n", nt + nf);
     if (binary && nt) {
         put_i32(fp, 4);
@@ -626,13 +647,15 @@ static void msh22_elements(FILE *fp, const st_tetmesh *m, int binary,
     for (size_t i = 0; i < nt; i++) {
         const uint32_t *t = m->tets + 4 * i;
         if (binary) {
-            int32_t rec[7] = {(int32_t)(i + 1), MSH_VOLUME, MSH_VOLUME,
+            const int32_t tag = msh_tet_tag(part, nparts, i);
+            int32_t rec[7] = {(int32_t)(i + 1), tag, tag,
                               (int32_t)(t[0] + 1), (int32_t)(t[1] + 1),
                               (int32_t)(t[2] + 1), (int32_t)(t[3] + 1)};
             fwrite(rec, sizeof rec[0], 7, fp);
         } else {
-            fprintf(fp, "%zu 4 2 %d %d %lu %lu %lu %lu\n", i + 1, MSH_VOLUME,
-                    MSH_VOLUME, (unsigned long)t[0] + 1,
+            const int32_t tag = msh_tet_tag(part, nparts, i);
+            fprintf(fp, "%zu 4 2 %d %d %lu %lu %lu %lu\n", i + 1, (int)tag,
+                    (int)tag, (unsigned long)t[0] + 1,
                     (unsigned long)t[1] + 1, (unsigned long)t[2] + 1,
                     (unsigned long)t[3] + 1);
         }
@@ -684,6 +707,50 @@ static void msh41_entity(FILE *fp, int binary, int tag, const double lo[3],
     }
 }
 
+/* The 4.1 element blocks of the tets: one (the volume's) without parts,
+ * one per part that has tets with them, each in tet order (tet i is
+ * element i+1). fp NULL: only the count of blocks. */
+static size_t msh41_tet_blocks(FILE *fp, const st_tetmesh *m, int binary, const double *part,
+                               size_t nparts)
+{
+    const size_t nt = m->ntets;
+    size_t nb = 0;
+    for (size_t k = 0; k < (nparts ? nparts : 1) && nt; k++) {
+        size_t cnt = 0;
+        for (size_t i = 0; i < nt; i++)
+            cnt += !nparts || st_tf_tet_part(part, nparts, i) == k;
+        if (!cnt)
+            continue;
+        nb++;
+        if (!fp)
+            continue;
+        const int tag = nparts ? (int)(MSH_PART + k) : MSH_VOLUME;
+        if (binary) {
+            put_i32(fp, 3);
+            put_i32(fp, tag);
+            put_i32(fp, 4);
+            put_u64(fp, cnt);
+        } else {
+            fprintf(fp, "3 %d 4 %zu\n", tag, cnt);
+        }
+        for (size_t i = 0; i < nt; i++) {
+            if (nparts && st_tf_tet_part(part, nparts, i) != k)
+                continue;
+            const uint32_t *t = m->tets + 4 * i;
+            if (binary) {
+                uint64_t rec[5] = {i + 1, (uint64_t)t[0] + 1, (uint64_t)t[1] + 1,
+                                   (uint64_t)t[2] + 1, (uint64_t)t[3] + 1};
+                fwrite(rec, sizeof rec[0], 5, fp);
+            } else {
+                fprintf(fp, "%zu %lu %lu %lu %lu\n", i + 1, (unsigned long)t[0] + 1,
+                        (unsigned long)t[1] + 1, (unsigned long)t[2] + 1,
+                        (unsigned long)t[3] + 1);
+            }
+        }
+    }
+    return nb;
+}
+
 void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
                         int binary, int volume_only, const uint32_t *faces,
                         size_t nf)
@@ -698,7 +765,9 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
         fputc('\n', fp);
     }
     fputs("$EndMeshFormat\n", fp);
-    msh_physical_names(fp, volume_only);
+    const double *part;
+    const size_t nparts = st_tf_parts(m, &part);
+    msh_physical_names(fp, m, nparts, volume_only);
     if (m->meta.count) {
         fputs("$Comments\n", fp);
         st_tf_put_meta(fp, &m->meta, "");
@@ -734,17 +803,21 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
         }
     fputs("$Entities\n", fp);
     const int nsurf = volume_only ? 0 : 1;
+    const size_t nvol = nparts ? nparts : 1;
+    const int node_tag = nparts ? MSH_PART : MSH_VOLUME;
     if (binary) {
         put_u64(fp, 0);
         put_u64(fp, 0);
         put_u64(fp, (uint64_t)nsurf);
-        put_u64(fp, 1);
+        put_u64(fp, nvol);
     } else {
-        fprintf(fp, "0 0 %d 1\n", nsurf);
+        fprintf(fp, "0 0 %d %zu\n", nsurf, nvol);
     }
     if (nsurf)
         msh41_entity(fp, binary, MSH_BOUNDARY, lo, hi, 0);
-    msh41_entity(fp, binary, MSH_VOLUME, lo, hi, nsurf ? MSH_BOUNDARY : 0);
+    for (size_t k = 0; k < nvol; k++)
+        msh41_entity(fp, binary, nparts ? (int)(MSH_PART + k) : MSH_VOLUME, lo, hi,
+                     nsurf ? MSH_BOUNDARY : 0);
     if (binary)
         fputc('\n', fp);
     fputs("$EndEntities\n$Nodes\n", fp);
@@ -756,7 +829,7 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
         put_u64(fp, np);
         if (np) {
             put_i32(fp, 3);
-            put_i32(fp, MSH_VOLUME);
+            put_i32(fp, node_tag);
             put_i32(fp, 0);
             put_u64(fp, np);
             for (size_t i = 0; i < np; i++)
@@ -767,7 +840,7 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
     } else {
         fprintf(fp, "%zu %zu %zu %zu\n", nb, np, np ? (size_t)1 : 0, np);
         if (np) {
-            fprintf(fp, "3 %d 0 %zu\n", MSH_VOLUME, np);
+            fprintf(fp, "3 %d 0 %zu\n", node_tag, np);
             for (size_t i = 0; i < np; i++)
                 fprintf(fp, "%zu\n", i + 1);
             for (size_t i = 0; i < np; i++) {
@@ -779,25 +852,13 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
     /* The tets are elements 1..nt, the boundary triangles nt+1..nt+nf. */
     fputs("$EndNodes\n$Elements\n", fp);
     size_t ne = nt + nf;
-    nb = (nt ? 1 : 0) + (nf ? 1 : 0);
+    nb = msh41_tet_blocks(NULL, m, binary, part, nparts) + (nf ? 1 : 0);
     if (binary) {
         put_u64(fp, nb);
         put_u64(fp, ne);
         put_u64(fp, ne ? 1 : 0);
         put_u64(fp, ne);
-        if (nt) {
-            put_i32(fp, 3);
-            put_i32(fp, MSH_VOLUME);
-            put_i32(fp, 4);
-            put_u64(fp, nt);
-            for (size_t i = 0; i < nt; i++) {
-                const uint32_t *t = m->tets + 4 * i;
-                uint64_t rec[5] = {i + 1, (uint64_t)t[0] + 1,
-                                   (uint64_t)t[1] + 1, (uint64_t)t[2] + 1,
-                                   (uint64_t)t[3] + 1};
-                fwrite(rec, sizeof rec[0], 5, fp);
-            }
-        }
+        msh41_tet_blocks(fp, m, binary, part, nparts);
         if (nf) {
             put_i32(fp, 2);
             put_i32(fp, MSH_BOUNDARY);
@@ -813,15 +874,7 @@ void st_tf_write_msh_fp(FILE *fp, const st_tetmesh *m, int version,
         fputc('\n', fp);
     } else {
         fprintf(fp, "%zu %zu %zu %zu\n", nb, ne, ne ? (size_t)1 : 0, ne);
-        if (nt) {
-            fprintf(fp, "3 %d 4 %zu\n", MSH_VOLUME, nt);
-            for (size_t i = 0; i < nt; i++) {
-                const uint32_t *t = m->tets + 4 * i;
-                fprintf(fp, "%zu %lu %lu %lu %lu\n", i + 1,
-                        (unsigned long)t[0] + 1, (unsigned long)t[1] + 1,
-                        (unsigned long)t[2] + 1, (unsigned long)t[3] + 1);
-            }
-        }
+        msh41_tet_blocks(fp, m, binary, part, nparts);
         if (nf) {
             fprintf(fp, "2 %d 2 %zu\n", MSH_BOUNDARY, nf);
             for (size_t i = 0; i < nf; i++) {

@@ -202,12 +202,19 @@ void st_tf_write_node_fp(FILE *fp, const st_tetmesh *m)
 
 void st_tf_write_ele_fp(FILE *fp, const st_tetmesh *m)
 {
-    fprintf(fp, "%zu 4 0\n", m->ntets);
+    /* With parts (parts.h): one attribute, the part index (TetGen's
+     * region attribute). */
+    const double *part;
+    const size_t nparts = st_tf_parts(m, &part);
+    fprintf(fp, "%zu 4 %d\n", m->ntets, nparts ? 1 : 0);
     for (size_t i = 0; i < m->ntets; i++) {
         const uint32_t *t = m->tets + 4 * i;
-        fprintf(fp, "%zu %lu %lu %lu %lu\n", i + 1, (unsigned long)t[0] + 1,
+        fprintf(fp, "%zu %lu %lu %lu %lu", i + 1, (unsigned long)t[0] + 1,
                 (unsigned long)t[1] + 1, (unsigned long)t[2] + 1,
                 (unsigned long)t[3] + 1);
+        if (nparts)
+            fprintf(fp, " %zu", st_tf_tet_part(part, nparts, i));
+        fputc('\n', fp);
     }
 }
 

@@ -18,7 +18,8 @@
  *              model units^3), computed at every write (min_dihedral is
  *              the active scalars, so ParaView colours by it at once),
  *              then the mesh's own per-cell arrays; point data: the mesh's
- *              per-point arrays. All Float64.
+ *              per-point arrays. All Float64 but "part" (the part
+ *              index, parts.h), Int32.
  *   field data every st_meta entry named by its key, in st_meta order: a
  *              canonical non-negative integer (seed, candidates) as a
  *              one-value UInt64 array, another value that is a number
@@ -223,6 +224,25 @@ static void vtu_doubles(vtu_doc *d, const char *indent, const char *name,
     vtu_array(d, v, n * (size_t)ncomp * sizeof *v);
 }
 
+/* The array of a mesh: "part" (one component, parts.h) as Int32, as
+ * simulators read tags; any other as Float64. ST_ENOMEM. */
+static st_status vtu_mesh_array(vtu_doc *d, const st_tet_array *a, size_t n)
+{
+    if (strcmp(a->name, "part") != 0 || a->ncomp != 1) {
+        vtu_doubles(d, "        ", a->name, a->values, n, a->ncomp);
+        return ST_OK;
+    }
+    int32_t *v = st_malloc_array(n ? n : 1, sizeof *v);
+    if (!v)
+        return ST_ENOMEM;
+    for (size_t i = 0; i < n; i++)
+        v[i] = (int32_t)a->values[i];
+    vbuf_printf(&d->xml, "        <DataArray type=\"Int32\" Name=\"part\"");
+    vtu_array(d, v, n * sizeof *v);
+    free(v);
+    return ST_OK;
+}
+
 static void vtu_field_data(vtu_doc *d, const st_meta *meta)
 {
     if (meta->count == 0)
@@ -264,8 +284,8 @@ static st_status vtu_arrays(vtu_doc *d, const st_tetmesh *m)
     vbuf_printf(&d->xml, "      <PointData>\n");
     for (size_t i = 0; i < m->narrays; i++) {
         const st_tet_array *a = &m->arrays[i];
-        if (a->assoc != ST_ON_CELLS)
-            vtu_doubles(d, "        ", a->name, a->values, m->npoints, a->ncomp);
+        if (a->assoc != ST_ON_CELLS && vtu_mesh_array(d, a, m->npoints))
+            return ST_ENOMEM;
     }
     vbuf_printf(&d->xml, "      </PointData>\n");
     if (m->ntets == 0) {
@@ -284,8 +304,8 @@ static st_status vtu_arrays(vtu_doc *d, const st_tetmesh *m)
     for (size_t i = 0; i < m->narrays; i++) {
         const st_tet_array *a = &m->arrays[i];
         if (a->assoc == ST_ON_CELLS && strcmp(a->name, qn[0]) && strcmp(a->name, qn[1]) &&
-            strcmp(a->name, qn[2]))
-            vtu_doubles(d, "        ", a->name, a->values, m->ntets, a->ncomp);
+            strcmp(a->name, qn[2]) && vtu_mesh_array(d, a, m->ntets))
+            return ST_ENOMEM;
     }
     vbuf_printf(&d->xml, "      </CellData>\n");
     return ST_OK;

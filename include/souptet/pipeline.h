@@ -44,6 +44,7 @@
 
 #include "souptet/enclose.h"
 #include "souptet/err.h"
+#include "souptet/parts.h"
 #include "souptet/pseudo.h"
 #include "souptet/progress.h"
 #include "souptet/smooth.h"
@@ -150,6 +151,12 @@ typedef struct st_pipeline_params {
     void *on_event_ctx;
     int try_all;           /* 1: run all tries candidates even once one
                               meets every goal (0) */
+    const st_parts *parts; /* the soup's parts (st_parts_split of the
+                              soup given to st_pipeline_run): the chosen
+                              mesh is tagged (st_parts_tag, on the run's
+                              field grid and pseudo-volume settings), and
+                              stats->parts says how. NULL: no parts, and
+                              the output is as without them (NULL) */
 } st_pipeline_params;
 
 st_pipeline_params st_pipeline_params_default(void);
@@ -201,6 +208,10 @@ typedef struct st_pipeline_stats {
     int goal_met;                        /* 1: a candidate met every goal
                                             and ended the run, maybe before
                                             all tries (see above) */
+    st_parts_tag_stats parts;            /* with p->parts: per part (the
+                                            caller frees it with
+                                            st_parts_tag_stats_free, also
+                                            on failure; all 0 without) */
 } st_pipeline_stats;
 
 /* The lattice cell width p gives for s: p->h, or the width of p->cells

@@ -4,7 +4,8 @@
  * A soup is a vertex array and a triangle array, exactly as the file gives
  * them: vertices are never welded, duplicated or degenerate triangles are
  * kept, orientation is whatever the file says. Polygons are fan-triangulated
- * (v0 v1 v2, v0 v2 v3, ...). All OBJ groups and objects form one soup.
+ * (v0 v1 v2, v0 v2 v3, ...). All OBJ groups and objects form one soup (their names
+ * are noted, below).
  *
  * Formats: OBJ (v/f, negative indices), OFF (also COFF/NOFF/...), PLY (ascii,
  * binary_little_endian, binary_big_endian; any scalar property type; the
@@ -12,6 +13,12 @@
  * binary), glTF 2.0 (.gltf with external or data-URI buffers, .glb: the
  * triangle, strip and fan primitives of the default scene's node trees,
  * in world space; see soup_gltf.c).
+ *
+ * Named parts: the readers also note where the file names a part (OBJ
+ * `o` and `g` lines, a glTF node with a mesh, an ASCII STL `solid NAME`)
+ * as runs in st_soup.names: a run starts at a triangle and lasts until the
+ * next run of its level. Nothing is stored for a file without names, and
+ * nothing else reads them: parts.h turns them into parts.
  *
  * Readers parse a memory buffer (so fuzzers and pipes use the same code) and
  * never trust a count from the file for an allocation: arrays grow with the
@@ -42,11 +49,26 @@ typedef enum st_soup_format {
 /* A zero-initialised st_soup is a valid empty soup. Grow xyz and tris only
  * through st_soup_add_vertex / st_soup_add_triangle: their capacity is
  * derived from the counts. */
+/* One named run of triangles: from triangle `first` up to the next run
+ * of the same level (or the end). level 1: an OBJ object (`o`), a glTF
+ * mesh node, an STL solid; level 2: an OBJ group (`g`). name is the
+ * rest of the line (blanks at both ends trimmed; "g a b" is "a b"), or the
+ * glTF node's (else its mesh's) name: bytes, NUL-terminated, at most 255
+ * (not checked as UTF-8; may be ""). */
+typedef struct st_soup_name {
+    size_t first;
+    char *name;
+    int level;
+} st_soup_name;
+
 typedef struct st_soup {
     double *xyz;        /* 3 * nverts coordinates, all finite */
     size_t nverts;
     uint32_t *tris;     /* 3 * ntris vertex indices, each < nverts */
     size_t ntris;
+    st_soup_name *names;    /* the file's named runs in file order (NULL,
+                               nnames 0: none); owned, freed by st_soup_free */
+    size_t nnames;
 } st_soup;
 
 /* An empty soup; NULL when out of memory. */
@@ -131,7 +153,13 @@ void st_soup_source_of(st_soup_source *src, const void *data, size_t size);
 st_status st_soup_bounds(const st_soup *s, double lo[3], double hi[3],
                          st_error *err);
 
-/* Append src's vertices and triangles to dst (src's indices shifted).
+/* Note a named run starting at the next triangle (s->ntris): name is
+ * len bytes, copied. ST_ENOMEM. */
+st_status st_soup_add_name(st_soup *s, int level, const char *name, size_t len,
+                           st_error *err);
+
+/* Append src's vertices and triangles to dst (src's indices shifted; the
+ * names are not carried).
  * ST_ENOMEM or ST_ELIMIT; dst keeps what it had on failure only in part. */
 st_status st_soup_append(st_soup *dst, const st_soup *src, st_error *err);
 

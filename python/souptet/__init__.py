@@ -64,6 +64,11 @@ class MeshResult:
                 V[i] = sum(embed_bary[i, c] * points[tets[embed_tet[i], c]])
     guessed     float, the share of the solid's boundary not on the input
                 but guessed (hole caps, a one-sided scan's far side)
+    parts       int32 (m,) or None: each tet's part (mesh(..., parts=...);
+                soupmesh --parts), the part owning most of its volume
+    part_share  float64 (m,) or None: the share of the tet that part owns
+                (0: the tet covers no part and took the nearest)
+    part_names  list of str or None: the parts' names, by index
     seconds     float, the library's wall time
     """
 
@@ -100,8 +105,22 @@ class MeshResult:
             _core.write(self._mesh, p, msh_version, binary)
 
 
+def read_parts(path, mode="auto"):
+    """Read a surface file with its parts (soupmesh --parts MODE).
+
+    mode   "names" (OBJ objects, or groups without objects; glTF mesh
+           nodes; STL solids), "pieces" (edge-connected pieces) or "auto"
+           (names where the file has them, else pieces)
+    Returns (V, F, part, names): V and F as read() gives them, part int32
+    (len(F),) each triangle's part, names a list of str (unique, UTF-8).
+    mesh(V, F, parts=part, part_names=names) tags the tets with them.
+    """
+    return _core.read_parts(path, mode)
+
+
 def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
-         threads=0, progress=None, float32=False, cancel=None, try_all=False):
+         threads=0, progress=None, float32=False, cancel=None, try_all=False,
+         parts=None, part_names=None):
     """Mesh a triangle soup into a coarse tet mesh that encloses it (soupmesh).
 
     V         (n, 3) numbers, the vertices in model units (finite)
@@ -144,13 +163,19 @@ def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
     cancel    souptet.Cancel or None: another thread's c.set() stops the
               run within about 0.1 s of work (the library polls the flag
               itself) and mesh() raises souptet.Cancelled (default None)
+    parts     None (default), "pieces" (the soup's edge-connected pieces),
+              or an integer array (len(F),) of each triangle's part
+              (0..65534; read_parts gives one): each tet gets the part
+              owning most of its volume, the inner part where one lies in
+              another (.parts, .part_share, .part_names; written by write())
+    part_names  list of str or None: the parts' names (default part_K)
     Returns a MeshResult. Not enclosing is not an error: see .encloses.
     Raises souptet.Error for bad input or parameters, MemoryError.
     """
     return MeshResult(_core.mesh(V, F, cells=cells, size=size, tets=tets, tries=tries,
                                  seed=seed, offset=offset, threads=threads,
                                  progress=progress, float32=float32, cancel=cancel,
-                                 try_all=try_all))
+                                 try_all=try_all, parts=parts, part_names=part_names))
 
 
 class Field:

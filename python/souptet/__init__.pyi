@@ -1,6 +1,6 @@
 # Type stub for souptet (the module's docstrings give units and defaults).
 import os
-from typing import Any, Callable, Dict, Optional, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -25,6 +25,7 @@ class Cancel:
     def is_set(self) -> bool: ...
 
 def read(path: _Path) -> Tuple[_F64, _I64]: ...
+def read_parts(path: _Path, mode: str = ...) -> Tuple[_F64, _I64, npt.NDArray[np.int32], List[str]]: ...
 
 class MeshResult:
     points: _F64
@@ -42,6 +43,9 @@ class MeshResult:
     seconds: float
     embed_tet: _I64
     embed_bary: _F64
+    parts: Optional[npt.NDArray[np.int32]]
+    part_share: Optional[_F64]
+    part_names: Optional[List[str]]
     def to_meshio(self) -> Any: ...
     def write(self, path: _Path, *, msh_version: int = ..., binary: bool = ...) -> None: ...
 
@@ -60,6 +64,8 @@ def mesh(
     float32: bool = ...,
     cancel: Optional[Cancel] = ...,
     try_all: bool = ...,
+    parts: Union[None, str, npt.ArrayLike] = ...,
+    part_names: Optional[List[str]] = ...,
 ) -> MeshResult: ...
 
 class Field:

@@ -4,6 +4,7 @@
  * gives it plain values (arrays, dicts, a capsule holding the mesh).
  *
  *   read(path) -> (V, F)
+ *   read_parts(path, mode) -> (V, F, part, names)   (parts.h)
  *   mesh(V, F, cells, size, tets, tries, seed, offset, threads, progress)
  *       -> dict (points, tets, boundary, embed_tet, embed_bary, ...,
  *          "_mesh": capsule "souptet.tetmesh")
@@ -21,6 +22,7 @@
 #include "souptet/grid.h"
 #include "souptet/meta.h"
 #include "souptet/outfile.h"
+#include "souptet/parts.h"
 #include "souptet/pipeline.h"
 #include "souptet/pseudo.h"
 #include "souptet/tetformat.h"
@@ -82,6 +84,148 @@ static PyObject *py_read(PyObject *self, PyObject *args)
     st_soup_free(s);
     Py_DECREF(path);
     return res;
+}
+
+/* The parts of a file (parts.h, soupmesh --parts MODE): (V, F, part, names),
+ * part int32 (len(F),), names a list of str. */
+static PyObject *py_read_parts(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *path = NULL;
+    const char *mode = "auto";
+    if (!PyArg_ParseTuple(args, "O&|s:read_parts", PyUnicode_FSConverter, &path, &mode))
+        return NULL;
+    const int md = st_parts_mode_from_name(mode);
+    if (md <= ST_PARTS_NONE) {
+        Py_DECREF(path);
+        return py_fail("mode must be auto, names or pieces, not '%s'", mode);
+    }
+    const char *p = PyBytes_AS_STRING(path);
+    st_soup *s = NULL;
+    st_parts parts;
+    memset(&parts, 0, sizeof parts);
+    st_error e;
+    st_error_clear(&e);
+    st_status rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = st_soup_read(&s, p, &e);
+    if (!rc)
+        rc = st_parts_split(&parts, s, (st_parts_mode)md, &e);
+    Py_END_ALLOW_THREADS
+    PyObject *res = NULL, *vf = NULL, *names = NULL;
+    PyArrayObject *P = NULL;
+    if (rc) {
+        py_raise(&e, p);
+        goto done;
+    }
+    npy_intp dn[1] = {(npy_intp)s->ntris};
+    P = (PyArrayObject *)PyArray_SimpleNew(1, dn, NPY_INT32);
+    vf = soup_arrays(s);
+    names = PyList_New((Py_ssize_t)parts.nparts);
+    if (!P || !vf || !names)
+        goto done;
+    int32_t *pp = PyArray_DATA(P);
+    for (size_t t = 0; t < s->ntris; t++)
+        pp[t] = parts.tri_part[t];
+    for (size_t k = 0; k < parts.nparts; k++) {
+        PyObject *n = PyUnicode_FromString(parts.names[k]);
+        if (!n)
+            goto done;
+        PyList_SET_ITEM(names, (Py_ssize_t)k, n);
+    }
+    res = Py_BuildValue("(OOOO)", PyTuple_GET_ITEM(vf, 0), PyTuple_GET_ITEM(vf, 1), P, names);
+done:
+    Py_XDECREF(P);
+    Py_XDECREF(vf);
+    Py_XDECREF(names);
+    st_parts_free(&parts);
+    st_soup_free(s);
+    Py_DECREF(path);
+    return res;
+}
+
+/* mesh()'s parts: None, a mode ("auto", "names", "pieces": st_parts_split
+ * of the arrays, which name nothing), or a (len(F),) integer array of part
+ * indices with part_names (None or a list of str). 0: *out filled (or
+ * zeroed for None); -1: an exception is set. */
+static int py_parts(PyObject *parts_o, PyObject *names_o, const st_soup *soup, st_parts *out)
+{
+    memset(out, 0, sizeof *out);
+    if (parts_o == Py_None)
+        return 0;
+    st_error e;
+    st_error_clear(&e);
+    if (PyUnicode_Check(parts_o)) {
+        const char *mode = PyUnicode_AsUTF8(parts_o);
+        const int md = mode ? st_parts_mode_from_name(mode) : -1;
+        if (md <= ST_PARTS_NONE) {
+            PyErr_Clear();
+            py_fail("parts must be an array, \"auto\", \"names\" or \"pieces\"");
+            return -1;
+        }
+        if (st_parts_split(out, soup, (st_parts_mode)md, &e)) {
+            py_raise(&e, NULL);
+            return -1;
+        }
+        return 0;
+    }
+    PyArrayObject *a = (PyArrayObject *)PyArray_FROMANY(parts_o, NPY_INT64, 1, 1, NPY_ARRAY_CARRAY_RO);
+    if (!a)
+        return -1;
+    const npy_intp n = PyArray_DIM(a, 0);
+    uint32_t *idx = NULL;
+    const char **names = NULL;
+    PyObject *seq = NULL;
+    Py_ssize_t nn = 0;
+    int rc = -1;
+    if ((size_t)n != soup->ntris) {
+        py_fail("parts must have one entry per row of F (%zu), not %zd", soup->ntris, (Py_ssize_t)n);
+        goto out;
+    }
+    idx = malloc((size_t)(n ? n : 1) * sizeof *idx);
+    if (!idx) {
+        PyErr_NoMemory();
+        goto out;
+    }
+    const int64_t *v = PyArray_DATA(a);
+    for (npy_intp t = 0; t < n; t++) {
+        if (v[t] < 0 || v[t] >= ST_PARTS_MAX) {
+            py_fail("parts[%zd] is %lld, not a part index in 0..%d", (Py_ssize_t)t,
+                    (long long)v[t], ST_PARTS_MAX - 1);
+            goto out;
+        }
+        idx[t] = (uint32_t)v[t];
+    }
+    if (names_o != Py_None) {
+        seq = PySequence_Fast(names_o, "part_names must be a list of str or None");
+        if (!seq)
+            goto out;
+        nn = PySequence_Fast_GET_SIZE(seq);
+        names = calloc((size_t)(nn ? nn : 1), sizeof *names);
+        if (!names) {
+            PyErr_NoMemory();
+            goto out;
+        }
+        for (Py_ssize_t k = 0; k < nn; k++) {
+            PyObject *it = PySequence_Fast_GET_ITEM(seq, k);
+            if (!PyUnicode_Check(it) || !(names[k] = PyUnicode_AsUTF8(it))) {
+                PyErr_Clear();
+                PyErr_SetString(PyExc_TypeError, "part_names must hold str (UTF-8)");
+                goto out;
+            }
+        }
+    }
+    if (st_parts_from_indices(out, idx, (size_t)n, names, (size_t)nn, &e)) {
+        py_raise(&e, NULL);
+        goto out;
+    }
+    rc = 0;
+out:
+    free(idx);
+    free(names);
+    Py_XDECREF(seq);
+    Py_DECREF(a);
+    return rc;
 }
 
 /* ---- souptet.Cancel: the library's cancel flag, as an object -------------- */
@@ -249,6 +393,53 @@ static void capsule_free(PyObject *cap)
     st_tetmesh_free(PyCapsule_GetPointer(cap, CAPSULE_NAME));
 }
 
+/* The result's parts, part_share and part_names (None without parts). */
+static int set_parts(PyObject *d, const st_tetmesh *m)
+{
+    const st_tet_array *pa = st_tetmesh_find_array(m, "part", ST_ON_CELLS);
+    const st_tet_array *sa = st_tetmesh_find_array(m, "part_share", ST_ON_CELLS);
+    if (!pa || !sa)
+        return set_item(d, "parts", (Py_INCREF(Py_None), Py_None)) ||
+               set_item(d, "part_share", (Py_INCREF(Py_None), Py_None)) ||
+               set_item(d, "part_names", (Py_INCREF(Py_None), Py_None));
+    npy_intp dn[1] = {(npy_intp)m->ntets};
+    PyArrayObject *P = (PyArrayObject *)PyArray_SimpleNew(1, dn, NPY_INT32);
+    PyArrayObject *S = (PyArrayObject *)PyArray_SimpleNew(1, dn, NPY_FLOAT64);
+    const char **nm = NULL;
+    size_t n = 0;
+    st_error e;
+    st_error_clear(&e);
+    if (!P || !S || st_parts_of_mesh(&nm, &n, m, &e)) {
+        Py_XDECREF(P);
+        Py_XDECREF(S);
+        if (!PyErr_Occurred())
+            PyErr_NoMemory();
+        return -1;
+    }
+    int32_t *p = PyArray_DATA(P);
+    for (size_t t = 0; t < m->ntets; t++)
+        p[t] = (int32_t)pa->values[t];
+    memcpy(PyArray_DATA(S), sa->values, m->ntets * sizeof(double));
+    PyObject *L = PyList_New((Py_ssize_t)n);
+    for (size_t k = 0; L && k < n; k++) {
+        const char *c = nm[k] ? nm[k] : "";
+        PyObject *s = PyUnicode_DecodeUTF8(c, (Py_ssize_t)strlen(c), "replace");
+        if (!s) {
+            Py_CLEAR(L);
+            break;
+        }
+        PyList_SET_ITEM(L, (Py_ssize_t)k, s);
+    }
+    free((void *)nm);
+    if (!L) {
+        Py_DECREF(P);
+        Py_DECREF(S);
+        return -1;
+    }
+    return set_item(d, "parts", (PyObject *)P) || set_item(d, "part_share", (PyObject *)S) ||
+           set_item(d, "part_names", L);
+}
+
 static PyObject *mesh_result(st_tetmesh *m, const st_pipeline_stats *st, const int64_t *et,
                              const double *eb, size_t nv)
 {
@@ -296,7 +487,8 @@ static PyObject *mesh_result(st_tetmesh *m, const st_pipeline_stats *st, const i
                      st->guess.boundary_faces
                          ? (double)st->guess.fill_faces / (double)st->guess.boundary_faces
                          : 0.0)) ||
-        set_item(d, "seconds", PyFloat_FromDouble(st->seconds_total)))
+        set_item(d, "seconds", PyFloat_FromDouble(st->seconds_total)) ||
+        set_parts(d, m))
         goto done;
     PyObject *cap = PyCapsule_New(m, CAPSULE_NAME, capsule_free);
     if (!cap)
@@ -353,13 +545,15 @@ static PyObject *py_mesh(PyObject *self, PyObject *args, PyObject *kw)
     (void)self;
     static char *kwlist[] = {"V", "F", "cells", "size", "tets", "tries", "seed",
                              "offset", "threads", "progress", "float32", "cancel", "try_all",
-                             NULL};
+                             "parts", "part_names", NULL};
     PyObject *V, *F, *cells_o = NULL, *size_o = Py_None, *tets_o = Py_None, *tries_o = NULL,
                      *seed_o = NULL, *offset_o = NULL, *threads_o = NULL, *progress = Py_None,
-                     *f32_o = Py_False, *cancel_o = Py_None, *try_all_o = Py_False;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|$OOOOOOOOOOO:mesh", kwlist, &V, &F, &cells_o,
+                     *f32_o = Py_False, *cancel_o = Py_None, *try_all_o = Py_False,
+                     *parts_o = Py_None, *pnames_o = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|$OOOOOOOOOOOOO:mesh", kwlist, &V, &F, &cells_o,
                                      &size_o, &tets_o, &tries_o, &seed_o, &offset_o,
-                                     &threads_o, &progress, &f32_o, &cancel_o, &try_all_o))
+                                     &threads_o, &progress, &f32_o, &cancel_o, &try_all_o,
+                                     &parts_o, &pnames_o))
         return NULL;
     if (cancel_o != Py_None && !PyObject_TypeCheck(cancel_o, &CancelType)) {
         PyErr_SetString(PyExc_TypeError, "cancel must be a souptet.Cancel or None");
@@ -401,6 +595,13 @@ static PyObject *py_mesh(PyObject *self, PyObject *args, PyObject *kw)
     st_soup *soup = NULL;
     if (py_soup(V, F, &soup))
         return NULL;
+    st_parts parts;
+    if (py_parts(parts_o, pnames_o, soup, &parts)) {
+        st_soup_free(soup);
+        return NULL;
+    }
+    if (parts.nparts)
+        p.parts = &parts;
 
     st_error e;
     st_error_clear(&e);
@@ -484,6 +685,8 @@ done:
     free(et);
     free(eb);
     free(st.candidates);
+    st_parts_tag_stats_free(&st.parts);
+    st_parts_free(&parts);
     st_tetmesh_free(m);
     st_soup_free(soup);
     return res;
@@ -633,6 +836,7 @@ static PyObject *py_defaults(PyObject *self, PyObject *noargs)
 
 static PyMethodDef methods[] = {
     {"read", py_read, METH_VARARGS, "read(path) -> (V, F)"},
+    {"read_parts", py_read_parts, METH_VARARGS, "read_parts(path, mode) -> (V, F, part, names)"},
     {"mesh", (PyCFunction)(void (*)(void))py_mesh, METH_VARARGS | METH_KEYWORDS,
      "mesh(V, F, **params) -> dict"},
     {"distance", (PyCFunction)(void (*)(void))py_distance, METH_VARARGS | METH_KEYWORDS,

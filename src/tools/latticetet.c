@@ -17,6 +17,7 @@
 #include "souptet/gridio.h"
 #include "souptet/lattice.h"
 #include "souptet/outfile.h"
+#include "souptet/parts.h"
 #include "souptet/sculpt.h"
 #include "souptet/soup.h"
 #include "souptet/tetio.h"
@@ -57,6 +58,10 @@ static void usage(void)
 "      --seed S         random rotation and offset of the lattice (0: axis-aligned\n"
 "                       at the box's corner; default 0 for --density, 1 for\n"
 "                       --sculpt, as soupmesh)\n"
+"      --parts MODE     with --sculpt: tag each tet with the surface's part\n"
+"                       it mostly covers (cell data part and part_share, as\n"
+"                       soupmesh --parts): names, pieces, auto or none\n"
+"                       (default none)\n"
 "      --no-repair      sculpt without bomb and manifold repair; with\n"
 "                       --density, the paper's rule alone: no cleanup of\n"
 "                       hanging tets, islands and pinched boundaries\n"
@@ -80,7 +85,7 @@ TOOL_HELP_TETFORMAT
 }
 
 enum { OPT_DENSITY = TOOL_OPT_FIRST, OPT_SCULPT, OPT_SURFACE, OPT_LATTICE, OPT_CELLS,
-       OPT_SEED, OPT_NOREPAIR };
+       OPT_SEED, OPT_NOREPAIR, OPT_PARTS };
 
 /* What the command line asks for. */
 typedef struct latticetet_settings {
@@ -92,6 +97,7 @@ typedef struct latticetet_settings {
     double rho;        /* --density; < 0 with --sculpt */
     double size;       /* -h; 0: from cells */
     int sculpt, repair, have_seed;
+    int parts_mode;    /* --parts (st_parts_mode) */
     uint64_t seed;
 } latticetet_settings;
 
@@ -104,6 +110,7 @@ static const struct option longopts[] = {
     {"size", required_argument, NULL, 'h'},
     {"seed", required_argument, NULL, OPT_SEED},
     {"no-repair", no_argument, NULL, OPT_NOREPAIR},
+    {"parts", required_argument, NULL, OPT_PARTS},
     TOOL_LONG_OPTIONS_OUTPUT,
     TOOL_LONG_OPTIONS_TETFORMAT,
     TOOL_LONG_OPTIONS_END};
@@ -148,6 +155,10 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         s->have_seed = 1;
         break;
     }
+    case OPT_PARTS:
+        if ((s->parts_mode = st_parts_mode_from_name(arg)) < 0)
+            return tool_usage_error(t, "--parts is auto, names, pieces or none, not '%s'", arg);
+        break;
     case OPT_NOREPAIR:
         s->repair = 0;
         break;
@@ -167,6 +178,8 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
         return tool_usage_error(t, "--sculpt needs --surface S (the input surface)");
     if (!s->sculpt && s->surface)
         return tool_usage_error(t, "--surface goes with --sculpt");
+    if (!s->sculpt && s->parts_mode > 0)
+        return tool_usage_error(t, "--parts goes with --sculpt --surface S");
     if ((s->cells || s->auto_cells) && s->size > 0)
         return tool_usage_error(t, "--cells and -h exclude each other");
     if (s->auto_cells && (s->sculpt || !s->repair))
@@ -387,6 +400,24 @@ static int run(tool_ctx *t, void *settings)
                        "made has its inside negative); nothing written");
         rc = tool_fail(t, &err);
         goto done;
+    }
+    /* --parts: each tet's part, on the field's grid (parts.h) */
+    if (s->parts_mode > 0) {
+        st_parts parts;
+        st_pseudo_params pp = st_pseudo_params_default();
+        st_status ps = st_parts_split(&parts, soup, (st_parts_mode)s->parts_mode, &err);
+        if (!ps) {
+            tool_say(t, 1, "%zu part%s (%s)", parts.nparts, parts.nparts == 1 ? "" : "s",
+                     st_parts_mode_name(parts.mode));
+            st_progress prog = tool_progress(t);
+            ps = st_parts_tag(m, soup, &parts, g, &pp, NULL, &prog, &err);
+            tool_progress_end(t);
+        }
+        st_parts_free(&parts);
+        if (ps) {
+            rc = tool_fail_file(t, &err, tool_in_name(surface));
+            goto done;
+        }
     }
     /* The field's metadata (source, history) carries over; the lattice's
      * own keys win. */

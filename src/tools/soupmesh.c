@@ -14,6 +14,7 @@
 #include "souptet/lattice.h"
 #include "souptet/mem.h"
 #include "souptet/outfile.h"
+#include "souptet/parts.h"
 #include "souptet/pipeline.h"
 #include "souptet/soup.h"
 #include "souptet/soupwrite.h"
@@ -55,6 +56,12 @@ TOOL_HELP_TETFORMAT
 "                       boundary, pushed further when needed) so that it still\n"
 "                       encloses the input once stored as float (Blender, glTF,\n"
 "                       STL, game engines), checked exactly\n"
+"      --parts MODE     tag each tet with the input's part it mostly covers\n"
+"                       (cell data part and part_share, a .msh group and a\n"
+"                       .mesh reference per part): names (OBJ objects or\n"
+"                       groups, glTF mesh nodes, STL solids), pieces (the\n"
+"                       edge-connected pieces), auto (names where the file\n"
+"                       has them, else pieces) or none (default none)\n"
 "      --cells N        BCC lattice cells along the longest side of the\n"
 "                       model's box (default 10; more cells, more tets)\n"
 "  -h, --size H         the lattice cell width in model units, instead of\n"
@@ -113,7 +120,7 @@ TOOL_HELP_TETFORMAT
 
 enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_TRY_ALL, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
        OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY,
-       OPT_BEST_EFFORT, OPT_OFFSET_FILL, OPT_FLOAT32 };
+       OPT_BEST_EFFORT, OPT_OFFSET_FILL, OPT_FLOAT32, OPT_PARTS };
 
 /* -v: a line as each stage, sculpt, fit iteration and candidate ends, so a
  * long run is never silent (pipeline.h, st_pipeline_event). */
@@ -245,6 +252,55 @@ static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_pa
     return tool_flush_stdout(t) ? TOOL_EXIT_FAIL : TOOL_EXIT_OK;
 }
 
+/* What --parts found in the input, and what it handled on the way. */
+static void say_parts(tool_ctx *t, const char *in_name, const st_parts *p)
+{
+    tool_say(t, 1, "%zu part%s (%s)", p->nparts, p->nparts == 1 ? "" : "s",
+             st_parts_mode_name(p->mode));
+    if (p->empty)
+        tool_say(t, 1, "%s: warning: %zu named part%s without faces skipped (first: '%s')",
+                 in_name, p->empty, p->empty == 1 ? "" : "s", p->first_empty);
+    if (p->unnamed)
+        tool_say(t, 1, "%s: warning: %zu part%s without a name, named part_K by index",
+                 in_name, p->unnamed, p->unnamed == 1 ? "" : "s");
+    if (p->not_utf8)
+        tool_say(t, 1, "%s: warning: %zu part name%s not UTF-8, named part_K by index",
+                 in_name, p->not_utf8, p->not_utf8 == 1 ? "" : "s");
+    if (p->duplicates)
+        tool_say(t, 1, "%s: warning: %zu part name%s given twice, suffixed _2, _3, ...",
+                 in_name, p->duplicates, p->duplicates == 1 ? "" : "s");
+    for (size_t k = 0; k < p->nparts; k++)
+        tool_say(t, 2, "part %zu '%s': %zu triangles", k, p->names[k], p->tris_of[k]);
+}
+
+/* Per part: the tets tagged, their volume, and the part's pseudo volume. */
+static void report_parts(tool_ctx *t, const st_parts *p, const st_parts_tag_stats *ps)
+{
+    for (size_t k = 0; k < ps->nparts && k < p->nparts; k++)
+        tool_say(t, 2, "part %zu '%s': %zu tets, volume %.6g (its pseudo volume %.6g)", k,
+                 p->names[k], ps->tets[k], ps->volume[k], ps->pseudo_volume[k]);
+    if (ps->uncovered)
+        tool_say(t, 2, "%zu tets cover no part (the margin): the nearest part's",
+                 ps->uncovered);
+}
+
+/* Each input vertex's part on the --embed point cloud: the part of the
+ * first triangle using it (-1 for a vertex no triangle uses). */
+static st_status embed_parts(st_tetmesh *side, const st_soup *soup, const st_parts *p,
+                             st_error *err)
+{
+    double *v = NULL;
+    st_status st = st_tetmesh_add_array(side, "part", ST_ON_POINTS, 1, &v, err);
+    if (st)
+        return st;
+    for (size_t i = 0; i < soup->nverts; i++)
+        v[i] = -1;
+    for (size_t k = soup->ntris; k-- > 0;)
+        for (int c = 0; c < 3; c++)
+            v[soup->tris[3 * k + c]] = p->tri_part[k];
+    return ST_OK;
+}
+
 /* What the command line asks for. */
 typedef struct soupmesh_settings {
     tool_common co;
@@ -254,6 +310,7 @@ typedef struct soupmesh_settings {
     int float32_by_stl;        /* --boundary .stl turned --float32 on */
     int embed_text;            /* --embed FILE.txt, else .vtu */
     st_soup_format boundary_format;
+    int parts_mode;            /* --parts (st_parts_mode) */
 } soupmesh_settings;
 
 static const struct option longopts[] = {
@@ -276,6 +333,7 @@ static const struct option longopts[] = {
     {"embed", required_argument, NULL, OPT_EMBED},
     {"boundary", required_argument, NULL, OPT_BOUNDARY},
     {"float32", no_argument, NULL, OPT_FLOAT32},
+    {"parts", required_argument, NULL, OPT_PARTS},
     TOOL_LONG_OPTIONS_OUTPUT,
     TOOL_LONG_OPTIONS_END};
 
@@ -352,6 +410,10 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
     case OPT_FLOAT32:
         s->pipeline.float32 = 1;
         break;
+    case OPT_PARTS:
+        if ((s->parts_mode = st_parts_mode_from_name(arg)) < 0)
+            return tool_usage_error(t, "--parts is auto, names, pieces or none, not '%s'", arg);
+        break;
     }
     return TOOL_CONTINUE;
 }
@@ -417,6 +479,8 @@ static int run(tool_ctx *t, void *settings)
     double *eb = NULL;
     st_tetmesh *side = NULL;
     st_soup *bsoup = NULL;
+    st_parts parts;
+    memset(&parts, 0, sizeof parts);
     st_outfile bof;
     memset(&bof, 0, sizeof bof);
     bof.slot = -1;
@@ -430,6 +494,14 @@ static int run(tool_ctx *t, void *settings)
     if (lattice_over_limit(soup, p, s->co.max_bytes, &err)) {
         rc = tool_fail_file(t, &err, in_name);
         goto done;
+    }
+    if (s->parts_mode != ST_PARTS_NONE) {
+        if (st_parts_split(&parts, soup, (st_parts_mode)s->parts_mode, &err)) {
+            rc = tool_fail_file(t, &err, in_name);
+            goto done;
+        }
+        say_parts(t, in_name, &parts);
+        s->pipeline.parts = &parts;
     }
     st_progress prog = tool_progress(t);
     if (st_pipeline_run(&m, &st, soup, p, &prog, &err)) {
@@ -450,6 +522,8 @@ static int run(tool_ctx *t, void *settings)
         tool_say(t, 2, "h %.6g for about %zu tets: %zu sculpts, %.2f s", st.h,
                  p->target_tets, st.sculpts, st.seconds_size);
     report(t, &st, p->tries, p->density_rho > 0);
+    if (p->parts)
+        report_parts(t, &parts, &st.parts);
     if (p->float32) {
         const st_float32_stats *f = &st.float32;
         tool_say(t, 2, "float32%s: %zu of %zu points moved (%zu on the boundary, %zu of "
@@ -484,7 +558,8 @@ static int run(tool_ctx *t, void *settings)
         }
         if (st_embed_compute(et, eb, &nout, &first, m, soup, &err) ||
             (!s->embed_text &&
-             st_embed_to_tetmesh(&side, soup->xyz, et, eb, soup->nverts, &err))) {
+             st_embed_to_tetmesh(&side, soup->xyz, et, eb, soup->nverts, &err)) ||
+            (side && p->parts && embed_parts(side, soup, &parts, &err))) {
             rc = tool_fail(t, &err);
             goto done;
         }
@@ -599,6 +674,8 @@ done:
     free(eb);
     st_tetmesh_free(side);
     free(st.candidates);
+    st_parts_tag_stats_free(&st.parts);
+    st_parts_free(&parts);
     st_tetmesh_free(m);
     st_soup_free(soup);
     return rc;

@@ -13,6 +13,7 @@
 #define _GNU_SOURCE
 #include "../cli/tool.h"
 #include "souptet/gridio.h"
+#include "souptet/parts.h"
 #include "souptet/pipeline.h"
 #include "souptet/soup.h"
 #include "souptet/tetio.h"
@@ -83,8 +84,54 @@ static const char *enclosure_word(const st_tetstat *r)
     return "no";
 }
 
+/* The name of part k, from the mesh's meta, or part_k. */
+static const char *part_label(char *buf, size_t size, const st_tetmesh *m, size_t k)
+{
+    char key[48];
+    snprintf(key, sizeof key, "part_name_%zu", k);
+    const char *v = st_meta_get(&m->meta, key);
+    if (v)
+        return v;
+    snprintf(buf, size, "part_%zu", k);
+    return buf;
+}
+
+/* The parts of a tagged mesh (parts.h, soupmesh --parts): per part its
+ * tets, their volume, the pseudo volume soupmesh measured for the part
+ * and the ratio of the two. */
+static void parts_json(FILE *f, const st_tetmesh *m, const st_parts_tag_stats *ps)
+{
+    fprintf(f, ",\n  \"parts\": [");
+    for (size_t k = 0; k < ps->nparts; k++) {
+        char lb[32], b[3][32];
+        const double pv = ps->pseudo_volume[k];
+        fprintf(f, "%s\n    {\"part\": %zu, \"name\": ", k ? "," : "", k);
+        tool_json_string(f, part_label(lb, sizeof lb, m, k));
+        fprintf(f, ", \"tets\": %zu, \"volume\": %s, \"pseudo_volume\": %s, "
+                   "\"volume_ratio\": %s}", ps->tets[k], tool_json_number(b[0], ps->volume[k]),
+                isfinite(pv) ? tool_json_number(b[1], pv) : "null",
+                isfinite(pv) && pv > 0 ? tool_json_number(b[2], ps->volume[k] / pv) : "null");
+    }
+    fprintf(f, "],\n  \"parts_uncovered_tets\": %zu", ps->uncovered);
+}
+
+static void parts_table(FILE *f, const st_tetmesh *m, const st_parts_tag_stats *ps)
+{
+    fprintf(f, "parts (%zu; %zu tets cover none):\n", ps->nparts, ps->uncovered);
+    for (size_t k = 0; k < ps->nparts; k++) {
+        char lb[32];
+        const double pv = ps->pseudo_volume[k];
+        fprintf(f, "  %-4zu %-23s %zu tets, volume %.6g", k, part_label(lb, sizeof lb, m, k),
+                ps->tets[k], ps->volume[k]);
+        if (isfinite(pv) && pv > 0)
+            fprintf(f, ", its pseudo volume %.6g (ratio %.4f)", pv, ps->volume[k] / pv);
+        fputc('\n', f);
+    }
+}
+
 static void print_json(FILE *f, const char *name, const char *sname,
-                       const char *fname, const st_tetstat *r)
+                       const char *fname, const st_tetstat *r, const st_tetmesh *m,
+                       const st_parts_tag_stats *ps)
 {
     char b[15][32];
     fprintf(f, "{\"file\": ");
@@ -178,6 +225,8 @@ static void print_json(FILE *f, const char *name, const char *sname,
                 r->field_voxels, r->field_inside, r->mesh_voxels,
                 r->both_voxels, tool_json_number(b[0], r->iou));
     }
+    if (ps && ps->nparts)
+        parts_json(f, m, ps);
     fprintf(f, "}\n");
 }
 
@@ -197,7 +246,8 @@ static void beyond_row(FILE *f, double ratio, const char *what, size_t n)
 }
 
 static void print_table(FILE *f, const char *name, const char *sname,
-                        const char *fname, const st_tetstat *r)
+                        const char *fname, const st_tetstat *r, const st_tetmesh *m,
+                        const st_parts_tag_stats *ps)
 {
     fprintf(f, "%s:\n", name);
     ROW("tets", "%zu", r->tets);
@@ -303,6 +353,8 @@ static void print_table(FILE *f, const char *name, const char *sname,
         ROW("both", "%zu", r->both_voxels);
         ROW("IoU", "%.6f", r->iou);
     }
+    if (ps && ps->nparts)
+        parts_table(f, m, ps);
 }
 #undef ROW
 
@@ -371,6 +423,8 @@ static int run(tool_ctx *t, void *settings)
     st_soup *soup = NULL;
     st_grid *g = NULL;
     st_tetstat r;
+    st_parts_tag_stats parts;
+    memset(&parts, 0, sizeof parts);
     int rc = TOOL_EXIT_FAIL;
     double t0 = tool_now();
     /* Read every input first: a bad one gives no half report. */
@@ -441,10 +495,12 @@ static int run(tool_ctx *t, void *settings)
     const char *sname = surface ? tool_in_name(surface) : "<stdin>";
     const char *fname = rebuilt ? "the mesh's field (rebuilt from its meta)"
                         : field ? tool_in_name(field) : "<stdin>";
+    if (st_parts_measure(&parts, m, &err))
+        goto failed;
     if (s->json)
-        print_json(stdout, name, sname, fname, &r);
+        print_json(stdout, name, sname, fname, &r, m, &parts);
     else
-        print_table(stdout, name, sname, fname, &r);
+        print_table(stdout, name, sname, fname, &r, m, &parts);
     if (tool_flush_stdout(t)) {
         rc = TOOL_EXIT_FAIL;
         goto done;
@@ -487,6 +543,7 @@ static int run(tool_ctx *t, void *settings)
 failed:
     rc = tool_fail_file(t, &err, name);
 done:
+    st_parts_tag_stats_free(&parts);
     st_tetmesh_free(m);
     st_soup_free(soup);
     st_grid_free(g);
