@@ -1299,7 +1299,6 @@ st_status st_fit(st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
     }
     c.bvh = bvh;
     c.prog = prog;
-    c.plateau_stop = 1;
     if (p.fill && p.fill->ntris > 0) {
         rc = st_bvh_build(&fown, p.fill, err);
         if (rc)

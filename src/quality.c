@@ -56,16 +56,6 @@ static const double qual_sphere[] = {0.1, 0.04, 0.015};
 #define QUAL_NSPHERE (sizeof qual_sphere / sizeof qual_sphere[0])
 /* Central-difference step for the score gradient, in units of h. */
 #define QUAL_GRAD_EPS 1e-4
-/* The plateau stop (fit_ctx.plateau_stop): a pass ends once the worst
- * tet's score has not risen by QUAL_PLATEAU_GAIN degrees over the last
- * QUAL_PLATEAU_ROUNDS rounds, and every boundary vertex is within the
- * offset. Only then: where vertices are still beyond, the rescues that
- * follow the pass need its later moves (a plateau stop regardless of the
- * condition left one rotor vertex beyond 0.4 h). The moves of those
- * rounds rarely raise the worst tet: the armadillo at --cells 6 spent 23
- * of its first pass's 40 rounds at 29.40 degrees. */
-#define QUAL_PLATEAU_GAIN 0.01
-#define QUAL_PLATEAU_ROUNDS 4
 
 static int cmp_cand(const void *a, const void *b)
 {
@@ -276,8 +266,6 @@ st_status sm_quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
         return st_error_set(err, ST_ENOMEM, NULL, 0,
                             "out of memory for the quality pass (%zu vertices)", sm->nv);
     }
-    double plateau_best = -INFINITY;
-    int plateau_since = 0;
     for (int round = 0; round < p->quality_rounds; round++) {
         if (st_progress_cancelled(c->prog)) {
             free(mark);
@@ -286,13 +274,10 @@ st_status sm_quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
         }
         memset(mark, 0, sm->nv);
         size_t nbad = 0;
-        double worst = INFINITY;
         for (size_t t = 0; t < m->ntets; t++) {
             const uint32_t *k = m->tets + 4 * t;
             double sc = sm_tet_score(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
                                      m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]);
-            if (sc < worst)
-                worst = sc;
             if (sc < p->quality_goal) {
                 nbad++;
                 for (int i = 0; i < 4; i++)
@@ -301,15 +286,6 @@ st_status sm_quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
         }
         if (nbad == 0)
             break;
-        if (c->plateau_stop) {
-            if (round == 0 || worst > plateau_best + QUAL_PLATEAU_GAIN) {
-                plateau_best = worst;
-                plateau_since = 0;
-            } else if (++plateau_since >= QUAL_PLATEAU_ROUNDS && dist &&
-                       sm_boundary_distances(c, dist).within == sm->nbv) {
-                break;
-            }
-        }
         size_t moved = 0, rejected = 0;
         for (size_t col = 0; col < sm->ncolours; col++) {
             dy.step++;

@@ -121,9 +121,6 @@ typedef struct fit_ctx {
                             their tangent plane only (sm_quality_fair) */
     const st_progress *prog;   /* its cancel flag stops the fit between
                                   iterations and rounds (may be NULL) */
-    int plateau_stop;    /* the quality pass may end on a plateau of the
-                            worst score once every boundary vertex is
-                            within the offset (quality.c; st_fit's) */
 } fit_ctx;
 
 /* Which vertices can be skipped: a vertex move is a deterministic function
