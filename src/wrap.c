@@ -988,6 +988,88 @@ static st_status hold_off_iso(st_grid *out, float **data, size_t *moved,
 
 /* ---- the whole job -------------------------------------------------------- */
 
+/* Extraction, pieces, quads to triangles and the check, with the
+ * fallbacks of wrap.h: halving the adaptivity, then the larger margins
+ * off the isovalue. *m gets the checked surface. */
+static st_status extract_checked(mesh *m, const st_grid *g, const st_wrap_params *p,
+                                 st_wrap_stats *stats, const st_progress *progress,
+                                 st_error *err)
+{
+    const float iso = (float)p->iso;
+    double A = p->adaptivity;
+    st_wrap_check chk;
+    size_t margin = 0;      /* index into hold_off_margin[] */
+    st_grid held;
+    float *held_data = NULL;
+    double held_for = -1.0; /* the margin `held` was made for */
+    for (;;) {
+        if (st_progress_cancelled(progress)) {
+            free(held_data);
+            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        }
+        st_progress_report(progress, "extract", 0.0);
+        st_status st = ST_OK;
+        if (held_for != hold_off_margin[margin]) {
+            free(held_data);
+            held_for = stats->iso_margin = hold_off_margin[margin];
+            st = hold_off_iso(&held, &held_data, &stats->iso_held_off, g,
+                              iso, (float)(stats->iso_margin * g->voxel),
+                              err);
+            if (st)
+                return st;
+        }
+        st_wrap_polys P;
+        st = st_wrap_polys_vdb(&P, &held, p->iso, A, err);
+        if (st) {
+            free(held_data);
+            return st;
+        }
+        stats->quads = P.nquads;
+        stats->triangles = P.ntris;
+        stats->cavities_filled = stats->specks_dropped = 0;
+        st = filter_pieces(&P, p->min_volume * g->voxel * g->voxel * g->voxel,
+                           p->keep_cavities, stats, err);
+        if (st == ST_OK && P.nquads + P.ntris == 0)
+            st = st_error_set(err, ST_EINPUT, NULL, 0,
+                              "every piece of the surface is smaller than "
+                              "--min-volume (%g voxels)", p->min_volume);
+        if (st == ST_OK)
+            st = mesh_build(m, &P, err);
+        st_wrap_polys_clear(&P);
+        if (st) {
+            free(held_data);
+            return st;
+        }
+        st_progress_report(progress, "check", 0.5);
+        if ((st = st_wrap_check_compute(&chk, m->s, err)) ||
+            (!chk.self_intersection_free &&
+             ((st = resplit(m, &stats->resplit, err)) ||
+              (st = st_wrap_check_compute(&chk, m->s, err))))) {
+            mesh_clear(m);
+            free(held_data);
+            return st;
+        }
+        if (st_wrap_check_ok(&chk))
+            break;
+        mesh_clear(m);
+        if (A > 0.0) {
+            A = A / 2 < ADAPTIVITY_FLOOR ? 0.0 : A / 2;
+        } else if (margin + 1 < HOLD_OFF_STEPS) {
+            margin++; /* the values held farther off the isovalue */
+        } else {
+            free(held_data);
+            return st_error_set(err, ST_EINTERNAL, NULL, 0,
+                                "the extracted surface fails its check: %s "
+                                "(%zu self-intersecting pairs)",
+                                check_failure(&chk),
+                                chk.self_intersecting_pairs);
+        }
+    }
+    free(held_data);
+    stats->adaptivity_used = A;
+    return ST_OK;
+}
+
 st_status st_wrap_field(st_soup **out, const st_grid *g,
                         const st_wrap_params *p, st_wrap_stats *stats,
                         const st_progress *progress, st_error *err)
@@ -1028,78 +1110,11 @@ st_status st_wrap_field(st_soup **out, const st_grid *g,
                             "nothing inside: no value of the field is below "
                             "the isovalue %g", p->iso);
 
-    double A = p->adaptivity;
     mesh m = {0};
     st_wrap_check chk;
-    size_t margin = 0;      /* index into hold_off_margin[] */
-    st_grid held;
-    float *held_data = NULL;
-    double held_for = -1.0; /* the margin `held` was made for */
-    for (;;) {
-        if (st_progress_cancelled(progress)) {
-            free(held_data);
-            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
-        }
-        st_progress_report(progress, "extract", 0.0);
-        st_status st = ST_OK;
-        if (held_for != hold_off_margin[margin]) {
-            free(held_data);
-            held_for = stats->iso_margin = hold_off_margin[margin];
-            st = hold_off_iso(&held, &held_data, &stats->iso_held_off, g,
-                              iso, (float)(stats->iso_margin * g->voxel),
-                              err);
-            if (st)
-                return st;
-        }
-        st_wrap_polys P;
-        st = st_wrap_polys_vdb(&P, &held, p->iso, A, err);
-        if (st) {
-            free(held_data);
-            return st;
-        }
-        stats->quads = P.nquads;
-        stats->triangles = P.ntris;
-        stats->cavities_filled = stats->specks_dropped = 0;
-        st = filter_pieces(&P, p->min_volume * g->voxel * g->voxel * g->voxel,
-                           p->keep_cavities, stats, err);
-        if (st == ST_OK && P.nquads + P.ntris == 0)
-            st = st_error_set(err, ST_EINPUT, NULL, 0,
-                              "every piece of the surface is smaller than "
-                              "--min-volume (%g voxels)", p->min_volume);
-        if (st == ST_OK)
-            st = mesh_build(&m, &P, err);
-        st_wrap_polys_clear(&P);
-        if (st) {
-            free(held_data);
-            return st;
-        }
-        st_progress_report(progress, "check", 0.5);
-        if ((st = st_wrap_check_compute(&chk, m.s, err)) ||
-            (!chk.self_intersection_free &&
-             ((st = resplit(&m, &stats->resplit, err)) ||
-              (st = st_wrap_check_compute(&chk, m.s, err))))) {
-            mesh_clear(&m);
-            free(held_data);
-            return st;
-        }
-        if (st_wrap_check_ok(&chk))
-            break;
-        mesh_clear(&m);
-        if (A > 0.0) {
-            A = A / 2 < ADAPTIVITY_FLOOR ? 0.0 : A / 2;
-        } else if (margin + 1 < HOLD_OFF_STEPS) {
-            margin++; /* the values held farther off the isovalue */
-        } else {
-            free(held_data);
-            return st_error_set(err, ST_EINTERNAL, NULL, 0,
-                                "the extracted surface fails its check: %s "
-                                "(%zu self-intersecting pairs)",
-                                check_failure(&chk),
-                                chk.self_intersecting_pairs);
-        }
-    }
-    free(held_data);
-    stats->adaptivity_used = A;
+    st_status xst = extract_checked(&m, g, p, stats, progress, err);
+    if (xst)
+        return xst;
     free(m.quads);
     free(m.split);
     m.quads = NULL;
