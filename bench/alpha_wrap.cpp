@@ -11,6 +11,13 @@
  *   alpha_wrap distance A B                 max and mean distance from A's
  *                                           vertices to B's triangles
  *                                           (an AABB tree over B), JSON
+ *   alpha_wrap check IN                     CGAL's own verdict on a surface
+ *                                           (soupwrap's output): a polygon
+ *                                           mesh at all, closed, no
+ *                                           degenerate face, no self-
+ *                                           intersection, outward; each by
+ *                                           CGAL's exact predicates; JSON,
+ *                                           exit 1 unless all hold
  *
  * Not installed; only scripts/bench.d/wrap.py runs it.
  */
@@ -20,6 +27,11 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/IO/polygon_soup_io.h>
 #include <CGAL/Polygon_mesh_processing/IO/polygon_mesh_io.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/alpha_wrap_3.h>
 
@@ -108,14 +120,47 @@ static int do_distance(const char *a, const char *b)
     return 0;
 }
 
+/* The predicates (orientation, collinearity, triangle intersection) are
+ * exact in this kernel; only constructions are not, and none is used. */
+static int do_check(const char *in)
+{
+    namespace PMP = CGAL::Polygon_mesh_processing;
+    std::vector<Point> pts;
+    std::vector<std::vector<std::size_t>> polys;
+    if (!read_soup(in, pts, polys))
+        return 1;
+    bool is_mesh = PMP::is_polygon_soup_a_polygon_mesh(polys);
+    bool closed = false, outward = false, self = true;
+    std::size_t degenerate = 0;
+    if (is_mesh) {
+        Mesh m;
+        PMP::polygon_soup_to_polygon_mesh(pts, polys, m);
+        closed = CGAL::is_closed(m);
+        for (auto f : faces(m))
+            degenerate += PMP::is_degenerate_triangle_face(f, m);
+        self = PMP::does_self_intersect(m);
+        outward = closed && PMP::is_outward_oriented(m);
+    }
+    bool ok = is_mesh && closed && degenerate == 0 && !self && outward;
+    std::printf("{\"polygon_mesh\": %s, \"closed\": %s, \"degenerate_faces\": "
+                "%zu, \"self_intersecting\": %s, \"outward\": %s, \"ok\": %s}\n",
+                is_mesh ? "true" : "false", closed ? "true" : "false",
+                degenerate, self ? "true" : "false",
+                outward ? "true" : "false", ok ? "true" : "false");
+    return ok ? 0 : 1;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 3 && std::string(argv[1]) == "check")
+        return do_check(argv[2]);
     if (argc == 6 && std::string(argv[1]) == "wrap")
         return do_wrap(argv[2], argv[3], std::atof(argv[4]),
                        std::atof(argv[5]));
     if (argc == 4 && std::string(argv[1]) == "distance")
         return do_distance(argv[2], argv[3]);
     std::fprintf(stderr, "usage: alpha_wrap wrap IN OUT ALPHA OFFSET\n"
-                         "       alpha_wrap distance A B\n");
+                         "       alpha_wrap distance A B\n"
+                         "       alpha_wrap check IN\n");
     return 2;
 }

@@ -35,6 +35,14 @@
  * flips the diagonals of the quads involved; more rounds than this only
  * swap the same pairs back and forth. */
 #define RESPLIT_ROUNDS 3
+/* How far every value is held off the isovalue before extraction, in
+ * voxels (hold_off_iso), tried in turn while the surface fails its check
+ * at adaptivity 0: a 64th of a voxel moves no crossing visibly and
+ * already separates the points that an exact isovalue puts on a voxel's
+ * center; the larger margins are for crossings that still round together
+ * (the surface moves by less than the margin, the inside not at all). */
+static const double hold_off_margin[] = {1.0 / 64, 1.0 / 8, 1.0 / 2};
+#define HOLD_OFF_STEPS (sizeof hold_off_margin / sizeof hold_off_margin[0])
 
 st_wrap_params st_wrap_params_default(void)
 {
@@ -931,7 +939,136 @@ done:
     return st;
 }
 
+/* ---- values at the isovalue ----------------------------------------------- */
+
+/* Away from the isovalue by at least delta (model units): every value in
+ * [iso - delta, iso) becomes iso - delta, every value in [iso, iso + delta)
+ * iso + delta, so the inside (value < iso) stays the same voxels.
+ *
+ * Why: a voxel whose value is the isovalue, or so close to it that the
+ * crossing rounds onto the voxel's center in volumeToMesh's float index
+ * coordinates, has every edge crossing next to it at that center; each
+ * cell around it whose crossings are all on those edges puts its point
+ * there too, so distinct vertices share one point and their quads are
+ * degenerate whichever diagonal splits them (measured: a CAD part whose
+ * axis-aligned faces lie on voxel centers, distance 0 there, gave 13 such
+ * quads at 200 cells, anchor-largeholes). Held apart by delta, the
+ * crossings on the edges from such a voxel are at least
+ * delta / (delta + the neighbour's distance) of a voxel from its center.
+ * *moved gets the number of values changed; *out is g itself when none
+ * is, else a shallow copy whose data the caller frees. */
+static st_status hold_off_iso(st_grid *out, float **data, size_t *moved,
+                              const st_grid *g, float iso, float delta,
+                              st_error *err)
+{
+    *out = *g;
+    *data = NULL;
+    *moved = 0;
+    const size_t n = st_grid_count(g);
+    const float lo = iso - delta, hi = iso + delta;
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++)
+        m += g->data[i] > lo && g->data[i] < hi;
+    if (m == 0)
+        return ST_OK;
+    float *d = st_malloc_array(n, sizeof *d);
+    if (!d)
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory for a copy of the field");
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        float v = g->data[i];
+        d[i] = v < iso ? (v > lo ? lo : v) : (v < hi ? hi : v);
+    }
+    out->data = d;
+    *data = d;
+    *moved = m;
+    return ST_OK;
+}
+
 /* ---- the whole job -------------------------------------------------------- */
+
+/* Extraction, pieces, quads to triangles and the check, with the
+ * fallbacks of wrap.h: halving the adaptivity, then the larger margins
+ * off the isovalue. *m gets the checked surface. */
+static st_status extract_checked(mesh *m, const st_grid *g, const st_wrap_params *p,
+                                 st_wrap_stats *stats, const st_progress *progress,
+                                 st_error *err)
+{
+    const float iso = (float)p->iso;
+    double A = p->adaptivity;
+    st_wrap_check chk;
+    size_t margin = 0;      /* index into hold_off_margin[] */
+    st_grid held;
+    float *held_data = NULL;
+    double held_for = -1.0; /* the margin `held` was made for */
+    for (;;) {
+        if (st_progress_cancelled(progress)) {
+            free(held_data);
+            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        }
+        st_progress_report(progress, "extract", 0.0);
+        st_status st = ST_OK;
+        if (held_for != hold_off_margin[margin]) {
+            free(held_data);
+            held_for = stats->iso_margin = hold_off_margin[margin];
+            st = hold_off_iso(&held, &held_data, &stats->iso_held_off, g,
+                              iso, (float)(stats->iso_margin * g->voxel),
+                              err);
+            if (st)
+                return st;
+        }
+        st_wrap_polys P;
+        st = st_wrap_polys_vdb(&P, &held, p->iso, A, err);
+        if (st) {
+            free(held_data);
+            return st;
+        }
+        stats->quads = P.nquads;
+        stats->triangles = P.ntris;
+        stats->cavities_filled = stats->specks_dropped = 0;
+        st = filter_pieces(&P, p->min_volume * g->voxel * g->voxel * g->voxel,
+                           p->keep_cavities, stats, err);
+        if (st == ST_OK && P.nquads + P.ntris == 0)
+            st = st_error_set(err, ST_EINPUT, NULL, 0,
+                              "every piece of the surface is smaller than "
+                              "--min-volume (%g voxels)", p->min_volume);
+        if (st == ST_OK)
+            st = mesh_build(m, &P, err);
+        st_wrap_polys_clear(&P);
+        if (st) {
+            free(held_data);
+            return st;
+        }
+        st_progress_report(progress, "check", 0.5);
+        if ((st = st_wrap_check_compute(&chk, m->s, err)) ||
+            (!chk.self_intersection_free &&
+             ((st = resplit(m, &stats->resplit, err)) ||
+              (st = st_wrap_check_compute(&chk, m->s, err))))) {
+            mesh_clear(m);
+            free(held_data);
+            return st;
+        }
+        if (st_wrap_check_ok(&chk))
+            break;
+        mesh_clear(m);
+        if (A > 0.0) {
+            A = A / 2 < ADAPTIVITY_FLOOR ? 0.0 : A / 2;
+        } else if (margin + 1 < HOLD_OFF_STEPS) {
+            margin++; /* the values held farther off the isovalue */
+        } else {
+            free(held_data);
+            return st_error_set(err, ST_EINTERNAL, NULL, 0,
+                                "the extracted surface fails its check: %s "
+                                "(%zu self-intersecting pairs)",
+                                check_failure(&chk),
+                                chk.self_intersecting_pairs);
+        }
+    }
+    free(held_data);
+    stats->adaptivity_used = A;
+    return ST_OK;
+}
 
 st_status st_wrap_field(st_soup **out, const st_grid *g,
                         const st_wrap_params *p, st_wrap_stats *stats,
@@ -973,53 +1110,11 @@ st_status st_wrap_field(st_soup **out, const st_grid *g,
                             "nothing inside: no value of the field is below "
                             "the isovalue %g", p->iso);
 
-    double A = p->adaptivity;
     mesh m = {0};
     st_wrap_check chk;
-    for (;;) {
-        if (st_progress_cancelled(progress))
-            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
-        st_progress_report(progress, "extract", 0.0);
-        st_wrap_polys P;
-        st_status st = st_wrap_polys_vdb(&P, g, p->iso, A, err);
-        if (st)
-            return st;
-        stats->quads = P.nquads;
-        stats->triangles = P.ntris;
-        stats->cavities_filled = stats->specks_dropped = 0;
-        st = filter_pieces(&P, p->min_volume * g->voxel * g->voxel * g->voxel,
-                           p->keep_cavities, stats, err);
-        if (st == ST_OK && P.nquads + P.ntris == 0)
-            st = st_error_set(err, ST_EINPUT, NULL, 0,
-                              "every piece of the surface is smaller than "
-                              "--min-volume (%g voxels)", p->min_volume);
-        if (st == ST_OK)
-            st = mesh_build(&m, &P, err);
-        st_wrap_polys_clear(&P);
-        if (st)
-            return st;
-        st_progress_report(progress, "check", 0.5);
-        if ((st = st_wrap_check_compute(&chk, m.s, err)) ||
-            (!chk.self_intersection_free &&
-             ((st = resplit(&m, &stats->resplit, err)) ||
-              (st = st_wrap_check_compute(&chk, m.s, err))))) {
-            mesh_clear(&m);
-            return st;
-        }
-        if (st_wrap_check_ok(&chk))
-            break;
-        if (A == 0.0) {
-            st_error_set(err, ST_EINTERNAL, NULL, 0,
-                         "the extracted surface fails its check: %s "
-                         "(%zu self-intersecting pairs)",
-                         check_failure(&chk), chk.self_intersecting_pairs);
-            mesh_clear(&m);
-            return ST_EINTERNAL;
-        }
-        mesh_clear(&m);
-        A = A / 2 < ADAPTIVITY_FLOOR ? 0.0 : A / 2;
-    }
-    stats->adaptivity_used = A;
+    st_status xst = extract_checked(&m, g, p, stats, progress, err);
+    if (xst)
+        return xst;
     free(m.quads);
     free(m.split);
     m.quads = NULL;

@@ -7,6 +7,11 @@
  *      the field at the isovalue, with a layer of "outside" voxels put
  *      around the grid, so a pseudo volume that reaches the grid's edge is
  *      closed there instead of left open (outside the grid is outside).
+ *      Every value is first held at least a 64th of a voxel off the
+ *      isovalue, on its own side (the inside voxels stay the same): at a
+ *      value equal to the isovalue volumeToMesh puts the points of up to
+ *      eight cells on one voxel center, and their quads are degenerate
+ *      (a CAD face lying on voxel centers, at distance 0, does that).
  *   2. Cavities and specks: volumeToMesh orients every polygon along the
  *      field's gradient, so a piece enclosing negative volume bounds
  *      outside voxels: a cavity. Cavities are dropped, so the solid is
@@ -37,7 +42,8 @@
  * Adaptivity > 0 lets volumeToMesh merge flat regions into larger
  * polygons. Merged meshes are not always manifold: when the result fails
  * the check (st_wrap_check), the extraction is repeated with half the
- * adaptivity, down to 0; stats say what was used.
+ * adaptivity, down to 0; then with the values held an 8th, then half a
+ * voxel off the isovalue; stats say what was used.
  */
 #ifndef SOUPTET_WRAP_H
 #define SOUPTET_WRAP_H
@@ -85,6 +91,8 @@ typedef struct st_wrap_stats {
     size_t smooth_steps;         /* Taubin steps done */
     size_t smooth_reverted;      /* vertex moves undone by the checks */
     size_t edge_voxels_inside;   /* inside voxels on the grid's outer layer */
+    double iso_margin;           /* voxels every value was held off iso */
+    size_t iso_held_off;         /* values that moved to keep that margin */
 } st_wrap_stats;
 
 /* What the output must be; each flag 1 when it holds. */

@@ -8,6 +8,7 @@
 #include "souptet/mem.h"
 #include "souptet/outfile.h"
 #include "souptet/soup.h"
+#include "souptet/symmetry.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -651,4 +652,36 @@ int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
 void tool_print_version(const tool_ctx *t)
 {
     printf("%s (souptet) %s\n", t->name, SOUPTET_VERSION);
+}
+
+int tool_report_symmetries(tool_ctx *t, const st_soup *soup, const st_bvh *bvh,
+                           double tolerance)
+{
+    if (t->verbosity < 2 || !soup || !(tolerance > 0.0))
+        return 0;
+    st_error err;
+    st_bvh *own = NULL;
+    const double t0 = tool_now();
+    if (!bvh) {
+        if (st_bvh_build(&own, soup, &err))
+            return tool_fail(t, &err);
+        bvh = own;
+    }
+    st_symmetry_params sp = st_symmetry_params_default();
+    sp.tolerance = tolerance;
+    st_symmetry_set set;
+    st_status st = st_symmetry_detect(&set, soup, bvh, &sp, &err);
+    st_bvh_free(own);
+    if (st)
+        return tool_fail(t, &err);
+    tool_say(t, 2, "symmetries: %zu with support >= %.2f within %.6g (%zu "
+             "candidates measured, %.3f s); detection only, the signs do "
+             "not use them: symmetric fill 0%%", set.n, sp.min_support,
+             tolerance, set.candidates, tool_now() - t0);
+    for (size_t i = 0; i < set.n; i++) {
+        char line[256];
+        st_symmetry_describe(set.items + i, line, sizeof line);
+        tool_say(t, 2, "  %s", line);
+    }
+    return 0;
 }

@@ -326,4 +326,14 @@ typedef struct tool_spec {
 int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
               tool_common *co);
 
+/* -v: the soup's symmetries (symmetry.h) within `tolerance` (the field's
+ * voxel), each on its own line at level 2, with its support and the time
+ * taken; bvh may be NULL (one is built). Detection only: the pseudo
+ * volume does not use them (yet), which the report says. 0, or the exit
+ * status after an error was printed. */
+struct st_soup;
+struct st_bvh;
+int tool_report_symmetries(tool_ctx *t, const struct st_soup *soup,
+                           const struct st_bvh *bvh, double tolerance);
+
 #endif

@@ -105,7 +105,8 @@ TOOL_HELP_TETFORMAT
 "                       (default 80%% of RAM)\n"
 "  -q, --quiet          no messages but errors\n"
 "  -v, --verbose        report every candidate, the timings and any guessed\n"
-"                       part of the solid (said without -v past a cell)\n"
+"                       part of the solid (said without -v past a cell),\n"
+"                       the input's symmetries (reported, not used)\n"
 "      --help           show this help and exit\n"
 "      --version        show the version and exit\n"
 "\n"
@@ -626,6 +627,8 @@ static int run(tool_ctx *t, void *settings)
                  100.0 * (double)st.guess.fill_faces / (double)st.guess.boundary_faces,
                  depth_h, st.guess.depth / diag);
     }
+    if ((rc = tool_report_symmetries(t, soup, NULL, st.voxel)))
+        goto done;
     if (t->verbosity >= 2 && p->density_rho <= 0) {
         /* both directions, in h and per the input's box diagonal */
         double sb = NAN;

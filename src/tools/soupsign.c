@@ -114,7 +114,8 @@ static void usage(void)
 "      --max-memory SZ  refuse fields larger than SZ (default 80%% of RAM)\n"
 "  -q, --quiet          no messages but errors\n"
 "  -v, --verbose        report the rule, the event distance, each step, the\n"
-"                       fill (boundary with no soup near) and timings\n"
+"                       fill (boundary with no soup near), the soup's\n"
+"                       symmetries (reported, not used) and timings\n"
 "      --help           show this help and exit\n"
 "      --version        show the version and exit\n"
 "\n"
@@ -483,6 +484,8 @@ static int run(tool_ctx *t, void *settings)
                                    : 0.0,
                  gs.depth / g->voxel, gs.depth);
     }
+    if (bvh && soup && (rc = tool_report_symmetries(t, soup, bvh, g->voxel)))
+        goto done;
     tool_say(t, 2, "read %.3f s, signs %.3f s (CPU %.3f s, all threads), write %.3f s",
              t1 - t0, voted ? ps.seconds_vote : ps.seconds_shells, cpu_sign, t3 - t2);
     rc = TOOL_EXIT_OK;

@@ -248,6 +248,8 @@ static int run(tool_ctx *t, void *settings)
                     "%.4g); %zu quads re-split",
              stats.quads, stats.triangles, stats.adaptivity_used,
              stats.resplit);
+    tool_say(t, 2, "isovalue margin: %zu values held %.4g voxels off it",
+             stats.iso_held_off, stats.iso_margin);
     tool_say(t, 2, "pieces: %zu cavities filled, %zu specks dropped",
              stats.cavities_filled, stats.specks_dropped);
     if (s->wrap.smooth)

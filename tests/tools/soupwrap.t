@@ -117,6 +117,61 @@ expect_fail "a missing file" 1 "^soupwrap: missing.vdb" soupwrap -o x.obj missin
 expect_fail "a missing surface" 1 "^soupwrap: missing.obj" soupwrap --surface missing.obj -o x.obj
 check "no partial output" test ! -e x.obj
 expect_fail "unknown output format" 2 "cannot tell the format" soupwrap -o x.xyz s.vdb
+# A screw-like CAD part with large holes (issue 37): a hex head on a shank
+# whose thread is rings of two radii with flat steps between them, all at
+# multiples of 1/8, so at -r 48 and 128 the steps lie on voxel centers: the
+# voxels there are at distance 0, the inside ones hold -FLT_MIN, and
+# volumeToMesh put up to eight points on each such center. soupwrap exited
+# 1 then ("the extracted surface fails its check: degenerate triangles").
+cat > screw.py <<'PY'
+import math, sys
+seg = 24
+V, F = [], []
+def ring(z, r, hexa=False):
+    b = len(V)
+    for i in range(seg):
+        a = 2 * math.pi * i / seg
+        s = math.pi / 3
+        rr = r * math.cos(s / 2) / math.cos((a + s / 2) % s - s / 2) if hexa else r
+        V.append((rr * math.cos(a), rr * math.sin(a), z))
+    return b
+def strip(b0, b1):
+    for i in range(seg):
+        j = (i + 1) % seg
+        F.append(((b0 + i, b0 + j, b1 + j), i))
+        F.append(((b0 + i, b1 + j, b1 + i), i))
+rings = [(ring(0.25 * k, 1.5 if k % 2 == 0 else 1.25),
+          ring(0.25 * k + 0.25, 1.5 if k % 2 == 0 else 1.25)) for k in range(32)]
+for a, b in rings:
+    strip(a, b)
+for k in range(31):
+    strip(rings[k][1], rings[k + 1][0])
+h0, h1 = ring(8.0, 2.75, True), ring(10.0, 2.75, True)
+strip(h0, rings[-1][1])
+strip(h0, h1)
+c0 = len(V); V.append((0, 0, 0))
+c1 = len(V); V.append((0, 0, 10.0))
+for i in range(seg):
+    j = (i + 1) % seg
+    F.append(((c0, rings[0][0] + j, rings[0][0] + i), i))
+    F.append(((c1, h1 + i, h1 + j), -1 - i))
+def gone(f, i):
+    zc = sum(V[v][2] for v in f) / 3
+    u = (i if i >= 0 else -1 - i) / seg
+    return ((0.05 < u < 0.35 and 1.0 < zc < 6.0) or (0.5 < u < 0.8 and 5.0 < zc < 9.0)
+            or (i < 0 and 0.6 < u < 0.9))
+keep = [f for f, i in F if not gone(f, i)]
+print("OFF\n%d %d 0" % (len(V), len(keep)))
+for v in V:
+    print("%.17g %.17g %.17g" % v)
+for f in keep:
+    print("3 %d %d %d" % f)
+PY
+check "screw-like part with large holes: -r 48 and -r 128 give valid surfaces" sh -c \
+    "python3 screw.py > screw.off && soupwrap --surface screw.off -r 48 -o sc48.off && soupwrap --surface screw.off -r 128 -o sc128.off && soupinfo --json sc48.off sc128.off > sc.json && python3 good.py sc.json 1"
+check "-v: the values held off the isovalue are reported" sh -c \
+    "soupwrap --surface screw.off -r 48 -v -o sc.off 2>&1 | grep -q 'isovalue margin: [1-9][0-9]* values held 0.01562 voxels off it'"
+
 expect_fail "-r without --surface" 2 "needs --surface" soupwrap -r 32 s.vdb
 expect_fail "field and --surface" 2 "not both" soupwrap --surface cube.off s.vdb
 expect_fail "bad --adaptivity" 2 "adaptivity" soupwrap --adaptivity 2 s.vdb

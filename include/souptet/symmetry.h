@@ -1,0 +1,113 @@
+/*
+ * symmetry.h - the mirror planes and rotation axes of a soup's surviving
+ * surface (issue 37: a lost side said by its opposite).
+ *
+ * Algorithm:
+ *   1. Samples: `samples` points spread over the soup by area (stratified
+ *      in the cumulative area, a fixed low-discrepancy point in each
+ *      triangle), each with its triangle's unit normal (unoriented: a
+ *      soup's orientation is not trusted).
+ *   2. Mirror candidates: the three planes through the area centroid
+ *      normal to the principal axes of the samples; and the votes of
+ *      Mitra, Guibas & Pauly 2006 ("Partial and approximate symmetry
+ *      detection for 3D geometry"): pairs of samples (a fixed pseudo-random
+ *      sequence) whose normals map onto each other by the mirror that
+ *      swaps the two points (within 15 degrees) vote for that plane in a
+ *      grid over direction and offset; the heaviest cells become
+ *      candidates.
+ *   3. Refinement, ICP-style: each sample's mirror image is matched to
+ *      the soup's nearest point within three tolerances (st_bvh_nearest)
+ *      with a compatible normal; the plane is re-estimated from the matched
+ *      pairs (normal along the mean of p - q, offset the mean of their
+ *      midpoints), a few rounds.
+ *   4. Rotation axes: the lines where two accepted mirror planes meet (two
+ *      mirrors at angle a make a rotation by 2a about that line) and the
+ *      principal axes through the centroid. An axis is continuous (a
+ *      turned part, a screw's shank) when rotations by three angles that
+ *      are no fraction of a full turn with a small denominator all hold;
+ *      else its order is the largest n <= max_order whose rotation by
+ *      360/n degrees holds.
+ *   5. Support: the share of the samples (so of the soup's area) whose
+ *      image lies within `tolerance` of the soup, on a triangle whose
+ *      normal is within 30 degrees of the image's normal. A symmetry is
+ *      accepted when its support is at least min_support; duplicates (the
+ *      same plane or line within 2 degrees and a tolerance) keep the best.
+ * Every step is deterministic, and the support counts are integer sums,
+ * so the result does not depend on the thread count.
+ */
+#ifndef SOUPTET_SYMMETRY_H
+#define SOUPTET_SYMMETRY_H
+
+#include <stddef.h>
+
+#include "souptet/bvh.h"
+#include "souptet/err.h"
+#include "souptet/soup.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define ST_SYMMETRY_DEFAULT_SAMPLES 2048
+/* Measured at a tolerance of 1/128 of the longest side (issue 37): the
+ * best plane of the non-symmetric corpus models (bunny, armadillo,
+ * elephant, fandisk) stays below 0.4; a human figure's rough left-right
+ * plane 0.535, a plane fandisk-largeholes only seems to have once its
+ * holes took the parts that disagree 0.439; the true planes of the CAD
+ * parts with large holes 0.50 (couplingdown), 0.54 (joint), 0.80-0.90
+ * (rotor, anchor, pinion). 0.6 refuses every false one measured and
+ * two true ones: a clear majority, as the issue asks. */
+#define ST_SYMMETRY_DEFAULT_MIN_SUPPORT 0.6
+#define ST_SYMMETRY_DEFAULT_MAX_ORDER 48
+#define ST_SYMMETRY_MAX 16          /* symmetries kept, best first */
+
+typedef enum st_symmetry_kind {
+    ST_SYMMETRY_MIRROR = 1,
+    ST_SYMMETRY_ROTATION = 2
+} st_symmetry_kind;
+
+typedef struct st_symmetry {
+    st_symmetry_kind kind;
+    double point[3];     /* on the plane, or on the axis */
+    double dir[3];       /* the plane's unit normal, or the axis' direction */
+    int order;           /* rotation: n >= 2, or 0 continuous; mirror: 0 */
+    double support;      /* share of the soup's area that maps onto it */
+} st_symmetry;
+
+typedef struct st_symmetry_params {
+    size_t samples;      /* area samples (ST_SYMMETRY_DEFAULT_SAMPLES) */
+    double tolerance;    /* model units, > 0 (the caller's voxel) */
+    double min_support;  /* accept at or above this share */
+    int max_order;       /* largest discrete rotation order tested, >= 2 */
+} st_symmetry_params;
+
+/* Samples, minimum support and order as above; tolerance 0 (set it). */
+st_symmetry_params st_symmetry_params_default(void);
+
+typedef struct st_symmetry_set {
+    st_symmetry items[ST_SYMMETRY_MAX];
+    size_t n;            /* accepted, mirrors by support then rotations */
+    size_t candidates;   /* planes and axes whose support was measured */
+} st_symmetry_set;
+
+/* The symmetries of soup s (bvh: st_bvh_build(s)). ST_EINPUT for a
+ * tolerance that is not positive and finite, or fewer than 16 samples;
+ * ST_ENOMEM. A soup without area gives none. */
+st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
+                             const st_bvh *bvh, const st_symmetry_params *p,
+                             st_error *err);
+
+/* The image of point x (w 1) or direction x (w 0) under y: its mirror,
+ * or its rotation by `angle` radians about the axis (the generator of an
+ * order-n axis is 2 pi / n). */
+void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
+                       int w, double out[3]);
+
+/* One line for a report: "mirror plane through (x, y, z) normal (a, b,
+ * c), support 0.87" or "rotation axis ... order 6 ...". */
+void st_symmetry_describe(const st_symmetry *y, char *buf, size_t size);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

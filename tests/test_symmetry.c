@@ -1,0 +1,178 @@
+/* test_symmetry.c - mirror planes and rotation axes (symmetry.h): a T
+ * bracket's two planes and not the third, a hexagonal bar's axis of order
+ * 6 (not continuous, not 12), the same with a third of the bar's side
+ * cut away, none on scattered triangles, the same answer on 1 and 2
+ * threads, bad parameters refused. */
+#include "souptet/bvh.h"
+#include "souptet/soup.h"
+#include "souptet/symmetry.h"
+#include "shapes.h"
+#include "tap.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+static int detect(st_symmetry_set *set, const st_soup *s, double tol)
+{
+    st_error err;
+    st_bvh *b = NULL;
+    st_symmetry_params p = st_symmetry_params_default();
+    p.tolerance = tol;
+    int rc = st_bvh_build(&b, s, &err) || st_symmetry_detect(set, s, b, &p, &err);
+    if (rc)
+        printf("#   %s\n", err.msg);
+    st_bvh_free(b);
+    for (size_t i = 0; !rc && i < set->n; i++) {
+        char line[256];
+        st_symmetry_describe(set->items + i, line, sizeof line);
+        printf("#   %s\n", line);
+    }
+    return rc;
+}
+
+/* The accepted mirror with normal along axis a (within 2 degrees), or
+ * NULL. */
+static const st_symmetry *mirror_along(const st_symmetry_set *set, int a)
+{
+    for (size_t i = 0; i < set->n; i++)
+        if (set->items[i].kind == ST_SYMMETRY_MIRROR &&
+            fabs(set->items[i].dir[a]) > 0.9994)
+            return set->items + i;
+    return NULL;
+}
+
+static const st_symmetry *axis_along(const st_symmetry_set *set, int a)
+{
+    for (size_t i = 0; i < set->n; i++)
+        if (set->items[i].kind == ST_SYMMETRY_ROTATION &&
+            fabs(set->items[i].dir[a]) > 0.9994)
+            return set->items + i;
+    return NULL;
+}
+
+/* Where plane y crosses axis a (its normal along a). */
+static double crossing(const st_symmetry *y, int a)
+{
+    double o = y->point[0] * y->dir[0] + y->point[1] * y->dir[1] +
+               y->point[2] * y->dir[2];
+    return y->dir[a] > 0 ? o : -o;
+}
+
+static void test_bracket(void)
+{
+    /* a T in xy, extruded along z: mirror x = 0.3 and z = 0.5, not y */
+    st_soup *s = st_soup_new();
+    add_box(s, (double[3]){-1.7, 0, 0}, (double[3]){2.3, 1, 1});
+    add_box(s, (double[3]){-0.2, 1, 0}, (double[3]){0.8, 4, 1});
+    st_symmetry_set set, set1;
+    TAP_CHECK(detect(&set, s, 0.04) == 0, "T bracket: detection runs");
+    const st_symmetry *mx = mirror_along(&set, 0), *mz = mirror_along(&set, 2);
+    TAP_CHECK(mx && fabs(crossing(mx, 0) - 0.3) < 0.04 && mx->support > 0.95,
+              "the plane x = 0.3 (support %.3f)", mx ? mx->support : 0.0);
+    TAP_CHECK(mz && fabs(crossing(mz, 2) - 0.5) < 0.04 && mz->support > 0.95,
+              "the plane z = 0.5 (support %.3f)", mz ? mz->support : 0.0);
+    TAP_CHECK(!mirror_along(&set, 1), "no plane across the T's stem");
+#ifdef _OPENMP
+    int nt = omp_get_max_threads();
+    omp_set_num_threads(1);
+    detect(&set1, s, 0.04);
+    omp_set_num_threads(2);
+    st_symmetry_set set2;
+    detect(&set2, s, 0.04);
+    omp_set_num_threads(nt);
+    TAP_CHECK(memcmp(&set1, &set2, sizeof set1) == 0 &&
+                  memcmp(&set, &set1, sizeof set) == 0,
+              "the same bytes on 1, 2 and %d threads", nt);
+#else
+    (void)set1;
+#endif
+    st_soup_free(s);
+}
+
+/* A hexagonal bar along z (circumradius 1, length 6), its side faces
+ * split in rings; `cut`: the faces of two of the six sides, over the
+ * middle two thirds of the length, left out. */
+static st_soup *hex_bar(int cut)
+{
+    st_soup *s = st_soup_new();
+    const int rings = 12;
+    for (int k = 0; k < 6; k++) {
+        double a0 = M_PI / 3 * k, a1 = M_PI / 3 * (k + 1);
+        for (int r = 0; r < rings; r++) {
+            double z0 = 6.0 * r / rings, z1 = 6.0 * (r + 1) / rings;
+            if (cut && (k == 1 || k == 2) && r >= 2 && r < 10)
+                continue;
+            double p0[3] = {cos(a0), sin(a0), z0}, p1[3] = {cos(a1), sin(a1), z0};
+            double p2[3] = {cos(a1), sin(a1), z1}, p3[3] = {cos(a0), sin(a0), z1};
+            add_tri(s, p0, p1, p2, 0);
+            add_tri(s, p0, p2, p3, 0);
+        }
+        double c0[3] = {0, 0, 0}, c1[3] = {0, 0, 6};
+        add_tri(s, c0, (double[3]){cos(a1), sin(a1), 0}, (double[3]){cos(a0), sin(a0), 0}, 0);
+        add_tri(s, c1, (double[3]){cos(a0), sin(a0), 6}, (double[3]){cos(a1), sin(a1), 6}, 0);
+    }
+    return s;
+}
+
+static void test_hex_bar(void)
+{
+    for (int cut = 0; cut < 2; cut++) {
+        st_soup *s = hex_bar(cut);
+        st_symmetry_set set;
+        TAP_CHECK(detect(&set, s, 0.05) == 0, "hex bar%s: detection runs",
+                  cut ? " with a third cut away" : "");
+        const st_symmetry *ax = axis_along(&set, 2);
+        double off = ax ? hypot(ax->point[0], ax->point[1]) : 1.0;
+        TAP_CHECK(ax && ax->order == 6 && off < 0.05 &&
+                      ax->support >= ST_SYMMETRY_DEFAULT_MIN_SUPPORT,
+                  "hex bar%s: the axis along z, order 6 (order %d, %.3f off, "
+                  "support %.3f)", cut ? " cut" : "", ax ? ax->order : -1, off,
+                  ax ? ax->support : 0.0);
+        TAP_CHECK(mirror_along(&set, 2) != NULL,
+                  "hex bar%s: the plane z = 3", cut ? " cut" : "");
+        st_soup_free(s);
+    }
+}
+
+static void test_none(void)
+{
+    st_soup *s = st_soup_new();
+    uint64_t h = 12345;
+    for (int i = 0; i < 300; i++) {
+        double p[3][3];
+        for (int v = 0; v < 3; v++)
+            for (int a = 0; a < 3; a++) {
+                h = h * 6364136223846793005ULL + 1442695040888963407ULL;
+                p[v][a] = (double)(h >> 11) * 0x1.0p-53 * (a == 0 ? 3.0 : 1.7);
+            }
+        add_tri(s, p[0], p[1], p[2], 0);
+    }
+    st_symmetry_set set;
+    TAP_CHECK(detect(&set, s, 0.02) == 0 && set.n == 0,
+              "scattered triangles: no symmetry (%zu)", set.n);
+    st_error err;
+    st_bvh *b = NULL;
+    st_bvh_build(&b, s, &err);
+    st_symmetry_params p = st_symmetry_params_default();
+    TAP_CHECK(st_symmetry_detect(&set, s, b, &p, &err) == ST_EINPUT,
+              "tolerance 0: ST_EINPUT");
+    p.tolerance = 0.1;
+    p.samples = 4;
+    TAP_CHECK(st_symmetry_detect(&set, s, b, &p, &err) == ST_EINPUT,
+              "4 samples: ST_EINPUT");
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
+int main(void)
+{
+    test_bracket();
+    test_hex_bar();
+    test_none();
+    return tap_done();
+}
