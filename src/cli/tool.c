@@ -2,6 +2,7 @@
 #define _GNU_SOURCE
 #include "tool.h"
 #include "../fpenv.h"
+#include "souptet_build.h"
 #include "souptet/dist.h"
 #include "souptet/grid.h"
 #include "souptet/gridio.h"
@@ -560,10 +561,35 @@ int tool_grid_output(const tool_ctx *t, const char *out)
                               ".vdb or .vti");
 }
 
+/* "STL" for a surface file's path, else NULL. */
+static const char *surface_format_upper(const char *path, char buf[8])
+{
+    st_soup_format f = st_path_is_stdio(path) ? ST_SOUP_UNKNOWN : st_soup_format_from_path(path);
+    if (f == ST_SOUP_UNKNOWN)
+        return NULL;
+    const char *n = st_soup_format_name(f);
+    size_t i = 0;
+    for (; n[i] && i < 7; i++)
+        buf[i] = (char)(n[i] >= 'a' && n[i] <= 'z' ? n[i] - 'a' + 'A' : n[i]);
+    buf[i] = '\0';
+    return f == ST_SOUP_GLTF ? "glTF" : buf;
+}
+
+int tool_surface_as_tetmesh(const tool_ctx *t, const char *out, const char *hint)
+{
+    char buf[8];
+    const char *fmt = surface_format_upper(out, buf);
+    if (!fmt)
+        return TOOL_CONTINUE;
+    return tool_usage_error(t, "%s is a surface format: %s (a tet mesh is .vtu, .msh, "
+                            ".node, .ele or .mesh)", fmt, hint ? hint : "not for -o");
+}
+
 int tool_tetmesh_output(const tool_ctx *t, const char *out, const char *tty_msg)
 {
     if (tty_msg)
         TOOL_TRY(tool_refuse_terminal(t, out, STDOUT_FILENO, tty_msg));
+    TOOL_TRY(tool_surface_as_tetmesh(t, out, NULL));
     return tool_output_format(t, out, st_path_is_stdio(out) ||
                               st_tetformat_from_path(out) != ST_TETFORMAT_NONE,
                               ".vtu, .msh, .node, .ele or .mesh");
@@ -605,9 +631,11 @@ int tool_common_option(tool_ctx *t, int c, char *const argv[],
     case 'v':
         t->verbosity = 2;
         return TOOL_CONTINUE;
+    case 'h':
     case TOOL_OPT_HELP:
         usage();
         return TOOL_EXIT_OK;
+    case 'V':
     case TOOL_OPT_VERSION:
         tool_print_version(t);
         return TOOL_EXIT_OK;
@@ -618,6 +646,20 @@ int tool_common_option(tool_ctx *t, int c, char *const argv[],
     }
 }
 
+/* --msh-version and --msh-binary shape a .msh file only: with another
+ * output (stdout is .vtu) they are a usage error, not silently ignored. */
+static int tetformat_fits(const tool_ctx *t, const tool_common *co)
+{
+    const st_tetformat_opts *o = &co->tetformat;
+    if (!o->msh_version && !o->binary)
+        return TOOL_CONTINUE;
+    if (st_tetformat_from_path(co->out) == ST_TETFORMAT_MSH)
+        return TOOL_CONTINUE;
+    return tool_usage_error(t, "%s shapes a .msh output, not '%s' (give -o FILE.msh)",
+                            o->msh_version ? "--msh-version" : "--msh-binary",
+                            tool_out_name(co->out));
+}
+
 int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
               tool_common *co)
 {
@@ -625,9 +667,13 @@ int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
     tool_init(&t, spec->name, argc, argv);
     *co = tool_common_default();
     int c, rc = TOOL_CONTINUE;
+    /* -h and -V in every tool (help and version, as TetGen, Gmsh and the
+     * GNU tools have them). */
+    char shortopts[64];
+    snprintf(shortopts, sizeof shortopts, "%shV", spec->shortopts);
     opterr = 0;
     while (rc == TOOL_CONTINUE &&
-           (c = getopt_long(argc, argv, spec->shortopts, spec->longopts, NULL)) != -1) {
+           (c = getopt_long(argc, argv, shortopts, spec->longopts, NULL)) != -1) {
         if (c == 'o')
             co->out = optarg;
         else if (c == TOOL_OPT_MSH_VERSION || c == TOOL_OPT_MSH_BINARY ||
@@ -635,11 +681,14 @@ int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
             rc = tool_tetformat_option(&t, c, optarg, &co->tetformat) ? TOOL_EXIT_USAGE
                                                                        : TOOL_CONTINUE;
         else if (c == 'q' || c == 'v' || c == ':' || c == '?' || c == TOOL_OPT_THREADS ||
-                 c == TOOL_OPT_MAXMEM || c == TOOL_OPT_HELP || c == TOOL_OPT_VERSION)
+                 c == TOOL_OPT_MAXMEM || c == TOOL_OPT_HELP || c == TOOL_OPT_VERSION ||
+                 c == 'h' || c == 'V')
             rc = tool_common_option(&t, c, argv, spec->usage, co);
         else
             rc = spec->option(&t, c, optarg, settings);
     }
+    if (rc == TOOL_CONTINUE)
+        rc = tetformat_fits(&t, co);
     if (rc == TOOL_CONTINUE)
         rc = spec->check(&t, argc, argv, settings);
     if (rc == TOOL_CONTINUE)
@@ -648,7 +697,32 @@ int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
     return rc;
 }
 
+const char *tool_version(void)
+{
+    return SOUPTET_VERSION;
+}
+
+const char *tool_commit(void)
+{
+    return SOUPTET_COMMIT;
+}
+
 void tool_print_version(const tool_ctx *t)
 {
-    printf("%s (souptet) %s\n", t->name, SOUPTET_VERSION);
+    printf("%s (souptet) %s\ncommit %s\n", t->name, SOUPTET_VERSION, SOUPTET_COMMIT);
+}
+
+st_status tool_meta_record(const tool_ctx *t, st_meta *meta)
+{
+    if (st_meta_set(meta, "version", SOUPTET_VERSION) ||
+        st_meta_set(meta, "commit", SOUPTET_COMMIT) ||
+        st_meta_history_append(meta, tool_command(t)))
+        return ST_ENOMEM;
+    return ST_OK;
+}
+
+void tool_deprecated(const tool_ctx *t, const char *old_name, const char *new_name)
+{
+    tool_say(t, 1, "%s is now %s (%s goes in the next release)", old_name, new_name,
+             old_name);
 }

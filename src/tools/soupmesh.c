@@ -57,10 +57,12 @@ TOOL_HELP_TETFORMAT
 "                       STL, game engines), checked exactly\n"
 "      --cells N        BCC lattice cells along the longest side of the\n"
 "                       model's box (default 10; more cells, more tets)\n"
-"  -h, --size H         the lattice cell width in model units, instead of\n"
-"                       --cells (as latticetet -h)\n"
+"      --size H         the lattice cell width in model units, instead of\n"
+"                       --cells (as latticetet --size)\n"
 "      --tets N         choose the cell width for about N tets (within 20%%;\n"
 "                       --cells or --size give the first guess)\n"
+"      --json           a summary of the run on stdout as JSON (needs -o FILE),\n"
+"                       or of --dry-run's estimate\n"
 "      --dry-run        print the cell width h, the estimated tets, memory\n"
 "                       and a time class, then exit (the field and signs are\n"
 "                       computed, the fit is not)\n"
@@ -81,8 +83,8 @@ TOOL_HELP_TETFORMAT
 "      --density RHO    the Spillmann mesher instead: cubic lattice tets with\n"
 "                       pseudo-volume density >= RHO, boundary faired (does\n"
 "                       not enclose)\n"
-"      --field-cells N  voxels along the longest side of the distance field\n"
-"                       (default max(128, 8 * cells))\n"
+"  -r, --voxels N       voxels along the longest side of the distance field\n"
+"                       (default max(128, 8 * cells); as soupdist -r)\n"
 "      --max-iters N    fit iterations at most (default 300)\n"
 "      --fill-holes on|off  cap the soup's holes for its pseudo volume\n"
 "                       (loops of boundary edges, when small beside the\n"
@@ -96,8 +98,8 @@ TOOL_HELP_TETFORMAT
 "  -q, --quiet          no messages but errors\n"
 "  -v, --verbose        report every candidate, the timings and any guessed\n"
 "                       part of the solid (said without -v past a cell)\n"
-"      --help           show this help and exit\n"
-"      --version        show the version and exit\n"
+"  -h, --help           show this help and exit\n"
+"  -V, --version        show the version and commit and exit\n"
 "\n"
 "Examples:\n"
 "  soupmesh -o bunny.vtu bunny.obj\n"
@@ -108,9 +110,10 @@ TOOL_HELP_TETFORMAT
 "the input but some boundary vertex is farther than --offset R * h from it.\n");
 }
 
-enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
+enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS_OLD,
        OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY,
-       OPT_BEST_EFFORT, OPT_OFFSET_FILL, OPT_FLOAT32 };
+       OPT_BEST_EFFORT, OPT_OFFSET_FILL, OPT_FLOAT32, OPT_SIZE,
+       OPT_JSON };
 
 /* -v: a line as each stage, sculpt, fit iteration and candidate ends, so a
  * long run is never silent (pipeline.h, st_pipeline_event). */
@@ -221,7 +224,7 @@ static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
  * s in all; the 20 000 and 200 000 boundaries are a rough extrapolation
  * (the fit is about linear in tets), not a measurement. */
 static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_params *p,
-                          const st_pipeline_stats *st)
+                          const st_pipeline_stats *st, int json)
 {
     double lo[3], hi[3];
     st_error e;
@@ -232,6 +235,13 @@ static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_pa
     double work = (double)st->estimated_tets * (double)p->tries;
     const char *cls = work < 20000 ? "seconds" : work < 200000 ? "minutes"
                                                                : "tens of minutes or more";
+    if (json) {
+        char n[2][32];
+        printf("{\"h\": %s, \"cells\": %.0f, \"estimated_tets\": %zu, \"memory_mib\": %.1f, "
+               "\"time\": \"%s\"}\n", tool_json_number(n[0], st->h),
+               ceil(st_lattice_h_for_cells(lo, hi, 1) / st->h), st->estimated_tets,
+               (lattice + field) / 1048576.0, cls);
+    } else
     printf("h %.17g\ncells %.0f\nestimated_tets %zu\nmemory_mib %.1f\ntime %s\n",
            st->h, ceil(st_lattice_h_for_cells(lo, hi, 1) / st->h), st->estimated_tets,
            (lattice + field) / 1048576.0, cls);
@@ -243,7 +253,7 @@ typedef struct soupmesh_settings {
     tool_common co;
     st_pipeline_params pipeline;
     const char *in, *embed, *boundary;
-    int have_cells, best_effort;
+    int have_cells, best_effort, json;
     int float32_by_stl;        /* --boundary .stl turned --float32 on */
     int embed_text;            /* --embed FILE.txt, else .vtu */
     st_soup_format boundary_format;
@@ -251,16 +261,18 @@ typedef struct soupmesh_settings {
 
 static const struct option longopts[] = {
     {"cells", required_argument, NULL, OPT_CELLS},
-    {"size", required_argument, NULL, 'h'},
+    {"size", required_argument, NULL, OPT_SIZE},
     {"tets", required_argument, NULL, OPT_TETS},
     {"dry-run", no_argument, NULL, OPT_DRY_RUN},
+    {"json", no_argument, NULL, OPT_JSON},
     {"offset", required_argument, NULL, OPT_OFFSET},
     {"offset-best-effort", no_argument, NULL, OPT_BEST_EFFORT},
     {"offset-fill", required_argument, NULL, OPT_OFFSET_FILL},
     {"tries", required_argument, NULL, OPT_TRIES},
     {"seed", required_argument, NULL, OPT_SEED},
     {"density", required_argument, NULL, OPT_DENSITY},
-    {"field-cells", required_argument, NULL, OPT_FIELD_CELLS},
+    {"voxels", required_argument, NULL, 'r'},
+    {"field-cells", required_argument, NULL, OPT_FIELD_CELLS_OLD},
     {"max-iters", required_argument, NULL, OPT_MAX_ITERS},
     {"no-quality", no_argument, NULL, OPT_NO_QUALITY},
     TOOL_LONG_OPTIONS_PSEUDO,
@@ -281,7 +293,7 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
             return TOOL_EXIT_USAGE;
         s->have_cells = 1;
         break;
-    case 'h':
+    case OPT_SIZE:
         if (tool_parse_double(t, "--size", arg, 1e-300, 1e300, &s->pipeline.h))
             return TOOL_EXIT_USAGE;
         break;
@@ -291,6 +303,9 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         break;
     case OPT_DRY_RUN:
         s->pipeline.dry_run = 1;
+        break;
+    case OPT_JSON:
+        s->json = 1;
         break;
     case OPT_OFFSET:
         if (tool_parse_double(t, "--offset", arg, 1e-3, 10.0, &s->pipeline.offset_ratio))
@@ -312,8 +327,12 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         if (tool_parse_double(t, "--density", arg, 1e-6, 1.0, &s->pipeline.density_rho))
             return TOOL_EXIT_USAGE;
         break;
-    case OPT_FIELD_CELLS:
-        if (tool_parse_size(t, "--field-cells", arg, 8, 4096, &s->pipeline.field_cells))
+    case OPT_FIELD_CELLS_OLD:
+        tool_deprecated(t, "--field-cells", "--voxels (-r)");
+        /* fall through */
+    case 'r':
+        if (tool_parse_size(t, c == 'r' ? "--voxels" : "--field-cells", arg, 8, 4096,
+                            &s->pipeline.field_cells))
             return TOOL_EXIT_USAGE;
         break;
     case OPT_MAX_ITERS:
@@ -359,7 +378,14 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
         return tool_usage_error(t, "no input surface (soupmesh -o out.vtu model.obj)");
     TOOL_TRY(tool_refuse_terminal(t, s->in, STDIN_FILENO,
                                   "will not read a surface from a terminal: give a file"));
+    if (s->co.out && st_soup_format_from_path(s->co.out) != ST_SOUP_GLTF) {
+        char hint[600];
+        snprintf(hint, sizeof hint, "use --boundary %.500s for the cage's surface", s->co.out);
+        TOOL_TRY(tool_surface_as_tetmesh(t, s->co.out, hint));
+    }
     TOOL_TRY(tool_tetmesh_output(t, s->co.out, p->dry_run ? NULL : TOOL_TTY_VTU));
+    if (s->json && !p->dry_run && st_path_is_stdio(s->co.out))
+        return tool_usage_error(t, "--json prints on stdout: give the mesh -o FILE");
     const char *embed = s->embed, *boundary = s->boundary;
     size_t elen = embed ? strlen(embed) : 0;
     s->embed_text = elen > 4 && strcmp(embed + elen - 4, ".txt") == 0;
@@ -383,6 +409,50 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
         return TOOL_EXIT_FAIL;
     s->pipeline.max_bytes = s->co.max_bytes;
     return TOOL_CONTINUE;
+}
+
+/* soupmesh --json: the run's summary on stdout, one JSON object (the keys
+ * as soupmesh.1 lists them; numbers in model units unless named _h, in
+ * cell widths h). */
+static void print_json(const soupmesh_settings *s, const st_pipeline_stats *st,
+                       int rc, double seconds)
+{
+    const st_pipeline_params *p = &s->pipeline;
+    const st_pipeline_candidate *b = &st->candidates[st->best];
+    char n[12][32];
+    printf("{\"tool\": \"soupmesh\", \"version\": ");
+    tool_json_string(stdout, tool_version());
+    printf(", \"commit\": ");
+    tool_json_string(stdout, tool_commit());
+    printf(",\n  \"input\": ");
+    tool_json_string(stdout, tool_in_name(s->in));
+    printf(", \"output\": ");
+    tool_json_string(stdout, tool_out_name(s->co.out));
+    printf(",\n  \"h\": %s, \"voxels\": [%zu, %zu, %zu], \"voxel\": %s, \"offset\": %s, "
+           "\"candidates\": %zu, \"best\": %zu, \"seed\": %" PRIu64 ",\n",
+           tool_json_number(n[0], st->h), st->field_dims[0], st->field_dims[1],
+           st->field_dims[2], tool_json_number(n[1], st->voxel),
+           tool_json_number(n[2], p->offset_ratio), st->ncandidates, st->best, b->seed);
+    printf("  \"tets\": %zu, \"points\": %zu, \"min_dihedral\": %s, \"max_dihedral\": %s,\n"
+           "  \"encloses\": %s, \"vertices_outside\": %zu, \"triangles_crossing\": %zu,\n",
+           b->tets, b->points, tool_json_number(n[3], b->min_dihedral),
+           tool_json_number(n[4], b->max_dihedral), st->encloses ? "true" : "false",
+           b->verts_outside, b->tris_crossing);
+    if (p->density_rho > 0)
+        printf("  \"offset_met\": null, \"beyond_offset\": null, \"boundary_vertices\": null, "
+               "\"max_distance_h\": null, \"measured_against\": null,\n");
+    else
+        printf("  \"offset_met\": %s, \"beyond_offset\": %zu, \"boundary_vertices\": %zu, "
+               "\"max_distance_h\": %s, \"measured_against\": \"%s\",\n",
+               b->converged ? "true" : "false", b->beyond_offset, b->boundary_vertices,
+               tool_json_number(n[5], b->max_distance / st->h),
+               st->fill_faces ? "input and fill" : "input");
+    double share = st->guess.boundary_faces
+                       ? (double)st->guess.fill_faces / (double)st->guess.boundary_faces : 0.0;
+    printf("  \"guessed_share\": %s, \"guessed_depth_h\": %s,\n"
+           "  \"seconds\": %s, \"exit_status\": %d}\n",
+           tool_json_number(n[6], share), tool_json_number(n[7], st->guess.depth / st->h),
+           tool_json_number(n[8], seconds), rc);
 }
 
 static int run(tool_ctx *t, void *settings)
@@ -425,14 +495,14 @@ static int run(tool_ctx *t, void *settings)
         tool_progress_end(t);
         if (!err.file[0])
             snprintf(err.file, sizeof err.file, "%s", in_name);
-        tool_limit_hint(&err, "use fewer --cells or --field-cells, or raise --max-memory");
+        tool_limit_hint(&err, "use fewer --cells or --voxels, or raise --max-memory");
         report(t, &st, p->density_rho > 0);
         rc = tool_fail(t, &err);
         goto done;
     }
     tool_progress_end(t);
     if (p->dry_run) {
-        rc = dry_run_report(t, soup, p, &st);
+        rc = dry_run_report(t, soup, p, &st, s->json);
         goto done;
     }
     if (p->target_tets)
@@ -581,6 +651,11 @@ static int run(tool_ctx *t, void *settings)
         if (!s->best_effort && rc == TOOL_EXIT_OK)
             rc = TOOL_EXIT_OFFSET_NOT_MET;
     }
+    if (s->json) {
+        print_json(s, &st, rc, tool_now() - t0);
+        if (tool_flush_stdout(t))
+            rc = TOOL_EXIT_FAIL;
+    }
 done:
     st_outfile_abort(&bof);
     st_soup_free(bsoup);
@@ -593,7 +668,7 @@ done:
     return rc;
 }
 
-static const tool_spec spec = {"soupmesh", usage, ":o:h:qv", longopts, option, check, run};
+static const tool_spec spec = {"soupmesh", usage, ":o:r:qv", longopts, option, check, run};
 
 int main(int argc, char *argv[])
 {

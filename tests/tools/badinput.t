@@ -242,13 +242,13 @@ for r in -5 1e9 abc "" 1.5; do
 done
 for s in 0 nan inf -inf abc; do
     expect_fail "soupdist -s '$s'" 2 "^soupdist: -s wants" soupdist -s "$s" -o x.vdb "$BUNNY"
-    expect_fail "latticetet -h '$s'" 2 "^latticetet: -h wants" latticetet --density 0.5 -h "$s" -o x.vtu s.vdb
+    expect_fail "latticetet --size '$s'" 2 "^latticetet: --size wants" latticetet --density 0.5 --size "$s" -o x.vtu s.vdb
 done
 for c in 0 -5 abc 1e9; do
     expect_fail "latticetet --cells '$c'" 2 "^latticetet: --cells wants" latticetet --density 0.5 --cells "$c" -o x.vtu s.vdb
     expect_fail "soupmesh --cells '$c'" 2 "^soupmesh: --cells wants" soupmesh --cells "$c" -o x.vtu "$BUNNY"
 done
-expect_fail "soupmesh --field-cells 0" 2 "^soupmesh: --field-cells wants" soupmesh --field-cells 0 -o x.vtu "$BUNNY"
+expect_fail "soupmesh --voxels 0" 2 "^soupmesh: --voxels wants" soupmesh --voxels 0 -o x.vtu "$BUNNY"
 for m in 0 -1G abc 1X 1e30; do
     expect_fail "--max-memory '$m'" 2 "^soupsign: --max-memory wants" soupsign --max-memory "$m" -o x.vdb d.vdb
 done

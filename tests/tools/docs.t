@@ -73,7 +73,7 @@ fi
 
 # -v reports as the run goes: every fit and quality iteration of every
 # candidate and each candidate's end come before the final summary.
-soupmesh -v --cells 5 --field-cells 48 --tries 2 --threads 2 -o v.vtu "$BUNNY" 2>v.log
+soupmesh -v --cells 5 --voxels 48 --tries 2 --threads 2 -o v.vtu "$BUNNY" 2>v.log
 for k in 0 1; do
     grep -q "^soupmesh: candidate $k: [0-9]* tets sculpted" v.log &&
         grep -q "^soupmesh: candidate $k: fit   1: " v.log &&
@@ -87,7 +87,7 @@ summary=$(grep -n 'candidate 0 (seed' v.log | head -1 | cut -d: -f1)
 ok $? "... before the summary (line ${first_iter:-none} < ${summary:-none})"
 grep -q '^soupmesh: field [0-9]*x[0-9]*x[0-9]*, voxel .*: distance and signs' v.log
 ok $? "... and the field as soon as it is done"
-soupmesh -q --cells 5 --field-cells 48 --tries 2 --threads 1 -o q.vtu "$BUNNY"
+soupmesh -q --cells 5 --voxels 48 --tries 2 --threads 1 -o q.vtu "$BUNNY"
 if "$PYVTK" -c 'import meshio' 2>/dev/null; then
     "$PYVTK" geomhash.py v.vtu >v.hash && "$PYVTK" geomhash.py q.vtu >q.hash && cmp -s v.hash q.hash
     ok $? "the reports change nothing: -v on 2 threads and -q on 1 give the same mesh"
@@ -96,7 +96,7 @@ fi
 # A terminal on stdin: refused at once (exit 2), as a terminal on stdout
 # is, instead of waiting silently. script(1) gives the tool a terminal.
 if command -v script >/dev/null 2>&1; then
-    soupmesh -q --cells 3 --field-cells 32 -o small.vtu "$BUNNY"
+    soupmesh -q --cells 3 --voxels 32 -o small.vtu "$BUNNY"
     soupdist -r 32 -o small.vdb "$BUNNY"
     soupsign -o small-s.vdb small.vdb
     for cmd in "soupinfo" "tetstat" "soupdist -o x.vdb" "soupmesh -o x.vtu -" \

@@ -12,10 +12,9 @@ check "soupmesh --cells 4" soupmesh -q --offset-best-effort --cells 4 -o c.vtu t
 check "soupmesh --size 0.5" soupmesh -q --offset-best-effort --size 0.5 -o s.vtu tet.off
 check "--size 0.5 is --cells 4 on a box of longest side 2: the same mesh" \
     "$TB/test_tetformat" --compare c.vtu s.vtu
-check "-h 0.5 is --size 0.5" sh -c "soupmesh -q --offset-best-effort -h 0.5 -o h.vtu tet.off && '$TB/test_tetformat' --compare s.vtu h.vtu"
 tetstat -q --json s.vtu >s.json && grep -q '"h": 0.5[,}]' s.json
 ok $? "the mesh records h = 0.5"
-soupmesh -q --offset-best-effort --size 0.3 --field-cells 32 -o t.vtu tet.off && tetstat -q --json t.vtu >t.json &&
+soupmesh -q --offset-best-effort --size 0.3 --voxels 32 -o t.vtu tet.off && tetstat -q --json t.vtu >t.json &&
     grep -q '"h": 0.29999999999999999[,}]\|"h": 0.3[,}]' t.json
 ok $? "--size 0.3 (not a divisor of the box) keeps h = 0.3"
 expect_fail "--cells and --size together are a usage error" 2 \
