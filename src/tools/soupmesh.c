@@ -35,12 +35,13 @@
 static void usage(void)
 {
     printf(
-"Usage: soupmesh [OPTION]... INPUT\n"
+"Usage: soupmesh [OPTION]... [INPUT]\n"
 "Mesh a triangle soup (any orientation, holes, interpenetrating parts) into a\n"
 "coarse tetrahedral mesh that encloses it, with dihedral angles far from 0 and\n"
 "180 degrees (Stuart et al. 2013 on the pseudo volume of Spillmann et al. 2006).\n"
 "\n"
-"INPUT is a surface: .obj .off .ply .stl .gltf .glb; '-' reads stdin (format sniffed).\n"
+"INPUT is a surface: .obj .off .ply .stl .gltf .glb; '-' or none reads stdin\n"
+"(format sniffed).\n"
 "\n"
 "  -o, --output OUT     the mesh, by extension: .vtu (VTK), .msh (Gmsh), .node/.ele\n"
 "                       (TetGen), .mesh (Medit); '-' or none: .vtu on stdout\n"
@@ -374,8 +375,12 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
         return tool_usage_error(t, "--tets and --dry-run size the sculpted mesh, "
                                    "not --density's");
     TOOL_TRY(tool_one_input(t, argc, argv, "input surface", NULL, &s->in));
-    if (!s->in)
+    /* No INPUT reads stdin, as in every tool; on a terminal, where a user
+     * has forgotten it, say how to give one. */
+    if (!s->in && isatty(STDIN_FILENO))
         return tool_usage_error(t, "no input surface (soupmesh -o out.vtu model.obj)");
+    if (!s->in)
+        s->in = "-";
     TOOL_TRY(tool_refuse_terminal(t, s->in, STDIN_FILENO,
                                   "will not read a surface from a terminal: give a file"));
     if (s->co.out && st_soup_format_from_path(s->co.out) != ST_SOUP_GLTF) {
