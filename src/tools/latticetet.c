@@ -391,7 +391,7 @@ static int run(tool_ctx *t, void *settings)
     /* The field's metadata (source, history) carries over; the lattice's
      * own keys win. */
     if (st_meta_inherit(&m->meta, &g->meta) != ST_OK ||
-        st_meta_history_append(&m->meta, tool_command(t)) != ST_OK) {
+        tool_meta_record(t, &m->meta) != ST_OK) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }

@@ -180,7 +180,7 @@ static int run(tool_ctx *t, void *settings)
     double t_write = tool_now();
     if (st_meta_set(&g->meta, "source", tool_in_name(in)) ||
         record_source(g, in, &src) ||
-        st_meta_history_append(&g->meta, tool_command(t))) {
+        tool_meta_record(t, &g->meta)) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }

@@ -531,7 +531,7 @@ static int run(tool_ctx *t, void *settings)
                      "input too moves it by up to half a float ulp", f->input_not_float32);
     }
     if (st_meta_set(&m->meta, "source", in_name) ||
-        st_meta_history_append(&m->meta, tool_command(t))) {
+        tool_meta_record(t, &m->meta)) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }

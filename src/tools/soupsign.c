@@ -409,7 +409,7 @@ static int run(tool_ctx *t, void *settings)
     const double cpu_sign = cpu_now() - c0;
     tool_progress_end(t);
     double t2 = tool_now();
-    if (st_meta_history_append(&g->meta, tool_command(t))) {
+    if (tool_meta_record(t, &g->meta)) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }

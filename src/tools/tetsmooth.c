@@ -340,7 +340,7 @@ static int run(tool_ctx *t, void *settings)
                  s->fit.offset_ratio, st.h, s->fit.step, s->fit.quality, st.converged, st.beyond_offset);
     }
     if (st_meta_set(&m->meta, "tetsmooth", param) ||
-        st_meta_history_append(&m->meta, tool_command(t))) {
+        tool_meta_record(t, &m->meta)) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }

@@ -83,8 +83,60 @@ static const char *enclosure_word(const st_tetstat *r)
     return "no";
 }
 
+/* What made the mesh, as its metadata recorded it: the parameters
+ * (version, commit, source, h, seed, offset_ratio, field_voxels, ...: every
+ * key in its order) and the history, one command line each. JSON: a
+ * "recorded" object of strings, "history" an array. */
+static void print_meta_json(FILE *f, const st_meta *meta)
+{
+    fprintf(f, ",\n  \"recorded\": {");
+    const char *sep = "";
+    for (size_t i = 0; i < meta->count; i++) {
+        const st_meta_entry *e = &meta->entries[i];
+        fprintf(f, "%s", sep);
+        tool_json_string(f, e->key);
+        fprintf(f, ": ");
+        sep = ", ";
+        if (strcmp(e->key, "history") != 0) {
+            tool_json_string(f, e->value);
+            continue;
+        }
+        fputc('[', f);
+        for (const char *l = e->value; *l;) {
+            size_t n = strcspn(l, "\n");
+            char *line = strndup(l, n);
+            if (l != e->value)
+                fprintf(f, ", ");
+            tool_json_string(f, line ? line : "");
+            free(line);
+            l += n + (l[n] == '\n');
+        }
+        fputc(']', f);
+    }
+    fputc('}', f);
+}
+
+static void print_meta_table(FILE *f, const st_meta *meta)
+{
+    if (!meta->count)
+        return;
+    fprintf(f, "recorded in the mesh:\n");
+    for (size_t i = 0; i < meta->count; i++) {
+        const st_meta_entry *e = &meta->entries[i];
+        if (strcmp(e->key, "history") == 0)
+            continue;
+        fprintf(f, "  %-28s %s\n", e->key, e->value);
+    }
+    const char *h = st_meta_get(meta, "history");
+    for (const char *l = h; l && *l;) {
+        size_t n = strcspn(l, "\n");
+        fprintf(f, "  %-28s %.*s\n", l == h ? "history" : "", (int)n, l);
+        l += n + (l[n] == '\n');
+    }
+}
+
 static void print_json(FILE *f, const char *name, const char *sname,
-                       const char *fname, const st_tetstat *r)
+                       const char *fname, const st_tetstat *r, const st_meta *meta)
 {
     char b[15][32];
     fprintf(f, "{\"file\": ");
@@ -178,6 +230,7 @@ static void print_json(FILE *f, const char *name, const char *sname,
                 r->field_voxels, r->field_inside, r->mesh_voxels,
                 r->both_voxels, tool_json_number(b[0], r->iou));
     }
+    print_meta_json(f, meta);
     fprintf(f, "}\n");
 }
 
@@ -442,9 +495,11 @@ static int run(tool_ctx *t, void *settings)
     const char *fname = rebuilt ? "the mesh's field (rebuilt from its meta)"
                         : field ? tool_in_name(field) : "<stdin>";
     if (s->json)
-        print_json(stdout, name, sname, fname, &r);
-    else
+        print_json(stdout, name, sname, fname, &r, &m->meta);
+    else {
         print_table(stdout, name, sname, fname, &r);
+        print_meta_table(stdout, &m->meta);
+    }
     if (tool_flush_stdout(t)) {
         rc = TOOL_EXIT_FAIL;
         goto done;
