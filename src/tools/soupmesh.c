@@ -16,6 +16,7 @@
 #include "souptet/outfile.h"
 #include "souptet/pipeline.h"
 #include "souptet/soup.h"
+#include "souptet/soupinfo.h"
 #include "souptet/soupwrite.h"
 #include "souptet/tetformat.h"
 #include "souptet/tetio.h"
@@ -154,6 +155,39 @@ static double box_diagonal(const st_soup *s)
         }
     return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+/* What the pseudo volume guessed where the input has no surface, for the
+ * note: caps over holes and the far side of one-sided parts need open
+ * edges; an input without any (its holes 0) had nothing capped, and the
+ * guess is where the vote's solid leaves the surface, which its
+ * duplicated, non-manifold or mis-oriented parts do not tell (say which
+ * of those it has). */
+static void guess_words(char *buf, size_t n, const st_soup *soup)
+{
+    st_soupinfo si;
+    st_error e;
+    if (st_soupinfo_compute(&si, soup, &e)) {
+        snprintf(buf, n, "hole caps, a one-sided view's far side");
+        return;
+    }
+    if (si.boundary_edges) {
+        snprintf(buf, n, "caps over the input's %zu hole%s, or the far side of a "
+                 "part seen from one side", si.holes, si.holes == 1 ? "" : "s");
+        return;
+    }
+    int k = snprintf(buf, n, "the input has no holes, so nothing was capped: where the "
+                     "vote's solid leaves the surface");
+    const char *sep = ", which has ";
+    struct { size_t v; const char *what; } c[] = {
+        {si.duplicated_triangles, "duplicated triangles"},
+        {si.nonmanifold_edges, "non-manifold edges"},
+        {si.inconsistent_edges, "mis-oriented edges"}};
+    for (size_t i = 0; i < 3 && k > 0 && (size_t)k < n; i++)
+        if (c[i].v) {
+            k += snprintf(buf + k, n - (size_t)k, "%s%zu %s", sep, c[i].v, c[i].what);
+            sep = ", ";
+        }
 }
 
 static void report(const tool_ctx *t, const st_pipeline_stats *st, int density)
@@ -604,16 +638,18 @@ static int run(tool_ctx *t, void *settings)
     const double diag = box_diagonal(soup);
     if (st.guess.fill_faces) {
         /* The solid where the input has no surface is the pseudo volume's
-         * guess (caps, a one-sided view's far side): said by default when
-         * it reaches past a lattice cell from the input, where the mesh
-         * resolves it (its volume, a simulation's mass, rest on it). */
+         * guess: said by default when it reaches past a lattice cell from
+         * the input, where the mesh resolves it (its volume, a
+         * simulation's mass, rest on it), naming what was guessed. */
         const double depth_h = st.guess.depth / st.h;
+        char what[200];
+        guess_words(what, sizeof what, soup);
         tool_say(t, depth_h > 1.0 ? 1 : 2,
                  "note: %.1f%% of the solid's boundary is not on the input but guessed "
-                 "(hole caps, a one-sided view's far side), up to %.2f h (%.3f of the "
-                 "diagonal) from it; the mesh's volume there rests on that guess",
+                 "(%s), up to %.2f h (%.3f of the diagonal) from it; the mesh's volume "
+                 "there rests on that guess",
                  100.0 * (double)st.guess.fill_faces / (double)st.guess.boundary_faces,
-                 depth_h, st.guess.depth / diag);
+                 what, depth_h, st.guess.depth / diag);
     }
     if (t->verbosity >= 2 && p->density_rho <= 0) {
         /* both directions, in h and per the input's box diagonal */
