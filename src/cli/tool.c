@@ -12,6 +12,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <getopt.h>
 #include <limits.h>
 #include <math.h>
@@ -29,8 +30,19 @@
 
 static const char *g_name = "souptet";
 static char *g_command_line;   /* freed at exit, whatever path main takes */
-static int g_progress_drawn;
+
+/* The progress line (tool_progress): its stage, the largest fraction
+ * reported in it (the line never goes back), when the stage began, and a
+ * thread that redraws it every second so the clock moves even while a
+ * stage reports nothing. g_progress_drawn is volatile for the signal
+ * handler, which ends the line (a bare write: nothing else is safe). */
+static pthread_mutex_t g_progress_mu = PTHREAD_MUTEX_INITIALIZER;
+static volatile sig_atomic_t g_progress_drawn;
 static double g_progress_last;
+static char g_progress_stage[64];
+static double g_progress_frac, g_progress_t0, g_progress_tdone;
+static int g_progress_ticker, g_progress_stop;
+#define PROGRESS_DONE 0.995   /* what prints as 100% */
 static int g_failed;           /* tool_fail has printed an error */
 static size_t g_ulimit_left;   /* >0: the default --max-memory came from ulimit -v */
 
@@ -42,6 +54,9 @@ static size_t g_ulimit_left;   /* >0: the default --max-memory came from ulimit 
 static void on_signal(int sig)
 {
     signal(sig, SIG_DFL);
+    /* The progress line ends, so the shell's prompt starts a line. */
+    if (g_progress_drawn && write(STDERR_FILENO, "\n", 1) < 0)
+        g_progress_drawn = 0;
     st_outfile_unlink_pending();
     sigset_t s;
     sigemptyset(&s);
@@ -422,25 +437,129 @@ void tool_set_threads(size_t threads)
 #endif
 }
 
+/* "12 s", "4 min 10 s", "1 h 05 min". */
+static void progress_duration(char *buf, size_t n, double s)
+{
+    long v = (long)(s + 0.5);
+    if (v < 60)
+        snprintf(buf, n, "%ld s", v);
+    else if (v < 3600)
+        snprintf(buf, n, "%ld min %02ld s", v / 60, v % 60);
+    else
+        snprintf(buf, n, "%ld h %02ld min", v / 3600, v / 60 % 60);
+}
+
+/* The line, from the state (the mutex held): the stage, its percentage,
+ * the time in it, and past 2% and 2 s of a stage, the time left at the
+ * rate so far. */
+static void progress_write(double now)
+{
+    char el[32], eta[32] = "";
+    double in_stage = now - g_progress_t0, f = g_progress_frac;
+    if (f >= PROGRESS_DONE && now - g_progress_tdone >= 1.0) {
+        /* The stage is done and the next has not reported yet: the clock
+         * since, so the line still moves. */
+        progress_duration(el, sizeof el, now - g_progress_tdone);
+        fprintf(stderr, "\r%s: %s done; working (%s)\033[K", g_name, g_progress_stage, el);
+        fflush(stderr);
+        g_progress_last = now;
+        g_progress_drawn = 1;
+        return;
+    }
+    progress_duration(el, sizeof el, in_stage);
+    if (f >= 0.02 && f < PROGRESS_DONE && in_stage >= 2.0) {
+        char left[24];
+        progress_duration(left, sizeof left, in_stage * (1.0 - f) / f);
+        snprintf(eta, sizeof eta, ", ETA %s", left);
+    }
+    fprintf(stderr, "\r%s: %s %3.0f%% (%s%s)\033[K", g_name, g_progress_stage, 100.0 * f,
+            el, eta);
+    fflush(stderr);
+    g_progress_last = now;
+    g_progress_drawn = 1;
+}
+
 static void progress_draw(void *ctx, const char *stage, double fraction)
 {
     (void)ctx;
     double now = tool_now();
-    /* Ten redraws a second are plenty for a person. */
-    if (fraction < 1.0 && g_progress_drawn && now - g_progress_last < 0.1)
+    pthread_mutex_lock(&g_progress_mu);
+    if (g_progress_stop) {
+        pthread_mutex_unlock(&g_progress_mu);
         return;
-    g_progress_last = now;
-    fprintf(stderr, "\r%s: %s %3.0f%%\033[K", g_name, stage, 100.0 * fraction);
-    fflush(stderr);
-    g_progress_drawn = 1;
+    }
+    /* A stage's line never goes back: rounds that report in turn (the
+     * fit's share of vertices within the offset falls a little as others
+     * move) show the furthest point reached. A new stage, or the same
+     * one starting over (back by more than half: a new sizing sculpt, a
+     * new pass), starts afresh. */
+    if (strncmp(stage, g_progress_stage, sizeof g_progress_stage - 1) != 0 ||
+        fraction < g_progress_frac - 0.5) {
+        snprintf(g_progress_stage, sizeof g_progress_stage, "%s", stage);
+        g_progress_frac = 0.0;
+        g_progress_t0 = now;
+    }
+    if (fraction > g_progress_frac) {
+        if (g_progress_frac < PROGRESS_DONE && fraction >= PROGRESS_DONE)
+            g_progress_tdone = now;
+        g_progress_frac = fraction > 1.0 ? 1.0 : fraction;
+    }
+    /* Ten redraws a second are plenty for a person. */
+    if (fraction >= 1.0 || !g_progress_drawn || now - g_progress_last >= 0.1)
+        progress_write(now);
+    pthread_mutex_unlock(&g_progress_mu);
+}
+
+/* Once a second, the line again with its clock moved, while a stage
+ * reports nothing new (detached; stops at exit). */
+static void *progress_ticker(void *arg)
+{
+    (void)arg;
+    for (;;) {
+        struct timespec ts = {0, 250000000};
+        nanosleep(&ts, NULL);
+        pthread_mutex_lock(&g_progress_mu);
+        int stop = g_progress_stop;
+        double now = tool_now();
+        if (!stop && g_progress_drawn && now - g_progress_last >= 1.0)
+            progress_write(now);
+        pthread_mutex_unlock(&g_progress_mu);
+        if (stop)
+            return NULL;
+    }
+}
+
+/* At exit, whatever the path: the line is ended and the ticker stops. */
+static void progress_at_exit(void)
+{
+    pthread_mutex_lock(&g_progress_mu);
+    g_progress_stop = 1;
+    if (g_progress_drawn) {
+        fprintf(stderr, "\r\033[K");
+        fflush(stderr);
+        g_progress_drawn = 0;
+    }
+    pthread_mutex_unlock(&g_progress_mu);
 }
 
 st_progress tool_progress(tool_ctx *t)
 {
     st_progress p = {NULL, NULL, NULL};
-    if (t->verbosity >= 1 && isatty(STDERR_FILENO)) {
+    /* SOUPTET_PROGRESS=1 draws the line on a stderr that is not a
+     * terminal too (tests; a log read as it grows). */
+    const char *force = getenv("SOUPTET_PROGRESS");
+    if (t->verbosity >= 1 && (isatty(STDERR_FILENO) || (force && strcmp(force, "1") == 0))) {
         p.fn = progress_draw;
         p.ctx = t;
+        pthread_mutex_lock(&g_progress_mu);
+        if (!g_progress_ticker) {
+            pthread_t th;
+            g_progress_ticker = 1;
+            if (pthread_create(&th, NULL, progress_ticker, NULL) == 0)
+                pthread_detach(th);
+            atexit(progress_at_exit);
+        }
+        pthread_mutex_unlock(&g_progress_mu);
     }
     return p;
 }
@@ -448,11 +567,13 @@ st_progress tool_progress(tool_ctx *t)
 void tool_progress_end(tool_ctx *t)
 {
     (void)t;
+    pthread_mutex_lock(&g_progress_mu);
     if (g_progress_drawn) {
         fprintf(stderr, "\r\033[K");
         fflush(stderr);
         g_progress_drawn = 0;
     }
+    pthread_mutex_unlock(&g_progress_mu);
 }
 
 void tool_json_string(FILE *f, const char *s)

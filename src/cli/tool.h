@@ -142,7 +142,13 @@ size_t tool_max_lattice_tets(size_t max_bytes);
 void tool_set_threads(size_t threads);
 
 /* A progress reporter that draws one line on stderr when stderr is a
- * terminal and verbosity >= 1; otherwise it does nothing. */
+ * terminal (or SOUPTET_PROGRESS=1 is set) and verbosity >= 1; otherwise
+ * it does nothing. The line: "tool: STAGE NN% (T s, ETA E)", a stage's
+ * percentage never going back (the furthest reported; a fall of more
+ * than half starts the stage over), the ETA from the stage's rate past
+ * 2% and 2 s; redrawn every second by a thread so the clock moves while
+ * nothing is reported ("STAGE done; working (T s)" after a stage's end).
+ * The line is cleared at exit and ended with a newline on a signal. */
 st_progress tool_progress(tool_ctx *t);
 /* Clear the progress line if one was drawn. */
 void tool_progress_end(tool_ctx *t);
