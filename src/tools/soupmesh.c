@@ -66,7 +66,8 @@ TOOL_HELP_TETFORMAT
 "      --json           a summary of the run on stdout as JSON (needs -o FILE),\n"
 "                       or of --dry-run's estimate\n"
 "      --dry-run        print the cell width h, the estimated tets, memory\n"
-"                       and a time class, then exit (the field and signs are\n"
+"                       and the run's seconds (from a measured sculpt and the\n"
+"                       threads), then exit (the field and signs are\n"
 "                       computed, the fit is not)\n"
 "      --offset R       stop fitting when every boundary vertex is within\n"
 "                       R * h of the surface (h = cell width; default 0.4);\n"
@@ -251,13 +252,26 @@ static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
     return 1;
 }
 
+/* How much longer a candidate's fit and quality pass take than its
+ * sculpt (the sculpted lattice's tets, the fit's iterations over them):
+ * measured with soupmesh -v at the defaults on this project's 2-core
+ * machine, fit+quality over sculpt: bunny 1.30/0.32 s (4.1), fandisk
+ * 1.09/0.22 (5.0), elephant 3.11/0.21 (14.8); 7 put the whole runs of
+ * those three at 1, 4 and 16 cells, 1 and 4 tries, at 0.43-1.01 of the
+ * estimate (geometric mean 0.7), 5 centres them. The estimate rests on
+ * the dry run's own measured sculpt, so a slower or faster (or busier)
+ * machine scales it. */
+#define DRY_RUN_FIT_PER_SCULPT 5.0
+
 /* soupmesh --dry-run: what a run would lay, on stdout, one "key value"
  * a line. Memory: the field (floats and a sign byte per voxel, twice for
  * the sweeps) and the lattices laid at once (the bound of
- * lattice_over_limit). The time class counts tets times candidates: on
- * this project's 2-core machine a bunny of ~1 000 to ~4 000 tets takes 2-5
- * s in all; the 20 000 and 200 000 boundaries are a rough extrapolation
- * (the fit is about linear in tets), not a measurement. */
+ * lattice_over_limit). Time: what the dry run measured (the field, the
+ * signs and its sculpt of the first candidate's lattice, or the sizing
+ * sculpts of --tets, which a run repeats), plus each wave of candidates
+ * (tries over the threads that run them, one thread each) taking a
+ * sculpt and DRY_RUN_FIT_PER_SCULPT sculpts' worth of fit: a measured
+ * rate, not a class of tet counts (which was 10x off). */
 static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_params *p,
                           const st_pipeline_stats *st, int json)
 {
@@ -267,19 +281,29 @@ static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_pa
     double lattice = st_pipeline_lattice_bytes(soup, st->h, p->tries, NULL, NULL);
     double field = (double)st->field_dims[0] * (double)st->field_dims[1] *
                    (double)st->field_dims[2] * 2.0 * (sizeof(float) + 1);
-    double work = (double)st->estimated_tets * (double)p->tries;
-    const char *cls = work < 20000 ? "seconds" : work < 200000 ? "minutes"
-                                                               : "tens of minutes or more";
+    size_t threads = 1;
+#ifdef _OPENMP
+    threads = (size_t)omp_get_max_threads();
+#endif
+    size_t at_once = p->tries < threads ? p->tries : threads;
+    double waves = ceil((double)p->tries / (double)(at_once ? at_once : 1));
+    double sculpt = st->sculpts ? st->seconds_size / (double)st->sculpts : 0.0;
+    double before = st->seconds_total - (p->target_tets ? 0.0 : st->seconds_size);
+    double seconds = before + waves * sculpt * (1.0 + DRY_RUN_FIT_PER_SCULPT);
+    const char *cls = seconds < 60 ? "seconds" : seconds < 3600 ? "minutes" : "hours";
+    double cells = ceil(st_lattice_h_for_cells(lo, hi, 1) / st->h);
+    double mib = (lattice + field) / 1048576.0;
     if (json) {
         char n[2][32];
         printf("{\"h\": %s, \"cells\": %.0f, \"estimated_tets\": %zu, \"memory_mib\": %.1f, "
-               "\"time\": \"%s\"}\n", tool_json_number(n[0], st->h),
-               ceil(st_lattice_h_for_cells(lo, hi, 1) / st->h), st->estimated_tets,
-               (lattice + field) / 1048576.0, cls);
-    } else
-    printf("h %.17g\ncells %.0f\nestimated_tets %zu\nmemory_mib %.1f\ntime %s\n",
-           st->h, ceil(st_lattice_h_for_cells(lo, hi, 1) / st->h), st->estimated_tets,
-           (lattice + field) / 1048576.0, cls);
+               "\"seconds\": %.1f, \"threads\": %zu, \"time\": \"%s\"}\n",
+               tool_json_number(n[0], st->h), cells, st->estimated_tets, mib, seconds, threads,
+               cls);
+    } else {
+        printf("h %.17g\ncells %.0f\nestimated_tets %zu\nmemory_mib %.1f\nseconds %.1f\n"
+               "threads %zu\ntime %s\n", st->h, cells, st->estimated_tets, mib, seconds,
+               threads, cls);
+    }
     return tool_flush_stdout(t) ? TOOL_EXIT_FAIL : TOOL_EXIT_OK;
 }
 
