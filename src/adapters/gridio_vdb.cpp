@@ -727,11 +727,39 @@ private:
             return fail("%s claims %ld entries, more than the %llu bytes "
                         "left can hold", what, long(count),
                         (unsigned long long)left());
-        for (int32_t i = 0; i < count; i++)
-            for (int k = 0; k < 3; k++)
-                if (st_status st = block(what))
-                    return st;
+        for (int32_t i = 0; i < count; i++) {
+            std::string key, type;
+            if (st_status st = block(what, &key))
+                return st;
+            if (st_status st = block(what, &type))
+                return st;
+            const uint64_t at = pos_;
+            if (st_status st = block(what))
+                return st;
+            /* A value of a fixed-size type is read by its type's size,
+             * whatever its length says: another length would put OpenVDB
+             * out of step with the walk (and on to a 1.7 GB string). */
+            const uint64_t want = fixed_size(type), got = pos_ - at - 4;
+            if (want && pos_ >= at + 4 && got != want)
+                return fail("%s: '%.40s' is a %.20s of %llu bytes, not %llu", what,
+                            key.c_str(), type.c_str(), (unsigned long long)got,
+                            (unsigned long long)want);
+        }
         return ST_OK;
+    }
+    /* The bytes of OpenVDB's fixed-size metadata types; 0 for the others
+     * (strings, and types it keeps as unknown, read by their length). */
+    static uint64_t fixed_size(const std::string &t)
+    {
+        static const struct { const char *name; uint64_t size; } k[] = {
+            {"bool", 1}, {"int32", 4}, {"int64", 8}, {"float", 4}, {"double", 8},
+            {"vec2i", 8}, {"vec2s", 8}, {"vec2d", 16}, {"vec3i", 12}, {"vec3s", 12},
+            {"vec3d", 24}, {"vec4i", 16}, {"vec4s", 16}, {"vec4d", 32}, {"mat4s", 64},
+            {"mat4d", 128}};
+        for (const auto &e : k)
+            if (t == e.name)
+                return e.size;
+        return 0;
     }
 };
 
