@@ -510,11 +510,16 @@ public:
                 return ST_OK;
             if (st_status st = meta_map("a grid's metadata"))
                 return st;
+            /* An instance shares another grid's tree: OpenVDB reads none
+             * for it and takes the rest on trust; souptet writes none. */
+            if (!parent.empty())
+                return fail("grid %ld is an instance of another grid's tree (souptet "
+                            "reads grids with trees of their own)", long(g));
             /* A float tree (as saved in full or as half floats) is walked
              * through: its transform, topology and buffers; an instance
              * has none of its own. Another type is OpenVDB's alone. */
             half_ = type == "Tree_float_5_4_3_HalfFloat";
-            if (parent.empty() && version_ >= 222 &&
+            if (version_ >= 222 &&
                 (type == "Tree_float_5_4_3" || half_)) {
                 bool walked = false;
                 if (st_status st = float_grid(&walked))
