@@ -450,7 +450,7 @@ static void progress_duration(char *buf, size_t n, double s)
 }
 
 /* The line, from the state (the mutex held): the stage, its percentage,
- * the time in it, and past 2% and 2 s of a stage, the time left at the
+ * the time in it, and past 2% and 1 s of a stage, the time left at the
  * rate so far. */
 static void progress_write(double now)
 {
@@ -467,7 +467,7 @@ static void progress_write(double now)
         return;
     }
     progress_duration(el, sizeof el, in_stage);
-    if (f >= 0.02 && f < PROGRESS_DONE && in_stage >= 2.0) {
+    if (f >= 0.02 && f < PROGRESS_DONE && in_stage >= 1.0) {
         char left[24];
         progress_duration(left, sizeof left, in_stage * (1.0 - f) / f);
         snprintf(eta, sizeof eta, ", ETA %s", left);

@@ -146,7 +146,7 @@ void tool_set_threads(size_t threads);
  * it does nothing. The line: "tool: STAGE NN% (T s, ETA E)", a stage's
  * percentage never going back (the furthest reported; a fall of more
  * than half starts the stage over), the ETA from the stage's rate past
- * 2% and 2 s; redrawn every second by a thread so the clock moves while
+ * 2% and 1 s; redrawn every second by a thread so the clock moves while
  * nothing is reported ("STAGE done; working (T s)" after a stage's end).
  * The line is cleared at exit and ended with a newline on a signal. */
 st_progress tool_progress(tool_ctx *t);
