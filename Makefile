@@ -118,6 +118,23 @@ ifneq ($(FLAGS_NOW),$(file < $(BUILD)/flags))
 endif
 $(LIB_OBJ) $(CLI_OBJ): $(BUILD)/flags
 
+# What --version prints: VERSION and the commit, from git describe in a
+# clone, else from the file COMMIT (git archive writes the commit into it:
+# .gitattributes export-subst), else "unknown". Rewritten only when it
+# changes, so only the CLI's objects rebuild.
+COMMIT := $(strip $(if $(wildcard .git),$(shell git describe --always --dirty --abbrev=12 2>/dev/null)))
+ifeq ($(COMMIT),)
+  COMMIT := $(strip $(shell sed -n '/^[0-9a-f]\{7,\}/p' COMMIT 2>/dev/null | head -1))
+endif
+COMMIT := $(if $(COMMIT),$(COMMIT),unknown)
+BUILD_H_NOW := \#define SOUPTET_COMMIT "$(COMMIT)"
+ifneq ($(BUILD_H_NOW),$(file < $(BUILD)/gen/souptet_build.h))
+  $(shell mkdir -p $(BUILD)/gen)
+  $(file > $(BUILD)/gen/souptet_build.h,$(BUILD_H_NOW))
+endif
+$(CLI_OBJ): $(BUILD)/gen/souptet_build.h
+$(CLI_OBJ): CFLAGS_ALL += -I$(BUILD)/gen
+
 $(BUILD)/obj/%.o: src/%.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -c $< -o $@

@@ -54,7 +54,7 @@ static void print_defaults(void)
     printf("tetsmooth --max-iters %d\n", fit.max_iters);
     printf("tetsmooth --quality-rounds %d\n", fit.quality_rounds);
 
-    printf("soupdist --cells %zu\n", dist.cells);
+    printf("soupdist --voxels %zu\n", dist.cells);
     printf("soupdist --band %.17g\n", dist.band);
 
     printf("soupsign -k %.17g\n", sign.k);
@@ -71,7 +71,7 @@ static void print_defaults(void)
     printf("soupwrap --min-volume %.17g\n", wr.min_volume);
     printf("soupwrap --fill-holes %s\n", onoff(ps.fill_holes));
     printf("soupwrap --shells %s\n", onoff(ps.closed_shells));
-    printf("soupwrap --cells %zu\n", dist.cells);
+    printf("soupwrap --voxels %zu\n", dist.cells);
 }
 
 int main(int argc, char **argv)

@@ -80,6 +80,7 @@
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/Prune.h>
 
+#include <array>
 #include <cerrno>
 #include <cstdarg>
 #include <cstdint>
@@ -95,6 +96,7 @@
 #include <new>
 #include <ostream>
 #include <set>
+#include <sstream>
 #include <streambuf>
 #include <string>
 #include <dlfcn.h>
@@ -470,8 +472,18 @@ public:
         uint32_t version;
         if (!get(&magic, 8) || !get(&version, 4))
             return ST_OK;   /* OpenVDB says what is wrong */
-        if (magic != 0x56444220 || version < 221 || version > 224)
-            return ST_OK;
+        if (magic != 0x56444220)
+            return ST_OK;   /* OpenVDB says it is not a VDB file */
+        /* Older formats take other paths through OpenVDB (a root node's
+         * table sized by the file's index range), a newer one is not this
+         * OpenVDB's to read (it read on past a metadata length it zero-
+         * fills, 1.7 GB in 10 s: a make fuzz timeout): neither is walked,
+         * so neither is read. */
+        if (version < 221 || version > 224)
+            return st_error_set_offset(err_, ST_EINPUT, name_, 8,
+                                       "OpenVDB file format version %lu: souptet reads "
+                                       "versions 221 to 224", (unsigned long)version);
+        version_ = version;
         unsigned char offsets = 0;
         if (!skip(8) || !get(&offsets, 1) || !skip(36))
             return ST_OK;
@@ -485,15 +497,41 @@ public:
                         "left can hold", long(ngrids),
                         (unsigned long long)left());
         for (int32_t g = 0; g < ngrids; g++) {
-            for (int k = 0; k < 3; k++)   /* name, type, instance parent */
-                if (st_status st = block("a grid descriptor's name"))
-                    return st;
+            std::string type, parent;
+            if (st_status st = block("a grid descriptor's name"))
+                return st;
+            if (st_status st = block("a grid descriptor's type", &type))
+                return st;
+            if (st_status st = block("a grid descriptor's parent", &parent))
+                return st;
             int64_t grid_pos, block_pos, end_pos;
             if (!get(&grid_pos, 8) || !get(&block_pos, 8) || !get(&end_pos, 8)
-                || !skip(4))   /* the grid's compression flags */
+                || !get(&compression_, 4))   /* the grid's compression flags */
                 return ST_OK;
             if (st_status st = meta_map("a grid's metadata"))
                 return st;
+            /* An instance shares another grid's tree: OpenVDB reads none
+             * for it and takes the rest on trust; souptet writes none. */
+            if (!parent.empty())
+                return fail("grid %ld is an instance of another grid's tree (souptet "
+                            "reads grids with trees of their own)", long(g));
+            /* A float tree (as saved in full or as half floats) is walked
+             * through: its transform, topology and buffers; an instance
+             * has none of its own. Another type is OpenVDB's alone. */
+            half_ = type == "Tree_float_5_4_3_HalfFloat";
+            if (version_ >= 222 &&
+                (type == "Tree_float_5_4_3" || half_)) {
+                bool walked = false;
+                if (st_status st = float_grid(&walked))
+                    return st;
+                if (!walked)
+                    break;
+                if (offsets && end_pos != int64_t(pos_))
+                    return fail("a grid ends at byte %llu, not at the %lld its "
+                                "descriptor gives", (unsigned long long)pos_,
+                                (long long)end_pos);
+                continue;
+            }
             if (!offsets || end_pos <= int64_t(pos_) || uint64_t(end_pos) > size_)
                 break;   /* the tree follows: OpenVDB's to read */
             pos_ = uint64_t(end_pos);
@@ -506,6 +544,140 @@ private:
     uint64_t size_, pos_ = 0;
     const char *name_;
     st_error *err_;
+    uint32_t version_ = 0, compression_ = 0;
+    bool half_ = false;
+    uint64_t leaves_ = 0;
+
+    /* What OpenVDB 10 reads of a FloatGrid after its metadata
+     * (Archive::readGrid), checked before it allocates or reads anything
+     * by a count in the file: the transform (a linear map: what souptet
+     * reads), one buffer, the root's tiles (their active flag a bool: 0
+     * or 1) and children at distinct origins, each internal node's masks
+     * and values, the leaves' masks, then every leaf's buffer; every
+     * compressed block's size within the bytes left (OpenVDB allocates
+     * it first). *walked = false where this cannot follow (an unknown
+     * map type: OpenVDB says what is wrong). */
+    st_status float_grid(bool *walked)
+    {
+        std::string map;
+        if (st_status st = block("the transform's type", &map))
+            return st;
+        uint64_t n = map == "AffineMap" || map == "UnitaryMap" ? 128
+                     : map == "ScaleMap" || map == "UniformScaleMap" ? 120
+                     : map == "TranslationMap" ? 24
+                     : map == "ScaleTranslateMap" || map == "UniformScaleTranslateMap" ? 144
+                     : 0;
+        if (n == 0) {
+            if (map == "NonlinearFrustumMap")
+                return fail("the grid's transform is a frustum: souptet reads linear "
+                            "transforms (a uniform scale and a translation)");
+            return ST_OK;
+        }
+        int32_t buffers;
+        float background;
+        uint32_t tiles, children;
+        if (!skip(n) || !get(&buffers, 4) || !get(&background, 4) || !get(&tiles, 4) ||
+            !get(&children, 4))
+            return fail("the grid's tree is cut short");
+        if (buffers != 1)
+            return fail("the tree has %ld buffers (OpenVDB reads one)", long(buffers));
+        if (tiles > left() / 17 || children > left() / (12 + 2 * 4096))
+            return fail("the root claims %lu tiles and %lu children, more than the "
+                        "%llu bytes left can hold", (unsigned long)tiles,
+                        (unsigned long)children, (unsigned long long)left());
+        std::set<std::array<int32_t, 3>> origins;
+        for (uint32_t i = 0; i < tiles + children; i++) {
+            std::array<int32_t, 3> o;
+            if (!get(o.data(), 12))
+                return fail("the grid's tree is cut short");
+            if (!origins.insert(o).second)
+                return fail("two root entries at (%ld, %ld, %ld)", long(o[0]), long(o[1]),
+                            long(o[2]));
+            if (i < tiles) {
+                unsigned char active;
+                if (!skip(4) || !get(&active, 1))
+                    return fail("the grid's tree is cut short");
+                if (active > 1)
+                    return fail("a root tile's active flag is %u, not 0 or 1",
+                                unsigned(active));
+            } else if (st_status st = internal(5))
+                return st;
+        }
+        for (uint64_t i = 0; i < leaves_; i++) {
+            std::vector<uint64_t> mask(8);
+            if (!get(mask.data(), 64))
+                return fail("a leaf's buffer is cut short");
+            if (st_status st = values(mask, 512))
+                return st;
+        }
+        *walked = true;
+        return ST_OK;
+    }
+
+    /* An internal node of 2^(3 log2dim) entries (5: 32768, 4: 4096) and
+     * its children (log2dim 4, then the leaves' masks). */
+    st_status internal(int log2dim)
+    {
+        const uint64_t entries = uint64_t(1) << (3 * log2dim), words = entries / 64;
+        std::vector<uint64_t> child(words), value(words);
+        if (!get(child.data(), words * 8) || !get(value.data(), words * 8))
+            return fail("an internal node is cut short");
+        if (st_status st = values(value, entries))
+            return st;
+        uint64_t nchild = 0;
+        for (uint64_t w : child)
+            nchild += uint64_t(__builtin_popcountll(w));
+        if (log2dim == 4) {
+            if (nchild > left() / 64)
+                return fail("a node claims %llu leaves, more than the bytes left hold",
+                            (unsigned long long)nchild);
+            leaves_ += nchild;
+            return skip(nchild * 64) ? ST_OK : fail("a leaf's mask is cut short");
+        }
+        if (nchild > left() / (2 * 512))
+            return fail("a node claims %llu children, more than the bytes left hold",
+                        (unsigned long long)nchild);
+        for (uint64_t i = 0; i < nchild; i++)
+            if (st_status st = internal(4))
+                return st;
+        return ST_OK;
+    }
+
+    /* io::readCompressedValues of `entries` values whose value mask is
+     * `mask` (the grid's compression flags). */
+    st_status values(const std::vector<uint64_t> &mask, uint64_t entries)
+    {
+        int8_t meta;
+        if (!get(&meta, 1))
+            return fail("a node's values are cut short");
+        if (meta == 2 || meta == 4 || meta == 5)
+            if (!skip(meta == 5 ? 8 : 4))
+                return fail("a node's values are cut short");
+        if (meta == 3 || meta == 4 || meta == 5)
+            if (!skip(entries / 8))
+                return fail("a node's selection mask is cut short");
+        uint64_t count = entries;
+        if ((compression_ & 0x2) && meta != 6) {
+            count = 0;
+            for (uint64_t w : mask)
+                count += uint64_t(__builtin_popcountll(w));
+        }
+        const uint64_t bytes = count * (half_ ? 2 : 4);
+        if (!(compression_ & 0x5))
+            return skip(bytes) ? ST_OK : fail("a node's values are cut short");
+        int64_t packed;
+        if (!get(&packed, 8))
+            return fail("a node's values are cut short");
+        if (packed <= 0 && uint64_t(-(packed + 1)) + 1 != bytes)
+            return fail("an uncompressed block of %lld bytes where %llu are due",
+                        -(long long)packed, (unsigned long long)bytes);
+        uint64_t len = packed <= 0 ? bytes : uint64_t(packed);
+        if (len > left())
+            return fail("a compressed block claims %llu bytes but %llu remain",
+                        (unsigned long long)len, (unsigned long long)left());
+        pos_ += len;
+        return ST_OK;
+    }
 
     uint64_t left() const { return size_ - pos_; }
     bool get(void *dst, size_t n)
@@ -535,8 +707,9 @@ private:
                                    "not a valid OpenVDB file (truncated or corrupt): %s",
                                    what);
     }
-    /* One length-prefixed block (a string or a metadata value). */
-    st_status block(const char *what)
+    /* One length-prefixed block (a string or a metadata value), into
+     * *text when given. */
+    st_status block(const char *what, std::string *text = nullptr)
     {
         uint32_t n;
         if (!get(&n, 4))
@@ -544,6 +717,8 @@ private:
         if (n > left())
             return fail("%s claims %lu bytes but %llu remain", what,
                         (unsigned long)n, (unsigned long long)left());
+        if (text)
+            text->assign(reinterpret_cast<const char *>(data_ + pos_), n);
         pos_ += n;
         return ST_OK;
     }
@@ -557,12 +732,57 @@ private:
             return fail("%s claims %ld entries, more than the %llu bytes "
                         "left can hold", what, long(count),
                         (unsigned long long)left());
-        for (int32_t i = 0; i < count; i++)
-            for (int k = 0; k < 3; k++)
-                if (st_status st = block(what))
-                    return st;
+        for (int32_t i = 0; i < count; i++) {
+            std::string key, type;
+            if (st_status st = block(what, &key))
+                return st;
+            if (st_status st = block(what, &type))
+                return st;
+            const uint64_t at = pos_;
+            if (st_status st = block(what))
+                return st;
+            /* A value of a fixed-size type is read by its type's size,
+             * whatever its length says: another length would put OpenVDB
+             * out of step with the walk (and on to a 1.7 GB string). */
+            const uint64_t want = fixed_size(type), got = pos_ - at - 4;
+            if (want && pos_ >= at + 4 && got != want)
+                return fail("%s: '%.40s' is a %.20s of %llu bytes, not %llu", what,
+                            key.c_str(), type.c_str(), (unsigned long long)got,
+                            (unsigned long long)want);
+        }
         return ST_OK;
     }
+    /* The bytes of OpenVDB's fixed-size metadata types; 0 for the others
+     * (strings, and types it keeps as unknown, read by their length). */
+    static uint64_t fixed_size(const std::string &t)
+    {
+        static const struct { const char *name; uint64_t size; } k[] = {
+            {"bool", 1}, {"int32", 4}, {"int64", 8}, {"float", 4}, {"double", 8},
+            {"vec2i", 8}, {"vec2s", 8}, {"vec2d", 16}, {"vec3i", 12}, {"vec3s", 12},
+            {"vec3d", 24}, {"vec4i", 16}, {"vec4s", 16}, {"vec4d", 32}, {"mat4s", 64},
+            {"mat4d", 128}};
+        for (const auto &e : k)
+            if (t == e.name)
+                return e.size;
+        return 0;
+    }
+};
+
+/* OpenVDB's header code (trees, nodes, the stream's readers, compiled
+ * here) warns on std::cerr ("WARNING: multi-buffer trees are no longer
+ * supported"), not through the logger init_openvdb turns off: the library
+ * must not print, so while a file is read std::cerr goes nowhere. What
+ * was wrong still comes back as the read's error. */
+class CerrMuted {
+public:
+    CerrMuted() : old_(std::cerr.rdbuf(&sink_)) {}
+    ~CerrMuted() { std::cerr.rdbuf(old_); }
+    CerrMuted(const CerrMuted &) = delete;
+    CerrMuted &operator=(const CerrMuted &) = delete;
+
+private:
+    std::stringbuf sink_;
+    std::streambuf *old_;
 };
 
 /* Read the first usable FloatGrid from a stream (file or memory). */
@@ -583,6 +803,7 @@ st_status read_stream(st_grid **out, std::istream &is, const char *name,
                             "(a VTK .vti field?)");
     // delayLoad = false: otherwise OpenVDB may copy a stream into a
     // temporary file to load grids lazily.
+    CerrMuted muted;
     openvdb::io::Stream strm(is, false);
     openvdb::GridPtrVecPtr grids = strm.getGrids();
     std::string seen;

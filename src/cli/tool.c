@@ -2,6 +2,7 @@
 #define _GNU_SOURCE
 #include "tool.h"
 #include "../fpenv.h"
+#include "souptet_build.h"
 #include "souptet/dist.h"
 #include "souptet/grid.h"
 #include "souptet/gridio.h"
@@ -12,6 +13,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <getopt.h>
 #include <limits.h>
 #include <math.h>
@@ -29,8 +31,19 @@
 
 static const char *g_name = "souptet";
 static char *g_command_line;   /* freed at exit, whatever path main takes */
-static int g_progress_drawn;
+
+/* The progress line (tool_progress): its stage, the largest fraction
+ * reported in it (the line never goes back), when the stage began, and a
+ * thread that redraws it every second so the clock moves even while a
+ * stage reports nothing. g_progress_drawn is volatile for the signal
+ * handler, which ends the line (a bare write: nothing else is safe). */
+static pthread_mutex_t g_progress_mu = PTHREAD_MUTEX_INITIALIZER;
+static volatile sig_atomic_t g_progress_drawn;
 static double g_progress_last;
+static char g_progress_stage[64];
+static double g_progress_frac, g_progress_t0, g_progress_tdone;
+static int g_progress_ticker, g_progress_stop;
+#define PROGRESS_DONE 0.995   /* what prints as 100% */
 static int g_failed;           /* tool_fail has printed an error */
 static size_t g_ulimit_left;   /* >0: the default --max-memory came from ulimit -v */
 
@@ -42,6 +55,9 @@ static size_t g_ulimit_left;   /* >0: the default --max-memory came from ulimit 
 static void on_signal(int sig)
 {
     signal(sig, SIG_DFL);
+    /* The progress line ends, so the shell's prompt starts a line. */
+    if (g_progress_drawn && write(STDERR_FILENO, "\n", 1) < 0)
+        g_progress_drawn = 0;
     st_outfile_unlink_pending();
     sigset_t s;
     sigemptyset(&s);
@@ -422,25 +438,129 @@ void tool_set_threads(size_t threads)
 #endif
 }
 
+/* "12 s", "4 min 10 s", "1 h 05 min". */
+static void progress_duration(char *buf, size_t n, double s)
+{
+    long v = (long)(s + 0.5);
+    if (v < 60)
+        snprintf(buf, n, "%ld s", v);
+    else if (v < 3600)
+        snprintf(buf, n, "%ld min %02ld s", v / 60, v % 60);
+    else
+        snprintf(buf, n, "%ld h %02ld min", v / 3600, v / 60 % 60);
+}
+
+/* The line, from the state (the mutex held): the stage, its percentage,
+ * the time in it, and past 2% and 1 s of a stage, the time left at the
+ * rate so far. */
+static void progress_write(double now)
+{
+    char el[32], eta[32] = "";
+    double in_stage = now - g_progress_t0, f = g_progress_frac;
+    if (f >= PROGRESS_DONE && now - g_progress_tdone >= 1.0) {
+        /* The stage is done and the next has not reported yet: the clock
+         * since, so the line still moves. */
+        progress_duration(el, sizeof el, now - g_progress_tdone);
+        fprintf(stderr, "\r%s: %s done; working (%s)\033[K", g_name, g_progress_stage, el);
+        fflush(stderr);
+        g_progress_last = now;
+        g_progress_drawn = 1;
+        return;
+    }
+    progress_duration(el, sizeof el, in_stage);
+    if (f >= 0.02 && f < PROGRESS_DONE && in_stage >= 1.0) {
+        char left[24];
+        progress_duration(left, sizeof left, in_stage * (1.0 - f) / f);
+        snprintf(eta, sizeof eta, ", ETA %s", left);
+    }
+    fprintf(stderr, "\r%s: %s %3.0f%% (%s%s)\033[K", g_name, g_progress_stage, 100.0 * f,
+            el, eta);
+    fflush(stderr);
+    g_progress_last = now;
+    g_progress_drawn = 1;
+}
+
 static void progress_draw(void *ctx, const char *stage, double fraction)
 {
     (void)ctx;
     double now = tool_now();
-    /* Ten redraws a second are plenty for a person. */
-    if (fraction < 1.0 && g_progress_drawn && now - g_progress_last < 0.1)
+    pthread_mutex_lock(&g_progress_mu);
+    if (g_progress_stop) {
+        pthread_mutex_unlock(&g_progress_mu);
         return;
-    g_progress_last = now;
-    fprintf(stderr, "\r%s: %s %3.0f%%\033[K", g_name, stage, 100.0 * fraction);
-    fflush(stderr);
-    g_progress_drawn = 1;
+    }
+    /* A stage's line never goes back: rounds that report in turn (the
+     * fit's share of vertices within the offset falls a little as others
+     * move) show the furthest point reached. A new stage, or the same
+     * one starting over (back by more than half: a new sizing sculpt, a
+     * new pass), starts afresh. */
+    if (strncmp(stage, g_progress_stage, sizeof g_progress_stage - 1) != 0 ||
+        fraction < g_progress_frac - 0.5) {
+        snprintf(g_progress_stage, sizeof g_progress_stage, "%s", stage);
+        g_progress_frac = 0.0;
+        g_progress_t0 = now;
+    }
+    if (fraction > g_progress_frac) {
+        if (g_progress_frac < PROGRESS_DONE && fraction >= PROGRESS_DONE)
+            g_progress_tdone = now;
+        g_progress_frac = fraction > 1.0 ? 1.0 : fraction;
+    }
+    /* Ten redraws a second are plenty for a person. */
+    if (fraction >= 1.0 || !g_progress_drawn || now - g_progress_last >= 0.1)
+        progress_write(now);
+    pthread_mutex_unlock(&g_progress_mu);
+}
+
+/* Once a second, the line again with its clock moved, while a stage
+ * reports nothing new (detached; stops at exit). */
+static void *progress_ticker(void *arg)
+{
+    (void)arg;
+    for (;;) {
+        struct timespec ts = {0, 250000000};
+        nanosleep(&ts, NULL);
+        pthread_mutex_lock(&g_progress_mu);
+        int stop = g_progress_stop;
+        double now = tool_now();
+        if (!stop && g_progress_drawn && now - g_progress_last >= 1.0)
+            progress_write(now);
+        pthread_mutex_unlock(&g_progress_mu);
+        if (stop)
+            return NULL;
+    }
+}
+
+/* At exit, whatever the path: the line is ended and the ticker stops. */
+static void progress_at_exit(void)
+{
+    pthread_mutex_lock(&g_progress_mu);
+    g_progress_stop = 1;
+    if (g_progress_drawn) {
+        fprintf(stderr, "\r\033[K");
+        fflush(stderr);
+        g_progress_drawn = 0;
+    }
+    pthread_mutex_unlock(&g_progress_mu);
 }
 
 st_progress tool_progress(tool_ctx *t)
 {
     st_progress p = {NULL, NULL, NULL};
-    if (t->verbosity >= 1 && isatty(STDERR_FILENO)) {
+    /* SOUPTET_PROGRESS=1 draws the line on a stderr that is not a
+     * terminal too (tests; a log read as it grows). */
+    const char *force = getenv("SOUPTET_PROGRESS");
+    if (t->verbosity >= 1 && (isatty(STDERR_FILENO) || (force && strcmp(force, "1") == 0))) {
         p.fn = progress_draw;
         p.ctx = t;
+        pthread_mutex_lock(&g_progress_mu);
+        if (!g_progress_ticker) {
+            pthread_t th;
+            g_progress_ticker = 1;
+            if (pthread_create(&th, NULL, progress_ticker, NULL) == 0)
+                pthread_detach(th);
+            atexit(progress_at_exit);
+        }
+        pthread_mutex_unlock(&g_progress_mu);
     }
     return p;
 }
@@ -448,11 +568,13 @@ st_progress tool_progress(tool_ctx *t)
 void tool_progress_end(tool_ctx *t)
 {
     (void)t;
+    pthread_mutex_lock(&g_progress_mu);
     if (g_progress_drawn) {
         fprintf(stderr, "\r\033[K");
         fflush(stderr);
         g_progress_drawn = 0;
     }
+    pthread_mutex_unlock(&g_progress_mu);
 }
 
 void tool_json_string(FILE *f, const char *s)
@@ -561,10 +683,35 @@ int tool_grid_output(const tool_ctx *t, const char *out)
                               ".vdb or .vti");
 }
 
+/* "STL" for a surface file's path, else NULL. */
+static const char *surface_format_upper(const char *path, char buf[8])
+{
+    st_soup_format f = st_path_is_stdio(path) ? ST_SOUP_UNKNOWN : st_soup_format_from_path(path);
+    if (f == ST_SOUP_UNKNOWN)
+        return NULL;
+    const char *n = st_soup_format_name(f);
+    size_t i = 0;
+    for (; n[i] && i < 7; i++)
+        buf[i] = (char)(n[i] >= 'a' && n[i] <= 'z' ? n[i] - 'a' + 'A' : n[i]);
+    buf[i] = '\0';
+    return f == ST_SOUP_GLTF ? "glTF" : buf;
+}
+
+int tool_surface_as_tetmesh(const tool_ctx *t, const char *out, const char *hint)
+{
+    char buf[8];
+    const char *fmt = surface_format_upper(out, buf);
+    if (!fmt)
+        return TOOL_CONTINUE;
+    return tool_usage_error(t, "%s is a surface format: %s (a tet mesh is .vtu, .msh, "
+                            ".node, .ele or .mesh)", fmt, hint ? hint : "not for -o");
+}
+
 int tool_tetmesh_output(const tool_ctx *t, const char *out, const char *tty_msg)
 {
     if (tty_msg)
         TOOL_TRY(tool_refuse_terminal(t, out, STDOUT_FILENO, tty_msg));
+    TOOL_TRY(tool_surface_as_tetmesh(t, out, NULL));
     return tool_output_format(t, out, st_path_is_stdio(out) ||
                               st_tetformat_from_path(out) != ST_TETFORMAT_NONE,
                               ".vtu, .msh, .node, .ele or .mesh");
@@ -606,9 +753,11 @@ int tool_common_option(tool_ctx *t, int c, char *const argv[],
     case 'v':
         t->verbosity = 2;
         return TOOL_CONTINUE;
+    case 'h':
     case TOOL_OPT_HELP:
         usage();
         return TOOL_EXIT_OK;
+    case 'V':
     case TOOL_OPT_VERSION:
         tool_print_version(t);
         return TOOL_EXIT_OK;
@@ -619,6 +768,20 @@ int tool_common_option(tool_ctx *t, int c, char *const argv[],
     }
 }
 
+/* --msh-version and --msh-binary shape a .msh file only: with another
+ * output (stdout is .vtu) they are a usage error, not silently ignored. */
+static int tetformat_fits(const tool_ctx *t, const tool_common *co)
+{
+    const st_tetformat_opts *o = &co->tetformat;
+    if (!o->msh_version && !o->binary)
+        return TOOL_CONTINUE;
+    if (st_tetformat_from_path(co->out) == ST_TETFORMAT_MSH)
+        return TOOL_CONTINUE;
+    return tool_usage_error(t, "%s shapes a .msh output, not '%s' (give -o FILE.msh)",
+                            o->msh_version ? "--msh-version" : "--msh-binary",
+                            tool_out_name(co->out));
+}
+
 int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
               tool_common *co)
 {
@@ -626,9 +789,13 @@ int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
     tool_init(&t, spec->name, argc, argv);
     *co = tool_common_default();
     int c, rc = TOOL_CONTINUE;
+    /* -h and -V in every tool (help and version, as TetGen, Gmsh and the
+     * GNU tools have them). */
+    char shortopts[64];
+    snprintf(shortopts, sizeof shortopts, "%shV", spec->shortopts);
     opterr = 0;
     while (rc == TOOL_CONTINUE &&
-           (c = getopt_long(argc, argv, spec->shortopts, spec->longopts, NULL)) != -1) {
+           (c = getopt_long(argc, argv, shortopts, spec->longopts, NULL)) != -1) {
         if (c == 'o')
             co->out = optarg;
         else if (c == TOOL_OPT_MSH_VERSION || c == TOOL_OPT_MSH_BINARY ||
@@ -636,11 +803,14 @@ int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
             rc = tool_tetformat_option(&t, c, optarg, &co->tetformat) ? TOOL_EXIT_USAGE
                                                                        : TOOL_CONTINUE;
         else if (c == 'q' || c == 'v' || c == ':' || c == '?' || c == TOOL_OPT_THREADS ||
-                 c == TOOL_OPT_MAXMEM || c == TOOL_OPT_HELP || c == TOOL_OPT_VERSION)
+                 c == TOOL_OPT_MAXMEM || c == TOOL_OPT_HELP || c == TOOL_OPT_VERSION ||
+                 c == 'h' || c == 'V')
             rc = tool_common_option(&t, c, argv, spec->usage, co);
         else
             rc = spec->option(&t, c, optarg, settings);
     }
+    if (rc == TOOL_CONTINUE)
+        rc = tetformat_fits(&t, co);
     if (rc == TOOL_CONTINUE)
         rc = spec->check(&t, argc, argv, settings);
     if (rc == TOOL_CONTINUE)
@@ -649,9 +819,34 @@ int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
     return rc;
 }
 
+const char *tool_version(void)
+{
+    return SOUPTET_VERSION;
+}
+
+const char *tool_commit(void)
+{
+    return SOUPTET_COMMIT;
+}
+
 void tool_print_version(const tool_ctx *t)
 {
-    printf("%s (souptet) %s\n", t->name, SOUPTET_VERSION);
+    printf("%s (souptet) %s\ncommit %s\n", t->name, SOUPTET_VERSION, SOUPTET_COMMIT);
+}
+
+st_status tool_meta_record(const tool_ctx *t, st_meta *meta)
+{
+    if (st_meta_set(meta, "version", SOUPTET_VERSION) ||
+        st_meta_set(meta, "commit", SOUPTET_COMMIT) ||
+        st_meta_history_append(meta, tool_command(t)))
+        return ST_ENOMEM;
+    return ST_OK;
+}
+
+void tool_deprecated(const tool_ctx *t, const char *old_name, const char *new_name)
+{
+    tool_say(t, 1, "%s is now %s (%s goes in the next release)", old_name, new_name,
+             old_name);
 }
 
 int tool_report_symmetries(tool_ctx *t, const st_soup *soup, const st_bvh *bvh,

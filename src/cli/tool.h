@@ -142,7 +142,13 @@ size_t tool_max_lattice_tets(size_t max_bytes);
 void tool_set_threads(size_t threads);
 
 /* A progress reporter that draws one line on stderr when stderr is a
- * terminal and verbosity >= 1; otherwise it does nothing. */
+ * terminal (or SOUPTET_PROGRESS=1 is set) and verbosity >= 1; otherwise
+ * it does nothing. The line: "tool: STAGE NN% (T s, ETA E)", a stage's
+ * percentage never going back (the furthest reported; a fall of more
+ * than half starts the stage over), the ETA from the stage's rate past
+ * 2% and 1 s; redrawn every second by a thread so the clock moves while
+ * nothing is reported ("STAGE done; working (T s)" after a stage's end).
+ * The line is cleared at exit and ended with a newline on a signal. */
 st_progress tool_progress(tool_ctx *t);
 /* Clear the progress line if one was drawn. */
 void tool_progress_end(tool_ctx *t);
@@ -150,8 +156,22 @@ void tool_progress_end(tool_ctx *t);
 /* Wall-clock seconds since an arbitrary origin. */
 double tool_now(void);
 
-/* Print the version line "name (souptet) X.Y.Z". */
+/* Print the version lines: "name (souptet) X.Y.Z" and "commit C" (git
+ * describe of the tree it was built from, or "unknown" from a tarball
+ * without one; the Makefile bakes both into build/gen/souptet_build.h). */
 void tool_print_version(const tool_ctx *t);
+/* The version and the commit the tool was built from (as printed by
+ * --version), for a mesh's or a field's metadata. */
+const char *tool_version(void);
+const char *tool_commit(void);
+/* Record in meta what made it: "version" and "commit" (tool_version,
+ * tool_commit) and the command line appended to its history. ST_ENOMEM
+ * on failure. */
+st_status tool_meta_record(const tool_ctx *t, st_meta *meta);
+
+/* An old option spelling kept for one release: "name: OLD is now NEW (OLD
+ * goes in the next release)" on stderr unless -q. */
+void tool_deprecated(const tool_ctx *t, const char *old_name, const char *new_name);
 
 /* JSON output: s as a quoted, escaped JSON string; x as the shortest of 15,
  * 16 or 17 significant digits that reads back as exactly x (so 0.1 does not
@@ -201,6 +221,10 @@ int tool_output_format(const tool_ctx *t, const char *out, int known, const char
  * to a terminal). */
 int tool_grid_output(const tool_ctx *t, const char *out);
 int tool_tetmesh_output(const tool_ctx *t, const char *out, const char *tty_msg);
+/* When out names a surface file (.stl .obj .off .ply .gltf .glb): a usage
+ * error "STL is a surface format: HINT (a tet mesh is ...)" (tool_tetmesh_output
+ * checks it with a plain hint; soupmesh first, naming --boundary). */
+int tool_surface_as_tetmesh(const tool_ctx *t, const char *out, const char *hint);
 /* When an output (NULL and "-" are fine) cannot be written there
  * (tool_output_unwritable): TOOL_EXIT_FAIL after tool_finish. */
 int tool_output_check(tool_ctx *t, const char *out);
@@ -209,7 +233,9 @@ int tool_output_check(tool_ctx *t, const char *out);
  *
  * A tool's option table starts with its own long options, then
  * TOOL_LONG_OPTIONS_OUTPUT (-o) when it writes a file, then
- * TOOL_LONG_OPTIONS_BASIC (-q, -v, --help, --version) and, for tools that
+ * TOOL_LONG_OPTIONS_BASIC (-q, -v, -h/--help, -V/--version: tool_main adds
+ * "hV" to every tool's short options, so no tool may use -h or -V for
+ * anything else) and, for tools that
  * compute, TOOL_LONG_OPTIONS_RESOURCES (--threads, --max-memory), the two
  * of them with the table's end as TOOL_LONG_OPTIONS_END; its own option
  * codes start at TOOL_OPT_FIRST. tool_main's getopt_long loop hands the
@@ -220,8 +246,8 @@ enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION
 #define TOOL_LONG_OPTIONS_BASIC                              \
     {"quiet", no_argument, NULL, 'q'},                       \
     {"verbose", no_argument, NULL, 'v'},                     \
-    {"help", no_argument, NULL, TOOL_OPT_HELP},              \
-    {"version", no_argument, NULL, TOOL_OPT_VERSION}
+    {"help", no_argument, NULL, 'h'},                        \
+    {"version", no_argument, NULL, 'V'}
 /* -o, --output OUT (into tool_common's out). */
 #define TOOL_LONG_OPTIONS_OUTPUT {"output", required_argument, NULL, 'o'}
 #define TOOL_LONG_OPTIONS_RESOURCES                          \

@@ -2,7 +2,7 @@
  * latticetet - a tet mesh of the pseudo volume from a lattice.
  *
  *   latticetet [FIELD] (--density RHO | --sculpt --surface S)
- *              [--lattice cubic5|bcc] [--cells N | -h SIZE] [--seed S]
+ *              [--lattice cubic5|bcc] [--cells N | --size SIZE] [--seed S]
  *              [-o OUT] [-q | -v] [--threads T]
  *
  * Reads a signed field (soupsign's output: .vdb, .vti, or an OpenVDB stream
@@ -54,7 +54,7 @@ static void usage(void)
 "                       soupmesh) (default 16 for --density, 10 for --sculpt); with\n"
 "                       --density, 'auto': the coarsest of 8, 10, 12, 14,\n"
 "                       16, 20, ..., 128 at which no part is too thin\n"
-"  -h, --size SIZE      cell width in model units (instead of --cells)\n"
+"      --size SIZE      cell width in model units (instead of --cells)\n"
 "      --seed S         random rotation and offset of the lattice (0: axis-aligned\n"
 "                       at the box's corner; default 0 for --density, 1 for\n"
 "                       --sculpt, as soupmesh)\n"
@@ -73,8 +73,8 @@ TOOL_HELP_TETFORMAT
 "                       (default 80%% of RAM)\n"
 "  -q, --quiet          no messages but errors\n"
 "  -v, --verbose        report tets kept, bombs, timings\n"
-"      --help           show this help and exit\n"
-"      --version        show the version and exit\n"
+"  -h, --help           show this help and exit\n"
+"  -V, --version        show the version and commit and exit\n"
 "\n"
 "Examples:\n"
 "  soupdist bunny.obj | soupsign | latticetet --density 0.5 -o bunny.vtu\n"
@@ -85,7 +85,7 @@ TOOL_HELP_TETFORMAT
 }
 
 enum { OPT_DENSITY = TOOL_OPT_FIRST, OPT_SCULPT, OPT_SURFACE, OPT_LATTICE, OPT_CELLS,
-       OPT_SEED, OPT_NOREPAIR, OPT_PARTS };
+       OPT_SEED, OPT_NOREPAIR, OPT_PARTS, OPT_SIZE };
 
 /* What the command line asks for. */
 typedef struct latticetet_settings {
@@ -95,7 +95,7 @@ typedef struct latticetet_settings {
     size_t cells;      /* 0 until given, then the default of the mode */
     int auto_cells;    /* --cells auto */
     double rho;        /* --density; < 0 with --sculpt */
-    double size;       /* -h; 0: from cells */
+    double size;       /* --size; 0: from cells */
     int sculpt, repair, have_seed;
     int parts_mode;    /* --parts (st_parts_mode) */
     uint64_t seed;
@@ -107,7 +107,7 @@ static const struct option longopts[] = {
     {"surface", required_argument, NULL, OPT_SURFACE},
     {"lattice", required_argument, NULL, OPT_LATTICE},
     {"cells", required_argument, NULL, OPT_CELLS},
-    {"size", required_argument, NULL, 'h'},
+    {"size", required_argument, NULL, OPT_SIZE},
     {"seed", required_argument, NULL, OPT_SEED},
     {"no-repair", no_argument, NULL, OPT_NOREPAIR},
     {"parts", required_argument, NULL, OPT_PARTS},
@@ -141,8 +141,8 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
             return TOOL_EXIT_USAGE;
         s->auto_cells = 0;
         break;
-    case 'h':
-        if (tool_parse_double(t, "-h", arg, 1e-300, 1e300, &s->size))
+    case OPT_SIZE:
+        if (tool_parse_double(t, "--size", arg, 1e-300, 1e300, &s->size))
             return TOOL_EXIT_USAGE;
         break;
     case OPT_SEED: {
@@ -181,7 +181,7 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
     if (!s->sculpt && s->parts_mode > 0)
         return tool_usage_error(t, "--parts goes with --sculpt --surface S");
     if ((s->cells || s->auto_cells) && s->size > 0)
-        return tool_usage_error(t, "--cells and -h exclude each other");
+        return tool_usage_error(t, "--cells and --size exclude each other");
     if (s->auto_cells && (s->sculpt || !s->repair))
         return tool_usage_error(t, "--cells auto goes with --density (and its "
                                    "cleanup: not with --no-repair)");
@@ -252,7 +252,7 @@ static int run(tool_ctx *t, void *settings)
     /* A lattice that cannot fit in --max-memory (or past 2^31 tets, far
      * beyond what a coarse mesh needs) is refused before it is built. */
     const size_t max_tets = tool_max_lattice_tets(s->co.max_bytes);
-    const char *limit_hint = "use fewer --cells or a larger -h, or raise "
+    const char *limit_hint = "use fewer --cells or a larger --size, or raise "
                              "--max-memory";
     size_t thin_parts = 0;   /* of the last density try: why no tets */
     if (!sculpt) {
@@ -422,7 +422,7 @@ static int run(tool_ctx *t, void *settings)
     /* The field's metadata (source, history) carries over; the lattice's
      * own keys win. */
     if (st_meta_inherit(&m->meta, &g->meta) != ST_OK ||
-        st_meta_history_append(&m->meta, tool_command(t)) != ST_OK) {
+        tool_meta_record(t, &m->meta) != ST_OK) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }
@@ -442,7 +442,7 @@ done:
     return rc;
 }
 
-static const tool_spec spec = {"latticetet", usage, ":h:o:qv", longopts, option, check, run};
+static const tool_spec spec = {"latticetet", usage, ":o:qv", longopts, option, check, run};
 
 int main(int argc, char *argv[])
 {

@@ -32,8 +32,8 @@ static void usage(void)
 "The grid covers the bounding box padded by P voxels; values within the band\n"
 "are exact distances, values beyond it are clamped to the band.\n"
 "\n"
-"  -r, --cells N        voxels along the longest side of the box (default %d)\n"
-"  -s, --voxel SIZE     voxel size in model units (instead of -r)\n"
+"  -r, --voxels N       voxels along the longest side of the box (default %d)\n"
+"  -s, --voxel-size SIZE  voxel size in model units (instead of -r)\n"
 "      --pad P          voxels of padding on each side (default: band + 2)\n"
 "      --band B         exact band in voxels, at least %g (default %g),\n"
 "                       or 'full' for distances everywhere (beyond the band:\n"
@@ -43,8 +43,8 @@ static void usage(void)
 "      --max-memory SZ  refuse grids larger than SZ (e.g. 8G; default 80%% of RAM)\n"
 "  -q, --quiet          no messages but errors\n"
 "  -v, --verbose        report grid size and timings\n"
-"      --help           show this help and exit\n"
-"      --version        show the version and exit\n"
+"  -h, --help           show this help and exit\n"
+"  -V, --version        show the version and commit and exit\n"
 "\n"
 "Examples:\n"
 "  soupdist -r 256 -o bunny.vdb bunny.obj\n"
@@ -54,7 +54,7 @@ static void usage(void)
         ST_DIST_DEFAULT_CELLS, ST_DIST_MIN_BAND, ST_DIST_DEFAULT_BAND);
 }
 
-enum { OPT_PAD = TOOL_OPT_FIRST, OPT_BAND };
+enum { OPT_PAD = TOOL_OPT_FIRST, OPT_BAND, OPT_CELLS_OLD, OPT_VOXEL_OLD };
 
 /* Which soup the field came from, so soupsign can use it as --surface
  * (pseudo.h): its absolute path, size and content hash. Nothing for stdin,
@@ -84,8 +84,10 @@ typedef struct soupdist_settings {
 } soupdist_settings;
 
 static const struct option longopts[] = {
-    {"cells", required_argument, NULL, 'r'},
-    {"voxel", required_argument, NULL, 's'},
+    {"voxels", required_argument, NULL, 'r'},
+    {"voxel-size", required_argument, NULL, 's'},
+    {"cells", required_argument, NULL, OPT_CELLS_OLD},   /* before 0.2 */
+    {"voxel", required_argument, NULL, OPT_VOXEL_OLD},   /* before 0.2 */
     {"pad", required_argument, NULL, OPT_PAD},
     {"band", required_argument, NULL, OPT_BAND},
     TOOL_LONG_OPTIONS_OUTPUT,
@@ -95,11 +97,17 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
 {
     soupdist_settings *s = settings;
     switch (c) {
+    case OPT_CELLS_OLD:
+        tool_deprecated(t, "--cells", "--voxels (-r)");
+        /* fall through */
     case 'r':
         if (tool_parse_size(t, "-r", arg, 1, 65536, &s->dist.cells))
             return TOOL_EXIT_USAGE;
         s->have_cells = 1;
         break;
+    case OPT_VOXEL_OLD:
+        tool_deprecated(t, "--voxel", "--voxel-size (-s)");
+        /* fall through */
     case 's':
         if (tool_parse_double(t, "-s", arg, 1e-300, 1e300, &s->dist.voxel))
             return TOOL_EXIT_USAGE;
@@ -172,7 +180,7 @@ static int run(tool_ctx *t, void *settings)
     double t_write = tool_now();
     if (st_meta_set(&g->meta, "source", tool_in_name(in)) ||
         record_source(g, in, &src) ||
-        st_meta_history_append(&g->meta, tool_command(t))) {
+        tool_meta_record(t, &g->meta)) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }

@@ -17,6 +17,7 @@
 #include "souptet/parts.h"
 #include "souptet/pipeline.h"
 #include "souptet/soup.h"
+#include "souptet/soupinfo.h"
 #include "souptet/soupwrite.h"
 #include "souptet/tetformat.h"
 #include "souptet/tetio.h"
@@ -36,12 +37,13 @@
 static void usage(void)
 {
     printf(
-"Usage: soupmesh [OPTION]... INPUT\n"
+"Usage: soupmesh [OPTION]... [INPUT]\n"
 "Mesh a triangle soup (any orientation, holes, interpenetrating parts) into a\n"
 "coarse tetrahedral mesh that encloses it, with dihedral angles far from 0 and\n"
 "180 degrees (Stuart et al. 2013 on the pseudo volume of Spillmann et al. 2006).\n"
 "\n"
-"INPUT is a surface: .obj .off .ply .stl .gltf .glb; '-' reads stdin (format sniffed).\n"
+"INPUT is a surface: .obj .off .ply .stl .gltf .glb; '-' or none reads stdin\n"
+"(format sniffed).\n"
 "\n"
 "  -o, --output OUT     the mesh, by extension: .vtu (VTK), .msh (Gmsh), .node/.ele\n"
 "                       (TetGen), .mesh (Medit); '-' or none: .vtu on stdout\n"
@@ -64,12 +66,15 @@ TOOL_HELP_TETFORMAT
 "                       has them, else pieces) or none (default none)\n"
 "      --cells N        BCC lattice cells along the longest side of the\n"
 "                       model's box (default 10; more cells, more tets)\n"
-"  -h, --size H         the lattice cell width in model units, instead of\n"
-"                       --cells (as latticetet -h)\n"
+"      --size H         the lattice cell width in model units, instead of\n"
+"                       --cells (as latticetet --size)\n"
 "      --tets N         choose the cell width for about N tets (within 20%%;\n"
 "                       --cells or --size give the first guess)\n"
+"      --json           a summary of the run on stdout as JSON (needs -o FILE),\n"
+"                       or of --dry-run's estimate\n"
 "      --dry-run        print the cell width h, the estimated tets, memory\n"
-"                       and a time class, then exit (the field and signs are\n"
+"                       and the run's seconds (from a measured sculpt and the\n"
+"                       threads), then exit (the field and signs are\n"
 "                       computed, the fit is not)\n"
 "      --offset R       stop fitting when every boundary vertex is within\n"
 "                       R * h of the surface (h = cell width; default 0.4);\n"
@@ -91,8 +96,8 @@ TOOL_HELP_TETFORMAT
 "      --density RHO    the Spillmann mesher instead: cubic lattice tets with\n"
 "                       pseudo-volume density >= RHO, boundary faired (does\n"
 "                       not enclose)\n"
-"      --field-cells N  voxels along the longest side of the distance field\n"
-"                       (default max(128, 8 * cells))\n"
+"  -r, --voxels N       voxels along the longest side of the distance field\n"
+"                       (default max(128, 8 * cells); as soupdist -r)\n"
 "      --max-iters N    fit iterations at most (default 300)\n"
 "      --fill-holes on|off  cap the soup's holes for its pseudo volume\n"
 "                       (loops of boundary edges, when small beside the\n"
@@ -107,8 +112,8 @@ TOOL_HELP_TETFORMAT
 "  -v, --verbose        report every candidate, the timings and any guessed\n"
 "                       part of the solid (said without -v past a cell),\n"
 "                       the input's symmetries (reported, not used)\n"
-"      --help           show this help and exit\n"
-"      --version        show the version and exit\n"
+"  -h, --help           show this help and exit\n"
+"  -V, --version        show the version and commit and exit\n"
 "\n"
 "Examples:\n"
 "  soupmesh -o bunny.vtu bunny.obj\n"
@@ -119,9 +124,10 @@ TOOL_HELP_TETFORMAT
 "the input but some boundary vertex is farther than --offset R * h from it.\n");
 }
 
-enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_TRY_ALL, OPT_SEED, OPT_DENSITY, OPT_FIELD_CELLS,
-       OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_TETS, OPT_DRY_RUN, OPT_BOUNDARY,
-       OPT_BEST_EFFORT, OPT_OFFSET_FILL, OPT_FLOAT32, OPT_PARTS };
+enum { OPT_CELLS = TOOL_OPT_FIRST, OPT_OFFSET, OPT_TRIES, OPT_TRY_ALL, OPT_SEED, OPT_DENSITY,
+       OPT_FIELD_CELLS_OLD, OPT_MAX_ITERS, OPT_NO_QUALITY, OPT_EMBED, OPT_TETS, OPT_DRY_RUN,
+       OPT_BOUNDARY, OPT_BEST_EFFORT, OPT_OFFSET_FILL, OPT_FLOAT32, OPT_PARTS, OPT_SIZE,
+       OPT_JSON };
 
 /* -v: a line as each stage, sculpt, fit iteration and candidate ends, so a
  * long run is never silent (pipeline.h, st_pipeline_event). */
@@ -161,6 +167,39 @@ static double box_diagonal(const st_soup *s)
         }
     return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+/* What the pseudo volume guessed where the input has no surface, for the
+ * note: caps over holes and the far side of one-sided parts need open
+ * edges; an input without any (its holes 0) had nothing capped, and the
+ * guess is where the vote's solid leaves the surface, which its
+ * duplicated, non-manifold or mis-oriented parts do not tell (say which
+ * of those it has). */
+static void guess_words(char *buf, size_t n, const st_soup *soup)
+{
+    st_soupinfo si;
+    st_error e;
+    if (st_soupinfo_compute(&si, soup, &e)) {
+        snprintf(buf, n, "hole caps, a one-sided view's far side");
+        return;
+    }
+    if (si.boundary_edges) {
+        snprintf(buf, n, "caps over the input's %zu hole%s, or the far side of a "
+                 "part seen from one side", si.holes, si.holes == 1 ? "" : "s");
+        return;
+    }
+    int k = snprintf(buf, n, "the input has no holes, so nothing was capped: where the "
+                     "vote's solid leaves the surface");
+    const char *sep = ", which has ";
+    struct { size_t v; const char *what; } c[] = {
+        {si.duplicated_triangles, "duplicated triangles"},
+        {si.nonmanifold_edges, "non-manifold edges"},
+        {si.inconsistent_edges, "mis-oriented edges"}};
+    for (size_t i = 0; i < 3 && k > 0 && (size_t)k < n; i++)
+        if (c[i].v) {
+            k += snprintf(buf + k, n - (size_t)k, "%s%zu %s", sep, c[i].v, c[i].what);
+            sep = ", ";
+        }
 }
 
 static void report(const tool_ctx *t, const st_pipeline_stats *st, size_t tries, int density)
@@ -228,15 +267,28 @@ static int lattice_over_limit(const st_soup *soup, const st_pipeline_params *p,
     return 1;
 }
 
+/* How much longer a candidate's fit and quality pass take than its
+ * sculpt (the sculpted lattice's tets, the fit's iterations over them):
+ * measured with soupmesh -v at the defaults on this project's 2-core
+ * machine, fit+quality over sculpt: bunny 1.30/0.32 s (4.1), fandisk
+ * 1.09/0.22 (5.0), elephant 3.11/0.21 (14.8); 7 put the whole runs of
+ * those three at 1, 4 and 16 cells, 1 and 4 tries, at 0.43-1.01 of the
+ * estimate (geometric mean 0.7), 5 centres them. The estimate rests on
+ * the dry run's own measured sculpt, so a slower or faster (or busier)
+ * machine scales it. */
+#define DRY_RUN_FIT_PER_SCULPT 5.0
+
 /* soupmesh --dry-run: what a run would lay, on stdout, one "key value"
  * a line. Memory: the field (floats and a sign byte per voxel, twice for
  * the sweeps) and the lattices laid at once (the bound of
- * lattice_over_limit). The time class counts tets times candidates: on
- * this project's 2-core machine a bunny of ~1 000 to ~4 000 tets takes 2-5
- * s in all; the 20 000 and 200 000 boundaries are a rough extrapolation
- * (the fit is about linear in tets), not a measurement. */
+ * lattice_over_limit). Time: what the dry run measured (the field, the
+ * signs and its sculpt of the first candidate's lattice, or the sizing
+ * sculpts of --tets, which a run repeats), plus each wave of candidates
+ * (tries over the threads that run them, one thread each) taking a
+ * sculpt and DRY_RUN_FIT_PER_SCULPT sculpts' worth of fit: a measured
+ * rate, not a class of tet counts (which was 10x off). */
 static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_params *p,
-                          const st_pipeline_stats *st)
+                          const st_pipeline_stats *st, int json)
 {
     double lo[3], hi[3];
     st_error e;
@@ -244,12 +296,29 @@ static int dry_run_report(tool_ctx *t, const st_soup *soup, const st_pipeline_pa
     double lattice = st_pipeline_lattice_bytes(soup, st->h, p->tries, NULL, NULL);
     double field = (double)st->field_dims[0] * (double)st->field_dims[1] *
                    (double)st->field_dims[2] * 2.0 * (sizeof(float) + 1);
-    double work = (double)st->estimated_tets * (double)p->tries;
-    const char *cls = work < 20000 ? "seconds" : work < 200000 ? "minutes"
-                                                               : "tens of minutes or more";
-    printf("h %.17g\ncells %.0f\nestimated_tets %zu\nmemory_mib %.1f\ntime %s\n",
-           st->h, ceil(st_lattice_h_for_cells(lo, hi, 1) / st->h), st->estimated_tets,
-           (lattice + field) / 1048576.0, cls);
+    size_t threads = 1;
+#ifdef _OPENMP
+    threads = (size_t)omp_get_max_threads();
+#endif
+    size_t at_once = p->tries < threads ? p->tries : threads;
+    double waves = ceil((double)p->tries / (double)(at_once ? at_once : 1));
+    double sculpt = st->sculpts ? st->seconds_size / (double)st->sculpts : 0.0;
+    double before = st->seconds_total - (p->target_tets ? 0.0 : st->seconds_size);
+    double seconds = before + waves * sculpt * (1.0 + DRY_RUN_FIT_PER_SCULPT);
+    const char *cls = seconds < 60 ? "seconds" : seconds < 3600 ? "minutes" : "hours";
+    double cells = ceil(st_lattice_h_for_cells(lo, hi, 1) / st->h);
+    double mib = (lattice + field) / 1048576.0;
+    if (json) {
+        char n[2][32];
+        printf("{\"h\": %s, \"cells\": %.0f, \"estimated_tets\": %zu, \"memory_mib\": %.1f, "
+               "\"seconds\": %.1f, \"threads\": %zu, \"time\": \"%s\"}\n",
+               tool_json_number(n[0], st->h), cells, st->estimated_tets, mib, seconds, threads,
+               cls);
+    } else {
+        printf("h %.17g\ncells %.0f\nestimated_tets %zu\nmemory_mib %.1f\nseconds %.1f\n"
+               "threads %zu\ntime %s\n", st->h, cells, st->estimated_tets, mib, seconds,
+               threads, cls);
+    }
     return tool_flush_stdout(t) ? TOOL_EXIT_FAIL : TOOL_EXIT_OK;
 }
 
@@ -307,7 +376,7 @@ typedef struct soupmesh_settings {
     tool_common co;
     st_pipeline_params pipeline;
     const char *in, *embed, *boundary;
-    int have_cells, best_effort;
+    int have_cells, best_effort, json;
     int float32_by_stl;        /* --boundary .stl turned --float32 on */
     int embed_text;            /* --embed FILE.txt, else .vtu */
     st_soup_format boundary_format;
@@ -316,9 +385,10 @@ typedef struct soupmesh_settings {
 
 static const struct option longopts[] = {
     {"cells", required_argument, NULL, OPT_CELLS},
-    {"size", required_argument, NULL, 'h'},
+    {"size", required_argument, NULL, OPT_SIZE},
     {"tets", required_argument, NULL, OPT_TETS},
     {"dry-run", no_argument, NULL, OPT_DRY_RUN},
+    {"json", no_argument, NULL, OPT_JSON},
     {"offset", required_argument, NULL, OPT_OFFSET},
     {"offset-best-effort", no_argument, NULL, OPT_BEST_EFFORT},
     {"offset-fill", required_argument, NULL, OPT_OFFSET_FILL},
@@ -326,7 +396,8 @@ static const struct option longopts[] = {
     {"try-all", no_argument, NULL, OPT_TRY_ALL},
     {"seed", required_argument, NULL, OPT_SEED},
     {"density", required_argument, NULL, OPT_DENSITY},
-    {"field-cells", required_argument, NULL, OPT_FIELD_CELLS},
+    {"voxels", required_argument, NULL, 'r'},
+    {"field-cells", required_argument, NULL, OPT_FIELD_CELLS_OLD},
     {"max-iters", required_argument, NULL, OPT_MAX_ITERS},
     {"no-quality", no_argument, NULL, OPT_NO_QUALITY},
     TOOL_LONG_OPTIONS_PSEUDO,
@@ -348,7 +419,7 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
             return TOOL_EXIT_USAGE;
         s->have_cells = 1;
         break;
-    case 'h':
+    case OPT_SIZE:
         if (tool_parse_double(t, "--size", arg, 1e-300, 1e300, &s->pipeline.h))
             return TOOL_EXIT_USAGE;
         break;
@@ -358,6 +429,9 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         break;
     case OPT_DRY_RUN:
         s->pipeline.dry_run = 1;
+        break;
+    case OPT_JSON:
+        s->json = 1;
         break;
     case OPT_OFFSET:
         if (tool_parse_double(t, "--offset", arg, 1e-3, 10.0, &s->pipeline.offset_ratio))
@@ -382,8 +456,12 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         if (tool_parse_double(t, "--density", arg, 1e-6, 1.0, &s->pipeline.density_rho))
             return TOOL_EXIT_USAGE;
         break;
-    case OPT_FIELD_CELLS:
-        if (tool_parse_size(t, "--field-cells", arg, 8, 4096, &s->pipeline.field_cells))
+    case OPT_FIELD_CELLS_OLD:
+        tool_deprecated(t, "--field-cells", "--voxels (-r)");
+        /* fall through */
+    case 'r':
+        if (tool_parse_size(t, c == 'r' ? "--voxels" : "--field-cells", arg, 8, 4096,
+                            &s->pipeline.field_cells))
             return TOOL_EXIT_USAGE;
         break;
     case OPT_MAX_ITERS:
@@ -429,11 +507,22 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
         return tool_usage_error(t, "--tets and --dry-run size the sculpted mesh, "
                                    "not --density's");
     TOOL_TRY(tool_one_input(t, argc, argv, "input surface", NULL, &s->in));
-    if (!s->in)
+    /* No INPUT reads stdin, as in every tool; on a terminal, where a user
+     * has forgotten it, say how to give one. */
+    if (!s->in && isatty(STDIN_FILENO))
         return tool_usage_error(t, "no input surface (soupmesh -o out.vtu model.obj)");
+    if (!s->in)
+        s->in = "-";
     TOOL_TRY(tool_refuse_terminal(t, s->in, STDIN_FILENO,
                                   "will not read a surface from a terminal: give a file"));
+    if (s->co.out && st_soup_format_from_path(s->co.out) != ST_SOUP_GLTF) {
+        char hint[600];
+        snprintf(hint, sizeof hint, "use --boundary %.500s for the cage's surface", s->co.out);
+        TOOL_TRY(tool_surface_as_tetmesh(t, s->co.out, hint));
+    }
     TOOL_TRY(tool_tetmesh_output(t, s->co.out, p->dry_run ? NULL : TOOL_TTY_VTU));
+    if (s->json && !p->dry_run && st_path_is_stdio(s->co.out))
+        return tool_usage_error(t, "--json prints on stdout: give the mesh -o FILE");
     const char *embed = s->embed, *boundary = s->boundary;
     size_t elen = embed ? strlen(embed) : 0;
     s->embed_text = elen > 4 && strcmp(embed + elen - 4, ".txt") == 0;
@@ -457,6 +546,50 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
         return TOOL_EXIT_FAIL;
     s->pipeline.max_bytes = s->co.max_bytes;
     return TOOL_CONTINUE;
+}
+
+/* soupmesh --json: the run's summary on stdout, one JSON object (the keys
+ * as soupmesh.1 lists them; numbers in model units unless named _h, in
+ * cell widths h). */
+static void print_json(const soupmesh_settings *s, const st_pipeline_stats *st,
+                       int rc, double seconds)
+{
+    const st_pipeline_params *p = &s->pipeline;
+    const st_pipeline_candidate *b = &st->candidates[st->best];
+    char n[12][32];
+    printf("{\"tool\": \"soupmesh\", \"version\": ");
+    tool_json_string(stdout, tool_version());
+    printf(", \"commit\": ");
+    tool_json_string(stdout, tool_commit());
+    printf(",\n  \"input\": ");
+    tool_json_string(stdout, tool_in_name(s->in));
+    printf(", \"output\": ");
+    tool_json_string(stdout, tool_out_name(s->co.out));
+    printf(",\n  \"h\": %s, \"voxels\": [%zu, %zu, %zu], \"voxel\": %s, \"offset\": %s, "
+           "\"candidates\": %zu, \"best\": %zu, \"seed\": %" PRIu64 ",\n",
+           tool_json_number(n[0], st->h), st->field_dims[0], st->field_dims[1],
+           st->field_dims[2], tool_json_number(n[1], st->voxel),
+           tool_json_number(n[2], p->offset_ratio), st->ncandidates, st->best, b->seed);
+    printf("  \"tets\": %zu, \"points\": %zu, \"min_dihedral\": %s, \"max_dihedral\": %s,\n"
+           "  \"encloses\": %s, \"vertices_outside\": %zu, \"triangles_crossing\": %zu,\n",
+           b->tets, b->points, tool_json_number(n[3], b->min_dihedral),
+           tool_json_number(n[4], b->max_dihedral), st->encloses ? "true" : "false",
+           b->verts_outside, b->tris_crossing);
+    if (p->density_rho > 0)
+        printf("  \"offset_met\": null, \"beyond_offset\": null, \"boundary_vertices\": null, "
+               "\"max_distance_h\": null, \"measured_against\": null,\n");
+    else
+        printf("  \"offset_met\": %s, \"beyond_offset\": %zu, \"boundary_vertices\": %zu, "
+               "\"max_distance_h\": %s, \"measured_against\": \"%s\",\n",
+               b->converged ? "true" : "false", b->beyond_offset, b->boundary_vertices,
+               tool_json_number(n[5], b->max_distance / st->h),
+               st->fill_faces ? "input and fill" : "input");
+    double share = st->guess.boundary_faces
+                       ? (double)st->guess.fill_faces / (double)st->guess.boundary_faces : 0.0;
+    printf("  \"guessed_share\": %s, \"guessed_depth_h\": %s,\n"
+           "  \"seconds\": %s, \"exit_status\": %d}\n",
+           tool_json_number(n[6], share), tool_json_number(n[7], st->guess.depth / st->h),
+           tool_json_number(n[8], seconds), rc);
 }
 
 static int run(tool_ctx *t, void *settings)
@@ -509,14 +642,14 @@ static int run(tool_ctx *t, void *settings)
         tool_progress_end(t);
         if (!err.file[0])
             snprintf(err.file, sizeof err.file, "%s", in_name);
-        tool_limit_hint(&err, "use fewer --cells or --field-cells, or raise --max-memory");
+        tool_limit_hint(&err, "use fewer --cells or --voxels, or raise --max-memory");
         report(t, &st, p->tries, p->density_rho > 0);
         rc = tool_fail(t, &err);
         goto done;
     }
     tool_progress_end(t);
     if (p->dry_run) {
-        rc = dry_run_report(t, soup, p, &st);
+        rc = dry_run_report(t, soup, p, &st, s->json);
         goto done;
     }
     if (p->target_tets)
@@ -542,7 +675,7 @@ static int run(tool_ctx *t, void *settings)
                      "input too moves it by up to half a float ulp", f->input_not_float32);
     }
     if (st_meta_set(&m->meta, "source", in_name) ||
-        st_meta_history_append(&m->meta, tool_command(t))) {
+        tool_meta_record(t, &m->meta)) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }
@@ -616,16 +749,18 @@ static int run(tool_ctx *t, void *settings)
     const double diag = box_diagonal(soup);
     if (st.guess.fill_faces) {
         /* The solid where the input has no surface is the pseudo volume's
-         * guess (caps, a one-sided view's far side): said by default when
-         * it reaches past a lattice cell from the input, where the mesh
-         * resolves it (its volume, a simulation's mass, rest on it). */
+         * guess: said by default when it reaches past a lattice cell from
+         * the input, where the mesh resolves it (its volume, a
+         * simulation's mass, rest on it), naming what was guessed. */
         const double depth_h = st.guess.depth / st.h;
+        char what[200];
+        guess_words(what, sizeof what, soup);
         tool_say(t, depth_h > 1.0 ? 1 : 2,
                  "note: %.1f%% of the solid's boundary is not on the input but guessed "
-                 "(hole caps, a one-sided view's far side), up to %.2f h (%.3f of the "
-                 "diagonal) from it; the mesh's volume there rests on that guess",
+                 "(%s), up to %.2f h (%.3f of the diagonal) from it; the mesh's volume "
+                 "there rests on that guess",
                  100.0 * (double)st.guess.fill_faces / (double)st.guess.boundary_faces,
-                 depth_h, st.guess.depth / diag);
+                 what, depth_h, st.guess.depth / diag);
     }
     if ((rc = tool_report_symmetries(t, soup, NULL, st.voxel)))
         goto done;
@@ -670,6 +805,11 @@ static int run(tool_ctx *t, void *settings)
         if (!s->best_effort && rc == TOOL_EXIT_OK)
             rc = TOOL_EXIT_OFFSET_NOT_MET;
     }
+    if (s->json) {
+        print_json(s, &st, rc, tool_now() - t0);
+        if (tool_flush_stdout(t))
+            rc = TOOL_EXIT_FAIL;
+    }
 done:
     st_outfile_abort(&bof);
     st_soup_free(bsoup);
@@ -684,7 +824,7 @@ done:
     return rc;
 }
 
-static const tool_spec spec = {"soupmesh", usage, ":o:h:qv", longopts, option, check, run};
+static const tool_spec spec = {"soupmesh", usage, ":o:r:qv", longopts, option, check, run};
 
 int main(int argc, char *argv[])
 {

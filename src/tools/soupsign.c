@@ -116,8 +116,8 @@ static void usage(void)
 "  -v, --verbose        report the rule, the event distance, each step, the\n"
 "                       fill (boundary with no soup near), the soup's\n"
 "                       symmetries (reported, not used) and timings\n"
-"      --help           show this help and exit\n"
-"      --version        show the version and exit\n"
+"  -h, --help           show this help and exit\n"
+"  -V, --version        show the version and commit and exit\n"
 "\n"
 "Examples:\n"
 "  soupdist bunny.obj | soupsign -o bunny-sdf.vti   (uses bunny.obj, recorded)\n"
@@ -410,7 +410,7 @@ static int run(tool_ctx *t, void *settings)
     const double cpu_sign = cpu_now() - c0;
     tool_progress_end(t);
     double t2 = tool_now();
-    if (st_meta_history_append(&g->meta, tool_command(t))) {
+    if (tool_meta_record(t, &g->meta)) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }

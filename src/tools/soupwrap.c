@@ -54,7 +54,7 @@ static void usage(void)
 "      --fill-holes on|off  with --surface: cap the soup's holes (default on)\n"
 "      --shells on|off  with --surface: the soup's closed pieces bound their\n"
 "                       solid exactly, as soupsign --shells (default on)\n"
-"  -r, --cells N        with --surface: voxels along the longest side\n"
+"  -r, --voxels N       with --surface: voxels along the longest side\n"
 "                       (default %d)\n"
 "  -o, --output OUT     .obj .off .ply (binary) .stl (binary); '-' or none:\n"
 "                       OBJ on stdout\n"
@@ -62,8 +62,8 @@ static void usage(void)
 "      --max-memory SZ  refuse fields larger than SZ (default 80%% of RAM)\n"
 "  -q, --quiet          no messages but errors\n"
 "  -v, --verbose        report sizes, checks and timings\n"
-"      --help           show this help and exit\n"
-"      --version        show the version and exit\n"
+"  -h, --help           show this help and exit\n"
+"  -V, --version        show the version and commit and exit\n"
 "\n"
 "Examples:\n"
 "  soupdist scan.ply | soupsign | soupwrap -o scan-closed.ply\n"
@@ -74,7 +74,8 @@ static void usage(void)
         ST_WRAP_DEFAULT_MIN_VOLUME, ST_DIST_DEFAULT_CELLS);
 }
 
-enum { OPT_ISO = TOOL_OPT_FIRST, OPT_ADAPT, OPT_SMOOTH, OPT_MINVOL, OPT_CAVITIES, OPT_SURFACE };
+enum { OPT_ISO = TOOL_OPT_FIRST, OPT_ADAPT, OPT_SMOOTH, OPT_MINVOL, OPT_CAVITIES, OPT_SURFACE,
+       OPT_CELLS_OLD };
 
 /* The history lines of the field plus this command line. Caller frees. */
 static char *history(const st_grid *g, const char *source, const char *cmd)
@@ -108,7 +109,8 @@ static const struct option longopts[] = {
     {"keep-cavities", no_argument, NULL, OPT_CAVITIES},
     {"surface", required_argument, NULL, OPT_SURFACE},
     TOOL_LONG_OPTIONS_PSEUDO,
-    {"cells", required_argument, NULL, 'r'},
+    {"voxels", required_argument, NULL, 'r'},
+    {"cells", required_argument, NULL, OPT_CELLS_OLD},   /* before 0.2 */
     TOOL_LONG_OPTIONS_OUTPUT,
     TOOL_LONG_OPTIONS_END};
 
@@ -143,6 +145,9 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
     case TOOL_OPT_FILL_HOLES:
     case TOOL_OPT_SHELLS:
         return tool_pseudo_option(t, c, arg, &s->fill_holes, &s->use_shells);
+    case OPT_CELLS_OLD:
+        tool_deprecated(t, "--cells", "--voxels (-r)");
+        /* fall through */
     case 'r':
         if (tool_parse_size(t, "-r", arg, 1, 65536, &s->dist.cells))
             return TOOL_EXIT_USAGE;

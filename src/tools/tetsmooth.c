@@ -71,8 +71,8 @@ TOOL_HELP_TETFORMAT
 "      --max-memory SZ  refuse meshes larger than SZ (default 80%% of RAM)\n"
 "  -q, --quiet          no messages but errors\n"
 "  -v, --verbose        per-iteration statistics\n"
-"      --help           show this help and exit\n"
-"      --version        show the version and exit\n"
+"  -h, --help           show this help and exit\n"
+"  -V, --version        show the version and commit and exit\n"
 "\n"
 "Examples:\n"
 "  latticetet --density 0.5 --cells 16 f.vdb | tetsmooth --fair -o m.vtu\n"
@@ -340,7 +340,7 @@ static int run(tool_ctx *t, void *settings)
                  s->fit.offset_ratio, st.h, s->fit.step, s->fit.quality, st.converged, st.beyond_offset);
     }
     if (st_meta_set(&m->meta, "tetsmooth", param) ||
-        st_meta_history_append(&m->meta, tool_command(t))) {
+        tool_meta_record(t, &m->meta)) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }

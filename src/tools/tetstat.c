@@ -53,8 +53,8 @@ static void usage(void)
 "      --max-memory SZ  refuse meshes and fields larger than SZ (default 80%% of RAM)\n"
 "  -q, --quiet          no messages but errors (no warnings about the mesh)\n"
 "  -v, --verbose        report the time of each stage on stderr\n"
-"      --help           show this help and exit\n"
-"      --version        show the version and exit\n"
+"  -h, --help           show this help and exit\n"
+"  -V, --version        show the version and commit and exit\n"
 "\n"
 "Examples:\n"
 "  tetstat bunny.vtu\n"
@@ -126,6 +126,58 @@ static void parts_table(FILE *f, const st_tetmesh *m, const st_parts_tag_stats *
         if (isfinite(pv) && pv > 0)
             fprintf(f, ", its pseudo volume %.6g (ratio %.4f)", pv, ps->volume[k] / pv);
         fputc('\n', f);
+    }
+}
+
+/* What made the mesh, as its metadata recorded it: the parameters
+ * (version, commit, source, h, seed, offset_ratio, field_voxels, ...: every
+ * key in its order) and the history, one command line each. JSON: a
+ * "recorded" object of strings, "history" an array. */
+static void print_meta_json(FILE *f, const st_meta *meta)
+{
+    fprintf(f, ",\n  \"recorded\": {");
+    const char *sep = "";
+    for (size_t i = 0; i < meta->count; i++) {
+        const st_meta_entry *e = &meta->entries[i];
+        fprintf(f, "%s", sep);
+        tool_json_string(f, e->key);
+        fprintf(f, ": ");
+        sep = ", ";
+        if (strcmp(e->key, "history") != 0) {
+            tool_json_string(f, e->value);
+            continue;
+        }
+        fputc('[', f);
+        for (const char *l = e->value; *l;) {
+            size_t n = strcspn(l, "\n");
+            char *line = strndup(l, n);
+            if (l != e->value)
+                fprintf(f, ", ");
+            tool_json_string(f, line ? line : "");
+            free(line);
+            l += n + (l[n] == '\n');
+        }
+        fputc(']', f);
+    }
+    fputc('}', f);
+}
+
+static void print_meta_table(FILE *f, const st_meta *meta)
+{
+    if (!meta->count)
+        return;
+    fprintf(f, "recorded in the mesh:\n");
+    for (size_t i = 0; i < meta->count; i++) {
+        const st_meta_entry *e = &meta->entries[i];
+        if (strcmp(e->key, "history") == 0)
+            continue;
+        fprintf(f, "  %-28s %s\n", e->key, e->value);
+    }
+    const char *h = st_meta_get(meta, "history");
+    for (const char *l = h; l && *l;) {
+        size_t n = strcspn(l, "\n");
+        fprintf(f, "  %-28s %.*s\n", l == h ? "history" : "", (int)n, l);
+        l += n + (l[n] == '\n');
     }
 }
 
@@ -227,6 +279,7 @@ static void print_json(FILE *f, const char *name, const char *sname,
     }
     if (ps && ps->nparts)
         parts_json(f, m, ps);
+    print_meta_json(f, &m->meta);
     fprintf(f, "}\n");
 }
 
@@ -499,8 +552,10 @@ static int run(tool_ctx *t, void *settings)
         goto failed;
     if (s->json)
         print_json(stdout, name, sname, fname, &r, m, &parts);
-    else
+    else {
         print_table(stdout, name, sname, fname, &r, m, &parts);
+        print_meta_table(stdout, &m->meta);
+    }
     if (tool_flush_stdout(t)) {
         rc = TOOL_EXIT_FAIL;
         goto done;

@@ -45,8 +45,8 @@ SHARED = [  # python function, parameter, tool, option
     (souptet.mesh, "tries", "soupmesh", "--tries"),
     (souptet.mesh, "seed", "soupmesh", "--seed"),
     (souptet.mesh, "offset", "soupmesh", "--offset"),
-    (souptet.pseudo_volume, "resolution", "soupdist", "--cells"),
-    (souptet.distance, "resolution", "soupdist", "--cells"),
+    (souptet.pseudo_volume, "resolution", "soupdist", "--voxels"),
+    (souptet.distance, "resolution", "soupdist", "--voxels"),
     (souptet.distance, "band", "soupdist", "--band"),
 ]
 

@@ -242,13 +242,13 @@ for r in -5 1e9 abc "" 1.5; do
 done
 for s in 0 nan inf -inf abc; do
     expect_fail "soupdist -s '$s'" 2 "^soupdist: -s wants" soupdist -s "$s" -o x.vdb "$BUNNY"
-    expect_fail "latticetet -h '$s'" 2 "^latticetet: -h wants" latticetet --density 0.5 -h "$s" -o x.vtu s.vdb
+    expect_fail "latticetet --size '$s'" 2 "^latticetet: --size wants" latticetet --density 0.5 --size "$s" -o x.vtu s.vdb
 done
 for c in 0 -5 abc 1e9; do
     expect_fail "latticetet --cells '$c'" 2 "^latticetet: --cells wants" latticetet --density 0.5 --cells "$c" -o x.vtu s.vdb
     expect_fail "soupmesh --cells '$c'" 2 "^soupmesh: --cells wants" soupmesh --cells "$c" -o x.vtu "$BUNNY"
 done
-expect_fail "soupmesh --field-cells 0" 2 "^soupmesh: --field-cells wants" soupmesh --field-cells 0 -o x.vtu "$BUNNY"
+expect_fail "soupmesh --voxels 0" 2 "^soupmesh: --voxels wants" soupmesh --voxels 0 -o x.vtu "$BUNNY"
 for m in 0 -1G abc 1X 1e30; do
     expect_fail "--max-memory '$m'" 2 "^soupsign: --max-memory wants" soupsign --max-memory "$m" -o x.vdb d.vdb
 done
@@ -265,5 +265,74 @@ expect_fail "a .vdb claiming a 4 GB metadata string: refused by the walk, naming
     soupsign -o x.vdb "$V"
 expect_fail "the same on stdin" 1 "^soupsign: <stdin>: byte [0-9]+: not a valid OpenVDB file" \
     sh -c "soupsign -o x.vdb < '$V'"
+
+# The walk goes on through a float grid's tree (issue 40, item 7), so
+# what OpenVDB would act on unchecked is refused first: a second buffer
+# (it read on with a "WARNING: multi-buffer trees" on stderr and exit 0),
+# a root tile's active flag of 255 (a bool load UBSan reports in
+# RootNode.h), a compressed block claiming 216 GB (allocated before it is
+# read: ASan's out-of-memory in make fuzz). soupdist's .vdb file (Blosc)
+# and stream (no compression), each with one defect.
+cat >craft.py <<'EOF'
+import struct, sys
+# craft.py IN OUT KIND: a .vdb of soupdist's with one defect OpenVDB would
+# act on before checking (see gridio_vdb.cpp, VdbWalk::float_grid).
+d = bytearray(open(sys.argv[1], 'rb').read())
+p = 0
+def u(fmt):
+    global p
+    v = struct.unpack_from('<' + fmt, d, p); p += struct.calcsize('<' + fmt); return v[0]
+def string():
+    global p
+    n = u('I'); s = bytes(d[p:p + n]); p += n; return s
+def metamap():
+    for _ in range(u('i')):
+        string(); string(); string()
+u('q'); u('I'); u('Q'); offsets = u('B'); p += 36
+metamap()
+assert u('i') == 1
+string(); string(); string()
+end_at = p + 16
+u('q'); u('q'); u('q'); compression = u('I')
+metamap()
+mp = string()
+p += {b'UniformScaleTranslateMap': 144, b'ScaleTranslateMap': 144}[mp]
+buffers_at = p
+u('i'); u('f'); tiles_at = p; u('I'); u('I')
+kind = sys.argv[3]
+if kind == 'buffers':
+    struct.pack_into('<i', d, buffers_at, 2)
+elif kind == 'tile':
+    # one root tile whose active flag is 255, far from the children
+    struct.pack_into('<I', d, tiles_at, 1)
+    d[tiles_at + 8:tiles_at + 8] = struct.pack('<iiifB', 1 << 20, 1 << 20, 1 << 20, 1.0, 255)
+    if offsets:
+        struct.pack_into('<q', d, end_at, struct.unpack_from('<q', d, end_at)[0] + 17)
+elif kind == 'claim':
+    assert compression & 5, 'needs a compressed file'
+    p += 12 + 4096 * 2           # the first child's origin and masks
+    meta = d[p]; p += 1
+    p += {2: 4, 4: 4, 5: 8}.get(meta, 0)
+    if meta in (3, 4, 5):
+        p += 4096
+    struct.pack_into('<q', d, p, 0x35eaa95400)
+open(sys.argv[2], 'wb').write(d)
+EOF
+soupdist -q -r 16 -o walk.vdb "$BUNNY" && soupdist -q -r 16 "$BUNNY" >walk-stream.vdb
+for spec in "walk-stream.vdb buffers the tree has 2 buffers .OpenVDB reads one." \
+            "walk.vdb buffers the tree has 2 buffers .OpenVDB reads one." \
+            "walk-stream.vdb tile a root tile's active flag is 255, not 0 or 1" \
+            "walk.vdb tile a root tile's active flag is 255, not 0 or 1" \
+            "walk.vdb claim a compressed block claims 231570232320 bytes but [0-9]+ remain"; do
+    set -- $spec
+    src=$1 kind=$2
+    shift 2
+    "$PYVTK" craft.py "$src" "bad-$kind-$src" "$kind"
+    expect_fail "$src with $kind: '$*', nothing on stderr from OpenVDB" 1 \
+        "^soupsign: bad-$kind-$src: byte [0-9]+: not a valid OpenVDB file \(truncated or corrupt\): $*\$" \
+        soupsign -o x.vdb "bad-$kind-$src"
+    [ "$(wc -l <"$WORK/.err")" -eq 1 ]
+    ok $? "... one line on stderr"
+done
 
 done_testing

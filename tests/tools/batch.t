@@ -27,7 +27,7 @@ f 3 4 8 7
 f 4 1 5 8
 OBJ
 printf 'OFF\n4 4 0\n0 0 0\n2 0 0\n0 2 0\n0 0 2\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n' >in/tet.off
-OPTS="--cells 3 --field-cells 16"
+OPTS="--cells 3 --voxels 16"
 
 # batch_run NAME ARGS...: run the batch; its stderr and the table in .out.
 batch_run() {
@@ -50,7 +50,7 @@ grep -q '0 to mesh, 2 already done' msg
 ok $? "another --threads (never changes a mesh): still cached"
 
 cp out/cube.vtu cube-before.vtu
-batch_run --cells 4 --field-cells 16
+batch_run --cells 4 --voxels 16
 grep -q '2 models, 2 to mesh, 0 already done' msg && [ "$(grep -c ' ok$' table)" -eq 2 ]
 ok $? "other options: both meshed again (the old code said cached)"
 ! cmp -s cube-before.vtu out/cube.vtu
@@ -79,7 +79,7 @@ sleep 1
 "$B" --one "$SOUPTET_BIN" "$f" "$WORK/out" vtu $OPTS 2>one.err
 [ $? -eq 0 ] && [ "$(stat -c %Y out/cube.vtu)" = "$before" ]
 ok $? "batch --one skips a model done with the same options"
-"$B" --one "$SOUPTET_BIN" "$f" "$WORK/out" vtu --cells 4 --field-cells 16 2>one.err
+"$B" --one "$SOUPTET_BIN" "$f" "$WORK/out" vtu --cells 4 --voxels 16 2>one.err
 [ $? -eq 0 ] && [ "$(stat -c %Y out/cube.vtu)" != "$before" ] && grep -q '^option 4$' out/cube.key
 ok $? "batch --one redoes it with other options"
 

@@ -9,7 +9,7 @@
 . "$(dirname "$0")/lib.sh"
 cd "$WORK" || exit 1
 BUNNY="$ROOT/corpus/bunny.obj"
-SM="--cells 6 --field-cells 64"
+SM="--cells 6 --voxels 64"
 
 check "soupmesh --boundary b.obj" soupmesh -q $SM --boundary b.obj -o m.vtu "$BUNNY"
 for f in ply stl off; do

@@ -108,12 +108,12 @@ same "tetstat --json --surface --field" "r.json" \
 same "soupinfo --json (with the self-intersection test)" "r.json" \
     "soupinfo --json '$BUNNY' ../soup.obj > r.json"
 same "soupmesh, 3 candidates -> .node/.ele with --embed" "m.node m.ele e.txt" \
-    "soupmesh -q --offset-best-effort --cells 4 --field-cells 32 --tries 3 --embed e.txt -o m.node '$BUNNY'"
+    "soupmesh -q --offset-best-effort --cells 4 --voxels 32 --tries 3 --embed e.txt -o m.node '$BUNNY'"
 
 # --tries 1: one candidate gets every thread (with more, each candidate
 # runs on one), at 12 cells its fit and quality loops run in parallel.
 same "soupmesh, 1 candidate at 12 cells -> .vtu" "m.vtu" \
-    "soupmesh -q --offset-best-effort --cells 12 --field-cells 32 --tries 1 -o m.vtu '$BUNNY'"
+    "soupmesh -q --offset-best-effort --cells 12 --voxels 32 --tries 1 -o m.vtu '$BUNNY'"
 
 # tetstat's report holds no command line: there --threads itself can vary.
 for n in 1 2 3; do

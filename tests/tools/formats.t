@@ -25,7 +25,7 @@ grep -q '^64 135$' "$WORK/.out"
 ok $? "the sample has 64 points and 135 tets"
 
 # A real mesh from the tools, when they are built (small: a few seconds).
-SM="--cells 4 --field-cells 32 --offset-best-effort"
+SM="--cells 4 --voxels 32 --offset-best-effort"
 have_soupmesh=0
 if [ -x "$SOUPTET_BIN/soupmesh" ]; then
     check "soupmesh makes b4.vtu from the bunny" \

@@ -41,7 +41,7 @@ check "sculpted mesh: tets, positive volumes, metadata" $PYVTK mesh.py y.vtu 150
 
 soupdist -r 48 -o d.vdb "$BUNNY" 2>/dev/null
 soupsign -o s.vdb d.vdb
-check "a field file in, bcc density, -h" latticetet --density 0.3 --lattice bcc -h 0.9 -o b.vtu s.vdb
+check "a field file in, bcc density, --size" latticetet --density 0.3 --lattice bcc --size 0.9 -o b.vtu s.vdb
 check "a Gmsh .msh by extension" sh -c "latticetet --density 0.5 --cells 8 -o m.msh s.vdb && grep -q MeshFormat m.msh"
 check "stdout is a .vtu document" sh -c "latticetet --density 0.5 --cells 8 s.vdb | head -c 200 | grep -q VTKFile"
 mkdir t1 t2
@@ -65,7 +65,7 @@ expect_fail "both --density and --sculpt" 2 "exclude" latticetet --density 0.5 -
 expect_fail "--sculpt without --surface" 2 "needs --surface" latticetet --sculpt s.vdb
 expect_fail "--density out of range" 2 "density" latticetet --density 1.5 s.vdb
 expect_fail "unknown lattice" 2 "cubic5 or bcc" latticetet --density 0.5 --lattice hex s.vdb
-expect_fail "--cells and -h together" 2 "exclude" latticetet --density 0.5 --cells 4 -h 1 s.vdb
+expect_fail "--cells and --size together" 2 "exclude" latticetet --density 0.5 --cells 4 --size 1 s.vdb
 expect_fail "a bad --seed" 2 "seed" latticetet --density 0.5 --seed -3 s.vdb
 expect_fail "an output format it cannot write" 2 "format" latticetet --density 0.5 -o m.xyz s.vdb
 

@@ -43,7 +43,7 @@ expect_fail "a .gltf with an external buffer on stdin says why it cannot be read
 
 # Every tool reads surfaces through one reader: the whole pipeline on a
 # node hierarchy, and tetstat's enclosure check against the same glTF.
-check "soupmesh meshes nodes.gltf" soupmesh -q --offset-best-effort --cells 3 --field-cells 24 -o n.vtu nodes.gltf
+check "soupmesh meshes nodes.gltf" soupmesh -q --offset-best-effort --cells 3 --voxels 24 -o n.vtu nodes.gltf
 tetstat -q --json --surface nodes.gltf n.vtu >ts.json 2>ts.err
 grep -q '"encloses": true' ts.json
 ok $? "tetstat --surface nodes.gltf: the mesh encloses all 12 triangles"

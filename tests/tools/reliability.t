@@ -112,7 +112,7 @@ piped() {
 for cmd in "soupdist -r 128 $BUNNY" "soupsign d64.vdb" "soupwrap s.vdb" \
            "latticetet --density 0.5 --cells 30 s64.vdb" \
            "tetsmooth --fair --iters 1 --no-quality l30.vtu" \
-           "soupmesh -q --offset-best-effort --cells 10 --field-cells 32 --max-iters 5 --no-quality $BUNNY"; do
+           "soupmesh -q --offset-best-effort --cells 10 --voxels 32 --max-iters 5 --no-quality $BUNNY"; do
     tool=${cmd%% *}
     # shellcheck disable=SC2086
     piped $cmd
@@ -126,7 +126,7 @@ ok $? "closed pipes: no temporary files"
 for cmd in "soupdist -r 32 $BUNNY" "soupsign d.vdb" "soupwrap s.vdb" \
            "latticetet --density 0.5 --cells 8 s.vdb" "tetsmooth --fair l.vtu" \
            "tetstat l.vtu" "tetstat --json l.vtu" "soupinfo $BUNNY" \
-           "soupmesh -q --offset-best-effort --cells 4 --field-cells 32 $BUNNY"; do
+           "soupmesh -q --offset-best-effort --cells 4 --voxels 32 $BUNNY"; do
     tool=${cmd%% *}
     expect_fail "$cmd > /dev/full: exit 1, '<stdout>: write failed'" 1 \
         "^$tool: <stdout>: write (failed|error)" sh -c "$cmd > /dev/full"
@@ -164,7 +164,7 @@ if mount -t tmpfs -o size=64k tmpfs full 2>/dev/null; then
              "soupwrap -o full/x.obj s.vdb" "soupwrap -o full/x.stl s.vdb" \
              "latticetet --density 0.5 --cells 30 -o full/x.vtu s64.vdb" \
              "latticetet --density 0.5 --cells 30 -o full/x.msh s64.vdb" \
-             "soupmesh -q --offset-best-effort --cells 8 --field-cells 32 --max-iters 5 --no-quality -o full/x.node $BUNNY"; do
+             "soupmesh -q --offset-best-effort --cells 8 --voxels 32 --max-iters 5 --no-quality -o full/x.node $BUNNY"; do
         tool=${c%% -*}
         out=$(echo "$c" | sed 's/.*-o \(full\/[^ ]*\).*/\1/')
         # (a TetGen pair may fail on either file)
@@ -174,7 +174,7 @@ if mount -t tmpfs -o size=64k tmpfs full 2>/dev/null; then
         rm -rf full/* full/.[!.]* 2>/dev/null
     done
     expect_fail "full disk: soupmesh --embed full/e.txt: exit 1 naming it" 1 "^soupmesh: full/e.txt: " \
-        soupmesh -q --cells 4 --field-cells 32 --embed full/e.txt -o m4.vtu "$BUNNY"
+        soupmesh -q --cells 4 --voxels 32 --embed full/e.txt -o m4.vtu "$BUNNY"
     [ -z "$(ls -A full)" ]
     ok $? "full disk: soupmesh --embed full/e.txt: nothing left on the disk"
     umount full
@@ -230,7 +230,7 @@ expect_fail "latticetet --cells 100000 (the most it takes): refused, names --cel
     "^latticetet: s.vdb: .*--cells" latticetet --density 0.5 --cells 100000 -o x.vtu s.vdb
 expect_fail "soupmesh: a lattice over --max-memory: refused, names --cells" 1 \
     "^soupmesh: .*bunny.obj: --cells 100 lays lattices .*--cells.*--max-memory" \
-    soupmesh --cells 100 --field-cells 64 --max-memory 200M -o x.vtu "$BUNNY"
+    soupmesh --cells 100 --voxels 64 --max-memory 200M -o x.vtu "$BUNNY"
 expect_fail "soupmesh --cells 4096 (the most it takes): refused, names --max-memory" 1 \
     "^soupmesh: .*bunny.obj: .*--max-memory" soupmesh --cells 4096 -o x.vtu "$BUNNY"
 expect_fail "soupdist -r 65536 (the most it takes): refused, names -r" 1 \
@@ -239,8 +239,8 @@ expect_fail "soupdist -s 1e-9: the size overflows, checked, names -s" 1 \
     "^soupdist: .*bunny.obj: .*overflows.*-s" soupdist -s 1e-9 -o x.vdb "$BUNNY"
 expect_fail "soupwrap --surface -r 65536: refused, names -r" 1 \
     "^soupwrap: .*bunny.obj: .*grid needs .*-r" soupwrap --surface "$BUNNY" -r 65536 -o x.obj
-expect_fail "latticetet -h 1e-9: refused, names -h" 1 \
-    "^latticetet: s.vdb: .*too many cells.*-h" latticetet --density 0.5 -h 1e-9 -o x.vtu s.vdb
+expect_fail "latticetet --size 1e-9: refused, names --size" 1 \
+    "^latticetet: s.vdb: .*too many cells.*--size" latticetet --density 0.5 --size 1e-9 -o x.vtu s.vdb
 check "no output after the refusals" sh -c "test ! -e x.vdb && test ! -e x.vtu && test ! -e x.obj"
 
 # Before the allocation: with the address space capped (ulimit -v) well
@@ -278,9 +278,9 @@ if (ulimit -v $VLIM && soupdist -q -r 16 -o v.vdb "$BUNNY") 2>/dev/null; then
     expect_fail "capped: latticetet --cells 200 --max-memory 1T: the allocation fails" 1 \
         "out of memory" capped latticetet --density 0.5 --cells 200 --max-memory 1T -o x.vtu s.vdb
     expect_fail "capped: soupmesh --cells 250 (default limit): refused before the lattice" 1 \
-        "^soupmesh: .*--cells 250 lays lattices" capped soupmesh --cells 250 --field-cells 64 -o x.vtu "$BUNNY"
+        "^soupmesh: .*--cells 250 lays lattices" capped soupmesh --cells 250 --voxels 64 -o x.vtu "$BUNNY"
     expect_fail "capped: soupmesh --cells 250 --max-memory 1T: the allocation fails" 1 \
-        "out of memory" capped soupmesh --cells 250 --field-cells 64 --max-memory 1T -o x.vtu "$BUNNY"
+        "out of memory" capped soupmesh --cells 250 --voxels 64 --max-memory 1T -o x.vtu "$BUNNY"
     # Headers that promise more than the file holds are refused before
     # anything of their size is allocated, whatever the limit.
     cat > huge.vti <<'EOF'

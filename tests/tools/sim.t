@@ -24,7 +24,7 @@ fi
 # is written with --volume-only (the tets alone), which SfePy's own
 # Mesh.from_file needs; so are two .msh of it, and the default .msh (its
 # boundary group kept for gmsh and meshio).
-SM="-q --offset-best-effort --cells 4 --field-cells 32"
+SM="-q --offset-best-effort --cells 4 --voxels 32"
 check "soupmesh meshes the bunny with --embed into a --volume-only Medit cage" \
     soupmesh $SM --volume-only --embed e.txt -o c.mesh "$ROOT/corpus/bunny.obj"
 check "the same cage as --volume-only .msh 4.1 and 2.2 binary, and the default .msh" \

@@ -51,13 +51,13 @@ check "the Spillmann mesher (--density)" soupmesh -q --density 0.5 --cells 8 -o 
 # with -q, and the exit status is 4; --offset-best-effort makes it 0 and a
 # warning.
 check "--offset 0.05: exit 4, written, said under -q" \
-    sh -c "soupmesh -q --cells 4 --field-cells 32 --offset 0.05 -o o5.vtu '$BUNNY' 2> o5.err; test \$? -eq 4 && test -s o5.vtu && grep -Eq '^soupmesh: .*bunny.obj: error: [0-9]+ of [0-9]+ boundary vertices stay farther than 0.05 h from the input, the farthest [0-9.]+ h' o5.err"
+    sh -c "soupmesh -q --cells 4 --voxels 32 --offset 0.05 -o o5.vtu '$BUNNY' 2> o5.err; test \$? -eq 4 && test -s o5.vtu && grep -Eq '^soupmesh: .*bunny.obj: error: [0-9]+ of [0-9]+ boundary vertices stay farther than 0.05 h from the input, the farthest [0-9.]+ h' o5.err"
 check "--offset 0.05 --offset-best-effort: exit 0, a warning" \
-    sh -c "soupmesh --offset-best-effort --cells 4 --field-cells 32 --offset 0.05 -o o5b.vtu '$BUNNY' 2> o5b.err && grep -q 'warning: [0-9]* of [0-9]* boundary vertices stay farther than 0.05 h' o5b.err"
+    sh -c "soupmesh --offset-best-effort --cells 4 --voxels 32 --offset 0.05 -o o5b.vtu '$BUNNY' 2> o5b.err && grep -q 'warning: [0-9]* of [0-9]* boundary vertices stay farther than 0.05 h' o5b.err"
 check "--offset-best-effort -q: silent" \
-    sh -c "soupmesh -q --offset-best-effort --cells 4 --field-cells 32 --offset 0.05 -o o5c.vtu '$BUNNY' 2> o5c.err && ! test -s o5c.err"
+    sh -c "soupmesh -q --offset-best-effort --cells 4 --voxels 32 --offset 0.05 -o o5c.vtu '$BUNNY' 2> o5c.err && ! test -s o5c.err"
 check "-v: both distances in h and per diagonal" \
-    sh -c "soupmesh -v --offset-best-effort --cells 4 --field-cells 32 -o o5d.vtu '$BUNNY' 2>&1 | grep -Eq 'boundary -> input max [0-9.]+ h \\([0-9.]+ diag\\), input -> boundary max [0-9.]+ h \\([0-9.]+ diag\\)'"
+    sh -c "soupmesh -v --offset-best-effort --cells 4 --voxels 32 -o o5d.vtu '$BUNNY' 2>&1 | grep -Eq 'boundary -> input max [0-9.]+ h \\([0-9.]+ diag\\), input -> boundary max [0-9.]+ h \\([0-9.]+ diag\\)'"
 check "tetstat agrees with soupmesh's exit 4" \
     sh -c "tetstat --json --surface '$BUNNY' o5.vtu | python3 -c 'import json,sys; d=json.load(sys.stdin)[\"surface\"]; assert d[\"offset_ratio\"] == 0.05 and d[\"beyond_offset\"] > 0 and not d[\"offset_met\"], d'"
 
@@ -179,37 +179,37 @@ for f in sys.argv[1:]:
     assert p.size and np.all(p.astype(np.float32).astype(np.float64) == p), f
 PY
 check "--float32: every coordinate written is a float32 value, it encloses the bunny (tetstat), meta float32" \
-    sh -c "soupmesh --offset-best-effort --cells 6 --field-cells 48 --float32 -o f32.vtu '$BUNNY' 2> f32.err &&
+    sh -c "soupmesh --offset-best-effort --cells 6 --voxels 48 --float32 -o f32.vtu '$BUNNY' 2> f32.err &&
            tetstat --json --surface '$BUNNY' f32.vtu > f32.json && /usr/bin/python3 encl.py f32.json 20 &&
            /usr/bin/python3 isf32.py f32.vtu && grep -q 'Name=\"float32\"' f32.vtu &&
            grep -q 'note: 1839 input vertices are not float32 values' f32.err"
 check "--float32 into .msh and .mesh: floats as written, tetstat says it encloses" \
-    sh -c "soupmesh -q --offset-best-effort --cells 6 --field-cells 48 --float32 -o f32.msh '$BUNNY' &&
-           soupmesh -q --offset-best-effort --cells 6 --field-cells 48 --float32 --volume-only -o f32.mesh '$BUNNY' &&
+    sh -c "soupmesh -q --offset-best-effort --cells 6 --voxels 48 --float32 -o f32.msh '$BUNNY' &&
+           soupmesh -q --offset-best-effort --cells 6 --voxels 48 --float32 --volume-only -o f32.mesh '$BUNNY' &&
            /usr/bin/python3 isf32.py f32.msh f32.mesh &&
            tetstat --surface '$BUNNY' f32.msh | grep -Eq 'encloses S +yes' &&
            tetstat --surface '$BUNNY' f32.mesh | grep -Eq 'encloses S +yes'"
 check "--float32 -v reports the rounding: points moved, exact checks, encloses" \
-    sh -c "soupmesh -v --offset-best-effort --cells 5 --field-cells 40 --float32 -o f32v.vtu '$BUNNY' 2>&1 |
+    sh -c "soupmesh -v --offset-best-effort --cells 5 --voxels 40 --float32 -o f32v.vtu '$BUNNY' 2>&1 |
            grep -Eq 'float32: [0-9]+ of [0-9]+ points moved .* [0-9]+ exact checks?, [0-9.]+ s: encloses the input'"
 check "--boundary .stl turns --float32 on: the mesh's points are floats, the STL's are the mesh's" \
-    sh -c "soupmesh -q --offset-best-effort --cells 6 --field-cells 48 --boundary fb.stl -o fb.vtu '$BUNNY' &&
+    sh -c "soupmesh -q --offset-best-effort --cells 6 --voxels 48 --boundary fb.stl -o fb.vtu '$BUNNY' &&
            grep -q 'Name=\"float32\"' fb.vtu && /usr/bin/python3 isf32.py fb.vtu &&
            /usr/bin/python3 -c 'import sys, meshio; m = set(map(tuple, meshio.read(\"fb.vtu\").points.tolist())); s = meshio.read(\"fb.stl\").points.astype(float); assert all(tuple(q) in m for q in s.tolist())'"
 check "an input in floats (an STL) gets no note; its --float32 mesh encloses it" \
-    sh -c "soupmesh --offset-best-effort --cells 5 --field-cells 40 --float32 -o fs.vtu fb.stl 2> fs.err &&
+    sh -c "soupmesh --offset-best-effort --cells 5 --voxels 40 --float32 -o fs.vtu fb.stl 2> fs.err &&
            ! grep -q 'not float32' fs.err && tetstat --surface fb.stl fs.vtu | grep -Eq 'encloses S +yes'"
 check "without --float32 nor an STL: no meta float32" sh -c "! grep -q 'Name=\"float32\"' b.vtu"
 # --volume-only: the tets alone in .msh and .mesh; accepted (no change)
 # for .vtu and TetGen.
 check "--volume-only: .msh without triangles nor the boundary group, .mesh without Triangles; .vtu unchanged" \
-    sh -c "soupmesh -q --offset-best-effort --cells 4 --field-cells 32 --volume-only -o vo.msh '$BUNNY' &&
+    sh -c "soupmesh -q --offset-best-effort --cells 4 --voxels 32 --volume-only -o vo.msh '$BUNNY' &&
            ! grep -q boundary vo.msh && grep -q '\"volume\"' vo.msh &&
-           soupmesh -q --offset-best-effort --cells 4 --field-cells 32 --volume-only -o vo.mesh '$BUNNY' &&
+           soupmesh -q --offset-best-effort --cells 4 --voxels 32 --volume-only -o vo.mesh '$BUNNY' &&
            ! grep -q '^Triangles' vo.mesh && grep -q '^Tetrahedra' vo.mesh &&
            tetstat vo.msh | grep -Eq 'tets +[0-9]+' &&
-           soupmesh -q --offset-best-effort --cells 4 --field-cells 32 --volume-only -o vo.vtu '$BUNNY' &&
-           soupmesh -q --offset-best-effort --cells 4 --field-cells 32 -o vd.vtu '$BUNNY' &&
+           soupmesh -q --offset-best-effort --cells 4 --voxels 32 --volume-only -o vo.vtu '$BUNNY' &&
+           soupmesh -q --offset-best-effort --cells 4 --voxels 32 -o vd.vtu '$BUNNY' &&
            /usr/bin/python3 samemesh.py vo.vtu vd.vtu"
 if command -v gmsh >/dev/null 2>&1; then
     check "gmsh reads the --volume-only .msh" gmsh vo.msh -0 -o vo-g.msh

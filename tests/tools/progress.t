@@ -1,0 +1,76 @@
+#!/bin/sh
+# tests/tools/progress.t - the progress line (issue 40, item 2), drawn on
+# a stderr that is not a terminal with SOUPTET_PROGRESS=1: a stage's
+# percentage never goes back, the clock moves while a stage reports
+# nothing (no jump of more than 2 s), an ETA where the work is counted,
+# the line cleared before the summary, and ended with a newline when a
+# signal stops the tool.
+. "$(dirname "$0")/lib.sh"
+cd "$WORK" || exit 1
+BUNNY="$ROOT/corpus/bunny.obj"
+
+cat >lines.py <<'EOF'
+import re, sys
+# The records of a progress stream: split at \r, escape codes dropped.
+data = open(sys.argv[1], 'rb').read().decode()
+recs = [r.replace('\x1b[K', '') for r in data.split('\r')]
+pat = re.compile(r'^(\w+): (.+?) +(\d+)% \((\d+) (?:s|min)(?:, ETA [^)]*)?\)$')
+done = re.compile(r'^(\w+): (.+?) done; working \((\d+) s\)$')
+bad, last, n, eta = [], None, 0, 0
+for r in recs:
+    m = pat.match(r)
+    if not m:
+        continue
+    n += 1
+    eta += 'ETA' in r
+    stage, pct, sec = m.group(2), int(m.group(3)), int(m.group(4))
+    if last and last[0] == stage:
+        if pct < last[1] and last[1] - pct <= 50:
+            bad.append('%s went back %d%% -> %d%%' % (stage, last[1], pct))
+        if pct >= last[1] and sec - last[2] > 2:
+            bad.append('%s: the clock jumped %d s -> %d s' % (stage, last[2], sec))
+    last = (stage, pct, sec)
+print('# %d records, %d with an ETA, %d "done; working"' % (n, eta, sum(bool(done.match(r)) for r in recs)))
+for b in bad[:5]:
+    print('#  ', b)
+mode = sys.argv[2] if len(sys.argv) > 2 else 'monotone'
+if mode == 'monotone':
+    sys.exit(1 if bad or n < 3 else 0)
+if mode == 'eta':
+    sys.exit(0 if eta > 0 else 1)
+EOF
+
+SOUPTET_PROGRESS=1 soupmesh --cells 12 --tries 6 --threads 1 -o m.vtu "$BUNNY" 2>p.err
+ok $? "soupmesh with SOUPTET_PROGRESS=1 on a non-terminal"
+"$PYVTK" lines.py p.err monotone
+ok $? "every stage's percentage only goes up, its clock never jumps more than 2 s"
+"$PYVTK" lines.py p.err eta >/dev/null
+ok $? "a stage longer than a second shows an ETA"
+"$PYVTK" -c '
+import sys
+d = open("p.err", "rb").read()
+i = d.rfind(b"soupmesh: ")
+sys.exit(0 if d[i - 4:i] == b"\r\x1b[K" and d[i:].count(b"\n") == 1 and b" tets, " in d[i:] else 1)'
+ok $? "the summary line follows the progress line, cleared (\\r, erase-line)"
+soupmesh -q --cells 4 -o q.vtu "$BUNNY" 2>q.err && ! [ -s q.err ]
+ok $? "no line without SOUPTET_PROGRESS on a non-terminal (nor with -q)"
+SOUPTET_PROGRESS=1 soupmesh -q --cells 4 -o q.vtu "$BUNNY" 2>q.err && ! [ -s q.err ]
+ok $? "... and none with -q even when forced"
+
+# A signal mid-run: the line ends with a newline (the shell's prompt
+# starts a line of its own), and no output is left.
+for sig in INT TERM; do
+    SOUPTET_PROGRESS=1 soupmesh --cells 30 --tries 4 -o s.vtu "$BUNNY" 2>s.err &
+    pid=$!
+    i=0
+    while [ $i -lt 50 ] && ! grep -q '%' s.err 2>/dev/null; do sleep 0.1; i=$((i + 1)); done
+    sleep 0.5
+    kill -$sig $pid
+    wait $pid
+    rc=$?
+    last=$(tail -c 1 s.err | od -An -c | tr -d ' ')
+    [ $rc -gt 128 ] && grep -q '%' s.err && [ "$last" = '\n' ] && ! [ -e s.vtu ]
+    ok $? "SIG$sig during the run: the progress line ends with a newline (exit $rc, last byte '$last')"
+done
+
+done_testing
