@@ -58,3 +58,22 @@ done_testing() {
 
 # The Python with Debian's vtk module (a python3 earlier on PATH may lack it).
 PYVTK=/usr/bin/python3
+
+# holed_bunny: the bundled bunny with three holes cut (every face whose
+# centre is within 0.09 of the diagonal of vertex 100, 1500 or 900), as
+# OBJ on stdout: a soup whose fill the pseudo volume must guess.
+holed_bunny() {
+    "$PYVTK" - "$ROOT/corpus/bunny.obj" <<'EOF'
+import math, sys
+lines = open(sys.argv[1]).read().splitlines()
+v = [l for l in lines if l.startswith("v ")]
+f = [l for l in lines if l.startswith("f ")]
+P = [tuple(map(float, l.split()[1:4])) for l in v]
+d = math.dist([min(p[k] for p in P) for k in range(3)], [max(p[k] for p in P) for k in range(3)])
+def centre(l):
+    ids = [int(t.split("/")[0]) - 1 for t in l.split()[1:4]]
+    return [sum(P[i][k] for i in ids) / 3 for k in range(3)]
+keep = [l for l in f if all(math.dist(centre(l), P[q]) > 0.09 * d for q in (100, 1500, 900))]
+print("\n".join(v + keep))
+EOF
+}
