@@ -405,6 +405,71 @@ static void run_candidate(st_tetmesh **meshes, st_pipeline_stats *st, size_t k,
     emit(p, &ev);
 }
 
+/* The candidates (see pipeline.h): batches of ST_PIPELINE_BATCH in
+ * index order, one thread per candidate when a batch has several; a
+ * single candidate keeps all threads for its own loops, and reports the
+ * fit's progress (several report only as each one finishes: the reporter
+ * is not called from two threads at once). After each batch, a candidate
+ * that meets every goal ends the run: the batches do not depend on the
+ * thread count, so neither does which candidates ran. st->ncandidates
+ * becomes the number that ran. */
+static void run_candidates(st_tetmesh **meshes, st_pipeline_stats *st, const st_grid *g,
+                           const st_soup *s, const st_bvh *bvh, const st_soup *fill,
+                           double h, const st_pipeline_params *p, const st_progress *prog)
+{
+    const size_t K = st->ncandidates;
+    size_t finished = 0, ran = 0;
+    /* several candidates: their fits see the cancel flag alone */
+    st_progress cancel_only = {NULL, NULL, prog ? prog->cancel : NULL};
+    for (size_t b0 = 0; b0 < K && !st->goal_met; b0 += ST_PIPELINE_BATCH) {
+        size_t b1 = b0 + ST_PIPELINE_BATCH < K ? b0 + ST_PIPELINE_BATCH : K;
+        int nthreads = b1 - b0 > 1 ? omp_get_max_threads() : 1;
+        if ((size_t)nthreads > b1 - b0)
+            nthreads = (int)(b1 - b0);
+        #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+        for (size_t k = b0; k < b1; k++) {
+            if (st_progress_cancelled(prog))
+                continue;
+            run_candidate(meshes, st, k, g, s, bvh, fill, h, p,
+                          K == 1 ? prog : &cancel_only);
+            #pragma omp critical(st_pipeline_progress)
+            {
+                finished++;
+                st_progress_report(prog, "candidates", (double)finished / (double)K);
+            }
+        }
+        ran = b1;
+        for (size_t k = b0; k < b1 && !p->try_all; k++)
+            if (meets_goals(&st->candidates[k], p))
+                st->goal_met = 1;
+    }
+    st->ncandidates = ran;
+    if (ran < K)
+        st_progress_report(prog, "candidates", 1.0);
+}
+
+/* The fill (pseudo.h): the pseudo volume's boundary where the soup has
+ * none. It counts as surface for the fit's condition (fill_counts), and
+ * how much of the boundary it is, how far from the soup, says how much of
+ * the solid is a guess (the closed shells' alone: none, and no call).
+ * *fill stays NULL where it does not count. */
+static st_status make_fill(st_soup **fill, st_pipeline_stats *st, const st_grid *g,
+                           const st_bvh *bvh, const st_pipeline_params *p, st_error *err)
+{
+    size_t nfill = 0;
+    st_status rc = st_pseudo_fill(fill, g, bvh, &nfill, err);
+    if (rc)
+        return rc;
+    st_pseudo_guess_measure(&st->guess, g, *fill, bvh);
+    if (p->density_rho <= 0 && p->fill_counts) {
+        st->fill_faces = nfill;
+    } else {
+        st_soup_free(*fill);
+        *fill = NULL;
+    }
+    return ST_OK;
+}
+
 /* The field and the pseudo volume's settings a run uses (voxels along the
  * longest side of the soup's box, its hole caps and closed shells): one
  * place for st_pipeline_run and st_pipeline_field_of_mesh. */
@@ -546,27 +611,12 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         goto done;
     }
 
-    /* The fill (pseudo.h): the pseudo volume's boundary where the soup has
-     * none. It counts as surface for the fit's condition (fill_counts),
-     * and how much of the boundary it is, how far from the soup, says how
-     * much of the solid is a guess (the closed shells' alone: none). */
     if (st_progress_cancelled(prog)) {
         rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
         goto done;
     }
-    if (!st->shells_only) {
-        size_t nfill = 0;
-        rc = st_pseudo_fill(&fill, g, bvh, &nfill, err);
-        if (rc)
-            goto done;
-        st_pseudo_guess_measure(&st->guess, g, fill, bvh);
-        if (p->density_rho <= 0 && p->fill_counts) {
-            st->fill_faces = nfill;
-        } else {
-            st_soup_free(fill);
-            fill = NULL;
-        }
-    }
+    if (!st->shells_only && (rc = make_fill(&fill, st, g, bvh, p, err)))
+        goto done;
     size_t K = p->tries;
     st->candidates = calloc(K, sizeof *st->candidates);
     meshes = calloc(K, sizeof *meshes);
@@ -578,41 +628,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     for (size_t k = 0; k < K; k++)
         st->candidates[k].seed = st_pipeline_candidate_seed(p->seed, k);
 
-    /* Batches of ST_PIPELINE_BATCH candidates in index order, one thread
-     * per candidate when a batch has several; a single candidate keeps all
-     * threads for its own loops, and reports the fit's progress (several
-     * report only as each one finishes: the reporter is not called from
-     * two threads at once). After each batch, a candidate that meets every
-     * goal ends the run (pipeline.h): the batches do not depend on the
-     * thread count, so neither does which candidates ran. */
-    size_t finished = 0, ran = 0;
-    /* several candidates: their fits see the cancel flag alone */
-    st_progress cancel_only = {NULL, NULL, prog ? prog->cancel : NULL};
-    for (size_t b0 = 0; b0 < K && !st->goal_met; b0 += ST_PIPELINE_BATCH) {
-        size_t b1 = b0 + ST_PIPELINE_BATCH < K ? b0 + ST_PIPELINE_BATCH : K;
-        int nthreads = b1 - b0 > 1 ? omp_get_max_threads() : 1;
-        if ((size_t)nthreads > b1 - b0)
-            nthreads = (int)(b1 - b0);
-        #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
-        for (size_t k = b0; k < b1; k++) {
-            if (st_progress_cancelled(prog))
-                continue;
-            run_candidate(meshes, st, k, g, s, bvh, fill, h, p,
-                          K == 1 ? prog : &cancel_only);
-            #pragma omp critical(st_pipeline_progress)
-            {
-                finished++;
-                st_progress_report(prog, "candidates", (double)finished / (double)K);
-            }
-        }
-        ran = b1;
-        for (size_t k = b0; k < b1 && !p->try_all; k++)
-            if (meets_goals(&st->candidates[k], p))
-                st->goal_met = 1;
-    }
-    st->ncandidates = ran;
-    if (ran < K)
-        st_progress_report(prog, "candidates", 1.0);
+    run_candidates(meshes, st, g, s, bvh, fill, h, p, prog);
     st->seconds_candidates = now_seconds() - t_cand;
     if (st_progress_cancelled(prog)) {
         rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
