@@ -363,8 +363,10 @@ static int better(const st_pipeline_candidate *a, size_t ka,
 
 /* 1 when candidate c meets every goal: it encloses, meets the fit's
  * stopping condition, and every tet scores at least the quality pass's
- * goal (smooth.h: min dihedral >= 35 degrees, max <= 133.3 by default).
- * A better one could only have larger angles within these. */
+ * goal (smooth.h: min dihedral >= 35 degrees by default) with its max
+ * dihedral bound (180 - 35 / 0.75 = 133.3) rounded down to a whole degree,
+ * 133, the bound the project holds its meshes to. A better one could only
+ * have larger angles within these. */
 static int meets_goals(const st_pipeline_candidate *c, const st_pipeline_params *p)
 {
     const double goal = st_fit_params_default().quality_goal;
@@ -372,7 +374,8 @@ static int meets_goals(const st_pipeline_candidate *c, const st_pipeline_params 
         return 0;
     if (p->density_rho > 0)
         return 0;   /* the Spillmann mesher has no such goal */
-    return c->min_dihedral >= goal && ST_FIT_MAX_WEIGHT * (180.0 - c->max_dihedral) >= goal;
+    return c->min_dihedral >= goal &&
+           c->max_dihedral <= 180.0 - ceil(goal / ST_FIT_MAX_WEIGHT);
 }
 
 /* Candidate k, start to end, its event included. */

@@ -107,7 +107,7 @@ int main(void)
         for (size_t k = 0; k < ST_PIPELINE_BATCH && k < st1.ncandidates; k++) {
             const st_pipeline_candidate *q = &st1.candidates[k];
             if (!q->failed && !q->verts_outside && !q->tris_crossing && q->converged &&
-                q->min_dihedral >= 35.0 && 0.75 * (180.0 - q->max_dihedral) >= 35.0)
+                q->min_dihedral >= 35.0 && q->max_dihedral <= 133.0)
                 goal_k = k;
         }
         size_t want = goal_k != SIZE_MAX ? ST_PIPELINE_BATCH : 3;

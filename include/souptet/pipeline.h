@@ -15,7 +15,7 @@
  * candidate's own loops then run on one thread). Once a batch has ended
  * with a candidate that meets every goal (it encloses, meets the fit's
  * stopping condition, and every tet scores at least the quality pass's
- * goal: min dihedral >= 35 and max <= 133.3 degrees by default, smooth.h),
+ * goal, min dihedral >= 35 degrees by default, smooth.h, and max <= 133),
  * no further batch runs, unless try_all: stats->ncandidates says how many
  * ran, stats->goal_met why. Which ran does not depend on the thread count.
  * Of those that ran, the winner is chosen by a total order that does not

@@ -135,7 +135,7 @@ def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
     tries     int, candidates with randomly rotated and offset lattices, at
               most, two at a time in parallel, the best enclosing one kept;
               no more start once one meets every goal (encloses, offset,
-              dihedral 35..133.3; soupmesh --tries) (default 4; NOTE:
+              dihedral 35..133; soupmesh --tries) (default 4; NOTE:
               soupmesh's default is 1 - here 4, because the worst angle
               improves and a script rarely tunes it; tries=1 gives
               soupmesh's mesh bit for bit)

@@ -88,7 +88,7 @@ TOOL_HELP_TETFORMAT
 "      --tries K        candidates with randomly rotated and offset lattices,\n"
 "                       at most, two at a time in parallel; the best\n"
 "                       enclosing one is kept; no more start once one meets\n"
-"                       every goal (encloses, --offset, dihedral 35..133.3)\n"
+"                       every goal (encloses, --offset, dihedral 35..133)\n"
 "                       (default 1)\n"
 "      --try-all        run all --tries candidates even then\n"
 "      --seed S         seed of the first candidate's lattice (default 1;\n"
@@ -231,7 +231,7 @@ static void report(const tool_ctx *t, const st_pipeline_stats *st, size_t tries,
     }
     if (st->goal_met && st->ncandidates < tries)
         tool_say(t, 2, "candidate %zu met every goal (encloses, --offset, dihedral "
-                 "35..133.3): the other %zu of --tries %zu not run (--try-all runs them)",
+                 "35..133): the other %zu of --tries %zu not run (--try-all runs them)",
                  st->best, tries - st->ncandidates, tries);
 }
 
