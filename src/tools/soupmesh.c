@@ -592,6 +592,88 @@ static void print_json(const soupmesh_settings *s, const st_pipeline_stats *st,
            tool_json_number(n[8], seconds), rc);
 }
 
+/* What --float32's rounding did (-v), and a note when the input itself is
+ * not float32. */
+static void report_float32(const tool_ctx *t, const soupmesh_settings *s,
+                           const st_pipeline_stats *st, const st_tetmesh *m)
+{
+    const st_float32_stats *f = &st->float32;
+    tool_say(t, 2, "float32%s: %zu of %zu points moved (%zu on the boundary, %zu of "
+             "them pushed, up to %u ulps further out), the farthest by %.3g (%.3g h); "
+             "%d exact check%s, %.3f s: %s (%zu vertices outside, %zu triangles "
+             "crossing, %zu inverted tets)",
+             s->float32_by_stl ? " (for the .stl boundary)" : "", f->points_moved,
+             m->npoints, f->boundary_points, f->pushed, f->max_push, f->max_move,
+             f->max_move / st->h, f->rounds, f->rounds == 1 ? "" : "s", f->seconds,
+             f->encloses ? "encloses the input" : "DOES NOT enclose the input",
+             f->verts_outside, f->tris_crossing, f->inverted);
+    if (f->input_not_float32)
+        tool_say(t, 1, "note: %zu input vertices are not float32 values: the mesh "
+                 "in float32 encloses the input as given (in double); rounding the "
+                 "input too moves it by up to half a float ulp", f->input_not_float32);
+}
+
+/* The note on the guessed part of the solid (pseudo.h's fill), if any. */
+static void say_guess(const tool_ctx *t, const st_pipeline_stats *st, const st_soup *soup,
+                      double diag)
+{
+    if (!st->guess.fill_faces)
+        return;
+    /* The solid where the input has no surface is the pseudo volume's
+     * guess: said by default when it reaches past a lattice cell from
+     * the input, where the mesh resolves it (its volume, a
+     * simulation's mass, rest on it), naming what was guessed. */
+    const double depth_h = st->guess.depth / st->h;
+    char what[200];
+    guess_words(what, sizeof what, soup);
+    tool_say(t, depth_h > 1.0 ? 1 : 2,
+             "note: %.1f%% of the solid's boundary is not on the input but guessed "
+             "(%s), up to %.2f h (%.3f of the diagonal) from it; the mesh's volume "
+             "there rests on that guess",
+             100.0 * (double)st->guess.fill_faces / (double)st->guess.boundary_faces,
+             what, depth_h, st->guess.depth / diag);
+}
+
+/* The exit status of a run that wrote its mesh: not enclosing (level 0,
+ * even with -q), Cetra's stopping condition missed (level 0 unless
+ * --offset-best-effort), else OK. */
+static int exit_status(const tool_ctx *t, const soupmesh_settings *s,
+                       const st_pipeline_stats *st, const char *in_name)
+{
+    const st_pipeline_params *p = &s->pipeline;
+    const char *out = s->co.out;
+    const st_pipeline_candidate *b = &st->candidates[st->best];
+    int rc = TOOL_EXIT_OK;
+    if (!st->encloses && p->density_rho <= 0) {
+        /* Level 0: printed even with -q, and the exit status says it. */
+        if (p->float32 && st->float32.inverted)
+            tool_say(t, 0, "%s: error: the mesh written to %s has %zu inverted tets once "
+                     "rounded to float32 (--float32)", in_name, tool_out_name(out),
+                     st->float32.inverted);
+        tool_say(t, 0, "%s: error: the mesh written to %s does not enclose the input%s "
+                 "(%zu vertices outside, %zu triangles crossing; best of %zu candidates); "
+                 "try more --cells or --tries", in_name, tool_out_name(out),
+                 p->float32 ? " once rounded to float32" : "",
+                 b->verts_outside, b->tris_crossing, st->ncandidates);
+        rc = TOOL_EXIT_NOT_ENCLOSING;
+    }
+    if (p->density_rho <= 0 && !b->converged) {
+        /* Cetra's stopping condition (every boundary vertex within
+         * R h of the input) is the fit's promise: said at level 0 and in
+         * the exit status unless the user settles for less. */
+        tool_say(t, s->best_effort ? 1 : 0,
+                 "%s: %s: %zu of %zu boundary vertices stay farther than %.3g h from the "
+                 "input%s, the farthest %.4g h (%.4g); best of %zu candidates%s",
+                 in_name, s->best_effort ? "warning" : "error",
+                 b->beyond_offset, b->boundary_vertices, p->offset_ratio,
+                 st->fill_faces ? " or its fill" : "", b->max_distance / st->h, b->max_distance, st->ncandidates,
+                 s->best_effort ? "" : "; try more --tries or --cells, or --offset-best-effort");
+        if (!s->best_effort && rc == TOOL_EXIT_OK)
+            rc = TOOL_EXIT_OFFSET_NOT_MET;
+    }
+    return rc;
+}
+
 static int run(tool_ctx *t, void *settings)
 {
     soupmesh_settings *s = settings;
@@ -658,22 +740,8 @@ static int run(tool_ctx *t, void *settings)
     report(t, &st, p->tries, p->density_rho > 0);
     if (p->parts)
         report_parts(t, &parts, &st.parts);
-    if (p->float32) {
-        const st_float32_stats *f = &st.float32;
-        tool_say(t, 2, "float32%s: %zu of %zu points moved (%zu on the boundary, %zu of "
-                 "them pushed, up to %u ulps further out), the farthest by %.3g (%.3g h); "
-                 "%d exact check%s, %.3f s: %s (%zu vertices outside, %zu triangles "
-                 "crossing, %zu inverted tets)",
-                 s->float32_by_stl ? " (for the .stl boundary)" : "", f->points_moved,
-                 m->npoints, f->boundary_points, f->pushed, f->max_push, f->max_move,
-                 f->max_move / st.h, f->rounds, f->rounds == 1 ? "" : "s", f->seconds,
-                 f->encloses ? "encloses the input" : "DOES NOT enclose the input",
-                 f->verts_outside, f->tris_crossing, f->inverted);
-        if (f->input_not_float32)
-            tool_say(t, 1, "note: %zu input vertices are not float32 values: the mesh "
-                     "in float32 encloses the input as given (in double); rounding the "
-                     "input too moves it by up to half a float ulp", f->input_not_float32);
-    }
+    if (p->float32)
+        report_float32(t, s, &st, m);
     if (st_meta_set(&m->meta, "source", in_name) ||
         tool_meta_record(t, &m->meta)) {
         rc = tool_fail_nomem(t, &err);
@@ -747,21 +815,7 @@ static int run(tool_ctx *t, void *settings)
              st.encloses ? "encloses the input" : "DOES NOT enclose the input",
              b->verts_outside, b->tris_crossing, tool_now() - t0);
     const double diag = box_diagonal(soup);
-    if (st.guess.fill_faces) {
-        /* The solid where the input has no surface is the pseudo volume's
-         * guess: said by default when it reaches past a lattice cell from
-         * the input, where the mesh resolves it (its volume, a
-         * simulation's mass, rest on it), naming what was guessed. */
-        const double depth_h = st.guess.depth / st.h;
-        char what[200];
-        guess_words(what, sizeof what, soup);
-        tool_say(t, depth_h > 1.0 ? 1 : 2,
-                 "note: %.1f%% of the solid's boundary is not on the input but guessed "
-                 "(%s), up to %.2f h (%.3f of the diagonal) from it; the mesh's volume "
-                 "there rests on that guess",
-                 100.0 * (double)st.guess.fill_faces / (double)st.guess.boundary_faces,
-                 what, depth_h, st.guess.depth / diag);
-    }
+    say_guess(t, &st, soup, diag);
     if ((rc = tool_report_symmetries(t, soup, NULL, st.voxel)))
         goto done;
     if (t->verbosity >= 2 && p->density_rho <= 0) {
@@ -777,34 +831,7 @@ static int run(tool_ctx *t, void *settings)
                  b->max_distance / st.h, b->max_distance / diag, sb / st.h, sb / diag,
                  b->beyond_offset, b->boundary_vertices, p->offset_ratio);
     }
-    rc = TOOL_EXIT_OK;
-    if (!st.encloses && p->density_rho <= 0) {
-        /* Level 0: printed even with -q, and the exit status says it. */
-        if (p->float32 && st.float32.inverted)
-            tool_say(t, 0, "%s: error: the mesh written to %s has %zu inverted tets once "
-                     "rounded to float32 (--float32)", in_name, tool_out_name(out),
-                     st.float32.inverted);
-        tool_say(t, 0, "%s: error: the mesh written to %s does not enclose the input%s "
-                 "(%zu vertices outside, %zu triangles crossing; best of %zu candidates); "
-                 "try more --cells or --tries", in_name, tool_out_name(out),
-                 p->float32 ? " once rounded to float32" : "",
-                 b->verts_outside, b->tris_crossing, st.ncandidates);
-        rc = TOOL_EXIT_NOT_ENCLOSING;
-    }
-    if (p->density_rho <= 0 && !b->converged) {
-        /* Cetra's stopping condition (every boundary vertex within
-         * R h of the input) is the fit's promise: said at level 0 and in
-         * the exit status unless the user settles for less. */
-        tool_say(t, s->best_effort ? 1 : 0,
-                 "%s: %s: %zu of %zu boundary vertices stay farther than %.3g h from the "
-                 "input%s, the farthest %.4g h (%.4g); best of %zu candidates%s",
-                 in_name, s->best_effort ? "warning" : "error",
-                 b->beyond_offset, b->boundary_vertices, p->offset_ratio,
-                 st.fill_faces ? " or its fill" : "", b->max_distance / st.h, b->max_distance, st.ncandidates,
-                 s->best_effort ? "" : "; try more --tries or --cells, or --offset-best-effort");
-        if (!s->best_effort && rc == TOOL_EXIT_OK)
-            rc = TOOL_EXIT_OFFSET_NOT_MET;
-    }
+    rc = exit_status(t, s, &st, in_name);
     if (s->json) {
         print_json(s, &st, rc, tool_now() - t0);
         if (tool_flush_stdout(t))
