@@ -10,6 +10,7 @@
  * doubles only rank and threshold.
  */
 #include "souptet/symmetry.h"
+#include "fpenv.h"
 #include "souptet/geom.h"
 #include "souptet/mem.h"
 

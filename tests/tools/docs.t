@@ -197,9 +197,7 @@ done
 # The pipe on a soup with holes (README, soupmesh(1)): without the field
 # tetsmooth fits to the soup alone and the mesh differs from soupmesh's;
 # with --field it is soupmesh's mesh again.
-sed -n '/^"\$PYVTK" - "\$ROOT\/corpus\/bunny.obj" > holed.obj <<.EOF.$/,/^EOF$/p' \
-    "$ROOT/tests/tools/tetstat.t" | sed '1d;$d' >holed.py
-"$PYVTK" holed.py "$BUNNY" >holed.obj && soupmesh -q -o holed-one.vtu holed.obj &&
+holed_bunny >holed.obj && soupmesh -q -o holed-one.vtu holed.obj &&
     soupdist holed.obj | soupsign -o holed-f.vti &&
     latticetet --sculpt --surface holed.obj holed-f.vti |
     tetsmooth -q --fit --surface holed.obj --field holed-f.vti >holed-field.vtu &&
