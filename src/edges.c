@@ -107,16 +107,14 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
     size_t *uf = st_malloc_array(nt ? nt : 1, sizeof *uf);
     /* the radix sorts' scratch: the half-edges */
     st_half_edge *tmp = st_malloc_array(3 * nt + 1, sizeof *tmp);
-    long long nw = -1;
-    if (!keys || !e->weld || !e->kept || !e->he || !e->piece || !uf || !tmp ||
-        (nw = st_weld_vertices(e->weld, s)) < 0) {
+    if (!keys || !e->weld || st_weld_vertices(e->weld, &e->nweld, s, err) ||
+        !e->kept || !e->he || !e->piece || !uf || !tmp) {
         free(keys);
         free(uf);
         free(tmp);
         st_soup_edges_free(e);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
     }
-    e->nweld = (size_t)nw;
 
     /* 1. welded, non-degenerate, first of its duplicates */
     size_t nk = 0;

@@ -439,7 +439,8 @@ st_status st_soupinfo_self_intersections(st_soupinfo *out, const st_soup *s,
     uint8_t *hit = st_calloc_array(nt, 1);
     st_bvh *bvh = NULL;
     size_t pairs = 0;
-    if (!weld || !W || !kind || !hit || st_weld_vertices(weld, s) < 0)
+    size_t nweld;
+    if (!weld || !W || !kind || !hit || st_weld_vertices(weld, &nweld, s, err) != ST_OK)
         goto done;
     for (size_t i = 0; i < 3 * nt; i++)
         W[i] = weld[s->tris[i]];

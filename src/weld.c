@@ -39,8 +39,10 @@ static uint64_t point_hash(const double *p)
                  mix64(coord_bits(p[1]) ^ mix64(coord_bits(p[2]))));
 }
 
-long long st_weld_vertices(uint32_t *weld, const st_soup *s)
+st_status st_weld_vertices(uint32_t *weld, size_t *nweld, const st_soup *s,
+                           st_error *err)
 {
+    *nweld = 0;
     size_t nref = 0;
     for (size_t v = 0; v < s->nverts; v++)
         weld[v] = NONE;
@@ -59,7 +61,8 @@ long long st_weld_vertices(uint32_t *weld, const st_soup *s)
     if (!table || !rep) {
         free(table);
         free(rep);
-        return -1;
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory welding %zu vertices", nref);
     }
     for (size_t i = 0; i < cap; i++)
         table[i] = NONE;
@@ -87,5 +90,6 @@ long long st_weld_vertices(uint32_t *weld, const st_soup *s)
     }
     free(table);
     free(rep);
-    return n;
+    *nweld = n;
+    return ST_OK;
 }

@@ -56,8 +56,10 @@ static void test_weld(void)
     st_soup_add_triangle(s, a, b, c, NULL);
     st_soup_add_triangle(s, a2, c, b2, NULL);
     uint32_t w[6];
-    long long n = st_weld_vertices(w, s);
-    TAP_CHECK(n == 4, "weld: 4 distinct points among 5 used vertices (%lld)", n);
+    size_t n = 0;
+    st_error err;
+    TAP_CHECK(st_weld_vertices(w, &n, s, &err) == ST_OK, "weld: ST_OK");
+    TAP_CHECK(n == 4, "weld: 4 distinct points among 5 used vertices (%zu)", n);
     TAP_CHECK(w[a] == 0 && w[b] == 1 && w[c] == 2, "weld: ids in order of first use");
     TAP_CHECK(w[a2] == w[a], "weld: -0 is 0");
     TAP_CHECK(w[b2] != w[b], "weld: one ulp apart stays apart (no epsilon)");

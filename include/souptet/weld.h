@@ -8,6 +8,7 @@
 #define SOUPTET_WELD_H
 
 #include <stdint.h>
+#include "souptet/err.h"
 #include "souptet/soup.h"
 
 #ifdef __cplusplus
@@ -18,8 +19,10 @@ extern "C" {
 
 /* weld[v] (s->nverts entries) = the welded id of referenced vertex v, ids
  * 0.. in order of first appearance; ST_WELD_NONE for a vertex no triangle
- * uses. Returns the number of welded ids, or -1 when out of memory. */
-long long st_weld_vertices(uint32_t *weld, const st_soup *s);
+ * uses; *nweld = the number of welded ids. Returns ST_OK, or ST_ENOMEM
+ * (err set, *nweld 0). */
+st_status st_weld_vertices(uint32_t *weld, size_t *nweld, const st_soup *s,
+                           st_error *err);
 
 #ifdef __cplusplus
 }
