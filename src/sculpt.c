@@ -311,6 +311,264 @@ static void dfs(search *S, size_t i)
     }
 }
 
+/* One repair round's bombs (section (2), (4) above): bomb[b] is the
+ * lattice tet of bomb b, optv[4b .. 4b + nopt[b]) its candidate vertices,
+ * parent[] the union-find of its cluster, and order[coff[r] ..
+ * coff[r + 1]) the bombs of the cluster whose root is r. claim[] (per
+ * lattice tet, -1 between rounds) is the first bomb whose candidates
+ * would add the tet, then a cluster's local tet numbering. */
+typedef struct bomb_round {
+    const st_lattice *L;
+    unsigned char *keep;
+    int64_t *claim;
+    size_t nb;
+    size_t *bomb;
+    uint32_t *optv;
+    int *nopt;
+    size_t *parent, *order, *coff;
+} bomb_round;
+
+/* The bombs, their candidates (the vertices with a complete snowflake),
+ * and their clusters: bombs whose candidates would add a common tet. */
+static void round_candidates(bomb_round *R)
+{
+    const st_lattice *L = R->L;
+    for (size_t t = 0; t < L->ntets; t++)
+        if (R->keep[t] && boundary_faces(L, R->keep, t) >= 2)
+            R->bomb[R->nb++] = t;
+    for (size_t b = 0; b < R->nb; b++) {
+        R->parent[b] = b;
+        R->nopt[b] = 0;
+        for (int c = 0; c < 4; c++) {
+            uint32_t v = L->tets[4 * R->bomb[b] + (size_t)c];
+            if (star_complete(L, v))
+                R->optv[4 * b + (size_t)R->nopt[b]++] = v;
+        }
+    }
+    for (size_t b = 0; b < R->nb; b++)
+        for (int o = 0; o < R->nopt[b]; o++) {
+            uint32_t v = R->optv[4 * b + (size_t)o];
+            for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++) {
+                size_t t = L->star[a];
+                if (R->keep[t])
+                    continue;
+                if (R->claim[t] < 0)
+                    R->claim[t] = (int64_t)b;
+                else
+                    uf_join(R->parent, b, (size_t)R->claim[t]);
+            }
+        }
+}
+
+/* Group bombs by cluster root (roots are the smallest members, so
+ * clusters come in order of their first bomb). */
+static st_status round_group(bomb_round *R, st_error *err)
+{
+    const size_t nb = R->nb;
+    for (size_t b = 0; b < nb; b++)
+        R->coff[uf_find(R->parent, b) + 1]++;
+    for (size_t b = 0; b < nb; b++)
+        R->coff[b + 1] += R->coff[b];
+    size_t *fill = st_malloc_array(nb + 1, sizeof *fill);
+    if (!fill)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    memcpy(fill, R->coff, (nb + 1) * sizeof *fill);
+    for (size_t b = 0; b < nb; b++)
+        R->order[fill[uf_find(R->parent, b)]++] = b;
+    free(fill);
+    return ST_OK;
+}
+
+/* Reset the claims of this round. */
+static void round_reset_claims(bomb_round *R)
+{
+    const st_lattice *L = R->L;
+    for (size_t b = 0; b < R->nb; b++)
+        for (int o = 0; o < R->nopt[b]; o++) {
+            uint32_t v = R->optv[4 * b + (size_t)o];
+            for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++)
+                R->claim[L->star[a]] = -1;
+        }
+}
+
+/* The cluster's options as local tets: claim[] becomes the local index
+ * (-2 - index) at a tet's first sight. */
+static void cluster_options(bomb_round *R, search *S, size_t c0)
+{
+    const st_lattice *L = R->L;
+    size_t nloc = 0, k = 0;
+    for (size_t q = 0; q < S->n; q++) {
+        size_t b = R->order[c0 + q];
+        S->nopt[q] = R->nopt[b];
+        for (int o = 0; o < 4; o++) {
+            S->opt_off[4 * q + (size_t)o] = k;
+            if (o >= R->nopt[b])
+                continue;
+            uint32_t v = R->optv[4 * b + (size_t)o];
+            for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++) {
+                size_t t = L->star[a];
+                if (R->keep[t])
+                    continue;
+                if (R->claim[t] >= 0)   /* first sight: number it */
+                    R->claim[t] = -2 - (int64_t)nloc++;
+                S->opt_tets[k++] = (uint32_t)(-2 - R->claim[t]);
+            }
+        }
+    }
+    S->opt_off[4 * S->n] = k;
+}
+
+/* Greedy: each bomb, in order, its cheapest candidate. Leaves the choice
+ * in best_sel and best_cost, nothing applied; returns its cost. */
+static size_t search_greedy(search *S)
+{
+    const size_t n = S->n;
+    for (size_t q = 0; q < n; q++) {
+        int bo = -1;
+        size_t bg = 0;
+        for (int o = 0; o < S->nopt[q]; o++) {
+            size_t g = opt_gain(S, q, o);
+            if (bo < 0 || g < bg) {
+                bo = o;
+                bg = g;
+            }
+        }
+        S->sel[q] = bo < 0 ? 0 : bo;
+        if (bo >= 0)
+            opt_apply(S, q, bo, +1);
+    }
+    S->best_cost = S->cost;
+    memcpy(S->best_sel, S->sel, n * sizeof *S->sel);
+    for (size_t q = 0; q < n; q++)
+        if (S->nopt[q] > 0)
+            opt_apply(S, q, S->sel[q], -1);
+    return S->best_cost;
+}
+
+/* The branch and bound from the greedy choice, for a cluster of at most
+ * cluster_max bombs that all have a candidate: 1 when it searched every
+ * choice within the budget (best_sel is then the cheapest), else 0
+ * (best_sel the best found, never worse than greedy). */
+static int search_exact(search *S, const st_sculpt_params *p)
+{
+    const size_t n = S->n;
+    if (n > p->cluster_max)
+        return 0;
+    int searched = 0;
+    S->budget = p->search_budget;
+    S->best_cost++;   /* let the search reach the greedy cost */
+    size_t greedy_cost = S->best_cost - 1;
+    int *greedy_sel = st_malloc_array(n, sizeof *greedy_sel);
+    if (greedy_sel)
+        memcpy(greedy_sel, S->best_sel, n * sizeof *greedy_sel);
+    int any_empty = 0;
+    for (size_t q = 0; q < n; q++)
+        any_empty |= S->nopt[q] == 0;
+    if (greedy_sel && !any_empty) {
+        dfs(S, 0);
+        searched = !S->exhausted;
+        if (S->best_cost > greedy_cost) {   /* nothing better */
+            S->best_cost = greedy_cost;
+            memcpy(S->best_sel, greedy_sel, n * sizeof *greedy_sel);
+        }
+    } else
+        S->best_cost = greedy_cost;
+    free(greedy_sel);
+    return searched;
+}
+
+/* One cluster, the bombs order[c0 .. c0 + n): its options, the greedy
+ * choice, the search, and the snowflakes of the choice added to keep. */
+static st_status solve_cluster(bomb_round *R, size_t c0, size_t n,
+                               const st_sculpt_params *p, st_sculpt_stats *ss,
+                               st_error *err)
+{
+    const st_lattice *L = R->L;
+    st_status st = ST_OK;
+    search S = {.n = n};
+    S.nopt = st_malloc_array(n, sizeof *S.nopt);
+    S.opt_off = st_calloc_array(4 * n + 1, sizeof *S.opt_off);
+    size_t total = 0;
+    for (size_t q = 0; q < n; q++)
+        for (int o = 0; o < R->nopt[R->order[c0 + q]]; o++) {
+            uint32_t v = R->optv[4 * R->order[c0 + q] + (size_t)o];
+            total += L->star_off[v + 1] - L->star_off[v];
+        }
+    S.opt_tets = st_malloc_array(total + 1, sizeof *S.opt_tets);
+    S.cnt = st_calloc_array(total + 1, sizeof *S.cnt);
+    S.sel = st_calloc_array(n, sizeof *S.sel);
+    S.best_sel = st_calloc_array(n, sizeof *S.best_sel);
+    if (!S.nopt || !S.opt_off || !S.opt_tets || !S.cnt || !S.sel || !S.best_sel) {
+        st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        goto done;
+    }
+    cluster_options(R, &S, c0);
+    ss->greedy_tets += search_greedy(&S);
+    if (search_exact(&S, p))
+        ss->clusters_exact++;
+    else
+        ss->clusters_greedy++;
+    /* Apply the choice. */
+    for (size_t q = 0; q < n; q++) {
+        if (S.nopt[q] == 0)
+            continue;
+        uint32_t v = R->optv[4 * R->order[c0 + q] + (size_t)S.best_sel[q]];
+        size_t added = add_star(L, R->keep, v, ST_SCULPT_BOMB);
+        if (added) {
+            ss->snowflakes++;
+            ss->bomb_tets += added;
+        }
+    }
+done:
+    free(S.nopt);
+    free(S.opt_off);
+    free(S.opt_tets);
+    free(S.cnt);
+    free(S.sel);
+    free(S.best_sel);
+    return st;
+}
+
+/* One round of repair over the nbombs bombs of keep: candidates,
+ * clusters, each cluster solved; the claims reset for the next round. */
+static st_status repair_round(unsigned char *keep, int64_t *claim, size_t nbombs,
+                              const st_lattice *L, const st_sculpt_params *p,
+                              st_sculpt_stats *ss, st_error *err)
+{
+    st_status st = ST_OK;
+    bomb_round R = {.L = L, .keep = keep, .claim = claim};
+    R.bomb = st_malloc_array(nbombs, sizeof *R.bomb);
+    R.optv = st_malloc_array(nbombs, 4 * sizeof *R.optv);
+    R.nopt = st_malloc_array(nbombs, sizeof *R.nopt);
+    R.parent = st_malloc_array(nbombs, sizeof *R.parent);
+    R.order = st_malloc_array(nbombs, sizeof *R.order);
+    R.coff = st_calloc_array(nbombs + 1, sizeof *R.coff);
+    if (!R.bomb || !R.optv || !R.nopt || !R.parent || !R.order || !R.coff) {
+        st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        goto done;
+    }
+    round_candidates(&R);
+    st = round_group(&R, err);
+    for (size_t r = 0; r < R.nb && st == ST_OK; r++) {
+        size_t c0 = R.coff[r], n = R.coff[r + 1] - c0;
+        if (n == 0)
+            continue;
+        ss->clusters++;
+        if (n > ss->largest_cluster)
+            ss->largest_cluster = n;
+        st = solve_cluster(&R, c0, n, p, ss, err);
+    }
+    round_reset_claims(&R);
+done:
+    free(R.bomb);
+    free(R.optv);
+    free(R.nopt);
+    free(R.parent);
+    free(R.order);
+    free(R.coff);
+    return st;
+}
+
 st_status st_sculpt_repair_bombs(unsigned char *keep, st_sculpt_stats *stats,
                                  const st_lattice *L,
                                  const st_sculpt_params *p, st_error *err)
@@ -336,184 +594,7 @@ st_status st_sculpt_repair_bombs(unsigned char *keep, st_sculpt_stats *stats,
     st_status st = ST_OK;
     for (int round = 0; round < 10 && nbombs; round++) {
         ss->repair_rounds++;
-        size_t *bomb = st_malloc_array(nbombs, sizeof *bomb);
-        uint32_t *optv = st_malloc_array(nbombs, 4 * sizeof *optv);
-        int *nopt = st_malloc_array(nbombs, sizeof *nopt);
-        size_t *parent = st_malloc_array(nbombs, sizeof *parent);
-        size_t *order = st_malloc_array(nbombs, sizeof *order);
-        size_t *coff = st_calloc_array(nbombs + 1, sizeof *coff);
-        if (!bomb || !optv || !nopt || !parent || !order || !coff) {
-            free(bomb); free(optv); free(nopt); free(parent); free(order); free(coff);
-            st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
-            break;
-        }
-        size_t nb = 0;
-        for (size_t t = 0; t < nt; t++)
-            if (keep[t] && boundary_faces(L, keep, t) >= 2)
-                bomb[nb++] = t;
-        /* Candidates: the bomb's vertices with a complete snowflake. */
-        for (size_t b = 0; b < nb; b++) {
-            parent[b] = b;
-            nopt[b] = 0;
-            for (int c = 0; c < 4; c++) {
-                uint32_t v = L->tets[4 * bomb[b] + (size_t)c];
-                if (star_complete(L, v))
-                    optv[4 * b + (size_t)nopt[b]++] = v;
-            }
-        }
-        /* Clusters: bombs whose candidates would add a common tet. */
-        for (size_t b = 0; b < nb; b++)
-            for (int o = 0; o < nopt[b]; o++) {
-                uint32_t v = optv[4 * b + (size_t)o];
-                for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++) {
-                    size_t t = L->star[a];
-                    if (keep[t])
-                        continue;
-                    if (claim[t] < 0)
-                        claim[t] = (int64_t)b;
-                    else
-                        uf_join(parent, b, (size_t)claim[t]);
-                }
-            }
-        /* Group bombs by cluster root (roots are the smallest members, so
-         * clusters come in order of their first bomb). */
-        for (size_t b = 0; b < nb; b++)
-            coff[uf_find(parent, b) + 1]++;
-        for (size_t b = 0; b < nb; b++)
-            coff[b + 1] += coff[b];
-        {
-            size_t *fill = st_malloc_array(nb + 1, sizeof *fill);
-            if (!fill) {
-                st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
-            } else {
-                memcpy(fill, coff, (nb + 1) * sizeof *fill);
-                for (size_t b = 0; b < nb; b++)
-                    order[fill[uf_find(parent, b)]++] = b;
-                free(fill);
-            }
-        }
-        for (size_t r = 0; r < nb && st == ST_OK; r++) {
-            size_t c0 = coff[r], c1 = coff[r + 1], n = c1 - c0;
-            if (n == 0)
-                continue;
-            ss->clusters++;
-            if (n > ss->largest_cluster)
-                ss->largest_cluster = n;
-            /* Local tet numbering: reuse claim[] as the local index
-             * (claims are reset to -1 below). */
-            search S;
-            memset(&S, 0, sizeof S);
-            S.n = n;
-            S.nopt = st_malloc_array(n, sizeof *S.nopt);
-            S.opt_off = st_calloc_array(4 * n + 1, sizeof *S.opt_off);
-            size_t total = 0;
-            for (size_t q = 0; q < n; q++)
-                for (int o = 0; o < nopt[order[c0 + q]]; o++) {
-                    uint32_t v = optv[4 * order[c0 + q] + (size_t)o];
-                    total += L->star_off[v + 1] - L->star_off[v];
-                }
-            S.opt_tets = st_malloc_array(total + 1, sizeof *S.opt_tets);
-            S.cnt = st_calloc_array(total + 1, sizeof *S.cnt);
-            S.sel = st_calloc_array(n, sizeof *S.sel);
-            S.best_sel = st_calloc_array(n, sizeof *S.best_sel);
-            if (!S.nopt || !S.opt_off || !S.opt_tets || !S.cnt || !S.sel || !S.best_sel) {
-                st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
-            } else {
-                size_t nloc = 0, k = 0;
-                for (size_t q = 0; q < n; q++) {
-                    size_t b = order[c0 + q];
-                    S.nopt[q] = nopt[b];
-                    for (int o = 0; o < 4; o++) {
-                        S.opt_off[4 * q + (size_t)o] = k;
-                        if (o >= nopt[b])
-                            continue;
-                        uint32_t v = optv[4 * b + (size_t)o];
-                        for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++) {
-                            size_t t = L->star[a];
-                            if (keep[t])
-                                continue;
-                            if (claim[t] >= 0)   /* first sight: number it */
-                                claim[t] = -2 - (int64_t)nloc++;
-                            S.opt_tets[k++] = (uint32_t)(-2 - claim[t]);
-                        }
-                    }
-                }
-                S.opt_off[4 * n] = k;
-                /* Greedy: each bomb, in order, its cheapest candidate. */
-                for (size_t q = 0; q < n; q++) {
-                    int bo = -1;
-                    size_t bg = 0;
-                    for (int o = 0; o < S.nopt[q]; o++) {
-                        size_t g = opt_gain(&S, q, o);
-                        if (bo < 0 || g < bg) {
-                            bo = o;
-                            bg = g;
-                        }
-                    }
-                    S.sel[q] = bo < 0 ? 0 : bo;
-                    if (bo >= 0)
-                        opt_apply(&S, q, bo, +1);
-                }
-                S.best_cost = S.cost;
-                ss->greedy_tets += S.cost;
-                memcpy(S.best_sel, S.sel, n * sizeof *S.sel);
-                for (size_t q = 0; q < n; q++)
-                    if (S.nopt[q] > 0)
-                        opt_apply(&S, q, S.sel[q], -1);
-                int searched = 0;
-                if (n <= p->cluster_max) {
-                    S.budget = p->search_budget;
-                    S.best_cost++;   /* let the search reach the greedy cost */
-                    size_t greedy_cost = S.best_cost - 1;
-                    int *greedy_sel = st_malloc_array(n, sizeof *greedy_sel);
-                    if (greedy_sel)
-                        memcpy(greedy_sel, S.best_sel, n * sizeof *greedy_sel);
-                    int any_empty = 0;
-                    for (size_t q = 0; q < n; q++)
-                        any_empty |= S.nopt[q] == 0;
-                    if (greedy_sel && !any_empty) {
-                        dfs(&S, 0);
-                        searched = !S.exhausted;
-                        if (S.best_cost > greedy_cost) {   /* nothing better */
-                            S.best_cost = greedy_cost;
-                            memcpy(S.best_sel, greedy_sel, n * sizeof *greedy_sel);
-                        }
-                    } else
-                        S.best_cost = greedy_cost;
-                    free(greedy_sel);
-                }
-                if (searched)
-                    ss->clusters_exact++;
-                else
-                    ss->clusters_greedy++;
-                /* Apply the choice. */
-                for (size_t q = 0; q < n; q++) {
-                    if (S.nopt[q] == 0)
-                        continue;
-                    uint32_t v = optv[4 * order[c0 + q] + (size_t)S.best_sel[q]];
-                    size_t added = add_star(L, keep, v, ST_SCULPT_BOMB);
-                    if (added) {
-                        ss->snowflakes++;
-                        ss->bomb_tets += added;
-                    }
-                }
-            }
-            free(S.nopt);
-            free(S.opt_off);
-            free(S.opt_tets);
-            free(S.cnt);
-            free(S.sel);
-            free(S.best_sel);
-        }
-        /* Reset the claims of this round. */
-        for (size_t b = 0; b < nb; b++)
-            for (int o = 0; o < nopt[b]; o++) {
-                uint32_t v = optv[4 * b + (size_t)o];
-                for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++)
-                    claim[L->star[a]] = -1;
-            }
-        free(bomb); free(optv); free(nopt); free(parent); free(order); free(coff);
-        if (st)
+        if ((st = repair_round(keep, claim, nbombs, L, p, ss, err)))
             break;
         nbombs = st_sculpt_count_bombs(L, keep, NULL);
     }
