@@ -293,25 +293,11 @@ static st_status build_topology(st_lattice *L, const st_progress *stop, st_error
     return st;
 }
 
-st_status st_lattice_build(st_lattice **out, const double lo[3],
-                           const double hi[3], const st_lattice_params *p,
-                           st_error *err)
+/* The lattice's frame: centred on the box; axis-aligned at the box's
+ * corner with seed 0, else a random rotation and offset from the seed. */
+static void lattice_frame(st_lattice *L, const double lo[3], const double hi[3],
+                          const st_lattice_params *p)
 {
-    *out = NULL;
-    for (int a = 0; a < 3; a++)
-        if (!isfinite(lo[a]) || !isfinite(hi[a]) || lo[a] > hi[a])
-            return st_error_set(err, ST_EINPUT, NULL, 0,
-                                "lattice box is empty or not finite");
-    if (!(p->h > 0) || !isfinite(p->h))
-        return st_error_set(err, ST_EINPUT, NULL, 0,
-                            "lattice cell width %g is not a positive number",
-                            p->h);
-    if (p->pad < 0 || p->pad > 1000)
-        return st_error_set(err, ST_EINPUT, NULL, 0,
-                            "lattice padding %d is out of range", p->pad);
-    st_lattice *L = calloc(1, sizeof *L);
-    if (!L)
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     L->kind = p->kind;
     L->h = p->h;
     L->seed = p->seed;
@@ -328,6 +314,15 @@ st_status st_lattice_build(st_lattice **out, const double lo[3],
         for (int a = 0; a < 3; a++)
             L->offset[a] = uniform01(&state) * p->h;
     }
+}
+
+/* The cells that cover the box in the lattice frame, padded (cell_lo, n),
+ * and the vertex count; *cap the tet count. ST_ELIMIT when an axis or the
+ * whole is over the limits. */
+static st_status lattice_cells(st_lattice *L, size_t *cap, const double lo[3],
+                               const double hi[3], const st_lattice_params *p,
+                               st_error *err)
+{
     /* The box in the lattice frame: u = R^T (x - center). */
     double umin[3] = {INFINITY, INFINITY, INFINITY};
     double umax[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -352,12 +347,10 @@ st_status st_lattice_build(st_lattice **out, const double lo[3],
             c1 = c0 + 1;   /* a flat box still gets one layer of cells */
         c0 -= p->pad;
         c1 += p->pad;
-        if (!(c1 - c0 < 1e7)) {
-            st_lattice_free(L);
+        if (!(c1 - c0 < 1e7))
             return st_error_set(err, ST_ELIMIT, NULL, 0,
                                 "lattice of cell width %g has too many "
                                 "cells along an axis", p->h);
-        }
         L->cell_lo[a] = (int64_t)c0;
         L->n[a] = (size_t)(c1 - c0);
         ncells *= (double)L->n[a];
@@ -368,103 +361,141 @@ st_status st_lattice_build(st_lattice **out, const double lo[3],
                       (double)(L->n[2] + 1) +
                       (p->kind == ST_LATTICE_BCC ? ncells : 0.0);
     if ((p->max_tets && ntets_d > (double)p->max_tets) ||
-        nverts_d >= 4294967295.0 || ntets_d >= 4294967295.0 / 4) {
-        st_error_set(err, ST_ELIMIT, NULL, 0,
-                     "a lattice of %.0f tets (%zux%zux%zu cells) is over "
-                     "the limit (use fewer cells)",
-                     ntets_d, L->n[0], L->n[1], L->n[2]);
-        st_lattice_free(L);
-        return ST_ELIMIT;
-    }
+        nverts_d >= 4294967295.0 || ntets_d >= 4294967295.0 / 4)
+        return st_error_set(err, ST_ELIMIT, NULL, 0,
+                            "a lattice of %.0f tets (%zux%zux%zu cells) is over "
+                            "the limit (use fewer cells)",
+                            ntets_d, L->n[0], L->n[1], L->n[2]);
     L->nverts = (size_t)nverts_d;
-    size_t cap = (size_t)ntets_d;
-    L->xyz = st_malloc_array(L->nverts, 3 * sizeof(double));
-    L->tets = st_malloc_array(cap, 4 * sizeof(uint32_t));
-    if (!L->xyz || !L->tets) {
-        st_lattice_free(L);
-        return st_error_set(err, ST_ENOMEM, NULL, 0,
-                            "out of memory for a lattice of %zu tets", cap);
-    }
+    *cap = (size_t)ntets_d;
+    return ST_OK;
+}
+
+/* Every vertex's position: x = center + R (offset + g h / 2). */
+static void lattice_vertices(st_lattice *L)
+{
     for (size_t v = 0; v < L->nverts; v++) {
         int64_t g[3];
         st_lattice_vertex_coords(L, (uint32_t)v, g);
         double u[3];
         for (int a = 0; a < 3; a++)
-            u[a] = L->offset[a] + (double)g[a] * (0.5 * p->h);
+            u[a] = L->offset[a] + (double)g[a] * (0.5 * L->h);
         for (int a = 0; a < 3; a++)
             L->xyz[3 * v + (size_t)a] = L->center[a] + L->rot[3 * a] * u[0] +
                                         L->rot[3 * a + 1] * u[1] +
                                         L->rot[3 * a + 2] * u[2];
     }
-    size_t nt = 0;
-    const size_t *n = L->n;
-    const st_progress stop = {NULL, NULL, p->cancel};
-    for (size_t k = 0; k < n[2]; k++) {
-        if (st_progress_cancelled(&stop)) {
-            st_lattice_free(L);
-            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+}
+
+/* Cube (i, j, k) of the 5-tet lattice: a central tet and four corners. */
+static void cubic5_cell(st_lattice *L, size_t *nt, size_t i, size_t j, size_t k)
+{
+    /* Corner c = (a, b, cc) bits; global parity decides which four
+     * corners form the central tet. */
+    int64_t par = (int64_t)(i + j + k) + L->cell_lo[0] + L->cell_lo[1] +
+                  L->cell_lo[2];
+    uint32_t v[8];
+    uint32_t ev[4], od[4];
+    int ne = 0, no = 0;
+    for (int c = 0; c < 8; c++) {
+        int a = c & 1, b = (c >> 1) & 1, cc = (c >> 2) & 1;
+        v[c] = corner_id(L, i + (size_t)a, j + (size_t)b, k + (size_t)cc);
+        if (((a + b + cc + par) & 1) == 0)
+            ev[ne++] = (uint32_t)c;
+        else
+            od[no++] = (uint32_t)c;
+    }
+    put_tet(L, nt, v[ev[0]], v[ev[1]], v[ev[2]], v[ev[3]]);
+    for (int o = 0; o < 4; o++) {
+        uint32_t nb[3];
+        for (int b = 0; b < 3; b++)
+            nb[b] = v[od[o] ^ (1u << b)];
+        put_tet(L, nt, v[od[o]], nb[0], nb[1], nb[2]);
+    }
+}
+
+/* Cell (i, j, k) of the BCC lattice: the four tets around each face it
+ * shares with its lower neighbours, between the two centres. */
+static void bcc_cell(st_lattice *L, size_t *nt, size_t i, size_t j, size_t k)
+{
+    size_t ci[3] = {i, j, k};
+    uint32_t cthis = centre_id(L, i, j, k);
+    for (int ax = 0; ax < 3; ax++) {
+        if (ci[ax] == 0)
+            continue;
+        size_t cn[3] = {i, j, k};
+        cn[ax]--;
+        uint32_t cnbr = centre_id(L, cn[0], cn[1], cn[2]);
+        int u = (ax + 1) % 3, w = (ax + 2) % 3;
+        /* The face's corners in cyclic order. */
+        static const int du[4] = {0, 1, 1, 0};
+        static const int dw[4] = {0, 0, 1, 1};
+        uint32_t fc[4];
+        for (int q = 0; q < 4; q++) {
+            size_t cc[3] = {i, j, k};
+            cc[u] += (size_t)du[q];
+            cc[w] += (size_t)dw[q];
+            fc[q] = corner_id(L, cc[0], cc[1], cc[2]);
         }
-        for (size_t j = 0; j < n[1]; j++)
-            for (size_t i = 0; i < n[0]; i++) {
-                if (p->kind == ST_LATTICE_CUBIC5) {
-                    /* Corner c = (a, b, cc) bits; global parity decides
-                     * which four corners form the central tet. */
-                    int64_t par = (int64_t)(i + j + k) + L->cell_lo[0] +
-                                  L->cell_lo[1] + L->cell_lo[2];
-                    uint32_t v[8];
-                    uint32_t ev[4], od[4];
-                    int ne = 0, no = 0;
-                    for (int c = 0; c < 8; c++) {
-                        int a = c & 1, b = (c >> 1) & 1, cc = (c >> 2) & 1;
-                        v[c] = corner_id(L, i + (size_t)a, j + (size_t)b,
-                                         k + (size_t)cc);
-                        if (((a + b + cc + par) & 1) == 0)
-                            ev[ne++] = (uint32_t)c;
-                        else
-                            od[no++] = (uint32_t)c;
-                    }
-                    put_tet(L, &nt, v[ev[0]], v[ev[1]], v[ev[2]], v[ev[3]]);
-                    for (int o = 0; o < 4; o++) {
-                        uint32_t nb[3];
-                        for (int b = 0; b < 3; b++)
-                            nb[b] = v[od[o] ^ (1u << b)];
-                        put_tet(L, &nt, v[od[o]], nb[0], nb[1], nb[2]);
-                    }
-                } else {
-                    size_t ci[3] = {i, j, k};
-                    uint32_t cthis = centre_id(L, i, j, k);
-                    for (int ax = 0; ax < 3; ax++) {
-                        if (ci[ax] == 0)
-                            continue;
-                        size_t cn[3] = {i, j, k};
-                        cn[ax]--;
-                        uint32_t cnbr = centre_id(L, cn[0], cn[1], cn[2]);
-                        int u = (ax + 1) % 3, w = (ax + 2) % 3;
-                        /* The face's corners in cyclic order. */
-                        static const int du[4] = {0, 1, 1, 0};
-                        static const int dw[4] = {0, 0, 1, 1};
-                        uint32_t fc[4];
-                        for (int q = 0; q < 4; q++) {
-                            size_t cc[3] = {i, j, k};
-                            cc[u] += (size_t)du[q];
-                            cc[w] += (size_t)dw[q];
-                            fc[q] = corner_id(L, cc[0], cc[1], cc[2]);
-                        }
-                        for (int q = 0; q < 4; q++)
-                            put_tet(L, &nt, fc[q], fc[(q + 1) % 4], cthis,
-                                    cnbr);
-                    }
-                }
+        for (int q = 0; q < 4; q++)
+            put_tet(L, nt, fc[q], fc[(q + 1) % 4], cthis, cnbr);
+    }
+}
+
+st_status st_lattice_build(st_lattice **out, const double lo[3],
+                           const double hi[3], const st_lattice_params *p,
+                           st_error *err)
+{
+    *out = NULL;
+    for (int a = 0; a < 3; a++)
+        if (!isfinite(lo[a]) || !isfinite(hi[a]) || lo[a] > hi[a])
+            return st_error_set(err, ST_EINPUT, NULL, 0,
+                                "lattice box is empty or not finite");
+    if (!(p->h > 0) || !isfinite(p->h))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "lattice cell width %g is not a positive number",
+                            p->h);
+    if (p->pad < 0 || p->pad > 1000)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "lattice padding %d is out of range", p->pad);
+    st_lattice *L = calloc(1, sizeof *L);
+    if (!L)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    const st_progress stop = {NULL, NULL, p->cancel};
+    size_t cap = 0, nt = 0;
+    lattice_frame(L, lo, hi, p);
+    st_status st = lattice_cells(L, &cap, lo, hi, p, err);
+    if (st)
+        goto done;
+    L->xyz = st_malloc_array(L->nverts, 3 * sizeof(double));
+    L->tets = st_malloc_array(cap, 4 * sizeof(uint32_t));
+    if (!L->xyz || !L->tets) {
+        st = st_error_set(err, ST_ENOMEM, NULL, 0,
+                          "out of memory for a lattice of %zu tets", cap);
+        goto done;
+    }
+    lattice_vertices(L);
+    for (size_t k = 0; k < L->n[2]; k++) {
+        if (st_progress_cancelled(&stop)) {
+            st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+            goto done;
+        }
+        for (size_t j = 0; j < L->n[1]; j++)
+            for (size_t i = 0; i < L->n[0]; i++) {
+                if (p->kind == ST_LATTICE_CUBIC5)
+                    cubic5_cell(L, &nt, i, j, k);
+                else
+                    bcc_cell(L, &nt, i, j, k);
             }
     }
     L->ntets = nt;
-    st_status st = build_topology(L, &stop, err);
-    if (st) {
+    st = build_topology(L, &stop, err);
+done:
+    if (st)
         st_lattice_free(L);
-        return st;
-    }
-    *out = L;
-    return ST_OK;
+    else
+        *out = L;
+    return st;
 }
 
 st_status st_lattice_to_tetmesh(st_tetmesh **out, const st_lattice *L,
