@@ -118,28 +118,29 @@ static int face_visit(void *ctx, uint32_t tri)
                                 c->s->xyz + 3 * (size_t)v[1], c->s->xyz + 3 * (size_t)v[2]);
 }
 
-/* How many of s's used vertices are not float32 values (*n); 1 when out
- * of memory. */
-static int input_not_float32(const st_soup *s, size_t *n)
+/* How many of s's used vertices are not float32 values (*n); ST_ENOMEM
+ * (err set) when out of memory. */
+static st_status input_not_float32(const st_soup *s, size_t *n, st_error *err)
 {
     unsigned char *used = st_calloc_array(s->nverts ? s->nverts : 1, 1);
     if (!used)
-        return 1;
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     for (size_t i = 0; i < 3 * s->ntris; i++)
         used[s->tris[i]] = 1;
     for (size_t v = 0; v < s->nverts; v++)
         if (used[v] && !st_points_are_float32(s->xyz + 3 * v, 1))
             (*n)++;
     free(used);
-    return 0;
+    return ST_OK;
 }
 
 /* The boundary faces around each point (CSR: aoff, np + 1 zeroed slots;
  * adj, 3 nf) and each face's unit outward normal (st_tetmesh_boundary
- * turns them out of positive tets), at the points xyz. 1 when out of
- * memory. */
-static int boundary_stars(const uint32_t *faces, size_t nf, const double *xyz, size_t np,
-                          double *normals, size_t *aoff, uint32_t *adj)
+ * turns them out of positive tets), at the points xyz. ST_ENOMEM (err
+ * set) when out of memory. */
+static st_status boundary_stars(const uint32_t *faces, size_t nf, const double *xyz,
+                                size_t np, double *normals, size_t *aoff, uint32_t *adj,
+                                st_error *err)
 {
     for (size_t f = 0; f < nf; f++) {
         const uint32_t *q = faces + 3 * f;
@@ -161,14 +162,14 @@ static int boundary_stars(const uint32_t *faces, size_t nf, const double *xyz, s
         aoff[v + 1] += aoff[v];
     size_t *fill = st_malloc_array(np ? np : 1, sizeof *fill);
     if (!fill)
-        return 1;
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     if (np)
         memcpy(fill, aoff, np * sizeof *fill);
     for (size_t f = 0; f < nf; f++)
         for (int k = 0; k < 3; k++)
             adj[fill[faces[3 * f + (size_t)k]]++] = (uint32_t)f;
     free(fill);
-    return 0;
+    return ST_OK;
 }
 
 /* Tets of m that are not positively oriented (exact). */
@@ -265,6 +266,166 @@ static st_status mark_failures(unsigned char *mark, unsigned char *fmark, int *a
     return ST_OK;
 }
 
+/* The rounding's state: the mesh as it was (orig, before), its boundary
+ * faces with their normals and the faces around each point (aoff, adj),
+ * each point's push level and score, the best rounding tried, and the
+ * enclosure test's scratch. */
+typedef struct f32_state {
+    st_tetmesh *m;
+    const st_soup *s;
+    const st_bvh *bvh;
+    size_t np, nf;
+    uint32_t *faces;
+    double *orig, *normals;
+    size_t *aoff;
+    uint32_t *adj;
+    unsigned *level;
+    double *score, *best_xyz;
+    unsigned *best_level;
+    unsigned char *vin, *hit, *mark, *fmark;
+    st_bvh *own;
+    st_locator *loc;
+    st_tetmesh before;   /* m at orig, for finding where a soup vertex lay */
+    int copied;          /* orig holds m's points */
+} f32_state;
+
+static void f32_free(f32_state *F)
+{
+    st_locator_free(F->loc);
+    st_bvh_free(F->own);
+    void *arrays[] = {F->faces, F->orig,  F->normals, F->aoff,  F->adj,
+                      F->level, F->score, F->best_xyz, F->best_level, F->mark,
+                      F->fmark, F->vin,   F->hit};
+    for (size_t i = 0; i < sizeof arrays / sizeof *arrays; i++)
+        free(arrays[i]);
+}
+
+/* The boundary, its stars and normals (st->boundary_points), the
+ * scratch, and a BVH over the soup when none was given. */
+static st_status f32_setup(f32_state *F, st_float32_stats *st, st_error *err)
+{
+    st_status rc = st_tetmesh_boundary(F->m, &F->faces, NULL, &F->nf, err);
+    if (rc)
+        return rc;
+    const size_t np = F->np, nf = F->nf;
+    F->orig = st_malloc_array(np ? np : 1, 3 * sizeof *F->orig);
+    F->normals = st_malloc_array(nf ? nf : 1, 3 * sizeof *F->normals);
+    F->aoff = st_calloc_array(np + 1, sizeof *F->aoff);
+    F->adj = st_malloc_array(nf ? 3 * nf : 1, sizeof *F->adj);
+    F->level = st_calloc_array(np ? np : 1, sizeof *F->level);
+    F->score = st_malloc_array(np ? np : 1, sizeof *F->score);
+    F->best_xyz = st_malloc_array(np ? np : 1, 3 * sizeof *F->best_xyz);
+    F->best_level = st_malloc_array(np ? np : 1, sizeof *F->best_level);
+    F->mark = st_calloc_array(np ? np : 1, 1);
+    F->fmark = st_calloc_array(nf ? nf : 1, 1);
+    F->vin = st_malloc_array(F->s->nverts ? F->s->nverts : 1, 1);
+    F->hit = st_malloc_array(F->s->ntris ? F->s->ntris : 1, 1);
+    if (!F->orig || !F->normals || !F->aoff || !F->adj || !F->level || !F->score ||
+        !F->best_xyz || !F->best_level || !F->mark || !F->fmark || !F->vin || !F->hit)
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory rounding %zu points to float32", np);
+    if (np)
+        memcpy(F->orig, F->m->xyz, np * 3 * sizeof *F->orig);
+    F->copied = 1;
+    if ((rc = boundary_stars(F->faces, nf, F->orig, np, F->normals, F->aoff, F->adj, err)))
+        return rc;
+    for (size_t v = 0; v < np; v++)
+        st->boundary_points += F->aoff[v + 1] > F->aoff[v];
+    if (!F->bvh && F->s->ntris) {
+        if ((rc = st_bvh_build(&F->own, F->s, err)))
+            return rc;
+        F->bvh = F->own;
+    }
+    F->before = *F->m;
+    F->before.xyz = F->orig;
+    return ST_OK;
+}
+
+/* 1 when a has fewer failures than b: vertices outside, then triangles
+ * crossing, then inverted tets. */
+static int f32_fewer_failures(const st_float32_stats *a, const st_float32_stats *b)
+{
+    return a->verts_outside < b->verts_outside ||
+           (a->verts_outside == b->verts_outside &&
+            (a->tris_crossing < b->tris_crossing ||
+             (a->tris_crossing == b->tris_crossing && a->inverted < b->inverted)));
+}
+
+/* Push out the boundary points named near the failure (all of them when
+ * *all): the next round rounds them one float further out. A point whose
+ * float goes inward by some face around it (score < 0: faces around it
+ * facing nearly opposite ways, a knife edge) would only go farther in by
+ * it: it stays. (Score 0: a point on the float grid under a face along
+ * it; one ulp out is outward.) Returns the number pushed. */
+static size_t f32_push(f32_state *F, int all)
+{
+    size_t bumped = 0;
+    for (size_t v = 0; v < F->np; v++)
+        if ((all || F->mark[v]) && F->aoff[v + 1] > F->aoff[v] && F->score[v] >= 0) {
+            F->level[v]++;
+            bumped++;
+        }
+    return bumped;
+}
+
+/* The rounds: round every point at its level, check exactly, keep the
+ * best rounding tried, push the points near the failure; at the end m
+ * holds the best rounding and *st its counts. */
+static st_status f32_rounds(f32_state *F, st_float32_stats *st, st_error *err)
+{
+    st_tetmesh *m = F->m;
+    const size_t np = F->np;
+    st_status rc;
+    st_float32_stats best = *st;
+    int have_best = 0;
+    for (int round = 1; round <= ST_FLOAT32_MAX_ROUNDS; round++) {
+        for (size_t v = 0; v < np; v++)
+            F->score[v] = round_point(m->xyz + 3 * v, F->orig + 3 * v, F->level[v],
+                                      F->adj + F->aoff[v], F->aoff[v + 1] - F->aoff[v],
+                                      F->normals);
+        st->rounds = round;
+        st_enclosure e;
+        if ((rc = st_enclosure_compute(&e, m, F->s, F->bvh, F->vin, F->hit, err)))
+            return rc;
+        const size_t inverted = count_not_positive(m);
+        st->verts_outside = e.vertices_outside;
+        st->tris_crossing = e.crossing_triangles;
+        st->inverted = inverted;
+        st->encloses = e.encloses && inverted == 0;
+        if (!have_best || f32_fewer_failures(st, &best)) {
+            best = *st;
+            have_best = 1;
+            if (np) {
+                memcpy(F->best_xyz, m->xyz, np * 3 * sizeof *F->best_xyz);
+                memcpy(F->best_level, F->level, np * sizeof *F->best_level);
+            }
+        }
+        if (st->encloses || round == ST_FLOAT32_MAX_ROUNDS)
+            break;
+        if (e.encloses)
+            break;   /* only inversions: pushing out is no cure */
+        /* Name the boundary points near the failure. */
+        int all = 0;
+        if ((rc = mark_failures(F->mark, F->fmark, &all, &F->loc, &F->before, m, F->s,
+                                F->bvh, F->faces, F->nf, F->aoff, &e, F->vin, F->hit,
+                                err)))
+            return rc;
+        if (f32_push(F, all) == 0)
+            break;   /* nothing left to try */
+    }
+    if (!st->encloses && have_best) {
+        /* Keep the best rounding tried, with its counts. */
+        int rounds = st->rounds;
+        *st = best;
+        st->rounds = rounds;
+        if (np) {
+            memcpy(m->xyz, F->best_xyz, np * 3 * sizeof *F->best_xyz);
+            memcpy(F->level, F->best_level, np * sizeof *F->level);
+        }
+    }
+    return ST_OK;
+}
+
 st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
                                      const st_bvh *bvh, st_float32_stats *st,
                                      st_error *err)
@@ -283,142 +444,18 @@ st_status st_enclosure_round_float32(st_tetmesh *m, const st_soup *s,
             return st_error_set(err, ST_ELIMIT, NULL, 0,
                                 "a mesh coordinate (%g) is beyond the float32 range",
                                 m->xyz[i]);
-    if (input_not_float32(s, &st->input_not_float32))
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    st_status rc = input_not_float32(s, &st->input_not_float32, err);
+    if (rc)
+        return rc;
 
-    st_status rc = ST_OK;
-    uint32_t *faces = NULL;
-    size_t nf = 0;
-    double *orig = NULL, *normals = NULL;
-    size_t *aoff = NULL;
-    uint32_t *adj = NULL;
-    unsigned *level = NULL;
-    double *score = NULL, *best_xyz = NULL;
-    unsigned *best_level = NULL;
-    unsigned char *vin = NULL, *hit = NULL, *mark = NULL, *fmark = NULL;
-    st_bvh *own = NULL;
-    st_locator *loc = NULL;
-    st_tetmesh before;
-    int copied = 0;
-
-    if ((rc = st_tetmesh_boundary(m, &faces, NULL, &nf, err)))
+    f32_state F = {.m = m, .s = s, .bvh = bvh, .np = np};
+    if ((rc = f32_setup(&F, st, err)) || (rc = f32_rounds(&F, st, err)))
         goto out;
-    orig = st_malloc_array(np ? np : 1, 3 * sizeof *orig);
-    normals = st_malloc_array(nf ? nf : 1, 3 * sizeof *normals);
-    aoff = st_calloc_array(np + 1, sizeof *aoff);
-    adj = st_malloc_array(nf ? 3 * nf : 1, sizeof *adj);
-    level = st_calloc_array(np ? np : 1, sizeof *level);
-    score = st_malloc_array(np ? np : 1, sizeof *score);
-    best_xyz = st_malloc_array(np ? np : 1, 3 * sizeof *best_xyz);
-    best_level = st_malloc_array(np ? np : 1, sizeof *best_level);
-    mark = st_calloc_array(np ? np : 1, 1);
-    fmark = st_calloc_array(nf ? nf : 1, 1);
-    vin = st_malloc_array(s->nverts ? s->nverts : 1, 1);
-    hit = st_malloc_array(s->ntris ? s->ntris : 1, 1);
-    if (!orig || !normals || !aoff || !adj || !level || !score || !best_xyz || !best_level || !mark ||
-        !fmark || !vin || !hit) {
-        rc = st_error_set(err, ST_ENOMEM, NULL, 0,
-                          "out of memory rounding %zu points to float32", np);
-        goto out;
-    }
-    if (np)
-        memcpy(orig, m->xyz, np * 3 * sizeof *orig);
-    copied = 1;
-    if (boundary_stars(faces, nf, orig, np, normals, aoff, adj)) {
-        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
-        goto out;
-    }
-    for (size_t v = 0; v < np; v++)
-        st->boundary_points += aoff[v + 1] > aoff[v];
-    if (!bvh && s->ntris) {
-        if ((rc = st_bvh_build(&own, s, err)))
-            goto out;
-        bvh = own;
-    }
-    /* The mesh as it was, for finding where a soup vertex lay. */
-    before = *m;
-    before.xyz = orig;
-
-    /* The best rounding tried (fewest failures: vertices outside, then
-     * triangles crossing, then inverted tets) is the one kept. */
-    st_float32_stats best = *st;
-    int have_best = 0;
-    for (int round = 1; round <= ST_FLOAT32_MAX_ROUNDS; round++) {
-        for (size_t v = 0; v < np; v++)
-            score[v] = round_point(m->xyz + 3 * v, orig + 3 * v, level[v], adj + aoff[v],
-                                   aoff[v + 1] - aoff[v], normals);
-        st->rounds = round;
-        st_enclosure e;
-        if ((rc = st_enclosure_compute(&e, m, s, bvh, vin, hit, err)))
-            goto out;
-        const size_t inverted = count_not_positive(m);
-        st->verts_outside = e.vertices_outside;
-        st->tris_crossing = e.crossing_triangles;
-        st->inverted = inverted;
-        st->encloses = e.encloses && inverted == 0;
-        if (!have_best || st->verts_outside < best.verts_outside ||
-            (st->verts_outside == best.verts_outside &&
-             (st->tris_crossing < best.tris_crossing ||
-              (st->tris_crossing == best.tris_crossing && st->inverted < best.inverted)))) {
-            best = *st;
-            have_best = 1;
-            if (np) {
-                memcpy(best_xyz, m->xyz, np * 3 * sizeof *best_xyz);
-                memcpy(best_level, level, np * sizeof *best_level);
-            }
-        }
-        if (st->encloses || round == ST_FLOAT32_MAX_ROUNDS)
-            break;
-        if (e.encloses)
-            break;   /* only inversions: pushing out is no cure */
-        /* Name the boundary points near the failure. */
-        int all = 0;
-        if ((rc = mark_failures(mark, fmark, &all, &loc, &before, m, s, bvh, faces, nf, aoff,
-                                &e, vin, hit, err)))
-            goto out;
-        /* A point whose float goes inward by some face around it (score
-         * < 0: faces around it facing nearly opposite ways, a knife edge)
-         * would only go farther in by it: it stays; the other points
-         * named go out. (Score 0: a point on the float grid under a face
-         * along it; one ulp out is outward.) */
-        size_t bumped = 0;
-        for (size_t v = 0; v < np; v++)
-            if ((all || mark[v]) && aoff[v + 1] > aoff[v] && score[v] >= 0) {
-                level[v]++;
-                bumped++;
-            }
-        if (bumped == 0)
-            break;   /* nothing left to try */
-    }
-    if (!st->encloses && have_best) {
-        /* Keep the best rounding tried, with its counts. */
-        int rounds = st->rounds;
-        *st = best;
-        st->rounds = rounds;
-        if (np) {
-            memcpy(m->xyz, best_xyz, np * 3 * sizeof *best_xyz);
-            memcpy(level, best_level, np * sizeof *level);
-        }
-    }
-    move_stats(st, orig, m->xyz, level, np);
+    move_stats(st, F.orig, m->xyz, F.level, np);
 out:
     st->seconds = now_seconds() - t0;
-    if (rc && copied && np)
-        memcpy(m->xyz, orig, np * 3 * sizeof *orig);   /* as it was */
-    st_locator_free(loc);
-    st_bvh_free(own);
-    free(faces);
-    free(orig);
-    free(normals);
-    free(aoff);
-    free(adj);
-    free(level);
-    free(score);
-    free(best_xyz);
-    free(best_level);
-    free(mark);
-    free(fmark);
-    free(vin);
-    free(hit);
+    if (rc && F.copied && np)
+        memcpy(m->xyz, F.orig, np * 3 * sizeof *F.orig);   /* as it was */
+    f32_free(&F);
     return rc;
 }
