@@ -201,199 +201,290 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
     return tool_output_check(t, s->co.out);
 }
 
+/* What run builds and reads as it goes, freed at its end. */
+typedef struct lt_run {
+    const latticetet_settings *s;
+    const char *in_name;
+    st_grid *g;
+    st_soup *soup;
+    st_lattice *L;
+    st_tetmesh *m;
+    double lo[3], hi[3];   /* the field's box */
+    double h;              /* the cell width */
+    size_t cells;          /* --cells (the last tried with auto) */
+    size_t max_tets;       /* the most tets --max-memory allows */
+    size_t thin_parts;     /* of the last density try: why no tets */
+    double t_read;         /* seconds to read the inputs */
+    double t_lattice;      /* when the lattices began (the end of the
+                            * reading: with --cells auto, the lattice
+                            * time of a try counts the tries before it) */
+} lt_run;
+
+/* --cells auto: the sizes it tries, coarse to fine; the first at which no
+ * part of the pseudo volume is too thin is kept. */
+static const size_t auto_seq[] = {8, 10, 12, 14, 16, 20, 24, 28, 32, 40,
+                                  48, 56, 64, 80, 96, 112, 128};
+#define N_AUTO (sizeof auto_seq / sizeof auto_seq[0])
+
+static const char *const limit_hint = "use fewer --cells or a larger --size, or raise "
+                                      "--max-memory";
+
+/* The signed field, and with --sculpt the surface. 0, or the exit status
+ * after an error was printed. */
+static int read_inputs(tool_ctx *t, lt_run *R, st_error *err)
+{
+    const latticetet_settings *s = R->s;
+    if (st_grid_read(&R->g, s->in, s->co.max_bytes, err) ||
+        tool_check_field_finite(R->g, R->in_name, err))
+        return tool_fail(t, err);
+    if (R->g->kind != ST_GRID_SIGNED) {
+        st_error_set(err, ST_EINPUT, R->in_name, 0,
+                     "the field is %s, not signed (run soupsign first)",
+                     st_grid_kind_name(R->g->kind));
+        return tool_fail(t, err);
+    }
+    if (s->sculpt && tool_soup_read(t, &R->soup, s->surface, err))
+        return tool_fail(t, err);
+    return 0;
+}
+
+/* The cell width: --size, or --cells over the field's box (over the
+ * surface's box with --sculpt, as soupmesh counts them). */
+static int cell_width(tool_ctx *t, lt_run *R, st_error *err)
+{
+    st_lattice_grid_box(R->g, R->lo, R->hi);
+    R->h = R->s->size > 0 ? R->s->size : st_lattice_h_for_cells(R->lo, R->hi, R->cells);
+    if (R->s->sculpt && !(R->s->size > 0)) {
+        double slo[3], shi[3];
+        if (st_soup_bounds(R->soup, slo, shi, err))
+            return tool_fail(t, err);
+        R->h = st_lattice_h_for_cells(slo, shi, R->cells);
+    }
+    return 0;
+}
+
+/* -v (and warnings): what the density filter's cleanup did; final: the
+ * thin parts are news (with --cells auto, only the last try's). */
+static void say_cleanup(tool_ctx *t, const lt_run *R, const st_density_clean_stats *cs,
+                        int final)
+{
+    tool_say(t, 2, "cleanup: %zu pieces of pseudo volume, %zu of "
+             "tets; %zu tets filled and %zu dropped at pinched "
+             "vertices; %zu pieces joined (%zu tets), %zu islands "
+             "dropped (%zu tets)", cs->pieces, cs->tet_pieces,
+             cs->filled, cs->dropped, cs->joins, cs->join_tets,
+             cs->islands, cs->island_tets);
+    if (cs->specks)
+        tool_say(t, 2, "%zu specks of the pseudo volume smaller than "
+                 "a tet (%zu voxels) not meshed", cs->specks,
+                 cs->speck_voxels);
+    if (cs->bad_vertices_left)
+        tool_say(t, 1, "warning: the boundary is not manifold at "
+                 "%zu vertices", cs->bad_vertices_left);
+    for (size_t q = 0; q < cs->nthin && q < ST_CLEAN_MAX_THIN; q++) {
+        const st_thin_part *p = &cs->thin[q];
+        tool_say(t, final ? 1 : 2, "%s: warning: a part of the pseudo volume is "
+                 "too thin for this lattice (h %.4g): %zu voxels in "
+                 "(%.4g %.4g %.4g)-(%.4g %.4g %.4g), %.4g thick, "
+                 "%.0f%% of it meshed; --cells %zu would hold it",
+                 R->in_name, R->h, p->voxels, p->lo[0], p->lo[1], p->lo[2],
+                 p->hi[0], p->hi[1], p->hi[2], p->thickness,
+                 100.0 * p->held, p->cells);
+    }
+    if (cs->nthin > ST_CLEAN_MAX_THIN)
+        tool_say(t, final ? 1 : 2, "%s: warning: %zu more parts too thin",
+                 R->in_name, cs->nthin - ST_CLEAN_MAX_THIN);
+}
+
+/* One density try at R->h: the lattice, the filter and its cleanup, the
+ * -v report; *nthin the parts too thin. 0, or the exit status after an
+ * error was printed. */
+static int density_try(tool_ctx *t, lt_run *R, int final_try, size_t *nthin,
+                       st_error *err)
+{
+    const latticetet_settings *s = R->s;
+    st_density_stats ds;
+    st_lattice_params lp = st_lattice_params_default();
+    lp.kind = s->kind;
+    lp.h = R->h;
+    lp.seed = s->seed;
+    lp.max_tets = R->max_tets;
+    if (st_lattice_build(&R->L, R->lo, R->hi, &lp, err)) {
+        if (!err->file[0])
+            snprintf(err->file, sizeof err->file, "%s", R->in_name);
+        tool_limit_hint(err, limit_hint);
+        return tool_fail(t, err);
+    }
+    double t2 = tool_now();
+    st_density_clean_stats cs;
+    memset(&cs, 0, sizeof cs);
+    if (st_lattice_density_filter_clean(&R->m, &ds, &cs, R->L, R->g, s->rho, s->repair,
+                                        err))
+        return tool_fail_file(t, err, R->in_name);
+    double t3 = tool_now();
+    const st_grid *g = R->g;
+    const st_lattice *L = R->L;
+    tool_say(t, 2, "grid %zux%zux%zu, voxel %.6g; %s lattice, h %.6g "
+             "(%.3g voxels), %zux%zux%zu cells, seed %" PRIu64,
+             g->nx, g->ny, g->nz, g->voxel, st_lattice_kind_name(s->kind), R->h,
+             R->h / g->voxel, L->n[0], L->n[1], L->n[2], s->seed);
+    tool_say(t, 2, "%zu of %zu lattice tets kept (rho >= %g); %zu decided "
+             "by their centroid's voxel; %zu point tests",
+             ds.kept, ds.lattice_tets, s->rho, ds.centroid_rule, ds.point_tests);
+    tool_say(t, 2, "read %.3f s, lattice %.3f s, density %.3f s",
+             R->t_read, t2 - R->t_lattice, t3 - t2);
+    if (s->repair)
+        say_cleanup(t, R, &cs, !s->auto_cells || cs.nthin == 0 || final_try);
+    *nthin = cs.nthin;
+    return 0;
+}
+
+/* --density: one try, or with --cells auto the tries of auto_seq until no
+ * part is too thin. */
+static int density_mesh(tool_ctx *t, lt_run *R, st_error *err)
+{
+    const int auto_cells = R->s->auto_cells;
+    for (size_t try_i = 0;; try_i++) {
+        if (auto_cells) {
+            st_lattice_free(R->L);
+            st_tetmesh_free(R->m);
+            R->L = NULL;
+            R->m = NULL;
+            R->cells = auto_seq[try_i];
+            R->h = st_lattice_h_for_cells(R->lo, R->hi, R->cells);
+        }
+        int rc = density_try(t, R, try_i + 1 == N_AUTO, &R->thin_parts, err);
+        if (rc || !auto_cells)
+            return rc;
+        if (R->thin_parts == 0) {
+            tool_say(t, 1, "--cells auto: %zu cells (h %.6g)", R->cells, R->h);
+            return 0;
+        }
+        if (try_i + 1 == N_AUTO) {
+            tool_say(t, 1, "%s: warning: --cells auto: parts still too thin at "
+                     "%zu cells, the finest it tries", R->in_name, R->cells);
+            return 0;
+        }
+    }
+}
+
+/* -v (and warnings): what the sculpt and its repairs did. */
+static void say_sculpt(tool_ctx *t, const lt_run *R, const st_sculpt_stats *ss)
+{
+    const latticetet_settings *s = R->s;
+    const st_grid *g = R->g;
+    tool_say(t, 2, "grid %zux%zux%zu, voxel %.6g; %s lattice, h %.6g "
+             "(%.3g voxels), seed %" PRIu64 "; surface %s: %zu triangles",
+             g->nx, g->ny, g->nz, g->voxel, st_lattice_kind_name(s->kind), R->h,
+             R->h / g->voxel, s->seed, s->surface, R->soup->ntris);
+    tool_say(t, 2, "%zu lattice tets: %zu overlap the pseudo volume, "
+             "%zu more meet a triangle", ss->lattice_tets, ss->kept_volume,
+             ss->kept_surface);
+    tool_say(t, 2, "bombs: %zu found (%zu with 3 boundary faces, %zu "
+             "isolated), %zu clusters (largest %zu; %zu searched exactly, "
+             "%zu too large: greedy), %zu snowflakes add %zu tets "
+             "(greedy: %zu), %zu rounds, %zu left",
+             ss->bombs, ss->bombs_3faces, ss->bombs_4faces, ss->clusters,
+             ss->largest_cluster, ss->clusters_exact, ss->clusters_greedy,
+             ss->snowflakes, ss->bomb_tets, ss->greedy_tets, ss->repair_rounds,
+             ss->bombs_left);
+    tool_say(t, 2, "boundary: %zu non-manifold vertices, %zu edges; "
+             "%zu tets added; %zu vertices, %zu edges left",
+             ss->nonmanifold_vertices, ss->nonmanifold_edges,
+             ss->manifold_tets, ss->nonmanifold_vertices_left,
+             ss->nonmanifold_edges_left);
+    tool_say(t, 2, "%zu tets; read %.3f s, lattice %.3f s, classify "
+             "%.3f s, repair %.3f s, mesh %.3f s", ss->tets, R->t_read,
+             ss->t_lattice, ss->t_classify, ss->t_repair, ss->t_mesh);
+    if (ss->bombs_left)
+        tool_say(t, 1, "warning: %zu bombs could not be repaired",
+                 ss->bombs_left);
+    if (ss->nonmanifold_vertices_left)
+        tool_say(t, 1, "warning: the boundary is not manifold at %zu "
+                 "vertices", ss->nonmanifold_vertices_left);
+}
+
+/* --sculpt: the BCC lattice sculpted to the field and the surface, bombs
+ * and the boundary repaired. */
+static int sculpt_mesh(tool_ctx *t, lt_run *R, st_error *err)
+{
+    const latticetet_settings *s = R->s;
+    st_sculpt_params sp = st_sculpt_params_default();
+    sp.kind = s->kind;
+    sp.h = R->h;
+    sp.seed = s->seed;
+    sp.max_tets = R->max_tets;
+    sp.repair_bombs = sp.repair_manifold = s->repair;
+    st_sculpt_stats ss;
+    if (st_sculpt(&R->m, &ss, R->g, R->soup, NULL, &sp, err)) {
+        if (!err->file[0])
+            snprintf(err->file, sizeof err->file, "%s", R->in_name);
+        tool_limit_hint(err, limit_hint);
+        return tool_fail(t, err);
+    }
+    say_sculpt(t, R, &ss);
+    return 0;
+}
+
+/* --parts: each tet's part, on the field's grid (parts.h). */
+static int tag_parts(tool_ctx *t, lt_run *R, st_error *err)
+{
+    st_parts parts;
+    st_pseudo_params pp = st_pseudo_params_default();
+    st_status ps = st_parts_split(&parts, R->soup, (st_parts_mode)R->s->parts_mode, err);
+    if (!ps) {
+        tool_say(t, 1, "%zu part%s (%s)", parts.nparts, parts.nparts == 1 ? "" : "s",
+                 st_parts_mode_name(parts.mode));
+        st_progress prog = tool_progress(t);
+        ps = st_parts_tag(R->m, R->soup, &parts, R->g, &pp, NULL, &prog, err);
+        tool_progress_end(t);
+    }
+    st_parts_free(&parts);
+    if (ps)
+        return tool_fail_file(t, err, tool_in_name(R->s->surface));
+    return 0;
+}
+
+/* The mesh on disk, with the field's metadata (source, history; the
+ * lattice's own keys win) and this run's. */
+static int write_mesh(tool_ctx *t, lt_run *R, st_error *err)
+{
+    st_tetmesh *m = R->m;
+    if (st_meta_inherit(&m->meta, &R->g->meta) != ST_OK ||
+        tool_meta_record(t, &m->meta) != ST_OK)
+        return tool_fail_nomem(t, err);
+    double tw = tool_now();
+    if (st_tetmesh_save(m, R->s->co.out, &R->s->co.tetformat, err))
+        return tool_fail(t, err);
+    tool_say(t, 2, "%zu tets, %zu points; write %.3f s", m->ntets, m->npoints,
+             tool_now() - tw);
+    return 0;
+}
+
 static int run(tool_ctx *t, void *settings)
 {
     const latticetet_settings *s = settings;
-    const char *in = s->in, *surface = s->surface;
-    const st_lattice_kind kind = s->kind;
-    const int sculpt = s->sculpt, repair = s->repair, auto_cells = s->auto_cells;
-    const double rho = s->rho, size = s->size;
-    const uint64_t seed = s->seed;
-    size_t cells = s->cells;
     tool_set_threads(s->co.threads);
     st_error err;
     st_error_clear(&err);
-    st_grid *g = NULL;
-    st_soup *soup = NULL;
-    st_lattice *L = NULL;
-    st_tetmesh *m = NULL;
-    int rc = TOOL_EXIT_FAIL;
-    const char *in_name = tool_in_name(in);
+    lt_run R = {.s = s, .in_name = tool_in_name(s->in), .cells = s->cells};
     double t0 = tool_now();
-    if (st_grid_read(&g, in, s->co.max_bytes, &err) ||
-        tool_check_field_finite(g, in_name, &err)) {
-        rc = tool_fail(t, &err);
+    int rc = read_inputs(t, &R, &err);
+    if (rc)
         goto done;
-    }
-    if (g->kind != ST_GRID_SIGNED) {
-        st_error_set(&err, ST_EINPUT, in_name, 0,
-                     "the field is %s, not signed (run soupsign first)",
-                     st_grid_kind_name(g->kind));
-        rc = tool_fail(t, &err);
+    R.t_lattice = tool_now();
+    R.t_read = R.t_lattice - t0;
+    if ((rc = cell_width(t, &R, &err)))
         goto done;
-    }
-    if (sculpt && tool_soup_read(t, &soup, surface, &err)) {
-        rc = tool_fail(t, &err);
-        goto done;
-    }
-    double t1 = tool_now();
-    double lo[3], hi[3];
-    st_lattice_grid_box(g, lo, hi);
-    double h = size > 0 ? size : st_lattice_h_for_cells(lo, hi, cells);
-    if (sculpt && !(size > 0)) {
-        /* --cells over the surface's box, as soupmesh counts them. */
-        double slo[3], shi[3];
-        if (st_soup_bounds(soup, slo, shi, &err)) {
-            rc = tool_fail(t, &err);
-            goto done;
-        }
-        h = st_lattice_h_for_cells(slo, shi, cells);
-    }
     /* A lattice that cannot fit in --max-memory (or past 2^31 tets, far
      * beyond what a coarse mesh needs) is refused before it is built. */
-    const size_t max_tets = tool_max_lattice_tets(s->co.max_bytes);
-    const char *limit_hint = "use fewer --cells or a larger --size, or raise "
-                             "--max-memory";
-    size_t thin_parts = 0;   /* of the last density try: why no tets */
-    if (!sculpt) {
-      /* --cells auto: the first size of AUTO_CELLS (coarse to fine) at
-       * which no part of the pseudo volume is too thin. */
-      static const size_t auto_seq[] = {8, 10, 12, 14, 16, 20, 24, 28, 32, 40,
-                                        48, 56, 64, 80, 96, 112, 128};
-      const size_t n_auto = sizeof auto_seq / sizeof auto_seq[0];
-      for (size_t try_i = 0;; try_i++) {
-        if (auto_cells) {
-            st_lattice_free(L);
-            st_tetmesh_free(m);
-            L = NULL;
-            m = NULL;
-            cells = auto_seq[try_i];
-            h = st_lattice_h_for_cells(lo, hi, cells);
-        }
-        st_lattice_params lp = st_lattice_params_default();
-        lp.kind = kind;
-        lp.h = h;
-        lp.seed = seed;
-        lp.max_tets = max_tets;
-        st_density_stats ds;
-        if (st_lattice_build(&L, lo, hi, &lp, &err)) {
-            if (!err.file[0])
-                snprintf(err.file, sizeof err.file, "%s", in_name);
-            tool_limit_hint(&err, limit_hint);
-            rc = tool_fail(t, &err);
-            goto done;
-        }
-        double t2 = tool_now();
-        st_density_clean_stats cs;
-        memset(&cs, 0, sizeof cs);
-        if (st_lattice_density_filter_clean(&m, &ds, &cs, L, g, rho, repair,
-                                            &err)) {
-            rc = tool_fail_file(t, &err, in_name);
-            goto done;
-        }
-        double t3 = tool_now();
-        tool_say(t, 2, "grid %zux%zux%zu, voxel %.6g; %s lattice, h %.6g "
-                 "(%.3g voxels), %zux%zux%zu cells, seed %" PRIu64,
-                 g->nx, g->ny, g->nz, g->voxel, st_lattice_kind_name(kind), h,
-                 h / g->voxel, L->n[0], L->n[1], L->n[2], seed);
-        tool_say(t, 2, "%zu of %zu lattice tets kept (rho >= %g); %zu decided "
-                 "by their centroid's voxel; %zu point tests",
-                 ds.kept, ds.lattice_tets, rho, ds.centroid_rule, ds.point_tests);
-        tool_say(t, 2, "read %.3f s, lattice %.3f s, density %.3f s",
-                 t1 - t0, t2 - t1, t3 - t2);
-        if (repair) {
-            tool_say(t, 2, "cleanup: %zu pieces of pseudo volume, %zu of "
-                     "tets; %zu tets filled and %zu dropped at pinched "
-                     "vertices; %zu pieces joined (%zu tets), %zu islands "
-                     "dropped (%zu tets)", cs.pieces, cs.tet_pieces,
-                     cs.filled, cs.dropped, cs.joins, cs.join_tets,
-                     cs.islands, cs.island_tets);
-            if (cs.specks)
-                tool_say(t, 2, "%zu specks of the pseudo volume smaller than "
-                         "a tet (%zu voxels) not meshed", cs.specks,
-                         cs.speck_voxels);
-            if (cs.bad_vertices_left)
-                tool_say(t, 1, "warning: the boundary is not manifold at "
-                         "%zu vertices", cs.bad_vertices_left);
-            /* with --cells auto, only the last try's parts are news */
-            const int final = !auto_cells || cs.nthin == 0 || try_i + 1 == n_auto;
-            for (size_t q = 0; q < cs.nthin && q < ST_CLEAN_MAX_THIN; q++) {
-                const st_thin_part *p = &cs.thin[q];
-                tool_say(t, final ? 1 : 2, "%s: warning: a part of the pseudo volume is "
-                         "too thin for this lattice (h %.4g): %zu voxels in "
-                         "(%.4g %.4g %.4g)-(%.4g %.4g %.4g), %.4g thick, "
-                         "%.0f%% of it meshed; --cells %zu would hold it",
-                         in_name, h, p->voxels, p->lo[0], p->lo[1], p->lo[2],
-                         p->hi[0], p->hi[1], p->hi[2], p->thickness,
-                         100.0 * p->held, p->cells);
-            }
-            if (cs.nthin > ST_CLEAN_MAX_THIN)
-                tool_say(t, final ? 1 : 2, "%s: warning: %zu more parts too thin",
-                         in_name, cs.nthin - ST_CLEAN_MAX_THIN);
-        }
-        thin_parts = cs.nthin;
-        if (!auto_cells)
-            break;
-        if (cs.nthin == 0) {
-            tool_say(t, 1, "--cells auto: %zu cells (h %.6g)", cells, h);
-            break;
-        }
-        if (try_i + 1 == n_auto) {
-            tool_say(t, 1, "%s: warning: --cells auto: parts still too thin at "
-                     "%zu cells, the finest it tries", in_name, cells);
-            break;
-        }
-      }
-    } else {
-        st_sculpt_params sp = st_sculpt_params_default();
-        sp.kind = kind;
-        sp.h = h;
-        sp.seed = seed;
-        sp.max_tets = max_tets;
-        sp.repair_bombs = repair;
-        sp.repair_manifold = repair;
-        st_sculpt_stats ss;
-        if (st_sculpt(&m, &ss, g, soup, NULL, &sp, &err)) {
-            if (!err.file[0])
-                snprintf(err.file, sizeof err.file, "%s", in_name);
-            tool_limit_hint(&err, limit_hint);
-            rc = tool_fail(t, &err);
-            goto done;
-        }
-        tool_say(t, 2, "grid %zux%zux%zu, voxel %.6g; %s lattice, h %.6g "
-                 "(%.3g voxels), seed %" PRIu64 "; surface %s: %zu triangles",
-                 g->nx, g->ny, g->nz, g->voxel, st_lattice_kind_name(kind), h,
-                 h / g->voxel, seed, surface, soup->ntris);
-        tool_say(t, 2, "%zu lattice tets: %zu overlap the pseudo volume, "
-                 "%zu more meet a triangle", ss.lattice_tets, ss.kept_volume,
-                 ss.kept_surface);
-        tool_say(t, 2, "bombs: %zu found (%zu with 3 boundary faces, %zu "
-                 "isolated), %zu clusters (largest %zu; %zu searched exactly, "
-                 "%zu too large: greedy), %zu snowflakes add %zu tets "
-                 "(greedy: %zu), %zu rounds, %zu left",
-                 ss.bombs, ss.bombs_3faces, ss.bombs_4faces, ss.clusters,
-                 ss.largest_cluster, ss.clusters_exact, ss.clusters_greedy,
-                 ss.snowflakes, ss.bomb_tets, ss.greedy_tets, ss.repair_rounds,
-                 ss.bombs_left);
-        tool_say(t, 2, "boundary: %zu non-manifold vertices, %zu edges; "
-                 "%zu tets added; %zu vertices, %zu edges left",
-                 ss.nonmanifold_vertices, ss.nonmanifold_edges,
-                 ss.manifold_tets, ss.nonmanifold_vertices_left,
-                 ss.nonmanifold_edges_left);
-        tool_say(t, 2, "%zu tets; read %.3f s, lattice %.3f s, classify "
-                 "%.3f s, repair %.3f s, mesh %.3f s", ss.tets, t1 - t0,
-                 ss.t_lattice, ss.t_classify, ss.t_repair, ss.t_mesh);
-        if (ss.bombs_left)
-            tool_say(t, 1, "warning: %zu bombs could not be repaired",
-                     ss.bombs_left);
-        if (ss.nonmanifold_vertices_left)
-            tool_say(t, 1, "warning: the boundary is not manifold at %zu "
-                     "vertices", ss.nonmanifold_vertices_left);
-    }
+    R.max_tets = tool_max_lattice_tets(s->co.max_bytes);
+    if ((rc = s->sculpt ? sculpt_mesh(t, &R, &err) : density_mesh(t, &R, &err)))
+        goto done;
     /* An empty mesh is no mesh: say why and write nothing (a pipe after
      * latticetet would mesh nothing without a word). */
-    if (m->ntets == 0) {
-        st_error_set(&err, ST_EINPUT, in_name, 0, thin_parts
+    if (R.m->ntets == 0) {
+        st_error_set(&err, ST_EINPUT, R.in_name, 0, R.thin_parts
                      ? "no tets kept: the pseudo volume is thinner than this lattice "
                        "holds (the --cells above would hold it); nothing written"
                      : "no tets kept: the pseudo volume is empty (a field soupsign "
@@ -401,44 +492,14 @@ static int run(tool_ctx *t, void *settings)
         rc = tool_fail(t, &err);
         goto done;
     }
-    /* --parts: each tet's part, on the field's grid (parts.h) */
-    if (s->parts_mode > 0) {
-        st_parts parts;
-        st_pseudo_params pp = st_pseudo_params_default();
-        st_status ps = st_parts_split(&parts, soup, (st_parts_mode)s->parts_mode, &err);
-        if (!ps) {
-            tool_say(t, 1, "%zu part%s (%s)", parts.nparts, parts.nparts == 1 ? "" : "s",
-                     st_parts_mode_name(parts.mode));
-            st_progress prog = tool_progress(t);
-            ps = st_parts_tag(m, soup, &parts, g, &pp, NULL, &prog, &err);
-            tool_progress_end(t);
-        }
-        st_parts_free(&parts);
-        if (ps) {
-            rc = tool_fail_file(t, &err, tool_in_name(surface));
-            goto done;
-        }
-    }
-    /* The field's metadata (source, history) carries over; the lattice's
-     * own keys win. */
-    if (st_meta_inherit(&m->meta, &g->meta) != ST_OK ||
-        tool_meta_record(t, &m->meta) != ST_OK) {
-        rc = tool_fail_nomem(t, &err);
+    if (s->parts_mode > 0 && (rc = tag_parts(t, &R, &err)))
         goto done;
-    }
-    double tw = tool_now();
-    if (st_tetmesh_save(m, s->co.out, &s->co.tetformat, &err)) {
-        rc = tool_fail(t, &err);
-        goto done;
-    }
-    tool_say(t, 2, "%zu tets, %zu points; write %.3f s", m->ntets, m->npoints,
-             tool_now() - tw);
-    rc = TOOL_EXIT_OK;
+    rc = write_mesh(t, &R, &err);
 done:
-    st_tetmesh_free(m);
-    st_lattice_free(L);
-    st_soup_free(soup);
-    st_grid_free(g);
+    st_tetmesh_free(R.m);
+    st_lattice_free(R.L);
+    st_soup_free(R.soup);
+    st_grid_free(R.g);
     return rc;
 }
 
