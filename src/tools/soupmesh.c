@@ -674,12 +674,148 @@ static int exit_status(const tool_ctx *t, const soupmesh_settings *s,
     return rc;
 }
 
+/* What run makes on its way, freed at its end. */
+typedef struct soupmesh_run {
+    soupmesh_settings *s;
+    const char *in_name;
+    st_soup *soup;
+    st_tetmesh *m;
+    st_pipeline_stats st;
+    st_parts parts;
+    int64_t *et;           /* --embed: each input vertex's tet */
+    double *eb;            /* and its barycentric coordinates */
+    size_t nout;           /* input vertices in no tet */
+    int64_t first;         /* the first of them */
+    st_tetmesh *side;      /* --embed .vtu: the point cloud */
+    st_soup *bsoup;        /* --boundary: the mesh's boundary */
+    st_outfile bof;        /* and its file, renamed after the mesh */
+} soupmesh_run;
+
+/* The soup read, the memory check, --parts, the pipeline. 0, or the exit
+ * status after an error was printed. */
+static int make_mesh(tool_ctx *t, soupmesh_run *R, st_error *err)
+{
+    soupmesh_settings *s = R->s;
+    const st_pipeline_params *p = &s->pipeline;
+    if (st_soup_read(&R->soup, s->in, err))
+        return tool_fail(t, err);
+    tool_say(t, 2, "%s: %zu vertices, %zu triangles", s->in, R->soup->nverts,
+             R->soup->ntris);
+    if (lattice_over_limit(R->soup, p, s->co.max_bytes, err))
+        return tool_fail_file(t, err, R->in_name);
+    if (s->parts_mode != ST_PARTS_NONE) {
+        if (st_parts_split(&R->parts, R->soup, (st_parts_mode)s->parts_mode, err))
+            return tool_fail_file(t, err, R->in_name);
+        say_parts(t, R->in_name, &R->parts);
+        s->pipeline.parts = &R->parts;
+    }
+    st_progress prog = tool_progress(t);
+    if (st_pipeline_run(&R->m, &R->st, R->soup, p, &prog, err)) {
+        tool_progress_end(t);
+        if (!err->file[0])
+            snprintf(err->file, sizeof err->file, "%s", R->in_name);
+        tool_limit_hint(err, "use fewer --cells or --voxels, or raise --max-memory");
+        report(t, &R->st, p->tries, p->density_rho > 0);
+        return tool_fail(t, err);
+    }
+    tool_progress_end(t);
+    return 0;
+}
+
+/* --embed: where the input vertices lie, worked out before anything is
+ * written, so a failure there leaves no mesh behind either. */
+static int embed_mesh(tool_ctx *t, soupmesh_run *R, st_error *err)
+{
+    const st_soup *soup = R->soup;
+    R->et = st_malloc_array(soup->nverts ? soup->nverts : 1, sizeof *R->et);
+    R->eb = st_malloc_array(soup->nverts ? soup->nverts : 1, 4 * sizeof *R->eb);
+    if (!R->et || !R->eb)
+        return tool_fail_nomem(t, err);
+    if (st_embed_compute(R->et, R->eb, &R->nout, &R->first, R->m, soup, err) ||
+        (!R->s->embed_text &&
+         st_embed_to_tetmesh(&R->side, soup->xyz, R->et, R->eb, soup->nverts, err)) ||
+        (R->side && R->s->pipeline.parts && embed_parts(R->side, soup, &R->parts, err)))
+        return tool_fail(t, err);
+    return 0;
+}
+
+/* --boundary: the boundary surface written to its temporary file before
+ * the mesh is saved (and renamed into place after it), so a failure on
+ * either side leaves neither half-done. */
+static int begin_boundary(tool_ctx *t, soupmesh_run *R, st_error *err)
+{
+    const soupmesh_settings *s = R->s;
+    const char *cmd = tool_command(t);
+    size_t n = strlen(cmd) + strlen(s->in) + 64;
+    char *comment = malloc(n);
+    if (!comment)
+        return tool_fail_nomem(t, err);
+    snprintf(comment, n, "souptet soupmesh: the boundary of the mesh; source: %s\n%s",
+             R->in_name, cmd);
+    st_status bs = st_tetmesh_boundary_soup(&R->bsoup, R->m, err);
+    if (!bs && !(bs = st_outfile_begin(&R->bof, s->boundary, 1, err)))
+        bs = st_soup_write(R->bof.fp, R->bsoup, s->boundary_format, comment, s->boundary,
+                           err);
+    free(comment);
+    return bs ? tool_fail(t, err) : 0;
+}
+
+/* The mesh, the boundary renamed after it, the --embed file. */
+static int write_outputs(tool_ctx *t, soupmesh_run *R, st_error *err)
+{
+    const soupmesh_settings *s = R->s;
+    if (st_tetmesh_save(R->m, s->co.out, &s->co.tetformat, err))
+        return tool_fail(t, err);
+    if (s->boundary && st_outfile_commit(&R->bof, err))
+        return tool_fail(t, err);
+    if (s->embed) {
+        if (s->embed_text
+                ? st_embed_write_text(s->embed, R->et, R->eb, R->soup->nverts, R->m->ntets,
+                                      tool_out_name(s->co.out), s->in, err)
+                : st_tetmesh_save(R->side, s->embed, NULL, err))
+            return tool_fail(t, err);
+        if (R->nout)
+            tool_say(t, 1, "warning: %zu input vertices are in no tet (first: %lld)",
+                     R->nout, (long long)R->first);
+    }
+    return 0;
+}
+
+/* The closing line, the note on what was guessed, -v: the symmetries and
+ * the distances both ways. 0, or the exit status after an error. */
+static int say_result(tool_ctx *t, soupmesh_run *R, double t0, st_error *err)
+{
+    const st_pipeline_params *p = &R->s->pipeline;
+    const st_pipeline_stats *st = &R->st;
+    const st_pipeline_candidate *b = &st->candidates[st->best];
+    tool_say(t, 1, "%zu tets, %zu points, dihedral %.2f..%.2f degrees, %s "
+             "(%zu vertices outside, %zu triangles crossing), %.2f s",
+             b->tets, b->points, b->min_dihedral, b->max_dihedral,
+             st->encloses ? "encloses the input" : "DOES NOT enclose the input",
+             b->verts_outside, b->tris_crossing, tool_now() - t0);
+    const double diag = box_diagonal(R->soup);
+    say_guess(t, st, R->soup, diag);
+    int rc = tool_report_symmetries(t, R->soup, NULL, st->voxel);
+    if (rc)
+        return rc;
+    if (t->verbosity >= 2 && p->density_rho <= 0) {
+        /* both directions, in h and per the input's box diagonal */
+        double sb = NAN;
+        if (st_tetstat_surface_to_boundary(&sb, R->m, R->soup, err))
+            return tool_fail(t, err);
+        tool_say(t, 2, "boundary -> input%s max %.4f h (%.6f diag), input -> boundary max "
+                 "%.4f h (%.6f diag); %zu of %zu boundary vertices beyond %.3g h",
+                 st->fill_faces ? " or fill" : "",
+                 b->max_distance / st->h, b->max_distance / diag, sb / st->h, sb / diag,
+                 b->beyond_offset, b->boundary_vertices, p->offset_ratio);
+    }
+    return 0;
+}
+
 static int run(tool_ctx *t, void *settings)
 {
     soupmesh_settings *s = settings;
     const st_pipeline_params *p = &s->pipeline;
-    const char *in = s->in, *out = s->co.out, *embed = s->embed, *boundary = s->boundary;
-    const char *in_name = tool_in_name(in);
     tool_set_threads(s->co.threads);
     if (t->verbosity >= 2) {
         s->pipeline.on_event = on_event;
@@ -687,167 +823,49 @@ static int run(tool_ctx *t, void *settings)
     }
     st_error err;
     st_error_clear(&err);
-    st_soup *soup = NULL;
-    st_tetmesh *m = NULL;
-    st_pipeline_stats st;
-    memset(&st, 0, sizeof st);
-    int64_t *et = NULL;
-    double *eb = NULL;
-    st_tetmesh *side = NULL;
-    st_soup *bsoup = NULL;
-    st_parts parts;
-    memset(&parts, 0, sizeof parts);
-    st_outfile bof;
-    memset(&bof, 0, sizeof bof);
-    bof.slot = -1;
-    int rc = TOOL_EXIT_FAIL;
+    soupmesh_run R = {.s = s, .in_name = tool_in_name(s->in), .first = -1, .bof.slot = -1};
     double t0 = tool_now();
-    if (st_soup_read(&soup, in, &err)) {
-        rc = tool_fail(t, &err);
+    int rc = make_mesh(t, &R, &err);
+    if (rc)
         goto done;
-    }
-    tool_say(t, 2, "%s: %zu vertices, %zu triangles", in, soup->nverts, soup->ntris);
-    if (lattice_over_limit(soup, p, s->co.max_bytes, &err)) {
-        rc = tool_fail_file(t, &err, in_name);
-        goto done;
-    }
-    if (s->parts_mode != ST_PARTS_NONE) {
-        if (st_parts_split(&parts, soup, (st_parts_mode)s->parts_mode, &err)) {
-            rc = tool_fail_file(t, &err, in_name);
-            goto done;
-        }
-        say_parts(t, in_name, &parts);
-        s->pipeline.parts = &parts;
-    }
-    st_progress prog = tool_progress(t);
-    if (st_pipeline_run(&m, &st, soup, p, &prog, &err)) {
-        tool_progress_end(t);
-        if (!err.file[0])
-            snprintf(err.file, sizeof err.file, "%s", in_name);
-        tool_limit_hint(&err, "use fewer --cells or --voxels, or raise --max-memory");
-        report(t, &st, p->tries, p->density_rho > 0);
-        rc = tool_fail(t, &err);
-        goto done;
-    }
-    tool_progress_end(t);
     if (p->dry_run) {
-        rc = dry_run_report(t, soup, p, &st, s->json);
+        rc = dry_run_report(t, R.soup, p, &R.st, s->json);
         goto done;
     }
     if (p->target_tets)
-        tool_say(t, 2, "h %.6g for about %zu tets: %zu sculpts, %.2f s", st.h,
-                 p->target_tets, st.sculpts, st.seconds_size);
-    report(t, &st, p->tries, p->density_rho > 0);
+        tool_say(t, 2, "h %.6g for about %zu tets: %zu sculpts, %.2f s", R.st.h,
+                 p->target_tets, R.st.sculpts, R.st.seconds_size);
+    report(t, &R.st, p->tries, p->density_rho > 0);
     if (p->parts)
-        report_parts(t, &parts, &st.parts);
+        report_parts(t, &R.parts, &R.st.parts);
     if (p->float32)
-        report_float32(t, s, &st, m);
-    if (st_meta_set(&m->meta, "source", in_name) ||
-        tool_meta_record(t, &m->meta)) {
+        report_float32(t, s, &R.st, R.m);
+    if (st_meta_set(&R.m->meta, "source", R.in_name) ||
+        tool_meta_record(t, &R.m->meta)) {
         rc = tool_fail_nomem(t, &err);
         goto done;
     }
-    /* Where the input vertices lie is worked out before anything is
-     * written, so a failure there leaves no mesh behind either. */
-    size_t nout = 0;
-    int64_t first = -1;
-    if (embed) {
-        et = st_malloc_array(soup->nverts ? soup->nverts : 1, sizeof *et);
-        eb = st_malloc_array(soup->nverts ? soup->nverts : 1, 4 * sizeof *eb);
-        if (!et || !eb) {
-            rc = tool_fail_nomem(t, &err);
-            goto done;
-        }
-        if (st_embed_compute(et, eb, &nout, &first, m, soup, &err) ||
-            (!s->embed_text &&
-             st_embed_to_tetmesh(&side, soup->xyz, et, eb, soup->nverts, &err)) ||
-            (side && p->parts && embed_parts(side, soup, &parts, &err))) {
-            rc = tool_fail(t, &err);
-            goto done;
-        }
-    }
-    /* The boundary surface is written to its temporary file before the
-     * mesh is saved and renamed into place after it, so a failure on
-     * either side leaves neither half-done. */
-    if (boundary) {
-        const char *cmd = tool_command(t);
-        size_t n = strlen(cmd) + strlen(in) + 64;
-        char *comment = malloc(n);
-        if (!comment) {
-            rc = tool_fail_nomem(t, &err);
-            goto done;
-        }
-        snprintf(comment, n, "souptet soupmesh: the boundary of the mesh; source: %s\n%s",
-                 in_name, cmd);
-        st_status bs = st_tetmesh_boundary_soup(&bsoup, m, &err);
-        if (!bs && !(bs = st_outfile_begin(&bof, boundary, 1, &err)))
-            bs = st_soup_write(bof.fp, bsoup, s->boundary_format, comment, boundary, &err);
-        free(comment);
-        if (bs) {
-            rc = tool_fail(t, &err);
-            goto done;
-        }
-    }
-    if (st_tetmesh_save(m, out, &s->co.tetformat, &err)) {
-        rc = tool_fail(t, &err);
+    if ((s->embed && (rc = embed_mesh(t, &R, &err))) ||
+        (s->boundary && (rc = begin_boundary(t, &R, &err))) ||
+        (rc = write_outputs(t, &R, &err)) || (rc = say_result(t, &R, t0, &err)))
         goto done;
-    }
-    if (boundary && st_outfile_commit(&bof, &err)) {
-        rc = tool_fail(t, &err);
-        goto done;
-    }
-    if (embed) {
-        if (s->embed_text
-                ? st_embed_write_text(embed, et, eb, soup->nverts, m->ntets,
-                                      tool_out_name(out), in, &err)
-                : st_tetmesh_save(side, embed, NULL, &err)) {
-            rc = tool_fail(t, &err);
-            goto done;
-        }
-        if (nout)
-            tool_say(t, 1, "warning: %zu input vertices are in no tet (first: %lld)", nout,
-                     (long long)first);
-    }
-    const st_pipeline_candidate *b = &st.candidates[st.best];
-    tool_say(t, 1, "%zu tets, %zu points, dihedral %.2f..%.2f degrees, %s "
-             "(%zu vertices outside, %zu triangles crossing), %.2f s",
-             b->tets, b->points, b->min_dihedral, b->max_dihedral,
-             st.encloses ? "encloses the input" : "DOES NOT enclose the input",
-             b->verts_outside, b->tris_crossing, tool_now() - t0);
-    const double diag = box_diagonal(soup);
-    say_guess(t, &st, soup, diag);
-    if ((rc = tool_report_symmetries(t, soup, NULL, st.voxel)))
-        goto done;
-    if (t->verbosity >= 2 && p->density_rho <= 0) {
-        /* both directions, in h and per the input's box diagonal */
-        double sb = NAN;
-        if (st_tetstat_surface_to_boundary(&sb, m, soup, &err)) {
-            rc = tool_fail(t, &err);
-            goto done;
-        }
-        tool_say(t, 2, "boundary -> input%s max %.4f h (%.6f diag), input -> boundary max "
-                 "%.4f h (%.6f diag); %zu of %zu boundary vertices beyond %.3g h",
-                 st.fill_faces ? " or fill" : "",
-                 b->max_distance / st.h, b->max_distance / diag, sb / st.h, sb / diag,
-                 b->beyond_offset, b->boundary_vertices, p->offset_ratio);
-    }
-    rc = exit_status(t, s, &st, in_name);
+    rc = exit_status(t, s, &R.st, R.in_name);
     if (s->json) {
-        print_json(s, &st, rc, tool_now() - t0);
+        print_json(s, &R.st, rc, tool_now() - t0);
         if (tool_flush_stdout(t))
             rc = TOOL_EXIT_FAIL;
     }
 done:
-    st_outfile_abort(&bof);
-    st_soup_free(bsoup);
-    free(et);
-    free(eb);
-    st_tetmesh_free(side);
-    free(st.candidates);
-    st_parts_tag_stats_free(&st.parts);
-    st_parts_free(&parts);
-    st_tetmesh_free(m);
-    st_soup_free(soup);
+    st_outfile_abort(&R.bof);
+    st_soup_free(R.bsoup);
+    free(R.et);
+    free(R.eb);
+    st_tetmesh_free(R.side);
+    free(R.st.candidates);
+    st_parts_tag_stats_free(&R.st.parts);
+    st_parts_free(&R.parts);
+    st_tetmesh_free(R.m);
+    st_soup_free(R.soup);
     return rc;
 }
 
