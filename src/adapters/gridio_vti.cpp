@@ -129,6 +129,90 @@ bool close_to(double a, double b, double scale)
 }
 
 /* Run a configured reader: information, limit check, data, conversion. */
+/* Where the grid lies: the spacing (uniform, positive, with the identity
+ * as direction matrix), the voxel and origin (the field data's exact
+ * values when they agree with the image's). */
+st_status read_placement(st_grid *g, vtkImageData *img, const int ext[6],
+                         const char *name, st_error *err)
+{
+    double sp[3], org[3];
+    img->GetSpacing(sp);
+    img->GetOrigin(org);
+    // The direction matrix must be the identity: index steps must move
+    // along the axes. Checked through the index-to-world transform rather
+    // than vtkMatrix3x3, which lives in a library the link line lacks.
+    double p0[3];
+    img->TransformContinuousIndexToPhysicalPoint(0, 0, 0, p0);
+    for (int a = 0; a < 3; a++) {
+        double e[3] = {0, 0, 0}, pa[3];
+        e[a] = 1;
+        img->TransformContinuousIndexToPhysicalPoint(e, pa);
+        for (int b = 0; b < 3; b++) {
+            const double want = b == a ? sp[a] : 0.0;
+            if (!close_to(pa[b] - p0[b], want,
+                          std::fabs(sp[a]) + std::fabs(p0[b])))
+                return st_error_set(err, ST_EINPUT, name, 0,
+                                    "image has a rotated direction matrix, "
+                                    "which is not supported");
+        }
+    }
+    if (!(sp[0] > 0) || !std::isfinite(sp[0]) ||
+        !close_to(sp[1], sp[0], sp[0]) || !close_to(sp[2], sp[0], sp[0]))
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "spacing %g %g %g is not uniform and positive",
+                            sp[0], sp[1], sp[2]);
+    double voxel = sp[0], origin[3];
+    for (int a = 0; a < 3; a++)     // the point at the extent's start
+        origin[a] = org[a] + sp[a] * ext[2 * a];
+    vtkFieldData *fd = img->GetFieldData();
+    double fv, fo[3];
+    if (field_doubles(fd, "voxel_size", 1, &fv) && close_to(fv, voxel, voxel))
+        voxel = fv;
+    if (field_doubles(fd, "origin", 3, fo) &&
+        close_to(fo[0], origin[0], std::fabs(origin[0]) + voxel) &&
+        close_to(fo[1], origin[1], std::fabs(origin[1]) + voxel) &&
+        close_to(fo[2], origin[2], std::fabs(origin[2]) + voxel))
+        for (int a = 0; a < 3; a++)
+            origin[a] = fo[a];
+    for (int a = 0; a < 3; a++)
+        if (!std::isfinite(origin[a]))
+            return st_error_set(err, ST_EINPUT, name, 0,
+                                "image origin is not finite");
+    g->voxel = voxel;
+    for (int a = 0; a < 3; a++)
+        g->origin[a] = origin[a];
+    return ST_OK;
+}
+
+/* The kind, the band and the other metadata, from the field data. */
+st_status read_kind_meta(st_grid *g, vtkFieldData *fd, const char *name, st_error *err)
+{
+    g->kind = ST_GRID_UNKNOWN;
+    g->band = INFINITY;
+    double band;
+    if (field_doubles(fd, "band", 1, &band) && !std::isnan(band))
+        g->band = band;
+    for (int i = 0; fd && i < fd->GetNumberOfArrays(); i++) {
+        vtkStringArray *s =
+            vtkStringArray::SafeDownCast(fd->GetAbstractArray(i));
+        if (!s || !s->GetName() || s->GetNumberOfValues() < 1)
+            continue;
+        std::string key = s->GetName();
+        const std::string value = s->GetValue(0);
+        if (key == "souptet_kind") {
+            g->kind = st_grid_kind_from_name(value.c_str());
+            continue;
+        }
+        if (is_reserved_name(key))
+            continue;
+        if (key.compare(0, std::strlen(kMetaPrefix), kMetaPrefix) == 0)
+            key = key.substr(std::strlen(kMetaPrefix));
+        if (st_meta_set(&g->meta, key.c_str(), value.c_str()))
+            return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
+    }
+    return ST_OK;
+}
+
 st_status read_with(vtkXMLImageDataReader *r, const char *name,
                     size_t max_bytes, st_grid **out, st_error *err)
 {
@@ -195,53 +279,8 @@ st_status read_with(vtkXMLImageDataReader *r, const char *name,
                             arr->GetName() ? arr->GetName() : "",
                             (long long)arr->GetNumberOfTuples(), n);
 
-    // Placement.
-    double sp[3], org[3];
-    img->GetSpacing(sp);
-    img->GetOrigin(org);
-    // The direction matrix must be the identity: index steps must move
-    // along the axes. Checked through the index-to-world transform rather
-    // than vtkMatrix3x3, which lives in a library the link line lacks.
-    double p0[3];
-    img->TransformContinuousIndexToPhysicalPoint(0, 0, 0, p0);
-    for (int a = 0; a < 3; a++) {
-        double e[3] = {0, 0, 0}, pa[3];
-        e[a] = 1;
-        img->TransformContinuousIndexToPhysicalPoint(e, pa);
-        for (int b = 0; b < 3; b++) {
-            const double want = b == a ? sp[a] : 0.0;
-            if (!close_to(pa[b] - p0[b], want,
-                          std::fabs(sp[a]) + std::fabs(p0[b])))
-                return st_error_set(err, ST_EINPUT, name, 0,
-                                    "image has a rotated direction matrix, "
-                                    "which is not supported");
-        }
-    }
-    if (!(sp[0] > 0) || !std::isfinite(sp[0]) ||
-        !close_to(sp[1], sp[0], sp[0]) || !close_to(sp[2], sp[0], sp[0]))
-        return st_error_set(err, ST_EINPUT, name, 0,
-                            "spacing %g %g %g is not uniform and positive",
-                            sp[0], sp[1], sp[2]);
-    double voxel = sp[0], origin[3];
-    for (int a = 0; a < 3; a++)     // the point at the extent's start
-        origin[a] = org[a] + sp[a] * ext[2 * a];
-    vtkFieldData *fd = img->GetFieldData();
-    double fv, fo[3];
-    if (field_doubles(fd, "voxel_size", 1, &fv) && close_to(fv, voxel, voxel))
-        voxel = fv;
-    if (field_doubles(fd, "origin", 3, fo) &&
-        close_to(fo[0], origin[0], std::fabs(origin[0]) + voxel) &&
-        close_to(fo[1], origin[1], std::fabs(origin[1]) + voxel) &&
-        close_to(fo[2], origin[2], std::fabs(origin[2]) + voxel))
-        for (int a = 0; a < 3; a++)
-            origin[a] = fo[a];
-    for (int a = 0; a < 3; a++)
-        if (!std::isfinite(origin[a]))
-            return st_error_set(err, ST_EINPUT, name, 0,
-                                "image origin is not finite");
-    g->voxel = voxel;
-    for (int a = 0; a < 3; a++)
-        g->origin[a] = origin[a];
+    if (st_status s = read_placement(g, img, ext, name, err))
+        return s;
 
     // Values.
     if (vtkFloatArray *f = vtkFloatArray::SafeDownCast(arr))
@@ -253,30 +292,8 @@ st_status read_with(vtkXMLImageDataReader *r, const char *name,
             g->data[i] = float(src[i]);
     }
 
-    // Kind, band, metadata.
-    g->kind = ST_GRID_UNKNOWN;
-    g->band = INFINITY;
-    double band;
-    if (field_doubles(fd, "band", 1, &band) && !std::isnan(band))
-        g->band = band;
-    for (int i = 0; fd && i < fd->GetNumberOfArrays(); i++) {
-        vtkStringArray *s =
-            vtkStringArray::SafeDownCast(fd->GetAbstractArray(i));
-        if (!s || !s->GetName() || s->GetNumberOfValues() < 1)
-            continue;
-        std::string key = s->GetName();
-        const std::string value = s->GetValue(0);
-        if (key == "souptet_kind") {
-            g->kind = st_grid_kind_from_name(value.c_str());
-            continue;
-        }
-        if (is_reserved_name(key))
-            continue;
-        if (key.compare(0, std::strlen(kMetaPrefix), kMetaPrefix) == 0)
-            key = key.substr(std::strlen(kMetaPrefix));
-        if (st_meta_set(&g->meta, key.c_str(), value.c_str()))
-            return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
-    }
+    if (st_status s = read_kind_meta(g, img->GetFieldData(), name, err))
+        return s;
     guard.g = nullptr;
     *out = g;
     return ST_OK;

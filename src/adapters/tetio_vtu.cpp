@@ -122,6 +122,175 @@ st_status read_arrays(st_tetmesh *m, vtkFieldData *src, st_tet_assoc assoc,
     return ST_OK;
 }
 
+/* The header's counts: np points and nc cells, refused when negative,
+ * past 32-bit point ids, or over max_bytes (*bytes: what they take). */
+st_status check_counts(vtkXMLUnstructuredGridReader *r, const char *name,
+                       size_t max_bytes, long long *np, long long *nc,
+                       size_t *bytes, st_error *err)
+{
+    r->SetupUpdateExtent(0, 1, 0);
+    *np = (long long)r->GetNumberOfPoints();
+    *nc = (long long)r->GetNumberOfCells();
+    if (*np < 0 || *nc < 0)
+        return st_error_set(err, ST_EINPUT, name, 0,
+                            "negative point or cell count");
+    if ((unsigned long long)*np >= UINT32_MAX)
+        return st_error_set(err, ST_ELIMIT, name, 0,
+                            "%lld points: more than a mesh can hold", *np);
+    size_t tmp;
+    if (st_size_mul(bytes, size_t(*np), 3 * sizeof(double)) != 0 ||
+        st_size_mul(&tmp, size_t(*nc), 4 * sizeof(uint32_t)) != 0 ||
+        st_size_add(bytes, *bytes, tmp) != 0 ||
+        (max_bytes && *bytes > max_bytes))
+        return st_error_set(err, ST_ELIMIT, name, 0,
+                            "%lld points and %lld cells need more than the "
+                            "memory limit of %zu bytes",
+                            *np, *nc, max_bytes);
+    return ST_OK;
+}
+
+/* The points, every one finite. */
+st_status read_points(st_tetmesh *m, vtkUnstructuredGrid *ug, const char *name,
+                      st_error *err)
+{
+    const vtkIdType npts = ug->GetNumberOfPoints();
+    vtkPoints *pts = ug->GetPoints();
+    if (npts > 0 && !pts)
+        return st_error_set(err, ST_EINPUT, name, 0, "no points");
+    for (vtkIdType i = 0; i < npts; i++) {
+        double p[3];
+        pts->GetPoint(i, p);
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) ||
+            !std::isfinite(p[2]))
+            return st_error_set(err, ST_EINPUT, name, 0,
+                                "point %lld is not finite (%g %g %g)",
+                                (long long)i, p[0], p[1], p[2]);
+        std::memcpy(m->xyz + 3 * size_t(i), p, sizeof p);
+    }
+    m->npoints = size_t(npts);
+    return ST_OK;
+}
+
+/* A points-only mesh as this file writes it: cell i is VTK_VERTEX i. */
+bool is_points_only(vtkUnstructuredGrid *ug)
+{
+    const vtkIdType npts = ug->GetNumberOfPoints(), ncells = ug->GetNumberOfCells();
+    bool points_only = ncells == npts && ncells > 0;
+    for (vtkIdType c = 0; points_only && c < ncells; c++) {
+        vtkIdType n;
+        const vtkIdType *ids;
+        if (ug->GetCellType(c) != VTK_VERTEX)
+            return false;
+        ug->GetCellPoints(c, n, ids);
+        points_only = n == 1 && ids[0] == c;
+    }
+    return points_only;
+}
+
+/* The cells, every one a tetrahedron of points in range. */
+st_status read_tets(st_tetmesh *m, vtkUnstructuredGrid *ug, const char *name,
+                    st_error *err)
+{
+    const vtkIdType npts = ug->GetNumberOfPoints(), ncells = ug->GetNumberOfCells();
+    for (vtkIdType c = 0; c < ncells; c++) {
+        const int type = ug->GetCellType(c);
+        vtkIdType n;
+        const vtkIdType *ids;
+        if (type != VTK_TETRA)
+            return st_error_set(err, ST_EINPUT, name, 0,
+                                "cell %lld is not a tetrahedron (VTK cell "
+                                "type %d; only type %d, VTK_TETRA, is "
+                                "accepted)",
+                                (long long)c, type, VTK_TETRA);
+        ug->GetCellPoints(c, n, ids);
+        if (n != 4)
+            return st_error_set(err, ST_EINPUT, name, 0,
+                                "tetrahedron %lld has %lld points",
+                                (long long)c, (long long)n);
+        uint32_t *t = m->tets + 4 * size_t(c);
+        for (int k = 0; k < 4; k++) {
+            if (ids[k] < 0 || ids[k] >= npts)
+                return st_error_set(err, ST_EINPUT, name, 0,
+                                    "tetrahedron %lld refers to point %lld "
+                                    "of %lld",
+                                    (long long)c, (long long)ids[k],
+                                    (long long)npts);
+            t[k] = uint32_t(ids[k]);
+        }
+    }
+    m->ntets = size_t(ncells);
+    return ST_OK;
+}
+
+/* Field data as metadata: strings, char arrays (C strings) and one-value
+ * numbers (%llu for 64-bit unsigned, else %.17g), into v with *keep true;
+ * *keep false for an array souptet does not keep. ST_ELIMIT (err set)
+ * past max_bytes. */
+st_status meta_value(vtkAbstractArray *a, std::string &v, bool *keep, const char *name,
+                     size_t *bytes, size_t max_bytes, st_error *err)
+{
+    *keep = false;
+    const int type = a->GetDataType();
+    vtkDataArray *d = vtkDataArray::SafeDownCast(a);
+    if (vtkStringArray *sa = vtkStringArray::SafeDownCast(a)) {
+        if (sa->GetNumberOfValues() < 1)
+            return ST_OK;
+        v = sa->GetValue(0);   // files before numbers were numbers
+    } else if (d && d->GetNumberOfComponents() == 1 &&
+               (type == VTK_UNSIGNED_CHAR || type == VTK_SIGNED_CHAR ||
+                type == VTK_CHAR)) {
+        const vtkIdType n = d->GetNumberOfTuples();
+        if (st_size_add(bytes, *bytes, size_t(n)) != 0 ||
+            (max_bytes && *bytes > max_bytes))
+            return st_error_set(err, ST_ELIMIT, name, 0,
+                                "mesh needs more than the memory limit "
+                                "of %zu bytes", max_bytes);
+        v.reserve(size_t(n));
+        for (vtkIdType k = 0; k < n; k++) {
+            const int c = int(d->GetComponent(k, 0)) & 0xff;
+            if (c == 0)
+                break;   // a C string ends there
+            v.push_back(char(c));
+        }
+    } else if (d && d->GetNumberOfComponents() == 1 && d->GetNumberOfTuples() == 1 &&
+               d->GetDataTypeSize() == 8 &&
+               (type == VTK_UNSIGNED_LONG || type == VTK_UNSIGNED_LONG_LONG ||
+                type == VTK_TYPE_UINT64)) {
+        // (the reader makes a vtkUnsignedLongArray, not the typed one)
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%llu",
+                      (unsigned long long)a->GetVariantValue(0).ToTypeUInt64());
+        v = buf;
+    } else if (d && d->GetNumberOfComponents() == 1 &&
+               d->GetNumberOfTuples() == 1) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.17g", d->GetComponent(0, 0));
+        v = buf;
+    } else {
+        return ST_OK;   // not metadata souptet knows how to keep
+    }
+    *keep = true;
+    return ST_OK;
+}
+
+/* The field data into m's metadata (meta_value). */
+st_status read_meta(st_tetmesh *m, vtkFieldData *fd, const char *name, size_t *bytes,
+                    size_t max_bytes, st_error *err)
+{
+    for (int i = 0; fd && i < fd->GetNumberOfArrays(); i++) {
+        vtkAbstractArray *a = fd->GetAbstractArray(i);
+        if (!a || !a->GetName() || !a->GetName()[0])
+            continue;
+        std::string v;
+        bool keep;
+        if (st_status st = meta_value(a, v, &keep, name, bytes, max_bytes, err))
+            return st;
+        if (keep && st_meta_set(&m->meta, a->GetName(), v.c_str()))
+            return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
+    }
+    return ST_OK;
+}
+
 st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
                     size_t max_bytes, st_tetmesh **out, st_error *err)
 {
@@ -131,24 +300,10 @@ st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
         return st_vtk::fail(name,
                           "not a readable VTK UnstructuredGrid (.vtu) file",
                           err);
-    r->SetupUpdateExtent(0, 1, 0);
-    const long long np = (long long)r->GetNumberOfPoints();
-    const long long nc = (long long)r->GetNumberOfCells();
-    if (np < 0 || nc < 0)
-        return st_error_set(err, ST_EINPUT, name, 0,
-                            "negative point or cell count");
-    if ((unsigned long long)np >= UINT32_MAX)
-        return st_error_set(err, ST_ELIMIT, name, 0,
-                            "%lld points: more than a mesh can hold", np);
-    size_t bytes = 0, tmp;
-    if (st_size_mul(&bytes, size_t(np), 3 * sizeof(double)) != 0 ||
-        st_size_mul(&tmp, size_t(nc), 4 * sizeof(uint32_t)) != 0 ||
-        st_size_add(&bytes, bytes, tmp) != 0 ||
-        (max_bytes && bytes > max_bytes))
-        return st_error_set(err, ST_ELIMIT, name, 0,
-                            "%lld points and %lld cells need more than the "
-                            "memory limit of %zu bytes",
-                            np, nc, max_bytes);
+    long long np, nc;
+    size_t bytes = 0;
+    if (st_status s = check_counts(r, name, max_bytes, &np, &nc, &bytes, err))
+        return s;
 
     r->Update();
     vtkUnstructuredGrid *ug = r->GetOutput();
@@ -175,115 +330,21 @@ st_status read_with(vtkXMLUnstructuredGridReader *r, const char *name,
         std::snprintf(err->file, sizeof err->file, "%s", name);
         return s;
     }
-    vtkPoints *pts = ug->GetPoints();
-    if (npts > 0 && !pts)
-        return st_error_set(err, ST_EINPUT, name, 0, "no points");
-    for (vtkIdType i = 0; i < npts; i++) {
-        double p[3];
-        pts->GetPoint(i, p);
-        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) ||
-            !std::isfinite(p[2]))
-            return st_error_set(err, ST_EINPUT, name, 0,
-                                "point %lld is not finite (%g %g %g)",
-                                (long long)i, p[0], p[1], p[2]);
-        std::memcpy(m->xyz + 3 * size_t(i), p, sizeof p);
-    }
-    m->npoints = size_t(npts);
-    // A points-only mesh as this file writes it: cell i is VTK_VERTEX i.
-    bool points_only = ncells == npts && ncells > 0;
-    for (vtkIdType c = 0; points_only && c < ncells; c++) {
-        vtkIdType n;
-        const vtkIdType *ids;
-        if (ug->GetCellType(c) != VTK_VERTEX) {
-            points_only = false;
-            break;
-        }
-        ug->GetCellPoints(c, n, ids);
-        points_only = n == 1 && ids[0] == c;
-    }
-    for (vtkIdType c = 0; !points_only && c < ncells; c++) {
-        const int type = ug->GetCellType(c);
-        vtkIdType n;
-        const vtkIdType *ids;
-        if (type != VTK_TETRA)
-            return st_error_set(err, ST_EINPUT, name, 0,
-                                "cell %lld is not a tetrahedron (VTK cell "
-                                "type %d; only type %d, VTK_TETRA, is "
-                                "accepted)",
-                                (long long)c, type, VTK_TETRA);
-        ug->GetCellPoints(c, n, ids);
-        if (n != 4)
-            return st_error_set(err, ST_EINPUT, name, 0,
-                                "tetrahedron %lld has %lld points",
-                                (long long)c, (long long)n);
-        uint32_t *t = m->tets + 4 * size_t(c);
-        for (int k = 0; k < 4; k++) {
-            if (ids[k] < 0 || ids[k] >= npts)
-                return st_error_set(err, ST_EINPUT, name, 0,
-                                    "tetrahedron %lld refers to point %lld "
-                                    "of %lld",
-                                    (long long)c, (long long)ids[k],
-                                    (long long)npts);
-            t[k] = uint32_t(ids[k]);
-        }
-    }
-    m->ntets = points_only ? 0 : size_t(ncells);
-
-    if (!points_only)
+    if (st_status s = read_points(m, ug, name, err))
+        return s;
+    const bool points_only = is_points_only(ug);
+    if (!points_only) {
+        if (st_status s = read_tets(m, ug, name, err))
+            return s;
         if (st_status s = read_arrays(m, ug->GetCellData(), ST_ON_CELLS,
                                       name, &bytes, max_bytes, err))
             return s;
+    }
     if (st_status s = read_arrays(m, ug->GetPointData(), ST_ON_POINTS, name,
                                   &bytes, max_bytes, err))
         return s;
-    vtkFieldData *fd = ug->GetFieldData();
-    for (int i = 0; fd && i < fd->GetNumberOfArrays(); i++) {
-        vtkAbstractArray *a = fd->GetAbstractArray(i);
-        if (!a || !a->GetName() || !a->GetName()[0])
-            continue;
-        std::string v;
-        const int type = a->GetDataType();
-        vtkDataArray *d = vtkDataArray::SafeDownCast(a);
-        if (vtkStringArray *sa = vtkStringArray::SafeDownCast(a)) {
-            if (sa->GetNumberOfValues() < 1)
-                continue;
-            v = sa->GetValue(0);   // files before numbers were numbers
-        } else if (d && d->GetNumberOfComponents() == 1 &&
-                   (type == VTK_UNSIGNED_CHAR || type == VTK_SIGNED_CHAR ||
-                    type == VTK_CHAR)) {
-            const vtkIdType n = d->GetNumberOfTuples();
-            if (st_size_add(&bytes, bytes, size_t(n)) != 0 ||
-                (max_bytes && bytes > max_bytes))
-                return st_error_set(err, ST_ELIMIT, name, 0,
-                                    "mesh needs more than the memory limit "
-                                    "of %zu bytes", max_bytes);
-            v.reserve(size_t(n));
-            for (vtkIdType k = 0; k < n; k++) {
-                const int c = int(d->GetComponent(k, 0)) & 0xff;
-                if (c == 0)
-                    break;   // a C string ends there
-                v.push_back(char(c));
-            }
-        } else if (d && d->GetNumberOfComponents() == 1 && d->GetNumberOfTuples() == 1 &&
-                   d->GetDataTypeSize() == 8 &&
-                   (type == VTK_UNSIGNED_LONG || type == VTK_UNSIGNED_LONG_LONG ||
-                    type == VTK_TYPE_UINT64)) {
-            // (the reader makes a vtkUnsignedLongArray, not the typed one)
-            char buf[32];
-            std::snprintf(buf, sizeof buf, "%llu",
-                          (unsigned long long)a->GetVariantValue(0).ToTypeUInt64());
-            v = buf;
-        } else if (d && d->GetNumberOfComponents() == 1 &&
-                   d->GetNumberOfTuples() == 1) {
-            char buf[64];
-            std::snprintf(buf, sizeof buf, "%.17g", d->GetComponent(0, 0));
-            v = buf;
-        } else {
-            continue;   // not metadata souptet knows how to keep
-        }
-        if (st_meta_set(&m->meta, a->GetName(), v.c_str()))
-            return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
-    }
+    if (st_status s = read_meta(m, ug->GetFieldData(), name, &bytes, max_bytes, err))
+        return s;
     guard.m = nullptr;
     *out = m;
     return ST_OK;
