@@ -482,15 +482,17 @@ static void test_real_model(void)
     st_soup_free(s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_layout();
-    test_band_exact_on_random_soup();
-    test_large_oblique_triangle();
-    test_bvh_nearest();
-    test_bvh_parallel_layout();
-    test_threads_identical();
-    test_fine_soup_exact();
-    test_real_model();
-    return tap_done();
+    static const tap_test tests[] = {
+        TAP_TEST(layout),
+        TAP_TEST(band_exact_on_random_soup),
+        TAP_TEST(large_oblique_triangle),
+        TAP_TEST(bvh_nearest),
+        TAP_TEST(bvh_parallel_layout),
+        TAP_TEST(threads_identical),
+        TAP_TEST(fine_soup_exact),
+        TAP_TEST(real_model),
+        {0}};
+    return tap_main(argc, argv, tests);
 }
