@@ -14,8 +14,8 @@
  * the order given, and "test_X --list" prints the names, one a line. An
  * unknown name or option is an error (exit 2, naming it, nothing run).
  * The plan counts the checks that ran. A program with set-up of its own
- * calls tap_select first (it answers --list and bad names before any
- * set-up), then tap_run and tap_done.
+ * calls tap_select first (it answers --list and bad names, and exits,
+ * before any set-up), then tap_run and tap_done.
  *
  * tap_data(name) is tests/data/name, found from the program's own path
  * (build/tests/test_X, or any build directory's, -> tests/data), so a test
@@ -107,9 +107,10 @@ static inline const char *tap_prog(void)
     return slash ? slash + 1 : tap_argv0 ? tap_argv0 : "test";
 }
 
-/* Reads the command line: -1 to go on and run, or the exit status (0 after
- * --list or --help, 2 for an unknown name or option, named on stderr). */
-static inline int tap_select(int argc, char **argv, const tap_test *tests)
+/* Reads the command line. After --list or --help it exits 0; for an
+ * unknown name or option it exits 2, naming it on stderr, before any
+ * set-up ran. Otherwise it returns, and tap_run runs what was asked. */
+static inline void tap_select(int argc, char **argv, const tap_test *tests)
 {
     tap_argv0 = argc > 0 ? argv[0] : NULL;
     if (argc == 2 && (strcmp(argv[1], "--list") == 0 || strcmp(argv[1], "--help") == 0)) {
@@ -119,17 +120,16 @@ static inline int tap_select(int argc, char **argv, const tap_test *tests)
         else
             for (const tap_test *t = tests; t->name; t++)
                 printf("%s\n", t->name);
-        return 0;
+        exit(0);
     }
     for (int i = 1; i < argc; i++)
         if (argv[i][0] == '-' || !tap_find(tests, argv[i])) {
             fprintf(stderr, "%s: %s '%s' (--list lists the tests)\n", tap_prog(),
                     argv[i][0] == '-' ? "unknown option" : "no test named", argv[i]);
-            return 2;
+            exit(2);
         }
     tap_names = argc > 1 ? argv + 1 : NULL;
     tap_nnames = argc > 1 ? argc - 1 : 0;
-    return -1;
 }
 
 /* Runs the tests tap_select chose: each named, or all in table order. */
@@ -152,9 +152,7 @@ static inline void tap_run(const tap_test *tests)
 /* tap_select, tap_run and tap_done: the whole main of most programs. */
 static inline int tap_main(int argc, char **argv, const tap_test *tests)
 {
-    int rc = tap_select(argc, argv, tests);
-    if (rc >= 0)
-        return rc;
+    tap_select(argc, argv, tests);
     tap_run(tests);
     return tap_done();
 }

@@ -117,6 +117,26 @@ static void test_pseudo_volume(void)
               "signs, no grid (%.3f s after the flag)", now() - k.t_set);
 }
 
+/* The next call, flag cleared, is an ordinary run. */
+static void test_cleared_flag(void)
+{
+    st_error err;
+    st_pipeline_params p = st_pipeline_params_default();
+    p.cells = 6;
+    volatile int flag = 0;
+    st_progress prog = {NULL, NULL, &flag};
+    st_tetmesh *m1 = NULL, *m2 = NULL;
+    st_status r1 = st_pipeline_run(&m1, NULL, g_bunny, &p, &prog, &err);
+    st_status r2 = st_pipeline_run(&m2, NULL, g_bunny, &p, NULL, &err);
+    TAP_CHECK(r1 == ST_OK && r2 == ST_OK && m1 && m2 && m1->npoints == m2->npoints &&
+              m1->ntets == m2->ntets &&
+              memcmp(m1->xyz, m2->xyz, 3 * m1->npoints * sizeof *m1->xyz) == 0 &&
+              memcmp(m1->tets, m2->tets, 4 * m1->ntets * sizeof *m1->tets) == 0,
+              "an unset flag changes nothing: the same mesh as without one");
+    st_tetmesh_free(m1);
+    st_tetmesh_free(m2);
+}
+
 /* The sculpt alone, the flag set: nothing classified, no mesh. */
 static void test_sculpt(void)
 {
@@ -139,38 +159,12 @@ static void test_sculpt(void)
     st_grid_free(g);
 }
 
-/* The next call, flag cleared, is an ordinary run. */
-static void test_cleared_flag(void)
-{
-    st_error err;
-    st_pipeline_params p = st_pipeline_params_default();
-    p.cells = 6;
-    volatile int flag = 0;
-    st_progress prog = {NULL, NULL, &flag};
-    st_tetmesh *m1 = NULL, *m2 = NULL;
-    st_status r1 = st_pipeline_run(&m1, NULL, g_bunny, &p, &prog, &err);
-    st_status r2 = st_pipeline_run(&m2, NULL, g_bunny, &p, NULL, &err);
-    TAP_CHECK(r1 == ST_OK && r2 == ST_OK && m1 && m2 && m1->npoints == m2->npoints &&
-              m1->ntets == m2->ntets &&
-              memcmp(m1->xyz, m2->xyz, 3 * m1->npoints * sizeof *m1->xyz) == 0 &&
-              memcmp(m1->tets, m2->tets, 4 * m1->ntets * sizeof *m1->tets) == 0,
-              "an unset flag changes nothing: the same mesh as without one");
-    st_tetmesh_free(m1);
-    st_tetmesh_free(m2);
-}
-
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(flag_before),
-        TAP_TEST(stages),
-        TAP_TEST(pseudo_volume),
-        TAP_TEST(sculpt),
-        TAP_TEST(cleared_flag),
-        {0}};
-    int rc = tap_select(argc, argv, tests);
-    if (rc >= 0)
-        return rc;
+    static const tap_test tests[] = {TAP_TEST(flag_before), TAP_TEST(stages),
+                                     TAP_TEST(pseudo_volume), TAP_TEST(sculpt), TAP_TEST(cleared_flag),
+                                     {0}};
+    tap_select(argc, argv, tests);
     st_error err;
     if (st_soup_read(&g_bunny, "corpus/bunny.obj", &err) != ST_OK) {
         TAP_CHECK(0, "read corpus/bunny.obj: %s", err.msg);

@@ -277,14 +277,8 @@ static void test_address_space(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(error_format),
-        TAP_TEST(checked_sizes),
-        TAP_TEST(meta),
-        TAP_TEST(grid),
-        TAP_TEST(outfile),
-        TAP_TEST(outfile_stale),
-        TAP_TEST(address_space),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(error_format), TAP_TEST(checked_sizes),
+                                     TAP_TEST(meta), TAP_TEST(grid), TAP_TEST(outfile),
+                                     TAP_TEST(outfile_stale), TAP_TEST(address_space), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -106,9 +106,7 @@ static void test_shared(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(shared),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(shared), {0}};
     if (argc > 1 && strcmp(argv[1], "--print") == 0) {
         print_defaults();
         return 0;

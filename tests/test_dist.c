@@ -484,15 +484,9 @@ static void test_real_model(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(layout),
-        TAP_TEST(band_exact_on_random_soup),
-        TAP_TEST(large_oblique_triangle),
-        TAP_TEST(bvh_nearest),
-        TAP_TEST(bvh_parallel_layout),
-        TAP_TEST(threads_identical),
-        TAP_TEST(fine_soup_exact),
-        TAP_TEST(real_model),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(layout), TAP_TEST(band_exact_on_random_soup),
+                                     TAP_TEST(large_oblique_triangle), TAP_TEST(bvh_nearest),
+                                     TAP_TEST(bvh_parallel_layout), TAP_TEST(threads_identical),
+                                     TAP_TEST(fine_soup_exact), TAP_TEST(real_model), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -258,12 +258,7 @@ static void test_many_vertices(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(weld),
-        TAP_TEST(closed_box),
-        TAP_TEST(damage),
-        TAP_TEST(order),
-        TAP_TEST(many_vertices),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(weld), TAP_TEST(closed_box), TAP_TEST(damage),
+                                     TAP_TEST(order), TAP_TEST(many_vertices), {0}};
     return tap_main(argc, argv, tests);
 }

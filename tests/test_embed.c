@@ -235,9 +235,6 @@ static void test_block(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(cube),
-        TAP_TEST(block),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(cube), TAP_TEST(block), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -650,17 +650,15 @@ static void test_float32_knife(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(cube_encloses_small_soup),
-        TAP_TEST(soup_sticking_out),
-        TAP_TEST(touching_boundary),
-        TAP_TEST(inverted_and_flat),
-        TAP_TEST(empty_mesh),
-        TAP_TEST(locator_brute_force),
-        TAP_TEST(threads_and_speed),
-        TAP_TEST(float32_face),
-        TAP_TEST(float32_rotated),
-        TAP_TEST(float32_knife),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(cube_encloses_small_soup),
+                                     TAP_TEST(soup_sticking_out),
+                                     TAP_TEST(touching_boundary),
+                                     TAP_TEST(inverted_and_flat),
+                                     TAP_TEST(empty_mesh),
+                                     TAP_TEST(locator_brute_force),
+                                     TAP_TEST(threads_and_speed),
+                                     TAP_TEST(float32_face),
+                                     TAP_TEST(float32_rotated),
+                                     TAP_TEST(float32_knife), {0}};
     return tap_main(argc, argv, tests);
 }

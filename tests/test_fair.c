@@ -270,14 +270,9 @@ static void test_star_score_is_min(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(star_score_is_min),
-        TAP_TEST(block),
-        TAP_TEST(ball_many_iters),
-        TAP_TEST(keeps_30),
-        TAP_TEST(thin_slab),
-        TAP_TEST(threads),
-        TAP_TEST(refusals),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(star_score_is_min), TAP_TEST(block),
+                                     TAP_TEST(ball_many_iters), TAP_TEST(keeps_30),
+                                     TAP_TEST(thin_slab), TAP_TEST(threads),
+                                     TAP_TEST(refusals), {0}};
     return tap_main(argc, argv, tests);
 }

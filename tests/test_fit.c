@@ -698,16 +698,9 @@ static void test_fill(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(sphere),
-        TAP_TEST(threads),
-        TAP_TEST(not_enclosing),
-        TAP_TEST(refusals),
-        TAP_TEST(bvh_query_tri),
-        TAP_TEST(bvh_query_tet),
-        TAP_TEST(band_edge),
-        TAP_TEST(peel),
-        TAP_TEST(fill),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads),
+                                     TAP_TEST(not_enclosing), TAP_TEST(refusals),
+                                     TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
+                                     TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), {0}};
     return tap_main(argc, argv, tests);
 }

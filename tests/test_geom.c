@@ -132,11 +132,7 @@ static void test_segment(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(voronoi_regions),
-        TAP_TEST(degenerate_triangles),
-        TAP_TEST(segment),
-        TAP_TEST(random_against_sampling),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(voronoi_regions), TAP_TEST(degenerate_triangles),
+                                     TAP_TEST(segment), TAP_TEST(random_against_sampling), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -735,21 +735,16 @@ static void round_trips_unknown(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        {"formats", formats},
-        {"round_trips_banded", round_trips_banded},
-        {"round_trips_full", round_trips_full},
-        {"round_trips_signed", round_trips_signed},
-        {"round_trips_signed_full", round_trips_signed_full},
-        {"round_trips_unknown", round_trips_unknown},
-        {"sparse_files", sparse_files},
-        {"foreign_files", foreign_files},
-        {"errors", errors},
-        {"no_leftovers", no_leftovers},
-        {0}};
-    int rc = tap_select(argc, argv, tests);
-    if (rc >= 0)
-        return rc;
+    static const tap_test tests[] = {{"formats", formats},
+                                     {"round_trips_banded", round_trips_banded},
+                                     {"round_trips_full", round_trips_full},
+                                     {"round_trips_signed", round_trips_signed},
+                                     {"round_trips_signed_full", round_trips_signed_full},
+                                     {"round_trips_unknown", round_trips_unknown},
+                                     {"sparse_files", sparse_files},
+                                     {"foreign_files", foreign_files}, {"errors", errors},
+                                     {"no_leftovers", no_leftovers}, {0}};
+    tap_select(argc, argv, tests);
     snprintf(dir, sizeof dir, "/tmp/test_gridio.XXXXXX");
     if (!mkdtemp(dir)) {
         printf("Bail out! cannot create a temporary directory\n");

@@ -702,12 +702,8 @@ static void test_corner_pierced(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(which_loops),
-        TAP_TEST(pseudo_volume),
-        TAP_TEST(bend),
-        TAP_TEST(corner),
-        TAP_TEST(corner_pierced),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
+                                     TAP_TEST(bend), TAP_TEST(corner), TAP_TEST(corner_pierced),
+                                     {0}};
     return tap_main(argc, argv, tests);
 }

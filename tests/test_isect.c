@@ -842,17 +842,10 @@ static void test_tri_tri_cross(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(point_in_tet),
-        TAP_TEST(tri_tri_cross),
-        TAP_TEST(point_in_tri),
-        TAP_TEST(segment_tri),
-        TAP_TEST(tri_tri),
-        TAP_TEST(tri_tet),
-        TAP_TEST(tri_box),
-        TAP_TEST(tri_box_maybe),
-        TAP_TEST(bvh_query_box),
-        TAP_TEST(speed),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(point_in_tet), TAP_TEST(tri_tri_cross),
+                                     TAP_TEST(point_in_tri), TAP_TEST(segment_tri),
+                                     TAP_TEST(tri_tri), TAP_TEST(tri_tet), TAP_TEST(tri_box),
+                                     TAP_TEST(tri_box_maybe), TAP_TEST(bvh_query_box),
+                                     TAP_TEST(speed), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -331,12 +331,7 @@ static void test_bad(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(cubic5),
-        TAP_TEST(bcc),
-        TAP_TEST(seeded),
-        TAP_TEST(density),
-        TAP_TEST(bad),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(cubic5), TAP_TEST(bcc), TAP_TEST(seeded),
+                                     TAP_TEST(density), TAP_TEST(bad), {0}};
     return tap_main(argc, argv, tests);
 }

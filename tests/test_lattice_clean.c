@@ -167,10 +167,7 @@ static void test_thin_plate(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(dumbbell),
-        TAP_TEST(edge_cubes),
-        TAP_TEST(thin_plate),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(dumbbell), TAP_TEST(edge_cubes),
+                                     TAP_TEST(thin_plate), {0}};
     return tap_main(argc, argv, tests);
 }

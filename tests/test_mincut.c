@@ -267,10 +267,7 @@ static void test_enclosed(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(brute_force),
-        TAP_TEST(cup),
-        TAP_TEST(enclosed),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(brute_force), TAP_TEST(cup), TAP_TEST(enclosed),
+                                     {0}};
     return tap_main(argc, argv, tests);
 }

@@ -211,12 +211,8 @@ static void test_mode_names(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(obj_names),
-        TAP_TEST(groups_utf8_stl),
-        TAP_TEST(pieces),
-        TAP_TEST(tag_nested),
-        TAP_TEST(mode_names),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(obj_names), TAP_TEST(groups_utf8_stl),
+                                     TAP_TEST(pieces), TAP_TEST(tag_nested),
+                                     TAP_TEST(mode_names), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -178,13 +178,13 @@ static void test_candidates(void)
 /* A dry run: h and the sculpted count, no mesh. */
 static void test_dry_run(void)
 {
-    st_soup *s = sphere_soup();
-    st_pipeline_params p = sphere_params();
-    st_error err;
-    st_tetmesh *m2 = NULL;
-    st_pipeline_stats st2;
     counts c;
     memset(&c, 0, sizeof c);
+    st_pipeline_params p = sphere_params();
+    st_soup *s = sphere_soup();
+    st_tetmesh *m2 = NULL;
+    st_pipeline_stats st2;
+    st_error err;
     p.on_event = on_event;
     p.on_event_ctx = &c;
     p.try_all = 0;
@@ -246,11 +246,11 @@ static void test_float32(void)
 
 static void test_refusals(void)
 {
-    st_soup *s = sphere_soup();
     st_pipeline_params p = sphere_params();
-    st_error err;
-    st_tetmesh *m2 = NULL;
     p.tries = 0;
+    st_soup *s = sphere_soup();
+    st_tetmesh *m2 = NULL;
+    st_error err;
     TAP_CHECK(st_pipeline_run(&m2, NULL, s, &p, NULL, &err) == ST_EINPUT && !m2,
               "tries 0: refused");
     p.tries = 1;
@@ -297,14 +297,8 @@ static void test_empty_soup(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(candidate_seed),
-        TAP_TEST(candidates),
-        TAP_TEST(dry_run),
-        TAP_TEST(float32),
-        TAP_TEST(refusals),
-        TAP_TEST(lattice_bound),
-        TAP_TEST(empty_soup),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(candidate_seed), TAP_TEST(candidates),
+                                     TAP_TEST(dry_run), TAP_TEST(float32), TAP_TEST(refusals),
+                                     TAP_TEST(lattice_bound), TAP_TEST(empty_soup), {0}};
     return tap_main(argc, argv, tests);
 }

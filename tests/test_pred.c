@@ -466,16 +466,11 @@ static void test_coplanar_perturbed_scales(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(random_integers),
-        TAP_TEST(drop_axes),
-        TAP_TEST(53bit_nearly_coplanar),
-        {"collinear_perturbed", test_collinear_perturbed_scales},
-        {"coplanar_perturbed", test_coplanar_perturbed_scales},
-        TAP_TEST(mixed_scales),
-        TAP_TEST(symmetries),
-        TAP_TEST(exact_counter),
-        TAP_TEST(speed),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(random_integers), TAP_TEST(drop_axes),
+                                     TAP_TEST(53bit_nearly_coplanar),
+                                     {"collinear_perturbed", test_collinear_perturbed_scales},
+                                     {"coplanar_perturbed", test_coplanar_perturbed_scales},
+                                     TAP_TEST(mixed_scales), TAP_TEST(symmetries),
+                                     TAP_TEST(exact_counter), TAP_TEST(speed), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -949,18 +949,11 @@ static void test_fill(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(entry_point),
-        TAP_TEST(large_holes),
-        TAP_TEST(hemisphere),
-        TAP_TEST(onesided),
-        TAP_TEST(onesided_caps),
-        TAP_TEST(columns),
-        TAP_TEST(columns_caps),
-        TAP_TEST(sides_orientation),
-        TAP_TEST(shared_tables),
-        TAP_TEST(shells_shortcut),
-        TAP_TEST(fill),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(entry_point), TAP_TEST(large_holes),
+                                     TAP_TEST(hemisphere), TAP_TEST(onesided),
+                                     TAP_TEST(onesided_caps), TAP_TEST(columns),
+                                     TAP_TEST(columns_caps), TAP_TEST(sides_orientation),
+                                     TAP_TEST(shared_tables), TAP_TEST(shells_shortcut),
+                                     TAP_TEST(fill), {0}};
     return tap_main(argc, argv, tests);
 }

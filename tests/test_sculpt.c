@@ -434,10 +434,7 @@ static void test_search_optimal(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(enclosure),
-        TAP_TEST(known_repairs),
-        TAP_TEST(search_optimal),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(enclosure), TAP_TEST(known_repairs),
+                                     TAP_TEST(search_optimal), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -180,9 +180,6 @@ static void test_open_pieces(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(overlapping_boxes),
-        TAP_TEST(open_pieces),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(overlapping_boxes), TAP_TEST(open_pieces), {0}};
     return tap_main(argc, argv, tests);
 }

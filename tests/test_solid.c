@@ -324,10 +324,6 @@ static void test_sphere(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(boxes),
-        TAP_TEST(tets),
-        TAP_TEST(sphere),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(boxes), TAP_TEST(tets), TAP_TEST(sphere), {0}};
     return tap_main(argc, argv, tests);
 }

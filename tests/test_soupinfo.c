@@ -480,22 +480,12 @@ static void test_self_intersections(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(cube_indexed),
-        TAP_TEST(cube_exact_soup),
-        TAP_TEST(negative_zero_welds),
-        TAP_TEST(face_removed),
-        TAP_TEST(two_holes_at_one_vertex),
-        TAP_TEST(flipped),
-        TAP_TEST(duplicated),
-        TAP_TEST(fin),
-        TAP_TEST(two_cubes),
-        TAP_TEST(degenerate),
-        TAP_TEST(torus),
-        TAP_TEST(moebius),
-        TAP_TEST(order_independent),
-        TAP_TEST(errors),
-        TAP_TEST(self_intersections),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(cube_indexed), TAP_TEST(cube_exact_soup),
+                                     TAP_TEST(negative_zero_welds), TAP_TEST(face_removed),
+                                     TAP_TEST(two_holes_at_one_vertex), TAP_TEST(flipped),
+                                     TAP_TEST(duplicated), TAP_TEST(fin), TAP_TEST(two_cubes),
+                                     TAP_TEST(degenerate), TAP_TEST(torus), TAP_TEST(moebius),
+                                     TAP_TEST(order_independent), TAP_TEST(errors),
+                                     TAP_TEST(self_intersections), {0}};
     return tap_main(argc, argv, tests);
 }

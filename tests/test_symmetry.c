@@ -171,10 +171,6 @@ static void test_none(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(bracket),
-        TAP_TEST(hex_bar),
-        TAP_TEST(none),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(bracket), TAP_TEST(hex_bar), TAP_TEST(none), {0}};
     return tap_main(argc, argv, tests);
 }

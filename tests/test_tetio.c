@@ -472,17 +472,10 @@ int main(int argc, char **argv)
         }
         return 0;
     }
-    static const tap_test tests[] = {
-        TAP_TEST(file_roundtrip),
-        TAP_TEST(mem_roundtrip),
-        TAP_TEST(points_only),
-        TAP_TEST(other_formats),
-        TAP_TEST(pipe),
-        TAP_TEST(bad_input),
-        {0}};
-    int rc = tap_select(argc, argv, tests);
-    if (rc >= 0)
-        return rc;
+    static const tap_test tests[] = {TAP_TEST(file_roundtrip), TAP_TEST(mem_roundtrip),
+                                     TAP_TEST(points_only), TAP_TEST(other_formats),
+                                     TAP_TEST(pipe), TAP_TEST(bad_input), {0}};
+    tap_select(argc, argv, tests);
     if (!mkdtemp(g_dir)) {
         perror("mkdtemp");
         return 1;

@@ -347,14 +347,9 @@ static void test_adjacency(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(regular),
-        TAP_TEST(cube_tets),
-        TAP_TEST(degenerate),
-        TAP_TEST(circumcenter_random),
-        TAP_TEST(build),
-        TAP_TEST(compact),
-        TAP_TEST(adjacency),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(regular), TAP_TEST(cube_tets),
+                                     TAP_TEST(degenerate), TAP_TEST(circumcenter_random),
+                                     TAP_TEST(build), TAP_TEST(compact), TAP_TEST(adjacency),
+                                     {0}};
     return tap_main(argc, argv, tests);
 }

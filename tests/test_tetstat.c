@@ -335,13 +335,8 @@ static void test_contacts(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(regular),
-        TAP_TEST(cubes),
-        TAP_TEST(bad_tets),
-        TAP_TEST(surface),
-        TAP_TEST(field),
-        TAP_TEST(contacts),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(regular), TAP_TEST(cubes), TAP_TEST(bad_tets),
+                                     TAP_TEST(surface), TAP_TEST(field), TAP_TEST(contacts),
+                                     {0}};
     return tap_main(argc, argv, tests);
 }

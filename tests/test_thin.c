@@ -108,10 +108,6 @@ static void test_wedge(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(plates),
-        TAP_TEST(slot),
-        TAP_TEST(wedge),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(plates), TAP_TEST(slot), TAP_TEST(wedge), {0}};
     return tap_main(argc, argv, tests);
 }

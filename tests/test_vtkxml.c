@@ -824,16 +824,10 @@ static void test_own_writers(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(findings),
-        TAP_TEST(near_misses),
-        TAP_TEST(foreign_writers),
-        TAP_TEST(own_writers),
-        TAP_TEST(vtk_messages),
-        {0}};
-    int rc = tap_select(argc, argv, tests);
-    if (rc >= 0)
-        return rc;
+    static const tap_test tests[] = {TAP_TEST(findings), TAP_TEST(near_misses),
+                                     TAP_TEST(foreign_writers), TAP_TEST(own_writers),
+                                     TAP_TEST(vtk_messages), {0}};
+    tap_select(argc, argv, tests);
     find_data(argv[0]);
     if (!mkdtemp(g_tmp)) {
         perror("mkdtemp");

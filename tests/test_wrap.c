@@ -423,12 +423,7 @@ static void test_write(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {
-        TAP_TEST(check),
-        TAP_TEST(write),
-        TAP_TEST(grid_edge),
-        TAP_TEST(iso_values),
-        TAP_TEST(shapes),
-        {0}};
+    static const tap_test tests[] = {TAP_TEST(check), TAP_TEST(write), TAP_TEST(grid_edge),
+                                     TAP_TEST(iso_values), TAP_TEST(shapes), {0}};
     return tap_main(argc, argv, tests);
 }
