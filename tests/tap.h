@@ -19,8 +19,8 @@
  *
  * tap_data(name) is tests/data/name, found from the program's own path
  * (build/tests/test_X, or any build directory's, -> tests/data), so a test
- * runs from any directory;
- * SOUPTET_TESTDATA overrides it.
+ * runs from any directory; SOUPTET_TESTDATA overrides it. tap_path does
+ * the same for any path in the source tree (corpus/bunny.obj).
  */
 #ifndef SOUPTET_TESTS_TAP_H
 #define SOUPTET_TESTS_TAP_H
@@ -157,35 +157,40 @@ static inline int tap_main(int argc, char **argv, const tap_test *tests)
     return tap_done();
 }
 
+/* path (relative to the source tree: "corpus/bunny.obj") as seen from
+ * here: the tree is the one holding this program (build/tests/test_X ->
+ * ../..) when it has tests/data, else the working directory. In a static
+ * buffer. */
+static inline const char *tap_path(const char *path)
+{
+    static char out[4096];
+    struct stat st;
+    char self[4000];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n > 0)
+        self[n] = 0;
+    else
+        snprintf(self, sizeof self, "%s", tap_argv0 ? tap_argv0 : "");
+    char *slash = strrchr(self, '/');
+    if (slash) {
+        *slash = 0;
+        snprintf(out, sizeof out, "%s/../../tests/data", self);
+        if (stat(out, &st) == 0 && S_ISDIR(st.st_mode)) {
+            snprintf(out, sizeof out, "%s/../../%s", self, path);
+            return out;
+        }
+    }
+    snprintf(out, sizeof out, "%s", path);
+    return out;
+}
+
 /* tests/data/name (see the top of this file), in a static buffer. */
 static inline const char *tap_data(const char *name)
 {
     static char path[4096];
-    struct stat st;
     const char *env = getenv("SOUPTET_TESTDATA");
-    if (env && *env) {
-        snprintf(path, sizeof path, "%s/%s", env, name);
-        return path;
-    }
-    char self[4000];
-    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-    if (n > 0) {
-        self[n] = 0;
-    } else if (tap_argv0) {
-        snprintf(self, sizeof self, "%s", tap_argv0);
-    } else {
-        self[0] = 0;
-    }
-    char *slash = strrchr(self, '/');
-    if (slash) {
-        *slash = 0;
-        snprintf(path, sizeof path, "%s/../../tests/data", self);
-        if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-            snprintf(path, sizeof path, "%s/../../tests/data/%s", self, name);
-            return path;
-        }
-    }
-    snprintf(path, sizeof path, "tests/data/%s", name);
+    snprintf(path, sizeof path, "%.3800s/%.200s", env && *env ? env : tap_path("tests/data"),
+             name);
     return path;
 }
 

@@ -166,7 +166,7 @@ int main(int argc, char **argv)
                                      {0}};
     tap_select(argc, argv, tests);
     st_error err;
-    if (st_soup_read(&g_bunny, "corpus/bunny.obj", &err) != ST_OK) {
+    if (st_soup_read(&g_bunny, tap_path("corpus/bunny.obj"), &err) != ST_OK) {
         TAP_CHECK(0, "read corpus/bunny.obj: %s", err.msg);
         return tap_done();
     }

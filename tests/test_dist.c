@@ -443,7 +443,7 @@ static void test_real_model(void)
 {
     st_soup *s;
     st_error err;
-    if (st_soup_read(&s, "corpus/bunny.obj", &err) != ST_OK) {
+    if (st_soup_read(&s, tap_path("corpus/bunny.obj"), &err) != ST_OK) {
         TAP_CHECK(0, "read corpus/bunny.obj: %s", err.msg);
         return;
     }
