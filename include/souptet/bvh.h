@@ -7,7 +7,7 @@
  * Threads: build once; queries are read-only and thread-safe, and answer
  * the same for any thread count.
  * Errors: st_bvh_build: ST_EINPUT (no triangles), ST_ELIMIT (more than
- * 32-bit indices hold), ST_ENOMEM; the queries cannot fail.
+ * 2^31 triangles), ST_ENOMEM; the queries cannot fail.
  *
  * Axis-aligned boxes, median splits on the longest axis of the centroids,
  * at most ST_BVH_LEAF triangles per leaf. Queries are read-only and may run

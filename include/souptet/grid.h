@@ -7,8 +7,9 @@
  * and its meta.
  * Threads: no global state; a grid may be read from many threads, written
  * by one.
- * Errors: st_grid_new: ST_EINPUT (zero or bad dimensions), ST_ELIMIT (over
- * max_bytes), ST_ENOMEM.
+ * Errors: st_grid_new: ST_EINPUT (no voxels, a voxel size or origin that
+ * is not a finite positive number), ST_ELIMIT (over max_bytes, or sizes
+ * that overflow), ST_ENOMEM.
  *
  * Values live at voxel centers: voxel (i, j, k) is centered at
  * origin + voxel * (i, j, k). Storage is x fastest:
