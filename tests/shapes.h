@@ -1,16 +1,19 @@
 /*
  * shapes.h - small closed and damaged test surfaces built in code (header
- * only, for the unit tests): exact soups of boxes and UV spheres, and
- * signed fields of shapes given by a function.
+ * only, for the unit tests): exact soups of boxes, UV spheres read from
+ * fixtures in tests/data, and signed fields of shapes given by a function.
  */
 #ifndef SOUPTET_TESTS_SHAPES_H
 #define SOUPTET_TESTS_SHAPES_H
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 
 #include "souptet/grid.h"
 #include "souptet/soup.h"
+#include "tap.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -82,25 +85,42 @@ static inline st_grid *signed_grid(size_t n, double w,
     return g;
 }
 
-/* A UV sphere of radius r at the origin, without the faces above z_cut. */
+/* A UV sphere of radius r at the origin, without the faces above z_cut:
+ * the fixture tests/data/sphere_uv32x16.off (32 x 16 quads, every other
+ * triangle flipped, its south pole 32 points 1e-16 apart: the tests are
+ * tuned to it as it is, so it is a file, where a fix shows). Radius 0.3
+ * has its own file (r sin cos rounds otherwise than a scaled unit
+ * sphere); any other r must be a power of 2, for which scaling is exact.
+ * Each triangle keeps its own three vertices, in the file's order. */
 static inline void add_sphere(st_soup *s, double r, double z_cut)
 {
-    const int nu = 32, nv = 16;
-    for (int i = 0; i < nv; i++)
-        for (int j = 0; j < nu; j++) {
-            double p[4][3];
-            for (int c = 0; c < 4; c++) {
-                int ii = i + (c >= 2), jj = j + (c == 1 || c == 2);
-                double th = M_PI * ii / nv, ph = 2 * M_PI * jj / nu;
-                p[c][0] = r * sin(th) * cos(ph);
-                p[c][1] = r * sin(th) * sin(ph);
-                p[c][2] = r * cos(th);
-            }
-            if (p[0][2] > z_cut || p[2][2] > z_cut)
-                continue;
-            add_tri(s, p[0], p[1], p[2], (i + j) & 1);
-            add_tri(s, p[0], p[2], p[3], 0);
-        }
+    const char *name = r == 0.3 ? "sphere_uv32x16_r0.3.off" : "sphere_uv32x16.off";
+    double scale = r == 0.3 ? 1.0 : r;
+    int e;
+    if (r != 0.3 && (!(r > 0) || frexp(r, &e) != 0.5)) {
+        printf("Bail out! add_sphere: no fixture for radius %.17g\n", r);
+        exit(1);
+    }
+    st_soup *f = NULL;
+    st_error err;
+    if (st_soup_read(&f, tap_data(name), &err) != ST_OK || f->nverts != 3 * f->ntris) {
+        printf("Bail out! add_sphere: %s: %s\n", tap_data(name),
+               f ? "not one vertex triple a triangle" : err.msg);
+        exit(1);
+    }
+    for (size_t t = 0; t < f->ntris; t++) {
+        const double *v = f->xyz + 9 * t;
+        if (v[2] * scale > z_cut || v[5] * scale > z_cut || v[8] * scale > z_cut)
+            continue;
+        uint32_t n = (uint32_t)s->nverts;
+        for (int k = 0; k < 3; k++)
+            st_soup_add_vertex(s, v[3 * k] * scale, v[3 * k + 1] * scale,
+                               v[3 * k + 2] * scale, NULL);
+        const uint32_t *tri = f->tris + 3 * t;
+        uint32_t b = (uint32_t)(3 * t);
+        st_soup_add_triangle(s, n + tri[0] - b, n + tri[1] - b, n + tri[2] - b, NULL);
+    }
+    st_soup_free(f);
 }
 
 #endif

@@ -275,14 +275,10 @@ static void test_address_space(void)
               WIFEXITED(ws) ? WEXITSTATUS(ws) : -1);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_error_format();
-    test_checked_sizes();
-    test_meta();
-    test_grid();
-    test_outfile();
-    test_outfile_stale();
-    test_address_space();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(error_format), TAP_TEST(checked_sizes),
+                                     TAP_TEST(meta), TAP_TEST(grid), TAP_TEST(outfile),
+                                     TAP_TEST(outfile_stale), TAP_TEST(address_space), {0}};
+    return tap_main(argc, argv, tests);
 }

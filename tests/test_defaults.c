@@ -74,12 +74,9 @@ static void print_defaults(void)
     printf("soupwrap --voxels %zu\n", dist.cells);
 }
 
-int main(int argc, char **argv)
+/* The defaults the tools share agree. */
+static void test_shared(void)
 {
-    if (argc > 1 && strcmp(argv[1], "--print") == 0) {
-        print_defaults();
-        return 0;
-    }
     st_pipeline_params pl = st_pipeline_params_default();
     st_fit_params fit = st_fit_params_default();
     st_dist_params dist = st_dist_params_default();
@@ -105,5 +102,14 @@ int main(int argc, char **argv)
     TAP_CHECK(pl.tries == 1, "soupmesh runs one candidate by default, as the pipe does");
     TAP_CHECK(pl.density_rho == 0 && pl.target_tets == 0 && pl.h == 0,
               "soupmesh sculpts at --cells by default");
-    return tap_done();
+}
+
+int main(int argc, char **argv)
+{
+    static const tap_test tests[] = {TAP_TEST(shared), {0}};
+    if (argc > 1 && strcmp(argv[1], "--print") == 0) {
+        print_defaults();
+        return 0;
+    }
+    return tap_main(argc, argv, tests);
 }

@@ -443,7 +443,7 @@ static void test_real_model(void)
 {
     st_soup *s;
     st_error err;
-    if (st_soup_read(&s, "corpus/bunny.obj", &err) != ST_OK) {
+    if (st_soup_read(&s, tap_path("corpus/bunny.obj"), &err) != ST_OK) {
         TAP_CHECK(0, "read corpus/bunny.obj: %s", err.msg);
         return;
     }
@@ -482,15 +482,11 @@ static void test_real_model(void)
     st_soup_free(s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_layout();
-    test_band_exact_on_random_soup();
-    test_large_oblique_triangle();
-    test_bvh_nearest();
-    test_bvh_parallel_layout();
-    test_threads_identical();
-    test_fine_soup_exact();
-    test_real_model();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(layout), TAP_TEST(band_exact_on_random_soup),
+                                     TAP_TEST(large_oblique_triangle), TAP_TEST(bvh_nearest),
+                                     TAP_TEST(bvh_parallel_layout), TAP_TEST(threads_identical),
+                                     TAP_TEST(fine_soup_exact), TAP_TEST(real_model), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -258,12 +258,9 @@ static void test_many_vertices(void)
     st_soup_free(s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_weld();
-    test_closed_box();
-    test_damage();
-    test_order();
-    test_many_vertices();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(weld), TAP_TEST(closed_box), TAP_TEST(damage),
+                                     TAP_TEST(order), TAP_TEST(many_vertices), {0}};
+    return tap_main(argc, argv, tests);
 }

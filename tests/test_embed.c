@@ -233,9 +233,8 @@ static void test_block(void)
     st_tetmesh_free(m);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_cube();
-    test_block();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(cube), TAP_TEST(block), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -648,17 +648,17 @@ static void test_float32_knife(void)
     st_soup_free(s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_cube_encloses_small_soup();
-    test_soup_sticking_out();
-    test_touching_boundary();
-    test_inverted_and_flat();
-    test_empty_mesh();
-    test_locator_brute_force();
-    test_threads_and_speed();
-    test_float32_face();
-    test_float32_rotated();
-    test_float32_knife();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(cube_encloses_small_soup),
+                                     TAP_TEST(soup_sticking_out),
+                                     TAP_TEST(touching_boundary),
+                                     TAP_TEST(inverted_and_flat),
+                                     TAP_TEST(empty_mesh),
+                                     TAP_TEST(locator_brute_force),
+                                     TAP_TEST(threads_and_speed),
+                                     TAP_TEST(float32_face),
+                                     TAP_TEST(float32_rotated),
+                                     TAP_TEST(float32_knife), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -268,14 +268,11 @@ static void test_star_score_is_min(void)
     st_tetmesh_free(m);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_star_score_is_min();
-    test_block();
-    test_ball_many_iters();
-    test_keeps_30();
-    test_thin_slab();
-    test_threads();
-    test_refusals();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(star_score_is_min), TAP_TEST(block),
+                                     TAP_TEST(ball_many_iters), TAP_TEST(keeps_30),
+                                     TAP_TEST(thin_slab), TAP_TEST(threads),
+                                     TAP_TEST(refusals), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -696,16 +696,11 @@ static void test_fill(void)
     st_soup_free(down);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_sphere();
-    test_threads();
-    test_not_enclosing();
-    test_refusals();
-    test_bvh_query_tri();
-    test_bvh_query_tet();
-    test_band_edge();
-    test_peel();
-    test_fill();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads),
+                                     TAP_TEST(not_enclosing), TAP_TEST(refusals),
+                                     TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
+                                     TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -582,19 +582,45 @@ static void find_data(char *dir, size_t n, const char *argv0)
     snprintf(dir, n, "tests/data/fuzz");
 }
 
+/* One test a reader, named for its directory. */
+static char g_base[4096];
+#define READER_TEST(fn, name)                      \
+    static void fn(void)                           \
+    {                                              \
+        run_reader(g_base, find_reader(name));     \
+    }
+READER_TEST(test_obj, "obj")
+READER_TEST(test_off, "off")
+READER_TEST(test_ply, "ply")
+READER_TEST(test_stl, "stl")
+READER_TEST(test_gltf, "gltf")
+READER_TEST(test_soupsniff, "soupsniff")
+READER_TEST(test_vdb, "vdb")
+READER_TEST(test_vti, "vti")
+READER_TEST(test_msh, "msh")
+READER_TEST(test_medit, "medit")
+READER_TEST(test_tetgen, "tetgen")
+READER_TEST(test_vtu, "vtu")
+READER_TEST(test_vtu_new, "vtu-new")
+READER_TEST(test_tetmesh, "tetmesh")
+
 int main(int argc, char **argv)
 {
+    static const tap_test tests[] = {TAP_TEST(obj), TAP_TEST(off), TAP_TEST(ply), TAP_TEST(stl),
+                                     TAP_TEST(gltf), TAP_TEST(soupsniff), TAP_TEST(vdb),
+                                     TAP_TEST(vti), TAP_TEST(msh), TAP_TEST(medit),
+                                     TAP_TEST(tetgen), TAP_TEST(vtu), {"vtu-new", test_vtu_new},
+                                     TAP_TEST(tetmesh), {0}};
     g_self = argv[0];
     if (argc == 5 && strcmp(argv[1], "--batch") == 0)
         return batch(argv[2], argv[3], (size_t)strtoull(argv[4], NULL, 10));
+    tap_select(argc, argv, tests);
     /* A child that dies must not kill the run with SIGPIPE on our side. */
     signal(SIGPIPE, SIG_IGN);
-    char dir[4096];
-    find_data(dir, sizeof dir, argv[0]);
-    TAP_NOTE("fuzz regression inputs from %s", dir);
-    load_todo(dir);
-    for (size_t i = 0; i < sizeof k_readers / sizeof k_readers[0]; i++)
-        run_reader(dir, &k_readers[i]);
+    find_data(g_base, sizeof g_base, argv[0]);
+    TAP_NOTE("fuzz regression inputs from %s", g_base);
+    load_todo(g_base);
+    tap_run(tests);
     free(g_todo);
     return tap_done();
 }

@@ -130,11 +130,9 @@ static void test_segment(void)
     TAP_NEAR(st_point_segment_dist2(p1, a, a, NULL), 2.0, 0, "zero-length segment");
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_voronoi_regions();
-    test_degenerate_triangles();
-    test_segment();
-    test_random_against_sampling();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(voronoi_regions), TAP_TEST(degenerate_triangles),
+                                     TAP_TEST(segment), TAP_TEST(random_against_sampling), {0}};
+    return tap_main(argc, argv, tests);
 }

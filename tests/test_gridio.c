@@ -707,23 +707,50 @@ static void remove_tree(const char *path)
     rmdir(path);
 }
 
-int main(void)
+/* The round trips of each kind of grid. */
+static void round_trips_banded(void)
 {
+    round_trips("banded", ST_GRID_DISTANCE, 0.02);
+}
+
+static void round_trips_full(void)
+{
+    round_trips("full", ST_GRID_DISTANCE, INFINITY);
+}
+
+static void round_trips_signed(void)
+{
+    round_trips("signed", ST_GRID_SIGNED, 0.02);
+}
+
+static void round_trips_signed_full(void)
+{
+    round_trips("signed_full", ST_GRID_SIGNED, INFINITY);
+}
+
+static void round_trips_unknown(void)
+{
+    round_trips("unknown", ST_GRID_UNKNOWN, 0.35);
+}
+
+int main(int argc, char **argv)
+{
+    static const tap_test tests[] = {{"formats", formats},
+                                     {"round_trips_banded", round_trips_banded},
+                                     {"round_trips_full", round_trips_full},
+                                     {"round_trips_signed", round_trips_signed},
+                                     {"round_trips_signed_full", round_trips_signed_full},
+                                     {"round_trips_unknown", round_trips_unknown},
+                                     {"sparse_files", sparse_files},
+                                     {"foreign_files", foreign_files}, {"errors", errors},
+                                     {"no_leftovers", no_leftovers}, {0}};
+    tap_select(argc, argv, tests);
     snprintf(dir, sizeof dir, "/tmp/test_gridio.XXXXXX");
     if (!mkdtemp(dir)) {
         printf("Bail out! cannot create a temporary directory\n");
         return 1;
     }
-    formats();
-    round_trips("banded", ST_GRID_DISTANCE, 0.02);
-    round_trips("full", ST_GRID_DISTANCE, INFINITY);
-    round_trips("signed", ST_GRID_SIGNED, 0.02);
-    round_trips("signed_full", ST_GRID_SIGNED, INFINITY);
-    round_trips("unknown", ST_GRID_UNKNOWN, 0.35);
-    sparse_files();
-    foreign_files();
-    errors();
-    no_leftovers();
+    tap_run(tests);
     if (!getenv("TEST_GRIDIO_KEEP"))
         remove_tree(dir);
     else

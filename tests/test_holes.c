@@ -700,12 +700,10 @@ static void test_corner_pierced(void)
     st_soup_free(cut);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_which_loops();
-    test_pseudo_volume();
-    test_bend();
-    test_corner();
-    test_corner_pierced();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
+                                     TAP_TEST(bend), TAP_TEST(corner), TAP_TEST(corner_pierced),
+                                     {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -840,17 +840,12 @@ static void test_tri_tri_cross(void)
     }
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_point_in_tet();
-    test_tri_tri_cross();
-    test_point_in_tri();
-    test_segment_tri();
-    test_tri_tri();
-    test_tri_tet();
-    test_tri_box();
-    test_tri_box_maybe();
-    test_bvh_query_box();
-    test_speed();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(point_in_tet), TAP_TEST(tri_tri_cross),
+                                     TAP_TEST(point_in_tri), TAP_TEST(segment_tri),
+                                     TAP_TEST(tri_tri), TAP_TEST(tri_tet), TAP_TEST(tri_box),
+                                     TAP_TEST(tri_box_maybe), TAP_TEST(bvh_query_box),
+                                     TAP_TEST(speed), {0}};
+    return tap_main(argc, argv, tests);
 }

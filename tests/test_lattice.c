@@ -329,12 +329,9 @@ static void test_bad(void)
               st_lattice_kind_from_name("cubic", &k) == -1, "lattice names");
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_cubic5();
-    test_bcc();
-    test_seeded();
-    test_density();
-    test_bad();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(cubic5), TAP_TEST(bcc), TAP_TEST(seeded),
+                                     TAP_TEST(density), TAP_TEST(bad), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -165,10 +165,9 @@ static void test_thin_plate(void)
     st_grid_free(g);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_dumbbell();
-    test_edge_cubes();
-    test_thin_plate();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(dumbbell), TAP_TEST(edge_cubes),
+                                     TAP_TEST(thin_plate), {0}};
+    return tap_main(argc, argv, tests);
 }

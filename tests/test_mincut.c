@@ -265,10 +265,9 @@ static void test_enclosed(void)
     st_grid_free(g);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_brute_force();
-    test_cup();
-    test_enclosed();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(brute_force), TAP_TEST(cup), TAP_TEST(enclosed),
+                                     {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -201,15 +201,18 @@ static void test_tag_nested(void)
     st_soup_free(s);
 }
 
-int main(void)
+static void test_mode_names(void)
 {
-    test_obj_names();
-    test_groups_utf8_stl();
-    test_pieces();
-    test_tag_nested();
     TAP_CHECK(st_parts_mode_from_name("pieces") == ST_PARTS_PIECES &&
                   st_parts_mode_from_name("colour") == -1 &&
                   strcmp(st_parts_mode_name(ST_PARTS_AUTO), "auto") == 0,
               "mode names both ways");
-    return tap_done();
+}
+
+int main(int argc, char **argv)
+{
+    static const tap_test tests[] = {TAP_TEST(obj_names), TAP_TEST(groups_utf8_stl),
+                                     TAP_TEST(pieces), TAP_TEST(tag_nested),
+                                     TAP_TEST(mode_names), {0}};
+    return tap_main(argc, argv, tests);
 }

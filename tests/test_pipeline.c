@@ -45,23 +45,107 @@ static int same_mesh(const st_tetmesh *a, const st_tetmesh *b)
            memcmp(a->tets, b->tets, 4 * a->ntets * sizeof *a->tets) == 0;
 }
 
-int main(void)
+/* The unit UV sphere (closed, half its triangles flipped), meshed with
+ * 4 cells in a field of 40 voxels. */
+static st_soup *sphere_soup(void)
 {
     st_soup *s = st_soup_new();
-    add_sphere(s, 1.0, 2.0);   /* closed, half its triangles flipped */
+    add_sphere(s, 1.0, 2.0);
+    return s;
+}
+
+static st_pipeline_params sphere_params(void)
+{
     st_pipeline_params p = st_pipeline_params_default();
     p.cells = 4;
     p.field_cells = 40;
     p.tries = 3;
     p.try_all = 1;
-    st_error err;
+    return p;
+}
 
+static void test_candidate_seed(void)
+{
     TAP_CHECK(st_pipeline_candidate_seed(7, 0) == 7, "candidate 0 takes the seed itself");
     TAP_CHECK(st_pipeline_candidate_seed(0, 1) != 0 && st_pipeline_candidate_seed(7, 1) !=
               st_pipeline_candidate_seed(7, 2), "later candidates: random, distinct, never 0");
+}
 
-    st_tetmesh *m1 = NULL, *m2 = NULL;
-    st_pipeline_stats st1, st2;
+/* 2 threads with events: the mesh m1 made on 1 thread without them. */
+static void check_events(const st_soup *s, st_pipeline_params p, const st_tetmesh *m1)
+{
+    st_error err;
+    st_tetmesh *m2 = NULL;
+    st_pipeline_stats st2;
+    counts c;
+    memset(&c, 0, sizeof c);
+    p.on_event = on_event;
+    p.on_event_ctx = &c;
+    omp_set_num_threads(2);
+    st_status r2 = st_pipeline_run(&m2, &st2, s, &p, NULL, &err);
+    TAP_CHECK(r2 == ST_OK && same_mesh(m1, m2),
+              "2 threads and events reported: the same mesh as 1 thread without");
+    TAP_CHECK(c.field == 1 && c.sculpted == 3 && c.candidate == 3 && c.size == 0,
+              "events: the field once, each candidate sculpted and done (%zu %zu %zu)",
+              c.field, c.sculpted, c.candidate);
+    TAP_CHECK(c.iteration >= 3 && !c.bad, "events: the fit's iterations, well formed (%zu)",
+              c.iteration);
+    free(st2.candidates);
+    st_tetmesh_free(m2);
+}
+
+/* Without try_all: the first batch (ST_PIPELINE_BATCH) runs, and the
+ * rest only when none of it meets every goal; the same for any thread
+ * count, and the winner is the best of those that ran (st1: try_all). */
+static void check_without_try_all(const st_soup *s, st_pipeline_params p,
+                                  const st_pipeline_stats *st1)
+{
+    st_error err;
+    p.try_all = 0;
+    size_t goal_k = SIZE_MAX;
+    for (size_t k = 0; k < ST_PIPELINE_BATCH && k < st1->ncandidates; k++) {
+        const st_pipeline_candidate *q = &st1->candidates[k];
+        if (!q->failed && !q->verts_outside && !q->tris_crossing && q->converged &&
+            q->min_dihedral >= 35.0 && q->max_dihedral <= 133.0)
+            goal_k = k;
+    }
+    size_t want = goal_k != SIZE_MAX ? ST_PIPELINE_BATCH : 3;
+    st_tetmesh *m3 = NULL, *m4 = NULL;
+    st_pipeline_stats st3, st4;
+    omp_set_num_threads(1);
+    st_status r3 = st_pipeline_run(&m3, &st3, s, &p, NULL, &err);
+    omp_set_num_threads(2);
+    st_status r4 = st_pipeline_run(&m4, &st4, s, &p, NULL, &err);
+    TAP_CHECK(r3 == ST_OK && r4 == ST_OK && st3.ncandidates == want &&
+              st4.ncandidates == want && st3.goal_met == (goal_k != SIZE_MAX) &&
+              same_mesh(m3, m4),
+              "without try_all: %zu of 3 candidates ran (goal met by %zu), "
+              "the same for 1 and 2 threads", st3.ncandidates, goal_k);
+    size_t b = 0;
+    for (size_t k = 1; k < want; k++) {
+        const st_pipeline_candidate *x = &st1->candidates[k], *y = &st1->candidates[b];
+        if (x->min_dihedral > y->min_dihedral ||
+            (x->min_dihedral == y->min_dihedral && x->max_dihedral < y->max_dihedral))
+            b = k;
+    }
+    TAP_CHECK(r3 == ST_OK && st3.best == b &&
+              st3.candidates[b].min_dihedral == st1->candidates[b].min_dihedral,
+              "without try_all: the best of those that ran (%zu), as with try_all", b);
+    free(st3.candidates);
+    free(st4.candidates);
+    st_tetmesh_free(m3);
+    st_tetmesh_free(m4);
+}
+
+/* Three candidates on 1 thread: the mesh, the winner, the meta; then the
+ * same with 2 threads and events, and without try_all. */
+static void test_candidates(void)
+{
+    st_soup *s = sphere_soup();
+    st_pipeline_params p = sphere_params();
+    st_error err;
+    st_tetmesh *m1 = NULL;
+    st_pipeline_stats st1;
     omp_set_num_threads(1);
     st_status r1 = st_pipeline_run(&m1, &st1, s, &p, NULL, &err);
     TAP_CHECK(r1 == ST_OK && m1 && m1->ntets > 0, "the sphere meshes (%zu tets)",
@@ -84,66 +168,26 @@ int main(void)
               strcmp(st_meta_get(&m1->meta, "candidates"), "3") == 0,
               "meta: h, encloses, candidates");
 
+    check_events(s, p, m1);
+    check_without_try_all(s, p, &st1);
+    free(st1.candidates);
+    st_tetmesh_free(m1);
+    st_soup_free(s);
+}
+
+/* A dry run: h and the sculpted count, no mesh. */
+static void test_dry_run(void)
+{
     counts c;
     memset(&c, 0, sizeof c);
+    st_pipeline_params p = sphere_params();
+    st_soup *s = sphere_soup();
+    st_tetmesh *m2 = NULL;
+    st_pipeline_stats st2;
+    st_error err;
     p.on_event = on_event;
     p.on_event_ctx = &c;
-    omp_set_num_threads(2);
-    st_status r2 = st_pipeline_run(&m2, &st2, s, &p, NULL, &err);
-    TAP_CHECK(r2 == ST_OK && same_mesh(m1, m2),
-              "2 threads and events reported: the same mesh as 1 thread without");
-    TAP_CHECK(c.field == 1 && c.sculpted == 3 && c.candidate == 3 && c.size == 0,
-              "events: the field once, each candidate sculpted and done (%zu %zu %zu)",
-              c.field, c.sculpted, c.candidate);
-    TAP_CHECK(c.iteration >= 3 && !c.bad, "events: the fit's iterations, well formed (%zu)",
-              c.iteration);
-
-    /* Without try_all: the first batch (ST_PIPELINE_BATCH) runs, and the
-     * rest only when none of it meets every goal; the same for any thread
-     * count, and the winner is the best of those that ran. */
-    {
-        p.try_all = 0;
-        size_t goal_k = SIZE_MAX;
-        for (size_t k = 0; k < ST_PIPELINE_BATCH && k < st1.ncandidates; k++) {
-            const st_pipeline_candidate *q = &st1.candidates[k];
-            if (!q->failed && !q->verts_outside && !q->tris_crossing && q->converged &&
-                q->min_dihedral >= 35.0 && q->max_dihedral <= 133.0)
-                goal_k = k;
-        }
-        size_t want = goal_k != SIZE_MAX ? ST_PIPELINE_BATCH : 3;
-        st_tetmesh *m3 = NULL, *m4 = NULL;
-        st_pipeline_stats st3, st4;
-        omp_set_num_threads(1);
-        st_status r3 = st_pipeline_run(&m3, &st3, s, &p, NULL, &err);
-        omp_set_num_threads(2);
-        st_status r4 = st_pipeline_run(&m4, &st4, s, &p, NULL, &err);
-        TAP_CHECK(r3 == ST_OK && r4 == ST_OK && st3.ncandidates == want &&
-                  st4.ncandidates == want && st3.goal_met == (goal_k != SIZE_MAX) &&
-                  same_mesh(m3, m4),
-                  "without try_all: %zu of 3 candidates ran (goal met by %zu), "
-                  "the same for 1 and 2 threads", st3.ncandidates, goal_k);
-        size_t b = 0;
-        for (size_t k = 1; k < want; k++) {
-            const st_pipeline_candidate *x = &st1.candidates[k], *y = &st1.candidates[b];
-            if (x->min_dihedral > y->min_dihedral ||
-                (x->min_dihedral == y->min_dihedral && x->max_dihedral < y->max_dihedral))
-                b = k;
-        }
-        TAP_CHECK(r3 == ST_OK && st3.best == b &&
-                  st3.candidates[b].min_dihedral == st1.candidates[b].min_dihedral,
-                  "without try_all: the best of those that ran (%zu), as with try_all", b);
-        free(st3.candidates);
-        free(st4.candidates);
-        st_tetmesh_free(m3);
-        st_tetmesh_free(m4);
-    }
-    free(st1.candidates);
-    free(st2.candidates);
-    st_tetmesh_free(m2);
-    m2 = NULL;
-
-    /* A dry run: h and the sculpted count, no mesh. */
-    memset(&c, 0, sizeof c);
+    p.try_all = 0;
     p.dry_run = 1;
     p.tries = 1;
     st_status r3 = st_pipeline_run(&m2, &st2, s, &p, NULL, &err);
@@ -151,61 +195,77 @@ int main(void)
               "dry run: no mesh, h %g and %zu tets estimated", st2.h, st2.estimated_tets);
     TAP_CHECK(c.size == 1 && c.sculpted == 0, "dry run: one sizing sculpt, no candidate");
     free(st2.candidates);
-    p.dry_run = 0;
-    p.on_event = NULL;
+    st_soup_free(s);
+}
 
-    /* float32: the same candidate, its points rounded to floats, still
-     * enclosing; the stats and meta say so. The sphere moved off the
-     * float grid (centre 20 + 1e-9) so every point has to move. */
-    {
-        st_soup *f = st_soup_new();
-        add_sphere(f, 1.0, 2.0);
-        for (size_t i = 0; i < f->nverts; i++)
-            for (int a = 0; a < 3; a++)
-                f->xyz[3 * i + (size_t)a] += 20.0 + 1e-9 * (a + 1);
-        st_tetmesh *md = NULL, *mf = NULL;
-        st_pipeline_stats sd, sf;
-        p.tries = 1;
-        st_status rd = st_pipeline_run(&md, &sd, f, &p, NULL, &err);
-        p.float32 = 1;
-        st_status rf = st_pipeline_run(&mf, &sf, f, &p, NULL, &err);
-        p.float32 = 0;
-        TAP_CHECK(rd == ST_OK && rf == ST_OK && md && mf && md->ntets == mf->ntets &&
-                  memcmp(md->tets, mf->tets, 4 * md->ntets * sizeof *md->tets) == 0,
-                  "float32: the same tets as without");
-        TAP_CHECK(mf && st_points_are_float32(mf->xyz, mf->npoints) &&
-                  md && !st_points_are_float32(md->xyz, md->npoints),
-                  "float32: every coordinate a float (without: not)");
-        size_t out = 9, cross = 9;
-        if (mf)
-            st_enclosure_count(mf, f, NULL, &out, &cross, &err);
-        TAP_CHECK(sf.encloses && sf.float32.encloses && out == 0 && cross == 0 &&
-                  sf.float32.rounds >= 1 && sf.float32.points_moved == mf->npoints &&
-                  sf.candidates[sf.best].verts_outside == 0,
-                  "float32: encloses, counted again on the result (%d checks, %zu moved, "
-                  "farthest %.3g)", sf.float32.rounds, sf.float32.points_moved,
-                  sf.float32.max_move);
-        const char *yes = mf ? st_meta_get(&mf->meta, "float32") : NULL;
-        TAP_CHECK(yes && strcmp(yes, "yes") == 0 && md && !st_meta_get(&md->meta, "float32") &&
-                  sd.float32.rounds == 0,
-                  "float32: meta float32 yes; without it, no meta and no rounding");
-        free(sd.candidates);
-        free(sf.candidates);
-        st_tetmesh_free(md);
-        st_tetmesh_free(mf);
-        st_soup_free(f);
-    }
+/* float32: the same candidate, its points rounded to floats, still
+ * enclosing; the stats and meta say so. The sphere moved off the
+ * float grid (centre 20 + 1e-9) so every point has to move. */
+static void test_float32(void)
+{
+    st_pipeline_params p = sphere_params();
+    p.try_all = 0;
+    st_error err;
+    st_soup *f = st_soup_new();
+    add_sphere(f, 1.0, 2.0);
+    for (size_t i = 0; i < f->nverts; i++)
+        for (int a = 0; a < 3; a++)
+            f->xyz[3 * i + (size_t)a] += 20.0 + 1e-9 * (a + 1);
+    st_tetmesh *md = NULL, *mf = NULL;
+    st_pipeline_stats sd, sf;
+    p.tries = 1;
+    st_status rd = st_pipeline_run(&md, &sd, f, &p, NULL, &err);
+    p.float32 = 1;
+    st_status rf = st_pipeline_run(&mf, &sf, f, &p, NULL, &err);
+    p.float32 = 0;
+    TAP_CHECK(rd == ST_OK && rf == ST_OK && md && mf && md->ntets == mf->ntets &&
+              memcmp(md->tets, mf->tets, 4 * md->ntets * sizeof *md->tets) == 0,
+              "float32: the same tets as without");
+    TAP_CHECK(mf && st_points_are_float32(mf->xyz, mf->npoints) &&
+              md && !st_points_are_float32(md->xyz, md->npoints),
+              "float32: every coordinate a float (without: not)");
+    size_t out = 9, cross = 9;
+    if (mf)
+        st_enclosure_count(mf, f, NULL, &out, &cross, &err);
+    TAP_CHECK(sf.encloses && sf.float32.encloses && out == 0 && cross == 0 &&
+              sf.float32.rounds >= 1 && sf.float32.points_moved == mf->npoints &&
+              sf.candidates[sf.best].verts_outside == 0,
+              "float32: encloses, counted again on the result (%d checks, %zu moved, "
+              "farthest %.3g)", sf.float32.rounds, sf.float32.points_moved,
+              sf.float32.max_move);
+    const char *yes = mf ? st_meta_get(&mf->meta, "float32") : NULL;
+    TAP_CHECK(yes && strcmp(yes, "yes") == 0 && md && !st_meta_get(&md->meta, "float32") &&
+              sd.float32.rounds == 0,
+              "float32: meta float32 yes; without it, no meta and no rounding");
+    free(sd.candidates);
+    free(sf.candidates);
+    st_tetmesh_free(md);
+    st_tetmesh_free(mf);
+    st_soup_free(f);
+}
 
+static void test_refusals(void)
+{
+    st_pipeline_params p = sphere_params();
     p.tries = 0;
+    st_soup *s = sphere_soup();
+    st_tetmesh *m2 = NULL;
+    st_error err;
     TAP_CHECK(st_pipeline_run(&m2, NULL, s, &p, NULL, &err) == ST_EINPUT && !m2,
               "tries 0: refused");
     p.tries = 1;
     p.offset_ratio = 0;
     TAP_CHECK(st_pipeline_run(&m2, NULL, s, &p, NULL, &err) == ST_EINPUT,
               "offset 0: refused");
-    p.offset_ratio = 0.4;
-    /* The lattice bound: the sphere's box has diagonal 2 sqrt(3); at
-     * h 0.5, floor(6.93) + 3 + 2 * 2 = 13 cells an axis, 12 tets a cell. */
+    st_soup_free(s);
+}
+
+/* The lattice bound: the sphere's box has diagonal 2 sqrt(3); at
+ * h 0.5, floor(6.93) + 3 + 2 * 2 = 13 cells an axis, 12 tets a cell. */
+static void test_lattice_bound(void)
+{
+    st_soup *s = sphere_soup();
+    st_pipeline_params p = sphere_params();
     double tets, at_once;
     double bytes = st_pipeline_lattice_bytes(s, 0.5, 1, &tets, &at_once);
     TAP_CHECK(tets == 12.0 * 13 * 13 * 13 && at_once == 1 &&
@@ -219,11 +279,26 @@ int main(void)
     p.cells = 4;
     TAP_CHECK(st_pipeline_cell_width(s, &p) == 0.5, "4 cells over a box of side 2: h 0.5 (%g)",
               st_pipeline_cell_width(s, &p));
+    st_soup_free(s);
+}
+
+static void test_empty_soup(void)
+{
+    st_pipeline_params p = sphere_params();
+    st_error err;
+    st_tetmesh *m2 = NULL;
+    p.tries = 1;
+    p.offset_ratio = 0.4;
     st_soup *empty = st_soup_new();
     TAP_CHECK(st_pipeline_run(&m2, NULL, empty, &p, NULL, &err) == ST_EINPUT,
               "an empty soup: refused (%s)", err.msg);
     st_soup_free(empty);
-    st_tetmesh_free(m1);
-    st_soup_free(s);
-    return tap_done();
+}
+
+int main(int argc, char **argv)
+{
+    static const tap_test tests[] = {TAP_TEST(candidate_seed), TAP_TEST(candidates),
+                                     TAP_TEST(dry_run), TAP_TEST(float32), TAP_TEST(refusals),
+                                     TAP_TEST(lattice_bound), TAP_TEST(empty_soup), {0}};
+    return tap_main(argc, argv, tests);
 }

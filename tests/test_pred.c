@@ -449,20 +449,28 @@ static void test_speed(void)
               "every coplanar call went to the exact stage");
 }
 
-int main(void)
+/* The perturbed cases at three scales each. */
+static void test_collinear_perturbed_scales(void)
 {
-    test_random_integers();
-    test_drop_axes();
-    test_53bit_nearly_coplanar();
     test_collinear_perturbed(0, "coordinates in [-1, 1]");
     test_collinear_perturbed(-997, "coordinates near 1e-300");
     test_collinear_perturbed(498, "coordinates near 1e150");
+}
+
+static void test_coplanar_perturbed_scales(void)
+{
     test_coplanar_perturbed(0, "coordinates near 1");
     test_coplanar_perturbed(-960, "coordinates near 1e-289");
     test_coplanar_perturbed(498, "coordinates near 1e150");
-    test_mixed_scales();
-    test_symmetries();
-    test_exact_counter();
-    test_speed();
-    return tap_done();
+}
+
+int main(int argc, char **argv)
+{
+    static const tap_test tests[] = {TAP_TEST(random_integers), TAP_TEST(drop_axes),
+                                     TAP_TEST(53bit_nearly_coplanar),
+                                     {"collinear_perturbed", test_collinear_perturbed_scales},
+                                     {"coplanar_perturbed", test_coplanar_perturbed_scales},
+                                     TAP_TEST(mixed_scales), TAP_TEST(symmetries),
+                                     TAP_TEST(exact_counter), TAP_TEST(speed), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -947,18 +947,13 @@ static void test_fill(void)
     }
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_entry_point();
-    test_large_holes();
-    test_hemisphere();
-    test_onesided();
-    test_onesided_caps();
-    test_columns();
-    test_columns_caps();
-    test_sides_orientation();
-    test_shared_tables();
-    test_shells_shortcut();
-    test_fill();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(entry_point), TAP_TEST(large_holes),
+                                     TAP_TEST(hemisphere), TAP_TEST(onesided),
+                                     TAP_TEST(onesided_caps), TAP_TEST(columns),
+                                     TAP_TEST(columns_caps), TAP_TEST(sides_orientation),
+                                     TAP_TEST(shared_tables), TAP_TEST(shells_shortcut),
+                                     TAP_TEST(fill), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -432,10 +432,9 @@ static void test_search_optimal(void)
     st_lattice_free(L);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_enclosure();
-    test_known_repairs();
-    test_search_optimal();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(enclosure), TAP_TEST(known_repairs),
+                                     TAP_TEST(search_optimal), {0}};
+    return tap_main(argc, argv, tests);
 }

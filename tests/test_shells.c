@@ -178,9 +178,8 @@ static void test_open_pieces(void)
     st_soup_free(s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_overlapping_boxes();
-    test_open_pieces();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(overlapping_boxes), TAP_TEST(open_pieces), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -754,11 +754,8 @@ int main(int argc, char **argv)
         report_variants();
         return 0;
     }
-    test_rays();
-    test_refusals();
-    test_shapes();
-    test_sweep_matches_lines();
-    test_refine();
-    test_zero_distance();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(rays), TAP_TEST(refusals), TAP_TEST(shapes),
+                                     TAP_TEST(sweep_matches_lines), TAP_TEST(refine),
+                                     TAP_TEST(zero_distance), {0}};
+    return tap_main(argc, argv, tests);
 }

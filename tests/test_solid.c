@@ -322,10 +322,8 @@ static void test_sphere(void)
     st_grid_free(g);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_boxes();
-    test_tets();
-    test_sphere();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(boxes), TAP_TEST(tets), TAP_TEST(sphere), {0}};
+    return tap_main(argc, argv, tests);
 }

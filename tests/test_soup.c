@@ -1456,24 +1456,20 @@ static int compare_main(const char *want, const char *got)
 
 int main(int argc, char **argv)
 {
+    static const tap_test tests[] = {TAP_TEST(soup_api), TAP_TEST(formats), TAP_TEST(obj),
+                                     TAP_TEST(numbers), TAP_TEST(off), TAP_TEST(ply),
+                                     TAP_TEST(stl), TAP_TEST(cube_everywhere),
+                                     TAP_TEST(read_errors), TAP_TEST(robust), {0}};
     if (argc == 4 && strcmp(argv[1], "--compare") == 0)
         return compare_main(argv[2], argv[3]);
+    tap_select(argc, argv, tests);
     snprintf(tmpdir, sizeof tmpdir, "%s/test_soup.XXXXXX",
              getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
     if (!mkdtemp(tmpdir)) {
         printf("Bail out! mkdtemp: %s\n", strerror(errno));
         return 1;
     }
-    test_soup_api();
-    test_formats();
-    test_obj();
-    test_numbers();
-    test_off();
-    test_ply();
-    test_stl();
-    test_cube_everywhere();
-    test_read_errors();
-    test_robust();
+    tap_run(tests);
 
     /* Clean up the temp dir (only the files this test wrote). */
     static const char *const files[] = {

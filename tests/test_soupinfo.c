@@ -478,22 +478,14 @@ static void test_self_intersections(void)
     st_soup_free(s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_cube_indexed();
-    test_cube_exact_soup();
-    test_negative_zero_welds();
-    test_face_removed();
-    test_two_holes_at_one_vertex();
-    test_flipped();
-    test_duplicated();
-    test_fin();
-    test_two_cubes();
-    test_degenerate();
-    test_torus();
-    test_moebius();
-    test_order_independent();
-    test_errors();
-    test_self_intersections();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(cube_indexed), TAP_TEST(cube_exact_soup),
+                                     TAP_TEST(negative_zero_welds), TAP_TEST(face_removed),
+                                     TAP_TEST(two_holes_at_one_vertex), TAP_TEST(flipped),
+                                     TAP_TEST(duplicated), TAP_TEST(fin), TAP_TEST(two_cubes),
+                                     TAP_TEST(degenerate), TAP_TEST(torus), TAP_TEST(moebius),
+                                     TAP_TEST(order_independent), TAP_TEST(errors),
+                                     TAP_TEST(self_intersections), {0}};
+    return tap_main(argc, argv, tests);
 }

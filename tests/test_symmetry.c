@@ -169,10 +169,8 @@ static void test_none(void)
     st_soup_free(s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_bracket();
-    test_hex_bar();
-    test_none();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(bracket), TAP_TEST(hex_bar), TAP_TEST(none), {0}};
+    return tap_main(argc, argv, tests);
 }

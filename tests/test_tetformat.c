@@ -783,17 +783,16 @@ int main(int argc, char **argv)
             argc == 5 && strcmp(argv[4], "--sets") == 0          ? 1
             : argc == 5 && strcmp(argv[4], "--renumbered") == 0 ? 2
                                                                  : 0);
+    static const tap_test tests[] = {TAP_TEST(paths), TAP_TEST(round_trips),
+                                     TAP_TEST(volume_only), TAP_TEST(written_text),
+                                     TAP_TEST(foreign_files), TAP_TEST(malformed),
+                                     TAP_TEST(truncations), {0}};
+    tap_select(argc, argv, tests);
     if (!mkdtemp(g_dir)) {
         perror("mkdtemp");
         return 1;
     }
-    test_paths();
-    test_round_trips();
-    test_volume_only();
-    test_written_text();
-    test_foreign_files();
-    test_malformed();
-    test_truncations();
+    tap_run(tests);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
     if (system(cmd) != 0)

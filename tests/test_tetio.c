@@ -472,16 +472,15 @@ int main(int argc, char **argv)
         }
         return 0;
     }
+    static const tap_test tests[] = {TAP_TEST(file_roundtrip), TAP_TEST(mem_roundtrip),
+                                     TAP_TEST(points_only), TAP_TEST(other_formats),
+                                     TAP_TEST(pipe), TAP_TEST(bad_input), {0}};
+    tap_select(argc, argv, tests);
     if (!mkdtemp(g_dir)) {
         perror("mkdtemp");
         return 1;
     }
-    test_file_roundtrip();
-    test_mem_roundtrip();
-    test_points_only();
-    test_other_formats();
-    test_pipe();
-    test_bad_input();
+    tap_run(tests);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
     if (system(cmd) != 0)

@@ -345,14 +345,11 @@ static void test_adjacency(void)
     st_tetmesh_free(m);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_regular();
-    test_cube_tets();
-    test_degenerate();
-    test_circumcenter_random();
-    test_build();
-    test_compact();
-    test_adjacency();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(regular), TAP_TEST(cube_tets),
+                                     TAP_TEST(degenerate), TAP_TEST(circumcenter_random),
+                                     TAP_TEST(build), TAP_TEST(compact), TAP_TEST(adjacency),
+                                     {0}};
+    return tap_main(argc, argv, tests);
 }

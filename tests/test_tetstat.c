@@ -333,13 +333,10 @@ static void test_contacts(void)
     st_tetmesh_free(m);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_regular();
-    test_cubes();
-    test_bad_tets();
-    test_surface();
-    test_field();
-    test_contacts();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(regular), TAP_TEST(cubes), TAP_TEST(bad_tets),
+                                     TAP_TEST(surface), TAP_TEST(field), TAP_TEST(contacts),
+                                     {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -80,22 +80,34 @@ static void check(const char *name, st_soup *s, double longest)
     }
 }
 
-int main(void)
+static void test_plates(void)
 {
     double h = 4.0 / CELLS;
     st_soup *s = st_soup_new();
     plates(s, 0.3 * h);
     check("plates 0.3 h apart", s, 4.0);
     st_soup_free(s);
+}
 
-    s = st_soup_new();
+static void test_slot(void)
+{
+    double h = 4.0 / CELLS;
+    st_soup *s = st_soup_new();
     slot(s, 0.3 * h);
     check("a slot 0.3 h wide", s, 4.0);
     st_soup_free(s);
+}
 
-    s = st_soup_new();
+static void test_wedge(void)
+{
+    st_soup *s = st_soup_new();
     wedge(s, 20.0);
     check("a 20 degree crease", s, 3.0);
     st_soup_free(s);
-    return tap_done();
+}
+
+int main(int argc, char **argv)
+{
+    static const tap_test tests[] = {TAP_TEST(plates), TAP_TEST(slot), TAP_TEST(wedge), {0}};
+    return tap_main(argc, argv, tests);
 }

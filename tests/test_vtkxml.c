@@ -824,17 +824,16 @@ static void test_own_writers(void)
 
 int main(int argc, char **argv)
 {
-    (void)argc;
+    static const tap_test tests[] = {TAP_TEST(findings), TAP_TEST(near_misses),
+                                     TAP_TEST(foreign_writers), TAP_TEST(own_writers),
+                                     TAP_TEST(vtk_messages), {0}};
+    tap_select(argc, argv, tests);
     find_data(argv[0]);
     if (!mkdtemp(g_tmp)) {
         perror("mkdtemp");
         return 1;
     }
-    test_findings();
-    test_near_misses();
-    test_foreign_writers();
-    test_own_writers();
-    test_vtk_messages();
+    tap_run(tests);
     char p[256];
     const char *own[] = {"own.vti", "own.vtu"};
     for (int i = 0; i < 2; i++) {

@@ -421,12 +421,9 @@ static void test_write(void)
     free(s.tris);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_check();
-    test_write();
-    test_grid_edge();
-    test_iso_values();
-    test_shapes();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(check), TAP_TEST(write), TAP_TEST(grid_edge),
+                                     TAP_TEST(iso_values), TAP_TEST(shapes), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -1,6 +1,14 @@
 /*
  * bvh.h - a bounding volume hierarchy over the triangles of a soup.
  *
+ * Units: model units (boxes and distances are the soup's coordinates).
+ * Ownership: the caller owns the BVH (st_bvh_free); the soup is borrowed
+ * and must outlive it.
+ * Threads: build once; queries are read-only and thread-safe, and answer
+ * the same for any thread count.
+ * Errors: st_bvh_build: ST_EINPUT (no triangles), ST_ELIMIT (more than
+ * 2^31 triangles), ST_ENOMEM; the queries cannot fail.
+ *
  * Axis-aligned boxes, median splits on the longest axis of the centroids,
  * at most ST_BVH_LEAF triangles per leaf. Queries are read-only and may run
  * from many threads at once.

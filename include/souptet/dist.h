@@ -1,5 +1,16 @@
 /*
- * dist.h - unsigned distance fields of triangle soups.
+ * dist.h - unsigned distance fields of triangle soups. The field the volume
+ * events are read from (Spillmann 2006, section 3; section 2.2 for the
+ * related work).
+ *
+ * Units: model units; voxel, pad and band in voxels where the parameter
+ * says so.
+ * Ownership: the caller owns the new grid (st_grid_free); the soup is
+ * borrowed for the call.
+ * Threads: OpenMP inside; the values are identical for any thread count
+ * (below).
+ * Errors: ST_EINPUT (bad parameters, an empty soup), ST_ELIMIT, ST_ENOMEM,
+ * ST_ECANCELLED (progress.h); no grid on error.
  *
  * The grid covers the bounding box of the soup's triangles padded by `pad`
  * voxels on every side. With `cells` the voxel size is the longest side of

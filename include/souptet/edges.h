@@ -4,6 +4,15 @@
  * together) and all but the first of each set of duplicated triangles
  * (the same three welded corners, in any order) left out.
  *
+ * Units: none: indices and counts only (welding compares coordinates bit
+ * for bit).
+ * Ownership: the caller owns the table (st_soup_edges_free); the soup is
+ * borrowed and must outlive it.
+ * Threads: no global state; the table is read-only once built and may be
+ * read from many threads.
+ * Errors: ST_ENOMEM, ST_ELIMIT (more vertices or half-edges than 32-bit
+ * indices hold).
+ *
  * An edge is a run of half-edges with the same unordered welded ends; its
  * length is the number of kept triangles that use it (1: a boundary edge,
  * 2: a manifold edge). Pieces are the classes of kept triangles joined by

@@ -4,6 +4,15 @@
  * simulator can move the high-resolution surface with the coarse mesh
  * (x = b0 p0 + b1 p1 + b2 p2 + b3 p3 of the deformed tet's corners).
  *
+ * Units: model units; barycentric coordinates are unitless and add up to 1.
+ * Ownership: the caller owns the output arrays (n entries, 4 doubles a
+ * vertex for bary) and any *out mesh (st_tetmesh_free); the mesh and
+ * surface are borrowed.
+ * Threads: OpenMP over vertices; the answer does not depend on the thread
+ * count (below).
+ * Errors: ST_EINPUT (a mesh without tets), ST_ENOMEM, ST_EIO
+ * (st_embed_write_text); a vertex in no tet is counted, not an error.
+ *
  * Containment is exact (st_point_in_tet, isect.h: a point on a face, edge
  * or corner is in the tet). A vertex in several tets (on a shared face,
  * edge or corner) gets the first of them in tet order, so the answer

@@ -1,6 +1,17 @@
 /*
  * enclose.h - does a tet mesh enclose a triangle soup? Exact point location
- * in a tet mesh, and the two enclosure counts of DESIGN.md's metrics.
+ * in a tet mesh, and the two enclosure counts of DESIGN.md's metrics. The
+ * first property Stuart 2013 asks of a control mesh (section 1: it must
+ * enclose the surface; section 3.3 keeps it so while vertices move).
+ *
+ * Units: model units; counts are exact integers.
+ * Ownership: the caller owns the locator (st_locator_free) and the optional
+ * per-item arrays it passes; mesh, soup and BVH are borrowed.
+ * Threads: the locator is read-only after st_locator_new and thread-safe;
+ * st_enclosure_compute runs OpenMP loops whose results do not depend on the
+ * thread count.
+ * Errors: ST_EINPUT (a mesh without tets, an empty soup), ST_ELIMIT,
+ * ST_ENOMEM; st_points_are_float32 cannot fail.
  *
  * A mesh M encloses a soup S when
  *   (a) every vertex of S lies in the closed union of M's tets, and
@@ -23,11 +34,6 @@
  * strictly inside the mesh is safe to embed and to move).
  * Tets of either orientation cover the same points: an inverted tet still
  * covers its points; a flat tet covers its (planar) convex hull.
- *
- * Threads: the point locator is read-only after st_locator_new and may be
- * queried from many threads at once. st_enclosure_compute runs OpenMP
- * loops over soup vertices and boundary faces; its counts and per-item
- * arrays do not depend on the thread count.
  */
 #ifndef SOUPTET_ENCLOSE_H
 #define SOUPTET_ENCLOSE_H

@@ -1,6 +1,13 @@
 /*
  * err.h - error records for the souptet library.
  *
+ * Units: none.
+ * Ownership: the caller owns every st_error (a plain struct, nothing to
+ * free).
+ * Threads: no global state: each thread fills its own st_error.
+ * Errors: this module defines them: st_status below; st_error_set returns
+ * the status it stores.
+ *
  * The library never prints and never exits.  A function that can fail takes
  * a caller-owned st_error as its last argument, fills it on failure, and
  * returns the status it stored there.  The message names what went wrong;

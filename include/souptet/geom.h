@@ -1,6 +1,11 @@
 /*
  * geom.h - small vector helpers and point-triangle distance.
  *
+ * Units: model units (distances squared where the name says dist2).
+ * Ownership: none: values in, values out.
+ * Threads: pure functions, thread-safe.
+ * Errors: none: nothing here can fail.
+ *
  * Distances are computed in double from the input coordinates; no tolerance
  * decides anything topological here (those decisions go through pred.h).
  */

@@ -1,6 +1,16 @@
 /*
  * grid.h - dense scalar fields on a regular grid of voxels.
  *
+ * Units: model units for origin, voxel size and distances; indices in
+ * voxels.
+ * Ownership: the caller owns a grid (st_grid_free, safe on NULL), its data
+ * and its meta.
+ * Threads: no global state; a grid may be read from many threads, written
+ * by one.
+ * Errors: st_grid_new: ST_EINPUT (no voxels, a voxel size or origin that
+ * is not a finite positive number), ST_ELIMIT (over max_bytes, or sizes
+ * that overflow), ST_ENOMEM.
+ *
  * Values live at voxel centers: voxel (i, j, k) is centered at
  * origin + voxel * (i, j, k). Storage is x fastest:
  * data[i + nx * (j + ny * k)].

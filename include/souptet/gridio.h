@@ -1,6 +1,17 @@
 /*
  * gridio.h - fields on disk and on pipes.
  *
+ * Units: model units, as in the grid (the .vdb transform and the .vti
+ * spacing carry the voxel size and origin).
+ * Ownership: the caller owns a grid read (st_grid_free); a grid written is
+ * borrowed.
+ * Threads: calls on different grids and files may run at once (OpenVDB is
+ * initialised once, thread-safely).
+ * Errors: ST_EIO (open, read, write), ST_EINPUT (a malformed or foreign
+ * file, named with its path), ST_ELIMIT (over max_bytes), ST_ENOMEM,
+ * ST_EINTERNAL (the library refused what it was given); a failed write
+ * leaves no file (outfile.h).
+ *
  * Behind this C header sit the only C++ sources that touch fields:
  * src/adapters/gridio_vdb.cpp (OpenVDB) and src/adapters/gridio_vti.cpp
  * (VTK XML ImageData).

@@ -2,6 +2,11 @@
  * isect.h - exact intersection tests between triangles, segments, points
  * and tetrahedra, built only on the exact predicates of pred.h.
  *
+ * Units: model units; answers are exact booleans.
+ * Ownership: none: values in, values out.
+ * Threads: pure functions, thread-safe.
+ * Errors: none: every test answers for every finite input.
+ *
  * Every answer is the exact answer for the closed sets given by the double
  * coordinates (boundaries included), with no tolerance: two triangles that
  * share only a vertex intersect; a point on a tet's face is in the tet.

@@ -2,6 +2,16 @@
  * lattice.h - tetrahedral lattices over a box, and the pseudo-volume
  * density filter (Spillmann, Wagner, Teschner 2006, section 4).
  *
+ * Units: model units for h and positions; lattice points in integer half
+ * cells.
+ * Ownership: the caller owns a lattice (st_lattice_free), a voxel summary
+ * (st_voxel_summary_free) and any mesh made (st_tetmesh_free); grids and
+ * soups are borrowed.
+ * Threads: OpenMP in the build and the density filter; the result depends
+ * only on the parameters and the seed, not on the thread count.
+ * Errors: ST_EINPUT (bad parameters), ST_ELIMIT (over max_bytes or 32-bit
+ * indices), ST_ENOMEM, ST_ECANCELLED, ST_EINTERNAL.
+ *
  * Two lattices, both of cubes of side h:
  *
  *   cubic5  every cube split into 5 tets: a central tet on the four cube

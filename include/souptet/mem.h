@@ -1,6 +1,12 @@
 /*
  * mem.h - checked allocation.
  *
+ * Units: bytes and element counts.
+ * Ownership: the caller frees what these return, with free().
+ * Threads: thread-safe (they call the C allocator only).
+ * Errors: NULL (or 0 from the size checks) on overflow or when out of
+ * memory; no st_error.
+ *
  * Every array allocation goes through these: the element count times the
  * element size is checked for overflow before anything is allocated, so a
  * count read from an untrusted file can never wrap into a small buffer.

@@ -1,6 +1,12 @@
 /*
  * meta.h - string metadata carried by fields and meshes.
  *
+ * Units: none: strings.
+ * Ownership: a struct owns its keys and values (st_meta_clear frees them);
+ * st_command_line's string is the caller's.
+ * Threads: no global state; one writer per st_meta.
+ * Errors: ST_ENOMEM (st_command_line: NULL).
+ *
  * An ordered list of key/value strings. Every tool appends its command line
  * to the "history" key (lines joined by '\n'), so every output says how it
  * was made (after Radiance's headers).

@@ -3,6 +3,13 @@
  * Kolmogorov's augmenting-path max-flow, 2004, on the grid's 6-neighbour
  * graph).
  *
+ * Units: voxels; capacities are integers.
+ * Ownership: the caller owns the label array (one int8 a voxel); the grid
+ * is borrowed.
+ * Threads: sequential solver: the result does not depend on the thread
+ * count; calls on different grids may run at once.
+ * Errors: ST_ENOMEM, ST_ELIMIT.
+ *
  * The labelling minimises
  *     sum over voxels of  evidence against its label
  *   + sum over neighbouring pairs labelled differently of  area(p, q),

@@ -1,6 +1,14 @@
 /*
  * outfile.h - output that appears whole or not at all.
  *
+ * Units: none: paths and bytes.
+ * Ownership: st_outfile_begin's stream and temporary are the st_outfile's
+ * until commit or abort.
+ * Threads: the list of temporaries in flight is shared by the process
+ * (async-signal-safe to read); begin and commit from one thread at a time.
+ * Errors: ST_EIO (naming the path and the reason; also a target that is not
+ * a regular file), ST_ENOMEM.
+ *
  * st_outfile_begin creates a temporary file beside the target (same
  * directory, so the final rename is atomic); st_outfile_commit checks every
  * write, closes, and renames it over the target; st_outfile_abort removes

@@ -2,6 +2,13 @@
  * parts.h - parts and materials: which part of the input each tet of a
  * cage belongs to (soupmesh --parts).
  *
+ * Units: model units.
+ * Ownership: the caller owns every st_parts (st_parts_free) and tag stats
+ * (st_parts_tag_stats_free); soups and meshes are borrowed.
+ * Threads: st_parts_tag samples tets in parallel; results do not depend on
+ * the thread count.
+ * Errors: ST_EINPUT, ST_ELIMIT, ST_ENOMEM, ST_ECANCELLED, with a message.
+ *
  * A soup's parts (st_parts_split) are either the parts its file names
  * (soup.h, st_soup_name: OBJ objects, or groups where the file has no
  * objects; glTF mesh nodes; ASCII STL solids) or its edge-connected pieces
@@ -19,11 +26,6 @@
  * samples (ties: the smaller index) and its share the fraction of samples
  * that part owns. A tet no part covers (the enclosure margin) takes the
  * part of the triangle nearest its centroid, with share 0.
- *
- * Units: model units. Ownership: the caller owns every st_parts and frees
- * it with st_parts_free. Threads: st_parts_tag samples tets in parallel;
- * results do not depend on the thread count. Errors: ST_EINPUT, ST_ELIMIT,
- * ST_ENOMEM, ST_ECANCELLED, with a message.
  */
 #ifndef SOUPTET_PARTS_H
 #define SOUPTET_PARTS_H

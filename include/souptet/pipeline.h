@@ -1,6 +1,16 @@
 /*
  * pipeline.h - the whole job in one call: a soup in, a coarse tet mesh
- * that encloses it out (what soupmesh runs).
+ * that encloses it out (what soupmesh runs). Stuart 2013, section 3 (the
+ * lattice, sculpting, fitting and candidates), with the pseudo volume of
+ * Spillmann 2006, section 3.
+ *
+ * Units: model units (h, offsets, distances); angles in degrees.
+ * Ownership: the caller owns *out (st_tetmesh_free) and stats->candidates
+ * (free()); the soup is borrowed.
+ * Threads: candidates run in parallel; the output depends only on the soup
+ * and the parameters (below).
+ * Errors: ST_EINPUT (bad parameters, an empty soup), ST_ELIMIT, ST_ENOMEM,
+ * ST_ECANCELLED; no mesh on error.
  *
  *   distance field (dist.h) -> signs, the pseudo volume (sign.h)
  *     -> per candidate: a seeded lattice, sculpted with bomb repair

@@ -1,6 +1,12 @@
 /*
  * pred.h - exact orientation predicates.
  *
+ * Units: none: signs of determinants of the coordinates given.
+ * Ownership: none: values in, values out.
+ * Threads: pure functions, thread-safe (the count of exact evaluations is
+ * atomic).
+ * Errors: none: every finite input gets an exact sign.
+ *
  * Every topological decision in souptet (which side of a plane, whether two
  * triangles cross, whether a lattice tet touches the surface, whether a ray
  * crosses a face) comes down to the sign of one of these determinants. The

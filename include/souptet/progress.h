@@ -1,6 +1,13 @@
 /*
  * progress.h - how long-running library calls report progress.
  *
+ * Units: fractions in [0, 1].
+ * Ownership: the caller owns the callback's context and the cancel flag,
+ * which must outlive the call.
+ * Threads: the callback is called from one thread; the flag may be set from
+ * any thread or a signal handler.
+ * Errors: a cancelled call returns ST_ECANCELLED and frees what it made.
+ *
  * The library never prints: a caller that wants a progress line passes a
  * callback. It is called from one thread only, with a stage name and the
  * fraction done in [0, 1], often enough for a display (a few times per

@@ -1,6 +1,16 @@
 /*
  * pseudo.h - the pseudo volume of a soup: the one entry point that
- * soupsign, soupwrap and the pipeline (soupmesh) call.
+ * soupsign, soupwrap and the pipeline (soupmesh) call. Spillmann 2006,
+ * section 3 (the vote), with steps of our own around it (below).
+ *
+ * Units: voxels for reaches and bands; the grid's model units for
+ * distances.
+ * Ownership: the caller owns *out (st_grid_free) and the BVH the _bvh
+ * variants hand back (st_bvh_free); the field is changed in place
+ * (st_pseudo_sign), the soup borrowed.
+ * Threads: OpenMP inside each step; the same bytes for any thread count.
+ * Errors: ST_EINPUT (a field that is not a distance field, bad parameters),
+ * ST_ELIMIT, ST_ENOMEM, ST_ECANCELLED, ST_EINTERNAL; no grid on error.
  *
  * Given the unsigned distance field g of soup s (dist.h), in this order:
  *   1. the closed shells of s as given (shells.h), before any cap joins an

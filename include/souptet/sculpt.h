@@ -3,6 +3,14 @@
  * repair by whole snowflakes (Stuart, Levine, Jones, Bargteil 2013,
  * section 3.2).
  *
+ * Units: model units (h, the lattice's); counts of tets.
+ * Ownership: the caller owns *out (st_tetmesh_free); the lattice, field and
+ * soup are borrowed.
+ * Threads: classification in parallel, repair sequential: deterministic for
+ * any thread count (below).
+ * Errors: ST_EINPUT (bad parameters), ST_ENOMEM, ST_ECANCELLED (the cancel
+ * flag), and what lattice.h returns; no mesh on error.
+ *
  * Keep rule. A lattice tet is kept when it overlaps the pseudo volume of
  * the signed field - a voxel centre inside the pseudo volume (value < 0)
  * lies in the closed tet, or a corner of the tet lies in an inside voxel -

@@ -1,6 +1,13 @@
 /*
  * shells.h - the closed shells of a soup, and the solid they bound.
  *
+ * Units: model units.
+ * Ownership: the caller owns an st_shells (st_shells_free); the soup and
+ * edge table are borrowed.
+ * Threads: no global state; st_shells_sign runs OpenMP loops whose result
+ * does not depend on the thread count.
+ * Errors: ST_EINPUT (a field of the wrong kind), ST_ELIMIT, ST_ENOMEM.
+ *
  * A closed shell is a piece of the soup (edges.h: exactly welded vertices,
  * degenerate and duplicated triangles left out) each of whose edges is
  * used by exactly two of its triangles, and whose triangles can be

@@ -2,44 +2,19 @@
  * sides.h - which side of an open soup the voxels near it are on, from the
  * soup's own orientation, as evidence for the pseudo volume's cut.
  *
- * The votes (sign.h) read only where rays cross the surface. Through a
- * large hole most rays reach a voxel inside the part without crossing
- * anything, and parity calls it outside: the part comes out hollow. Its
- * surviving faces still say which side is inside: orientation. A soup's
- * file orientation is not trusted; instead
- *   1. each piece's triangles are oriented to agree across every edge of
- *      exactly two triangles (breadth-first, as shells.h does; a conflict
- *      is left where it is found), giving orientable regions;
- *   2. each region is turned, as a whole, to the way the votes read it
- *      (the majority of the votes, st_sign_votes): for each triangle,
- *      the voxels a voxel and a half in front of and behind its centroid,
- *      weighted by area, where they disagree; a tie keeps it;
- *   3. every voxel within band_voxels of the soup whose votes leave it to
- *      the cut
- *      gets the local generalized winding number of the oriented soup
- *      (Jacobson et al. 2013): the signed solid angles (Van Oosterom and
- *      Strackee 1983) of the triangles in the cube of radius_voxels
- *      around it, over 4 pi: near +1/2 just inside a wall, near -1/2 just
- *      outside, less where the wall has a hole. Times `weight`, clamped to
- *      +-max_evidence, rounded, it is evidence in votes of margin;
- *   4. whether the soup is a one-sided view (a scan from one side, whose
- *      far side was never seen): a closed surface's oriented area sums to
- *      zero in every projection, so the projected area of the oriented
- *      soup facing away from its mean normal v equals that facing v; a
- *      soup whose faces nearly all face v (back_front, that ratio, below
- *      onesided_ratio) is a view from v. st_sides_mirror then completes
- *      the signed solid behind it. With past_caps the view reads only the
- *      seen surface (not its caps) and v is the direction most square to
- *      the faces on its rim, where the scan turned away (iteratively
- *      reweighted least absolute cosines, so walls along v outweigh the
- *      faces that meet an unseen one at a sharp edge; the mean normal when
- *      that is over 45 degrees from it).
- *   5. whether the seen soup (without its caps) is a one-sided view along
- *      an axis (columns; st_sides_columns then drops what the cut put
- *      where no seen surface is above it along that axis, and reads the
- *      caps that face away from the viewer).
- * So the cut (mincut.h) has, on each side of every surviving wall, the
- * side it is on, and spans the holes between walls by the least area.
+ * Units: voxels for bands and radii; evidence in votes (int8).
+ * Ownership: the caller owns the evidence array (one byte a voxel); grid,
+ * votes and soup are borrowed.
+ * Threads: OpenMP over voxels; deterministic for any thread count (below).
+ * Errors: ST_ENOMEM, ST_ELIMIT.
+ *
+ * The votes (sign.h) read only where rays cross the surface, so through a
+ * large hole a part comes out hollow; its surviving faces still say which
+ * side is inside. Each orientable region of the soup, turned the way the
+ * votes read it, gives the voxels near it its local generalized winding
+ * number (Jacobson et al. 2013) as evidence for the cut (mincut.h), and a
+ * one-sided scan is recognised (st_sides_mirror, st_sides_columns complete
+ * it). The steps: doc/design/sides.md.
  *
  * Memory: one byte per voxel (the evidence, the caller's) and O(triangles).
  * Deterministic for any number of threads (each voxel sums its triangles

@@ -2,6 +2,14 @@
  * sign.h - the pseudo volume of a soup: signs for a distance field by
  * multi-direction volume-event voting (Spillmann, Wagner, Teschner 2006, §3).
  *
+ * Units: voxels (event distances, steps); the field's model units for
+ * distances.
+ * Ownership: the field is signed in place and stays the caller's, as do the
+ * vote arrays it passes; soups and BVHs are borrowed.
+ * Threads: OpenMP over lines; results do not depend on the thread count.
+ * Errors: ST_EINPUT (a field that is not a distance field, bad parameters),
+ * ST_ENOMEM, ST_ECANCELLED.
+ *
  * Along each of the 13 lines of the 26-neighbourhood through every voxel, a
  * ray reads the distance field. The paper's probability P = 1 - c|d| marks
  * a volume event where P rises above k, i.e. where |d| falls below the
@@ -9,43 +17,10 @@
  * Parity toggles per event; a voxel's vote along a ray is the parity the ray
  * has when it reaches it; the majority of the votes decides the sign.
  *
- * What the paper leaves open, and how it is decided here (each selectable):
- *   - c: 1 / max|d| over the grid (the paper), or 1 / (D voxels) (a band
- *     variant: the event distance then does not depend on how far the grid
- *     reaches, so a narrow-band field suffices).
- *   - where in an event run the toggle lands: on the first voxel of the run
- *     (the paper's reading: "an event is reported" when P rises above k),
- *     or on the voxel of least distance (the one nearest the surface).
- *   - rays whose line holds an odd number of events (a ray through a hole
- *     ends "inside"): kept (the paper), or ignored, both directions.
- *   - k = 1: P > 1 never happens, yet the paper says k = 1 is Nooruddin and
- *     Turk's parity counting, which counts surface crossings. On samples a
- *     crossing shows as the ray passing within half a step of the surface,
- *     so k = 1 uses that event distance (half a voxel times the step
- *     length of the direction).
- *   - ties (as many inside as outside votes) are outside: the pseudo volume
- *     is not grown on no evidence.
- *   - interpenetrating parts: where two shells overlap, every ray has
- *     crossed an even number of surfaces, so parity says outside, from
- *     every direction. With nested_union a voxel that no ray reaches from
- *     outside without meeting an event (hidden along all rays) is inside
- *     whatever the parity: the union of the parts, as a person sees it.
- *     (Not in the paper, whose rule is parity only.)
- *   - two crossings in one event run: where two surfaces come closer than
- *     the event distance (interpenetrating shells meeting, thin walls and
- *     tunnels), the samples' distance dips twice without leaving the run.
- *     With split_runs (crossing toggle only), a rise of a fifth of the
- *     event distance between two dips ends one event and starts the next,
- *     each with its own crossing toggle; the paper counts one.
- *   - the cut (not in the paper): the votes decide a voxel only as
- *     evidence (a majority inside, or outside where a ray sees it from
- *     outside; hidden voxels have none under nested_union) for a minimum
- *     cut of the grid (mincut.h) in which cutting next to the surface is
- *     cheap and cutting free space costs a voxel face. So holes and
- *     deleted faces are spanned by the least area, ties and hidden voxels
- *     join the side that encloses them, and stray votes in the open are
- *     outvoted by their neighbours. Voxels whose votes are nearly
- *     unanimous are decided by them and cost the cut nothing.
+ * What the paper leaves open (the constant c, where in an event run the
+ * toggle lands, rays with an odd count of events, k = 1, ties,
+ * interpenetrating parts, two crossings in one run, the cut) and how each
+ * is decided here, each selectable in st_sign_params: doc/design/sign.md.
  * Results do not depend on the thread count.
  *
  * Memory: st_sign_field needs the grid (4 bytes per voxel) plus ONE BYTE PER

@@ -3,6 +3,15 @@
  * boundary fairing, and Cetra's enclosing vertex adjustment followed by a
  * quality pass.
  *
+ * Units: model units (h, offsets, distances); angles in degrees.
+ * Ownership: the mesh is changed in place and stays the caller's; soups,
+ * fields and BVHs are borrowed.
+ * Threads: OpenMP over independent sets; deterministic for any thread
+ * count; no global state (below).
+ * Errors: ST_EINPUT (an inverted or flat tet, bad parameters), ST_ENOMEM,
+ * ST_ECANCELLED; on error the mesh may hold moves already accepted, each of
+ * which kept the invariant.
+ *
  * st_fair (Spillmann, Wagner, Teschner 2006, section 4): implicit fairing
  * of the boundary surface (Desbrun et al. 1999), a local rescale along the
  * vertex normals so the mesh keeps its volume, interior vertices carried

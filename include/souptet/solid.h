@@ -2,6 +2,12 @@
  * solid.h - the exact solid of closed surfaces at voxel centers: ground
  * truth for measuring pseudo volumes.
  *
+ * Units: the grid's model units; IoU, precision and recall are ratios.
+ * Ownership: the caller owns the inside array (one byte a voxel); grids and
+ * shells are borrowed.
+ * Threads: OpenMP over rows; exact, so the same for any thread count.
+ * Errors: ST_ELIMIT, ST_ENOMEM.
+ *
  * A voxel center is inside a closed surface when a ray from it crosses the
  * surface an odd number of times. The ray runs along -x from the center
  * (so one pass over a row of voxels answers the whole row), and every

@@ -1,6 +1,14 @@
 /*
  * soup.h - triangle soups and the surface readers.
  *
+ * Units: whatever the file's coordinates are (model units, never rescaled).
+ * Ownership: the caller owns a soup (st_soup_free, safe on NULL) and
+ * everything in it.
+ * Threads: no global state; readers on different files may run at once; a
+ * soup is read-only to everything but its owner.
+ * Errors: ST_EIO (naming the path), ST_EINPUT (naming file and line or byte
+ * offset), ST_ELIMIT, ST_ENOMEM; no soup on error.
+ *
  * A soup is a vertex array and a triangle array, exactly as the file gives
  * them: vertices are never welded, duplicated or degenerate triangles are
  * kept, orientation is whatever the file says. Polygons are fan-triangulated

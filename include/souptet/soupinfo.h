@@ -3,6 +3,14 @@
  * that makes meshers refuse it (holes, cracks, non-manifold and
  * mis-oriented edges, degenerate and duplicated triangles, pieces).
  *
+ * Units: model units (areas, volumes); counts of edges, triangles and
+ * pieces.
+ * Ownership: the caller owns *out (a plain struct) and the optional flags
+ * array; the soup is borrowed.
+ * Threads: OpenMP in the self-intersection search; counts do not depend on
+ * the thread count.
+ * Errors: ST_EINPUT (an empty soup), ST_ELIMIT, ST_ENOMEM.
+ *
  * Everything is decided on exact coordinates, never with a tolerance:
  *
  * - Welding: two vertices are the same point when their three coordinates

@@ -2,6 +2,13 @@
  * soupwrite.h - writing a triangle soup as OBJ, OFF, binary PLY or binary
  * STL (the format picked by the caller, usually from the extension).
  *
+ * Units: model units, as stored (binary STL rounds to float).
+ * Ownership: the caller owns the stream and opens and commits it
+ * (outfile.h); the soup is borrowed.
+ * Threads: no global state; writes to different streams may run at once.
+ * Errors: ST_EIO (a failed write), ST_EINPUT (a format that cannot hold the
+ * soup), ST_ELIMIT.
+ *
  * The writers put the vertices and triangles out as they are (no welding,
  * no reordering), so reading a file back with st_soup_read gives the same
  * soup: coordinates are printed with the fewest digits that read back as

@@ -2,36 +2,16 @@
  * symmetry.h - the mirror planes and rotation axes of a soup's surviving
  * surface (issue 37: a lost side said by its opposite).
  *
- * Algorithm:
- *   1. Samples: `samples` points spread over the soup by area (stratified
- *      in the cumulative area, a fixed low-discrepancy point in each
- *      triangle), each with its triangle's unit normal (unoriented: a
- *      soup's orientation is not trusted).
- *   2. Mirror candidates: the three planes through the area centroid
- *      normal to the principal axes of the samples; and the votes of
- *      Mitra, Guibas & Pauly 2006 ("Partial and approximate symmetry
- *      detection for 3D geometry"): pairs of samples (a fixed pseudo-random
- *      sequence) whose normals map onto each other by the mirror that
- *      swaps the two points (within 15 degrees) vote for that plane in a
- *      grid over direction and offset; the heaviest cells become
- *      candidates.
- *   3. Refinement, ICP-style: each sample's mirror image is matched to
- *      the soup's nearest point within three tolerances (st_bvh_nearest)
- *      with a compatible normal; the plane is re-estimated from the matched
- *      pairs (normal along the mean of p - q, offset the mean of their
- *      midpoints), a few rounds.
- *   4. Rotation axes: the lines where two accepted mirror planes meet (two
- *      mirrors at angle a make a rotation by 2a about that line) and the
- *      principal axes through the centroid. An axis is continuous (a
- *      turned part, a screw's shank) when rotations by three angles that
- *      are no fraction of a full turn with a small denominator all hold;
- *      else its order is the largest n <= max_order whose rotation by
- *      360/n degrees holds.
- *   5. Support: the share of the samples (so of the soup's area) whose
- *      image lies within `tolerance` of the soup, on a triangle whose
- *      normal is within 30 degrees of the image's normal. A symmetry is
- *      accepted when its support is at least min_support; duplicates (the
- *      same plane or line within 2 degrees and a tolerance) keep the best.
+ * Units: model units (tolerances, offsets); angles in degrees.
+ * Ownership: the caller owns the set *out (a plain struct); the soup and
+ * BVH are borrowed.
+ * Threads: OpenMP in the support counts; deterministic for any thread count
+ * (below).
+ * Errors: ST_EINPUT (an empty soup, bad parameters), ST_ENOMEM.
+ *
+ * The algorithm (area samples, mirror candidates from principal axes and
+ * the votes of Mitra, Guibas & Pauly 2006, ICP-style refinement, rotation
+ * axes, support): doc/design/symmetry.md.
  * Every step is deterministic, and the support counts are integer sums,
  * so the result does not depend on the thread count.
  */

@@ -10,6 +10,14 @@
  * hold the bytes. (One file per format: src/tetformat_msh.c,
  * tetformat_tetgen.c, tetformat_medit.c, tetformat_vtu.c.)
  *
+ * Units: model units, as in the file (coordinates are never rescaled).
+ * Ownership: the caller owns a mesh read (st_tetmesh_free); a mesh written
+ * is borrowed.
+ * Threads: no global state; calls on different meshes and files may run at
+ * once.
+ * Errors: ST_EIO, ST_EINPUT (with file and line or byte offset), ST_ELIMIT
+ * (over max_bytes), ST_ENOMEM; no mesh on error (what is refused: below).
+ *
  * What is kept. Points and tets, exactly (coordinates are written with 17
  * significant digits or as raw doubles, so a round trip is bit-exact), and
  * the mesh's meta entries (source, h, history, ...) as comments: Gmsh's

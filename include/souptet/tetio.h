@@ -4,6 +4,14 @@
  * .msh, .node/.ele and .mesh in tetformat_*.c; .vtu written by
  * tetformat_vtu.c in C, read by the VTK adapter src/adapters/tetio_vtu.cpp).
  *
+ * Units: model units, as stored.
+ * Ownership: the caller owns a mesh read (st_tetmesh_free) and the buffer
+ * of st_tetmesh_write_mem (free()); a mesh written is borrowed.
+ * Threads: no global state of ours (VTK's reader is used one call at a time
+ * per mesh); calls on different files may run at once.
+ * Errors: ST_EIO, ST_EINPUT (with file and line or byte offset), ST_ELIMIT
+ * (over max_bytes), ST_ENOMEM; a failed save leaves no file (outfile.h).
+ *
  * .vtu: VTK XML UnstructuredGrid, binary, zlib-compressed, VTK_TETRA
  * cells. The writer adds per-cell arrays min_dihedral, max_dihedral and
  * volume (degrees, model units^3) and stores the mesh's meta entries

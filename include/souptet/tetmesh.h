@@ -1,6 +1,14 @@
 /*
  * tetmesh.h - tetrahedral meshes: points, tets, named arrays, metadata.
  *
+ * Units: model units for points; volumes in units^3, angles in degrees.
+ * Ownership: the caller owns a mesh (st_tetmesh_free, safe on NULL), its
+ * arrays and meta; copies are deep.
+ * Threads: no global state; a mesh may be read from many threads, written
+ * by one; st_tetmesh_quality runs OpenMP loops independent of the thread
+ * count.
+ * Errors: ST_EINPUT (bad indices, array sizes), ST_ELIMIT, ST_ENOMEM.
+ *
  * A tet (a, b, c, d) is positively oriented when st_orient3d(a, b, c, d) < 0,
  * i.e. d lies on the side of triangle (a, b, c) from which a, b, c appear
  * counterclockwise; its signed volume (b-a).((c-a)x(d-a))/6 is then > 0.

@@ -3,6 +3,11 @@
  * circumcenter. Constructed values in double (these are measurements, not
  * decisions: decisions use pred.h).
  *
+ * Units: model units; volumes in units^3, angles in degrees.
+ * Ownership: none: values in, values out.
+ * Threads: pure functions, thread-safe.
+ * Errors: none; st_tet_circumcenter returns 0 for a flat tet.
+ *
  * A tet is given by its four corners p[0..3]; its six edges are
  * (0 1) (0 2) (0 3) (1 2) (1 3) (2 3), and the dihedral angle of edge
  * (i j) is the angle between the two faces that contain it, in degrees,

@@ -1,6 +1,15 @@
 /*
  * tetstat.h - the quality and fit of a tet mesh: the metrics of DESIGN.md
- * ("Metrics"), computed into a struct (the tetstat tool prints them).
+ * ("Metrics"), computed into a struct (the tetstat tool prints them). The
+ * quality and stopping measures of Stuart 2013, section 4, and the IoU
+ * against the pseudo volume.
+ *
+ * Units: model units; angles in degrees; ratios where said.
+ * Ownership: the caller owns *out (a plain struct); mesh, soup and field
+ * are borrowed.
+ * Threads: OpenMP inside; deterministic for any thread count (below).
+ * Errors: ST_ENOMEM, and what enclose.h and bvh.h return (ST_EINPUT for an
+ * empty surface).
  *
  * Over the mesh (st_tetstat_mesh):
  *   counts of tets and points (and points no tet uses), bounds;

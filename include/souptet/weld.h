@@ -3,6 +3,13 @@
  * -0 equal to 0) become one. The topology of a soup (its edges, holes and
  * pieces) is read on welded vertices, so an exact soup (every triangle
  * with its own three vertices) has the topology of the mesh it came from.
+ *
+ * Units: none: bit patterns of coordinates, indices.
+ * Ownership: the caller owns the weld array (s->nverts entries); the soup
+ * is borrowed.
+ * Threads: no global state; thread-safe on different arrays.
+ * Errors: out of memory is the only failure, reported by the return value
+ * (below).
  */
 #ifndef SOUPTET_WELD_H
 #define SOUPTET_WELD_H

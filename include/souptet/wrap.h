@@ -2,48 +2,19 @@
  * wrap.h - the repaired soup: a closed, oriented, 2-manifold triangle
  * surface around the pseudo volume of a signed field (soupwrap).
  *
- * Algorithm:
- *   1. Extraction (src/adapters/wrap_vdb.cpp): OpenVDB's volumeToMesh on
- *      the field at the isovalue, with a layer of "outside" voxels put
- *      around the grid, so a pseudo volume that reaches the grid's edge is
- *      closed there instead of left open (outside the grid is outside).
- *      Every value is first held at least a 64th of a voxel off the
- *      isovalue, on its own side (the inside voxels stay the same): at a
- *      value equal to the isovalue volumeToMesh puts the points of up to
- *      eight cells on one voxel center, and their quads are degenerate
- *      (a CAD face lying on voxel centers, at distance 0, does that).
- *   2. Cavities and specks: volumeToMesh orients every polygon along the
- *      field's gradient, so a piece enclosing negative volume bounds
- *      outside voxels: a cavity. Cavities are dropped, so the solid is
- *      filled (sign voting leaves such pockets where it errs, thousands
- *      of single voxels on a 50%-deleted model; a real cavity is "hidden
- *      from every ray" and already inside under the default rule), unless
- *      keep_cavities; so is a piece found inside another by exact ray
- *      parity once cavities are filled (an island in a cavity), and every
- *      outer piece enclosing less than min_volume voxels. Whole closed
- *      pieces go, so what stays is as closed and manifold as before.
- *   3. Coordinates are rounded to float, once, before anything is decided:
- *      every output format (OBJ, OFF, PLY, STL) then holds the very points
- *      the checks below were made on (STL has nothing but floats).
- *   4. Quads are split into two triangles along the diagonal that keeps
- *      both triangles non-degenerate (exactly: their corners not collinear),
- *      does not duplicate an existing edge (which would make it
- *      non-manifold) and does not fold the pair onto itself; of two such
- *      diagonals the one with the larger smallest angle.
- *   5. Triangles found to self-intersect (exact test, soupinfo.h) have
- *      their quads re-split along the other diagonal where that is allowed
- *      and removes the intersection.
- *   6. --smooth N: N steps of Taubin smoothing (lambda/mu, a low-pass that
- *      does not shrink). After every half step each moved vertex whose
- *      move makes a triangle degenerate, turns a triangle's normal by more
- *      than 90 degrees, or creates a self-intersection, is put back, until
- *      the surface is as valid as before the step. Topology never changes.
+ * Units: the field's model units; iso in distance units; min_volume in
+ * voxels.
+ * Ownership: the caller owns *out (st_soup_free) and polys
+ * (st_wrap_polys_clear); the field is borrowed.
+ * Threads: OpenVDB's extraction and our checks are deterministic for any
+ * thread count.
+ * Errors: ST_EINPUT (a field that is not signed), ST_ENOMEM, ST_ELIMIT,
+ * ST_ECANCELLED, ST_EINTERNAL (no adaptivity gave a valid surface).
  *
- * Adaptivity > 0 lets volumeToMesh merge flat regions into larger
- * polygons. Merged meshes are not always manifold: when the result fails
- * the check (st_wrap_check), the extraction is repeated with half the
- * adaptivity, down to 0; then with the values held an 8th, then half a
- * voxel off the isovalue; stats say what was used.
+ * The steps (extraction with OpenVDB's volumeToMesh, cavities and specks
+ * dropped, coordinates rounded to float, quads split, self-intersections
+ * re-split, Taubin smoothing, and the retries with less adaptivity that the
+ * stats report): doc/design/wrap.md.
  */
 #ifndef SOUPTET_WRAP_H
 #define SOUPTET_WRAP_H
