@@ -375,12 +375,86 @@ st_status st_sides_mirror(st_grid *g, const st_soup *soup, size_t seen_triangles
     return ST_OK;
 }
 
+/* The steps of st_sides_evidence_edges (defined after it). */
+static void region_scores(double *score, const st_grid *g, const uint8_t *votes,
+                          const st_soup *s, const st_soup_edges *E, const uint8_t *flip,
+                          const uint32_t *region);
+static st_status oriented_soup(st_soup *o, uint8_t *rim, size_t *nview, st_sides_stats *st,
+                               const st_soup *s, const st_soup_edges *E, const uint32_t *nbr,
+                               const uint8_t *flip, const uint32_t *region, const double *score,
+                               const st_sides_params *p, st_error *err);
+static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
+                               int decided, const st_bvh *bvh, const st_soup *o,
+                               const st_sides_params *p);
+
 st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
                             int decided, const st_soup *s,
                             const st_sides_params *p, st_sides_stats *stats,
                             st_error *err)
 {
     return st_sides_evidence_edges(evidence, g, votes, decided, s, NULL, p, stats, err);
+}
+
+st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint8_t *votes,
+                                  int decided, const st_soup *s, const st_soup_edges *edges,
+                                  const st_sides_params *p, st_sides_stats *stats,
+                                  st_error *err)
+{
+    st_sides_stats local;
+    st_sides_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    const size_t n = st_grid_count(g);
+    memset(evidence, 0, n);
+    st_soup_edges own;
+    st_status rc = edges ? ST_OK : st_soup_edges_build(&own, s, err);
+    if (rc)
+        return rc;
+    const st_soup_edges E = edges ? *edges : own;
+    const size_t nt = s->ntris;
+    uint32_t *nbr = st_malloc_array(3 * nt + 1, sizeof *nbr);
+    uint8_t *same = st_malloc_array(3 * nt + 1, 1);
+    uint8_t *flip = st_malloc_array(nt + 1, 1);
+    uint8_t *rim = st_malloc_array(nt + 1, 1);
+    uint32_t *region = st_malloc_array(nt + 1, sizeof *region);
+    uint32_t *queue = st_malloc_array(nt + 1, sizeof *queue);
+    double *score = st_calloc_array(nt + 1, sizeof *score);
+    st_soup *o = st_soup_new();
+    st_bvh *bvh = NULL;
+    if (!nbr || !same || !flip || !rim || !region || !queue || !score || !o) {
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's sides");
+        goto done;
+    }
+    st_soup_edges_neighbours(&E, s, nbr, same, NULL);
+
+    /* 1. orientable regions, by propagation */
+    st->conflicts = st_soup_edges_orient(&E, s, nbr, same, flip, region, queue, NULL);
+    for (size_t t = 0; t < nt; t++)
+        st->regions += E.kept[t] && region[t] == t;
+    /* 2. each region turned to the votes' reading */
+    region_scores(score, g, votes, s, &E, flip, region);
+    size_t nview = 0;
+    if ((rc = oriented_soup(o, rim, &nview, st, s, &E, nbr, flip, region, score, p, err)))
+        goto done;
+    if (o->ntris == 0)
+        goto done;
+    if ((rc = st_bvh_build(&bvh, o, err)))
+        goto done;
+    /* 3. the local winding number near the soup; 4. the view */
+    st->voxels = winding_evidence(evidence, g, votes, decided, bvh, o, p);
+    view_of(o, nview, rim, p, st);
+done:
+    st_bvh_free(bvh);
+    st_soup_free(o);
+    if (!edges)
+        st_soup_edges_free(&own);
+    free(nbr);
+    free(same);
+    free(flip);
+    free(rim);
+    free(region);
+    free(queue);
+    free(score);
+    return rc;
 }
 
 /* 2. Each region's score: the votes' reading of its triangles' sides
@@ -511,68 +585,6 @@ static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t
                 count++;
             }
     return count;
-}
-
-st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint8_t *votes,
-                                  int decided, const st_soup *s, const st_soup_edges *edges,
-                                  const st_sides_params *p, st_sides_stats *stats,
-                                  st_error *err)
-{
-    st_sides_stats local;
-    st_sides_stats *st = stats ? stats : &local;
-    memset(st, 0, sizeof *st);
-    const size_t n = st_grid_count(g);
-    memset(evidence, 0, n);
-    st_soup_edges own;
-    st_status rc = edges ? ST_OK : st_soup_edges_build(&own, s, err);
-    if (rc)
-        return rc;
-    const st_soup_edges E = edges ? *edges : own;
-    const size_t nt = s->ntris;
-    uint32_t *nbr = st_malloc_array(3 * nt + 1, sizeof *nbr);
-    uint8_t *same = st_malloc_array(3 * nt + 1, 1);
-    uint8_t *flip = st_malloc_array(nt + 1, 1);
-    uint8_t *rim = st_malloc_array(nt + 1, 1);
-    uint32_t *region = st_malloc_array(nt + 1, sizeof *region);
-    uint32_t *queue = st_malloc_array(nt + 1, sizeof *queue);
-    double *score = st_calloc_array(nt + 1, sizeof *score);
-    st_soup *o = st_soup_new();
-    st_bvh *bvh = NULL;
-    if (!nbr || !same || !flip || !rim || !region || !queue || !score || !o) {
-        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's sides");
-        goto done;
-    }
-    st_soup_edges_neighbours(&E, s, nbr, same, NULL);
-
-    /* 1. orientable regions, by propagation */
-    st->conflicts = st_soup_edges_orient(&E, s, nbr, same, flip, region, queue, NULL);
-    for (size_t t = 0; t < nt; t++)
-        st->regions += E.kept[t] && region[t] == t;
-    /* 2. each region turned to the votes' reading */
-    region_scores(score, g, votes, s, &E, flip, region);
-    size_t nview = 0;
-    if ((rc = oriented_soup(o, rim, &nview, st, s, &E, nbr, flip, region, score, p, err)))
-        goto done;
-    if (o->ntris == 0)
-        goto done;
-    if ((rc = st_bvh_build(&bvh, o, err)))
-        goto done;
-    /* 3. the local winding number near the soup; 4. the view */
-    st->voxels = winding_evidence(evidence, g, votes, decided, bvh, o, p);
-    view_of(o, nview, rim, p, st);
-done:
-    st_bvh_free(bvh);
-    st_soup_free(o);
-    if (!edges)
-        st_soup_edges_free(&own);
-    free(nbr);
-    free(same);
-    free(flip);
-    free(rim);
-    free(region);
-    free(queue);
-    free(score);
-    return rc;
 }
 
 typedef struct col_hit {
