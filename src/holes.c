@@ -1,5 +1,6 @@
 /*
  * holes.c - caps for the holes of a soup (see holes.h).
+ * Design notes and measurements: doc/design/holes.md.
  *
  *   1. the soup's edges and pieces on welded vertices (edges.h:
  *      degenerate and duplicated triangles left out);
@@ -12,6 +13,10 @@
  *      and keep the cap if it is small beside the pieces near the loop (a
  *      bounding volume hierarchy finds them); with bend, the cap is the
  *      triangulation that bends least instead (O(n^3) too).
+ *
+ * st_soup_hole_caps_shared reads as these steps around one state (a
+ * capper: the rim, the loop being capped, the caps): rim_build (2),
+ * rim_intact, rim_pair and trace_loop (3), cap_loop (4).
  */
 #include "souptet/holes.h"
 #include "fpenv.h"
@@ -29,62 +34,41 @@
 
 #define NONE UINT32_MAX
 /* A cone from a rebuilt corner replaces the cap of the loop's own points
- * when its bend along the loop is below CONE_BETTER times the cap's: on
- * the corpus (issue 17) 0.999 rebuilds more of the large holes (core IoU
- * mean 0.822, worst 0.716) but costs deleted50 rotor 0.989 -> 0.940; 0.5
- * (0.819, 0.685) keeps it at 0.994; 0.25 rebuilds little (0.760). */
+ * when its bend along the loop is below CONE_BETTER times the cap's: more
+ * rebuilds more of the large holes but costs the deleted faces, less
+ * rebuilds little (doc/design/holes.md, "CONE_BETTER"). */
 #define CONE_BETTER 0.5
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
+
+/* The rim of the soup's holes: its boundary edges (an edge of one kept
+ * triangle, on welded vertices), how they pair at their ends, and the
+ * soup's areas the caps are measured against. */
+typedef struct rim {
+    size_t nb;                  /* boundary edges */
+    uint32_t *a, *b, *t;        /* each one's welded ends and its triangle */
+    uint32_t *pa, *pb;          /* its partner at end a, at end b (NONE: none) */
+    uint8_t *used;              /* walked into a loop */
+    uint32_t *vstart, *vlist;   /* the boundary edges at each welded vertex */
+    uint32_t *tstart, *tlist;   /* the kept triangles at each vertex where holes touch */
+    uint32_t *wpos;             /* a soup vertex welded to each welded vertex */
+    double *piece_area;         /* each piece's area */
+    uint32_t *stamp;            /* per triangle or piece: scratch marks */
+    double total, area;         /* the kept soup's area, its rim triangles' */
+} rim;
 
 st_holes_params st_holes_params_default(void)
 {
     /* 0.25: a hole's cap is at most a quarter of the surface around it (on
      * the corpus, holes of 3 rings of faces on models of 3 000 faces and
      * up: under 0.15); an open patch's own loop spans about its area. */
-    /* History (the measurements that led here). planes on every soup:
-     * rebuilt corners (a cone from one, or fans from several)
-     * recover more of the large holes (core IoU at 128^3, mean / worst:
-     * 0.743 / 0.584 -> 0.842 / 0.685; with bend 0.876 / 0.803; the cone
-     * alone 0.819 / 0.685) and of the holes class (cheese 0.896 ->
-     * 0.922), but lose on deleted faces and one-sided scans: deleted50
-     * cheese 0.980 -> 0.925, pinion 0.999 -> 0.996, rotor 0.989 ->
-     * 0.986; onesided cheese 0.845 -> 0.813, rotor 0.883 -> 0.871, anchor
-     * 1.000 -> 0.995 (elephant onesided 0.801 -> 0.551 at CONE_BETTER
-     * 0.999). A plane support bound does not make it the default: a
-     * rebuilt corner's triangles on a face's plane at most k times the
-     * area left of that face (the soup's triangles joined across edges
-     * where they lie exactly in one plane, st_orient3d), largeholes 0.842
-     * -> 0.784 (k 1), 0.821 (k 2; rotor 0.936 -> 0.829, fandisk 0.964 ->
-     * 0.944), 0.831 (k 4), while deleted50 cheese 0.925 -> 0.945 (k 2; not
-     * the 0.980 without planes, its loss is recall) and anchor 0.998 ->
-     * 0.923 (0.911 without planes): on a CAD part's curved faces a face is
-     * one facet, and a face that lost most of itself bears fans larger
-     * than what is left of it. planes also costs soupsign 2.4 times the
-     * user time on the armadillo's deleted faces at 256^3 (2.3 s -> 5.5 s;
-     * its holes 1.4 s -> 1.5 s). With rebuilt corners that pierce the
-     * soup rejected (holes_planes.c) it is closer but still not the
-     * default: class means deleted50 0.9945, holes 0.9837, onesided
-     * 0.8461, largeholes 0.838, but deleted50 cheese 0.971 (0.980
-     * without planes), onesided cheese 0.879 (0.905), and 3.2 times the
-     * user time on the armadillo's deleted faces (1.9 s -> 6.2 s). */
-    /* bend on every soup: the caps that bend least recover more
-     * of a CAD part's large holes (issue 17, the corpus's largeholes:
-     * core IoU 0.743 -> 0.829) and of its small ones, but extend a face's
-     * plane across a lost concave corner and continue a one-sided scan's
-     * walls past its far side (deleted50 joint 0.974 -> 0.895, onesided
-     * rotor 0.883 -> 0.754). */
     /* bend and planes where the soup is intact (issue 17): the rim at
-     * most half the soup's area and not one-sided along an axis below
-     * 0.02. On the corpus the rim reads 0.76-0.87 where faces were deleted
-     * at random and 0.003-0.15 for the holes, large holes and one-sided
-     * scans; along an axis the one-sided scans read 0.000 and every other
-     * soup with holes 0.39 and up. Core IoU at 128^3 against the least-area
-     * caps everywhere (mean / worst): large holes 0.743 / 0.584 -> 0.875 /
-     * 0.803, holes 0.978 / 0.896 -> 0.986 / 0.920, every other class the
-     * same to four digits; planes-bend on every soup instead: deleted50
-     * joint 0.974 -> 0.895, onesided joint 1.000 -> 0.899. */
+     * most half the soup's area (faces deleted at random leave a rim of
+     * most of it) and not one-sided along an axis below 0.02 (one-sided
+     * scans read 0.000, every other soup with holes 0.39 and up). The
+     * measurements behind these values, and the variants not kept:
+     * doc/design/holes.md. */
     st_holes_params p = {0.25, 256, 0.01, 1, 1, 0.5, 0.02};
     return p;
 }
@@ -122,19 +106,24 @@ static void emit_triangles(const uint16_t *best, size_t n, size_t *stack, uint32
     }
 }
 
+/* "out of memory" where the holes' scratch is allocated. */
+static st_status oom(st_error *err)
+{
+    return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
+}
+
 /* The least-area triangulation of the polygon pts[0..n) (n >= 3): fills
- * tri[3 (n - 2)] with local indices and returns its area; -1 when out of
- * memory. */
-static double least_area(const double *const *pts, size_t n, uint32_t *tri)
+ * tri[3 (n - 2)] with local indices and *area with its area. ST_ENOMEM. */
+static st_status least_area(double *area, const double *const *pts, size_t n, uint32_t *tri,
+                            st_error *err)
 {
     double *w = malloc(n * n * sizeof *w);
     uint16_t *best = malloc(n * n * sizeof *best);
     size_t *stack = malloc(2 * n * sizeof *stack);
+    st_status rc = ST_OK;
     if (!w || !best || !stack) {
-        free(w);
-        free(best);
-        free(stack);
-        return -1.0;
+        rc = oom(err);
+        goto done;
     }
     for (size_t i = 0; i + 1 < n; i++)
         w[i * n + i + 1] = 0.0;
@@ -153,12 +142,13 @@ static double least_area(const double *const *pts, size_t n, uint32_t *tri)
             w[i * n + j] = m;
             best[i * n + j] = (uint16_t)mk;
         }
-    const double area = w[n - 1];
+    *area = w[n - 1];
     emit_triangles(best, n, stack, tri);
+done:
     free(w);
     free(best);
     free(stack);
-    return area;
+    return rc;
 }
 
 /* The triangulation of the polygon pts[0..n) (n >= 3) on its own vertices
@@ -177,18 +167,19 @@ static double least_area(const double *const *pts, size_t n, uint32_t *tri)
  * one (ruled between two rims of the loop) only by its facets' small
  * angles; the least-area cap cuts straight across a curved face and,
  * where the loop runs over several faces of a part, folds through its
- * solid. Fills tri[3 (n - 2)] and returns the cap's area; -1 when out of
- * memory. */
-static double least_bend(const double *const *pts, const double *const *side, size_t n,
-                         uint32_t *tri)
+ * solid. Fills tri[3 (n - 2)] and *area with the cap's area (an
+ * st_holes_fill, holes_internal.h). ST_ENOMEM. */
+static st_status least_bend(double *area, const double *const *pts, const double *const *side,
+                            size_t n, uint32_t *tri, st_error *err)
 {
     double *ang = malloc(n * n * sizeof *ang), *w = malloc(n * n * sizeof *w);
     double *nrm = malloc(3 * n * n * sizeof *nrm);
     uint16_t *best = malloc(n * n * sizeof *best);
     size_t *stack = malloc(2 * n * sizeof *stack);
+    st_status rc = ST_OK;
     if (!ang || !w || !nrm || !best || !stack) {
-        free(ang), free(w), free(nrm), free(best), free(stack);
-        return -1.0;
+        rc = oom(err);
+        goto done;
     }
     /* (i, i + 1): the soup's triangle across the edge, passed i -> c -> i+1;
      * (i, j) above: the triangle (i, k, j) of its best triangulation */
@@ -225,24 +216,19 @@ static double least_bend(const double *const *pts, const double *const *side, si
             best[i * n + j] = (uint16_t)mk;
             memcpy(nrm + 3 * (i * n + j), bn, sizeof bn);
         }
-    const double area = w[n - 1];
+    *area = w[n - 1];
     emit_triangles(best, n, stack, tri);
+done:
     free(ang), free(w), free(nrm), free(best), free(stack);
-    return area;
+    return rc;
 }
 
-/* least_area and least_bend as st_holes_fill (holes_internal.h) */
-static double fill_area(const double *const *pts, const double *const *side, size_t n,
-                        uint32_t *tri)
+/* least_area as an st_holes_fill (holes_internal.h) */
+static st_status fill_area(double *area, const double *const *pts, const double *const *side,
+                           size_t n, uint32_t *tri, st_error *err)
 {
     (void)side;
-    return least_area(pts, n, tri);
-}
-
-static double fill_bend(const double *const *pts, const double *const *side, size_t n,
-                        uint32_t *tri)
-{
-    return least_bend(pts, side, n, tri);
+    return least_area(area, pts, n, tri, err);
 }
 
 /* The bend along the loop of the cap tri[3 (n - 2)] (local indices, as
@@ -397,11 +383,11 @@ static int covered(const double *lo, const double *hi, size_t n, double a)
  * (each edge then lies more in the other's triangle than in its hole);
  * only a matching that pairs every edge is kept, else the edges stay
  * unpaired and their loops open. hit[] (k bytes) is scratch. */
-static void pair_by_sides(const st_soup *s, const uint32_t *weld, const uint32_t *wpos,
-                          const uint32_t *be_a, const uint32_t *be_b, const uint32_t *be_t,
-                          uint32_t *pa, uint32_t *pb, uint32_t v, const uint32_t *ev, size_t k,
-                          uint8_t *hit)
+static void pair_by_sides(rim *r, const st_soup *s, const uint32_t *weld, uint32_t v,
+                          const uint32_t *ev, size_t k, uint8_t *hit)
 {
+    const uint32_t *wpos = r->wpos, *be_a = r->a, *be_b = r->b, *be_t = r->t;
+    uint32_t *pa = r->pa, *pb = r->pb;
     enum { MAXK = 32 };
     if (k > MAXK)
         return;
@@ -460,9 +446,10 @@ static void pair_by_sides(const st_soup *s, const uint32_t *weld, const uint32_t
  * the way it faces most, the projected area facing the other way over that
  * facing it, summed over the regions; the least over the three axes. 0
  * for a scan seen from one side along an axis (its faces facing away were
- * never seen), near 1 for a closed part with holes in it. -1 when out of
- * memory. */
-static double axis_one_sided(const st_soup *s, const st_soup_edges *E)
+ * never seen), near 1 for a closed part with holes in it: in *ratio.
+ * ST_ENOMEM. */
+static st_status axis_one_sided(double *ratio, const st_soup *s, const st_soup_edges *E,
+                                st_error *err)
 {
     const size_t nt = s->ntris;
     uint32_t *nbr = st_malloc_array(3 * nt + 1, sizeof *nbr);
@@ -470,9 +457,11 @@ static double axis_one_sided(const st_soup *s, const st_soup_edges *E)
     uint8_t *flip = st_malloc_array(nt + 1, 1);
     uint32_t *queue = st_malloc_array(nt + 1, sizeof *queue);
     uint32_t *region = st_malloc_array(nt + 1, sizeof *region);
-    double ratio = -1.0;
-    if (!nbr || !same || !flip || !queue || !region)
+    st_status rc = ST_OK;
+    if (!nbr || !same || !flip || !queue || !region) {
+        rc = oom(err);
         goto done;
+    }
     st_soup_edges_neighbours(E, s, nbr, same, NULL);
     size_t nq = 0;
     st_soup_edges_orient(E, s, nbr, same, flip, region, queue, &nq);
@@ -499,17 +488,17 @@ static double axis_one_sided(const st_soup *s, const st_soup_edges *E)
                 pos[k] = neg[k] = 0.0;
             }
     }
-    ratio = INFINITY;
+    *ratio = INFINITY;
     for (int k = 0; k < 3; k++)
         if (front[k] > 0.0)
-            ratio = fmin(ratio, back[k] / front[k]);
+            *ratio = fmin(*ratio, back[k] / front[k]);
 done:
     free(nbr);
     free(same);
     free(flip);
     free(queue);
     free(region);
-    return ratio;
+    return rc;
 }
 
 /* The k (even, > 2) boundary edges ev at welded vertex v, where holes
@@ -520,12 +509,14 @@ done:
  * pairs those two edges. Pairs only when the gaps account for every edge
  * exactly once; otherwise (a vertex on a sharp crease, where one plane
  * does not order the fans) the edges are paired by their hole sides
- * (pair_by_sides) or stay unpaired. Returns -1 when out of memory. */
-static int pair_by_angle(const st_soup *s, const uint32_t *weld, const uint32_t *wpos,
-                         const uint32_t *be_a, const uint32_t *be_b, uint32_t *pa, uint32_t *pb,
-                         uint32_t v, const uint32_t *ev, size_t k, const uint32_t *tv, size_t nt,
-                         const uint32_t *be_t)
+ * (pair_by_sides) or stay unpaired. ST_ENOMEM. */
+static st_status pair_by_angle(rim *r, const st_soup *s, const uint32_t *weld, uint32_t v,
+                               st_error *err)
 {
+    const uint32_t *wpos = r->wpos, *be_a = r->a, *be_b = r->b;
+    uint32_t *pa = r->pa, *pb = r->pb;
+    const uint32_t *ev = r->vlist + r->vstart[v], *tv = r->tlist + r->tstart[v];
+    const size_t k = r->vstart[v + 1] - r->vstart[v], nt = r->tstart[v + 1] - r->tstart[v];
     const double *o = s->xyz + 3 * (size_t)wpos[v];
     double nsum[3] = {0, 0, 0}, first[3] = {0, 0, 0};
     for (size_t i = 0; i < nt; i++) {
@@ -542,7 +533,7 @@ static int pair_by_angle(const st_soup *s, const uint32_t *weld, const uint32_t 
     }
     const double len = st_norm3(nsum);
     if (!(len > 0))
-        return 0;
+        return ST_OK;
     double nn[3] = {nsum[0] / len, nsum[1] / len, nsum[2] / len}, ax[3] = {1, 0, 0}, U[3], W[3];
     if (fabs(nn[0]) > 0.9)
         ax[0] = 0, ax[1] = 1;
@@ -555,9 +546,10 @@ static int pair_by_angle(const st_soup *s, const uint32_t *weld, const uint32_t 
     double *ang = malloc(k * sizeof *ang);
     uint32_t *ord = malloc(k * sizeof *ord);
     uint8_t *hit = calloc(k, 1);
+    st_status rc = ST_OK;
     if (!lo || !hi || !ang || !ord || !hit) {
-        free(lo), free(hi), free(ang), free(ord), free(hit);
-        return -1;
+        rc = oom(err);
+        goto done;
     }
 #define ANGLE(p) atan2(((p)[0] - o[0]) * W[0] + ((p)[1] - o[1]) * W[1] + ((p)[2] - o[2]) * W[2], \
                        ((p)[0] - o[0]) * U[0] + ((p)[1] - o[1]) * U[1] + ((p)[2] - o[2]) * U[2])
@@ -611,10 +603,401 @@ static int pair_by_angle(const st_soup *s, const uint32_t *weld, const uint32_t 
             }
         }
     else
-        pair_by_sides(s, weld, wpos, be_a, be_b, be_t, pa, pb, v, ev, k, hit);
-    (void)be_b;
+        pair_by_sides(r, s, weld, v, ev, k, hit);
+done:
     free(lo), free(hi), free(ang), free(ord), free(hit);
-    return 0;
+    return rc;
+}
+
+/* ---- the rim, its loops and their caps --------------------------------- */
+
+static void rim_free(rim *r)
+{
+    free(r->a), free(r->b), free(r->t), free(r->pa), free(r->pb), free(r->used);
+    free(r->vstart), free(r->vlist), free(r->tstart), free(r->tlist), free(r->wpos);
+    free(r->piece_area), free(r->stamp);
+    memset(r, 0, sizeof *r);
+}
+
+/* 2. The pieces' areas, and the boundary edges of E (r->a, b, t, their
+ * partners none yet), counted at their ends in bdeg[nweld + 1]. */
+static st_status rim_edges(rim *r, const st_soup *s, const st_soup_edges *E, uint32_t *bdeg,
+                           st_error *err)
+{
+    const size_t nt = s->ntris, nh = E->nhalf;
+    const st_half_edge *he = E->he;
+    r->piece_area = st_calloc_array(nt ? nt : 1, sizeof *r->piece_area);
+    if (!r->piece_area)
+        return oom(err);
+    for (size_t t = 0; t < nt; t++)
+        if (E->kept[t]) {
+            const uint32_t *v = s->tris + 3 * t;
+            const double a = tri_area(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
+                                      s->xyz + 3 * (size_t)v[2]);
+            r->piece_area[E->piece[t]] += a;
+            r->total += a;
+        }
+    size_t nb = 0;
+    for (size_t i = 0, j; i < nh; i = j) {
+        for (j = i + 1; j < nh && he[j].key == he[i].key; j++)
+            ;
+        nb += j - i == 1;
+    }
+    r->nb = nb;
+    r->a = st_malloc_array(nb ? nb : 1, sizeof *r->a);
+    r->b = st_malloc_array(nb ? nb : 1, sizeof *r->b);
+    r->t = st_malloc_array(nb ? nb : 1, sizeof *r->t);
+    r->pa = st_malloc_array(nb ? nb : 1, sizeof *r->pa);
+    r->pb = st_malloc_array(nb ? nb : 1, sizeof *r->pb);
+    r->used = st_calloc_array(nb ? nb : 1, 1);
+    r->stamp = st_malloc_array(nt ? nt : 1, sizeof *r->stamp);
+    if (!r->a || !r->b || !r->t || !r->pa || !r->pb || !r->used || !r->stamp)
+        return oom(err);
+    for (size_t t = 0; t < nt; t++)
+        r->stamp[t] = NONE;
+    size_t e = 0;
+    for (size_t i = 0, j; i < nh; i = j) {
+        for (j = i + 1; j < nh && he[j].key == he[i].key; j++)
+            ;
+        if (j - i != 1)
+            continue;
+        const uint32_t a = (uint32_t)(he[i].key >> 32), b = (uint32_t)he[i].key;
+        r->a[e] = a;
+        r->b[e] = b;
+        r->t[e] = he[i].t;
+        r->pa[e] = r->pb[e] = NONE;
+        bdeg[a]++;
+        bdeg[b]++;
+        e++;
+    }
+    return ST_OK;
+}
+
+/* The boundary edges at each welded vertex (bdeg: how many), a position
+ * for each welded vertex (the first soup vertex welded to it), and the
+ * kept triangles at each vertex where holes touch. */
+static st_status rim_vertices(rim *r, const st_soup *s, const st_soup_edges *E, uint32_t *bdeg,
+                              st_error *err)
+{
+    const size_t nt = s->ntris, nw = E->nweld, nb = r->nb;
+    const uint32_t *weld = E->weld;
+    r->vstart = st_calloc_array(nw + 2, sizeof *r->vstart);
+    r->vlist = st_malloc_array(2 * nb + 1, sizeof *r->vlist);
+    r->tstart = st_calloc_array(nw + 2, sizeof *r->tstart);
+    r->wpos = st_malloc_array(nw + 1, sizeof *r->wpos);
+    if (!r->vstart || !r->vlist || !r->tstart || !r->wpos)
+        return oom(err);
+    uint32_t *vstart = r->vstart, *tstart = r->tstart;
+    for (size_t v = 0; v < nw; v++)
+        vstart[v + 1] = vstart[v] + bdeg[v];
+    for (size_t v = 0; v < nw; v++)
+        bdeg[v] = 0;
+    for (size_t i = 0; i < nb; i++) {
+        r->vlist[vstart[r->a[i]] + bdeg[r->a[i]]++] = (uint32_t)i;
+        r->vlist[vstart[r->b[i]] + bdeg[r->b[i]]++] = (uint32_t)i;
+    }
+    for (size_t v = s->nverts; v-- > 0;)
+        if (weld[v] != ST_WELD_NONE)
+            r->wpos[weld[v]] = (uint32_t)v;
+    for (size_t t = 0; t < nt; t++)
+        if (E->kept[t])
+            for (int c = 0; c < 3; c++) {
+                const uint32_t w = weld[s->tris[3 * t + c]];
+                if (bdeg[w] > 2)
+                    tstart[w + 1]++;
+            }
+    for (size_t v = 0; v < nw; v++)
+        tstart[v + 1] += tstart[v];
+    r->tlist = st_malloc_array(tstart[nw] + 1, sizeof *r->tlist);
+    size_t *tfill = st_calloc_array(nw + 1, sizeof *tfill);
+    if (!r->tlist || !tfill) {
+        free(tfill);
+        return oom(err);
+    }
+    for (size_t t = 0; t < nt; t++)
+        if (E->kept[t])
+            for (int c = 0; c < 3; c++) {
+                const uint32_t w = weld[s->tris[3 * t + c]];
+                if (vstart[w + 1] - vstart[w] > 2)
+                    r->tlist[tstart[w] + tfill[w]++] = (uint32_t)t;
+            }
+    free(tfill);
+    return ST_OK;
+}
+
+/* The rim's area: the kept triangles on a boundary edge, each once. */
+static void rim_area(rim *r, const st_soup *s)
+{
+    for (size_t i = 0; i < r->nb; i++) {
+        const uint32_t t = r->t[i];
+        if (r->stamp[t] == NONE) {
+            const uint32_t *v = s->tris + 3 * (size_t)t;
+            r->area += tri_area(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
+                                s->xyz + 3 * (size_t)v[2]);
+            r->stamp[t] = 0;
+        }
+    }
+    for (size_t i = 0; i < r->nb; i++)
+        r->stamp[r->t[i]] = NONE;
+}
+
+static st_status rim_build(rim *r, const st_soup *s, const st_soup_edges *E, st_error *err)
+{
+    uint32_t *bdeg = st_calloc_array(E->nweld + 1, sizeof *bdeg);
+    st_status rc = bdeg ? rim_edges(r, s, E, bdeg, err) : oom(err);
+    rc = rc ? rc : rim_vertices(r, s, E, bdeg, err);
+    if (!rc)
+        rim_area(r, s);
+    free(bdeg);
+    return rc;
+}
+
+/* 3. Pair the boundary edges at every vertex: the two of a vertex with
+ * two; where holes touch, by the angular gaps between the triangles
+ * around it (pair_by_angle), or on a crease by their hole sides
+ * (pair_by_sides). */
+static st_status rim_pair(rim *r, const st_soup *s, const st_soup_edges *E, st_error *err)
+{
+    for (size_t v = 0; v < E->nweld; v++) {
+        const size_t k = r->vstart[v + 1] - r->vstart[v];
+        const uint32_t *ev = r->vlist + r->vstart[v];
+        st_status rc;
+        if (k == 2) {
+            set_partner(r->a, r->pa, r->pb, ev[0], (uint32_t)v, ev[1]);
+            set_partner(r->a, r->pa, r->pb, ev[1], (uint32_t)v, ev[0]);
+        } else if (k > 2 && !(k & 1) && (rc = pair_by_angle(r, s, E->weld, (uint32_t)v, err)))
+            return rc;
+    }
+    return ST_OK;
+}
+
+/* Whether the caps continue the faces (bend, planes): where the rim is
+ * more than p->intact of the soup's area (faces deleted at random: most
+ * of what is left touches a hole), the fragments' planes and bends say
+ * little about the lost surface; a scan seen from one side along an axis
+ * (p->onesided) has loops that are the horizon where it turned away, not
+ * lost faces of a part (the bent caps would continue its walls past the
+ * far side). Else every cap is the least-area one. */
+static st_status rim_intact(int *intact, const rim *r, const st_soup *s, const st_soup_edges *E,
+                            const st_holes_params *p, st_holes_stats *st, st_error *err)
+{
+    st->rim_share = r->total > 0.0 ? r->area / r->total : 0.0;
+    *intact = r->area <= p->intact * r->total;
+    st->one_sided = -1.0;
+    if (*intact && (p->bend || p->planes) && p->onesided > 0.0) {
+        const st_status rc = axis_one_sided(&st->one_sided, s, E, err);
+        if (rc)
+            return rc;
+        *intact = st->one_sided >= p->onesided;
+    }
+    return ST_OK;
+}
+
+/* One loop of the rim: its welded vertices and boundary edges, their
+ * points (a soup vertex welded to each), the third point of the soup's
+ * triangle beside each edge, and a triangulation. */
+typedef struct loop {
+    size_t n;
+    uint32_t *v, *e;            /* nb + 1 each */
+    const double **pts, **side; /* max_loop + 1 each */
+    uint32_t *tri;              /* 3 (max_loop + 1) */
+} loop;
+
+static st_status loop_alloc(loop *l, size_t nb, size_t max_loop, st_error *err)
+{
+    l->v = st_malloc_array(nb + 1, sizeof *l->v);
+    l->e = st_malloc_array(nb + 1, sizeof *l->e);
+    l->pts = st_malloc_array(max_loop + 1, sizeof *l->pts);
+    l->side = st_malloc_array(max_loop + 1, sizeof *l->side);
+    l->tri = st_malloc_array(3 * (max_loop + 1), sizeof *l->tri);
+    return l->v && l->e && l->pts && l->side && l->tri ? ST_OK : oom(err);
+}
+
+static void loop_free(loop *l)
+{
+    free(l->v), free(l->e), free(l->pts), free(l->side), free(l->tri);
+}
+
+/* Walks the loop from boundary edge e0 (not used yet) by the partners,
+ * marking its edges used, into l (l->n edges). Returns 1 when it closes,
+ * 0 when it is pinched (an odd vertex, one not paired, or an edge met
+ * twice). */
+static int trace_loop(rim *r, size_t e0, loop *l)
+{
+    size_t n = 0;
+    const uint32_t start = r->a[e0];
+    uint32_t v = r->b[e0], cur = (uint32_t)e0;
+    int closed = 1;
+    r->used[e0] = 1;
+    l->v[n] = start;
+    l->e[n++] = cur;
+    for (;;) {
+        const uint32_t next = r->a[cur] == v ? r->pa[cur] : r->pb[cur];
+        if (next == NONE) {
+            closed = 0;
+            break;
+        }
+        if (next == e0 && v == start)
+            break;
+        if (r->used[next] || n > r->nb) {
+            closed = 0;
+            break;
+        }
+        r->used[next] = 1;
+        l->v[n] = v;
+        l->e[n++] = next;
+        cur = next;
+        v = r->a[cur] == v ? r->b[cur] : r->a[cur];
+    }
+    l->n = n;
+    return closed;
+}
+
+/* Capping the loops of one soup: what cap_loop reads and fills. */
+typedef struct capper {
+    const st_soup *s;
+    const st_soup_edges *E;
+    const st_bvh *bvh;
+    const st_holes_params *p;
+    int bend, planes;           /* how the caps continue the faces */
+    rim r;
+    loop l;
+    st_soup *out;               /* the caps */
+    st_holes_stats st;
+} capper;
+
+/* The loop's points (pts) and, beside each edge, the third point of the
+ * soup's triangle on it (side; a kept triangle has one). */
+static void loop_points(capper *c, int sides)
+{
+    const st_soup *s = c->s;
+    const uint32_t *weld = c->E->weld;
+    loop *l = &c->l;
+    for (size_t i = 0; i < l->n; i++) {
+        const uint32_t *tv = s->tris + 3 * (size_t)c->r.t[l->e[i]];
+        if (!sides) {
+            const double *q = NULL;
+            for (int k = 0; k < 3; k++)
+                if (weld[tv[k]] == l->v[i])
+                    q = s->xyz + 3 * (size_t)tv[k];
+            l->pts[i] = q;
+            continue;
+        }
+        const uint32_t a = l->v[i], b = l->v[(i + 1) % l->n];
+        l->side[i] = l->pts[i];
+        for (int k = 0; k < 3; k++)
+            if (weld[tv[k]] != a && weld[tv[k]] != b)
+                l->side[i] = s->xyz + 3 * (size_t)tv[k];
+    }
+}
+
+/* The area of the surface around loop e0: the pieces with a triangle
+ * whose box meets the loop's box grown by a quarter of its extent each
+ * way (the loop's own pieces among them). */
+static double around_loop(capper *c, size_t e0)
+{
+    const double *const *pts = c->l.pts;
+    double blo[3], bhi[3], ext = 0.0;
+    for (int q = 0; q < 3; q++)
+        blo[q] = bhi[q] = pts[0][q];
+    for (size_t i = 1; i < c->l.n; i++)
+        for (int q = 0; q < 3; q++) {
+            blo[q] = fmin(blo[q], pts[i][q]);
+            bhi[q] = fmax(bhi[q], pts[i][q]);
+        }
+    for (int q = 0; q < 3; q++)
+        ext = fmax(ext, bhi[q] - blo[q]);
+    for (int q = 0; q < 3; q++) {
+        blo[q] -= 0.25 * ext;
+        bhi[q] += 0.25 * ext;
+    }
+    around_ctx ac = {c->E->kept, c->E->piece, c->r.stamp, (uint32_t)e0, c->r.piece_area, 0.0};
+    st_bvh_query_box(c->bvh, blo, bhi, add_piece, &ac);
+    return ac.around;
+}
+
+/* The loop's cap rebuilt from the planes along it, appended to the caps
+ * with *rebuilt 1 when it continues the faces clearly better than the
+ * cap of the loop's own points in l->tri (a flat hole's cap continues
+ * them exactly): the cone from one corner or the fans from several,
+ * whichever continues them better. */
+static st_status cap_planes(capper *c, int *rebuilt, st_error *err)
+{
+    const loop *l = &c->l;
+    const size_t n = l->n;
+    const double below = CONE_BETTER * rim_bend(l->pts, l->side, n, l->tri);
+    int coned = 0, fanned = 0;
+    double cb, fb = INFINITY;
+    st_soup *cone = st_soup_new(), *fans = st_soup_new();
+    st_status rc = ST_OK;
+    *rebuilt = 0;
+    if (!cone || !fans) {
+        rc = oom(err);
+        goto done;
+    }
+    const st_holes_guard guard = {c->bvh, c->E->kept};
+    rc = st_holes_planes_cap(cone, &coned, l->pts, l->side, n, below, &guard, &cb, err);
+    if (!rc)
+        rc = st_holes_planes_fans(fans, &fanned, l->pts, l->side, n, below,
+                                  c->bend ? least_bend : fill_area, &guard, &fb, err);
+    if (!rc && (coned || fanned))
+        rc = st_soup_append(c->out, fanned && (!coned || fb < cb) ? fans : cone, err);
+    *rebuilt = !rc && (coned || fanned);
+done:
+    st_soup_free(cone);
+    st_soup_free(fans);
+    return rc;
+}
+
+/* 4. The cap of the closed loop from e0 in c->l: by least area, kept if
+ * small beside the surface around it (or a flat hole); then with planes
+ * rebuilt from the planes along it, else with bend spanned by the least
+ * bend. Appended to c->out; counted in c->st. */
+static st_status cap_loop(capper *c, size_t e0, st_error *err)
+{
+    const st_holes_params *p = c->p;
+    loop *l = &c->l;
+    const size_t n = l->n;
+    if (n < 3)
+        return ST_OK;
+    if (n > p->max_loop) {
+        c->st.too_long++;
+        return ST_OK;
+    }
+    loop_points(c, 0);
+    double cap, bent;
+    st_status rc = least_area(&cap, l->pts, n, l->tri, err);
+    if (rc)
+        return rc;
+    const double around = around_loop(c, e0);
+    if (!(cap > 0.0) || (cap > p->max_cap_ratio * around &&
+                         !flat_hole(c->s, l->pts, n, c->r.t, l->e, p->flat))) {
+        c->st.too_large++;
+        return ST_OK;
+    }
+    if (c->bend || c->planes)
+        loop_points(c, 1);
+    if (c->bend && (rc = least_bend(&bent, l->pts, l->side, n, l->tri, err)))
+        return rc;
+    int rebuilt = 0;
+    if (c->planes && (rc = cap_planes(c, &rebuilt, err)))
+        return rc;
+    if (rebuilt) {
+        c->st.filled++;
+        c->st.rebuilt++;
+        return ST_OK;
+    }
+    const size_t base = c->out->nverts;
+    for (size_t i = 0; i < n; i++)
+        if ((rc = st_soup_add_vertex(c->out, l->pts[i][0], l->pts[i][1], l->pts[i][2], err)))
+            return rc;
+    for (size_t i = 0; i + 2 < n; i++)
+        if ((rc = st_soup_add_triangle(c->out, (uint32_t)(base + l->tri[3 * i]),
+                                       (uint32_t)(base + l->tri[3 * i + 1]),
+                                       (uint32_t)(base + l->tri[3 * i + 2]), err)))
+            return rc;
+    c->st.filled++;
+    return ST_OK;
 }
 
 st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
@@ -629,8 +1012,6 @@ st_status st_soup_hole_caps_shared(st_soup **caps, const st_soup *s,
                                    const st_holes_params *p, st_holes_stats *stats,
                                    st_error *err)
 {
-    st_holes_stats st0;
-    memset(&st0, 0, sizeof st0);
     *caps = NULL;
     if (s->ntris > (size_t)INT32_MAX)
         return st_error_set(err, ST_ELIMIT, NULL, 0,
@@ -638,349 +1019,60 @@ st_status st_soup_hole_caps_shared(st_soup **caps, const st_soup *s,
     if (p->max_loop > 4096 || !(p->max_cap_ratio >= 0))
         return st_error_set(err, ST_EINPUT, NULL, 0,
                             "hole filling: loops of at most 4096 edges, a cap ratio >= 0");
-    const size_t nt = s->ntris;
-    st_status rc = ST_ENOMEM;
+    /* 1. the edges and pieces (the caller's, else built here) */
     st_soup_edges own_edges;
-    const st_soup_edges *Ep = edges;
-    if (!Ep) {
-        if ((rc = st_soup_edges_build(&own_edges, s, err)))
-            return rc;
-        Ep = &own_edges;
-    }
-    rc = ST_ENOMEM;
-    const uint32_t *weld = Ep->weld, *piece = Ep->piece;
-    const uint8_t *kept = Ep->kept;
-    const st_half_edge *he = Ep->he;
-    const size_t nh = Ep->nhalf, nw = Ep->nweld;
-    st_soup *out = st_soup_new();
-    double *piece_area = st_calloc_array(nt ? nt : 1, sizeof *piece_area);
-    uint32_t *stamp = NULL, *be_a = NULL, *be_b = NULL, *be_t = NULL,
-             *loop_v = NULL, *loop_e = NULL, *tri = NULL;
-    uint8_t *used = NULL;
-    uint32_t *pa = NULL, *pb = NULL, *bdeg = NULL, *vstart = NULL, *vlist = NULL,
-             *tstart = NULL, *tlist = NULL, *wpos = NULL;
-    const double **pts = NULL, **side = NULL;
+    st_status rc = edges ? ST_OK : st_soup_edges_build(&own_edges, s, err);
+    if (rc)
+        return rc;
+    capper c;
+    memset(&c, 0, sizeof c);
+    c.s = s;
+    c.E = edges ? edges : &own_edges;
+    c.bvh = shared_bvh;
+    c.p = p;
     st_bvh *own_bvh = NULL;
-    const st_bvh *bvh = shared_bvh;
-    if (!out || !piece_area)
+    int intact = 0;
+    if (!(c.out = st_soup_new())) {
+        rc = oom(err);
         goto done;
-    if (!bvh && (rc = st_bvh_build(&own_bvh, s, err)))
-        goto fail;
-    bvh = bvh ? bvh : own_bvh;
-    rc = ST_ENOMEM;
-
-    /* the pieces' areas and the boundary edges */
-    double total = 0.0;
-    for (size_t t = 0; t < nt; t++)
-        if (kept[t]) {
-            const uint32_t *v = s->tris + 3 * t;
-            const double a = tri_area(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
-                                      s->xyz + 3 * (size_t)v[2]);
-            piece_area[piece[t]] += a;
-            total += a;
-        }
-    size_t nb = 0;
-    for (size_t i = 0, j; i < nh; i = j) {
-        for (j = i + 1; j < nh && he[j].key == he[i].key; j++)
-            ;
-        nb += j - i == 1;
     }
-    st0.boundary_edges = nb;
-    be_a = st_malloc_array(nb ? nb : 1, sizeof *be_a);
-    be_b = st_malloc_array(nb ? nb : 1, sizeof *be_b);
-    be_t = st_malloc_array(nb ? nb : 1, sizeof *be_t);
-    used = st_calloc_array(nb ? nb : 1, 1);
-    stamp = st_malloc_array(nt ? nt : 1, sizeof *stamp);
-    loop_v = st_malloc_array(nb + 1, sizeof *loop_v);
-    loop_e = st_malloc_array(nb + 1, sizeof *loop_e);
-    tri = st_malloc_array(3 * (p->max_loop + 1), sizeof *tri);
-    pts = st_malloc_array(p->max_loop + 1, sizeof *pts);
-    side = st_malloc_array(p->max_loop + 1, sizeof *side);
-    pa = st_malloc_array(nb ? nb : 1, sizeof *pa);
-    pb = st_malloc_array(nb ? nb : 1, sizeof *pb);
-    bdeg = st_calloc_array((size_t)nw + 1, sizeof *bdeg);
-    vstart = st_calloc_array((size_t)nw + 2, sizeof *vstart);
-    vlist = st_malloc_array(2 * nb + 1, sizeof *vlist);
-    tstart = st_calloc_array((size_t)nw + 2, sizeof *tstart);
-    wpos = st_malloc_array((size_t)nw + 1, sizeof *wpos);
-    if (!be_a || !be_b || !be_t || !used || !stamp || !loop_v || !loop_e || !tri || !pts || !side ||
-        !pa || !pb || !bdeg || !vstart || !vlist || !tstart || !wpos)
+    if (!c.bvh && (rc = st_bvh_build(&own_bvh, s, err)))
         goto done;
-    for (size_t t = 0; t < nt; t++)
-        stamp[t] = NONE;
-    size_t e = 0;
-    for (size_t i = 0, j; i < nh; i = j) {
-        for (j = i + 1; j < nh && he[j].key == he[i].key; j++)
-            ;
-        if (j - i != 1)
+    c.bvh = c.bvh ? c.bvh : own_bvh;
+    /* 2, 3. the rim, its pairs and loops; 4. their caps */
+    if ((rc = rim_build(&c.r, s, c.E, err)) || (rc = loop_alloc(&c.l, c.r.nb, p->max_loop, err)))
+        goto done;
+    c.st.boundary_edges = c.r.nb;
+    if ((rc = rim_intact(&intact, &c.r, s, c.E, p, &c.st, err)))
+        goto done;
+    c.bend = p->bend && intact;
+    c.planes = p->planes && intact;
+    c.st.continued = c.bend || c.planes;
+    if ((rc = rim_pair(&c.r, s, c.E, err)))
+        goto done;
+    for (size_t e0 = 0; e0 < c.r.nb; e0++) {
+        if (c.r.used[e0])
             continue;
-        const uint32_t a = (uint32_t)(he[i].key >> 32), b = (uint32_t)he[i].key;
-        be_a[e] = a;
-        be_b[e] = b;
-        be_t[e] = he[i].t;
-        pa[e] = pb[e] = NONE;
-        bdeg[a]++;
-        bdeg[b]++;
-        e++;
-    }
-    /* The boundary edges at each vertex, and a position for each welded
-     * vertex (the first soup vertex welded to it). */
-    for (size_t v = 0; v < (size_t)nw; v++)
-        vstart[v + 1] = vstart[v] + bdeg[v];
-    for (size_t v = 0; v < (size_t)nw; v++)
-        bdeg[v] = 0;
-    for (size_t i = 0; i < nb; i++) {
-        vlist[vstart[be_a[i]] + bdeg[be_a[i]]++] = (uint32_t)i;
-        vlist[vstart[be_b[i]] + bdeg[be_b[i]]++] = (uint32_t)i;
-    }
-    for (size_t v = s->nverts; v-- > 0;)
-        if (weld[v] != ST_WELD_NONE)
-            wpos[weld[v]] = (uint32_t)v;
-    /* The kept triangles at each vertex where holes touch. */
-    for (size_t t = 0; t < nt; t++)
-        if (kept[t])
-            for (int c = 0; c < 3; c++) {
-                const uint32_t w = weld[s->tris[3 * t + c]];
-                if (bdeg[w] > 2)
-                    tstart[w + 1]++;
-            }
-    for (size_t v = 0; v < (size_t)nw; v++)
-        tstart[v + 1] += tstart[v];
-    tlist = st_malloc_array(tstart[nw] + 1, sizeof *tlist);
-    if (!tlist)
-        goto done;
-    size_t *tfill = st_calloc_array((size_t)nw + 1, sizeof *tfill);
-    if (!tfill)
-        goto done;
-    for (size_t t = 0; t < nt; t++)
-        if (kept[t])
-            for (int c = 0; c < 3; c++) {
-                const uint32_t w = weld[s->tris[3 * t + c]];
-                if (vstart[w + 1] - vstart[w] > 2)
-                    tlist[tstart[w] + tfill[w]++] = (uint32_t)t;
-            }
-    free(tfill);
-    /* The rim: the kept triangles on a boundary edge. Where it is more
-     * than p->intact of the soup's area (faces deleted at random: most of
-     * what is left touches a hole), the fragments' planes and bends say
-     * little about the lost surface, and every cap is the least-area one. */
-    double rim = 0.0;
-    for (size_t i = 0; i < nb; i++) {
-        const uint32_t t = be_t[i];
-        if (stamp[t] == NONE) {
-            const uint32_t *v = s->tris + 3 * (size_t)t;
-            rim += tri_area(s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
-                            s->xyz + 3 * (size_t)v[2]);
-            stamp[t] = 0;
+        if (!trace_loop(&c.r, e0, &c.l)) {
+            c.st.pinched += c.l.n;
+            continue;
         }
-    }
-    for (size_t i = 0; i < nb; i++)
-        stamp[be_t[i]] = NONE;
-    st0.rim_share = total > 0.0 ? rim / total : 0.0;
-    /* A scan seen from one side along an axis: its loops are the horizon
-     * where it turned away, not lost faces of a part (the bent caps would
-     * continue its walls past the far side): the least-area caps. */
-    int intact = rim <= p->intact * total;
-    st0.one_sided = -1.0;
-    if (intact && (p->bend || p->planes) && p->onesided > 0.0) {
-        st0.one_sided = axis_one_sided(s, Ep);
-        if (st0.one_sided < 0.0)
+        c.st.loops++;
+        if ((rc = cap_loop(&c, e0, err)))
             goto done;
-        intact = st0.one_sided >= p->onesided;
     }
-    const int bend = p->bend && intact, planes = p->planes && intact;
-    st0.continued = bend || planes;
-    /* Pair the boundary edges at every vertex: the two of a vertex with
-     * two; where holes touch, by the angular gaps between the triangles
-     * around it (pair_by_angle), or on a crease by their hole sides
-     * (pair_by_sides). */
-    for (size_t v = 0; v < (size_t)nw; v++) {
-        const size_t k = vstart[v + 1] - vstart[v];
-        const uint32_t *ev = vlist + vstart[v];
-        if (k == 2) {
-            set_partner(be_a, pa, pb, ev[0], (uint32_t)v, ev[1]);
-            set_partner(be_a, pa, pb, ev[1], (uint32_t)v, ev[0]);
-        } else if (k > 2 && !(k & 1)) {
-            int r = pair_by_angle(s, weld, wpos, be_a, be_b, pa, pb, (uint32_t)v, ev, k,
-                                  tlist + tstart[v], tstart[v + 1] - tstart[v], be_t);
-            if (r < 0)
-                goto done;
-        }
-    }
-    /* 3, 4. loops and caps */
-    for (size_t e0 = 0; e0 < nb; e0++) {
-        if (used[e0])
-            continue;
-        size_t n = 0;
-        int pinched = 0;
-        const uint32_t start = be_a[e0];
-        uint32_t v = be_b[e0], cur = (uint32_t)e0;
-        used[e0] = 1;
-        loop_v[n] = start;
-        loop_e[n++] = cur;
-        for (;;) {
-            const uint32_t next = be_a[cur] == v ? pa[cur] : pb[cur];
-            if (next == NONE) {     /* an odd vertex, or one not paired */
-                pinched = 1;
-                break;
-            }
-            if (next == e0 && v == start)
-                break;
-            if (used[next] || n > nb) {
-                pinched = 1;
-                break;
-            }
-            used[next] = 1;
-            loop_v[n] = v;
-            loop_e[n++] = next;
-            cur = next;
-            v = be_a[cur] == v ? be_b[cur] : be_a[cur];
-        }
-        if (pinched) {
-            st0.pinched += n;
-            continue;
-        }
-        st0.loops++;
-        if (n < 3)
-            continue;
-        if (n > p->max_loop) {
-            st0.too_long++;
-            continue;
-        }
-        /* The loop's positions: a vertex of the soup welded to each. */
-        for (size_t i = 0; i < n; i++) {
-            const uint32_t *tv = s->tris + 3 * (size_t)be_t[loop_e[i]];
-            const double *q = NULL;
-            for (int c = 0; c < 3; c++)
-                if (weld[tv[c]] == loop_v[i])
-                    q = s->xyz + 3 * (size_t)tv[c];
-            pts[i] = q;
-        }
-        const double cap = least_area(pts, n, tri);
-        if (cap < 0) {
-            rc = ST_ENOMEM;
-            goto done;
-        }
-        /* The surface around the loop: the pieces with a triangle whose box
-         * meets the loop's box grown by a quarter of its extent each way
-         * (the loop's own pieces among them). */
-        double blo[3], bhi[3], ext = 0.0;
-        for (int q = 0; q < 3; q++)
-            blo[q] = bhi[q] = pts[0][q];
-        for (size_t i = 1; i < n; i++)
-            for (int q = 0; q < 3; q++) {
-                blo[q] = fmin(blo[q], pts[i][q]);
-                bhi[q] = fmax(bhi[q], pts[i][q]);
-            }
-        for (int q = 0; q < 3; q++)
-            ext = fmax(ext, bhi[q] - blo[q]);
-        for (int q = 0; q < 3; q++) {
-            blo[q] -= 0.25 * ext;
-            bhi[q] += 0.25 * ext;
-        }
-        around_ctx ac = {kept, piece, stamp, (uint32_t)e0, piece_area, 0.0};
-        st_bvh_query_box(bvh, blo, bhi, add_piece, &ac);
-        const double around = ac.around;
-        if (!(cap > 0.0) || (cap > p->max_cap_ratio * around &&
-                             !flat_hole(s, pts, n, be_t, loop_e, p->flat))) {
-            st0.too_large++;
-            continue;
-        }
-        /* Accepted by its least area; with planes rebuilt from the
-         * planes along it, else with bend spanned by the least bend,
-         * the soup's triangle on each loop edge beside it. */
-        if (bend || planes)
-            for (size_t i = 0; i < n; i++) {
-                const uint32_t *tv = s->tris + 3 * (size_t)be_t[loop_e[i]];
-                const uint32_t a = loop_v[i], b = loop_v[(i + 1) % n];
-                side[i] = pts[i];   /* (a kept triangle has a third point) */
-                for (int c = 0; c < 3; c++)
-                    if (weld[tv[c]] != a && weld[tv[c]] != b)
-                        side[i] = s->xyz + 3 * (size_t)tv[c];
-            }
-        if (bend && least_bend(pts, side, n, tri) < 0) {
-            rc = ST_ENOMEM;
-            goto done;
-        }
-        if (planes) {
-            /* the cone from a rebuilt corner when it continues the faces
-             * along the loop clearly better than the cap of the loop's own
-             * points (a flat hole's cap continues them exactly) */
-            int coned = 0;
-            const double below = CONE_BETTER * rim_bend(pts, side, n, tri);
-            /* the cone from one corner, with planes 2 the fans from
-             * several too: whichever continues the faces better */
-            double cb, fb = INFINITY;
-            int fanned = 0;
-            st_soup *cone = st_soup_new(), *fans = planes ? st_soup_new() : NULL;
-            if (!cone || (planes && !fans)) {
-                st_soup_free(cone);
-                st_soup_free(fans);
-                rc = ST_ENOMEM;
-                goto done;
-            }
-            const st_holes_guard guard = {bvh, kept};
-            rc = st_holes_planes_cap(cone, &coned, pts, side, n, below, &guard, &cb, err);
-            if (!rc && fans)
-                rc = st_holes_planes_fans(fans, &fanned, pts, side, n, below,
-                                          bend ? fill_bend : fill_area, &guard, &fb, err);
-            if (!rc && (coned || fanned))
-                rc = st_soup_append(out, fanned && (!coned || fb < cb) ? fans : cone, err);
-            coned |= fanned;
-            st_soup_free(cone);
-            st_soup_free(fans);
-            if (rc)
-                goto fail;
-            if (coned) {
-                st0.filled++;
-                st0.rebuilt++;
-                continue;
-            }
-        }
-        const size_t base = out->nverts;
-        for (size_t i = 0; i < n; i++)
-            if ((rc = st_soup_add_vertex(out, pts[i][0], pts[i][1], pts[i][2], err)))
-                goto fail;
-        for (size_t i = 0; i + 2 < n; i++)
-            if ((rc = st_soup_add_triangle(out, (uint32_t)(base + tri[3 * i]),
-                                           (uint32_t)(base + tri[3 * i + 1]),
-                                           (uint32_t)(base + tri[3 * i + 2]), err)))
-                goto fail;
-        st0.filled++;
-    }
-    rc = ST_OK;
 done:
-    if (rc == ST_ENOMEM)
-        st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
-fail:
     if (!edges)
         st_soup_edges_free(&own_edges);
     st_bvh_free(own_bvh);
-    free(piece_area);
-    free(stamp);
-    free(be_a);
-    free(be_b);
-    free(be_t);
-    free(pa);
-    free(pb);
-    free(bdeg);
-    free(vstart);
-    free(vlist);
-    free(tstart);
-    free(tlist);
-    free(wpos);
-    free(used);
-    free(loop_v);
-    free(loop_e);
-    free(tri);
-    free(pts);
-    free(side);
+    rim_free(&c.r);
+    loop_free(&c.l);
     if (rc) {
-        st_soup_free(out);
+        st_soup_free(c.out);
         return rc;
     }
     if (stats)
-        *stats = st0;
-    *caps = out;
+        *stats = c.st;
+    *caps = c.out;
     return ST_OK;
 }

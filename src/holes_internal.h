@@ -68,9 +68,10 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
                               const st_holes_guard *guard, double *bent, st_error *err);
 
 /* A triangulation of the loop pts[0..n) (side as above): fills
- * tri[3 (n - 2)] with local indices; < 0 when out of memory. */
-typedef double (*st_holes_fill)(const double *const *pts, const double *const *side, size_t n,
-                                uint32_t *tri);
+ * tri[3 (n - 2)] with local indices and *area with its area. ST_ENOMEM. */
+typedef st_status (*st_holes_fill)(double *area, const double *const *pts,
+                                   const double *const *side, size_t n, uint32_t *tri,
+                                   st_error *err);
 
 /* The cap of the loop from several rebuilt corners: the point where planes
  * along the loop meet that continues most of its length, fans from it over

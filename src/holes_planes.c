@@ -1,6 +1,7 @@
 /*
  * holes_planes.c - a hole's cap from a corner rebuilt from the planes
  * around it (holes_internal.h; issue 17, the large holes of CAD parts).
+ * Design notes and measurements: doc/design/holes.md.
  *
  * A CAD part's large hole takes whole faces and the corners where they
  * met: a cap over the loop's own points cannot bring a lost corner back.
@@ -38,26 +39,9 @@
  * the point more than once) is capped the same way, and one that no
  * point continues along two edges by the caller's triangulation of its
  * own points. The caller keeps the fans or the single cone, whichever
- * continues the soup along the loop better. (That last triangulation is
- * not tested for piercing: with it, a rebuilt cap that pierces falls
- * back whole, and the corpus's large holes lose, core IoU at 128^3,
- * 0.838 -> 0.808 with planes, 0.875 -> 0.850 with planes-bend, joint
- * 0.751 -> 0.587, for deleted faces' 0.9945 -> 0.9958, cheese 0.971 ->
- * 0.980.)
- *
- * The piercing test (issue 17, core IoU at 128^3, planes, class means,
- * before -> after): deleted50 0.9903 -> 0.9945 (cheese 0.925 -> 0.971),
- * holes 0.9825 -> 0.9837, onesided 0.8389 -> 0.8461, largeholes 0.8414
- * -> 0.8381 (rotor 0.936 -> 0.886, pinion 0.770 -> 0.794); planes-bend
- * within 0.001 of before. It costs soupsign 1.4 times the user time with
- * planes on the armadillo's deleted faces at 256^3 (4.4 s -> 6.2 s; the
- * least-area caps 1.9 s). Not kept: apexes made of the soup's planes
- * only, each set of planes once per loop (a fan's plane taken as that of
- * the edge it continues; it stops a small loop taking up to 16 apexes a
- * rounding apart, each from the line of two planes nearest the loop's
- * moving centroid): rotor 0.886 -> 0.931, but fandisk 0.970 -> 0.944,
- * joint 0.751 -> 0.738, cheese deleted50 0.971 -> 0.959 (0.963 -> 0.938
- * with planes-bend), man onesided 0.775 -> 0.679.
+ * continues the soup along the loop better. That last triangulation is
+ * not tested for piercing, and the piercing test's cost and the variants
+ * not kept are measured in doc/design/holes.md.
  */
 #include "holes_internal.h"
 #include "fpenv.h"
@@ -71,13 +55,8 @@
 
 /* Apexes within the loop's box grown by REACH times its extent each way:
  * a lost corner lies near the loop's box (a box's lost corner at a corner
- * of it), a point where nearly parallel planes meet far beyond. Not kept:
- * that box cut to the kept soup's box (a lost corner lies within the
- * part's surviving extent). It removes the spike that pinion's large
- * holes send out a gear's length past its teeth, but the apexes the
- * loops take next are worse elsewhere (core IoU at 128^3, planes-bend:
- * pinion 0.803 -> 0.830, rotor 0.950 -> 0.879, joint 0.803 -> 0.782; the
- * soup's box grown by a tenth of its extent: rotor 0.950, joint 0.659). */
+ * of it), a point where nearly parallel planes meet far beyond (other
+ * boxes tried: doc/design/holes.md, "REACH"). */
 #define REACH 0.75
 /* Planes whose offsets and normals differ by less than SAME (relative to
  * the loop's extent) are one face's (its triangles' rounding). */
@@ -90,6 +69,12 @@
  * each cone measured over the loop): a curved face along the loop has a
  * plane on each edge; the planes along most of the loop are kept. */
 #define MAX_PLANES 24
+
+/* "out of memory" where the holes' scratch is allocated. */
+static st_status oom(st_error *err)
+{
+    return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
+}
 
 typedef struct plane {
     double n[3], d;     /* unit normal, n . x = d */
@@ -287,7 +272,7 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
     cand *cs = malloc(MAX_CAND * sizeof *cs);
     st_status rc = ST_OK;
     if (!rim || !tn || !pl || !cs) {
-        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
+        rc = oom(err);
         goto out;
     }
     double lo[3], hi[3], o[3], ext;
@@ -356,9 +341,7 @@ typedef struct fan_v {
 } fan_v;
 
 /* Which of the loop's edges apex continues (FAN_FLAT): flag[n]. Returns
- * their length. (Fanning only the longest run of them, when it spans two
- * planes: core IoU on the corpus's largeholes 0.842 -> 0.824, rotor
- * 0.936 -> 0.851; only the runs that span two planes: 0.828.) */
+ * their length. (All of them are fanned: doc/design/holes.md.) */
 static double fan_flags(const double *apex, const fan_v *v, const double *rim, size_t n,
                         int *flag)
 {
@@ -396,25 +379,262 @@ typedef struct fan_out {
     size_t nt, cap;
 } fan_out;
 
-static int fan_push(fan_out *o, const double *a, const double *b, const double *c, long oa,
-                    long ob, long oc)
+static st_status fan_push(fan_out *o, const double *a, const double *b, const double *c, long oa,
+                          long ob, long oc, st_error *err)
 {
     if (o->nt == o->cap) {
         size_t nc = o->cap ? 2 * o->cap : 64;
         const double **t = realloc(o->tri, 3 * nc * sizeof *t);
         if (!t)
-            return -1;
+            return oom(err);
         o->tri = t;
         long *g = realloc(o->orig, 3 * nc * sizeof *g);
         if (!g)
-            return -1;
+            return oom(err);
         o->orig = g;
         o->cap = nc;
     }
     o->tri[3 * o->nt] = a, o->tri[3 * o->nt + 1] = b, o->tri[3 * o->nt + 2] = c;
     o->orig[3 * o->nt] = oa, o->orig[3 * o->nt + 1] = ob, o->orig[3 * o->nt + 2] = oc;
     o->nt++;
-    return 0;
+    return ST_OK;
+}
+
+/* The fans of one loop being built: the loops still to cap, one after
+ * another in stk (each led by its length in lens), the one being capped
+ * (cur, m vertices; lp, ls its points and sides), its planes and apexes,
+ * and the triangles so far (fo). */
+typedef struct fanner {
+    size_t maxv, nloops, napex, top;
+    fan_v *stk, *cur, *nxt;
+    size_t *lens;
+    double *rim;
+    plane *pl;
+    const double **lp, **ls;
+    uint32_t *tri;
+    double (*apx)[3];
+    int *flag;
+    cand *cs;
+    fan_out fo;
+    double lo[3], hi[3], ext;   /* the original loop's reach box, extent */
+    const st_holes_guard *guard;
+} fanner;
+
+static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
+{
+    const size_t maxv = f->maxv = n + 2 * MAX_APEX + 2;
+    f->stk = malloc(2 * maxv * (MAX_APEX + 2) * sizeof *f->stk);
+    f->cur = malloc(maxv * sizeof *f->cur);
+    f->nxt = malloc(2 * maxv * sizeof *f->nxt);
+    f->lens = malloc(maxv * sizeof *f->lens);
+    f->rim = malloc(3 * maxv * sizeof *f->rim);
+    f->pl = malloc(maxv * sizeof *f->pl);
+    f->lp = malloc(maxv * sizeof *f->lp);
+    f->ls = malloc(maxv * sizeof *f->ls);
+    f->tri = malloc(3 * maxv * sizeof *f->tri);
+    f->apx = malloc(MAX_APEX * sizeof *f->apx);
+    f->flag = malloc(maxv * sizeof *f->flag);
+    f->cs = malloc(MAX_CAND * sizeof *f->cs);
+    if (!f->flag || !f->stk || !f->cur || !f->nxt || !f->lens || !f->rim || !f->pl || !f->lp ||
+        !f->ls || !f->tri || !f->apx || !f->cs)
+        return oom(err);
+    return ST_OK;
+}
+
+static void fanner_free(fanner *f)
+{
+    free(f->stk), free(f->cur), free(f->nxt), free(f->lens), free(f->rim), free(f->pl);
+    free(f->lp), free(f->ls), free(f->tri), free(f->apx), free(f->fo.tri), free(f->fo.orig);
+    free(f->flag), free(f->cs);
+}
+
+/* The apex for the loop in f->cur (m vertices, centroid o): by the length
+ * of the loop they continue, the most first, each without the edges
+ * whose fans pierce the soup, until none left could continue more. Its
+ * point in ax and its continued edges in f->flag; returns how many. */
+static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
+{
+    const size_t np = loop_planes(f->pl, f->rim, (const double *const *)f->lp,
+                                  (const double *const *)f->ls, m, f->ext);
+    size_t nc = 0;
+    if (f->napex < MAX_APEX)
+        for (size_t a = 0; a < np; a++)
+            for (size_t b = a + 1; b < np; b++)
+                for (size_t c = b; c < np; c++) {
+                    cand *k = f->cs + nc;
+                    if (!candidate(k->x, f->pl, a, b, c, o, f->lo, f->hi))
+                        continue;
+                    const double g = fan_flags(k->x, f->cur, f->rim, m, f->flag);
+                    if (!(g > 0.0))
+                        continue;
+                    k->key = -g, k->tie = (double)nc, k->done = 0;
+                    nc++;
+                }
+    double best = 0.0;
+    for (cand *k; (k = least_cand(f->cs, nc)) != NULL && -k->key > best; k->done = 1) {
+        fan_flags(k->x, f->cur, f->rim, m, f->flag);
+        const double g = fans_uncross(f->guard, k->x, f->cur, m, f->flag);
+        if (g > best) {
+            best = g;
+            memcpy(ax, k->x, 3 * sizeof *ax);
+        }
+    }
+    size_t ncont = 0;
+    if (best > 0.0) {
+        fan_flags(ax, f->cur, f->rim, m, f->flag);
+        fans_uncross(f->guard, ax, f->cur, m, f->flag);
+        for (size_t i = 0; i < m; i++)
+            ncont += (size_t)f->flag[i];
+    }
+    return ncont;
+}
+
+/* The loop in f->cur (m vertices) by fill, the triangulation of its own
+ * points. */
+static st_status fill_loop(fanner *f, size_t m, st_holes_fill fill, st_error *err)
+{
+    double area;
+    st_status rc = fill(&area, (const double *const *)f->lp, (const double *const *)f->ls, m,
+                        f->tri, err);
+    for (size_t t = 0; !rc && t + 2 < m; t++) {
+        const uint32_t *c = f->tri + 3 * t;
+        long og[3];
+        for (int e = 0; e < 3; e++) {
+            const size_t u = c[e], w = c[(e + 1) % 3];
+            og[e] = (u + 1) % m == w ? f->cur[u].orig : (w + 1) % m == u ? f->cur[w].orig : -1;
+        }
+        rc = fan_push(&f->fo, f->lp[c[0]], f->lp[c[1]], f->lp[c[2]], og[0], og[1], og[2], err);
+    }
+    return rc;
+}
+
+/* The fans from apex A over the flagged edges of f->cur (m vertices),
+ * and in f->nxt (*k vertices) the loop with each run of them replaced by
+ * A, started at an edge A does not continue; *s0 == m when A continues
+ * them all (a cone over the whole loop). */
+static st_status fan_apex(fanner *f, size_t m, const double *A, size_t *k, size_t *s0,
+                          st_error *err)
+{
+    const int *flag = f->flag;
+    fan_v *nxt = f->nxt;
+    size_t s = 0;
+    while (s < m && flag[s])
+        s++;
+    *s0 = s;
+    *k = 0;
+    for (size_t r = 0; r < m; r++) {
+        const size_t i = (s + r) % m;
+        const fan_v *vi = f->cur + i, *vj = f->cur + (i + 1) % m;
+        if (!flag[i]) {
+            nxt[(*k)++] = *vi;
+            continue;
+        }
+        const st_status rc = fan_push(&f->fo, vi->p, vj->p, A, vi->orig, -1, -1, err);
+        if (rc)
+            return rc;
+        const int first = r == 0 || !flag[(i + m - 1) % m];
+        const int last = r + 1 == m || !flag[(i + 1) % m];
+        if (first && s < m) {      /* vi stays, its edge now to the apex */
+            nxt[*k].p = vi->p;
+            nxt[*k].side = vj->p;
+            nxt[*k].orig = -1;
+            (*k)++;
+        }
+        if (last) {
+            nxt[*k].p = A;
+            nxt[*k].side = vi->p;
+            nxt[*k].orig = -1;
+            (*k)++;
+        }
+    }
+    return ST_OK;
+}
+
+/* Pushes the loop in f->nxt (k vertices) onto the stack, split where it
+ * meets apex A more than once: rotated to start at A, cut before each
+ * later occurrence of it. 0 when the stack is full (never on a loop of
+ * this size). */
+static int push_split(fanner *f, size_t k, const double *A)
+{
+    fan_v *nxt = f->nxt;
+    size_t firstA = 0;
+    while (nxt[firstA].p != A)
+        firstA++;
+    for (size_t i = 0; i < k; i++)
+        nxt[k + i] = nxt[(firstA + i) % k];
+    size_t st = k;
+    for (size_t i = k + 1; i <= 2 * k; i++)
+        if (i == 2 * k || nxt[i].p == A) {
+            const size_t len = i - st;
+            if (len >= 3) {
+                if (f->nloops == f->maxv || f->top + len > 2 * f->maxv * (MAX_APEX + 2))
+                    return 0;
+                memcpy(f->stk + f->top, nxt + st, len * sizeof *f->stk);
+                f->top += len;
+                f->lens[f->nloops++] = len;
+            }
+            st = i;
+        }
+    return 1;
+}
+
+/* The caps' bend along the original loop pts[0..n). */
+static double fans_bend(const fan_out *fo, const double *const *pts, const double *const *side,
+                        size_t n)
+{
+    double rb = 0.0;
+    for (size_t t = 0; t < fo->nt; t++) {
+        double nt[3], nr[3];
+        const double **c = fo->tri + 3 * t;
+        unit_normal(nt, c[0], c[1], c[2]);
+        for (int e = 0; e < 3; e++) {
+            const long i = fo->orig[3 * t + e];
+            if (i < 0)
+                continue;
+            unit_normal(nr, pts[i], side[i], pts[((size_t)i + 1) % n]);
+            rb += dist3(pts[i], pts[((size_t)i + 1) % n]) * bend(nt, nr);
+        }
+    }
+    return rb;
+}
+
+/* Caps the loops on f's stack, from the original loop pts[0..n) down:
+ * each by the fans from its best apex, the loop left pushed back, or by
+ * fill when no apex continues two of its edges. *whole 0 when the stack
+ * overflowed (the fans are then not used). */
+static st_status fan_loops(fanner *f, int *whole, st_holes_fill fill, st_error *err)
+{
+    st_status rc = ST_OK;
+    *whole = 1;
+    while (f->nloops && !rc) {
+        /* pop the last loop */
+        const size_t m = f->lens[--f->nloops];
+        f->top -= m;
+        memcpy(f->cur, f->stk + f->top, m * sizeof *f->cur);
+        if (m < 3)
+            continue;
+        double o[3] = {0, 0, 0}, ax[3] = {0, 0, 0};
+        for (size_t i = 0; i < m; i++)
+            for (int k = 0; k < 3; k++)
+                o[k] += f->cur[i].p[k] / (double)m;
+        for (size_t i = 0; i < m; i++) {
+            f->lp[i] = f->cur[i].p;
+            f->ls[i] = f->cur[i].side;
+        }
+        if (best_apex(f, m, o, ax) < 2) {
+            rc = fill_loop(f, m, fill, err);
+            continue;
+        }
+        memcpy(f->apx[f->napex], ax, sizeof ax);
+        const double *A = f->apx[f->napex++];
+        size_t k, s0;
+        rc = fan_apex(f, m, A, &k, &s0, err);
+        if (!rc && s0 < m && !push_split(f, k, A)) {
+            *whole = 0;
+            break;
+        }
+    }
+    return rc;
 }
 
 st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts,
@@ -424,191 +644,42 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
 {
     *done = 0;
     *bent = INFINITY;
-    const size_t maxv = n + 2 * MAX_APEX + 2;
-    /* the loops still to cap, one after another in stk (each led by its
-     * length), and the scratch of one */
-    fan_v *stk = malloc(2 * maxv * (MAX_APEX + 2) * sizeof *stk), *cur = malloc(maxv * sizeof *cur),
-          *nxt = malloc(2 * maxv * sizeof *nxt);
-    size_t *lens = malloc(maxv * sizeof *lens);
-    double *rim = malloc(3 * maxv * sizeof *rim);
-    plane *pl = malloc(maxv * sizeof *pl);
-    const double **lp = malloc(maxv * sizeof *lp), **ls = malloc(maxv * sizeof *ls);
-    uint32_t *tri = malloc(3 * maxv * sizeof *tri);
-    double (*apx)[3] = malloc(MAX_APEX * sizeof *apx);
-    int *flag = malloc(maxv * sizeof *flag);
-    cand *cs = malloc(MAX_CAND * sizeof *cs);
-    fan_out fo = {NULL, NULL, 0, 0};
-    st_status rc = ST_OK;
-    if (!flag || !stk || !cur || !nxt || !lens || !rim || !pl || !lp || !ls || !tri || !apx || !cs)
-        goto oom;
-    double lo[3], hi[3], o0[3], ext;
-    reach_box(lo, hi, o0, &ext, pts, n);
-    size_t nloops = 1, napex = 0, top = 0;
+    fanner f;
+    memset(&f, 0, sizeof f);
+    f.guard = guard;
+    int whole = 0;
+    st_status rc = fanner_alloc(&f, n, err);
+    if (rc)
+        goto done;
+    double o0[3];
+    reach_box(f.lo, f.hi, o0, &f.ext, pts, n);
     for (size_t i = 0; i < n; i++) {
-        stk[i].p = pts[i];
-        stk[i].side = side[i];
-        stk[i].orig = (long)i;
+        f.stk[i].p = pts[i];
+        f.stk[i].side = side[i];
+        f.stk[i].orig = (long)i;
     }
-    lens[0] = n;
-    top = n;
-    while (nloops) {
-        /* pop the last loop */
-        const size_t m = lens[--nloops];
-        top -= m;
-        memcpy(cur, stk + top, m * sizeof *cur);
-        if (m < 3)
-            continue;
-        double o[3] = {0, 0, 0};
-        for (size_t i = 0; i < m; i++)
-            for (int k = 0; k < 3; k++)
-                o[k] += cur[i].p[k] / (double)m;
-        for (size_t i = 0; i < m; i++) {
-            lp[i] = cur[i].p;
-            ls[i] = cur[i].side;
-        }
-        const size_t np = loop_planes(pl, rim, (const double *const *)lp,
-                                      (const double *const *)ls, m, ext);
-        /* the apexes by the length of the loop they continue, the most
-         * first, each without the edges whose fans pierce the soup, until
-         * none left could continue more */
-        size_t nc = 0;
-        if (napex < MAX_APEX)
-            for (size_t a = 0; a < np; a++)
-                for (size_t b = a + 1; b < np; b++)
-                    for (size_t c = b; c < np; c++) {
-                        cand *k = cs + nc;
-                        if (!candidate(k->x, pl, a, b, c, o, lo, hi))
-                            continue;
-                        const double g = fan_flags(k->x, cur, rim, m, flag);
-                        if (!(g > 0.0))
-                            continue;
-                        k->key = -g, k->tie = (double)nc, k->done = 0;
-                        nc++;
-                    }
-        double best = 0.0, ax[3] = {0, 0, 0};
-        for (cand *k; (k = least_cand(cs, nc)) != NULL && -k->key > best; k->done = 1) {
-            fan_flags(k->x, cur, rim, m, flag);
-            const double g = fans_uncross(guard, k->x, cur, m, flag);
-            if (g > best) {
-                best = g;
-                memcpy(ax, k->x, sizeof ax);
-            }
-        }
-        /* which edges the apex continues */
-        size_t ncont = 0;
-        if (best > 0.0) {
-            fan_flags(ax, cur, rim, m, flag);
-            fans_uncross(guard, ax, cur, m, flag);
-            for (size_t i = 0; i < m; i++)
-                ncont += (size_t)flag[i];
-        }
-        if (ncont < 2) {
-            /* no apex: the loop's own triangulation */
-            if (fill((const double *const *)lp, (const double *const *)ls, m, tri) < 0)
-                goto oom;
-            for (size_t t = 0; t + 2 < m; t++) {
-                const uint32_t *c = tri + 3 * t;
-                long og[3];
-                for (int e = 0; e < 3; e++) {
-                    const size_t u = c[e], w = c[(e + 1) % 3];
-                    og[e] = (u + 1) % m == w ? cur[u].orig : (w + 1) % m == u ? cur[w].orig : -1;
-                }
-                if (fan_push(&fo, lp[c[0]], lp[c[1]], lp[c[2]], og[0], og[1], og[2]))
-                    goto oom;
-            }
-            continue;
-        }
-        memcpy(apx[napex], ax, sizeof ax);
-        const double *A = apx[napex++];
-        /* start at an edge the apex does not continue (all: the cone) */
-        size_t s0 = 0;
-        while (s0 < m && flag[s0])
-            s0++;
-        /* the fans, and the loop with each run of continued edges replaced
-         * by the apex */
-        size_t k = 0;
-        for (size_t r = 0; r < m; r++) {
-            const size_t i = (s0 + r) % m;
-            const fan_v *vi = cur + i, *vj = cur + (i + 1) % m;
-            if (!flag[i]) {
-                nxt[k++] = *vi;
-                continue;
-            }
-            if (fan_push(&fo, vi->p, vj->p, A, vi->orig, -1, -1))
-                goto oom;
-            const int first = r == 0 || !flag[(i + m - 1) % m];
-            const int last = r + 1 == m || !flag[(i + 1) % m];
-            if (first && s0 < m) {      /* vi stays, its edge now to the apex */
-                nxt[k].p = vi->p;
-                nxt[k].side = vj->p;
-                nxt[k].orig = -1;
-                k++;
-            }
-            if (last) {
-                nxt[k].p = A;
-                nxt[k].side = vi->p;
-                nxt[k].orig = -1;
-                k++;
-            }
-        }
-        if (s0 == m)
-            continue;           /* a cone over the whole loop */
-        /* split where the loop meets the apex more than once */
-        size_t firstA = 0;
-        while (nxt[firstA].p != A)
-            firstA++;
-        /* rotate so the loop starts at the apex, then cut before each
-         * later occurrence of it */
-        for (size_t i = 0; i < k; i++)
-            nxt[k + i] = nxt[(firstA + i) % k];
-        size_t st = k;
-        for (size_t i = k + 1; i <= 2 * k; i++)
-            if (i == 2 * k || nxt[i].p == A) {
-                const size_t len = i - st;
-                if (len >= 3) {
-                    if (nloops == maxv || top + len > 2 * maxv * (MAX_APEX + 2))
-                        goto out;   /* (never on a loop of this size) */
-                    memcpy(stk + top, nxt + st, len * sizeof *stk);
-                    top += len;
-                    lens[nloops++] = len;
-                }
-                st = i;
-            }
-    }
-    /* the caps' bend along the original loop */
-    double rb = 0.0;
-    for (size_t t = 0; t < fo.nt; t++) {
-        double nt[3], nr[3];
-        const double **c = fo.tri + 3 * t;
-        unit_normal(nt, c[0], c[1], c[2]);
-        for (int e = 0; e < 3; e++) {
-            const long i = fo.orig[3 * t + e];
-            if (i < 0)
-                continue;
-            unit_normal(nr, pts[i], side[i], pts[((size_t)i + 1) % n]);
-            rb += dist3(pts[i], pts[((size_t)i + 1) % n]) * bend(nt, nr);
-        }
-    }
-    if (napex == 0 || !(rb < below))
-        goto out;
-    for (size_t t = 0; t < fo.nt; t++) {
+    f.lens[0] = n;
+    f.top = n;
+    f.nloops = 1;
+    if ((rc = fan_loops(&f, &whole, fill, err)) || !whole)
+        goto done;
+    const double rb = fans_bend(&f.fo, pts, side, n);
+    if (f.napex == 0 || !(rb < below))
+        goto done;
+    for (size_t t = 0; t < f.fo.nt; t++) {
         const size_t base = out->nverts;
         for (int c = 0; c < 3; c++) {
-            const double *q = fo.tri[3 * t + c];
+            const double *q = f.fo.tri[3 * t + c];
             if ((rc = st_soup_add_vertex(out, q[0], q[1], q[2], err)))
-                goto out;
+                goto done;
         }
         if ((rc = st_soup_add_triangle(out, (uint32_t)base, (uint32_t)(base + 1),
                                        (uint32_t)(base + 2), err)))
-            goto out;
+            goto done;
     }
     *done = 1;
     *bent = rb;
-    goto out;
-oom:
-    rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
-out:
-    free(stk), free(cur), free(nxt), free(lens), free(rim), free(pl), free(lp), free(ls);
-    free(tri), free(apx), free(fo.tri), free(fo.orig), free(flag), free(cs);
+done:
+    fanner_free(&f);
     return rc;
 }

@@ -1,5 +1,6 @@
 /*
  * sides.c - the side of an oriented soup near each voxel (see sides.h).
+ * Design notes and measurements: doc/design/sides.md.
  */
 #include "fpenv.h"
 #include "souptet/sides.h"
@@ -25,11 +26,9 @@ st_sides_params st_sides_params_default(void)
      * two thirds of a hemisphere (w about 1/3); weight 24 turns that into
      * 8 votes of margin, below the 10 that decide a voxel alone
      * (mincut.h), so the votes and the cut's area still have a say. */
-    /* one-sided below 0.25: the corpus's one-sided scans read 0.00-0.16,
-     * its soups with holes and deleted faces 0.41 and up, closed ones 1 */
-    /* the column rule below 0.02 along an axis: the corpus's one-sided
-     * scans read 0.000-0.001 (their faces facing down were deleted), its
-     * other damaged soups 0.4 and up */
+    /* one-sided below 0.25 and the column rule below 0.02 along an axis:
+     * between what the corpus's one-sided scans and its other damaged
+     * soups read (doc/design/sides.md) */
     st_sides_params p = {2.5, 3.0, 24.0, 9, 0.25, 0, 1e-3, 0.25, 0, 0.02, 0, 1};
     return p;
 }
@@ -376,6 +375,18 @@ st_status st_sides_mirror(st_grid *g, const st_soup *soup, size_t seen_triangles
     return ST_OK;
 }
 
+/* The steps of st_sides_evidence_edges (defined after it). */
+static void region_scores(double *score, const st_grid *g, const uint8_t *votes,
+                          const st_soup *s, const st_soup_edges *E, const uint8_t *flip,
+                          const uint32_t *region);
+static st_status oriented_soup(st_soup *o, uint8_t *rim, size_t *nview, st_sides_stats *st,
+                               const st_soup *s, const st_soup_edges *E, const uint32_t *nbr,
+                               const uint8_t *flip, const uint32_t *region, const double *score,
+                               const st_sides_params *p, st_error *err);
+static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
+                               int decided, const st_bvh *bvh, const st_soup *o,
+                               const st_sides_params *p);
+
 st_status st_sides_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
                             int decided, const st_soup *s,
                             const st_sides_params *p, st_sides_stats *stats,
@@ -419,11 +430,42 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
     st->conflicts = st_soup_edges_orient(&E, s, nbr, same, flip, region, queue, NULL);
     for (size_t t = 0; t < nt; t++)
         st->regions += E.kept[t] && region[t] == t;
-
     /* 2. each region turned to the votes' reading */
+    region_scores(score, g, votes, s, &E, flip, region);
+    size_t nview = 0;
+    if ((rc = oriented_soup(o, rim, &nview, st, s, &E, nbr, flip, region, score, p, err)))
+        goto done;
+    if (o->ntris == 0)
+        goto done;
+    if ((rc = st_bvh_build(&bvh, o, err)))
+        goto done;
+    /* 3. the local winding number near the soup; 4. the view */
+    st->voxels = winding_evidence(evidence, g, votes, decided, bvh, o, p);
+    view_of(o, nview, rim, p, st);
+done:
+    st_bvh_free(bvh);
+    st_soup_free(o);
+    if (!edges)
+        st_soup_edges_free(&own);
+    free(nbr);
+    free(same);
+    free(flip);
+    free(rim);
+    free(region);
+    free(queue);
+    free(score);
+    return rc;
+}
+
+/* 2. Each region's score: the votes' reading of its triangles' sides
+ * (front outside, back inside: agrees), weighted by area. */
+static void region_scores(double *score, const st_grid *g, const uint8_t *votes,
+                          const st_soup *s, const st_soup_edges *E, const uint8_t *flip,
+                          const uint32_t *region)
+{
     const double off = 1.5 * g->voxel;
-    for (size_t t = 0; t < nt; t++) {
-        if (!E.kept[t])
+    for (size_t t = 0; t < s->ntris; t++) {
+        if (!E->kept[t])
             continue;
         const uint32_t *v = s->tris + 3 * t;
         const double *A = s->xyz + 3 * (size_t)v[0], *B = s->xyz + 3 * (size_t)v[1],
@@ -452,16 +494,28 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
         if (fin != bin)   /* front outside, back inside: agrees */
             score[region[t]] += bin ? 0.5 * len : -0.5 * len;
     }
+}
+
+/* The soup s oriented (o: each region turned to its score), the rim of
+ * its seen triangles (rim[*nview]), the regions turned, and the column
+ * rule's direction: the axis direction the seen soup faces most
+ * exclusively. */
+static st_status oriented_soup(st_soup *o, uint8_t *rim, size_t *nview, st_sides_stats *st,
+                               const st_soup *s, const st_soup_edges *E, const uint32_t *nbr,
+                               const uint8_t *flip, const uint32_t *region, const double *score,
+                               const st_sides_params *p, st_error *err)
+{
+    const size_t nt = s->ntris;
+    st_status rc = ST_OK;
     for (size_t v = 0; v < s->nverts; v++)
         if ((rc = st_soup_add_vertex(o, s->xyz[3 * v], s->xyz[3 * v + 1], s->xyz[3 * v + 2],
                                      err)))
-            goto done;
-    size_t nview = 0;
+            return rc;
     const size_t seen = p->seen_triangles && p->seen_triangles < nt ? p->seen_triangles : nt;
     const size_t cseen = p->column_seen && p->column_seen < nt ? p->column_seen : nt;
     double axis_area[3][2] = {{0.0}};   /* [axis][0: facing +, 1: facing -] */
     for (size_t t = 0; t < nt; t++) {
-        if (!E.kept[t])
+        if (!E->kept[t])
             continue;
         if (t < seen) {
             /* on the seen surface's boundary: a free edge or one shared
@@ -469,14 +523,14 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
             int edge = 0;
             for (size_t slot = 3 * t; slot < 3 * t + 3; slot++)
                 edge |= nbr[slot] == ST_EDGES_NONE || nbr[slot] >= seen;
-            rim[nview++] = (uint8_t)edge;
+            rim[(*nview)++] = (uint8_t)edge;
         }
         if (region[t] == t && score[t] < 0.0)
             st->turned++;
         const int back = flip[t] ^ (score[region[t]] < 0.0);
         const uint32_t *v = s->tris + 3 * t;
         if ((rc = st_soup_add_triangle(o, v[0], back ? v[2] : v[1], back ? v[1] : v[2], err)))
-            goto done;
+            return rc;
         if (t < cseen) {
             double an[3];
             tri_normal(o, o->ntris - 1, an);
@@ -484,8 +538,6 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
                 axis_area[k][an[k] < 0.0] += fabs(an[k]);
         }
     }
-    /* the column rule's direction: the axis direction the seen soup faces
-     * most exclusively */
     st->column_back_front = INFINITY;
     for (int k = 0; k < 3; k++)
         for (int d = 0; d < 2; d++) {
@@ -498,12 +550,15 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
             }
         }
     st->columns = st->column_back_front < p->column_ratio;
-    if (o->ntris == 0)
-        goto done;
-    if ((rc = st_bvh_build(&bvh, o, err)))
-        goto done;
+    return ST_OK;
+}
 
-    /* 3. the local winding number near the soup */
+/* 3. The local winding number of the oriented soup (its BVH) near each
+ * undecided voxel in the band, as evidence; returns how many voxels. */
+static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
+                               int decided, const st_bvh *bvh, const st_soup *o,
+                               const st_sides_params *p)
+{
     const float band = (float)(p->band_voxels * g->voxel);
     const double r = p->radius_voxels * g->voxel;
     const double scale = p->weight / (4.0 * M_PI);
@@ -529,21 +584,7 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
                 evidence[i] = (int8_t)lround(e);
                 count++;
             }
-    st->voxels = count;
-    view_of(o, nview, rim, p, st);
-done:
-    st_bvh_free(bvh);
-    st_soup_free(o);
-    if (!edges)
-        st_soup_edges_free(&own);
-    free(nbr);
-    free(same);
-    free(flip);
-    free(rim);
-    free(region);
-    free(queue);
-    free(score);
-    return rc;
+    return count;
 }
 
 typedef struct col_hit {
@@ -673,44 +714,44 @@ done:
     return rc;
 }
 
-st_status st_sides_columns(st_grid *g, const st_soup *s, const st_sides_params *p,
-                           const st_sides_stats *st, double band_voxels, size_t *changed,
-                           st_error *err)
+/* The column rule on one field: the axis k (a and b across it) and the
+ * direction dir the viewer looks along, the crossings of each line along
+ * k (hit[start[col]..start[col + 1]), voxel units) and the caps' exits
+ * (exit_caps: exits, ctop). */
+typedef struct col_ctx {
+    st_grid *g;
+    int k, a, b, dir;
+    size_t na, nb, nk, nt;      /* nt: the seen triangles (the caps after) */
+    size_t *start;
+    col_hit *hit;
+    const uint8_t *exits;
+    const double *ctop;
+    float band;
+} col_ctx;
+
+/* The triangles' (the seen ones, then the caps exits marks) crossings of
+ * each line along axis k, in voxel coordinates: counted, then stored
+ * (pass 0, 1) in c->start, c->hit. */
+static st_status col_crossings(col_ctx *c, const st_soup *s, size_t nall, st_error *err)
 {
-    *changed = 0;
-    if (!st->columns || !s)
-        return ST_OK;
-    const int k = st->column_axis, a = (k + 1) % 3, b = (k + 2) % 3, dir = st->column_dir;
-    const size_t dims[3] = {g->nx, g->ny, g->nz};
-    const size_t na = dims[a], nb = dims[b], nk = dims[k];
-    const size_t seen = p->column_seen;
-    const size_t nt = seen && seen < s->ntris ? seen : s->ntris;
-    /* the crossings of the caps that face away too (not past a fold,
-     * where the mirror has continued the solid past them) */
-    const size_t nall = p->column_caps && !st->fold ? s->ntris : nt;
-    const size_t ncol = na * nb;
-    size_t *start = st_calloc_array(ncol + 1, sizeof *start);
+    const st_grid *g = c->g;
+    const int k = c->k, a = c->a, b = c->b;
+    const size_t na = c->na, nb = c->nb, ncol = na * nb;
     size_t *fill = st_calloc_array(ncol + 1, sizeof *fill);
-    col_hit *hit = NULL;
-    uint8_t *exits = NULL;
-    double *ctop = NULL;
-    st_status rc = ST_OK;
-    if (!start || !fill) {
-        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the columns");
-        goto done;
+    c->start = st_calloc_array(ncol + 1, sizeof *c->start);
+    if (!c->start || !fill) {
+        free(fill);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the columns");
     }
-    if (nall > nt && (rc = exit_caps(&exits, &ctop, s, nt, k, dir, err)))
-        goto done;
-    /* the seen triangles' crossings of each line along axis k, in voxel
-     * coordinates: counted, then stored (pass 0, 1) */
+    size_t *start = c->start;
     for (int pass = 0; pass < 2; pass++) {
         for (size_t t = 0; t < nall; t++) {
-            if (t >= nt && !(exits[t] & 1))
+            if (t >= c->nt && !(c->exits[t] & 1))
                 continue;
             double P[3][3], lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
             for (int v = 0; v < 3; v++)
-                for (int c = 0; c < 3; c++)
-                    P[v][c] = (s->xyz[3 * (size_t)s->tris[3 * t + v] + c] - g->origin[c]) /
+                for (int q = 0; q < 3; q++)
+                    P[v][q] = (s->xyz[3 * (size_t)s->tris[3 * t + v] + q] - g->origin[q]) /
                               g->voxel;
             for (int v = 0; v < 3; v++) {
                 lo[0] = fmin(lo[0], P[v][a]);
@@ -727,8 +768,8 @@ st_status st_sides_columns(st_grid *g, const st_soup *s, const st_sides_params *
                         continue;
                     const size_t col = (size_t)i + na * (size_t)j;
                     if (pass) {
-                        col_hit *x = &hit[start[col] + fill[col]++];
-                        x->h = dir * h;
+                        col_hit *x = &c->hit[start[col] + fill[col]++];
+                        x->h = c->dir * h;
                         x->t = (uint32_t)t;
                     } else {
                         start[col + 1]++;
@@ -737,116 +778,165 @@ st_status st_sides_columns(st_grid *g, const st_soup *s, const st_sides_params *
         }
         if (pass)
             break;
-        for (size_t c = 0; c < ncol; c++)
-            start[c + 1] += start[c];
-        hit = st_malloc_array(start[ncol] + 1, sizeof *hit);
-        if (!hit) {
-            rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the columns");
-            goto done;
+        for (size_t q = 0; q < ncol; q++)
+            start[q + 1] += start[q];
+        c->hit = st_malloc_array(start[ncol] + 1, sizeof *c->hit);
+        if (!c->hit) {
+            free(fill);
+            return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the columns");
         }
     }
-    const float band = (float)(band_voxels * g->voxel);
+    free(fill);
+    return ST_OK;
+}
+
+/* Where the solid of the segment line[first..end) after crossing seg - 1
+ * (of n; h the crossings) ends: the step (inside, then outside) that the
+ * confident voxels (|d| >= band) agree with most, then the first cap
+ * that faces away below the entry (half a voxel clear of it and of the
+ * next): where its piece rises less than a voxel above the crossing
+ * (flat: the lost face, a pocket's ceiling), the solid ends there at the
+ * latest; else, where the segment's solid ends at it or below, the air
+ * run from it down to the next entry is mirrored above it (a bore's
+ * lower half seen, its cap across the middle: the upper half), where
+ * that leaves solid below the entry. */
+static size_t col_split(const col_ctx *c, const size_t *line, size_t first, size_t end,
+                        const col_hit *h, size_t seg, size_t n, const col_hit *cap, size_t ncap)
+{
+    const st_grid *g = c->g;
+    const int dir = c->dir;
+    const size_t nk = c->nk;
+    size_t split = first;   /* inside before split */
+    if (seg == 0)
+        return split;
+    long score = 0, best = 0;
+    for (size_t i = first; i < end; i++) {
+        const float d = g->data[line[i]];
+        if (fabsf(d) >= c->band)
+            score += d < 0.0f ? 1 : -1;
+        if (score >= best) {
+            best = score;
+            split = i + 1;
+        }
+    }
+    const double top = h[seg - 1].h - 0.5;
+    const double bottom = seg < n ? h[seg].h + 0.5 : -INFINITY;
+    for (size_t q = 0; q < ncap; q++) {
+        if (!(cap[q].h < top && cap[q].h > bottom) || !(c->exits[cap[q].t] & 1))
+            continue;
+        size_t capi = first;   /* the first voxel below the cap */
+        while (capi < end && dir * (double)(dir > 0 ? nk - 1 - capi : capi) > cap[q].h)
+            capi++;
+        const double rise = ((c->ctop[cap[q].t] - dir * g->origin[c->k]) / g->voxel) - cap[q].h;
+        const size_t air = end - capi;
+        if (rise < 1.0 && capi < split)
+            split = capi;
+        if (seg < n && split + 1 >= capi && rise >= 1.0 && air > 0 && air < capi - first &&
+            capi - air < split)
+            split = capi - air;
+        break;
+    }
+    return split;
+}
+
+/* The column worker: line col's crossings sorted from the viewer, each
+ * segment between them: nothing before the first crossing; after one,
+ * the solid it enters and then nothing (col_split), its end not below
+ * the cut; only made outside (counted in *count). ST_ENOMEM (the caller
+ * says so). */
+static st_status column(const col_ctx *c, size_t col, size_t *count)
+{
+    st_grid *g = c->g;
+    const int dir = c->dir;
+    const size_t nk = c->nk, ci = col % c->na, cj = col / c->na;
+    col_hit *h = c->hit + c->start[col];
+    size_t n = c->start[col + 1] - c->start[col];
+    /* from the viewer: the greatest dir * coordinate first */
+    qsort(h, n, sizeof *h, cmp_hit_desc);
+    /* the caps' crossings apart (in order); the seen soup's: within half
+     * a voxel are one (an edge or vertex on the line, or a sliver) */
+    col_hit *cap = malloc((n + 1) * sizeof *cap);
+    size_t *line = malloc((nk + 1) * sizeof *line);
+    if (!line || !cap) {
+        free(line);
+        free(cap);
+        return ST_ENOMEM;
+    }
+    size_t u = 0, ncap = 0;
+    for (size_t m = 0; m < n; m++)
+        if (h[m].t >= c->nt)
+            cap[ncap++] = h[m];
+        else if (u == 0 || h[u - 1].h - h[m].h > 0.5)
+            h[u++] = h[m];
+    n = u;
+    for (size_t step = 0; step < nk; step++) {
+        const size_t m = dir > 0 ? nk - 1 - step : step;
+        size_t ijk[3];
+        ijk[c->k] = m;
+        ijk[c->a] = ci;
+        ijk[c->b] = cj;
+        line[step] = st_grid_index(g, ijk[0], ijk[1], ijk[2]);
+    }
+    size_t first = 0;
+    for (size_t seg = 0; seg <= n; seg++) {
+        size_t end = first;   /* the segment: line[first..end) */
+        while (end < nk && (seg == n || dir * (double)(dir > 0 ? nk - 1 - end : end) > h[seg].h))
+            end++;
+        const size_t split = col_split(c, line, first, end, h, seg, n, cap, ncap);
+        for (size_t i = split; i < end; i++) {
+            float *d = &g->data[line[i]];
+            if (*d < 0.0f) {
+                *d = st_grid_signed_value(*d, 0);
+                (*count)++;
+            }
+        }
+        first = end;
+    }
+    free(line);
+    free(cap);
+    return ST_OK;
+}
+
+st_status st_sides_columns(st_grid *g, const st_soup *s, const st_sides_params *p,
+                           const st_sides_stats *st, double band_voxels, size_t *changed,
+                           st_error *err)
+{
+    *changed = 0;
+    if (!st->columns || !s)
+        return ST_OK;
+    col_ctx c;
+    memset(&c, 0, sizeof c);
+    c.g = g;
+    c.k = st->column_axis, c.a = (c.k + 1) % 3, c.b = (c.k + 2) % 3, c.dir = st->column_dir;
+    const size_t dims[3] = {g->nx, g->ny, g->nz};
+    c.na = dims[c.a], c.nb = dims[c.b], c.nk = dims[c.k];
+    const size_t seen = p->column_seen;
+    c.nt = seen && seen < s->ntris ? seen : s->ntris;
+    c.band = (float)(band_voxels * g->voxel);
+    /* the crossings of the caps that face away too (not past a fold,
+     * where the mirror has continued the solid past them) */
+    const size_t nall = p->column_caps && !st->fold ? s->ntris : c.nt;
+    const size_t ncol = c.na * c.nb;
+    uint8_t *exits = NULL;
+    double *ctop = NULL;
+    st_status rc = ST_OK;
+    if (nall > c.nt && (rc = exit_caps(&exits, &ctop, s, c.nt, c.k, c.dir, err)))
+        goto done;
+    c.exits = exits;
+    c.ctop = ctop;
+    if ((rc = col_crossings(&c, s, nall, err)))
+        goto done;
     size_t count = 0;
     int oom = 0;
     #pragma omp parallel for schedule(dynamic, 64) reduction(+ : count) reduction(| : oom)
-    for (size_t col = 0; col < ncol; col++) {
-        const size_t ci = col % na, cj = col / na;
-        col_hit *h = hit + start[col];
-        size_t n = start[col + 1] - start[col];
-        /* from the viewer: the greatest dir * coordinate first */
-        qsort(h, n, sizeof *h, cmp_hit_desc);
-        /* the caps' crossings apart (in order); the seen soup's: within
-         * half a voxel are one (an edge or vertex on the line, or a
-         * sliver) */
-        col_hit *cap = malloc((n + 1) * sizeof *cap);
-        size_t *line = malloc((nk + 1) * sizeof *line);
-        if (!line || !cap) {
-            free(line);
-            free(cap);
-            oom = 1;
-            continue;
-        }
-        size_t u = 0, ncap = 0;
-        for (size_t m = 0; m < n; m++)
-            if (h[m].t >= nt)
-                cap[ncap++] = h[m];
-            else if (u == 0 || h[u - 1].h - h[m].h > 0.5)
-                h[u++] = h[m];
-        n = u;
-        for (size_t step = 0; step < nk; step++) {
-            const size_t m = dir > 0 ? nk - 1 - step : step;
-            size_t ijk[3];
-            ijk[k] = m;
-            ijk[a] = ci;
-            ijk[b] = cj;
-            line[step] = st_grid_index(g, ijk[0], ijk[1], ijk[2]);
-        }
-        /* each segment: nothing before the first crossing; after one, the
-         * solid it enters and then nothing: the step (inside, then
-         * outside) that the confident voxels (|d| >= band) agree with
-         * most, its end not below the cut; only made outside */
-        size_t first = 0;
-        for (size_t seg = 0; seg <= n; seg++) {
-            size_t end = first;   /* the segment: line[first..end) */
-            while (end < nk && (seg == n || dir * (double)(dir > 0 ? nk - 1 - end : end) > h[seg].h))
-                end++;
-            size_t split = first;   /* inside before split */
-            if (seg > 0) {
-                long score = 0, best = 0;
-                for (size_t i = first; i < end; i++) {
-                    const float d = g->data[line[i]];
-                    if (fabsf(d) >= band)
-                        score += d < 0.0f ? 1 : -1;
-                    if (score >= best) {
-                        best = score;
-                        split = i + 1;
-                    }
-                }
-            }
-            /* the first cap that faces away below the entry (half a voxel
-             * clear of it and of the next): where its piece rises less
-             * than a voxel above the crossing (flat: the lost face, a
-             * pocket's ceiling), the solid ends there at the latest; else,
-             * where the segment's solid ends at it or below, the air run
-             * from it down to the next entry is mirrored above it (a
-             * bore's lower half seen, its cap across the middle: the upper
-             * half), where that leaves solid below the entry */
-            const double top = seg > 0 ? h[seg - 1].h - 0.5 : INFINITY;
-            const double bottom = seg < n ? h[seg].h + 0.5 : -INFINITY;
-            for (size_t c = 0; c < ncap && seg > 0; c++) {
-                if (!(cap[c].h < top && cap[c].h > bottom) || !(exits[cap[c].t] & 1))
-                    continue;
-                size_t capi = first;   /* the first voxel below the cap */
-                while (capi < end && dir * (double)(dir > 0 ? nk - 1 - capi : capi) > cap[c].h)
-                    capi++;
-                const double rise = ((ctop[cap[c].t] - dir * g->origin[k]) / g->voxel) - cap[c].h;
-                const size_t air = end - capi;
-                if (rise < 1.0 && capi < split)
-                    split = capi;
-                if (seg < n && split + 1 >= capi && rise >= 1.0 && air > 0 && air < capi - first &&
-                    capi - air < split)
-                    split = capi - air;
-                break;
-            }
-            for (size_t i = split; i < end; i++) {
-                float *d = &g->data[line[i]];
-                if (*d < 0.0f) {
-                    *d = st_grid_signed_value(*d, 0);
-                    count++;
-                }
-            }
-            first = end;
-        }
-        free(line);
-        free(cap);
-    }
+    for (size_t col = 0; col < ncol; col++)
+        oom |= column(&c, col, &count) != ST_OK;
     *changed = count;
     if (oom)
         rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the columns");
 done:
-    free(start);
-    free(fill);
-    free(hit);
+    free(c.start);
+    free(c.hit);
     free(exits);
     free(ctop);
     return rc;

@@ -1,5 +1,6 @@
 /*
  * sign.c - volume-event voting (see sign.h; Spillmann et al. 2006, §3).
+ * Design notes and measurements: doc/design/sign.md.
  *
  * Per direction, two streaming passes over the grid:
  *   1. walk every line, find its event runs (voxels with |d| < t), count
@@ -64,32 +65,23 @@ st_sign_params st_sign_params_paper(void)
 
 st_sign_params st_sign_params_default(void)
 {
-    /* Chosen by the accuracy benchmark (make bench STAGE=accuracy: IoU
-     * against the undamaged solid at 128^3 over the MeshLab-damaged
-     * corpus; the table is in the closing note of issue 4):
+    /* Chosen by the accuracy benchmark (make bench STAGE=accuracy; the
+     * figures are in doc/design/sign.md):
      *   - the crossing toggle: both rays of a line agree on which side of
-     *     the surface every voxel is (bunny, closed: IoU 0.944 with the
-     *     paper's first-voxel toggle, 0.981 nearest, 0.998 crossing), and
-     *     a line with an odd number of events gives every voxel one inside
-     *     and one outside vote, so it is neutral without being dropped;
+     *     the surface every voxel is, and a line with an odd number of
+     *     events gives every voxel one inside and one outside vote, so it
+     *     is neutral without being dropped;
      *   - the event distance of k = 1, half a step along each direction:
      *     the least that catches every crossing (a sample lies within half
      *     a step of it), where k = 0.8 on a band field (0.6 voxel) misses
      *     crossings of the diagonal rays, whose steps are 1.41 and 1.73
-     *     voxels, and a missed crossing breaks the union below (bunny,
-     *     interpenetrating: 0.925 at k = 0.8, 0.989 at k = 1);
-     *   - the union of hidden parts, for interpenetrating shells (0.57
-     *     without it);
+     *     voxels, and a missed crossing breaks the union below;
+     *   - the union of hidden parts, for interpenetrating shells;
      *   - split event runs: two crossings closer than the event distance
      *     (where interpenetrating shells meet, across thin walls and
-     *     tunnels) are two events, not one (with the cut, votes only, no
-     *     refinement: torus, interpenetrating, 0.878 whole runs, 0.993
-     *     split; cheese, interpenetrating, 0.916, 0.922);
+     *     tunnels) are two events, not one;
      *   - the cut of the undecided voxels (mincut.h): the votes as
-     *     evidence, the surface as a cheap place to cut (split runs, no
-     *     refinement, votes alone / cut: cheese, closed, 0.948 / 0.995;
-     *     cheese, deleted50, 0.672 / 0.883; bunny, holes, 0.932 / 0.950;
-     *     man, interpenetrating, 0.935 / 0.946).
+     *     evidence, the surface as a cheap place to cut.
      * Nothing here depends on how far the grid reaches (c is not used at
      * k = 1), so a narrow-band field suffices. */
     st_sign_params p = {1.0, 0.0, 26, ST_TOGGLE_CROSSING, 0, 1, 1, 1};
@@ -1016,16 +1008,12 @@ st_status st_sign_field_evidence(st_grid *g, const st_sign_params *p, const int8
 st_sign_refine_params st_sign_refine_params_default(void)
 {
     /* band 1.5 voxels: the answers are only as good as the confident
-     * neighbours' votes, and on thin parts (CGAL's man's fingers) some
-     * votes between 1 and 1.5 voxels from the surface are wrong too: at
-     * 128^3, closed man 0.9972 with band 1, 0.9991 with 1.5; armadillo and
-     * elephant 0.99997 / 1.0000; the damaged classes within 0.002 either
-     * way (issue 4's note has the bench tables for both). Radius 2: a
-     * voxel inside a feature thinner than a voxel still finds neighbours
-     * 1.5 voxels from it (radius 3 changed nothing on man and cheese).
-     * Up to 6 answers, unanimous: a disagreement (a hole, an overlap of
-     * interpenetrating shells, whose inner faces do not separate inside
-     * from outside) leaves the vote. */
+     * neighbours' votes, and on thin parts some votes between 1 and 1.5
+     * voxels from the surface are wrong too. Radius 2: a voxel inside a
+     * feature thinner than a voxel still finds neighbours 1.5 voxels from
+     * it. Up to 6 answers, unanimous: a disagreement (a hole, an overlap
+     * of interpenetrating shells, whose inner faces do not separate
+     * inside from outside) leaves the vote. Measured: doc/design/sign.md. */
     st_sign_refine_params p = {1.5, 2, 6};
     return p;
 }
@@ -1192,6 +1180,170 @@ st_status st_sign_refine(st_grid *g, const st_soup *soup,
     return st;
 }
 
+/* The neighbour offsets within radius voxels per axis, nearest first
+ * (offset_cmp); returns how many (offs holds 7^3). */
+static int refine_offsets(refine_offset *offs, int radius)
+{
+    int noffs = 0;
+    for (int z = -radius; z <= radius; z++)
+        for (int y = -radius; y <= radius; y++)
+            for (int x = -radius; x <= radius; x++)
+                if (x || y || z) {
+                    int ax = abs(x), ay = abs(y), az = abs(z);
+                    int cheb = ax > ay ? (ax > az ? ax : az) : (ay > az ? ay : az);
+                    refine_offset o = {{x, y, z}, x * x + y * y + z * z, cheb};
+                    offs[noffs++] = o;
+                }
+    qsort(offs, (size_t)noffs, sizeof *offs, offset_cmp);
+    return noffs;
+}
+
+/* The refinement of one field, read by every thread. Tiles of TILE^3
+ * voxels share one BVH query (the query and the candidates' boxes cost
+ * more than the exact tests); each voxel then keeps the candidates whose
+ * boxes meet its own reach. */
+enum { TILE = 4 };
+typedef struct refine_ctx {
+    const st_grid *g;
+    const st_soup *soup;
+    const st_bvh *bvh;
+    const st_sign_refine_params *p;
+    refine_offset offs[7 * 7 * 7];
+    int noffs;
+    float band;
+    double reach;
+    long nx, ny, nz, tx, ty;
+} refine_ctx;
+
+/* One thread's: the candidates of its tile (b), those near the voxel
+ * (sel, indices into b) and the sign flips it found. */
+typedef struct refine_worker {
+    refine_buf b;
+    uint32_t *sel;
+    size_t nsel, selcap;
+    int seloom;
+    size_t *flip, nflip, flipcap;
+} refine_worker;
+
+/* Whether voxel (i, j, k) at pv, of value dv, is inside: its neighbours'
+ * answers (the parity of the soup's crossings on the segment to each
+ * confident neighbour, from its sign), unanimous against the vote, else
+ * the vote. */
+static int refine_voxel(const refine_ctx *c, refine_worker *w, long i, long j, long k,
+                        const double pv[3], float dv)
+{
+    const st_grid *g = c->g;
+    const refine_offset *offs = c->offs;
+    /* The candidates within the reach of the neighbours taken so far:
+     * offsets come nearest first, so grow the reach only when needed. */
+    int have = 0;
+    int nin = 0, nout = 0;
+    for (int o = 0; o < c->noffs && nin + nout < c->p->answers; o++) {
+        long ui = i + offs[o].d[0], uj = j + offs[o].d[1], uk = k + offs[o].d[2];
+        if (ui < 0 || ui >= c->nx || uj < 0 || uj >= c->ny || uk < 0 || uk >= c->nz)
+            continue;
+        float du = g->data[st_grid_index(g, (size_t)ui, (size_t)uj, (size_t)uk)];
+        if (fabsf(du) < c->band)
+            continue;
+        if (offs[o].cheb > have) {
+            have = offs[o].cheb;
+            const double rr = have * g->voxel;
+            w->nsel = 0;
+            for (size_t q = 0; q < w->b.n; q++) {
+                const refine_tri *r = &w->b.t[q];
+                int out = (r->hi[0] < pv[0] - rr) | (r->lo[0] > pv[0] + rr) |
+                          (r->hi[1] < pv[1] - rr) | (r->lo[1] > pv[1] + rr) |
+                          (r->hi[2] < pv[2] - rr) | (r->lo[2] > pv[2] + rr);
+                w->sel[w->nsel] = (uint32_t)q;
+                w->nsel += !out;
+            }
+        }
+        double pu[3];
+        st_grid_center(g, (size_t)ui, (size_t)uj, (size_t)uk, pu);
+        int par = segment_parity(c->soup, &w->b, w->sel, w->nsel, pv, pu);
+        if (par < 0)
+            continue;
+        if ((du < 0) ^ par)
+            nin++;
+        else
+            nout++;
+        /* One answer that agrees with the vote settles it (only a
+         * unanimous answer against the vote changes a sign), so stop: the
+         * same result, one segment for most voxels. */
+        if ((dv < 0) ? nin : nout)
+            break;
+    }
+    int inside = dv < 0;
+    if (nin && !nout)
+        inside = 1;
+    else if (nout && !nin)
+        inside = 0;
+    return inside;
+}
+
+/* Tile t: the voxels in the band whose sign the answers change, listed
+ * in w->flip (the grid is not written: the neighbours read may lie in
+ * another thread's tile). Out of memory: w->b.oom or w->seloom. */
+static void refine_tile(const refine_ctx *c, refine_worker *w, long t)
+{
+    const st_grid *g = c->g;
+    const long i0 = (t % c->tx) * TILE, j0 = ((t / c->tx) % c->ty) * TILE,
+               k0 = (t / (c->tx * c->ty)) * TILE;
+    const long i1 = i0 + TILE < c->nx ? i0 + TILE : c->nx,
+               j1 = j0 + TILE < c->ny ? j0 + TILE : c->ny,
+               k1 = k0 + TILE < c->nz ? k0 + TILE : c->nz;
+    int any = 0;
+    for (long k = k0; k < k1 && !any; k++)
+        for (long j = j0; j < j1 && !any; j++)
+            for (long i = i0; i < i1 && !any; i++)
+                any = fabsf(g->data[st_grid_index(g, (size_t)i, (size_t)j, (size_t)k)]) < c->band;
+    if (!any)
+        return;
+    double lo[3], hi[3], plo[3], phi[3];
+    st_grid_center(g, (size_t)i0, (size_t)j0, (size_t)k0, plo);
+    st_grid_center(g, (size_t)(i1 - 1), (size_t)(j1 - 1), (size_t)(k1 - 1), phi);
+    for (int a = 0; a < 3; a++) {
+        lo[a] = plo[a] - c->reach;
+        hi[a] = phi[a] + c->reach;
+    }
+    w->b.n = 0;
+    st_bvh_query_box(c->bvh, lo, hi, refine_collect, &w->b);
+    if (w->b.oom)
+        return;
+    if (w->selcap < w->b.n) {
+        uint32_t *ns = st_realloc_array(w->sel, w->b.n, sizeof *ns);
+        if (!ns) {
+            w->seloom = 1;
+            return;
+        }
+        w->sel = ns;
+        w->selcap = w->b.n;
+    }
+    for (long k = k0; k < k1; k++)
+        for (long j = j0; j < j1; j++)
+            for (long i = i0; i < i1; i++) {
+                size_t idx = st_grid_index(g, (size_t)i, (size_t)j, (size_t)k);
+                float dv = g->data[idx];
+                if (!(fabsf(dv) < c->band))
+                    continue;
+                double pv[3];
+                st_grid_center(g, (size_t)i, (size_t)j, (size_t)k, pv);
+                if (refine_voxel(c, w, i, j, k, pv, dv) == (dv < 0))
+                    continue;
+                if (w->nflip == w->flipcap) {
+                    size_t cap = w->flipcap ? 2 * w->flipcap : 256;
+                    size_t *nf = st_realloc_array(w->flip, cap, sizeof *nf);
+                    if (!nf) {
+                        w->seloom = 1;
+                        continue;
+                    }
+                    w->flip = nf;
+                    w->flipcap = cap;
+                }
+                w->flip[w->nflip++] = idx;
+            }
+}
+
 st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
                              const st_sign_refine_params *p, size_t *changed,
                              st_error *err)
@@ -1209,162 +1361,43 @@ st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
                             "answers %d)", p->band_voxels, p->radius, p->answers);
     if (!soup || soup->ntris == 0)
         return st_error_set(err, ST_EINPUT, NULL, 0, "no triangles to refine with");
-    refine_offset offs[7 * 7 * 7];
-    int noffs = 0;
-    for (int z = -p->radius; z <= p->radius; z++)
-        for (int y = -p->radius; y <= p->radius; y++)
-            for (int x = -p->radius; x <= p->radius; x++)
-                if (x || y || z) {
-                    int ax = abs(x), ay = abs(y), az = abs(z);
-                    int cheb = ax > ay ? (ax > az ? ax : az) : (ay > az ? ay : az);
-                    refine_offset o = {{x, y, z}, x * x + y * y + z * z, cheb};
-                    offs[noffs++] = o;
-                }
-    qsort(offs, (size_t)noffs, sizeof *offs, offset_cmp);
-
-    const float band = (float)(p->band_voxels * g->voxel);
-    const long nx = (long)g->nx, ny = (long)g->ny, nz = (long)g->nz;
-    const double reach = p->radius * g->voxel;
-    /* Tiles of TILE^3 voxels share one BVH query (the query and the
-     * candidates' boxes cost more than the exact tests); each voxel then
-     * keeps the candidates whose boxes meet its own reach. */
-    enum { TILE = 4 };
-    const long tx = (nx + TILE - 1) / TILE, ty = (ny + TILE - 1) / TILE,
-               tz = (nz + TILE - 1) / TILE;
-    const long ntiles = tx * ty * tz;
+    refine_ctx c;
+    c.g = g;
+    c.soup = soup;
+    c.bvh = bvh;
+    c.p = p;
+    c.noffs = refine_offsets(c.offs, p->radius);
+    c.band = (float)(p->band_voxels * g->voxel);
+    c.nx = (long)g->nx, c.ny = (long)g->ny, c.nz = (long)g->nz;
+    c.reach = p->radius * g->voxel;
+    c.tx = (c.nx + TILE - 1) / TILE, c.ty = (c.ny + TILE - 1) / TILE;
+    const long ntiles = c.tx * c.ty * ((c.nz + TILE - 1) / TILE);
     size_t nchanged = 0;
     int oom = 0;
-    /* The voxels read as neighbours may lie in another thread's tile, so
-     * no voxel is rewritten while the tiles are decided: each thread lists
-     * the sign flips it found and applies them after the loop's barrier.
-     * (A flipped voxel is in the band, which no neighbour test uses, so
-     * the answers are the same; this removes the data race.) */
+    /* No voxel is rewritten while the tiles are decided: each thread
+     * lists the sign flips it found and applies them after the loop's
+     * barrier. (A flipped voxel is in the band, which no neighbour test
+     * uses, so the answers are the same; this removes the data race.) */
     #pragma omp parallel reduction(+ : nchanged)
     {
-        refine_buf b = {NULL, 0, 0, 0, soup};
-        uint32_t *sel = NULL;   /* the candidates (in b) near the voxel */
-        size_t nsel = 0, selcap = 0;
-        int seloom = 0;
-        size_t *flip = NULL, nflip = 0, flipcap = 0;
+        refine_worker w = {{NULL, 0, 0, 0, soup}, NULL, 0, 0, 0, NULL, 0, 0};
         #pragma omp for schedule(dynamic, 4)
-        for (long t = 0; t < ntiles; t++) {
-            if (b.oom || seloom)
-                continue;
-            const long i0 = (t % tx) * TILE, j0 = ((t / tx) % ty) * TILE,
-                       k0 = (t / (tx * ty)) * TILE;
-            const long i1 = i0 + TILE < nx ? i0 + TILE : nx,
-                       j1 = j0 + TILE < ny ? j0 + TILE : ny,
-                       k1 = k0 + TILE < nz ? k0 + TILE : nz;
-            int any = 0;
-            for (long k = k0; k < k1 && !any; k++)
-                for (long j = j0; j < j1 && !any; j++)
-                    for (long i = i0; i < i1 && !any; i++)
-                        any = fabsf(g->data[st_grid_index(g, (size_t)i, (size_t)j, (size_t)k)]) < band;
-            if (!any)
-                continue;
-            double lo[3], hi[3], plo[3], phi[3];
-            st_grid_center(g, (size_t)i0, (size_t)j0, (size_t)k0, plo);
-            st_grid_center(g, (size_t)(i1 - 1), (size_t)(j1 - 1), (size_t)(k1 - 1), phi);
-            for (int a = 0; a < 3; a++) {
-                lo[a] = plo[a] - reach;
-                hi[a] = phi[a] + reach;
-            }
-            b.n = 0;
-            st_bvh_query_box(bvh, lo, hi, refine_collect, &b);
-            if (b.oom)
-                continue;
-            if (selcap < b.n) {
-                uint32_t *ns = st_realloc_array(sel, b.n, sizeof *ns);
-                if (!ns) {
-                    seloom = 1;
-                    continue;
-                }
-                sel = ns;
-                selcap = b.n;
-            }
-            for (long k = k0; k < k1; k++)
-                for (long j = j0; j < j1; j++)
-                    for (long i = i0; i < i1; i++) {
-                        size_t idx = st_grid_index(g, (size_t)i, (size_t)j, (size_t)k);
-                        float dv = g->data[idx];
-                        if (!(fabsf(dv) < band))
-                            continue;
-                        double pv[3];
-                        st_grid_center(g, (size_t)i, (size_t)j, (size_t)k, pv);
-                        /* The candidates within the reach of the
-                         * neighbours taken so far: offsets come nearest
-                         * first, so grow the reach only when needed. */
-                        int have = 0;
-                        int nin = 0, nout = 0;
-                        for (int o = 0; o < noffs && nin + nout < p->answers; o++) {
-                            long ui = i + offs[o].d[0], uj = j + offs[o].d[1], uk = k + offs[o].d[2];
-                            if (ui < 0 || ui >= nx || uj < 0 || uj >= ny || uk < 0 || uk >= nz)
-                                continue;
-                            float du = g->data[st_grid_index(g, (size_t)ui, (size_t)uj, (size_t)uk)];
-                            if (fabsf(du) < band)
-                                continue;
-                            if (offs[o].cheb > have) {
-                                have = offs[o].cheb;
-                                const double rr = have * g->voxel;
-                                nsel = 0;
-                                for (size_t q = 0; q < b.n; q++) {
-                                    const refine_tri *r = &b.t[q];
-                                    int out = (r->hi[0] < pv[0] - rr) | (r->lo[0] > pv[0] + rr) |
-                                              (r->hi[1] < pv[1] - rr) | (r->lo[1] > pv[1] + rr) |
-                                              (r->hi[2] < pv[2] - rr) | (r->lo[2] > pv[2] + rr);
-                                    sel[nsel] = (uint32_t)q;
-                                    nsel += !out;
-                                }
-                            }
-                            double pu[3];
-                            st_grid_center(g, (size_t)ui, (size_t)uj, (size_t)uk, pu);
-                            int par = segment_parity(soup, &b, sel, nsel, pv, pu);
-                            if (par < 0)
-                                continue;
-                            if ((du < 0) ^ par)
-                                nin++;
-                            else
-                                nout++;
-                            /* One answer that agrees with the vote settles
-                             * it (only a unanimous answer against the vote
-                             * changes a sign), so stop: the same result,
-                             * one segment for most voxels. */
-                            if ((dv < 0) ? nin : nout)
-                                break;
-                        }
-                        int inside = dv < 0;
-                        if (nin && !nout)
-                            inside = 1;
-                        else if (nout && !nin)
-                            inside = 0;
-                        if (inside != (dv < 0)) {
-                            if (nflip == flipcap) {
-                                size_t cap = flipcap ? 2 * flipcap : 256;
-                                size_t *nf = st_realloc_array(flip, cap, sizeof *nf);
-                                if (!nf) {
-                                    seloom = 1;
-                                    continue;
-                                }
-                                flip = nf;
-                                flipcap = cap;
-                            }
-                            flip[nflip++] = idx;
-                        }
-                    }
-        }
+        for (long t = 0; t < ntiles; t++)
+            if (!w.b.oom && !w.seloom)
+                refine_tile(&c, &w, t);
         /* (the implicit barrier of the loop above: every read is done) */
-        for (size_t f = 0; f < nflip; f++) {
-            float dv = g->data[flip[f]];
-            g->data[flip[f]] = st_grid_signed_value(dv, !(dv < 0));
+        for (size_t f = 0; f < w.nflip; f++) {
+            float dv = g->data[w.flip[f]];
+            g->data[w.flip[f]] = st_grid_signed_value(dv, !(dv < 0));
         }
-        nchanged += nflip;
-        free(flip);
-        if (b.oom || seloom) {
+        nchanged += w.nflip;
+        free(w.flip);
+        if (w.b.oom || w.seloom) {
             #pragma omp atomic write
             oom = 1;
         }
-        free(b.t);
-        free(sel);
+        free(w.b.t);
+        free(w.sel);
     }
     if (oom)
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory in the refinement");
