@@ -216,8 +216,7 @@ static st_status svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
     }
     /* The star tets' boxes, once for all the points: in_star's test order
      * and answers, without recomputing a tet's box for every point (the
-     * box rejects most (point, tet) pairs; issue 23: this scan was the
-     * largest part of the fit on dragon_res3, 9 million tet tests). */
+     * box rejects most (point, tet) pairs; doc/design/fit.md, Cost). */
     enum { BOXED_MAX = 96 };
     double tbox[BOXED_MAX][6];
     int tor[BOXED_MAX];   /* and their orientations (in_star_tet_o) */
@@ -292,8 +291,8 @@ static st_status svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
  * one does not, *failed says which (a point grid index). The star with v
  * at p must be positive (move_ok tests that first); was_positive: it was
  * positive where the list was gathered, so each point is inside its tet's
- * face opposite v (issue 23: this loop is most of the fit's time on large
- * soups, a few thousand points per star on the dragon). */
+ * face opposite v (the fit's hottest loop on large soups:
+ * doc/design/fit.md, Cost). */
 static int svertices_kept(const fit_ctx *c, uint32_t v, const double p[3],
                           const star_pt *list, size_t n, int was_positive,
                           uint32_t *failed)
@@ -541,8 +540,7 @@ st_status sm_fit_ctx_open(fit_ctx *c, st_tetmesh *m, const st_soup *s, const st_
         goto done;
     c->full_check = nonmanifold > 0;
     /* the point grid's bins a quarter of the cell: the swept test and the
-     * star scans visit whole bins (issue 23: 10 million triangles at
-     * --cells 10 put ~100k S vertices in an h bin) */
+     * star scans visit whole bins (doc/design/fit.md, Cost) */
     if (sm_pgrid_build(&c->pg, s, h / 4.0) ||
         !(c->blocker = st_malloc_array(m->npoints, sizeof *c->blocker)) ||
         !(c->dpos = st_malloc_array(m->npoints, 3 * sizeof *c->dpos))) {
