@@ -41,7 +41,8 @@
  * ends at 10..166, 20 degrees at 20..153 with the volume still within
  * 0.01% (8, 12 and 16 cells), so 20 is the default.
  */
-#include "smooth_internal.h"
+#include "quality.h"
+#include "smooth_mesh.h"
 #include "fpenv.h"
 
 #include "souptet/mem.h"

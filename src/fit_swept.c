@@ -4,10 +4,11 @@
  * the region the star's boundary faces sweep can leave the star.
  *
  * The claim. Let v be a boundary vertex of a mesh in which no face has
- * more than two tets (fit_ctx.full_check 0), moving from x to p, its star
- * positive at both (every tet orient3d < 0; sm_move_ok tests p, the caller
- * x). R(y) is the closed star with v at y; L its faces not holding v (the
- * link, which does not move); C(y) the boundary faces holding v, (y, a, b).
+ * more than two tets (fit_ctx.full_check 0, invariant.h), moving from x
+ * to p, its star positive at both (every tet orient3d < 0; sm_move_ok
+ * tests p, the caller x). R(y) is the closed star with v at y; L its
+ * faces not holding v (the link, which does not move); C(y) the boundary
+ * faces holding v, (y, a, b).
  * Faces holding v shared by two star tets cancel in the boundary chain (two
  * positive tets on one face lie on its two sides, so they induce opposite
  * orientations), so the chain boundary of the star is L + C(y), and at a
@@ -34,7 +35,7 @@
  * st_point_in_tet and the star tests: no decision is taken in floating
  * point.
  */
-#include "smooth_internal.h"
+#include "fit_swept.h"
 #include "fpenv.h"
 
 #include "souptet/isect.h"
@@ -60,15 +61,14 @@ static int in_closed_star(const sm_mesh *sm, uint32_t v, const double y[3], cons
     return 0;
 }
 
-int sm_swept_applies(const fit_ctx *c, uint32_t v)
+int sm_swept_applies(const sm_mesh *sm, uint32_t v)
 {
-    return c->sm.vf_off[v + 1] - c->sm.vf_off[v] <= SWEPT_MAX_FACES;
+    return sm->vf_off[v + 1] - sm->vf_off[v] <= SWEPT_MAX_FACES;
 }
 
-int sm_swept_kept(const fit_ctx *c, uint32_t v, const double p[3], uint32_t *failed)
+int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[3],
+                  uint32_t *failed)
 {
-    const sm_mesh *sm = &c->sm;
-    const pgrid *g = &c->pg;
     const size_t nf = sm->vf_off[v + 1] - sm->vf_off[v];
     if (nf > SWEPT_MAX_FACES)
         return -1;

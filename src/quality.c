@@ -8,7 +8,7 @@
  * centroid, line searches along the gradient of its worst tet's score and
  * along the summed unit gradients of the tets within QUAL_ACTIVE of the
  * worst, small steps along the axes), best first; the first that raises
- * the lowest score of the star and keeps the fit's invariant (fit.c; and,
+ * the lowest score of the star and keeps the fit's invariant (invariant.c; and,
  * for a boundary vertex, keeps it within max(d_offset, its distance) of
  * S) is taken. A boundary vertex at the band's edge, or past it where a
  * thin gap held it back, can take no step with an outward component, and
@@ -20,12 +20,17 @@
  * of the worst (a plateau: the worst tet's gradient lowers the next, the
  * summed one cancels), steps along the 26 directions to a cube's
  * neighbours at 0.1, 0.04 and 0.015 h still find a way up; st_fit adds
- * them (cube_steps) in one last pass after its rescues (fit.c says why).
- * Rounds repeat until no tet scores below the goal or nothing moves. Vertices move colour by colour, within a colour in parallel,
+ * them (cube_steps) in one last pass after its rescues (doc/design/fit.md
+ * says why). Rounds repeat until no tet scores below the goal or nothing
+ * moves. Vertices move colour by colour, within a colour in parallel,
  * each check reading only its own star: the result does not depend on
  * the thread count.
+ *
+ * quality_vertex builds the candidates of one move in a qual_move, step
+ * by step (qual_towards, qual_gradients, qual_gradient_steps,
+ * qual_tangent_steps, qual_axis_steps), and qual_take tries them.
  */
-#include "smooth_internal.h"
+#include "quality.h"
 #include "fpenv.h"
 
 #include "souptet/mem.h"
@@ -56,6 +61,10 @@ static const double qual_sphere[] = {0.1, 0.04, 0.015};
 #define QUAL_NSPHERE (sizeof qual_sphere / sizeof qual_sphere[0])
 /* Central-difference step for the score gradient, in units of h. */
 #define QUAL_GRAD_EPS 1e-4
+/* Candidates of one move at most: the ODT and centroid steps, the two
+ * gradients' line searches, their tangential ones, the axes, the cube. */
+#define QUAL_NCAND (5 + 2 * QUAL_NSTEPS + 2 * QUAL_NTANGENT * QUAL_NSTEPS + 6 + \
+                    26 * QUAL_NSPHERE)
 
 static int cmp_cand(const void *a, const void *b)
 {
@@ -65,7 +74,6 @@ static int cmp_cand(const void *a, const void *b)
     return (x[4] > y[4]) - (x[4] < y[4]);
 }
 
-/* Try to raise the lowest score of v's star; 1 when v moved. */
 /* The sum of the area-weighted outward normals of v's boundary faces. */
 static void fair_normal(const sm_mesh *sm, uint32_t v, double n[3])
 {
@@ -89,45 +97,60 @@ static void fair_normal(const sm_mesh *sm, uint32_t v, double n[3])
         n[0] = n[1] = n[2] = 0.0;
 }
 
-static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *rejected)
+/* One quality move of v: its candidate positions and what they are
+ * built from. */
+typedef struct qual_move {
+    uint32_t v;
+    const double *x;      /* v's position */
+    double s0;            /* the lowest score of v's star as it is */
+    int tangent_only;     /* no surface, a boundary vertex: fair_boundary */
+    double gw[3], ga[3];  /* the worst tet's unit score gradient, and the
+                             sum over the tets within QUAL_ACTIVE of it */
+    double dx, nrm[3];    /* with S: the distance to it and the unit way
+                             away from it; tangent_only: 1 and the
+                             boundary's normal (0: none) */
+    int nc;
+    double cand[QUAL_NCAND][5];   /* {score, x, y, z, order} */
+} qual_move;
+
+/* Toward the ODT target (1, 1/2, 1/4 of the way) and toward the
+ * neighbours' centroid (1, 1/2). */
+static void qual_towards(const fit_ctx *c, qual_move *q)
 {
     const sm_mesh *sm = &c->sm;
-    /* no surface (after fairing): the boundary stays, or with
-     * fair_boundary moves only within its tangent plane */
-    const int tangent_only = !c->s && sm->onb[v];
-    if (tangent_only && !c->fair_boundary)
-        return 0;
-    double *x = sm->m->xyz + 3 * (size_t)v;
-    double s0 = sm_star_score(sm, v, x);
-    /* candidates: {score, x, y, z, order} */
-    double cand[5 + 2 * QUAL_NSTEPS + 6 + 2 * QUAL_NTANGENT * QUAL_NSTEPS +
-                26 * QUAL_NSPHERE][5];
-    int nc = 0;
+    const uint32_t v = q->v;
+    const double *x = q->x;
     double t[3];
     sm_odt_target(sm, v, t);
     static const double fr[] = {1.0, 0.5, 0.25};
-    for (int k = 0; k < 3; k++, nc++)
+    for (int k = 0; k < 3; k++, q->nc++)
         for (int a = 0; a < 3; a++)
-            cand[nc][1 + a] = x[a] + fr[k] * (t[a] - x[a]);
+            q->cand[q->nc][1 + a] = x[a] + fr[k] * (t[a] - x[a]);
     double cen[3] = {0, 0, 0};
     size_t deg = sm->vv_off[v + 1] - sm->vv_off[v];
     for (size_t j = sm->vv_off[v]; j < sm->vv_off[v + 1]; j++)
         for (int a = 0; a < 3; a++)
             cen[a] += sm->m->xyz[3 * (size_t)sm->vv[j] + (size_t)a] / (double)deg;
-    for (int k = 0; k < 2; k++, nc++)
+    for (int k = 0; k < 2; k++, q->nc++)
         for (int a = 0; a < 3; a++)
-            cand[nc][1 + a] = x[a] + fr[k] * (cen[a] - x[a]);
-    /* gradients (central differences) of the worst tet's score, and the
-     * sum of the unit gradients of every tet within QUAL_ACTIVE degrees of
-     * it (so that raising the worst does not just lower the next one) */
-    double ws = sm_star_score(sm, v, x);
-    double gw[3] = {0, 0, 0}, ga[3] = {0, 0, 0}, e = QUAL_GRAD_EPS * c->h, best = INFINITY;
+            q->cand[q->nc][1 + a] = x[a] + fr[k] * (cen[a] - x[a]);
+}
+
+/* The gradients (central differences) of the worst tet's score, and the
+ * sum of the unit gradients of every tet within QUAL_ACTIVE degrees of it
+ * (so that raising the worst does not just lower the next one). */
+static void qual_gradients(const fit_ctx *c, qual_move *q)
+{
+    const sm_mesh *sm = &c->sm;
+    const uint32_t v = q->v;
+    const double *x = q->x;
+    double ws = q->s0, e = QUAL_GRAD_EPS * c->h, best = INFINITY;
     for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
         const uint32_t *k = sm->m->tets + 4 * (size_t)sm->vt[j];
-        const double *q[4];
+        const double *p[4];
         for (int i = 0; i < 4; i++)
-            q[i] = sm->m->xyz + 3 * (size_t)k[i];
-        double sc = sm_tet_score(q[0], q[1], q[2], q[3]);
+            p[i] = sm->m->xyz + 3 * (size_t)k[i];
+        double sc = sm_tet_score(p[0], p[1], p[2], p[3]);
         if (sc > ws + QUAL_ACTIVE)
             continue;
         double g[3];
@@ -139,8 +162,8 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
             pm[a] -= e;
             const double *qp[4], *qm[4];
             for (int i = 0; i < 4; i++) {
-                qp[i] = k[i] == v ? pp : q[i];
-                qm[i] = k[i] == v ? pm : q[i];
+                qp[i] = k[i] == v ? pp : p[i];
+                qm[i] = k[i] == v ? pm : p[i];
             }
             g[a] = sm_tet_score(qp[0], qp[1], qp[2], qp[3]) -
                    sm_tet_score(qm[0], qm[1], qm[2], qm[3]);
@@ -149,94 +172,123 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
         if (!(gl > 0.0) || !isfinite(gl))
             continue;
         for (int a = 0; a < 3; a++)
-            ga[a] += g[a] / gl;
+            q->ga[a] += g[a] / gl;
         if (sc < best) {
             best = sc;
             for (int a = 0; a < 3; a++)
-                gw[a] = g[a] / gl;
+                q->gw[a] = g[a] / gl;
         }
     }
-    const double *dirs[2] = {gw, ga};
+}
+
+/* Line searches along both gradients. */
+static void qual_gradient_steps(const fit_ctx *c, qual_move *q)
+{
+    const double *dirs[2] = {q->gw, q->ga};
     for (int d = 0; d < 2; d++) {
         const double *g = dirs[d];
         double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
         if (gl > 0.0 && isfinite(gl))
-            for (size_t k2 = 0; k2 < QUAL_NSTEPS; k2++, nc++)
+            for (size_t k = 0; k < QUAL_NSTEPS; k++, q->nc++)
                 for (int a = 0; a < 3; a++)
-                    cand[nc][1 + a] = x[a] + qual_steps[k2] * c->h * g[a] / gl;
+                    q->cand[q->nc][1 + a] = q->x[a] + qual_steps[k] * c->h * g[a] / gl;
     }
-    /* a boundary vertex may not move away from S beyond the band (nor
-     * beyond where it is), so at the band's edge or past it (held back by
-     * a thin gap) every step with an outward component fails: search the
-     * same gradients within the tangent plane of S's distance too, and
-     * slightly inward of it, where the surface curves away */
-    double dx = 0.0, nrm[3] = {0, 0, 0};
-    if (c->s && sm->onb[v]) {
+}
+
+/* A boundary vertex may not move away from S beyond the band (nor beyond
+ * where it is), so at the band's edge or past it (held back by a thin
+ * gap) every step with an outward component fails: the same gradients
+ * within the tangent plane of S's distance too, and slightly inward of
+ * it, where the surface curves away. With tangent_only, the boundary's
+ * area-weighted normal instead (the gradient of the volume in v, so steps
+ * across it keep the volume to first order), and only those candidates. */
+static void qual_tangent_steps(const fit_ctx *c, qual_move *q)
+{
+    const sm_mesh *sm = &c->sm;
+    if (c->s && sm->onb[q->v]) {
         double cp[3];
-        dx = sm_dist_to_s(c, x, cp);
-        if (dx > 0.0)
+        q->dx = sm_dist_to_s(c, q->x, cp);
+        if (q->dx > 0.0)
             for (int a = 0; a < 3; a++)
-                nrm[a] = (x[a] - cp[a]) / dx;
+                q->nrm[a] = (q->x[a] - cp[a]) / q->dx;
     }
-    if (tangent_only) {
-        /* the boundary's area-weighted normal: the gradient of the volume
-         * in v, so steps across it keep the volume to first order; only
-         * those candidates are kept */
-        nc = 0;
-        fair_normal(sm, v, nrm);
-        dx = nrm[0] != 0.0 || nrm[1] != 0.0 || nrm[2] != 0.0 ? 1.0 : 0.0;
+    if (q->tangent_only) {
+        q->nc = 0;
+        fair_normal(sm, q->v, q->nrm);
+        q->dx = q->nrm[0] != 0.0 || q->nrm[1] != 0.0 || q->nrm[2] != 0.0 ? 1.0 : 0.0;
     }
-    if (dx > 0.0)
-        for (int d = 0; d < 2; d++) {
-            const double *g = dirs[d];
-            double gn = g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2];
-            double gt[3] = {g[0] - gn * nrm[0], g[1] - gn * nrm[1], g[2] - gn * nrm[2]};
-            double gl = sqrt(gt[0] * gt[0] + gt[1] * gt[1] + gt[2] * gt[2]);
-            if (!(gl > 0.0) || !isfinite(gl))
-                continue;
-            for (int b = 0; b < (tangent_only ? 1 : QUAL_NTANGENT); b++)
-                for (size_t k2 = 0; k2 < QUAL_NSTEPS; k2++, nc++) {
-                    double st = qual_steps[k2] * c->h;
-                    for (int a = 0; a < 3; a++)
-                        cand[nc][1 + a] = x[a] + st * (gt[a] / gl - qual_inward[b] * nrm[a]);
-                }
-        }
-    /* the six axis directions, a small step: a way out where the
-     * gradients point into the invariant */
-    for (int a = 0; a < 6 && !tangent_only; a++, nc++)
-        for (int b2 = 0; b2 < 3; b2++)
-            cand[nc][1 + b2] = x[b2] + (b2 == a / 2 ? (a & 1 ? -1.0 : 1.0) * QUAL_AXIS_STEP * c->h : 0.0);
-    /* the 26 directions to a cube's neighbours at a few step lengths:
-     * where the worst tets' gradients cancel (a plateau of equally bad
-     * tets) a step off them may still raise the lowest score */
-    for (int dz = -1; dz <= 1 && c->cube_steps && !tangent_only; dz++)
+    if (!(q->dx > 0.0))
+        return;
+    const double *dirs[2] = {q->gw, q->ga}, *nrm = q->nrm;
+    for (int d = 0; d < 2; d++) {
+        const double *g = dirs[d];
+        double gn = g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2];
+        double gt[3] = {g[0] - gn * nrm[0], g[1] - gn * nrm[1], g[2] - gn * nrm[2]};
+        double gl = sqrt(gt[0] * gt[0] + gt[1] * gt[1] + gt[2] * gt[2]);
+        if (!(gl > 0.0) || !isfinite(gl))
+            continue;
+        for (int b = 0; b < (q->tangent_only ? 1 : QUAL_NTANGENT); b++)
+            for (size_t k = 0; k < QUAL_NSTEPS; k++, q->nc++) {
+                double st = qual_steps[k] * c->h;
+                for (int a = 0; a < 3; a++)
+                    q->cand[q->nc][1 + a] =
+                        q->x[a] + st * (gt[a] / gl - qual_inward[b] * nrm[a]);
+            }
+    }
+}
+
+/* The six axis directions, a small step (a way out where the gradients
+ * point into the invariant); with cube_steps the 26 directions to a
+ * cube's neighbours at a few step lengths (where the worst tets'
+ * gradients cancel, a plateau of equally bad tets, a step off them may
+ * still raise the lowest score). Not with tangent_only. */
+static void qual_axis_steps(const fit_ctx *c, qual_move *q)
+{
+    const double *x = q->x;
+    if (q->tangent_only)
+        return;
+    for (int a = 0; a < 6; a++, q->nc++)
+        for (int b = 0; b < 3; b++)
+            q->cand[q->nc][1 + b] =
+                x[b] + (b == a / 2 ? (a & 1 ? -1.0 : 1.0) * QUAL_AXIS_STEP * c->h : 0.0);
+    for (int dz = -1; dz <= 1 && c->cube_steps; dz++)
         for (int dy = -1; dy <= 1; dy++)
             for (int dxx = -1; dxx <= 1; dxx++) {
                 if (!dxx && !dy && !dz)
                     continue;
                 double l = sqrt((double)(dxx * dxx + dy * dy + dz * dz));
-                for (size_t k2 = 0; k2 < QUAL_NSPHERE; k2++, nc++) {
-                    double st = qual_sphere[k2] * c->h / l;
-                    cand[nc][1] = x[0] + st * dxx;
-                    cand[nc][2] = x[1] + st * dy;
-                    cand[nc][3] = x[2] + st * dz;
+                for (size_t k = 0; k < QUAL_NSPHERE; k++, q->nc++) {
+                    double st = qual_sphere[k] * c->h / l;
+                    q->cand[q->nc][1] = x[0] + st * dxx;
+                    q->cand[q->nc][2] = x[1] + st * dy;
+                    q->cand[q->nc][3] = x[2] + st * dz;
                 }
             }
-    if (nc == 0)
+}
+
+/* The candidates by score, best first; the first that raises the star's
+ * lowest score by QUAL_MIN_GAIN, keeps a boundary vertex within
+ * max(d_offset, its distance) of S and keeps the invariant is taken.
+ * 1 when v moved; *rejected counts the invariant's refusals. */
+static int qual_take(const fit_ctx *c, qual_move *q, star_pts *sp, size_t *rejected)
+{
+    const sm_mesh *sm = &c->sm;
+    const uint32_t v = q->v;
+    if (q->nc == 0)
         return 0;
-    for (int i = 0; i < nc; i++) {
-        cand[i][0] = sm_star_score(sm, v, cand[i] + 1);
-        cand[i][4] = i;
+    for (int i = 0; i < q->nc; i++) {
+        q->cand[i][0] = sm_star_score(sm, v, q->cand[i] + 1);
+        q->cand[i][4] = i;
     }
-    qsort(cand, (size_t)nc, sizeof cand[0], cmp_cand);
-    if (!(cand[0][0] > s0 + QUAL_MIN_GAIN))
+    qsort(q->cand, (size_t)q->nc, sizeof q->cand[0], cmp_cand);
+    if (!(q->cand[0][0] > q->s0 + QUAL_MIN_GAIN))
         return 0;
     sm_star_pts_collect(c, v, sp);
-    double dmax = fmax(c->d_offset, dx);
-    for (int i = 0; i < nc; i++) {
-        if (!(cand[i][0] > s0 + QUAL_MIN_GAIN))
+    double dmax = fmax(c->d_offset, q->dx);
+    for (int i = 0; i < q->nc; i++) {
+        if (!(q->cand[i][0] > q->s0 + QUAL_MIN_GAIN))
             break;
-        const double *p = cand[i] + 1;
+        const double *p = q->cand[i] + 1;
         if (sm->onb[v] && c->s) {
             int64_t tri;
             double d2 = sm_nearest_d2(c, p, dmax * dmax, &tri, NULL);
@@ -244,7 +296,7 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
                 continue;
         }
         if (sm_move_ok(c, v, p, sp)) {
-            memcpy(x, p, 3 * sizeof *x);
+            memcpy(sm->m->xyz + 3 * (size_t)v, p, 3 * sizeof *p);
             return 1;
         }
         (*rejected)++;
@@ -252,59 +304,99 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
     return 0;
 }
 
-/* ST_OK, or ST_ENOMEM (err set) before any vertex moved. */
+/* Try to raise the lowest score of v's star; 1 when v moved. */
+static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *rejected)
+{
+    const sm_mesh *sm = &c->sm;
+    qual_move q;
+    q.v = v;
+    q.x = sm->m->xyz + 3 * (size_t)v;
+    /* no surface (after fairing): the boundary stays, or with
+     * fair_boundary moves only within its tangent plane */
+    q.tangent_only = !c->s && sm->onb[v];
+    if (q.tangent_only && !c->fair_boundary)
+        return 0;
+    q.s0 = sm_star_score(sm, v, q.x);
+    q.nc = 0;
+    q.dx = 0.0;
+    for (int a = 0; a < 3; a++)
+        q.gw[a] = q.ga[a] = q.nrm[a] = 0.0;
+    qual_towards(c, &q);
+    qual_gradients(c, &q);
+    qual_gradient_steps(c, &q);
+    qual_tangent_steps(c, &q);
+    qual_axis_steps(c, &q);
+    return qual_take(c, &q, sp, rejected);
+}
+
+/* Mark the corners of the tets scoring below goal; the count of those. */
+static size_t qual_mark(const st_tetmesh *m, double goal, unsigned char *mark)
+{
+    size_t nbad = 0;
+    for (size_t t = 0; t < m->ntets; t++) {
+        const uint32_t *k = m->tets + 4 * t;
+        double sc = sm_tet_score(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
+                                 m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]);
+        if (sc < goal) {
+            nbad++;
+            for (int i = 0; i < 4; i++)
+                mark[k[i]] = 1;
+        }
+    }
+    return nbad;
+}
+
+/* One colour set's quality moves of the marked vertices, in parallel;
+ * *moved and *rejected count. */
+static void qual_colour(const fit_ctx *c, size_t col, const unsigned char *mark, dirty *dy,
+                        size_t *moved, size_t *rejected)
+{
+    const sm_mesh *sm = &c->sm;
+    size_t mv = 0, rj = 0;
+    dy->step++;
+    #pragma omp parallel reduction(+ : mv, rj) \
+        if (PAR_CHECKED(sm->col_off[col + 1] - sm->col_off[col]))
+    {
+        star_pts sp = STAR_PTS_INIT;
+        #pragma omp for schedule(dynamic, 8)
+        for (size_t j = sm->col_off[col]; j < sm->col_off[col + 1]; j++) {
+            uint32_t v = sm->col_v[j];
+            if (mark[v] && !sm_dirty_unchanged(dy, sm, v)) {
+                int k = quality_vertex(c, v, &sp, &rj);
+                sm_dirty_mark(dy, v, k);
+                mv += (size_t)k;
+            }
+        }
+        free(sp.list);
+    }
+    *moved += mv;
+    *rejected += rj;
+}
+
 st_status sm_quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
-                              st_fit_stats *st, double t0, st_error *err)
+                          st_fit_stats *st, double t0, st_error *err)
 {
     sm_mesh *sm = &c->sm;
-    st_tetmesh *m = sm->m;
-    unsigned char *mark = st_calloc_array(sm->nv, 1);
+    st_status rc = ST_OK;
     dirty dy;
+    memset(&dy, 0, sizeof dy);
+    unsigned char *mark = st_calloc_array(sm->nv, 1);
     if (!mark || sm_dirty_init(&dy, sm->nv)) {
-        free(mark);
-        sm_dirty_free(&dy);
-        return st_error_set(err, ST_ENOMEM, NULL, 0,
-                            "out of memory for the quality pass (%zu vertices)", sm->nv);
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0,
+                          "out of memory for the quality pass (%zu vertices)", sm->nv);
+        goto done;
     }
     for (int round = 0; round < p->quality_rounds; round++) {
         if (st_progress_cancelled(c->prog)) {
-            free(mark);
-            sm_dirty_free(&dy);
-            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+            rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+            goto done;
         }
         memset(mark, 0, sm->nv);
-        size_t nbad = 0;
-        for (size_t t = 0; t < m->ntets; t++) {
-            const uint32_t *k = m->tets + 4 * t;
-            double sc = sm_tet_score(m->xyz + 3 * (size_t)k[0], m->xyz + 3 * (size_t)k[1],
-                                     m->xyz + 3 * (size_t)k[2], m->xyz + 3 * (size_t)k[3]);
-            if (sc < p->quality_goal) {
-                nbad++;
-                for (int i = 0; i < 4; i++)
-                    mark[k[i]] = 1;
-            }
-        }
-        if (nbad == 0)
+        if (qual_mark(sm->m, p->quality_goal, mark) == 0)
             break;
         size_t moved = 0, rejected = 0;
-        for (size_t col = 0; col < sm->ncolours; col++) {
-            dy.step++;
-            #pragma omp parallel reduction(+ : moved, rejected) \
-                if (PAR_CHECKED(sm->col_off[col + 1] - sm->col_off[col]))
-            {
-                star_pts sp = {NULL, 0, 0, 1, 0, 0, 0, 0};
-                #pragma omp for schedule(dynamic, 8)
-                for (size_t j = sm->col_off[col]; j < sm->col_off[col + 1]; j++) {
-                    uint32_t v = sm->col_v[j];
-                    if (mark[v] && !sm_dirty_unchanged(&dy, sm, v)) {
-                        int k = quality_vertex(c, v, &sp, &rejected);
-                        sm_dirty_mark(&dy, v, k);
-                        moved += (size_t)k;
-                    }
-                }
-                free(sp.list);
-            }
-        }
+        for (size_t col = 0; col < sm->ncolours; col++)
+            qual_colour(c, col, mark, &dy, &moved, &rejected);
         st->quality_rounds = round + 1;
         st->quality_moves += moved;
         if (p->on_iter && c->s) {
@@ -315,13 +407,15 @@ st_status sm_quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
         if (moved == 0)
             break;
     }
+done:
     free(mark);
     sm_dirty_free(&dy);
-    return ST_OK;
+    return rc;
 }
 
 /* The quality pass on a borrowed mesh (fairing's), with or without the
- * boundary's tangent moves. */
+ * boundary's tangent moves. No surface: of the fit's parameters only the
+ * rounds and the goal count (no on_iter). */
 static st_status quality_on(sm_mesh *sm, double h, int rounds, double goal, int boundary,
                             size_t *moves, st_error *err)
 {
@@ -330,7 +424,8 @@ static st_status quality_on(sm_mesh *sm, double h, int rounds, double goal, int 
     c.sm = *sm;   /* borrowed: not freed here */
     c.h = h;
     c.fair_boundary = boundary;
-    st_fit_params p = st_fit_params_default();
+    st_fit_params p;
+    memset(&p, 0, sizeof p);
     p.quality_rounds = rounds;
     p.quality_goal = goal;
     st_fit_stats st;

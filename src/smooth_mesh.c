@@ -1,13 +1,14 @@
 /*
  * smooth_mesh.c - incidence, colouring and local checks shared by the
- * vertex-moving passes (fair.c, fit.c, quality.c); see smooth_internal.h.
+ * vertex-moving passes (fair.c, fit.c, quality.c, invariant.c; see
+ * smooth_mesh.h).
  *
  * Colouring: greedy in vertex order over the edge graph. In a tet every
  * pair of corners is an edge, so two vertices of one colour never share a
  * tet: moving all of a colour at once, each checked against its own star,
  * gives the same result as moving them one by one, in any thread order.
  */
-#include "smooth_internal.h"
+#include "smooth_mesh.h"
 #include "fpenv.h"
 
 #include "souptet/geom.h"

@@ -19,7 +19,7 @@
 #include "cubetets.h"
 #include "shapes.h"
 #include "tap.h"
-#include "../src/smooth_internal.h"
+#include "../src/smooth_mesh.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -563,7 +563,7 @@ static int boundary_manifold(const st_tetmesh *m)
     return ok;
 }
 
-/* The lowest tet score of m (smooth_internal.h). */
+/* The lowest tet score of m (smooth_mesh.h). */
 static double min_score(const st_tetmesh *m)
 {
     double lo = INFINITY;

@@ -1,0 +1,85 @@
+/*
+ * smooth_mesh.h - the mesh the vertex-moving passes work on (private;
+ * smooth_mesh.c): a tet mesh's incidence (vertex -> tets, vertex ->
+ * vertices, boundary faces), a colouring of its vertices into independent
+ * sets, and the scores and exact star checks every pass uses (fair.c,
+ * fit.c, quality.c and the fit's invariant, invariant.c).
+ *
+ * Units: the mesh's; scores and dihedral angles in degrees.
+ * Ownership: sm_mesh borrows its st_tetmesh (whose xyz the passes move in
+ *   place) and owns its arrays (sm_mesh_free).
+ * Threads: the queries read only; vertices of one colour share no tet, so
+ *   each may move in parallel while the others' stars stay as they are.
+ * Errors: sm_mesh_build returns ST_ENOMEM (err set); the rest cannot fail.
+ */
+#ifndef SOUPTET_SMOOTH_MESH_H
+#define SOUPTET_SMOOTH_MESH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "souptet/err.h"
+#include "souptet/tetmesh.h"
+
+/* When a loop is worth a parallel region: each region costs a barrier,
+ * and on a loaded machine a barrier among spinning threads costs
+ * milliseconds (fairing the bunny at 12 cells took 14 s on 2 threads under
+ * load, 0.5 s on one), so small colour sets run serially. The thresholds
+ * are items per region for cheap items (a few flops), vertex moves (a star
+ * of ~20 tets) and checked moves (exact tests against the surface). The
+ * result does not depend on them. */
+#define PAR_CHEAP(n) ((n) > 8192)
+#define PAR_MOVES(n) ((n) > 512)
+#define PAR_CHECKED(n) ((n) > 64)
+
+typedef struct sm_mesh {
+    st_tetmesh *m;            /* borrowed; xyz is moved in place */
+    size_t nv, nt;
+    size_t *vt_off;           /* vertex -> incident tets (CSR, nv + 1) */
+    uint32_t *vt;
+    size_t *vv_off;           /* vertex -> edge neighbours (CSR) */
+    uint32_t *vv;
+    uint32_t *bf;             /* boundary faces, 3 each, outward */
+    size_t nbf;
+    size_t *vf_off;           /* vertex -> boundary faces (CSR) */
+    uint32_t *vf;
+    unsigned char *onb;       /* 1 for a boundary vertex */
+    size_t nbv;               /* boundary vertex count */
+    size_t *bv_off;           /* boundary vertex -> boundary edge nbrs */
+    uint32_t *bv;
+    size_t ncolours;          /* vertices grouped by colour: a colour set */
+    size_t *col_off;          /* shares no tet, so its vertices can move */
+    uint32_t *col_v;          /* at once (ncolours + 1 offsets) */
+} sm_mesh;
+
+/* Build the incidence of m (which must have tets). */
+st_status sm_mesh_build(sm_mesh *sm, st_tetmesh *m, st_error *err);
+void sm_mesh_free(sm_mesh *sm);
+
+/* Count tets that are not positively oriented (exact). */
+size_t sm_count_nonpositive(const st_tetmesh *m);
+
+/* 1 when every tet of v's star is positively oriented (exact) with v at p. */
+int sm_star_positive(const sm_mesh *sm, uint32_t v, const double p[3]);
+
+/* The score of a tet: min(min dihedral, ST_FIT_MAX_WEIGHT * (180 - max)). */
+double sm_tet_score(const double *a, const double *b, const double *c,
+                    const double *d);
+/* The lowest tet score of v's star with v at p. */
+double sm_star_score(const sm_mesh *sm, uint32_t v, const double p[3]);
+
+/* Min and max dihedral over all tets (parallel, deterministic). */
+void sm_dihedral_range(const st_tetmesh *m, double *mind, double *maxd);
+
+/* The volume-weighted mean of the circumcenters of v's tets (ODT target,
+ * Alliez et al. 2005); v's position when its star has no volume. */
+void sm_odt_target(const sm_mesh *sm, uint32_t v, double out[3]);
+
+/* The volume enclosed by the boundary faces (divergence theorem) with the
+ * points at xyz (3 per mesh point): the mesh volume, for a conforming mesh. */
+double sm_boundary_volume(const sm_mesh *sm, const double *xyz);
+
+/* Monotonic seconds. */
+double sm_now(void);
+
+#endif
