@@ -42,7 +42,9 @@
  * only in proportion to the bytes it has read.
  */
 #include "fpenv.h"
-#include "soup_parse.h"
+#include "bytes.h"
+#include "soup_internal.h"
+#include "soupread.h"
 #include "souptet/mem.h"
 
 #include <errno.h>
@@ -572,40 +574,20 @@ static size_t ctype_size(int ct)
 
 /* ---- buffers ------------------------------------------------------------ */
 
-static int b64val(unsigned char c)
-{
-    if (c >= 'A' && c <= 'Z') return c - 'A';
-    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-    if (c >= '0' && c <= '9') return c - '0' + 52;
-    if (c == '+' || c == '-') return 62;
-    if (c == '/' || c == '_') return 63;
-    return -1;
-}
-
-/* Decode base64 text (padding optional) into a new buffer. */
+/* Decode base64 text (padding optional, the URL-safe alphabet too) into
+ * a new buffer. */
 static st_status decode_b64(gltf *g, size_t bi, const char *s, size_t n,
                             buffer *b)
 {
     unsigned char *out = malloc(n / 4 * 3 + 3);
     if (!out)
         return st_error_set(g->err, ST_ENOMEM, g->name, 0, "out of memory");
-    size_t o = 0;
-    unsigned acc = 0;
-    int bits = 0;
-    size_t i = 0;
-    for (; i < n && s[i] != '='; i++) {
-        int v = b64val((unsigned char)s[i]);
-        if (v < 0) {
-            free(out);
-            return gbad(g, "/buffers/%zu/uri: bad base64 at character %zu",
-                        bi, i);
-        }
-        acc = acc << 6 | (unsigned)v;
-        bits += 6;
-        if (bits >= 8) {
-            bits -= 8;
-            out[o++] = (unsigned char)(acc >> bits);
-        }
+    size_t i;
+    size_t o = st_b64_decode((const unsigned char *)s, n, ST_B64_URL, out, &i);
+    if (i < n && s[i] != '=') {
+        free(out);
+        return gbad(g, "/buffers/%zu/uri: bad base64 at character %zu",
+                    bi, i);
     }
     for (; i < n; i++)
         if (s[i] != '=') {
@@ -919,10 +901,8 @@ static st_status get_accessor(gltf *g, size_t ai, accessor *a)
         for (size_t k = 0; k < sc; k++) {
             const unsigned char *p = a->sidx + k * is;
             size_t x = is == 1 ? p[0]
-                     : is == 2 ? (size_t)(p[0] | p[1] << 8)
-                               : (size_t)((uint32_t)p[0] | (uint32_t)p[1] << 8 |
-                                          (uint32_t)p[2] << 16 |
-                                          (uint32_t)p[3] << 24);
+                     : is == 2 ? (size_t)st_le16(p)
+                               : (size_t)st_le32(p);
             if (x >= count || (k > 0 && x <= prev))
                 return gbad(g, "/accessors/%zu/sparse/indices: index %zu "
                                "(entry %zu) is %s",
@@ -947,21 +927,19 @@ static double read_comp(const unsigned char *p, int ct, int normalized)
         return normalized ? v / 255.0 : v;
     }
     case 5122: {
-        double v = (double)(int16_t)(uint16_t)(p[0] | p[1] << 8);
+        double v = (double)(int16_t)(uint16_t)st_le16(p);
         return normalized ? fmax(v / 32767.0, -1.0) : v;
     }
     case 5123: {
-        double v = (double)(uint16_t)(p[0] | p[1] << 8);
+        double v = (double)st_le16(p);
         return normalized ? v / 65535.0 : v;
     }
     case 5125: {
-        double v = (double)((uint32_t)p[0] | (uint32_t)p[1] << 8 |
-                            (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24);
+        double v = (double)st_le32(p);
         return normalized ? v / 4294967295.0 : v;
     }
     case 5126: {
-        uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 |
-                     (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+        uint32_t u = st_le32(p);
         float f;
         memcpy(&f, &u, 4);
         return f;
@@ -982,10 +960,8 @@ static void acc_read(const accessor *a, size_t i, double *out)
             size_t mid = lo + (hi - lo) / 2;
             const unsigned char *q = a->sidx + mid * is;
             size_t x = is == 1 ? q[0]
-                     : is == 2 ? (size_t)(q[0] | q[1] << 8)
-                               : (size_t)((uint32_t)q[0] | (uint32_t)q[1] << 8 |
-                                          (uint32_t)q[2] << 16 |
-                                          (uint32_t)q[3] << 24);
+                     : is == 2 ? (size_t)st_le16(q)
+                               : (size_t)st_le32(q);
             if (x == i) {
                 p = a->sval + mid * cs * (size_t)a->ncomp;
                 break;
@@ -1395,12 +1371,6 @@ static st_status read_document(gltf *g)
     return st;
 }
 
-static uint32_t le32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
-           (uint32_t)p[3] << 24;
-}
-
 st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
                               size_t size, const char *name, const char *path,
                               const st_soup__file_hook *hook,
@@ -1418,12 +1388,12 @@ st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
     const unsigned char *js = data;
     size_t jn = size;
     st_status st = ST_OK;
-    if (size >= 4 && le32(data) == GLB_MAGIC) {
+    if (size >= 4 && st_le32(data) == GLB_MAGIC) {
         if (size < 20)
             return st_error_set_offset(err, ST_EINPUT, name, 0,
                                        "GLB: %zu bytes, shorter than its "
                                        "headers", size);
-        uint32_t version = le32(data + 4), length = le32(data + 8);
+        uint32_t version = st_le32(data + 4), length = st_le32(data + 8);
         if (version != 2)
             return st_error_set_offset(err, ST_EINPUT, name, 4,
                                        "GLB version %lu (only 2 is read)",
@@ -1438,7 +1408,7 @@ st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
                                        "GLB length %lu, shorter than its "
                                        "headers", (unsigned long)length);
         size_t pos = 12;
-        uint32_t clen = le32(data + pos), ctype = le32(data + pos + 4);
+        uint32_t clen = st_le32(data + pos), ctype = st_le32(data + pos + 4);
         if (ctype != GLB_JSON)
             return st_error_set_offset(err, ST_EINPUT, name, 16,
                                        "GLB: the first chunk is not JSON");
@@ -1450,7 +1420,7 @@ st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
         jn = clen;
         pos = 20 + (size_t)clen;
         if (length - pos >= 8) {
-            uint32_t blen = le32(data + pos), btype = le32(data + pos + 4);
+            uint32_t blen = st_le32(data + pos), btype = st_le32(data + pos + 4);
             if (btype == GLB_BIN) {
                 if (blen > length - pos - 8)
                     return st_error_set_offset(err, ST_EINPUT, name,
