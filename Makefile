@@ -70,8 +70,8 @@ LDFLAGS_ALL := $(OPT) -fopenmp $(LDFLAGS)
 
 # Two libraries. libsouptet: the C core (soups, fields, signs, lattices,
 # fit, embedding, the .msh/.node/.ele/.mesh formats), needing libgomp,
-# libxxhash and libm alone: what the Python module and the Blender add-on
-# link. libsouptet-io: what needs OpenVDB or VTK (.vdb/.vti fields, the
+# libxxhash, libjansson (glTF's JSON), zlib and libm alone: what the
+# Python module and the Blender add-on link. libsouptet-io: what needs OpenVDB or VTK (.vdb/.vti fields, the
 # .vtu front door, the wrap's volumeToMesh), on top of the core: what the
 # tools link too. Each as a static archive (the tools and tests) and a
 # shared library with a soname, exporting only the names its public
@@ -92,7 +92,7 @@ LIBA      := $(LIBA_IO) $(LIBA_CORE)
 SOVERSION := 0
 LIBSO_CORE := $(BUILD)/libsouptet.so.$(VERSION)
 LIBSO_IO   := $(BUILD)/libsouptet-io.so.$(VERSION)
-CORE_LIBS := -lxxhash -lz $(OMPLIB) -lm
+CORE_LIBS := -lxxhash -ljansson -lz $(OMPLIB) -lm
 IO_LIBS   := -lopenvdb -ltbb -lImath-3_1 \
         -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
         -lvtkCommonDataModel-9.1 -lvtkCommonMath-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1

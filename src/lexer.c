@@ -22,51 +22,6 @@ void st_text_init(st_text *t, const unsigned char *data,
     t->flags = flags;
 }
 
-/* Skip blanks on the current line; with ST_TEXT_CONT also a backslash that
- * ends a line, continuing on the next one. Stops at '\n', a token or end. */
-void st_text_skip_blank(st_text *t)
-{
-    for (;;) {
-        while (t->p < t->end && st_text_blank(*t->p))
-            t->p++;
-        if (!(t->flags & ST_TEXT_CONT) || t->p == t->end || *t->p != '\\')
-            return;
-        const unsigned char *q = t->p + 1;
-        while (q < t->end && *q == '\r')
-            q++;
-        if (q == t->end) {              /* a lone backslash at the end */
-            t->p = q;
-            return;
-        }
-        if (*q != '\n')
-            return;                     /* an ordinary backslash token */
-        t->p = q + 1;
-        t->line++;
-    }
-}
-
-/* True at the end of the current line (after blanks): '\n', end of buffer
- * or, with ST_TEXT_HASH, a comment. */
-int st_text_at_eol(st_text *t)
-{
-    st_text_skip_blank(t);
-    return t->p == t->end || *t->p == '\n' ||
-           ((t->flags & ST_TEXT_HASH) && *t->p == '#');
-}
-
-/* The next token on the current line: *tok and its length, 0 at the end of
- * the line (the cursor then stays there). */
-size_t st_text_token(st_text *t, const unsigned char **tok)
-{
-    if (st_text_at_eol(t))
-        return 0;
-    const unsigned char *s = t->p;
-    while (t->p < t->end && *t->p != '\n' && !st_text_blank(*t->p))
-        t->p++;
-    *tok = s;
-    return (size_t)(t->p - s);
-}
-
 /* The rest of the current line as one name: blanks at both ends trimmed
  * (a backslash continuation is not followed: names are one line). The
  * cursor stays where it was. */
@@ -82,33 +37,6 @@ size_t st_text_rest(const st_text *t, const unsigned char **name)
         q--;
     *name = p;
     return (size_t)(q - p);
-}
-
-/* Move to the start of the next line (or to the end). */
-void st_text_next_line(st_text *t)
-{
-    const unsigned char *nl =
-        memchr(t->p, '\n', (size_t)(t->end - t->p));
-    if (!nl) {
-        t->p = t->end;
-        return;
-    }
-    t->p = nl + 1;
-    t->line++;
-}
-
-/* The next token anywhere: skips blank lines and (with ST_TEXT_HASH)
- * comments. 0 at the end of the buffer. */
-size_t st_text_token_any(st_text *t, const unsigned char **tok)
-{
-    for (;;) {
-        size_t n = st_text_token(t, tok);
-        if (n)
-            return n;
-        if (t->p == t->end)
-            return 0;
-        st_text_next_line(t);
-    }
 }
 
 /* The line to blame for "the file ends here": the last line that exists

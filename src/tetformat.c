@@ -70,7 +70,7 @@ st_tetformat st_tetformat_sniff(const unsigned char *data, size_t size)
         return ST_TETFORMAT_VTU;
     st_text t;
     st_text_init(&t, data, size, ST_TEXT_HASH);
-    const unsigned char *tok;
+    const unsigned char *tok = NULL;
     size_t n = st_text_token_any(&t, &tok);
     if (st_tok_eq(tok, n, "$MeshFormat"))
         return ST_TETFORMAT_MSH;
