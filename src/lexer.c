@@ -39,6 +39,19 @@ size_t st_text_rest(const st_text *t, const unsigned char **name)
     return (size_t)(q - p);
 }
 
+const unsigned char *st_text_line(const unsigned char *p,
+                                  const unsigned char *end,
+                                  const unsigned char **q,
+                                  const unsigned char **e)
+{
+    const unsigned char *nl = memchr(p, '\n', (size_t)(end - p));
+    *e = nl ? nl : end;
+    *q = p;
+    while (*q < *e && st_text_blank(**q))
+        ++*q;
+    return nl ? nl + 1 : end;
+}
+
 /* The line to blame for "the file ends here": the last line that exists
  * (a final '\n' does not start a new one). */
 long long st_text_eof_line(const st_text *t)
@@ -78,6 +91,24 @@ static const double pow10_exact[23] = {
 /* The longest token handed to strtod; longer ones are not numbers we take. */
 #define SLOW_MAX 400
 
+/* One more digit d of the mantissa (frac: after the point): the first 19
+ * significant ones into m (nd of them), a later one only moves the power
+ * of ten e10 (before the point) and marks the value inexact (not 0). */
+static inline void take_digit(uint64_t *m, int *nd, long *e10, int *inexact,
+                              unsigned d, int frac)
+{
+    if (*nd < 19) {
+        if (*m || d) {
+            *m = *m * 10 + d;
+            ++*nd;
+        }
+        *e10 -= frac;
+    } else {
+        *e10 += !frac;
+        *inexact |= d != 0;
+    }
+}
+
 st_status st_text_double(const unsigned char *tok, size_t n, double *out)
 {
     /*
@@ -99,30 +130,12 @@ st_status st_text_double(const unsigned char *tok, size_t n, double *out)
     long e10 = 0;
     for (; i < n && tok[i] >= '0' && tok[i] <= '9'; i++) {
         digits = 1;
-        unsigned d = (unsigned)(tok[i] - '0');
-        if (nd < 19) {
-            if (m || d) {
-                m = m * 10 + d;
-                nd++;
-            }
-        } else {
-            e10++;
-            inexact |= d != 0;
-        }
+        take_digit(&m, &nd, &e10, &inexact, (unsigned)(tok[i] - '0'), 0);
     }
     if (i < n && tok[i] == '.') {
         for (i++; i < n && tok[i] >= '0' && tok[i] <= '9'; i++) {
             digits = 1;
-            unsigned d = (unsigned)(tok[i] - '0');
-            if (nd < 19) {
-                if (m || d) {
-                    m = m * 10 + d;
-                    nd++;
-                }
-                e10--;
-            } else {
-                inexact |= d != 0;
-            }
+            take_digit(&m, &nd, &e10, &inexact, (unsigned)(tok[i] - '0'), 1);
         }
     }
     if (!digits)

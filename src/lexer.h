@@ -125,6 +125,14 @@ static inline size_t st_text_token_any(st_text *t, const unsigned char **tok)
  * cursor stays where it was. */
 size_t st_text_rest(const st_text *t, const unsigned char **name);
 
+/* The line at p (p < end), outside any cursor: its first byte that is
+ * not blank in *q, its end ('\n' or end) in *e; returns the start of the
+ * next line (end after the last). */
+const unsigned char *st_text_line(const unsigned char *p,
+                                  const unsigned char *end,
+                                  const unsigned char **q,
+                                  const unsigned char **e);
+
 /* The line to blame for "the file ends here": the last line that exists
  * (a final '\n' does not start a new one). */
 long long st_text_eof_line(const st_text *t);

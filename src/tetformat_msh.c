@@ -442,11 +442,7 @@ static const unsigned char *find_end(const unsigned char *p,
                                      const unsigned char *name, size_t nn)
 {
     while (p < end) {
-        const unsigned char *nl = memchr(p, '\n', (size_t)(end - p));
-        const unsigned char *e = nl ? nl : end;
-        const unsigned char *q = p;
-        while (q < e && st_text_blank(*q))
-            q++;
+        const unsigned char *q, *e, *next = st_text_line(p, end, &q, &e);
         if ((size_t)(e - q) >= 4 + nn && memcmp(q, "$End", 4) == 0 &&
             memcmp(q + 4, name, nn) == 0) {
             const unsigned char *z = q + 4 + nn;
@@ -455,7 +451,7 @@ static const unsigned char *find_end(const unsigned char *p,
             if (z == e)
                 return p;
         }
-        p = nl ? nl + 1 : end;
+        p = next;
     }
     return NULL;
 }

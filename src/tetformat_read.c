@@ -41,30 +41,29 @@ st_status st_rd_room(rd *r, size_t extra_points, size_t extra_tets)
     return ST_OK;
 }
 
-st_status st_rd_point(rd *r, const double p[3])
+/* A point p or a tet v (the other NULL), within max_bytes. */
+static st_status rd_add(rd *r, const double *p, const uint32_t *v)
 {
-    st_status s = st_rd_room(r, 1, 0);
+    st_status s = st_rd_room(r, p ? 1 : 0, p ? 0 : 1);
     if (s)
         return s;
     st_error e;
     st_error_clear(&e);
-    s = st_tetmesh_add_point(r->m, p, &e);
+    s = p ? st_tetmesh_add_point(r->m, p, &e)
+          : st_tetmesh_add_tet(r->m, v[0], v[1], v[2], v[3], &e);
     if (s)
         return st_rd_fail_at(r, s, r->t.p, "%s", e.msg);
     return ST_OK;
 }
 
+st_status st_rd_point(rd *r, const double p[3])
+{
+    return rd_add(r, p, NULL);
+}
+
 st_status st_rd_tet(rd *r, const uint32_t v[4])
 {
-    st_status s = st_rd_room(r, 0, 1);
-    if (s)
-        return s;
-    st_error e;
-    st_error_clear(&e);
-    s = st_tetmesh_add_tet(r->m, v[0], v[1], v[2], v[3], &e);
-    if (s)
-        return st_rd_fail_at(r, s, r->t.p, "%s", e.msg);
-    return ST_OK;
+    return rd_add(r, NULL, v);
 }
 
 /* The next token anywhere (text); fails with "what" at the end. */
@@ -77,19 +76,25 @@ st_status st_rd_token(rd *r, const unsigned char **tok, size_t *n,
     return ST_OK;
 }
 
-st_status st_rd_int(rd *r, long long *v, const char *what)
+/* The next token as an integer (iv) or a double (dv), the other NULL. */
+static st_status rd_number(rd *r, const char *what, long long *iv, double *dv)
 {
     const unsigned char *tok = NULL;
     size_t n;
     st_status s = st_rd_token(r, &tok, &n, what);
     if (s)
         return s;
-    if (st_text_int(tok, n, v) != 0) {
+    if (iv ? st_text_int(tok, n, iv) : st_text_double(tok, n, dv)) {
         char q[ST_QUOTE_SIZE];
         return rd_fail(r, "bad %s '%s'", what,
                        st_text_quote(q, sizeof q, tok, n));
     }
     return ST_OK;
+}
+
+st_status st_rd_int(rd *r, long long *v, const char *what)
+{
+    return rd_number(r, what, v, NULL);
 }
 
 /* An integer in [lo, hi]. */
@@ -106,16 +111,9 @@ st_status st_rd_int_in(rd *r, long long *v, long long lo, long long hi,
 
 st_status st_rd_double(rd *r, double *v, const char *what)
 {
-    const unsigned char *tok = NULL;
-    size_t n;
-    st_status s = st_rd_token(r, &tok, &n, what);
+    st_status s = rd_number(r, what, NULL, v);
     if (s)
         return s;
-    if (st_text_double(tok, n, v) != 0) {
-        char q[ST_QUOTE_SIZE];
-        return rd_fail(r, "bad %s '%s'", what,
-                       st_text_quote(q, sizeof q, tok, n));
-    }
     if (!isfinite(*v))
         return rd_fail(r, "%s is not finite", what);
     return ST_OK;
@@ -267,17 +265,13 @@ st_status st_rd_hash_meta(rd *r)
 {
     const unsigned char *p = r->t.begin, *end = r->t.end;
     while (p < end) {
-        const unsigned char *nl = memchr(p, '\n', (size_t)(end - p));
-        const unsigned char *e = nl ? nl : end;
-        const unsigned char *q = p;
-        while (q < e && st_text_blank(*q))
-            q++;
+        const unsigned char *q, *e, *next = st_text_line(p, end, &q, &e);
         if (q < e && *q == '#') {
             st_status s = st_rd_meta_line(r, q + 1, e);
             if (s)
                 return s;
         }
-        p = nl ? nl + 1 : end;
+        p = next;
     }
     return ST_OK;
 }
