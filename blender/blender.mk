@@ -8,7 +8,7 @@
 #
 # The add-on loads _bundled/libsouptet.so.0 by path before importing the
 # module, so the extension finds it whatever its RUNPATH; the library needs
-# only libgomp and libxxhash from the system. The module's VTK/OpenVDB part
+# only libgomp, libxxhash, libjansson and zlib from the system. The module's VTK/OpenVDB part
 # (souptet._io) stays out: the add-on writes .vtu itself. Built with the
 # Python module (release and debug configs), so make check's
 # tests/tools/blender.t finds it.

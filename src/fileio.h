@@ -2,7 +2,7 @@
  * fileio.h - the file plumbing every reader and writer shares: path
  * extensions, whole-file and standard-input reads, a file's first bytes,
  * the VTK XML sniff, and the check before a library opens a file by name.
- * Private (not installed): soup.c, gridio.c, tetio.c, tetformat*.c,
+ * Private (not installed): soupread.c, gridio.c, tetio.c, tetformat*.c,
  * vtkxml.c and the C++ adapters use it; extern "C", never prints.
  */
 #ifndef SOUPTET_FILEIO_H

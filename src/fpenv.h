@@ -6,7 +6,7 @@
  * The predicates' error bounds and expansion arithmetic (pred.c), the
  * exact segment/triangle tests (isect.c), the order-independent distance
  * minimum (dist.c), the rounding arguments of the quality scores
- * (smooth_mesh.c), the correctly rounded number parser (soup.c) and every
+ * (smooth_mesh.c), the correctly rounded number parser (lexer.c) and every
  * isfinite()/isnan() that rejects bad input assume: round to nearest even,
  * each operation rounded once to double, no reassociation, no reciprocal
  * or contraction rewrites, and NaN and infinity that exist. -ffast-math

@@ -104,6 +104,18 @@ void st_grid_center(const st_grid *g, size_t i, size_t j, size_t k,
     p[2] = g->origin[2] + g->voxel * (double)k;
 }
 
+int st_grid_voxel_of(const st_grid *g, const double p[3], size_t ijk[3])
+{
+    size_t n[3] = {g->nx, g->ny, g->nz};
+    for (int a = 0; a < 3; a++) {
+        double f = floor((p[a] - g->origin[a]) / g->voxel + 0.5);
+        if (!(f >= 0) || !(f < (double)n[a]))
+            return 0;
+        ijk[a] = (size_t)f;
+    }
+    return 1;
+}
+
 const char *st_grid_kind_name(st_grid_kind kind)
 {
     switch (kind) {

@@ -608,18 +608,6 @@ void st_voxel_summary_free(st_voxel_summary *s)
     free(s);
 }
 
-int st_grid_voxel_of(const st_grid *g, const double p[3], size_t ijk[3])
-{
-    size_t n[3] = {g->nx, g->ny, g->nz};
-    for (int a = 0; a < 3; a++) {
-        double f = floor((p[a] - g->origin[a]) / g->voxel + 0.5);
-        if (!(f >= 0) || !(f < (double)n[a]))
-            return 0;
-        ijk[a] = (size_t)f;
-    }
-    return 1;
-}
-
 /* A filtered test of "p is outside the closed tet", exact-equivalent to
  * st_point_in_tet(...) == ST_OUTSIDE: each face plane's value n.(p - a),
  * n = (b - a) x (c - a), is computed in double together with a bound on its

@@ -36,16 +36,22 @@
  * Errors name a JSON pointer (/accessors/3) or a byte offset (JSON syntax,
  * GLB structure).
  *
- * JSON: a small parser here (RFC 8259), not a library: glTF needs only a
- * tree of the document, the parser is fuzzed with the reader, gives byte
- * offsets, limits nesting (64 levels; glTF needs under 10) and allocates
- * only in proportion to the bytes it has read.
+ * JSON: jansson (json_loadb on the unterminated buffer), fuzzed with the
+ * reader. Its syntax errors are reported at byte offsets in this reader's
+ * words (json_what); nesting is limited to 64 levels (glTF needs under
+ * 10) by a pre-scan of the brackets and quotes. Numbers are read as
+ * doubles (one too large for a double is an error); strings must be
+ * UTF-8 (RFC 8259, glTF 3.2); of duplicate member names the last counts
+ * (jansson's rule, JavaScript's JSON.parse's).
  */
 #include "fpenv.h"
-#include "soup_parse.h"
+#include "bytes.h"
+#include "soup_internal.h"
+#include "soupread.h"
 #include "souptet/mem.h"
 
 #include <errno.h>
+#include <jansson.h>
 #include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
@@ -58,409 +64,168 @@
 /* ==== JSON ================================================================ */
 
 #define JSON_MAX_DEPTH 64      /* glTF documents nest less than 10 deep */
-#define JSON_MAX_NUMBER 320    /* characters of one number token */
 
-typedef enum jtype { J_NULL, J_BOOL, J_NUM, J_STR, J_ARR, J_OBJ } jtype;
-
-typedef struct jnode {
-    jtype type;
-    size_t off;          /* byte offset in the JSON text */
-    size_t parent;       /* SIZE_MAX for the root */
-    double num;          /* J_NUM, J_BOOL (0/1) */
-    size_t str, slen;    /* J_STR: decoded bytes in the string arena */
-    size_t key, klen;    /* member of an object: its decoded key */
-    size_t first, count; /* J_ARR/J_OBJ: children in kids[first..] */
-} jnode;
-
-typedef struct json {
-    jnode *nodes;
-    size_t n, cap;
-    char *arena;         /* decoded strings, each NUL-terminated */
-    size_t an, acap;
-    size_t *kids;        /* children of every container, in order */
-    const unsigned char *p, *begin, *end;
-    const char *name;
-    st_error *err;
-} json;
-
-static st_status jerr(json *j, const unsigned char *at, const char *what)
+/* Member k of object o, element i of array a: NULL when absent or when o,
+ * a is not an object, an array (or NULL). */
+static const json_t *jget(const json_t *o, const char *k)
 {
-    return st_error_set_offset(j->err, ST_EINPUT, j->name,
-                               (long long)(at - j->begin),
-                               "JSON: %s", what);
+    return json_is_object(o) ? json_object_get(o, k) : NULL;
 }
 
-static st_status joom(json *j)
+static const json_t *jat(const json_t *a, size_t i)
 {
-    return st_error_set(j->err, ST_ENOMEM, j->name, 0, "out of memory");
+    return json_is_array(a) ? json_array_get(a, i) : NULL;
 }
 
-static void jskip(json *j)
-{
-    while (j->p < j->end && (*j->p == ' ' || *j->p == '\t' ||
-                             *j->p == '\n' || *j->p == '\r'))
-        j->p++;
-}
+/* What a pass over the brackets and quotes of the text finds: the offset
+ * of the first '[' or '{' nested more than JSON_MAX_DEPTH deep, and of the
+ * opening quote of a string the text ends in (-1: none). */
+typedef struct json_scan {
+    long long deep, open_quote;
+} json_scan;
 
-static st_status jnew(json *j, jtype type, size_t parent, size_t *out)
+static json_scan json_prescan(const unsigned char *p, size_t n)
 {
-    if (j->n == j->cap) {
-        size_t nc = j->cap ? 2 * j->cap : 64;
-        jnode *nn = st_realloc_array(j->nodes, nc, sizeof *nn);
-        if (!nn)
-            return joom(j);
-        j->nodes = nn;
-        j->cap = nc;
-    }
-    jnode *x = &j->nodes[j->n];
-    memset(x, 0, sizeof *x);
-    x->type = type;
-    x->off = (size_t)(j->p - j->begin);
-    x->parent = parent;
-    *out = j->n++;
-    return ST_OK;
-}
-
-static st_status jput(json *j, const char *b, size_t n)
-{
-    if (j->acap - j->an < n) {
-        size_t nc = j->acap ? j->acap : 256;
-        while (nc - j->an < n) {
-            if (nc > SIZE_MAX / 2)
-                return joom(j);
-            nc *= 2;
-        }
-        char *na = realloc(j->arena, nc);
-        if (!na)
-            return joom(j);
-        j->arena = na;
-        j->acap = nc;
-    }
-    memcpy(j->arena + j->an, b, n);
-    j->an += n;
-    return ST_OK;
-}
-
-static int hexval(unsigned char c)
-{
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
-}
-
-static int hex4(const unsigned char *p, const unsigned char *end, unsigned *u)
-{
-    if (end - p < 4)
-        return -1;
-    unsigned v = 0;
-    for (int i = 0; i < 4; i++) {
-        int h = hexval(p[i]);
-        if (h < 0)
-            return -1;
-        v = v << 4 | (unsigned)h;
-    }
-    *u = v;
-    return 0;
-}
-
-/* A string at j->p (the opening quote): decoded into the arena. */
-static st_status jstring(json *j, size_t *at, size_t *len)
-{
-    const unsigned char *start = j->p;
-    j->p++;
-    *at = j->an;
-    for (;;) {
-        if (j->p >= j->end)
-            return jerr(j, start, "string without its closing quote");
-        unsigned char c = *j->p;
-        if (c == '"') {
-            j->p++;
-            break;
-        }
-        if (c < 0x20)
-            return jerr(j, j->p, "control character in a string");
-        if (c != '\\') {
-            const unsigned char *q = j->p;
-            while (q < j->end && *q != '"' && *q != '\\' && *q >= 0x20)
-                q++;
-            if (jput(j, (const char *)j->p, (size_t)(q - j->p)))
-                return ST_ENOMEM;
-            j->p = q;
-            continue;
-        }
-        if (j->end - j->p < 2)
-            return jerr(j, j->p, "string ends in an escape");
-        unsigned char e = j->p[1];
-        char ch;
-        switch (e) {
-        case '"': ch = '"'; break;
-        case '\\': ch = '\\'; break;
-        case '/': ch = '/'; break;
-        case 'b': ch = '\b'; break;
-        case 'f': ch = '\f'; break;
-        case 'n': ch = '\n'; break;
-        case 'r': ch = '\r'; break;
-        case 't': ch = '\t'; break;
-        case 'u': {
-            unsigned u;
-            if (hex4(j->p + 2, j->end, &u))
-                return jerr(j, j->p, "bad \\u escape");
-            const unsigned char *esc = j->p;
-            j->p += 6;
-            if (u >= 0xD800 && u <= 0xDBFF) {
-                unsigned lo;
-                if (j->end - j->p < 6 || j->p[0] != '\\' || j->p[1] != 'u' ||
-                    hex4(j->p + 2, j->end, &lo) || lo < 0xDC00 || lo > 0xDFFF)
-                    return jerr(j, esc, "unpaired UTF-16 surrogate");
-                j->p += 6;
-                u = 0x10000 + ((u - 0xD800) << 10) + (lo - 0xDC00);
-            } else if (u >= 0xDC00 && u <= 0xDFFF) {
-                return jerr(j, esc, "unpaired UTF-16 surrogate");
-            }
-            char b[4];
-            size_t n;
-            if (u < 0x80) {
-                b[0] = (char)u; n = 1;
-            } else if (u < 0x800) {
-                b[0] = (char)(0xC0 | u >> 6);
-                b[1] = (char)(0x80 | (u & 0x3F)); n = 2;
-            } else if (u < 0x10000) {
-                b[0] = (char)(0xE0 | u >> 12);
-                b[1] = (char)(0x80 | (u >> 6 & 0x3F));
-                b[2] = (char)(0x80 | (u & 0x3F)); n = 3;
-            } else {
-                b[0] = (char)(0xF0 | u >> 18);
-                b[1] = (char)(0x80 | (u >> 12 & 0x3F));
-                b[2] = (char)(0x80 | (u >> 6 & 0x3F));
-                b[3] = (char)(0x80 | (u & 0x3F)); n = 4;
-            }
-            if (jput(j, b, n))
-                return ST_ENOMEM;
-            continue;
-        }
-        default:
-            return jerr(j, j->p, "bad escape in a string");
-        }
-        if (jput(j, &ch, 1))
-            return ST_ENOMEM;
-        j->p += 2;
-    }
-    *len = j->an - *at;
-    return jput(j, "", 1);
-}
-
-static st_status jnumber(json *j, double *out)
-{
-    const unsigned char *s = j->p, *q = j->p;
-    if (q < j->end && *q == '-')
-        q++;
-    if (q >= j->end || *q < '0' || *q > '9')
-        return jerr(j, s, "unexpected character");
-    if (*q == '0')
-        q++;
-    else
-        while (q < j->end && *q >= '0' && *q <= '9')
-            q++;
-    if (q < j->end && *q == '.') {
-        q++;
-        if (q >= j->end || *q < '0' || *q > '9')
-            return jerr(j, s, "bad number");
-        while (q < j->end && *q >= '0' && *q <= '9')
-            q++;
-    }
-    if (q < j->end && (*q == 'e' || *q == 'E')) {
-        q++;
-        if (q < j->end && (*q == '+' || *q == '-'))
-            q++;
-        if (q >= j->end || *q < '0' || *q > '9')
-            return jerr(j, s, "bad number");
-        while (q < j->end && *q >= '0' && *q <= '9')
-            q++;
-    }
-    size_t n = (size_t)(q - s);
-    if (n > JSON_MAX_NUMBER)
-        return jerr(j, s, "number too long");
-    char buf[JSON_MAX_NUMBER + 1];
-    memcpy(buf, s, n);
-    buf[n] = '\0';
-    *out = strtod(buf, NULL);   /* JSON's grammar is strtod's, in "C" */
-    j->p = q;
-    return ST_OK;
-}
-
-static int jlit(json *j, const char *lit)
-{
-    size_t n = strlen(lit);
-    if ((size_t)(j->end - j->p) < n || memcmp(j->p, lit, n) != 0)
-        return 0;
-    j->p += n;
-    return 1;
-}
-
-/* One value and everything in it, iteratively (an explicit stack of open
- * containers, JSON_MAX_DEPTH deep). */
-static st_status jparse_value(json *j)
-{
-    size_t stack[JSON_MAX_DEPTH];
+    json_scan sc = {-1, -1};
     int depth = 0;
-    size_t parent = SIZE_MAX;
-    for (;;) {
-        /* A member's key first, when the open container is an object. */
-        size_t key = 0, klen = 0;
-        int has_key = 0;
-        jskip(j);
-        if (parent != SIZE_MAX) {
-            jnode *pn = &j->nodes[parent];
-            int first = pn->count == 0;
-            if (j->p < j->end &&
-                *j->p == (pn->type == J_ARR ? ']' : '}')) {
-                j->p++;
-                depth--;
-                parent = depth ? stack[depth - 1] : SIZE_MAX;
-                goto after_value;
-            }
-            if (!first) {
-                if (j->p >= j->end || *j->p != ',')
-                    return jerr(j, j->p, pn->type == J_ARR
-                                             ? "expected ',' or ']'"
-                                             : "expected ',' or '}'");
-                j->p++;
-                jskip(j);
-            }
-            if (pn->type == J_OBJ) {
-                if (j->p >= j->end || *j->p != '"')
-                    return jerr(j, j->p, "expected a member name");
-                st_status ks = jstring(j, &key, &klen);
-                if (ks)
-                    return ks;
-                jskip(j);
-                if (j->p >= j->end || *j->p != ':')
-                    return jerr(j, j->p, "expected ':'");
-                j->p++;
-                jskip(j);
-                has_key = 1;
-            }
-            j->nodes[parent].count++;
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = p[i];
+        if (sc.open_quote >= 0) {
+            if (c == '\\')
+                i++;
+            else if (c == '"')
+                sc.open_quote = -1;
+        } else if (c == '"') {
+            sc.open_quote = (long long)i;
+        } else if (c == '[' || c == '{') {
+            if (++depth > JSON_MAX_DEPTH && sc.deep < 0)
+                sc.deep = (long long)i;
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            depth--;
         }
-        if (j->p >= j->end)
-            return jerr(j, j->p, "document ends inside a value");
-        size_t id;
-        unsigned char c = *j->p;
-        st_status st;
-        if (c == '{' || c == '[') {
-            if (depth == JSON_MAX_DEPTH)
-                return jerr(j, j->p, "nested more than 64 deep");
-            if ((st = jnew(j, c == '{' ? J_OBJ : J_ARR, parent, &id)))
-                return st;
-            j->p++;
-            if (has_key) {
-                j->nodes[id].key = key;
-                j->nodes[id].klen = klen;
-            }
-            stack[depth++] = id;
-            parent = id;
-            continue;
-        }
-        if ((st = jnew(j, J_NULL, parent, &id)))
-            return st;
-        jnode *x = &j->nodes[id];
-        if (has_key) {
-            x->key = key;
-            x->klen = klen;
-        }
-        if (c == '"') {
-            size_t at, len;
-            if ((st = jstring(j, &at, &len)))
-                return st;
-            x = &j->nodes[id];
-            x->type = J_STR;
-            x->str = at;
-            x->slen = len;
-        } else if (jlit(j, "true")) {
-            x->type = J_BOOL;
-            x->num = 1;
-        } else if (jlit(j, "false")) {
-            x->type = J_BOOL;
-        } else if (jlit(j, "null")) {
-            x->type = J_NULL;
-        } else {
-            double v = 0;
-            if ((st = jnumber(j, &v)))
-                return st;
-            x->type = J_NUM;
-            x->num = v;
-        }
-    after_value:
-        if (depth == 0)
-            return ST_OK;
     }
+    return sc;
 }
 
-static void json_free(json *j)
+/* Where a message of json_what points. */
+enum { AT_TOKEN, AT_HERE, AT_BYTE, AT_ESCAPE, AT_NUMBER, AT_STRING };
+
+/* jansson's syntax messages as this reader words them, and the offset to
+ * blame in the text: the start of the token jansson quotes ("near '...'",
+ * up to 20 bytes) else jansson's position (AT_TOKEN); a control character
+ * where it stands (AT_HERE); the byte that is not UTF-8 (AT_BYTE); the
+ * backslash of a bad escape (AT_ESCAPE); the start of a number too large
+ * for a double (AT_NUMBER); the opening quote of a string the text ends
+ * in (AT_STRING). */
+static const char *json_what(const json_error_t *je, const unsigned char *text,
+                             const json_scan *sc, long long *at)
 {
-    free(j->nodes);
-    free(j->arena);
-    free(j->kids);
+    static const struct { const char *jansson, *ours; int rule; } k[] = {
+        {"unexpected token", "unexpected character", AT_TOKEN},
+        {"invalid token", "unexpected character", AT_TOKEN},
+        {"']' expected", "expected ',' or ']'", AT_TOKEN},
+        {"'}' expected", "expected ',' or '}'", AT_TOKEN},
+        {"':' expected", "expected ':'", AT_TOKEN},
+        {"string or '}' expected", "expected a member name", AT_TOKEN},
+        {"end of file expected", "text after the document", AT_TOKEN},
+        {"'[' or '{' expected", "document ends inside a value", AT_TOKEN},
+        {"premature end of input", "string without its closing quote", AT_STRING},
+        {"unexpected newline", "control character in a string", AT_HERE},
+        {"control character", "control character in a string", AT_HERE},
+        {"invalid escape", "bad escape in a string", AT_ESCAPE},
+        {"invalid Unicode", "unpaired UTF-16 surrogate", AT_ESCAPE},
+        {"real number overflow", "number out of range", AT_NUMBER},
+        {"unable to decode byte", "not UTF-8", AT_BYTE},
+    };
+    const char *t = je->text, *what = t;
+    int rule = AT_TOKEN;
+    for (size_t i = 0; i < sizeof k / sizeof k[0]; i++)
+        if (strncmp(t, k[i].jansson, strlen(k[i].jansson)) == 0) {
+            what = k[i].ours;
+            rule = k[i].rule;
+        }
+    const char *near = strstr(t, " near '"), *q = NULL;
+    size_t tlen = strlen(t), qlen = 0;
+    if (near && t[tlen - 1] == '\'') {
+        q = near + 7;
+        qlen = (size_t)(t + tlen - 1 - q);
+    }
+    const long long pos = je->position;
+    *at = q && (size_t)pos >= qlen ? pos - (long long)qlen : pos;
+    switch (rule) {
+    case AT_HERE:
+        *at = pos;
+        break;
+    case AT_BYTE:
+        *at = pos > 0 ? pos - 1 : 0;
+        break;
+    case AT_STRING:
+        if (!q && sc->open_quote >= 0)
+            *at = sc->open_quote;
+        break;
+    case AT_NUMBER:
+        if (!q)
+            while (*at > 0 && strchr("0123456789+-.eE", text[*at - 1]))
+                --*at;
+        break;
+    case AT_ESCAPE: {
+        const char *bs = NULL;
+        for (const char *c = q; c && c < q + qlen; c++)
+            if (*c == '\\')
+                bs = c;
+        if (bs) {
+            *at += (long long)(bs - q);
+            if (bs[1] == 'u' && strncmp(t, "invalid escape", 14) == 0)
+                what = "bad \\u escape";
+        }
+        break;
+    }
+    default:                                    /* AT_TOKEN */
+        if (strstr(t, "near end of file") && strncmp(t, "unexpected", 10) == 0)
+            what = "document ends inside a value";
+        else if (q && strncmp(t, "invalid token", 13) == 0 &&
+                 ((q[0] >= '0' && q[0] <= '9') ||
+                  (q[0] == '-' && qlen > 1 && q[1] >= '0' && q[1] <= '9')))
+            what = "bad number";
+        break;
+    }
+    return what;
 }
 
-/* Parse the whole text; node 0 is the root. */
-static st_status json_parse(json *j, const unsigned char *data, size_t size,
-                            const char *name, st_error *err)
+/* The JSON text [data, data + size) as a tree in *root (the caller
+ * json_decref's it). A UTF-8 byte order mark is tolerated (some exporters
+ * write one). Errors at byte offsets from base (the text's place in the
+ * file); numbers are all doubles, strings may hold NUL (a uri that does
+ * is refused where it is used). */
+static st_status json_parse(json_t **root, const unsigned char *data,
+                            size_t size, long long base, const char *name,
+                            st_error *err)
 {
-    memset(j, 0, sizeof *j);
-    j->p = j->begin = data;
-    j->end = data + size;
-    j->name = name;
-    j->err = err;
-    /* A UTF-8 byte order mark is tolerated (some exporters write one). */
+    size_t bom = 0;
     if (size >= 3 && data[0] == 0xEF && data[1] == 0xBB && data[2] == 0xBF)
-        j->p += 3;
-    st_status st = jparse_value(j);
-    if (st)
-        return st;
-    jskip(j);
-    if (j->p != j->end)
-        return jerr(j, j->p, "text after the document");
-    /* Children of each container contiguous, in document order: a stable
-     * counting sort by parent (nodes are numbered in document order). */
-    j->kids = st_realloc_array(NULL, j->n ? j->n : 1, sizeof *j->kids);
-    if (!j->kids)
-        return joom(j);
-    size_t next = 0;
-    for (size_t i = 0; i < j->n; i++)
-        if (j->nodes[i].type == J_ARR || j->nodes[i].type == J_OBJ) {
-            j->nodes[i].first = next;
-            next += j->nodes[i].count;
-            j->nodes[i].count = 0;
-        }
-    for (size_t i = 1; i < j->n; i++) {
-        jnode *pn = &j->nodes[j->nodes[i].parent];
-        j->kids[pn->first + pn->count++] = i;
+        bom = 3;
+    const json_scan sc = json_prescan(data + bom, size - bom);
+    json_error_t je;
+    *root = json_loadb((const char *)data + bom, size - bom,
+                       JSON_DECODE_ANY | JSON_DECODE_INT_AS_REAL |
+                           JSON_ALLOW_NUL,
+                       &je);
+    long long at = 0;
+    const char *what = NULL;
+    if (!*root && json_error_code(&je) == json_error_out_of_memory)
+        return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
+    if (!*root)
+        what = json_what(&je, data + bom, &sc, &at);
+    if (sc.deep >= 0 && (*root || sc.deep < at)) {
+        at = sc.deep;
+        what = "nested more than 64 deep";
     }
-    return ST_OK;
-}
-
-/* Member k of object o, or NULL. Names are compared whole (a key with an
- * embedded NUL matches nothing glTF defines). */
-static const jnode *jget(const json *j, const jnode *o, const char *k)
-{
-    if (!o || o->type != J_OBJ)
-        return NULL;
-    size_t kl = strlen(k);
-    for (size_t i = 0; i < o->count; i++) {
-        const jnode *m = &j->nodes[j->kids[o->first + i]];
-        if (m->klen == kl && memcmp(j->arena + m->key, k, kl) == 0)
-            return m;
-    }
-    return NULL;
-}
-
-static const jnode *jat(const json *j, const jnode *a, size_t i)
-{
-    if (!a || (a->type != J_ARR) || i >= a->count)
-        return NULL;
-    return &j->nodes[j->kids[a->first + i]];
+    if (!what)
+        return ST_OK;
+    json_decref(*root);
+    *root = NULL;
+    return st_error_set_offset(err, ST_EINPUT, name,
+                               base + (long long)bom + at, "JSON: %s", what);
 }
 
 /* ==== glTF ================================================================ */
@@ -476,8 +241,7 @@ typedef struct buffer {
 } buffer;
 
 typedef struct gltf {
-    json j;
-    const jnode *root;
+    json_t *root;
     const char *name;           /* for messages */
     const char *path;           /* the .gltf's path, NULL: no files */
     const st_soup__file_hook *hook; /* told each file's bytes, or NULL */
@@ -520,42 +284,42 @@ static st_status gbad(gltf *g, const char *fmt, ...)
 }
 
 /* A non-negative integer member (absent: dflt; dflt < 0: required). */
-static st_status get_index(gltf *g, const jnode *o, const char *key,
+static st_status get_index(gltf *g, const json_t *o, const char *key,
                            long long dflt, size_t limit, const char *where,
                            size_t wi, size_t *out)
 {
-    const jnode *v = jget(&g->j, o, key);
+    const json_t *v = jget(o, key);
     if (!v) {
         if (dflt < 0)
             return gbad(g, "%s/%zu: no \"%s\"", where, wi, key);
         *out = (size_t)dflt;
         return ST_OK;
     }
-    if (v->type != J_NUM || !(v->num >= 0) || v->num != floor(v->num) ||
-        v->num >= (double)limit)
+    if (!json_is_number(v) || !(json_number_value(v) >= 0) || json_number_value(v) != floor(json_number_value(v)) ||
+        json_number_value(v) >= (double)limit)
         return gbad(g, "%s/%zu/%s: %s", where, wi, key,
-                    v->type != J_NUM ? "not a number"
+                    !json_is_number(v) ? "not a number"
                                      : limit == SIZE_MAX
                                            ? "not a non-negative integer"
                                            : "out of range");
-    *out = (size_t)v->num;
+    *out = (size_t)json_number_value(v);
     return ST_OK;
 }
 
-static size_t array_count(const jnode *a)
+static size_t array_count(const json_t *a)
 {
-    return a && a->type == J_ARR ? a->count : 0;
+    return json_is_array(a) ? json_array_size(a) : 0;
 }
 
-static int type_ncomp(const json *j, const jnode *t)
+static int type_ncomp(const json_t *t)
 {
     static const struct { const char *n; int c; } k[] = {
         {"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4},
         {"MAT2", 4},   {"MAT3", 9}, {"MAT4", 16}};
-    if (!t || t->type != J_STR)
+    if (!t || !json_is_string(t))
         return 0;
     for (size_t i = 0; i < sizeof k / sizeof k[0]; i++)
-        if (strcmp(j->arena + t->str, k[i].n) == 0)
+        if (strcmp(json_string_value(t), k[i].n) == 0)
             return k[i].c;
     return 0;
 }
@@ -572,40 +336,20 @@ static size_t ctype_size(int ct)
 
 /* ---- buffers ------------------------------------------------------------ */
 
-static int b64val(unsigned char c)
-{
-    if (c >= 'A' && c <= 'Z') return c - 'A';
-    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-    if (c >= '0' && c <= '9') return c - '0' + 52;
-    if (c == '+' || c == '-') return 62;
-    if (c == '/' || c == '_') return 63;
-    return -1;
-}
-
-/* Decode base64 text (padding optional) into a new buffer. */
+/* Decode base64 text (padding optional, the URL-safe alphabet too) into
+ * a new buffer. */
 static st_status decode_b64(gltf *g, size_t bi, const char *s, size_t n,
                             buffer *b)
 {
     unsigned char *out = malloc(n / 4 * 3 + 3);
     if (!out)
         return st_error_set(g->err, ST_ENOMEM, g->name, 0, "out of memory");
-    size_t o = 0;
-    unsigned acc = 0;
-    int bits = 0;
-    size_t i = 0;
-    for (; i < n && s[i] != '='; i++) {
-        int v = b64val((unsigned char)s[i]);
-        if (v < 0) {
-            free(out);
-            return gbad(g, "/buffers/%zu/uri: bad base64 at character %zu",
-                        bi, i);
-        }
-        acc = acc << 6 | (unsigned)v;
-        bits += 6;
-        if (bits >= 8) {
-            bits -= 8;
-            out[o++] = (unsigned char)(acc >> bits);
-        }
+    size_t i;
+    size_t o = st_b64_decode((const unsigned char *)s, n, ST_B64_URL, out, &i);
+    if (i < n && s[i] != '=') {
+        free(out);
+        return gbad(g, "/buffers/%zu/uri: bad base64 at character %zu",
+                    bi, i);
     }
     for (; i < n; i++)
         if (s[i] != '=') {
@@ -620,6 +364,14 @@ static st_status decode_b64(gltf *g, size_t bi, const char *s, size_t n,
                     bi, o, b->size);
     }
     return ST_OK;
+}
+
+static int hexval(unsigned char c)
+{
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
 }
 
 /* Read a file beside the .gltf: uri is a relative reference, percent-
@@ -728,8 +480,8 @@ static st_status load_buffer(gltf *g, size_t bi)
     buffer *b = &g->buffers[bi];
     if (b->data)
         return ST_OK;
-    const jnode *bn = jat(&g->j, jget(&g->j, g->root, "buffers"), bi);
-    const jnode *uri = jget(&g->j, bn, "uri");
+    const json_t *bn = jat(jget(g->root, "buffers"), bi);
+    const json_t *uri = jget(bn, "uri");
     st_status st;
     if (!uri) {
         if (bi != 0 || !g->have_glb_bin)
@@ -742,10 +494,10 @@ static st_status load_buffer(gltf *g, size_t bi)
         b->data = g->glb_bin;
         return ST_OK;
     }
-    if (uri->type != J_STR)
+    if (!json_is_string(uri))
         return gbad(g, "/buffers/%zu/uri: not a string", bi);
-    const char *u = g->j.arena + uri->str;
-    if (uri->slen != strlen(u))
+    const char *u = json_string_value(uri);
+    if (json_string_length(uri) != strlen(u))
         return gbad(g, "/buffers/%zu/uri: a NUL in the URI", bi);
     if (strncmp(u, "data:", 5) == 0) {
         const char *comma = strchr(u, ',');
@@ -767,9 +519,9 @@ static st_status load_buffer(gltf *g, size_t bi)
 static st_status get_view(gltf *g, size_t vi, const unsigned char **data,
                           size_t *len, size_t *stride)
 {
-    const jnode *views = jget(&g->j, g->root, "bufferViews");
-    const jnode *v = jat(&g->j, views, vi);
-    if (!v || v->type != J_OBJ)
+    const json_t *views = jget(g->root, "bufferViews");
+    const json_t *v = jat(views, vi);
+    if (!v || !json_is_object(v))
         return gbad(g, "/bufferViews/%zu: no such buffer view", vi);
     size_t bi, off, bl, bs;
     st_status st;
@@ -815,8 +567,8 @@ static st_status get_accessor(gltf *g, size_t ai, accessor *a)
 {
     memset(a, 0, sizeof *a);
     a->idx = ai;
-    const jnode *an = jat(&g->j, jget(&g->j, g->root, "accessors"), ai);
-    if (!an || an->type != J_OBJ)
+    const json_t *an = jat(jget(g->root, "accessors"), ai);
+    if (!an || !json_is_object(an))
         return gbad(g, "/accessors/%zu: no such accessor", ai);
     size_t ct, count, off = 0;
     st_status st;
@@ -832,18 +584,18 @@ static st_status get_accessor(gltf *g, size_t ai, accessor *a)
     if (!cs)
         return gbad(g, "/accessors/%zu/componentType: %zu is not a glTF "
                        "component type", ai, ct);
-    a->ncomp = type_ncomp(&g->j, jget(&g->j, an, "type"));
+    a->ncomp = type_ncomp(jget(an, "type"));
     if (!a->ncomp)
         return gbad(g, "/accessors/%zu/type: not SCALAR, VEC2..4 or "
                        "MAT2..4", ai);
-    const jnode *nz = jget(&g->j, an, "normalized");
-    a->normalized = nz && nz->type == J_BOOL && nz->num != 0;
+    const json_t *nz = jget(an, "normalized");
+    a->normalized = json_is_true(nz);
     if (count == 0)
         return gbad(g, "/accessors/%zu/count: 0 (at least 1)", ai);
     a->count = count;
     size_t esize = cs * (size_t)a->ncomp;
     size_t vi;
-    const jnode *bv = jget(&g->j, an, "bufferView");
+    const json_t *bv = jget(an, "bufferView");
     if (bv) {
         if ((st = get_index(g, an, "bufferView", -1, SIZE_MAX, "/accessors",
                             ai, &vi)))
@@ -867,7 +619,7 @@ static st_status get_accessor(gltf *g, size_t ai, accessor *a)
                        "more than the input's %zu bytes",
                     ai, count, g->total_bytes);
     }
-    const jnode *sp = jget(&g->j, an, "sparse");
+    const json_t *sp = jget(an, "sparse");
     if (sp) {
         size_t sc;
         if ((st = get_index(g, sp, "count", -1, SIZE_MAX, "/accessors", ai,
@@ -876,8 +628,8 @@ static st_status get_accessor(gltf *g, size_t ai, accessor *a)
         if (sc == 0 || sc > count)
             return gbad(g, "/accessors/%zu/sparse/count: %zu (1..%zu)", ai,
                         sc, count);
-        const jnode *si = jget(&g->j, sp, "indices");
-        const jnode *sv = jget(&g->j, sp, "values");
+        const json_t *si = jget(sp, "indices");
+        const json_t *sv = jget(sp, "values");
         size_t iv, ioff = 0, it, vv, voff = 0;
         if (!si || !sv)
             return gbad(g, "/accessors/%zu/sparse: needs indices and values",
@@ -919,10 +671,8 @@ static st_status get_accessor(gltf *g, size_t ai, accessor *a)
         for (size_t k = 0; k < sc; k++) {
             const unsigned char *p = a->sidx + k * is;
             size_t x = is == 1 ? p[0]
-                     : is == 2 ? (size_t)(p[0] | p[1] << 8)
-                               : (size_t)((uint32_t)p[0] | (uint32_t)p[1] << 8 |
-                                          (uint32_t)p[2] << 16 |
-                                          (uint32_t)p[3] << 24);
+                     : is == 2 ? (size_t)st_le16(p)
+                               : (size_t)st_le32(p);
             if (x >= count || (k > 0 && x <= prev))
                 return gbad(g, "/accessors/%zu/sparse/indices: index %zu "
                                "(entry %zu) is %s",
@@ -947,21 +697,19 @@ static double read_comp(const unsigned char *p, int ct, int normalized)
         return normalized ? v / 255.0 : v;
     }
     case 5122: {
-        double v = (double)(int16_t)(uint16_t)(p[0] | p[1] << 8);
+        double v = (double)(int16_t)(uint16_t)st_le16(p);
         return normalized ? fmax(v / 32767.0, -1.0) : v;
     }
     case 5123: {
-        double v = (double)(uint16_t)(p[0] | p[1] << 8);
+        double v = (double)st_le16(p);
         return normalized ? v / 65535.0 : v;
     }
     case 5125: {
-        double v = (double)((uint32_t)p[0] | (uint32_t)p[1] << 8 |
-                            (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24);
+        double v = (double)st_le32(p);
         return normalized ? v / 4294967295.0 : v;
     }
     case 5126: {
-        uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 |
-                     (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+        uint32_t u = st_le32(p);
         float f;
         memcpy(&f, &u, 4);
         return f;
@@ -982,10 +730,8 @@ static void acc_read(const accessor *a, size_t i, double *out)
             size_t mid = lo + (hi - lo) / 2;
             const unsigned char *q = a->sidx + mid * is;
             size_t x = is == 1 ? q[0]
-                     : is == 2 ? (size_t)(q[0] | q[1] << 8)
-                               : (size_t)((uint32_t)q[0] | (uint32_t)q[1] << 8 |
-                                          (uint32_t)q[2] << 16 |
-                                          (uint32_t)q[3] << 24);
+                     : is == 2 ? (size_t)st_le16(q)
+                               : (size_t)st_le32(q);
             if (x == i) {
                 p = a->sval + mid * cs * (size_t)a->ncomp;
                 break;
@@ -1019,34 +765,34 @@ static void mat_mul(double out[16], const double a[16], const double b[16])
 }
 
 /* n numbers of member key into v (absent: v unchanged). */
-static st_status get_numbers(gltf *g, const jnode *o, const char *key,
+static st_status get_numbers(gltf *g, const json_t *o, const char *key,
                              size_t n, double *v, size_t ni)
 {
-    const jnode *a = jget(&g->j, o, key);
+    const json_t *a = jget(o, key);
     if (!a)
         return ST_OK;
-    if (a->type != J_ARR || a->count != n)
+    if (!json_is_array(a) || json_array_size(a) != n)
         return gbad(g, "/nodes/%zu/%s: not an array of %zu numbers", ni, key,
                     n);
     for (size_t i = 0; i < n; i++) {
-        const jnode *x = jat(&g->j, a, i);
-        if (x->type != J_NUM || !isfinite(x->num))
+        const json_t *x = jat(a, i);
+        if (!json_is_number(x) || !isfinite(json_number_value(x)))
             return gbad(g, "/nodes/%zu/%s/%zu: not a finite number", ni, key,
                         i);
-        v[i] = x->num;
+        v[i] = json_number_value(x);
     }
     return ST_OK;
 }
 
 /* The node's local transform, column-major. */
-static st_status local_matrix(gltf *g, const jnode *nd, size_t ni,
+static st_status local_matrix(gltf *g, const json_t *nd, size_t ni,
                               double m[16])
 {
     static const double id[16] = {1, 0, 0, 0, 0, 1, 0, 0,
                                   0, 0, 1, 0, 0, 0, 0, 1};
     memcpy(m, id, sizeof id);
     st_status st;
-    if (jget(&g->j, nd, "matrix"))
+    if (jget(nd, "matrix"))
         return get_numbers(g, nd, "matrix", 16, m, ni);
     double t[3] = {0, 0, 0}, r[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
     if ((st = get_numbers(g, nd, "translation", 3, t, ni)) ||
@@ -1072,7 +818,7 @@ static st_status local_matrix(gltf *g, const jnode *nd, size_t ni,
     return ST_OK;
 }
 
-static st_status add_primitive(gltf *g, const jnode *prim, size_t mi,
+static st_status add_primitive(gltf *g, const json_t *prim, size_t mi,
                                size_t pi, const double M[16])
 {
     size_t mode;
@@ -1080,8 +826,8 @@ static st_status add_primitive(gltf *g, const jnode *prim, size_t mi,
     if ((st = get_index(g, prim, "mode", 4, 7, "/meshes/primitives", mi,
                         &mode)))
         return st;
-    const jnode *ext = jget(&g->j, prim, "extensions");
-    if (jget(&g->j, ext, "KHR_draco_mesh_compression"))
+    const json_t *ext = jget(prim, "extensions");
+    if (jget(ext, "KHR_draco_mesh_compression"))
         return gbad(g, "/meshes/%zu/primitives/%zu: Draco-compressed "
                        "(KHR_draco_mesh_compression) geometry is not read; "
                        "decompress it first (e.g. gltf-transform copy)",
@@ -1090,9 +836,9 @@ static st_status add_primitive(gltf *g, const jnode *prim, size_t mi,
         g->ignored++;
         return ST_OK;
     }
-    const jnode *attrs = jget(&g->j, prim, "attributes");
+    const json_t *attrs = jget(prim, "attributes");
     size_t pa;
-    if (!jget(&g->j, attrs, "POSITION")) {
+    if (!jget(attrs, "POSITION")) {
         g->ignored++;
         return ST_OK;
     }
@@ -1120,7 +866,7 @@ static st_status add_primitive(gltf *g, const jnode *prim, size_t mi,
             return st_soup__push_failed(g->err, st, g->name, 0, -1);
     }
     size_t n = pos.count;
-    int indexed = jget(&g->j, prim, "indices") != NULL;
+    int indexed = jget(prim, "indices") != NULL;
     if (indexed) {
         size_t ii;
         if ((st = get_index(g, prim, "indices", -1, SIZE_MAX,
@@ -1174,14 +920,14 @@ static st_status add_primitive(gltf *g, const jnode *prim, size_t mi,
 
 static st_status add_mesh(gltf *g, size_t mi, const double M[16])
 {
-    const jnode *mesh = jat(&g->j, jget(&g->j, g->root, "meshes"), mi);
-    if (!mesh || mesh->type != J_OBJ)
+    const json_t *mesh = jat(jget(g->root, "meshes"), mi);
+    if (!mesh || !json_is_object(mesh))
         return gbad(g, "/meshes/%zu: no such mesh", mi);
-    const jnode *prims = jget(&g->j, mesh, "primitives");
-    if (!prims || prims->type != J_ARR)
+    const json_t *prims = jget(mesh, "primitives");
+    if (!prims || !json_is_array(prims))
         return gbad(g, "/meshes/%zu: no primitives", mi);
-    for (size_t p = 0; p < prims->count; p++) {
-        st_status st = add_primitive(g, jat(&g->j, prims, p), mi, p, M);
+    for (size_t p = 0; p < json_array_size(prims); p++) {
+        st_status st = add_primitive(g, jat(prims, p), mi, p, M);
         if (st)
             return st;
     }
@@ -1192,24 +938,24 @@ static st_status add_mesh(gltf *g, size_t mi, const double M[16])
  * (a chain of nodes may be as long as the file). A node reached twice is
  * a cycle or a node with two parents: both invalid glTF. */
 /* A mesh node is a part (parts.h): its name, else its mesh's, else "". */
-static st_status node_name(gltf *g, const jnode *nd, size_t mi)
+static st_status node_name(gltf *g, const json_t *nd, size_t mi)
 {
-    const jnode *nm = jget(&g->j, nd, "name");
-    if (!nm || nm->type != J_STR) {
-        const jnode *mesh = jat(&g->j, jget(&g->j, g->root, "meshes"), mi);
-        nm = mesh && mesh->type == J_OBJ ? jget(&g->j, mesh, "name") : NULL;
+    const json_t *nm = jget(nd, "name");
+    if (!nm || !json_is_string(nm)) {
+        const json_t *mesh = jat(jget(g->root, "meshes"), mi);
+        nm = mesh && json_is_object(mesh) ? jget(mesh, "name") : NULL;
     }
-    const int named = nm && nm->type == J_STR;
+    const int named = nm && json_is_string(nm);
     if (st_soup__push_name(g->s, 1,
-                           named ? (const unsigned char *)g->j.arena + nm->str : NULL,
-                           named ? nm->slen : 0))
+                           named ? (const unsigned char *)json_string_value(nm) : NULL,
+                           named ? json_string_length(nm) : 0))
         return st_error_set(g->err, ST_ENOMEM, g->name, 0, "out of memory");
     return ST_OK;
 }
 
 static st_status walk(gltf *g, const size_t *roots, size_t nroots)
 {
-    const jnode *nodes = jget(&g->j, g->root, "nodes");
+    const json_t *nodes = jget(g->root, "nodes");
     size_t nn = array_count(nodes);
     if (nn == 0)
         return ST_OK;
@@ -1240,8 +986,8 @@ static st_status walk(gltf *g, const size_t *roots, size_t nroots)
         top++;
         while (top > 0 && !st) {
             frame f = stack[--top];
-            const jnode *nd = jat(&g->j, nodes, f.node);
-            if (!nd || nd->type != J_OBJ) {
+            const json_t *nd = jat(nodes, f.node);
+            if (!nd || !json_is_object(nd)) {
                 st = gbad(g, "/nodes/%zu: not an object", f.node);
                 break;
             }
@@ -1249,7 +995,7 @@ static st_status walk(gltf *g, const size_t *roots, size_t nroots)
             if ((st = local_matrix(g, nd, f.node, L)))
                 break;
             mat_mul(W, f.M, L);
-            if (jget(&g->j, nd, "mesh")) {
+            if (jget(nd, "mesh")) {
                 size_t mi;
                 if ((st = get_index(g, nd, "mesh", -1, SIZE_MAX, "/nodes",
                                     f.node, &mi)) ||
@@ -1258,17 +1004,17 @@ static st_status walk(gltf *g, const size_t *roots, size_t nroots)
                     break;
             }
             /* Children pushed last first: they are visited in order. */
-            const jnode *ch = jget(&g->j, nd, "children");
+            const json_t *ch = jget(nd, "children");
             for (size_t cc = array_count(ch); cc > 0; cc--) {
                 const size_t c = cc - 1;
-                const jnode *x = jat(&g->j, ch, c);
-                if (x->type != J_NUM || !(x->num >= 0) ||
-                    x->num != floor(x->num) || x->num >= (double)nn) {
+                const json_t *x = jat(ch, c);
+                if (!json_is_number(x) || !(json_number_value(x) >= 0) ||
+                    json_number_value(x) != floor(json_number_value(x)) || json_number_value(x) >= (double)nn) {
                     st = gbad(g, "/nodes/%zu/children/%zu: not a node index",
                               f.node, c);
                     break;
                 }
-                size_t k = (size_t)x->num;
+                size_t k = (size_t)json_number_value(x);
                 if (seen[k]) {
                     st = gbad(g, "/nodes/%zu/children/%zu: node %zu reached "
                                  "twice (a cycle, or a node with two "
@@ -1290,23 +1036,22 @@ out:
 
 static st_status read_document(gltf *g)
 {
-    const json *j = &g->j;
-    const jnode *root = g->root;
-    if (root->type != J_OBJ)
+    const json_t *root = g->root;
+    if (!json_is_object(root))
         return gbad(g, "the document is not a JSON object");
-    const jnode *asset = jget(j, root, "asset");
-    const jnode *ver = jget(j, asset, "version");
-    if (!ver || ver->type != J_STR)
+    const json_t *asset = jget(root, "asset");
+    const json_t *ver = jget(asset, "version");
+    if (!ver || !json_is_string(ver))
         return gbad(g, "/asset/version: missing (not a glTF file?)");
-    if (strncmp(j->arena + ver->str, "2.", 2) != 0)
+    if (strncmp(json_string_value(ver), "2.", 2) != 0)
         return gbad(g, "/asset/version: \"%.20s\" (only glTF 2.x is read)",
-                    j->arena + ver->str);
-    const jnode *req = jget(j, root, "extensionsRequired");
+                    json_string_value(ver));
+    const json_t *req = jget(root, "extensionsRequired");
     for (size_t i = 0; i < array_count(req); i++) {
-        const jnode *e = jat(j, req, i);
-        if (e->type != J_STR)
+        const json_t *e = jat(req, i);
+        if (!json_is_string(e))
             continue;
-        const char *en = j->arena + e->str;
+        const char *en = json_string_value(e);
         if (strcmp(en, "KHR_draco_mesh_compression") == 0)
             return gbad(g, "/extensionsRequired/%zu: Draco-compressed "
                            "(KHR_draco_mesh_compression) geometry is not "
@@ -1317,7 +1062,7 @@ static st_status read_document(gltf *g)
             return gbad(g, "/extensionsRequired/%zu: %s is not supported",
                         i, en);
     }
-    const jnode *bufs = jget(j, root, "buffers");
+    const json_t *bufs = jget(root, "buffers");
     g->nbuffers = array_count(bufs);
     if (g->nbuffers) {
         g->buffers = calloc(g->nbuffers, sizeof *g->buffers);
@@ -1326,7 +1071,7 @@ static st_status read_document(gltf *g)
                                 "out of memory");
         for (size_t i = 0; i < g->nbuffers; i++) {
             size_t bl;
-            st_status st = get_index(g, jat(j, bufs, i), "byteLength", -1,
+            st_status st = get_index(g, jat(bufs, i), "byteLength", -1,
                                      SIZE_MAX, "/buffers", i, &bl);
             if (st)
                 return st;
@@ -1335,30 +1080,30 @@ static st_status read_document(gltf *g)
     }
     /* The roots: the default scene's nodes, else every node no other
      * lists as a child. */
-    const jnode *nodes = jget(j, root, "nodes");
+    const json_t *nodes = jget(root, "nodes");
     size_t nn = array_count(nodes);
     size_t *roots = st_realloc_array(NULL, nn ? nn : 1, sizeof *roots);
     if (!roots)
         return st_error_set(g->err, ST_ENOMEM, g->name, 0, "out of memory");
     size_t nr = 0;
     st_status st = ST_OK;
-    const jnode *scene = jget(j, root, "scene");
+    const json_t *scene = jget(root, "scene");
     if (scene) {
         size_t si;
-        const jnode *scenes = jget(j, root, "scenes");
+        const json_t *scenes = jget(root, "scenes");
         st = get_index(g, root, "scene", -1, array_count(scenes), "", 0, &si);
         if (st) {
             st = gbad(g, "/scene: not an index into /scenes");
         } else {
-            const jnode *sn = jget(j, jat(j, scenes, si), "nodes");
+            const json_t *sn = jget(jat(scenes, si), "nodes");
             for (size_t i = 0; i < array_count(sn) && !st; i++) {
-                const jnode *x = jat(j, sn, i);
-                if (x->type != J_NUM || !(x->num >= 0) ||
-                    x->num != floor(x->num) || x->num >= (double)nn)
+                const json_t *x = jat(sn, i);
+                if (!json_is_number(x) || !(json_number_value(x) >= 0) ||
+                    json_number_value(x) != floor(json_number_value(x)) || json_number_value(x) >= (double)nn)
                     st = gbad(g, "/scenes/%zu/nodes/%zu: not a node index",
                               si, i);
                 else
-                    roots[nr++] = (size_t)x->num;
+                    roots[nr++] = (size_t)json_number_value(x);
             }
         }
     } else if (nn) {
@@ -1369,11 +1114,11 @@ static st_status read_document(gltf *g)
                                 "out of memory");
         }
         for (size_t n = 0; n < nn; n++) {
-            const jnode *ch = jget(j, jat(j, nodes, n), "children");
+            const json_t *ch = jget(jat(nodes, n), "children");
             for (size_t c = 0; c < array_count(ch); c++) {
-                const jnode *x = jat(j, ch, c);
-                if (x->type == J_NUM && x->num >= 0 && x->num < (double)nn)
-                    child[(size_t)x->num] = 1;
+                const json_t *x = jat(ch, c);
+                if (json_is_number(x) && json_number_value(x) >= 0 && json_number_value(x) < (double)nn)
+                    child[(size_t)json_number_value(x)] = 1;
             }
         }
         for (size_t n = 0; n < nn; n++)
@@ -1395,12 +1140,6 @@ static st_status read_document(gltf *g)
     return st;
 }
 
-static uint32_t le32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
-           (uint32_t)p[3] << 24;
-}
-
 st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
                               size_t size, const char *name, const char *path,
                               const st_soup__file_hook *hook,
@@ -1418,12 +1157,12 @@ st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
     const unsigned char *js = data;
     size_t jn = size;
     st_status st = ST_OK;
-    if (size >= 4 && le32(data) == GLB_MAGIC) {
+    if (size >= 4 && st_le32(data) == GLB_MAGIC) {
         if (size < 20)
             return st_error_set_offset(err, ST_EINPUT, name, 0,
                                        "GLB: %zu bytes, shorter than its "
                                        "headers", size);
-        uint32_t version = le32(data + 4), length = le32(data + 8);
+        uint32_t version = st_le32(data + 4), length = st_le32(data + 8);
         if (version != 2)
             return st_error_set_offset(err, ST_EINPUT, name, 4,
                                        "GLB version %lu (only 2 is read)",
@@ -1438,7 +1177,7 @@ st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
                                        "GLB length %lu, shorter than its "
                                        "headers", (unsigned long)length);
         size_t pos = 12;
-        uint32_t clen = le32(data + pos), ctype = le32(data + pos + 4);
+        uint32_t clen = st_le32(data + pos), ctype = st_le32(data + pos + 4);
         if (ctype != GLB_JSON)
             return st_error_set_offset(err, ST_EINPUT, name, 16,
                                        "GLB: the first chunk is not JSON");
@@ -1450,7 +1189,7 @@ st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
         jn = clen;
         pos = 20 + (size_t)clen;
         if (length - pos >= 8) {
-            uint32_t blen = le32(data + pos), btype = le32(data + pos + 4);
+            uint32_t blen = st_le32(data + pos), btype = st_le32(data + pos + 4);
             if (btype == GLB_BIN) {
                 if (blen > length - pos - 8)
                     return st_error_set_offset(err, ST_EINPUT, name,
@@ -1464,19 +1203,15 @@ st_status st_soup__parse_gltf(st_soup *s, const unsigned char *data,
             }
         }
         /* JSON chunk offsets are reported from the file's start. */
-        st = json_parse(&g.j, js, jn, name, err);
-        if (st && err && err->offset >= 0)
-            err->offset += 20;
+        st = json_parse(&g.root, js, jn, 20, name, err);
     } else {
-        st = json_parse(&g.j, js, jn, name, err);
+        st = json_parse(&g.root, js, jn, 0, name, err);
     }
-    if (st == ST_OK) {
-        g.root = &g.j.nodes[0];
+    if (st == ST_OK)
         st = read_document(&g);
-    }
     for (size_t i = 0; i < g.nbuffers; i++)
         free(g.buffers[i].owned);
     free(g.buffers);
-    json_free(&g.j);
+    json_decref(g.root);
     return st;
 }

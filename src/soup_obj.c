@@ -9,10 +9,13 @@
  * line ends and backslash line continuations are handled by the st_text
  * cursor.
  */
-#include "soup_parse.h"
+#include "lexer.h"
+#include "soup_internal.h"
+#include "soupread.h"
 #include "fpenv.h"
 
 #include <math.h>
+#include <string.h>
 
 /* Read the three coordinates of a `v` record (more values are ignored). */
 static st_status read_vertex(st_soup *s, st_text *t, const char *name,
@@ -26,11 +29,11 @@ static st_status read_vertex(st_soup *s, st_text *t, const char *name,
             return st_error_set(err, ST_EINPUT, name, t->line,
                                 "vertex has %d coordinate%s (need 3)", k,
                                 k == 1 ? "" : "s");
-        if (st_soup__scan_double(tok, n, &c[k]) != 0) {
+        if (st_text_double(tok, n, &c[k]) != 0) {
             char q[ST_QUOTE_SIZE];
             return st_error_set(err, ST_EINPUT, name, t->line,
                                 "bad coordinate '%s'",
-                                st_soup__quote(q, sizeof q, tok, n));
+                                st_text_quote(q, sizeof q, tok, n));
         }
         if (!isfinite(c[k]))
             return st_error_set(err, ST_EINPUT, name, t->line,
@@ -72,11 +75,11 @@ static st_status read_face(st_soup *s, st_text *t, fwd_ref *fwd,
         while (il < n && tok[il] != '/')
             il++;
         long long idx;
-        if (st_soup__scan_int(tok, il, &idx) != 0 ||
+        if (st_text_int(tok, il, &idx) != 0 ||
             !valid_tail(tok + il, n - il))
             return st_error_set(err, ST_EINPUT, name, t->line,
                                 "bad face vertex '%s'",
-                                st_soup__quote(q, sizeof q, tok, n));
+                                st_text_quote(q, sizeof q, tok, n));
         uint32_t v;
         if (idx == 0)
             return st_error_set(err, ST_EINPUT, name, t->line,

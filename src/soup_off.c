@@ -10,10 +10,13 @@
  * untrusted: they are checked against the bytes that follow and nothing is
  * allocated from them (the soup grows with the records actually read).
  */
-#include "soup_parse.h"
+#include "lexer.h"
+#include "soup_internal.h"
+#include "soupread.h"
 #include "fpenv.h"
 
 #include <math.h>
+#include <string.h>
 
 /* The shortest records: "0 0 0\n" and "3 0 0 0\n". The last record may
  * lack its newline, hence the +1 where these are used. */
@@ -25,7 +28,7 @@ static st_status bad(st_error *err, const char *name, long long line,
 {
     char q[ST_QUOTE_SIZE];
     return st_error_set(err, ST_EINPUT, name, line, "%s '%s'", what,
-                        st_soup__quote(q, sizeof q, tok, n));
+                        st_text_quote(q, sizeof q, tok, n));
 }
 
 /* Check the keyword: [ST][C][N]OFF. */
@@ -67,7 +70,7 @@ static st_status read_count(st_text *t, const unsigned char *tok, size_t n,
     if (!n)
         return st_error_set(err, ST_EINPUT, name, st_text_eof_line(t),
                             "missing vertex and face counts");
-    if (st_soup__scan_int(tok, n, out) != 0 || *out < 0)
+    if (st_text_int(tok, n, out) != 0 || *out < 0)
         return bad(err, name, t->line, "bad count", tok, n);
     return ST_OK;
 }
@@ -121,7 +124,7 @@ st_status st_soup__parse_off(st_soup *s, const unsigned char *data,
                 return st_error_set(err, ST_EINPUT, name, t.line,
                                     "vertex has %d coordinate%s (need 3)",
                                     k, k == 1 ? "" : "s");
-            if (st_soup__scan_double(tok, n, &c[k]) != 0)
+            if (st_text_double(tok, n, &c[k]) != 0)
                 return bad(err, name, t.line, "bad coordinate", tok, n);
             if (!isfinite(c[k]))
                 return st_error_set(err, ST_EINPUT, name, t.line,
@@ -139,7 +142,7 @@ st_status st_soup__parse_off(st_soup *s, const unsigned char *data,
                                 "header says %lld faces, file ends after "
                                 "%lld", nf, f);
         long long cnt;
-        if (st_soup__scan_int(tok, n, &cnt) != 0)
+        if (st_text_int(tok, n, &cnt) != 0)
             return bad(err, name, t.line, "bad face vertex count", tok, n);
         if (cnt < 3)
             return st_error_set(err, ST_EINPUT, name, t.line,
@@ -152,7 +155,7 @@ st_status st_soup__parse_off(st_soup *s, const unsigned char *data,
                                     "face lists %lld of its %lld vertices",
                                     k, cnt);
             long long idx;
-            if (st_soup__scan_int(tok, n, &idx) != 0)
+            if (st_text_int(tok, n, &idx) != 0)
                 return bad(err, name, t.line, "bad face index", tok, n);
             if (idx < 0 || idx >= nv)
                 return st_error_set(err, ST_EINPUT, name, t.line,

@@ -10,12 +10,15 @@
  * its declared type. Header problems are reported at a line, binary body
  * problems at a byte offset, ascii body problems at a line.
  */
-#include "soup_parse.h"
+#include "lexer.h"
+#include "soup_internal.h"
+#include "soupread.h"
 #include "fpenv.h"
 #include "souptet/mem.h"
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 typedef enum ptype {
     T_NONE = 0, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64
@@ -102,7 +105,7 @@ static st_status hdr_error(ply *p, long long line, const char *what,
     char q[ST_QUOTE_SIZE];
     if (tok)
         return st_error_set(p->err, ST_EINPUT, p->name, line, "%s '%s'",
-                            what, st_soup__quote(q, sizeof q, tok, n));
+                            what, st_text_quote(q, sizeof q, tok, n));
     return st_error_set(p->err, ST_EINPUT, p->name, line, "%s", what);
 }
 
@@ -123,7 +126,7 @@ static st_status hdr_element(ply *p, st_text *t)
         return hdr_error(p, t->line, "element line needs a name and a count",
                          NULL, 0);
     long long count;
-    if (st_soup__scan_int(ct, nc, &count) != 0 || count < 0)
+    if (st_text_int(ct, nc, &count) != 0 || count < 0)
         return hdr_error(p, t->line, "bad element count", ct, nc);
     /* One entry per header line: the header's own length bounds this. */
     elem *ne = st_realloc_array(p->elems, p->nelems + 1, sizeof *ne);
@@ -134,7 +137,7 @@ static st_status hdr_element(ply *p, st_text *t)
     memset(e, 0, sizeof *e);
     e->count = (unsigned long long)count;
     e->line = t->line;
-    st_soup__quote(e->name, sizeof e->name, nm, nn);
+    st_text_quote(e->name, sizeof e->name, nm, nn);
     if (st_tok_eq(nm, nn, "vertex"))
         e->kind = E_VERTEX;
     else if (st_tok_eq(nm, nn, "face"))
@@ -287,7 +290,7 @@ static st_status read_header(ply *p, st_text *t)
                 len++;
             st_soup__warn(p->warn, p->name, t->line, -1,
                           "header line without a keyword skipped: '%s'",
-                          st_soup__quote(q, sizeof q, tok, len));
+                          st_text_quote(q, sizeof q, tok, len));
         }
         if (st)
             return st;
@@ -501,7 +504,7 @@ static st_status asc_truncated(ply *p, const st_text *t, const elem *e,
 static st_status asc_int(ply *p, st_text *t, const unsigned char *tok,
                          size_t n, long long *v, const char *what)
 {
-    if (st_soup__scan_int(tok, n, v) == 0)
+    if (st_text_int(tok, n, v) == 0)
         return ST_OK;
     return hdr_error(p, t->line, what, tok, n);
 }
@@ -525,7 +528,7 @@ static st_status read_ascii(ply *p, st_soup *s, st_text *t)
                     if (pr->role == R_NONE)
                         continue;
                     double d;
-                    if (st_soup__scan_double(tok, n, &d) != 0)
+                    if (st_text_double(tok, n, &d) != 0)
                         return hdr_error(p, t->line, "bad coordinate", tok,
                                          n);
                     if (!isfinite(d))

@@ -13,21 +13,19 @@
  * triangle 12 float32 LE (normal, 3 vertices) and a uint16 attribute. The
  * count must match the file size exactly.
  */
-#include "soup_parse.h"
+#include "bytes.h"
+#include "lexer.h"
+#include "soup_internal.h"
+#include "soupread.h"
 #include "fpenv.h"
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #define STL_HEADER 80
 #define STL_PREFIX 84       /* header + count */
 #define STL_RECORD 50
-
-static uint32_t le32(const unsigned char *q)
-{
-    return (uint32_t)q[0] | (uint32_t)q[1] << 8 | (uint32_t)q[2] << 16 |
-           (uint32_t)q[3] << 24;
-}
 
 /* No byte a text file would not contain (NUL and other controls). UTF-8
  * bytes >= 0x80 are allowed: solid names may use them. */
@@ -59,7 +57,7 @@ int st_soup__stl_is_ascii(const unsigned char *data, size_t size)
     if (n && (st_tok_ieq(tok, n, "facet") || st_tok_ieq(tok, n, "endsolid")))
         return 1;
     if (size >= STL_PREFIX &&
-        (uint64_t)le32(data + STL_HEADER) * STL_RECORD + STL_PREFIX == size)
+        (uint64_t)st_le32(data + STL_HEADER) * STL_RECORD + STL_PREFIX == size)
         return 0;
     return looks_like_text(data, size < 1000 ? size : 1000);
 }
@@ -84,7 +82,7 @@ static st_status asc_expected(asc *a, const char *what,
     char q[ST_QUOTE_SIZE];
     return st_error_set(a->err, ST_EINPUT, a->name, a->t.line,
                         "expected %s, found '%s'", what,
-                        st_soup__quote(q, sizeof q, tok, n));
+                        st_text_quote(q, sizeof q, tok, n));
 }
 
 /* The next token must be the keyword kw. */
@@ -135,7 +133,7 @@ static st_status asc_facet(asc *a, st_soup *s)
         for (int j = 0; j < 3; j++) {
             if (!(n = st_text_token_any(&a->t, &tok)))
                 return asc_eof(a);
-            if (st_soup__scan_double(tok, n, &c[j]) != 0)
+            if (st_text_double(tok, n, &c[j]) != 0)
                 return asc_expected(a, "a coordinate", tok, n);
             if (!isfinite(c[j]))
                 return st_error_set(a->err, ST_EINPUT, a->name, a->t.line,
@@ -211,7 +209,7 @@ static st_status parse_binary(st_soup *s, const unsigned char *data,
         return st_error_set_offset(err, ST_EINPUT, name, (long long)size,
                                    "too short for a binary STL (%zu bytes, "
                                    "need at least %d)", size, STL_PREFIX);
-    uint32_t count = le32(data + STL_HEADER);
+    uint32_t count = st_le32(data + STL_HEADER);
     uint64_t want = (uint64_t)count * STL_RECORD + STL_PREFIX;
     if (want != size)
         return st_error_set_offset(err, ST_EINPUT, name, STL_HEADER,
@@ -229,7 +227,7 @@ static st_status parse_binary(st_soup *s, const unsigned char *data,
             double c[3];
             for (int j = 0; j < 3; j++) {
                 size_t off = rec + 12 + 12 * (size_t)v + 4 * (size_t)j;
-                uint32_t bits = le32(data + off);
+                uint32_t bits = st_le32(data + off);
                 float f;
                 memcpy(&f, &bits, sizeof f);
                 if (!isfinite(f))

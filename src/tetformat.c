@@ -10,10 +10,10 @@
  * This file: the names, the shared reading and writing helpers, the
  * dispatch and the atomic save; each format in its own file
  * (tetformat_msh.c, tetformat_tetgen.c, tetformat_medit.c), the parsing
- * state they share in tetformat_internal.h.
+ * state they share in tetformat_read.h (tetformat_read.c).
  *
  * Every reader parses a whole file held in memory through the bounded
- * cursor of soup_parse.h (the buffer is never NUL-terminated), converts
+ * cursor of lexer.h (the buffer is never NUL-terminated), converts
  * numbers from tokens, and grows the mesh only with records actually
  * present (st_tetmesh_add_point / add_tet grow geometrically): a header
  * count is checked against the bytes left before it is believed, only to
@@ -70,7 +70,7 @@ st_tetformat st_tetformat_sniff(const unsigned char *data, size_t size)
         return ST_TETFORMAT_VTU;
     st_text t;
     st_text_init(&t, data, size, ST_TEXT_HASH);
-    const unsigned char *tok;
+    const unsigned char *tok = NULL;
     size_t n = st_text_token_any(&t, &tok);
     if (st_tok_eq(tok, n, "$MeshFormat"))
         return ST_TETFORMAT_MSH;

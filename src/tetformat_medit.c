@@ -50,14 +50,14 @@ static st_status medit_parse(rd *r)
         return rd_fail(r, "not a Medit .mesh file (no "
                        "MeshVersionFormatted)");
     long long v;
-    if ((s = rd_int_in(r, &v, 1, 4, "mesh version")))
+    if ((s = st_rd_int_in(r, &v, 1, 4, "mesh version")))
         return s;
     int have_vertices = 0;
     while ((n = st_text_token_any(&r->t, &tok)) != 0) {
         if (st_tok_ieq(tok, n, "end"))
             break;
         if (st_tok_ieq(tok, n, "dimension")) {
-            if ((s = rd_int(r, &v, "dimension")))
+            if ((s = st_rd_int(r, &v, "dimension")))
                 return s;
             if (v != 3)
                 return rd_fail(r, "dimension %lld (3 expected)", v);
@@ -65,39 +65,39 @@ static st_status medit_parse(rd *r)
             if (have_vertices)
                 return rd_fail(r, "second Vertices section");
             have_vertices = 1;
-            if ((s = rd_int_in(r, &v, 0, (long long)UINT32_MAX,
+            if ((s = st_rd_int_in(r, &v, 0, (long long)UINT32_MAX,
                                "vertex count")) ||
-                (s = rd_count_fits(r, (unsigned long long)v, 8,
+                (s = st_rd_count_fits(r, (unsigned long long)v, 8,
                                    "vertices")))
                 return s;
             for (long long i = 0; i < v; i++) {
                 double p[3];
                 long long ref;
-                if ((s = rd_xyz(r, p)) ||
-                    (s = rd_int(r, &ref, "vertex reference")) ||
-                    (s = rd_point(r, p)))
+                if ((s = st_rd_xyz(r, p)) ||
+                    (s = st_rd_int(r, &ref, "vertex reference")) ||
+                    (s = st_rd_point(r, p)))
                     return s;
             }
         } else if (st_tok_ieq(tok, n, "tetrahedra")) {
             if (!have_vertices)
                 return rd_fail(r, "Tetrahedra before Vertices");
-            if ((s = rd_int_in(r, &v, 0, LLONG_MAX, "tet count")) ||
-                (s = rd_count_fits(r, (unsigned long long)v, 10, "tets")))
+            if ((s = st_rd_int_in(r, &v, 0, LLONG_MAX, "tet count")) ||
+                (s = st_rd_count_fits(r, (unsigned long long)v, 10, "tets")))
                 return s;
             long long np = (long long)r->m->npoints;
             for (long long i = 0; i < v; i++) {
                 uint32_t t[4];
                 long long c, ref;
                 for (int k = 0; k < 4; k++) {
-                    if ((s = rd_int(r, &c, "tet corner")))
+                    if ((s = st_rd_int(r, &c, "tet corner")))
                         return s;
                     if (c < 1 || c > np)
                         return rd_fail(r, "tet corner %lld out of range "
                                        "(1..%lld)", c, np);
                     t[k] = (uint32_t)(c - 1);
                 }
-                if ((s = rd_int(r, &ref, "tet reference")) ||
-                    (s = rd_tet(r, t)))
+                if ((s = st_rd_int(r, &ref, "tet reference")) ||
+                    (s = st_rd_tet(r, t)))
                     return s;
             }
         } else {
@@ -106,22 +106,22 @@ static st_status medit_parse(rd *r)
                  i++)
                 if (st_tok_ieq(tok, n, k_medit_volume[i]))
                     return rd_fail(r, "'%s': only tetrahedra are read",
-                                   st_soup__quote(q, sizeof q, tok, n));
+                                   st_text_quote(q, sizeof q, tok, n));
             for (i = 0; i < sizeof k_medit_skip / sizeof *k_medit_skip; i++)
                 if (st_tok_ieq(tok, n, k_medit_skip[i].kw))
                     break;
             if (i == sizeof k_medit_skip / sizeof *k_medit_skip)
                 return rd_fail(r, "unknown keyword '%s'",
-                               st_soup__quote(q, sizeof q, tok, n));
-            if ((s = rd_int_in(r, &v, 0, LLONG_MAX, "record count")))
+                               st_text_quote(q, sizeof q, tok, n));
+            if ((s = st_rd_int_in(r, &v, 0, LLONG_MAX, "record count")))
                 return s;
             int per = k_medit_skip[i].per;
-            if ((s = rd_count_fits(r, (unsigned long long)v,
+            if ((s = st_rd_count_fits(r, (unsigned long long)v,
                                    2 * (size_t)per, "records")))
                 return s;
             for (long long j = 0; j < v * per; j++) {
                 double x;
-                if ((s = rd_double(r, &x, "value")))
+                if ((s = st_rd_double(r, &x, "value")))
                     return s;
             }
         }
@@ -137,14 +137,14 @@ st_status st_tetmesh_parse_medit(st_tetmesh **out, const unsigned char *data,
 {
     *out = NULL;
     rd r;
-    if (rd_begin(&r, max_bytes, err, name))
+    if (st_rd_begin(&r, max_bytes, err, name))
         return ST_ENOMEM;
     st_text_init(&r.t, data, size, ST_TEXT_HASH);
     r.name = name ? name : "<mesh>";
-    st_status s = rd_hash_meta(&r);
+    st_status s = st_rd_hash_meta(&r);
     if (!s)
         s = medit_parse(&r);
-    return rd_finish(&r, s, out);
+    return st_rd_finish(&r, s, out);
 }
 
 st_status st_tetmesh_read_medit(st_tetmesh **out, const char *path,

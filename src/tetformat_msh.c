@@ -53,7 +53,7 @@ typedef struct msh {
 static st_status bin_uint(msh *ms, size_t sz, uint64_t *v, const char *what)
 {
     rd *r = &ms->r;
-    if (rd_left(r) < sz)
+    if (st_rd_left(r) < sz)
         return rd_fail(r, "file ends in %s", what);
     uint64_t x = 0;
     const unsigned char *q = r->t.p;
@@ -90,7 +90,7 @@ static st_status msh_expect(msh *ms, const char *kw)
         if (!n)
             return rd_fail(&ms->r, "file ends before %s", kw);
         return rd_fail(&ms->r, "expected %s, found '%s'", kw,
-                       st_soup__quote(q, sizeof q, tok, n));
+                       st_text_quote(q, sizeof q, tok, n));
     }
     return ST_OK;
 }
@@ -101,7 +101,7 @@ static st_status msh_size(msh *ms, uint64_t *v, const char *what)
     if (ms->r.binary && ms->version == 41)
         return bin_uint(ms, (size_t)ms->dsize, v, what);
     long long x;
-    st_status s = rd_int_in(&ms->r, &x, 0, LLONG_MAX, what);
+    st_status s = st_rd_int_in(&ms->r, &x, 0, LLONG_MAX, what);
     *v = (uint64_t)x;
     return s;
 }
@@ -115,16 +115,16 @@ static st_status msh_i32(msh *ms, long long *v, const char *what)
         *v = x;
         return s;
     }
-    return rd_int(&ms->r, v, what);
+    return st_rd_int(&ms->r, v, what);
 }
 
 static st_status msh_coord(msh *ms, double *v)
 {
     if (!ms->r.binary)
-        return rd_double(&ms->r, v, "coordinate");
+        return st_rd_double(&ms->r, v, "coordinate");
     st_status s = bin_f64(ms, v, "a node's coordinates");
     if (!s && !isfinite(*v))
-        return rd_fail_at(&ms->r, ST_EINPUT, ms->r.t.p - 8,
+        return st_rd_fail_at(&ms->r, ST_EINPUT, ms->r.t.p - 8,
                           "coordinate is not finite");
     return s;
 }
@@ -135,7 +135,7 @@ static st_status msh_add_tag(msh *ms, uint64_t tag)
         size_t nc = ms->cap_tags < 64 ? 64 : ms->cap_tags * 2;
         tagidx *nt = st_realloc_array(ms->tags, nc, sizeof *nt);
         if (!nt)
-            return rd_fail_at(&ms->r, ST_ENOMEM, ms->r.t.p, "out of memory");
+            return st_rd_fail_at(&ms->r, ST_ENOMEM, ms->r.t.p, "out of memory");
         ms->tags = nt;
         ms->cap_tags = nc;
     }
@@ -169,7 +169,7 @@ static st_status msh_index_tags(msh *ms, const unsigned char *section,
     for (size_t i = 1; i < ms->ntags; i++)
         if (ms->tags[i].tag == ms->tags[i - 1].tag) {
             ms->r.t.line = line;   /* blame the section's first line */
-            return rd_fail_at(&ms->r, ST_EINPUT, section,
+            return st_rd_fail_at(&ms->r, ST_EINPUT, section,
                               "node tag %llu appears twice in $Nodes",
                               (unsigned long long)ms->tags[i].tag);
         }
@@ -211,7 +211,7 @@ static st_status msh_node(msh *ms, uint64_t tag, int nparam)
             return s;
     }
     st_status s = msh_add_tag(ms, tag);
-    return s ? s : rd_point(&ms->r, p);
+    return s ? s : st_rd_point(&ms->r, p);
 }
 
 static st_status msh_nodes(msh *ms)
@@ -231,7 +231,7 @@ static st_status msh_nodes(msh *ms)
             return s;
         if (r->binary)
             st_text_next_line(&r->t);
-        if ((s = rd_count_fits(r, n, r->binary ? 28 : 8, "nodes")))
+        if ((s = st_rd_count_fits(r, n, r->binary ? 28 : 8, "nodes")))
             return s;
         for (uint64_t i = 0; i < n; i++) {
             uint64_t tag;
@@ -255,7 +255,7 @@ static st_status msh_nodes(msh *ms)
             (s = msh_size(ms, &mintag, "smallest node tag")) ||
             (s = msh_size(ms, &maxtag, "largest node tag")))
             return s;
-        if ((s = rd_count_fits(r, n,
+        if ((s = st_rd_count_fits(r, n,
                                r->binary ? (size_t)ms->dsize + 24 : 8,
                                "nodes")))
             return s;
@@ -333,7 +333,7 @@ static st_status msh_element(msh *ms, uint64_t etag, int type, int ntags22)
                            (unsigned long long)etag, (unsigned long long)nt);
         v[k] = (uint32_t)idx;
     }
-    return type == 4 ? rd_tet(r, v) : ST_OK;
+    return type == 4 ? st_rd_tet(r, v) : ST_OK;
 }
 
 /* Check an element type: known, and a tet or lower-dimensional. */
@@ -362,7 +362,7 @@ static st_status msh_elements(msh *ms)
             return s;
         if (r->binary)
             st_text_next_line(&r->t);
-        if ((s = rd_count_fits(r, n, r->binary ? 12 : 8, "elements")))
+        if ((s = st_rd_count_fits(r, n, r->binary ? 12 : 8, "elements")))
             return s;
         uint64_t done = 0;
         while (done < n) {
@@ -389,9 +389,9 @@ static st_status msh_elements(msh *ms)
                 uint64_t etag;
                 long long type, ntags;
                 if ((s = msh_size(ms, &etag, "element tag")) ||
-                    (s = rd_int(r, &type, "element type")) ||
+                    (s = st_rd_int(r, &type, "element type")) ||
                     (s = msh_type_ok(ms, type)) ||
-                    (s = rd_int_in(r, &ntags, 0, INT_MAX, "tag count")) ||
+                    (s = st_rd_int_in(r, &ntags, 0, INT_MAX, "tag count")) ||
                     (s = msh_element(ms, etag, (int)type, (int)ntags)))
                     return s;
                 done++;
@@ -404,7 +404,7 @@ static st_status msh_elements(msh *ms)
             (s = msh_size(ms, &mintag, "smallest element tag")) ||
             (s = msh_size(ms, &maxtag, "largest element tag")))
             return s;
-        if ((s = rd_count_fits(r, n, r->binary ? 2 * (size_t)ms->dsize : 4,
+        if ((s = st_rd_count_fits(r, n, r->binary ? 2 * (size_t)ms->dsize : 4,
                                "elements")))
             return s;
         for (uint64_t b = 0; b < nblocks; b++) {
@@ -442,11 +442,7 @@ static const unsigned char *find_end(const unsigned char *p,
                                      const unsigned char *name, size_t nn)
 {
     while (p < end) {
-        const unsigned char *nl = memchr(p, '\n', (size_t)(end - p));
-        const unsigned char *e = nl ? nl : end;
-        const unsigned char *q = p;
-        while (q < e && st_text_blank(*q))
-            q++;
+        const unsigned char *q, *e, *next = st_text_line(p, end, &q, &e);
         if ((size_t)(e - q) >= 4 + nn && memcmp(q, "$End", 4) == 0 &&
             memcmp(q + 4, name, nn) == 0) {
             const unsigned char *z = q + 4 + nn;
@@ -455,7 +451,7 @@ static const unsigned char *find_end(const unsigned char *p,
             if (z == e)
                 return p;
         }
-        p = nl ? nl + 1 : end;
+        p = next;
     }
     return NULL;
 }
@@ -472,7 +468,7 @@ static st_status msh_comments(msh *ms)
     while (r->t.p < stop) {
         const unsigned char *nl =
             memchr(r->t.p, '\n', (size_t)(stop - r->t.p));
-        st_status s = rd_meta_line(r, r->t.p, nl ? nl : stop);
+        st_status s = st_rd_meta_line(r, r->t.p, nl ? nl : stop);
         if (s)
             return s;
         st_text_next_line(&r->t);
@@ -486,7 +482,7 @@ static st_status msh_format(msh *ms)
     const unsigned char *tok;
     size_t n;
     char q[ST_QUOTE_SIZE];
-    st_status s = rd_token(r, &tok, &n, "the format version");
+    st_status s = st_rd_token(r, &tok, &n, "the format version");
     if (s)
         return s;
     if (st_tok_eq(tok, n, "4.1"))
@@ -496,10 +492,10 @@ static st_status msh_format(msh *ms)
         ms->version = 22;
     else
         return rd_fail(r, "Gmsh format version '%s' is not read (4.1 and "
-                       "2.2 are)", st_soup__quote(q, sizeof q, tok, n));
+                       "2.2 are)", st_text_quote(q, sizeof q, tok, n));
     long long ftype, dsize;
-    if ((s = rd_int_in(r, &ftype, 0, 1, "file type")) ||
-        (s = rd_int(r, &dsize, "data size")))
+    if ((s = st_rd_int_in(r, &ftype, 0, 1, "file type")) ||
+        (s = st_rd_int(r, &dsize, "data size")))
         return s;
     if (ftype == 1) {
         if (ms->version == 41 ? dsize != 4 && dsize != 8 : dsize != 8)
@@ -508,7 +504,7 @@ static st_status msh_format(msh *ms)
         st_text_next_line(&r->t);
         r->binary = 1;
         /* The integer 1 in the writer's byte order. */
-        if (rd_left(r) < 4)
+        if (st_rd_left(r) < 4)
             return rd_fail(r, "file ends in $MeshFormat");
         const unsigned char *p = r->t.p;
         if (p[0] == 1 && !p[1] && !p[2] && !p[3])
@@ -528,7 +524,7 @@ static st_status msh_parse(msh *ms)
     const unsigned char *tok;
     size_t n = st_text_token_any(&r->t, &tok);
     if (!st_tok_eq(tok, n, "$MeshFormat"))
-        return rd_fail_at(r, ST_EINPUT, r->t.begin,
+        return st_rd_fail_at(r, ST_EINPUT, r->t.begin,
                           "not a Gmsh .msh file (no $MeshFormat)");
     st_status s = msh_format(ms);
     if (s)
@@ -550,13 +546,13 @@ static st_status msh_parse(msh *ms)
             char q[ST_QUOTE_SIZE];
             if (!stop)
                 return rd_fail(r, "section '%s' has no end marker",
-                               st_soup__quote(q, sizeof q, tok, n));
-            rd_jump(r, stop);
+                               st_text_quote(q, sizeof q, tok, n));
+            st_rd_jump(r, stop);
             st_text_next_line(&r->t);
         } else {
             char q[ST_QUOTE_SIZE];
             s = rd_fail(r, "expected a section ($Nodes, ...), found '%s'",
-                        st_soup__quote(q, sizeof q, tok, n));
+                        st_text_quote(q, sizeof q, tok, n));
         }
         if (s)
             return s;
@@ -575,13 +571,13 @@ st_status st_tetmesh_parse_msh(st_tetmesh **out, const unsigned char *data,
     *out = NULL;
     msh ms;
     memset(&ms, 0, sizeof ms);
-    if (rd_begin(&ms.r, max_bytes, err, name))
+    if (st_rd_begin(&ms.r, max_bytes, err, name))
         return ST_ENOMEM;
     st_text_init(&ms.r.t, data, size, 0);
     ms.r.name = name ? name : "<msh>";
     st_status s = msh_parse(&ms);
     free(ms.tags);
-    return rd_finish(&ms.r, s, out);
+    return st_rd_finish(&ms.r, s, out);
 }
 
 st_status st_tetmesh_read_msh(st_tetmesh **out, const char *path,

@@ -39,7 +39,7 @@ static st_status tg_opt_int(rd *r, long long *v, long long dflt,
         *v = dflt;
         return ST_OK;
     }
-    return rd_int_in(r, v, lo, hi, what);
+    return st_rd_int_in(r, v, lo, hi, what);
 }
 
 /* A value on the current line (a record never continues on the next). */
@@ -53,12 +53,12 @@ static st_status tg_need(rd *r, const char *what)
 static st_status tg_node(rd *r, long long *base)
 {
     st_status s;
-    if ((s = rd_hash_meta(r)))
+    if ((s = st_rd_hash_meta(r)))
         return s;
     if (!tg_next_record(r))
         return rd_fail(r, "empty .node file");
     long long n, dim, nattr, nbm;
-    if ((s = rd_int_in(r, &n, 0, (long long)UINT32_MAX, "point count")) ||
+    if ((s = st_rd_int_in(r, &n, 0, (long long)UINT32_MAX, "point count")) ||
         (s = tg_opt_int(r, &dim, 3, 0, LLONG_MAX, "dimension")) ||
         (s = tg_opt_int(r, &nattr, 0, 0, INT_MAX, "attribute count")) ||
         (s = tg_opt_int(r, &nbm, 0, 0, 1, "boundary marker flag")))
@@ -68,7 +68,7 @@ static st_status tg_node(rd *r, long long *base)
     if (n == 0)
         return rd_fail(r, "0 points (the points are then in a .poly file, "
                        "which is not read)");
-    if ((s = rd_count_fits(r, (unsigned long long)n, 8, "points")))
+    if ((s = st_rd_count_fits(r, (unsigned long long)n, 8, "points")))
         return s;
     st_text_next_line(&r->t);
     for (long long i = 0; i < n; i++) {
@@ -76,7 +76,7 @@ static st_status tg_node(rd *r, long long *base)
             return rd_fail(r, "file ends after %lld of %lld points", i, n);
         long long idx;
         double p[3];
-        if ((s = rd_int(r, &idx, "point number")))
+        if ((s = st_rd_int(r, &idx, "point number")))
             return s;
         if (i == 0) {
             if (idx != 0 && idx != 1)
@@ -89,9 +89,9 @@ static st_status tg_node(rd *r, long long *base)
         }
         for (int k = 0; k < 3; k++)
             if ((s = tg_need(r, "3 coordinates")) ||
-                (s = rd_double(r, &p[k], "coordinate")))
+                (s = st_rd_double(r, &p[k], "coordinate")))
                 return s;
-        if ((s = rd_point(r, p)))
+        if ((s = st_rd_point(r, p)))
             return s;
         st_text_next_line(&r->t); /* attributes and markers: ignored */
     }
@@ -104,7 +104,7 @@ static st_status tg_ele(rd *r, long long base)
     if (!tg_next_record(r))
         return rd_fail(r, "empty .ele file");
     long long n, npt, nreg;
-    if ((s = rd_int_in(r, &n, 0, LLONG_MAX, "tet count")) ||
+    if ((s = st_rd_int_in(r, &n, 0, LLONG_MAX, "tet count")) ||
         (s = tg_opt_int(r, &npt, 4, 0, LLONG_MAX, "nodes per tet")) ||
         (s = tg_opt_int(r, &nreg, 0, 0, 1, "region attribute flag")))
         return s;
@@ -113,7 +113,7 @@ static st_status tg_ele(rd *r, long long base)
                        npt);
     if (n == 0)
         return rd_fail(r, "0 tets");
-    if ((s = rd_count_fits(r, (unsigned long long)n, 10, "tets")))
+    if ((s = st_rd_count_fits(r, (unsigned long long)n, 10, "tets")))
         return s;
     st_text_next_line(&r->t);
     size_t np = r->m->npoints;
@@ -122,11 +122,11 @@ static st_status tg_ele(rd *r, long long base)
             return rd_fail(r, "file ends after %lld of %lld tets", i, n);
         long long idx, v;
         uint32_t t[4];
-        if ((s = rd_int(r, &idx, "tet number")))
+        if ((s = st_rd_int(r, &idx, "tet number")))
             return s;
         for (int k = 0; k < 4; k++) {
             if ((s = tg_need(r, "4 corners")) ||
-                (s = rd_int(r, &v, "corner")))
+                (s = st_rd_int(r, &v, "corner")))
                 return s;
             if (v < base || v - base >= (long long)np)
                 return rd_fail(r, "corner %lld out of range (points are "
@@ -134,7 +134,7 @@ static st_status tg_ele(rd *r, long long base)
                                base + (long long)np - 1);
             t[k] = (uint32_t)(v - base);
         }
-        if ((s = rd_tet(r, t)))
+        if ((s = st_rd_tet(r, t)))
             return s;
         st_text_next_line(&r->t);
     }
@@ -150,7 +150,7 @@ st_status st_tetmesh_parse_tetgen(st_tetmesh **out,
 {
     *out = NULL;
     rd r;
-    if (rd_begin(&r, max_bytes, err, node_name))
+    if (st_rd_begin(&r, max_bytes, err, node_name))
         return ST_ENOMEM;
     st_text_init(&r.t, node, node_size, ST_TEXT_HASH);
     r.name = node_name ? node_name : "<node>";
@@ -161,7 +161,7 @@ st_status st_tetmesh_parse_tetgen(st_tetmesh **out,
         r.name = ele_name ? ele_name : "<ele>";
         s = tg_ele(&r, base);
     }
-    return rd_finish(&r, s, out);
+    return st_rd_finish(&r, s, out);
 }
 
 st_status st_tetmesh_read_tetgen(st_tetmesh **out, const char *path,

@@ -13,7 +13,6 @@
 #include "souptet/tetformat.h"
 #include "adapters/tetio_internal.h"
 #include "fileio.h"
-#include "tetformat_internal.h"
 
 #include <errno.h>
 #include <stdio.h>

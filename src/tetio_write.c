@@ -13,7 +13,7 @@
 #include "souptet/outfile.h"
 #include "souptet/tetformat.h"
 #include "fileio.h"
-#include "tetformat_internal.h"
+#include "tetformat_write.h"
 
 #include <errno.h>
 #include <stdio.h>

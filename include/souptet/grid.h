@@ -87,6 +87,10 @@ static inline float st_grid_signed_value(float d, int inside)
 void st_grid_center(const st_grid *g, size_t i, size_t j, size_t k,
                     double p[3]);
 
+/* The voxel containing point p (voxel i covers centres +- voxel/2, ties
+ * rounded up): 1 and its indices when on the grid, 0 when off it. */
+int st_grid_voxel_of(const st_grid *g, const double p[3], size_t ijk[3]);
+
 /* "distance", "signed" or "unknown", and back (UNKNOWN for other text). */
 const char *st_grid_kind_name(st_grid_kind kind);
 st_grid_kind st_grid_kind_from_name(const char *name);

@@ -153,10 +153,6 @@ st_status st_voxel_summary_build(st_voxel_summary **out, const st_grid *g,
                                  st_error *err);
 void st_voxel_summary_free(st_voxel_summary *s);   /* safe on NULL */
 
-/* The voxel containing point p (voxel i covers centres +- voxel/2, ties
- * rounded up): 1 and its indices when on the grid, 0 when off it. */
-int st_grid_voxel_of(const st_grid *g, const double p[3], size_t ijk[3]);
-
 /* Count the voxel centres in the closed tet (p0 p1 p2 p3) (exact test,
  * st_point_in_tet): *M all of them, *m those inside (value < 0). With
  * stop_at_inside, stop at the first inside one (*m is then 0 or 1 and *M a

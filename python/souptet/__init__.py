@@ -5,8 +5,8 @@
     m.points, m.tets, m.boundary, m.min_dihedral, m.encloses
     m.write("bunny.msh")
 
-The work is done by the C library (libsouptet: needs libgomp and libxxhash
-only). wrap() and writing .vtu need libsouptet-io (OpenVDB, VTK), imported
+The work is done by the C library (libsouptet: needs libgomp, libxxhash,
+libjansson and zlib only). wrap() and writing .vtu need libsouptet-io (OpenVDB, VTK), imported
 only when called; without it they raise souptet.Error saying so.
 
 Arrays: V float64 (n, 3); F, tets, boundary and embed_tet are int64.

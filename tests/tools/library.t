@@ -26,6 +26,11 @@ readelf -d "$core" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' > needed.txt
 ok $? "the core needs no VTK, OpenVDB, TBB or C++ runtime ($(tr '\n' ' ' < needed.txt))"
 readelf -d "$io" | grep -q 'Shared library: \[libsouptet.so.0\]'
 ok $? "the io library stands on the core (NEEDED libsouptet.so.0)"
+# glTF's JSON is read by the core through jansson; the io library reads
+# no JSON of its own, and gets it with the core
+readelf -d "$io" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' > io-needed.txt
+grep -q '^libjansson\.so' needed.txt && ! grep -q jansson io-needed.txt
+ok $? "the core needs libjansson (glTF), the io library does not itself"
 # soupmesh writes every mesh format in C and reads no field: it loads no
 # VTK or OpenVDB (whose relocations cost a process about 60 ms)
 readelf -d "$SOUPTET_BIN/soupmesh" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' > tool-needed.txt
