@@ -627,14 +627,12 @@ oom:
     return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
 }
 
-st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
-                          const st_soup *s, const st_pipeline_params *p,
-                          const st_progress *prog, st_error *err)
+/* The arguments' checks; *cells: p->cells, or with an absolute cell
+ * width the cells it makes along the longest side (the field's resolution
+ * follows them). */
+static st_status check_params(size_t *cells, const st_soup *s, const st_pipeline_params *p,
+                              st_error *err)
 {
-    *out = NULL;
-    st_pipeline_stats local;
-    st_pipeline_stats *st = stats ? stats : &local;
-    memset(st, 0, sizeof *st);
     if (!p || p->cells < 1)
         return st_error_set(err, ST_EINPUT, NULL, 0, "cells must be >= 1");
     if (p->tries < 1 || p->tries > ST_PIPELINE_MAX_TRIES)
@@ -645,11 +643,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                             "the offset ratio must be > 0");
     if (!s || s->ntris == 0)
         return st_error_set(err, ST_EINPUT, NULL, 0, "the soup has no triangles");
-
-    double t_start = now_seconds();
-    /* With an absolute cell width, the cells it makes along the longest
-     * side stand for p->cells (the field's resolution follows them). */
-    size_t cells = p->cells;
+    *cells = p->cells;
     if (p->h != 0) {
         double blo[3], bhi[3];
         st_status bs = st_soup_bounds(s, blo, bhi, err);
@@ -664,8 +658,89 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                                 "a cell width of %g makes %.0f cells along "
                                 "the longest side, more than %d",
                                 p->h, n, ST_PIPELINE_MAX_CELLS);
-        cells = n < 1 ? 1 : (size_t)n;
+        *cells = n < 1 ? 1 : (size_t)n;
     }
+    return ST_OK;
+}
+
+/* The pseudo volume (pseudo.h), as soupsign --surface gives it: the field
+ * and its refinement see the hole caps; the mesh is fitted to, and must
+ * enclose, the soup itself. *bvh: the soup's BVH from the pseudo volume
+ * (the caps and the refinement used it), the fit's, the sculpting's and
+ * the checks'. Its times and dimensions go to st, and the "field" event
+ * out. */
+static st_status make_field(st_grid **g, st_bvh **bvh, st_pipeline_stats *st,
+                            const st_soup *s, const st_dist_params *dp,
+                            const st_pseudo_params *pp, const st_pipeline_params *p,
+                            double t_start, const st_progress *prog, st_error *err)
+{
+    st_pseudo_stats ps;
+    st_status rc = st_pseudo_volume_bvh(g, s, dp, pp, &ps, prog, bvh, err);
+    if (rc)
+        return rc;
+    double t_sign = t_start + (now_seconds() - t_start) -
+                    (ps.seconds_shells + ps.seconds_holes + ps.seconds_vote + ps.seconds_refine +
+                     ps.seconds_bvh);
+    st->seconds_dist = t_sign - t_start;
+    double t_cand = now_seconds();
+    st->seconds_sign = t_cand - t_sign;
+    st->shells_only = ps.shells_only;
+    st->field_dims[0] = (*g)->nx;
+    st->field_dims[1] = (*g)->ny;
+    st->field_dims[2] = (*g)->nz;
+    st->voxel = (*g)->voxel;
+    st_pipeline_event ev;
+    memset(&ev, 0, sizeof ev);
+    ev.what = "field";
+    memcpy(ev.field_dims, st->field_dims, sizeof ev.field_dims);
+    ev.voxel = (*g)->voxel;
+    ev.seconds = t_cand - t_start;
+    emit(p, &ev);
+    return ST_OK;
+}
+
+/* The best of the candidates that ran (better) into st->best, and
+ * whether it encloses; with float32, its counts, angles and enclosure as
+ * a float32 consumer will hold it (the rounded mesh's). All failed: the
+ * first one's message. */
+static st_status choose_best(st_pipeline_stats *st, st_tetmesh **meshes, const st_soup *s,
+                             const st_bvh *bvh, const st_pipeline_params *p, st_error *err)
+{
+    size_t best = 0;
+    for (size_t k = 1; k < st->ncandidates; k++)
+        if (better(&st->candidates[k], k, &st->candidates[best], best))
+            best = k;
+    if (st->candidates[best].failed)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "%s", st->candidates[0].message);
+    st->best = best;
+    st->encloses = st->candidates[best].verts_outside == 0 &&
+                   st->candidates[best].tris_crossing == 0;
+    if (p->float32) {
+        st_pipeline_candidate *c = &st->candidates[best];
+        st_status rc = st_enclosure_round_float32(meshes[best], s, bvh, &st->float32, err);
+        if (rc)
+            return rc;
+        c->verts_outside = st->float32.verts_outside;
+        c->tris_crossing = st->float32.tris_crossing;
+        dihedral_range(meshes[best], &c->min_dihedral, &c->max_dihedral);
+        st->encloses = st->float32.encloses;
+    }
+    return ST_OK;
+}
+
+st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
+                          const st_soup *s, const st_pipeline_params *p,
+                          const st_progress *prog, st_error *err)
+{
+    *out = NULL;
+    st_pipeline_stats local;
+    st_pipeline_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    size_t cells = 0;
+    st_status rc = check_params(&cells, s, p, err);
+    if (rc)
+        return rc;
+    double t_start = now_seconds();
     st_dist_params dp;
     st_pseudo_params pp;
     field_params(&dp, &pp, p->field_cells ? p->field_cells : (cells * 8 > 128 ? cells * 8 : 128),
@@ -674,35 +749,10 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     st_bvh *bvh = NULL;
     st_tetmesh **meshes = NULL;
     st_soup *fill = NULL;
-    /* The pseudo volume (pseudo.h), as soupsign --surface gives it: the
-     * field and its refinement see the hole caps; the mesh is fitted to,
-     * and must enclose, the soup itself. */
-    st_pseudo_stats ps;
-    /* the soup's BVH from the pseudo volume (the caps and the refinement
-     * used it): the fit's, the sculpting's and the checks' */
-    st_status rc = st_pseudo_volume_bvh(&g, s, &dp, &pp, &ps, prog, &bvh, err);
+    rc = make_field(&g, &bvh, st, s, &dp, &pp, p, t_start, prog, err);
     if (rc)
         goto done;
-    double t_sign = t_start + (now_seconds() - t_start) -
-                    (ps.seconds_shells + ps.seconds_holes + ps.seconds_vote + ps.seconds_refine +
-                     ps.seconds_bvh);
-    st->seconds_dist = t_sign - t_start;
     double t_cand = now_seconds();
-    st->seconds_sign = t_cand - t_sign;
-    st->shells_only = ps.shells_only;
-    st->field_dims[0] = g->nx;
-    st->field_dims[1] = g->ny;
-    st->field_dims[2] = g->nz;
-    st->voxel = g->voxel;
-    {
-        st_pipeline_event ev;
-        memset(&ev, 0, sizeof ev);
-        ev.what = "field";
-        memcpy(ev.field_dims, st->field_dims, sizeof ev.field_dims);
-        ev.voxel = g->voxel;
-        ev.seconds = t_cand - t_start;
-        emit(p, &ev);
-    }
 
     double lo[3], hi[3];
     rc = st_soup_bounds(s, lo, hi, err);
@@ -746,30 +796,9 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         goto done;
     }
 
-    size_t best = 0;
-    for (size_t k = 1; k < st->ncandidates; k++)
-        if (better(&st->candidates[k], k, &st->candidates[best], best))
-            best = k;
-    if (st->candidates[best].failed) {
-        rc = st_error_set(err, ST_EINPUT, NULL, 0, "%s",
-                          st->candidates[0].message);
+    if ((rc = choose_best(st, meshes, s, bvh, p, err)))
         goto done;
-    }
-    st->best = best;
-    st->encloses = st->candidates[best].verts_outside == 0 &&
-                   st->candidates[best].tris_crossing == 0;
-    if (p->float32) {
-        /* The chosen mesh as a float32 consumer will hold it: its counts,
-         * angles and enclosure are then the rounded mesh's. */
-        st_pipeline_candidate *c = &st->candidates[best];
-        rc = st_enclosure_round_float32(meshes[best], s, bvh, &st->float32, err);
-        if (rc)
-            goto done;
-        c->verts_outside = st->float32.verts_outside;
-        c->tris_crossing = st->float32.tris_crossing;
-        dihedral_range(meshes[best], &c->min_dihedral, &c->max_dihedral);
-        st->encloses = st->float32.encloses;
-    }
+    const size_t best = st->best;
     rc = set_meta(meshes[best], p, st, dp.cells, err);
     if (rc)
         goto done;
