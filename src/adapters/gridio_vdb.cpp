@@ -803,11 +803,14 @@ private:
             if (bytes) {
                 /* blosc's header: version, flags, type size (4 bytes),
                  * then the uncompressed size, block size and compressed
-                 * size, 32 bits each, little-endian. */
+                 * size, 32 bits each, little-endian. OpenVDB pads an
+                 * array of fewer than 128 bytes to 128 before compressing
+                 * it (a 78-leaf mask: 128 bytes). */
+                const uint64_t raw = count * elem, padded = raw < 128 ? 128 : raw;
                 uint32_t head[4] = {0, 0, 0, 0};
                 if (bytes >= 16)
                     std::memcpy(head, data_ + pos_, 16);
-                if (bytes < 16 || head[1] != count * elem || head[3] != bytes)
+                if (bytes < 16 || (head[1] != raw && head[1] != padded) || head[3] != bytes)
                     return fail("%s: the blosc block of its %s (%lu bytes) does not "
                                 "hold %llu bytes", what, array ? "sizes" : "mask",
                                 (unsigned long)bytes, (unsigned long long)(count * elem));
