@@ -134,14 +134,105 @@ static void emit(const st_pipeline_params *p, st_pipeline_event *ev)
     p->on_event(p->on_event_ctx, ev);
 }
 
+/* The candidates' progress line (run_candidates): one stage a batch,
+ * "candidates 1-2 of 8", whose fraction is the mean of its candidates'
+ * shares done. A candidate's share moves through its inner stages, each
+ * given a part of it by what it took on the models measured (soupmesh -v,
+ * dragon_res2 at 20 cells: sculpt 0.34 s, fit 2.7 s, quality 1.9 s): the
+ * sculpt to 0.1, the fit to 0.6 (its share of boundary vertices within
+ * the offset), the quality pass to 1 (its steps, fit.c). A share only
+ * grows (the fit's share falls a little as vertices move), so the line
+ * never goes back. The fit reports from the candidate's thread; the
+ * batch's report goes out under one lock, one call at a time. */
+typedef struct batch_progress {
+    const st_progress *parent;
+    char stage[96];
+    double done[ST_PIPELINE_BATCH];
+    size_t n;
+} batch_progress;
+
+typedef struct candidate_progress {
+    batch_progress *b;
+    size_t i;
+} candidate_progress;
+
+static void candidate_share(candidate_progress *cp, double share)
+{
+    batch_progress *b = cp->b;
+    #pragma omp critical(st_pipeline_progress)
+    {
+        if (share > b->done[cp->i]) {
+            b->done[cp->i] = share > 1.0 ? 1.0 : share;
+            double sum = 0;
+            for (size_t i = 0; i < b->n; i++)
+                sum += b->done[i];
+            st_progress_report(b->parent, b->stage, sum / (double)b->n);
+        }
+    }
+}
+
+/* A candidate's share at `fraction` of its inner stage. */
+static double stage_share(const char *stage, double fraction)
+{
+    const int q = strcmp(stage, "quality") == 0;
+    const double lo = q ? 0.6 : 0.1, hi = q ? 1.0 : 0.6;
+    fraction = fraction < 0 ? 0 : fraction > 1 ? 1 : fraction;
+    return lo + (hi - lo) * fraction;
+}
+
+/* st_fit's own reports. Its "fit" fraction, the share within the
+ * offset, starts near 1 and then stalls for most of the fit: the
+ * iterations (relay_iter) give the fit's part instead. */
+static void candidate_relay(void *ctx, const char *stage, double fraction)
+{
+    if (strcmp(stage, "fit") != 0)
+        candidate_share(ctx, stage_share(stage, fraction));
+}
+
+/* The fit stops when every boundary vertex is within the offset or after
+ * this many iterations that bring no new one (fit.c's FIT_STALL_ITERS;
+ * here only for the progress line). */
+#define PROGRESS_FIT_STALL 10
+
+/* The fit's iterations: the "iteration" event, and the candidate's
+ * progress through the fit and the quality pass. The fit's part: the
+ * share of the vertices it had left out that it has brought within,
+ * combined with how far it is into the stall that would end it (its work
+ * is what ends first); the quality pass's part: its rounds out of the
+ * most it runs (quality_rounds, an upper bound: the line may jump to the
+ * end). */
 typedef struct iter_relay {
     const st_pipeline_params *p;
     size_t k;
+    candidate_progress *cp;   /* NULL: no progress line */
+    int quality_rounds;
+    size_t first_within, best_within;
+    int since_best;
 } iter_relay;
 
 static void relay_iter(void *ctx, const st_fit_iter *it)
 {
-    const iter_relay *r = ctx;
+    iter_relay *r = ctx;
+    if (r->cp && strcmp(it->phase, "fit") == 0) {
+        if (it->iter == 1) {
+            r->first_within = r->best_within = it->within_offset;
+            r->since_best = 0;
+        } else if (it->within_offset > r->best_within) {
+            r->best_within = it->within_offset;
+            r->since_best = 0;
+        } else {
+            r->since_best++;
+        }
+        const double left = (double)it->boundary_vertices - (double)r->first_within;
+        const double fw = left > 0 ? ((double)r->best_within - (double)r->first_within) / left : 1;
+        const double fs = (double)r->since_best / PROGRESS_FIT_STALL;
+        candidate_share(r->cp, stage_share("fit", 1.0 - (1.0 - fw) * (1.0 - (fs < 1 ? fs : 1))));
+    } else if (r->cp && strcmp(it->phase, "quality") == 0 && r->quality_rounds > 0) {
+        double f = (double)it->iter / (double)r->quality_rounds;
+        candidate_share(r->cp, stage_share("quality", f < 0.95 ? f : 0.95));
+    }
+    if (!r->p->on_event)
+        return;
     st_pipeline_event ev;
     memset(&ev, 0, sizeof ev);
     ev.what = "iteration";
@@ -172,6 +263,8 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
         return rc;
     c->bombs = ss.bombs;
     c->bombs_left = ss.bombs_left;
+    if (prog && prog->fn == candidate_relay)
+        candidate_share(prog->ctx, 0.1);
     double t1 = now_seconds();
     c->seconds_sculpt = t1 - t0;
     st_pipeline_event ev;
@@ -183,9 +276,10 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
     ev.seconds = c->seconds_sculpt;
     emit(p, &ev);
 
-    iter_relay relay = {p, k};
     st_fit_params fp = st_fit_params_default();
-    if (p->on_event) {
+    iter_relay relay = {p, k, prog && prog->fn == candidate_relay ? prog->ctx : NULL,
+                        fp.quality_rounds, 0, 0, 0};
+    if (p->on_event || relay.cp) {
         fp.on_iter = relay_iter;
         fp.on_iter_ctx = &relay;
     }
@@ -410,9 +504,9 @@ static void run_candidate(st_tetmesh **meshes, st_pipeline_stats *st, size_t k,
 
 /* The candidates (see pipeline.h): batches of ST_PIPELINE_BATCH in
  * index order, one thread per candidate when a batch has several; a
- * single candidate keeps all threads for its own loops, and reports the
- * fit's progress (several report only as each one finishes: the reporter
- * is not called from two threads at once). After each batch, a candidate
+ * single candidate keeps all threads for its own loops. Each batch is a
+ * stage of the progress line (batch_progress), moved by its candidates'
+ * sculpts, fits and quality passes. After each batch, a candidate
  * that meets every goal ends the run: the batches do not depend on the
  * thread count, so neither does which candidates ran. st->ncandidates
  * becomes the number that ran. */
@@ -421,25 +515,39 @@ static void run_candidates(st_tetmesh **meshes, st_pipeline_stats *st, const st_
                            double h, const st_pipeline_params *p, const st_progress *prog)
 {
     const size_t K = st->ncandidates;
-    size_t finished = 0, ran = 0;
-    /* several candidates: their fits see the cancel flag alone */
-    st_progress cancel_only = {NULL, NULL, prog ? prog->cancel : NULL};
+    size_t ran = 0;
     for (size_t b0 = 0; b0 < K && !st->goal_met; b0 += ST_PIPELINE_BATCH) {
         size_t b1 = b0 + ST_PIPELINE_BATCH < K ? b0 + ST_PIPELINE_BATCH : K;
         int nthreads = b1 - b0 > 1 ? omp_get_max_threads() : 1;
         if ((size_t)nthreads > b1 - b0)
             nthreads = (int)(b1 - b0);
+        batch_progress bp;
+        memset(&bp, 0, sizeof bp);
+        bp.parent = prog;
+        bp.n = b1 - b0;
+        if (K == 1)
+            snprintf(bp.stage, sizeof bp.stage, "candidate");
+        else if (b1 - b0 == 1)
+            snprintf(bp.stage, sizeof bp.stage, "candidates %zu of %zu", b1, K);
+        else
+            snprintf(bp.stage, sizeof bp.stage, "candidates %zu-%zu of %zu", b0 + 1, b1, K);
+        candidate_progress cps[ST_PIPELINE_BATCH];
+        st_progress relays[ST_PIPELINE_BATCH];
+        for (size_t i = 0; i < bp.n; i++) {
+            cps[i].b = &bp;
+            cps[i].i = i;
+            relays[i].fn = prog && prog->fn ? candidate_relay : NULL;
+            relays[i].ctx = &cps[i];
+            relays[i].cancel = prog ? prog->cancel : NULL;
+        }
+        st_progress_report(prog, bp.stage, 0.0);
         #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
         for (size_t k = b0; k < b1; k++) {
             if (st_progress_cancelled(prog))
                 continue;
-            run_candidate(meshes, st, k, g, s, bvh, fill, h, p,
-                          K == 1 ? prog : &cancel_only);
-            #pragma omp critical(st_pipeline_progress)
-            {
-                finished++;
-                st_progress_report(prog, "candidates", (double)finished / (double)K);
-            }
+            run_candidate(meshes, st, k, g, s, bvh, fill, h, p, &relays[k - b0]);
+            if (relays[k - b0].fn)
+                candidate_share(&cps[k - b0], 1.0);
         }
         ran = b1;
         for (size_t k = b0; k < b1 && !p->try_all; k++)
@@ -447,8 +555,6 @@ static void run_candidates(st_tetmesh **meshes, st_pipeline_stats *st, const st_
                 st->goal_met = 1;
     }
     st->ncandidates = ran;
-    if (ran < K)
-        st_progress_report(prog, "candidates", 1.0);
 }
 
 /* The fill (pseudo.h): the pseudo volume's boundary where the soup has
@@ -457,9 +563,11 @@ static void run_candidates(st_tetmesh **meshes, st_pipeline_stats *st, const st_
  * the solid is a guess (the closed shells' alone: none, and no call).
  * *fill stays NULL where it does not count. */
 static st_status make_fill(st_soup **fill, st_pipeline_stats *st, const st_grid *g,
-                           const st_bvh *bvh, const st_pipeline_params *p, st_error *err)
+                           const st_bvh *bvh, const st_pipeline_params *p,
+                           const st_progress *prog, st_error *err)
 {
     size_t nfill = 0;
+    st_progress_report(prog, "fill", 0.0);
     st_status rc = st_pseudo_fill(fill, g, bvh, &nfill, err);
     if (rc)
         return rc;
@@ -519,14 +627,12 @@ oom:
     return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
 }
 
-st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
-                          const st_soup *s, const st_pipeline_params *p,
-                          const st_progress *prog, st_error *err)
+/* The arguments' checks; *cells: p->cells, or with an absolute cell
+ * width the cells it makes along the longest side (the field's resolution
+ * follows them). */
+static st_status check_params(size_t *cells, const st_soup *s, const st_pipeline_params *p,
+                              st_error *err)
 {
-    *out = NULL;
-    st_pipeline_stats local;
-    st_pipeline_stats *st = stats ? stats : &local;
-    memset(st, 0, sizeof *st);
     if (!p || p->cells < 1)
         return st_error_set(err, ST_EINPUT, NULL, 0, "cells must be >= 1");
     if (p->tries < 1 || p->tries > ST_PIPELINE_MAX_TRIES)
@@ -537,11 +643,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                             "the offset ratio must be > 0");
     if (!s || s->ntris == 0)
         return st_error_set(err, ST_EINPUT, NULL, 0, "the soup has no triangles");
-
-    double t_start = now_seconds();
-    /* With an absolute cell width, the cells it makes along the longest
-     * side stand for p->cells (the field's resolution follows them). */
-    size_t cells = p->cells;
+    *cells = p->cells;
     if (p->h != 0) {
         double blo[3], bhi[3];
         st_status bs = st_soup_bounds(s, blo, bhi, err);
@@ -556,8 +658,89 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                                 "a cell width of %g makes %.0f cells along "
                                 "the longest side, more than %d",
                                 p->h, n, ST_PIPELINE_MAX_CELLS);
-        cells = n < 1 ? 1 : (size_t)n;
+        *cells = n < 1 ? 1 : (size_t)n;
     }
+    return ST_OK;
+}
+
+/* The pseudo volume (pseudo.h), as soupsign --surface gives it: the field
+ * and its refinement see the hole caps; the mesh is fitted to, and must
+ * enclose, the soup itself. *bvh: the soup's BVH from the pseudo volume
+ * (the caps and the refinement used it), the fit's, the sculpting's and
+ * the checks'. Its times and dimensions go to st, and the "field" event
+ * out. */
+static st_status make_field(st_grid **g, st_bvh **bvh, st_pipeline_stats *st,
+                            const st_soup *s, const st_dist_params *dp,
+                            const st_pseudo_params *pp, const st_pipeline_params *p,
+                            double t_start, const st_progress *prog, st_error *err)
+{
+    st_pseudo_stats ps;
+    st_status rc = st_pseudo_volume_bvh(g, s, dp, pp, &ps, prog, bvh, err);
+    if (rc)
+        return rc;
+    double t_sign = t_start + (now_seconds() - t_start) -
+                    (ps.seconds_shells + ps.seconds_holes + ps.seconds_vote + ps.seconds_refine +
+                     ps.seconds_bvh);
+    st->seconds_dist = t_sign - t_start;
+    double t_cand = now_seconds();
+    st->seconds_sign = t_cand - t_sign;
+    st->shells_only = ps.shells_only;
+    st->field_dims[0] = (*g)->nx;
+    st->field_dims[1] = (*g)->ny;
+    st->field_dims[2] = (*g)->nz;
+    st->voxel = (*g)->voxel;
+    st_pipeline_event ev;
+    memset(&ev, 0, sizeof ev);
+    ev.what = "field";
+    memcpy(ev.field_dims, st->field_dims, sizeof ev.field_dims);
+    ev.voxel = (*g)->voxel;
+    ev.seconds = t_cand - t_start;
+    emit(p, &ev);
+    return ST_OK;
+}
+
+/* The best of the candidates that ran (better) into st->best, and
+ * whether it encloses; with float32, its counts, angles and enclosure as
+ * a float32 consumer will hold it (the rounded mesh's). All failed: the
+ * first one's message. */
+static st_status choose_best(st_pipeline_stats *st, st_tetmesh **meshes, const st_soup *s,
+                             const st_bvh *bvh, const st_pipeline_params *p, st_error *err)
+{
+    size_t best = 0;
+    for (size_t k = 1; k < st->ncandidates; k++)
+        if (better(&st->candidates[k], k, &st->candidates[best], best))
+            best = k;
+    if (st->candidates[best].failed)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "%s", st->candidates[0].message);
+    st->best = best;
+    st->encloses = st->candidates[best].verts_outside == 0 &&
+                   st->candidates[best].tris_crossing == 0;
+    if (p->float32) {
+        st_pipeline_candidate *c = &st->candidates[best];
+        st_status rc = st_enclosure_round_float32(meshes[best], s, bvh, &st->float32, err);
+        if (rc)
+            return rc;
+        c->verts_outside = st->float32.verts_outside;
+        c->tris_crossing = st->float32.tris_crossing;
+        dihedral_range(meshes[best], &c->min_dihedral, &c->max_dihedral);
+        st->encloses = st->float32.encloses;
+    }
+    return ST_OK;
+}
+
+st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
+                          const st_soup *s, const st_pipeline_params *p,
+                          const st_progress *prog, st_error *err)
+{
+    *out = NULL;
+    st_pipeline_stats local;
+    st_pipeline_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    size_t cells = 0;
+    st_status rc = check_params(&cells, s, p, err);
+    if (rc)
+        return rc;
+    double t_start = now_seconds();
     st_dist_params dp;
     st_pseudo_params pp;
     field_params(&dp, &pp, p->field_cells ? p->field_cells : (cells * 8 > 128 ? cells * 8 : 128),
@@ -566,35 +749,10 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     st_bvh *bvh = NULL;
     st_tetmesh **meshes = NULL;
     st_soup *fill = NULL;
-    /* The pseudo volume (pseudo.h), as soupsign --surface gives it: the
-     * field and its refinement see the hole caps; the mesh is fitted to,
-     * and must enclose, the soup itself. */
-    st_pseudo_stats ps;
-    /* the soup's BVH from the pseudo volume (the caps and the refinement
-     * used it): the fit's, the sculpting's and the checks' */
-    st_status rc = st_pseudo_volume_bvh(&g, s, &dp, &pp, &ps, prog, &bvh, err);
+    rc = make_field(&g, &bvh, st, s, &dp, &pp, p, t_start, prog, err);
     if (rc)
         goto done;
-    double t_sign = t_start + (now_seconds() - t_start) -
-                    (ps.seconds_shells + ps.seconds_holes + ps.seconds_vote + ps.seconds_refine +
-                     ps.seconds_bvh);
-    st->seconds_dist = t_sign - t_start;
     double t_cand = now_seconds();
-    st->seconds_sign = t_cand - t_sign;
-    st->shells_only = ps.shells_only;
-    st->field_dims[0] = g->nx;
-    st->field_dims[1] = g->ny;
-    st->field_dims[2] = g->nz;
-    st->voxel = g->voxel;
-    {
-        st_pipeline_event ev;
-        memset(&ev, 0, sizeof ev);
-        ev.what = "field";
-        memcpy(ev.field_dims, st->field_dims, sizeof ev.field_dims);
-        ev.voxel = g->voxel;
-        ev.seconds = t_cand - t_start;
-        emit(p, &ev);
-    }
 
     double lo[3], hi[3];
     rc = st_soup_bounds(s, lo, hi, err);
@@ -618,7 +776,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
         goto done;
     }
-    if (!st->shells_only && (rc = make_fill(&fill, st, g, bvh, p, err)))
+    if (!st->shells_only && (rc = make_fill(&fill, st, g, bvh, p, prog, err)))
         goto done;
     size_t K = p->tries;
     st->candidates = calloc(K, sizeof *st->candidates);
@@ -638,30 +796,9 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         goto done;
     }
 
-    size_t best = 0;
-    for (size_t k = 1; k < st->ncandidates; k++)
-        if (better(&st->candidates[k], k, &st->candidates[best], best))
-            best = k;
-    if (st->candidates[best].failed) {
-        rc = st_error_set(err, ST_EINPUT, NULL, 0, "%s",
-                          st->candidates[0].message);
+    if ((rc = choose_best(st, meshes, s, bvh, p, err)))
         goto done;
-    }
-    st->best = best;
-    st->encloses = st->candidates[best].verts_outside == 0 &&
-                   st->candidates[best].tris_crossing == 0;
-    if (p->float32) {
-        /* The chosen mesh as a float32 consumer will hold it: its counts,
-         * angles and enclosure are then the rounded mesh's. */
-        st_pipeline_candidate *c = &st->candidates[best];
-        rc = st_enclosure_round_float32(meshes[best], s, bvh, &st->float32, err);
-        if (rc)
-            goto done;
-        c->verts_outside = st->float32.verts_outside;
-        c->tris_crossing = st->float32.tris_crossing;
-        dihedral_range(meshes[best], &c->min_dihedral, &c->max_dihedral);
-        st->encloses = st->float32.encloses;
-    }
+    const size_t best = st->best;
     rc = set_meta(meshes[best], p, st, dp.cells, err);
     if (rc)
         goto done;

@@ -112,6 +112,8 @@ static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_soup_edg
     st_status rc = votes && evidence ? ST_OK
                  : st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the sides");
     st_sides_params sp = p->sides_params;
+    if (!sp.progress)
+        sp.progress = progress;
     /* s: the soup, then its caps */
     const size_t seen = !edges && st->cap_triangles ? s->ntris - st->cap_triangles : 0;
     if (sp.past_caps && !sp.seen_triangles)
@@ -121,12 +123,20 @@ static st_status vote_with_sides(st_grid *g, const st_soup *s, const st_soup_edg
     /* voxels the cut takes as the votes say get no evidence (mincut.h) */
     const int decided = st_mincut_params_default().fixed_evidence;
     rc = rc ? rc : st_sign_votes_progress(g, &p->sign, votes, progress, err);
+    if (!rc)
+        st_progress_report(progress, "sides", 0.0);
     rc = rc ? rc : st_sides_evidence_edges(evidence, g, votes, decided, s, edges, &sp,
                                            &st->sides, err);
+    if (!rc)
+        st_progress_report(progress, "cut", 0.0);
     rc = rc ? rc : st_sign_field_evidence(g, &p->sign, evidence, votes, progress, err);
+    if (!rc)
+        st_progress_report(progress, "sides", 0.5);
     rc = rc ? rc : st_sides_mirror(g, s, sp.seen_triangles, &st->sides, &st->mirrored, err);
     rc = rc ? rc : st_sides_columns(g, s, &sp, &st->sides, p->refine.band_voxels,
                                     &st->columned, err);
+    if (!rc)
+        st_progress_report(progress, "sides", 1.0);
     free(votes);
     free(evidence);
     return rc;
@@ -179,6 +189,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     }
     if (s && p->closed_shells) {
         st->failed_step = "shells";
+        st_progress_report(progress, "shells", 0.0);
         rc = st_soup_closed_shells_edges(&shells, s, &edges, err);
         if (rc)
             goto done;
@@ -199,6 +210,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     st->seconds_shells = t1 - t0;
     st->failed_step = "holes";
     if (s && p->fill_holes) {
+        st_progress_report(progress, "holes", 0.0);
         if ((rc = st_bvh_build(&bvh, s, err)) ||
             (rc = add_caps(g, s, &edges, bvh, p, st, &with_caps, err)))
             goto done;
@@ -223,12 +235,14 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     st->seconds_vote = t3 - t2;
     st->failed_step = "refine";
     if (s && p->refine_signs) {
+        st_progress_report(progress, "refine", 0.0);
         if (!with_caps && bvh && s->ntris)
             rc = st_sign_refine_bvh(g, bvh, &p->refine, &st->refined, err);
         else
             rc = st_sign_refine(g, with_caps ? with_caps : s, &p->refine, &st->refined, err);
         if (rc)
             goto done;
+        st_progress_report(progress, "refine", 1.0);
     }
     STOP_IF_CANCELLED();
     double t4 = now_seconds();
@@ -246,6 +260,7 @@ count_inside:;
     st->failed_step = NULL;
     if (bvh_out && s) {
         const double tb = now_seconds();
+        st_progress_report(progress, "bvh", 0.0);
         if (!bvh && (rc = st_bvh_build(&bvh, s, err)))
             goto done;
         st->seconds_bvh = now_seconds() - tb;

@@ -12,6 +12,7 @@
 #include "souptet/sign.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -29,7 +30,7 @@ st_sides_params st_sides_params_default(void)
     /* one-sided below 0.25 and the column rule below 0.02 along an axis:
      * between what the corpus's one-sided scans and its other damaged
      * soups read (doc/design/sides.md) */
-    st_sides_params p = {2.5, 3.0, 24.0, 9, 0.25, 0, 1e-3, 0.25, 0, 0.02, 0, 1};
+    st_sides_params p = {2.5, 3.0, 24.0, 9, 0.25, 0, 1e-3, 0.25, 0, 0.02, 0, 1, NULL};
     return p;
 }
 
@@ -563,9 +564,13 @@ static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t
     const double r = p->radius_voxels * g->voxel;
     const double scale = p->weight / (4.0 * M_PI);
     const double cap = (double)p->max_evidence;
-    size_t count = 0;
+    size_t count = 0, slices = 0;
     #pragma omp parallel for schedule(dynamic, 1) reduction(+ : count)
-    for (size_t z = 0; z < g->nz; z++)
+    for (size_t z = 0; z < g->nz; z++) {
+        /* the progress line: the slices done, from the calling thread */
+        const size_t done = __atomic_fetch_add(&slices, 1, __ATOMIC_RELAXED);
+        if (omp_get_thread_num() == 0)
+            st_progress_report(p->progress, "sides", 0.5 * (double)done / (double)g->nz);
         for (size_t y = 0; y < g->ny; y++)
             for (size_t x = 0; x < g->nx; x++) {
                 const size_t i = st_grid_index(g, x, y, z);
@@ -584,6 +589,7 @@ static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t
                 evidence[i] = (int8_t)lround(e);
                 count++;
             }
+    }
     return count;
 }
 

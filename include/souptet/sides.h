@@ -29,6 +29,7 @@
 #include "souptet/edges.h"
 #include "souptet/err.h"
 #include "souptet/grid.h"
+#include "souptet/progress.h"
 #include "souptet/soup.h"
 
 #ifdef __cplusplus
@@ -55,6 +56,8 @@ typedef struct st_sides_params {
                                triangles (the seen surface); 0: all */
     int column_caps;        /* the column rule reads the caps that face
                                away too (1; st_sides_columns) */
+    const st_progress *progress;   /* NULL, or "sides" reports from the
+                               winding numbers' slices (NULL) */
 } st_sides_params;
 
 st_sides_params st_sides_params_default(void);

@@ -738,6 +738,11 @@ private:
                 return st;
             if (st_status st = block(what, &type))
                 return st;
+            if (type == "__delayedload") {
+                if (st_status st = delayed_load())
+                    return st;
+                continue;
+            }
             const uint64_t at = pos_;
             if (st_status st = block(what))
                 return st;
@@ -752,6 +757,70 @@ private:
         }
         return ST_OK;
     }
+    /* OpenVDB's delayed-load metadata (io::DelayedLoadMetadata::readValue,
+     * type "__delayedload"): a leaf count, then a one-byte mask and an
+     * 8-byte compressed size per leaf, each array stored raw or as one
+     * blosc block (a 4-byte length first; the sizes' length 0xffffffff:
+     * no sizes). OpenVDB sizes its arrays by the count and by the
+     * uncompressed size in each blosc header, and allocates each block by
+     * its length, all before it reads them: a 3 KB file asked for 2.6 GB.
+     * So: every byte it reads lies within the value's length, the count is
+     * at most one leaf per 64 bytes of the file (a leaf's value mask, in
+     * every tree OpenVDB reads), and a blosc header gives the array's own
+     * size and its block's length. souptet reads without delayed loading,
+     * so the arrays themselves are not used. */
+    st_status delayed_load()
+    {
+        const char *what = "the grid's delayed-load metadata";
+        uint32_t n;
+        if (!get(&n, 4))
+            return ST_OK;
+        if (n > left())
+            return fail("%s claims %lu bytes but %llu remain", what, (unsigned long)n,
+                        (unsigned long long)left());
+        const uint64_t end = pos_ + n;
+        if (n == 0)
+            return ST_OK;   /* OpenVDB reads nothing */
+        uint32_t count;
+        if (end - pos_ < 4 || !get(&count, 4))
+            return fail("%s is cut short", what);
+        if (count > size_ / 64)
+            return fail("%s claims %lu leaves, more than a file of %llu bytes holds "
+                        "(64 bytes a leaf at least)", what, (unsigned long)count,
+                        (unsigned long long)size_);
+        for (int array = 0; array < 2; array++) {
+            const uint64_t elem = array == 0 ? 1 : 8;
+            uint32_t bytes;
+            if (end - pos_ < 4 || !get(&bytes, 4))
+                return fail("%s is cut short", what);
+            if (array == 1 && bytes == 0xffffffffu)
+                break;      /* no compressed sizes */
+            const uint64_t want = bytes ? bytes : count * elem;
+            if (want > end - pos_)
+                return fail("%s claims %llu bytes for its %s but %llu remain", what,
+                            (unsigned long long)want, array ? "sizes" : "mask",
+                            (unsigned long long)(end - pos_));
+            if (bytes) {
+                /* blosc's header: version, flags, type size (4 bytes),
+                 * then the uncompressed size, block size and compressed
+                 * size, 32 bits each, little-endian. OpenVDB pads an
+                 * array of fewer than 128 bytes to 128 before compressing
+                 * it (a 78-leaf mask: 128 bytes). */
+                const uint64_t raw = count * elem, padded = raw < 128 ? 128 : raw;
+                uint32_t head[4] = {0, 0, 0, 0};
+                if (bytes >= 16)
+                    std::memcpy(head, data_ + pos_, 16);
+                if (bytes < 16 || (head[1] != raw && head[1] != padded) || head[3] != bytes)
+                    return fail("%s: the blosc block of its %s (%lu bytes) does not "
+                                "hold %llu bytes", what, array ? "sizes" : "mask",
+                                (unsigned long)bytes, (unsigned long long)(count * elem));
+            }
+            pos_ += want;
+        }
+        pos_ = end;         /* OpenVDB skips what follows, as unknown */
+        return ST_OK;
+    }
+
     /* The bytes of OpenVDB's fixed-size metadata types; 0 for the others
      * (strings, and types it keeps as unknown, read by their length). */
     static uint64_t fixed_size(const std::string &t)

@@ -57,6 +57,62 @@ ok $? "no line without SOUPTET_PROGRESS on a non-terminal (nor with -q)"
 SOUPTET_PROGRESS=1 soupmesh -q --cells 4 -o q.vtu "$BUNNY" 2>q.err && ! [ -s q.err ]
 ok $? "... and none with -q even when forced"
 
+# Every stage moves (issue 40, item 2): on a holed soup whose run takes a
+# few seconds, with two batches of candidates, the stages come in order,
+# each batch of candidates shows distinct percentages as its candidates
+# sculpt, fit and pass for quality (before,
+# nothing moved between the distance band's 100% and the first
+# candidate's end), and the line changes at least every 2.5 s.
+cat >stamp.py <<'EOF'
+import sys, time
+# Each progress record of stdin, with the seconds since start.
+t0, buf, out = time.time(), b'', open(sys.argv[1], 'w')
+while True:
+    c = sys.stdin.buffer.read(1)
+    if not c:
+        break
+    if c in (b'\r', b'\n'):
+        rec = buf.decode(errors='replace').replace('\x1b[K', '')
+        if rec:
+            out.write('%.3f %s\n' % (time.time() - t0, rec))
+            out.flush()
+        buf = b''
+    else:
+        buf += c
+EOF
+cat >stages.py <<'EOF'
+import re, sys
+pat = re.compile(r'^([\d.]+) soupmesh: (.+?) +(\d+)% \(')
+recs = [(float(m.group(1)), m.group(2), int(m.group(3)))
+        for m in map(pat.match, open(sys.argv[1])) if m]
+order, pcts = [], {}
+for t, stage, pct in recs:
+    if not order or order[-1] != stage:
+        order.append(stage)
+    pcts.setdefault(stage, set()).add(pct)
+gaps = [b[0] - a[0] for a, b in zip(recs, recs[1:])]
+print('# stages: ' + ', '.join('%s (%d distinct)' % (s, len(pcts[s])) for s in order))
+print('# longest time without a new record: %.2f s' % max(gaps or [0]))
+# (a stage is drawn when 0.1 s passed since the last draw, or at its end:
+# on a fast machine a short stage such as the sides may not show)
+want = ['distance band', 'signs', 'candidates 1-2 of 4', 'candidates 3-4 of 4']
+at = [order.index(w) if w in order else -1 for w in want]
+bad = [w for w, i in zip(want, at) if i < 0]
+if bad or at != sorted(at):
+    print('# missing or out of order: %s' % bad)
+    sys.exit(1)
+if any(len(pcts[w]) < 3 for w in want[2:]):
+    sys.exit(1)
+sys.exit(0 if max(gaps or [0]) <= 2.5 else 1)
+EOF
+holed_bunny >holed.obj
+(SOUPTET_PROGRESS=1 soupmesh --cells 12 --tries 4 --try-all -o h.vtu holed.obj 2>&1 >/dev/null;
+ echo "exit $?" >&2) 2>h.rc | "$PYVTK" stamp.py h.rec
+grep -q '^exit 0$' h.rc
+ok $? "soupmesh on a holed soup, 4 candidates in 2 batches"
+"$PYVTK" stages.py h.rec
+ok $? "each stage in order; each batch of candidates moves (>= 3 distinct percentages: before, its 'candidates N%' went from 0 to 100 in one step), a new record at least every 2.5 s"
+
 # A signal mid-run: the line ends with a newline (the shell's prompt
 # starts a line of its own), and no output is left.
 for sig in INT TERM; do

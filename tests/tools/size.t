@@ -40,8 +40,9 @@ soupmesh --dry-run --tets 1000 "$BUNNY" >dry.txt 2>dry.err
 rc=$?
 [ $rc -eq 0 ] && grep -q '^h [0-9.e+-]*$' dry.txt && grep -q '^estimated_tets [0-9]*$' dry.txt &&
     grep -q '^memory_mib [0-9.]*$' dry.txt && grep -q '^seconds [0-9.]*$' dry.txt &&
+    grep -q '^seconds_all_batches [0-9.]*$' dry.txt && grep -q '^batches 1$' dry.txt &&
     grep -q '^threads [0-9]*$' dry.txt && grep -q '^time seconds$' dry.txt && [ ! -s dry.err ]
-ok $? "--dry-run prints h, estimated_tets, memory_mib, seconds, threads and time, and nothing else"
+ok $? "--dry-run prints h, estimated_tets, memory_mib, seconds, seconds_all_batches, batches, threads and time, and nothing else"
 est=$(sed -n 's/^estimated_tets //p' dry.txt)
 n=$(sed -n 's/.*"tets": \([0-9]*\).*/\1/p' b1.json | head -1)
 [ -n "$est" ] && [ "$est" = "$n" ]
@@ -53,12 +54,17 @@ ok $? "--dry-run --size with that h estimates the same count"
 mkdir -p nothing && (cd nothing && soupmesh -q --dry-run -o x.vtu "$BUNNY" >/dev/null) && [ -z "$(ls nothing)" ]
 ok $? "--dry-run writes no mesh"
 # The time estimate (issue 40, item 3) against the real run, within 2x,
-# on two models (the bunny at 12 cells and 2 tries, and with three holes
-# at the defaults), each timed right after its estimate; a machine shared
-# with other jobs makes one pair noisy, so a pair off by more gets one
-# more try.
+# on two models (the bunny at 12 cells and 6 tries, 3 batches, and with
+# three holes at 4 tries, 2 batches: both runs stop after their first
+# batch, which is what the estimate counts), each timed right after its
+# estimate; a machine shared with other jobs makes one pair noisy, so a
+# pair off by more gets one more try.
 holed_bunny > holed.obj
-for spec in "--cells 12 --tries 2|$BUNNY" "--tries 1|holed.obj"; do
+soupmesh -q --dry-run --cells 12 --tries 6 "$BUNNY" >dry6.txt &&
+    awk '/^seconds / { s = $2 } /^seconds_all_batches / { a = $2 } /^batches / { b = $2 }
+         END { exit !(b == 3 && a > s && a <= 3 * s + 0.2) }' dry6.txt
+ok $? "--dry-run --tries 6: 3 batches; seconds_all_batches, every batch run, above seconds (the first) and at most 3 times it"
+for spec in "--cells 12 --tries 6|$BUNNY" "--tries 4|holed.obj"; do
     opts=${spec%%|*} model=${spec#*|}
     for attempt in 1 2; do
         est=$(soupmesh -q --dry-run $opts "$model" | sed -n 's/^seconds //p')
