@@ -104,6 +104,8 @@ TOOL_HELP_TETFORMAT
 "                       surface around them; default on)\n"
 "      --shells on|off  the soup's closed pieces (every edge shared by two\n"
 "                       faces) bound their solid exactly (default on)\n"
+"      --symmetry on|off  fill holes from the soup's symmetries, as soupsign\n"
+"                       --symmetry (default off)\n"
 "      --no-quality     skip the quality pass after the fit\n"
 "      --threads T      threads to use (default: all cores)\n"
 "      --max-memory SZ  refuse fields and lattices larger than SZ\n"
@@ -478,8 +480,11 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         break;
     case TOOL_OPT_FILL_HOLES:
     case TOOL_OPT_SHELLS:
-        return tool_pseudo_option(t, c, arg, &s->pipeline.fill_holes,
-                                  &s->pipeline.closed_shells);
+    case TOOL_OPT_SYMMETRY:
+        return tool_pseudo_option(t, c, arg,
+                                  &(tool_pseudo_switches){&s->pipeline.fill_holes,
+                                                          &s->pipeline.closed_shells,
+                                                          &s->pipeline.symmetry});
     case OPT_EMBED:
         s->embed = arg;
         break;
@@ -816,7 +821,8 @@ static int run(tool_ctx *t, void *settings)
              b->verts_outside, b->tris_crossing, tool_now() - t0);
     const double diag = box_diagonal(soup);
     say_guess(t, &st, soup, diag);
-    if ((rc = tool_report_symmetries(t, soup, NULL, st.voxel)))
+    if ((rc = tool_report_symmetries(t, soup, NULL, st.voxel, &st.symmetries,
+                                     &st.symmetry_fill, st.seconds_symmetry)))
         goto done;
     if (t->verbosity >= 2 && p->density_rho <= 0) {
         /* both directions, in h and per the input's box diagonal */
