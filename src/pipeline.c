@@ -38,6 +38,7 @@ st_pipeline_params st_pipeline_params_default(void)
     p.max_bytes = 0;
     p.fill_holes = 1;
     p.closed_shells = 1;
+    p.symmetry = 0;
     p.fill_counts = 1;
     p.float32 = 0;
     return p;
@@ -585,7 +586,7 @@ static st_status make_fill(st_soup **fill, st_pipeline_stats *st, const st_grid 
  * longest side of the soup's box, its hole caps and closed shells): one
  * place for st_pipeline_run and st_pipeline_field_of_mesh. */
 static void field_params(st_dist_params *dp, st_pseudo_params *pp, size_t voxels,
-                         size_t max_bytes, int fill_holes, int closed_shells)
+                         size_t max_bytes, int fill_holes, int closed_shells, int symmetry)
 {
     *dp = st_dist_params_default();
     dp->cells = voxels;
@@ -593,6 +594,7 @@ static void field_params(st_dist_params *dp, st_pseudo_params *pp, size_t voxels
     *pp = st_pseudo_params_default();
     pp->fill_holes = fill_holes;
     pp->closed_shells = closed_shells;
+    pp->symmetry = symmetry;
 }
 
 static st_status set_meta(st_tetmesh *m, const st_pipeline_params *p,
@@ -603,7 +605,8 @@ static st_status set_meta(st_tetmesh *m, const st_pipeline_params *p,
     snprintf(buf, sizeof buf, "%zu", field_voxels);
     if (st_meta_set(&m->meta, "field_voxels", buf) ||
         st_meta_set(&m->meta, "fill_holes", p->fill_holes ? "yes" : "no") ||
-        st_meta_set(&m->meta, "closed_shells", p->closed_shells ? "yes" : "no"))
+        st_meta_set(&m->meta, "closed_shells", p->closed_shells ? "yes" : "no") ||
+        (p->symmetry && st_meta_set(&m->meta, "symmetry", "yes")))
         goto oom;
     snprintf(buf, sizeof buf, "%.17g", p->offset_ratio);
     if (st_meta_set(&m->meta, "offset_ratio", buf))
@@ -685,6 +688,9 @@ static st_status make_field(st_grid **g, st_bvh **bvh, st_pipeline_stats *st,
     double t_cand = now_seconds();
     st->seconds_sign = t_cand - t_sign;
     st->shells_only = ps.shells_only;
+    st->symmetries = ps.symmetries;
+    st->symmetry_fill = ps.symmetry_fill;
+    st->seconds_symmetry = ps.seconds_symmetry;
     st->field_dims[0] = (*g)->nx;
     st->field_dims[1] = (*g)->ny;
     st->field_dims[2] = (*g)->nz;
@@ -744,7 +750,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     st_dist_params dp;
     st_pseudo_params pp;
     field_params(&dp, &pp, p->field_cells ? p->field_cells : (cells * 8 > 128 ? cells * 8 : 128),
-                 p->max_bytes, p->fill_holes, p->closed_shells);
+                 p->max_bytes, p->fill_holes, p->closed_shells, p->symmetry);
     st_grid *g = NULL;
     st_bvh *bvh = NULL;
     st_tetmesh **meshes = NULL;
@@ -843,6 +849,7 @@ st_status st_pipeline_field_of_mesh(st_grid **out, const st_tetmesh *m, const st
                             "field_voxels, fill_holes, closed_shells: a soupmesh mesh does)");
     st_dist_params dp;
     st_pseudo_params pp;
-    field_params(&dp, &pp, (size_t)n, max_bytes, holes, shells);
+    /* "symmetry" is recorded only when it was on */
+    field_params(&dp, &pp, (size_t)n, max_bytes, holes, shells, meta_yes(m, "symmetry") == 1);
     return st_pseudo_volume(out, s, &dp, &pp, NULL, prog, err);
 }

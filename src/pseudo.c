@@ -39,6 +39,7 @@ st_pseudo_params st_pseudo_params_default(void)
     p.sides = 1;
     p.sides_params = st_sides_params_default();
     p.shells_shortcut = 1;
+    p.symmetry = 0;
     return p;
 }
 
@@ -64,6 +65,41 @@ static st_status shells_only(st_grid *g, const st_shells *shells, const st_pseud
     return rc;
 }
 
+/* Step 2's symmetry (pseudo.h): the soup's symmetries at a voxel's
+ * tolerance; where they are, *caps becomes the caps the fill does not
+ * cover and the fill. */
+static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_bvh *bvh,
+                                st_pseudo_stats *st, st_soup **caps, st_error *err)
+{
+    const double t0 = now_seconds();
+    st_symmetry_params sp = st_symmetry_params_default();
+    sp.tolerance = g->voxel;
+    st_status rc = st_symmetry_detect(&st->symmetries, s, bvh, &sp, err);
+    if (rc || st->symmetries.n == 0) {
+        st->seconds_symmetry = now_seconds() - t0;
+        return rc;
+    }
+    st_soup *fill = NULL, *kept = NULL;
+    rc = st_symmetry_fill(&fill, &kept, s, bvh, &st->symmetries, *caps, g->voxel,
+                          &st->symmetry_fill, err);
+    rc = rc ? rc : st_soup_append(kept, fill, err);
+    char buf[160];
+    snprintf(buf, sizeof buf, "%zu symmetries, %zu maps: %zu triangles, %zu of %zu caps covered",
+             st->symmetries.n, st->symmetry_fill.maps, st->symmetry_fill.triangles,
+             st->symmetry_fill.caps_covered, st->symmetry_fill.caps);
+    if (!rc && st_meta_set(&g->meta, "symmetry_fill", buf))
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    st_soup_free(fill);
+    if (rc) {
+        st_soup_free(kept);
+    } else {
+        st_soup_free(*caps);
+        *caps = kept;
+    }
+    st->seconds_symmetry = now_seconds() - t0;
+    return rc;
+}
+
 /* Step 2: the caps of s's holes, lowered into g; *with_caps gets s and its
  * caps as one soup (NULL when there are none). */
 static st_status add_caps(st_grid *g, const st_soup *s, const st_soup_edges *edges,
@@ -75,6 +111,10 @@ static st_status add_caps(st_grid *g, const st_soup *s, const st_soup_edges *edg
     st_status rc = st_soup_hole_caps_shared(&caps, s, edges, bvh, &p->holes, &st->holes, err);
     if (rc)
         return rc;
+    if (p->symmetry && caps->ntris && (rc = symmetric_fill(g, s, bvh, st, &caps, err))) {
+        st_soup_free(caps);
+        return rc;
+    }
     st->cap_triangles = caps->ntris;
     double reach = p->cap_reach * g->voxel;
     if (g->band < reach)

@@ -133,6 +133,8 @@ typedef struct st_pipeline_params {
                               (holes.h) (1) */
     int closed_shells;     /* the soup's closed pieces sign their solid
                               exactly (shells.h) (1) */
+    int symmetry;          /* with fill_holes: the soup's symmetries fill
+                              the holes they cover (pseudo.h, symmetry.h) (0) */
     int fill_counts;       /* the fill counts as surface for the fit's
                               stopping condition (2. below, and the pull):
                               the pseudo volume's boundary where the soup
@@ -218,6 +220,11 @@ typedef struct st_pipeline_stats {
     int goal_met;                        /* 1: a candidate met every goal
                                             and ended the run, maybe before
                                             all tries (see above) */
+    st_symmetry_set symmetries;          /* the signs' step 2 (pseudo.h):
+                                            found (candidates 0: not looked
+                                            for) */
+    st_symmetry_fill_stats symmetry_fill;/* and what the fill took */
+    double seconds_symmetry;
     st_parts_tag_stats parts;            /* with p->parts: per part (the
                                             caller frees it with
                                             st_parts_tag_stats_free, also

@@ -65,6 +65,7 @@
 #include "souptet/progress.h"
 #include "souptet/sign.h"
 #include "souptet/soup.h"
+#include "souptet/symmetry.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -82,6 +83,11 @@ typedef struct st_pseudo_params {
     double cap_reach;               /* voxels (3; the field's band if less) */
     int shells_shortcut;            /* the shells alone when they are the
                                        whole soup (1; 0: every step runs) */
+    int symmetry;                   /* step 2: where the soup has caps, its
+                                       symmetries (symmetry.h) fill the holes
+                                       their images cover, and those holes'
+                                       caps are dropped (0: off; measured in
+                                       doc/design/symmetry.md) */
 } st_pseudo_params;
 
 /* Every step on, the project's default rule. */
@@ -92,7 +98,10 @@ typedef struct st_pseudo_stats {
     int surface;                    /* the soup was given */
     double event_distance;          /* the vote's, model units */
     st_holes_stats holes;
-    size_t cap_triangles;
+    size_t cap_triangles;           /* the caps', and the symmetric fill's */
+    st_symmetry_set symmetries;     /* found (step 2 with symmetry on and caps) */
+    st_symmetry_fill_stats symmetry_fill;
+    double seconds_symmetry;        /* detection and fill, within seconds_holes */
     st_sides_stats sides;
     size_t mirrored;                /* voxels a one-sided view's mirror added */
     size_t columned;                /* voxels the column rule made outside */

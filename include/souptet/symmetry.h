@@ -87,6 +87,34 @@ void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
  * c), support 0.87" or "rotation axis ... order 6 ...". */
 void st_symmetry_describe(const st_symmetry *y, char *buf, size_t size);
 
+/* ---- use: the lost side filled from its symmetric copy ----------------- */
+
+typedef struct st_symmetry_fill_stats {
+    size_t maps;          /* maps tried: a mirror is one, a rotation of
+                             order n is n - 1, a continuous one FILL_ANGLES */
+    size_t triangles;     /* fill triangles kept */
+    double area;          /* their area, model units squared */
+    size_t caps;          /* cap pieces (connected) given */
+    size_t caps_covered;  /* of them, dropped: the fill runs along their rim */
+} st_symmetry_fill_stats;
+
+/* Where soup s has holes (caps: their caps, holes.h, each piece's
+ * triangles joined by shared vertices), the images of s's triangles under
+ * the symmetries of set: *fill gets every image whose centroid lies
+ * farther than tol from s and from the images kept before it (the soup
+ * wins where it is; the first map that covers a place wins there) and
+ * within reach of a cap (half its piece's box diagonal). Mirror images
+ * are re-oriented so the fill keeps s's orientation. *kept_caps gets the
+ * caps minus the pieces whose rim the fill runs along (at least 3/4 of the
+ * rim's length within 3 tol of the fill): the fill has the shape there.
+ * Deterministic for any thread count. bvh: st_bvh_build(s). Both outputs
+ * are the caller's (st_soup_free); empty soups when set has nothing.
+ * ST_EINPUT for a tol that is not positive and finite; ST_ENOMEM. */
+st_status st_symmetry_fill(st_soup **fill, st_soup **kept_caps, const st_soup *s,
+                           const st_bvh *bvh, const st_symmetry_set *set,
+                           const st_soup *caps, double tol,
+                           st_symmetry_fill_stats *stats, st_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -369,12 +369,14 @@ int tool_tetformat_option(const tool_ctx *t, int c, const char *arg,
     return 0;
 }
 
-int tool_pseudo_option(const tool_ctx *t, int c, const char *arg, int *fill_holes,
-                       int *shells)
+int tool_pseudo_option(const tool_ctx *t, int c, const char *arg,
+                       const tool_pseudo_switches *sw)
 {
-    int fill = c == TOOL_OPT_FILL_HOLES;
-    return tool_parse_switch(t, fill ? "--fill-holes" : "--shells", arg,
-                             fill ? fill_holes : shells) ? TOOL_EXIT_USAGE : TOOL_CONTINUE;
+    const char *name = c == TOOL_OPT_FILL_HOLES ? "--fill-holes"
+                     : c == TOOL_OPT_SHELLS ? "--shells" : "--symmetry";
+    int *to = c == TOOL_OPT_FILL_HOLES ? sw->fill_holes
+            : c == TOOL_OPT_SHELLS ? sw->shells : sw->symmetry;
+    return tool_parse_switch(t, name, arg, to) ? TOOL_EXIT_USAGE : TOOL_CONTINUE;
 }
 
 int tool_parse_bytes(const tool_ctx *t, const char *opt, const char *arg,
@@ -850,32 +852,37 @@ void tool_deprecated(const tool_ctx *t, const char *old_name, const char *new_na
 }
 
 int tool_report_symmetries(tool_ctx *t, const st_soup *soup, const st_bvh *bvh,
-                           double tolerance)
+                           double tolerance, const st_symmetry_set *set,
+                           const st_symmetry_fill_stats *fill, double seconds)
 {
     if (t->verbosity < 2 || !soup || !(tolerance > 0.0))
         return 0;
-    st_error err;
-    st_bvh *own = NULL;
-    const double t0 = tool_now();
-    if (!bvh) {
-        if (st_bvh_build(&own, soup, &err))
-            return tool_fail(t, &err);
-        bvh = own;
-    }
     st_symmetry_params sp = st_symmetry_params_default();
-    sp.tolerance = tolerance;
-    st_symmetry_set set;
-    st_status st = st_symmetry_detect(&set, soup, bvh, &sp, &err);
-    st_bvh_free(own);
-    if (st)
-        return tool_fail(t, &err);
-    tool_say(t, 2, "symmetries: %zu with support >= %.2f within %.6g (%zu "
-             "candidates measured, %.3f s); detection only, the signs do "
-             "not use them: symmetric fill 0%%", set.n, sp.min_support,
-             tolerance, set.candidates, tool_now() - t0);
-    for (size_t i = 0; i < set.n; i++) {
+    st_symmetry_set own;
+    if (set->candidates > 0) {
+        tool_say(t, 2, "symmetries: %zu with support >= %.2f within %.6g (%zu candidates "
+                 "measured); fill: %zu triangles from %zu maps, %zu of %zu caps dropped as "
+                 "covered, %.3f s", set->n, sp.min_support, tolerance, set->candidates,
+                 fill->triangles, fill->maps, fill->caps_covered, fill->caps, seconds);
+    } else {
+        st_error err;
+        st_bvh *built = NULL;
+        const double t0 = tool_now();
+        if (!bvh && st_bvh_build(&built, soup, &err))
+            return tool_fail(t, &err);
+        sp.tolerance = tolerance;
+        st_status st = st_symmetry_detect(&own, soup, bvh ? bvh : built, &sp, &err);
+        st_bvh_free(built);
+        if (st)
+            return tool_fail(t, &err);
+        tool_say(t, 2, "symmetries: %zu with support >= %.2f within %.6g (%zu candidates "
+                 "measured, %.3f s); not used (--symmetry on fills capped holes from them)",
+                 own.n, sp.min_support, tolerance, own.candidates, tool_now() - t0);
+        set = &own;
+    }
+    for (size_t i = 0; i < set->n; i++) {
         char line[256];
-        st_symmetry_describe(set.items + i, line, sizeof line);
+        st_symmetry_describe(set->items + i, line, sizeof line);
         tool_say(t, 2, "  %s", line);
     }
     return 0;

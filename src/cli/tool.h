@@ -242,7 +242,7 @@ int tool_output_check(tool_ctx *t, const char *out);
  * shared codes to tool_common_option (below). */
 enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION,
        TOOL_OPT_MSH_VERSION, TOOL_OPT_MSH_BINARY, TOOL_OPT_FILL_HOLES, TOOL_OPT_SHELLS,
-       TOOL_OPT_VOLUME_ONLY, TOOL_OPT_FIRST = 1100 };
+       TOOL_OPT_SYMMETRY, TOOL_OPT_VOLUME_ONLY, TOOL_OPT_FIRST = 1100 };
 #define TOOL_LONG_OPTIONS_BASIC                              \
     {"quiet", no_argument, NULL, 'q'},                       \
     {"verbose", no_argument, NULL, 'v'},                     \
@@ -259,16 +259,20 @@ enum { TOOL_OPT_THREADS = 1000, TOOL_OPT_MAXMEM, TOOL_OPT_HELP, TOOL_OPT_VERSION
     TOOL_LONG_OPTIONS_RESOURCES,                             \
     {NULL, 0, NULL, 0}
 
-/* The pseudo volume's switches --fill-holes on|off and --shells on|off
- * (soupsign, soupwrap, soupmesh: pseudo.h): their table entries, and
- * their handling for c TOOL_OPT_FILL_HOLES or TOOL_OPT_SHELLS into
- * *fill_holes or *shells. Returns TOOL_CONTINUE, or TOOL_EXIT_USAGE after
- * a usage error (printed). */
+/* The pseudo volume's switches --fill-holes, --shells and --symmetry,
+ * each on|off (soupsign, soupwrap, soupmesh: pseudo.h): their table
+ * entries, and their handling for c TOOL_OPT_FILL_HOLES, TOOL_OPT_SHELLS
+ * or TOOL_OPT_SYMMETRY into the matching field of *sw. Returns
+ * TOOL_CONTINUE, or TOOL_EXIT_USAGE after a usage error (printed). */
 #define TOOL_LONG_OPTIONS_PSEUDO                                   \
     {"fill-holes", required_argument, NULL, TOOL_OPT_FILL_HOLES},  \
-    {"shells", required_argument, NULL, TOOL_OPT_SHELLS}
-int tool_pseudo_option(const tool_ctx *t, int c, const char *arg, int *fill_holes,
-                       int *shells);
+    {"shells", required_argument, NULL, TOOL_OPT_SHELLS},          \
+    {"symmetry", required_argument, NULL, TOOL_OPT_SYMMETRY}
+typedef struct tool_pseudo_switches {
+    int *fill_holes, *shells, *symmetry;
+} tool_pseudo_switches;
+int tool_pseudo_option(const tool_ctx *t, int c, const char *arg,
+                       const tool_pseudo_switches *sw);
 
 /* The tet-mesh format options of every tool that writes a tet mesh
  * (soupmesh, latticetet, tetsmooth): their table entries, their --help
@@ -352,14 +356,18 @@ typedef struct tool_spec {
 int tool_main(const tool_spec *spec, int argc, char *argv[], void *settings,
               tool_common *co);
 
-/* -v: the soup's symmetries (symmetry.h) within `tolerance` (the field's
- * voxel), each on its own line at level 2, with its support and the time
- * taken; bvh may be NULL (one is built). Detection only: the pseudo
- * volume does not use them (yet), which the report says. 0, or the exit
- * status after an error was printed. */
+/* -v: the soup's symmetries (symmetry.h) at the field's voxel
+ * (tolerance), each on its own line at level 2 with its support, and what
+ * the pseudo volume's fill took from them (pseudo.h, step 2). set and fill:
+ * the step's, when it looked (set->candidates > 0); else this looks
+ * itself (bvh may be NULL: one is built) and says they were not used. 0,
+ * or the exit status after an error was printed. */
 struct st_soup;
 struct st_bvh;
-int tool_report_symmetries(tool_ctx *t, const struct st_soup *soup,
-                           const struct st_bvh *bvh, double tolerance);
+struct st_symmetry_set;
+struct st_symmetry_fill_stats;
+int tool_report_symmetries(tool_ctx *t, const struct st_soup *soup, const struct st_bvh *bvh,
+                           double tolerance, const struct st_symmetry_set *set,
+                           const struct st_symmetry_fill_stats *fill, double seconds);
 
 #endif

@@ -104,6 +104,8 @@ TOOL_HELP_TETFORMAT
 "                       surface around them; default on)\n"
 "      --shells on|off  the soup's closed pieces (every edge shared by two\n"
 "                       faces) bound their solid exactly (default on)\n"
+"      --symmetry on|off  fill holes from the soup's symmetries, as soupsign\n"
+"                       --symmetry (default off)\n"
 "      --no-quality     skip the quality pass after the fit\n"
 "      --threads T      threads to use (default: all cores)\n"
 "      --max-memory SZ  refuse fields and lattices larger than SZ\n"
@@ -488,8 +490,11 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         break;
     case TOOL_OPT_FILL_HOLES:
     case TOOL_OPT_SHELLS:
-        return tool_pseudo_option(t, c, arg, &s->pipeline.fill_holes,
-                                  &s->pipeline.closed_shells);
+    case TOOL_OPT_SYMMETRY:
+        return tool_pseudo_option(t, c, arg,
+                                  &(tool_pseudo_switches){&s->pipeline.fill_holes,
+                                                          &s->pipeline.closed_shells,
+                                                          &s->pipeline.symmetry});
     case OPT_EMBED:
         s->embed = arg;
         break;
@@ -805,7 +810,8 @@ static int say_result(tool_ctx *t, soupmesh_run *R, double t0, st_error *err)
              b->verts_outside, b->tris_crossing, tool_now() - t0);
     const double diag = box_diagonal(R->soup);
     say_guess(t, st, R->soup, diag);
-    int rc = tool_report_symmetries(t, R->soup, NULL, st->voxel);
+    int rc = tool_report_symmetries(t, R->soup, NULL, st->voxel, &st->symmetries,
+                                    &st->symmetry_fill, st->seconds_symmetry);
     if (rc)
         return rc;
     if (t->verbosity >= 2 && p->density_rho <= 0) {

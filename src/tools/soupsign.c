@@ -88,6 +88,9 @@ static void usage(void)
 "                       shared by two faces) bound their solid exactly: inside\n"
 "                       them is inside, and when the surface is nothing else\n"
 "                       the signs are exactly their solid (default on)\n"
+"      --symmetry on|off  with --surface and --fill-holes: the surface's mirror\n"
+"                       planes and rotation axes fill the holes their images\n"
+"                       cover, in place of those holes' caps (default off)\n"
 "      --sides on|off   with --surface: the side of the surface's oriented walls\n"
 "                       each voxel near them is on (its pieces oriented by\n"
 "                       propagation, each turned the way the votes read it)\n"
@@ -204,7 +207,7 @@ typedef struct soupsign_settings {
     st_sign_params sign;
     st_sign_refine_params refine;
     const char *in, *surface;
-    int paper, fill_holes, bend_caps, use_shells, use_sides, past_caps, columns, no_surface;
+    int paper, fill_holes, symmetry, bend_caps, use_shells, use_sides, past_caps, columns, no_surface;
 } soupsign_settings;
 
 static int option(tool_ctx *t, int c, const char *arg, void *settings)
@@ -268,7 +271,10 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         break;
     case TOOL_OPT_FILL_HOLES:
     case TOOL_OPT_SHELLS:
-        return tool_pseudo_option(t, c, arg, &s->fill_holes, &s->use_shells);
+    case TOOL_OPT_SYMMETRY:
+        return tool_pseudo_option(t, c, arg,
+                                  &(tool_pseudo_switches){&s->fill_holes, &s->use_shells,
+                                                          &s->symmetry});
     case OPT_CAPS:
         if (strcmp(arg, "auto") == 0)
             s->bend_caps = -1;
@@ -384,6 +390,7 @@ static int run(tool_ctx *t, void *settings)
     pp.sign = *p;
     pp.refine = s->refine;
     pp.fill_holes = s->fill_holes;
+    pp.symmetry = s->symmetry;
     if (s->bend_caps >= 0) {     /* chosen: on every soup */
         pp.holes.bend = s->bend_caps & 1;
         pp.holes.planes = (s->bend_caps & 2) != 0;
@@ -484,7 +491,8 @@ static int run(tool_ctx *t, void *settings)
                                    : 0.0,
                  gs.depth / g->voxel, gs.depth);
     }
-    if (bvh && soup && (rc = tool_report_symmetries(t, soup, bvh, g->voxel)))
+    if (bvh && soup && (rc = tool_report_symmetries(t, soup, bvh, g->voxel, &ps.symmetries,
+                                                    &ps.symmetry_fill, ps.seconds_symmetry)))
         goto done;
     tool_say(t, 2, "read %.3f s, signs %.3f s (CPU %.3f s, all threads), write %.3f s",
              t1 - t0, voted ? ps.seconds_vote : ps.seconds_shells, cpu_sign, t3 - t2);

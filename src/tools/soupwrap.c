@@ -54,6 +54,8 @@ static void usage(void)
 "      --fill-holes on|off  with --surface: cap the soup's holes (default on)\n"
 "      --shells on|off  with --surface: the soup's closed pieces bound their\n"
 "                       solid exactly, as soupsign --shells (default on)\n"
+"      --symmetry on|off  with --surface: fill holes from the soup's\n"
+"                       symmetries, as soupsign --symmetry (default off)\n"
 "  -r, --voxels N       with --surface: voxels along the longest side\n"
 "                       (default %d)\n"
 "  -o, --output OUT     .obj .off .ply (binary) .stl (binary); '-' or none:\n"
@@ -98,7 +100,7 @@ typedef struct soupwrap_settings {
     st_dist_params dist;
     const char *in, *surface;
     st_soup_format format;
-    int have_cells, fill_holes, use_shells;
+    int have_cells, fill_holes, use_shells, symmetry;
 } soupwrap_settings;
 
 static const struct option longopts[] = {
@@ -144,7 +146,10 @@ static int option(tool_ctx *t, int c, const char *arg, void *settings)
         break;
     case TOOL_OPT_FILL_HOLES:
     case TOOL_OPT_SHELLS:
-        return tool_pseudo_option(t, c, arg, &s->fill_holes, &s->use_shells);
+    case TOOL_OPT_SYMMETRY:
+        return tool_pseudo_option(t, c, arg,
+                                  &(tool_pseudo_switches){&s->fill_holes, &s->use_shells,
+                                                          &s->symmetry});
     case OPT_CELLS_OLD:
         tool_deprecated(t, "--cells", "--voxels (-r)");
         /* fall through */
@@ -207,6 +212,7 @@ static int run(tool_ctx *t, void *settings)
         st_pseudo_params pp = st_pseudo_params_default();
         pp.fill_holes = s->fill_holes;
         pp.closed_shells = s->use_shells;
+        pp.symmetry = s->symmetry;
         if (st_pseudo_volume(&g, input, &s->dist, &pp, NULL, &prog, &err)) {
             if (!err.file[0])
                 snprintf(err.file, sizeof err.file, "%s", srcname);
