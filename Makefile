@@ -76,8 +76,16 @@ LDFLAGS_ALL := $(OPT) -fopenmp $(LDFLAGS)
 # tools link too. Each as a static archive (the tools and tests) and a
 # shared library with a soname, exporting only the names its public
 # headers declare (scripts/exports writes the version scripts).
-IO_C     := src/gridio.c src/gridio_path.c src/tetio.c src/tetio_write.c src/vtkxml.c src/wrap.c
-CORE_C   := $(filter-out $(IO_C),$(sort $(wildcard src/*.c)))
+# The library's C files are in the folders of its layers, src/LAYER/
+# (src/MODULES; scripts/layout puts them there): libsouptet-io's are the
+# layer io's, src/io/.
+LIB_C    := $(filter-out src/adapters/% src/cli/% src/tools/%,$(sort $(wildcard src/*.c src/*/*.c)))
+IO_C     := $(filter src/io/%,$(LIB_C))
+ifeq ($(IO_C),)
+  # A flat src/ that scripts/layout has not laid out yet: by name.
+  IO_C := $(filter $(addprefix src/,gridio.c gridio_path.c tetio.c tetio_write.c vtkxml.c wrap.c),$(LIB_C))
+endif
+CORE_C   := $(filter-out $(IO_C),$(LIB_C))
 LIB_CXX  := $(sort $(wildcard src/adapters/*.cpp))
 TOOLS   := $(basename $(notdir $(sort $(wildcard src/tools/*.c))))
 TESTS_C := $(basename $(notdir $(sort $(wildcard tests/test_*.c))))
