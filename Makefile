@@ -54,7 +54,7 @@ OMPLIB ?= -lgomp
 # CFLAGS say (so these come after them: the last flag wins). -ffp-contract=off:
 # fused multiply-adds would change rounding behind the back of the error
 # bounds in the predicates and the exact distances; the rest undo
-# -ffast-math, -Ofast and their parts (src/fpenv.h refuses to compile under
+# -ffast-math, -Ofast and their parts (src/base/fpenv.h refuses to compile under
 # the ones a macro shows, for builds that do not go through this file).
 FP_EXACT := -fno-fast-math -fno-unsafe-math-optimizations -fno-associative-math \
             -fno-reciprocal-math -fno-finite-math-only -fsigned-zeros -ffp-contract=off

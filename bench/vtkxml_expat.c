@@ -12,7 +12,7 @@
  *   build/bench/vtkxml_expat REPS FILE...  (.vtu: UnstructuredGrid, else
  *                                           ImageData)
  */
-#include "vtkxml.h"
+#include "../src/io/vtkxml.h"
 
 #include <expat.h>
 #include <stdio.h>

@@ -1,7 +1,7 @@
 /* test_fair.c - st_fair: volume kept, nothing inverted, corners rounded,
  * deterministic for any thread count. Meshes are blocks of 5-tet cubes
  * built here. */
-#include "../src/smooth_mesh.h"
+#include "../src/tet/smooth_mesh.h"
 #include "souptet/pred.h"
 #include "souptet/smooth.h"
 #include "souptet/tetmesh.h"

@@ -19,7 +19,7 @@
 #include "cubetets.h"
 #include "shapes.h"
 #include "tap.h"
-#include "../src/smooth_mesh.h"
+#include "../src/tet/smooth_mesh.h"
 
 #include <math.h>
 #include <stdint.h>

@@ -401,7 +401,7 @@ static void test_bad_input(void)
                               &r, &err);
     /* The field adapter collects VTK's messages too: each adapter gets
      * its own, whichever ran first. */
-    /* Documents that pass the pre-flight check (src/vtkxml.h) but whose
+    /* Documents that pass the pre-flight check (src/io/vtkxml.h) but whose
      * zlib block is not zlib: VTK itself fails and reports it. */
     st_grid *g = NULL;
     const char *junk =

@@ -1,5 +1,5 @@
 /*
- * test_vtkxml.c - the pre-flight check of VTK XML input (src/vtkxml.h):
+ * test_vtkxml.c - the pre-flight check of VTK XML input (src/io/vtkxml.h):
  * no .vti/.vtu file reaches VTK unless its structure and every size it
  * declares have been checked.
  *
@@ -22,8 +22,8 @@
 #include "souptet/meta.h"
 #include "souptet/tetio.h"
 #include "souptet/tetmesh.h"
-#include "../src/fileio.h"
-#include "../src/vtkxml.h"
+#include "../src/base/fileio.h"
+#include "../src/io/vtkxml.h"
 #include "../src/adapters/gridio_internal.h"
 #include "../src/adapters/tetio_internal.h"
 #include "tap.h"

@@ -2,12 +2,12 @@
  * tetformat.h - the tet-mesh formats: their one enum and writer options,
  * and the simulator formats themselves, plain C, no library: Gmsh .msh
  * (4.1 and 2.2, ASCII and binary), TetGen .node/.ele and Medit .mesh,
- * and the writing of .vtu (src/tetformat_vtu.c; reading .vtu is the VTK
+ * and the writing of .vtu (src/tet/tetformat_vtu.c; reading .vtu is the VTK
  * adapter's). Tools and library callers read and write
  * every format through one front door, tetio.h (st_tetmesh_read,
  * st_tetmesh_save, st_tetmesh_write), which dispatches here; the
  * per-format functions below are for tests, fuzzers and callers that
- * hold the bytes. (One file per format: src/tetformat_msh.c,
+ * hold the bytes. (One file per format: src/tet/tetformat_msh.c,
  * tetformat_tetgen.c, tetformat_medit.c, tetformat_vtu.c.)
  *
  * Units: model units, as in the file (coordinates are never rescaled).

@@ -1,11 +1,11 @@
 /*
- * gridio_internal.h - private glue between src/gridio.c (C) and the field
+ * gridio_internal.h - private glue between src/io/gridio.c (C) and the field
  * adapters src/adapters/gridio_vdb.cpp and gridio_vti.cpp (C++).
  *
  * Not installed and not part of the API: the tools use gridio.h only.
  * Everything here is extern "C", never throws, never prints. The calls go
  * one way, gridio.c to the adapters; what both need (reading standard
- * input, checking an input file) is src/fileio.h's.
+ * input, checking an input file) is src/base/fileio.h's.
  */
 #ifndef SOUPTET_GRIDIO_INTERNAL_H
 #define SOUPTET_GRIDIO_INTERNAL_H

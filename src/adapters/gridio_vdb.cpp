@@ -68,11 +68,11 @@
  * init_openvdb).
  */
 #include "souptet/gridio.h"
-#include "../fpenv.h"
+#include "../base/fpenv.h"
 #include "souptet/meta.h"
 #include "souptet/outfile.h"
 #include "gridio_internal.h"
-#include "../fileio.h"
+#include "../base/fileio.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/io/Stream.h>

@@ -34,19 +34,19 @@
  *
  * VTK's XML reader trusts the file (fuzzing crashed it with misspelled
  * attributes and made it allocate from block headers), so every input is
- * read into memory and passes st_vtkxml_check (src/vtkxml.h) before VTK
+ * read into memory and passes st_vtkxml_check (src/io/vtkxml.h) before VTK
  * sees a byte; files by path take the same in-memory path.
  *
  * VTK's messages go into the st_error of the call that caused them, never
  * to stderr (vtk_capture.h).
  */
 #include "souptet/gridio.h"
-#include "../fpenv.h"
+#include "../base/fpenv.h"
 #include "souptet/meta.h"
 #include "souptet/outfile.h"
 #include "gridio_internal.h"
-#include "../fileio.h"
-#include "../vtkxml.h"
+#include "../base/fileio.h"
+#include "../io/vtkxml.h"
 #include "vtk_capture.h"
 
 #include <vtkAbstractArray.h>

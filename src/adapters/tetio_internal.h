@@ -1,5 +1,5 @@
 /*
- * tetio_internal.h - private glue between src/tetio.c (C) and the VTK
+ * tetio_internal.h - private glue between src/io/tetio.c (C) and the VTK
  * reading adapter src/adapters/tetio_vtu.cpp (C++). Not installed; extern "C",
  * never throws, never prints.
  */

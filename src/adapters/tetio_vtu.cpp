@@ -1,7 +1,7 @@
 /*
  * tetio_vtu.cpp - reading VTK XML UnstructuredGrid (.vtu) into an
  * st_tetmesh, for meshes from ParaView, simulators built on VTK and the
- * pipes between souptet's tools. Writing is C (src/tetformat_vtu.c, whose
+ * pipes between souptet's tools. Writing is C (src/tet/tetformat_vtu.c, whose
  * comment gives the mapping; reading inverts it): a tool that only writes
  * meshes need not load VTK.
  *
@@ -16,20 +16,20 @@
  * cannot parse, cells that are not tetrahedra, point indices out of range,
  * non-finite coordinates, arrays whose length does not match, more than
  * max_bytes of mesh. Before VTK sees a byte, every input (files by path
- * are read into memory first) passes st_vtkxml_check (src/vtkxml.h): VTK's
+ * are read into memory first) passes st_vtkxml_check (src/io/vtkxml.h): VTK's
  * reader trusts the file's structure and the sizes in it.
  *
  * VTK's messages go into the st_error of the call that caused them, never
  * to stderr (vtk_capture.h).
  */
 #include "souptet/tetio.h"
-#include "../fpenv.h"
+#include "../base/fpenv.h"
 #include "souptet/mem.h"
 #include "souptet/meta.h"
 #include "souptet/tetmesh.h"
-#include "../fileio.h"
+#include "../base/fileio.h"
 #include "tetio_internal.h"
-#include "../vtkxml.h"
+#include "../io/vtkxml.h"
 #include "vtk_capture.h"
 
 #include <vtkCellArray.h>

@@ -4,7 +4,7 @@
  * vtkxml.h).
  */
 #include "vtk_capture.h"
-#include "../vtkxml.h"
+#include "../io/vtkxml.h"
 
 #include <vtkDataCompressor.h>
 #include <vtkLZ4DataCompressor.h>

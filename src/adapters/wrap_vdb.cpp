@@ -21,7 +21,7 @@
  * logger.
  */
 #include "souptet/wrap.h"
-#include "../fpenv.h"
+#include "../base/fpenv.h"
 #include "souptet/mem.h"
 
 #include <openvdb/openvdb.h>

@@ -1,7 +1,7 @@
 /* tool.c - shared tool plumbing (see tool.h). */
 #define _GNU_SOURCE
 #include "tool.h"
-#include "../fpenv.h"
+#include "../base/fpenv.h"
 #include "souptet_build.h"
 #include "souptet/dist.h"
 #include "souptet/grid.h"

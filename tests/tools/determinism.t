@@ -65,7 +65,7 @@ soupsign -q -o s.vdb d.vdb
 latticetet -q --density 0.5 --cells 8 -o l.vtu s.vdb
 latticetet -q --sculpt --surface "$BUNNY" --cells 6 -o b6.vtu s.vdb
 # The fit and quality loops run a colour set in parallel only past 64
-# vertices (PAR_CHECKED, src/smooth_mesh.h): b6's largest has 48, so
+# vertices (PAR_CHECKED, src/tet/smooth_mesh.h): b6's largest has 48, so
 # with it those loops always ran on one thread; b12's largest has 182.
 latticetet -q --sculpt --surface "$BUNNY" --cells 12 -o b12.vtu s.vdb
 # The bunny as an exact soup (every triangle its own vertices).

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Exactness cannot be compiled away: the predicates refuse to compile under
 # -ffast-math, -Ofast, -ffinite-math-only and extended-precision
-# evaluation (src/fpenv.h), every library source that uses floating point
+# evaluation (src/base/fpenv.h), every library source that uses floating point
 # includes that check, and the Makefile's own flags win over a user's
 # CFLAGS=-ffast-math (pred.c and test_pred built that way still pass).
 . "$(dirname "$0")/lib.sh"

@@ -12,7 +12,7 @@ skip() {
     echo "ok $TAP_N - $1 # SKIP $2"
 }
 
-# st_outfile's temporaries are "dir/.NAME.tmp-PID@HOST.XXXXXX" (src/outfile.c).
+# st_outfile's temporaries are "dir/.NAME.tmp-PID@HOST.XXXXXX" (src/base/outfile.c).
 no_temps() {
     ! ls -A "$1" | grep -Eq '^\..+\.[A-Za-z0-9]{6}$'
 }

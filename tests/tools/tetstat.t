@@ -244,7 +244,7 @@ head -c 600 s.vtu > trunc.vtu
 expect_fail "a truncated mesh" 1 "^tetstat: trunc.vtu:[0-9:]* " tetstat trunc.vtu
 expect_fail "empty stdin" 1 "^tetstat: <stdin>: empty" sh -c "tetstat < /dev/null"
 expect_fail "a missing surface" 1 "^tetstat: nope.obj" tetstat --surface nope.obj cube.vtu
-# Well-formed (it passes the pre-flight check of src/vtkxml.h), but its
+# Well-formed (it passes the pre-flight check of src/io/vtkxml.h), but its
 # zlib block is not zlib: VTK itself fails and says so.
 printf '<VTKFile type="ImageData" version="1.0" compressor="vtkZLibDataCompressor"><ImageData WholeExtent="0 1 0 0 0 0"><Piece Extent="0 1 0 0 0 0"><PointData><DataArray type="Float32" Name="f" format="binary">AQAAAGAAAAAAAAAABAAAAA==AAAAAA==</DataArray></PointData></Piece></ImageData></VTKFile>' > junk.vti
 expect_fail "a garbled field: VTK's message reaches the field reader" 1 "^tetstat: junk.vti: .*Zlib error" tetstat --field junk.vti cube.vtu

@@ -1,0 +1,1071 @@
+/*
+ * dist.c - unsigned distance fields of triangle soups (see dist.h).
+ *
+ * Band pass. The grid is cut into bricks of 4^3 voxels. Every triangle is
+ * binned into the bricks its band may reach (near its bounding ball and,
+ * for a large CAD triangle, near its plane, so it costs its area times the
+ * band and not its bounding box). Bricks are processed in parallel, each
+ * writing only its own voxels. A brick's voxels are walked in 2x2x2
+ * groups: a group keeps the brick's candidates whose ball comes within the
+ * band of one of its voxels, in buckets by a lower bound on their distance
+ * from the group's center (less the triangle's radius); each voxel then
+ * walks the buckets in order and stops at the first whose bound, less the
+ * voxel's offset from the center, is not below its best so far.
+ * Candidates that survive a per-voxel ball bound and a plane bound are
+ * measured exactly. The minimum is the same whatever the order, so the
+ * pruning changes the work, never the answer. A full field also keeps
+ * each voxel's nearest triangle, the first of any ties in a fixed order,
+ * so its bricks walk their candidates whole, sorted by (bound, index).
+ *
+ * Full field. Beyond the band, a vector distance transform over
+ * triangles: four raster sweeps hand each voxel the nearest of the
+ * triangles its already-swept neighbours hold, measured exactly (so never
+ * below the truth; dist.h says how far above it can be). The sweeps run
+ * on one thread, in one fixed order.
+ */
+#include "souptet/dist.h"
+#include "../base/fpenv.h"
+#include "souptet/geom.h"
+#include "souptet/mem.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+st_dist_params st_dist_params_default(void)
+{
+    st_dist_params p;
+    p.cells = ST_DIST_DEFAULT_CELLS;
+    p.voxel = 0.0;
+    p.pad = -1;
+    p.band = ST_DIST_DEFAULT_BAND;
+    p.max_bytes = 0;
+    return p;
+}
+
+long st_dist_default_pad(double band)
+{
+    if (!isfinite(band))
+        band = ST_DIST_DEFAULT_BAND;
+    return (long)ceil(band) + 2;
+}
+
+st_status st_dist_layout(const st_soup *s, const st_dist_params *p,
+                         size_t dims[3], double origin[3], double *voxel,
+                         st_error *err)
+{
+    double lo[3], hi[3];
+    st_status st = st_soup_bounds(s, lo, hi, err);
+    if (st)
+        return st;
+    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    double h = p->voxel;
+    if (h == 0.0) {
+        if (p->cells == 0)
+            return st_error_set(err, ST_EINPUT, NULL, 0,
+                                "the resolution must be at least 1 cell");
+        if (!(ext > 0.0))
+            return st_error_set(err, ST_EINPUT, NULL, 0,
+                                "the soup has no extent (all its vertices "
+                                "coincide): give a voxel size with -s");
+        h = ext / (double)p->cells;
+    }
+    if (!(h > 0.0) || !isfinite(h))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "voxel size %g is not a positive number", h);
+    long pad = p->pad >= 0 ? p->pad : st_dist_default_pad(p->band);
+    for (int a = 0; a < 3; a++) {
+        double n = ceil((hi[a] - lo[a]) / h - 1e-9);
+        if (n < 1.0)
+            n = 1.0;
+        n += 2.0 * (double)pad;
+        /* 2^40 voxels along an axis is far past any memory; refuse it here
+         * so the size arithmetic below stays exact. */
+        if (!(n < 1099511627776.0))
+            return st_error_set(err, ST_ELIMIT, NULL, 0,
+                                "a voxel size of %g makes %.3g voxels along "
+                                "an axis", h, n);
+        dims[a] = (size_t)n;
+        origin[a] = 0.5 * (lo[a] + hi[a]) - 0.5 * (n - 1.0) * h;
+    }
+    *voxel = h;
+    return ST_OK;
+}
+
+/* Everything the band kernel needs about one triangle. */
+typedef struct tri_setup {
+    double v[3][3];      /* vertices */
+    double e[3][3];      /* edges v[i+1] - v[i] */
+    double inv_ee[3];    /* 1 / |e_i|^2, 0 for a zero-length edge */
+    double nu[3];        /* unit normal (zero when degenerate) */
+    double m[3][3];      /* in-plane inward edge normals n x e_i */
+    double mo[3];        /* m_i . v_i */
+    int degenerate;
+    int dom;             /* axis of the largest normal component */
+} tri_setup;
+
+/* fmin/fmax are library calls when NaN rules must be kept; nothing here is
+ * NaN (coordinates are finite), so plain comparisons do. */
+#define MIN2(a, b) ((a) < (b) ? (a) : (b))
+#define MAX2(a, b) ((a) > (b) ? (a) : (b))
+
+/* A ball around a triangle: the cheap part of a triangle, for binning and
+ * for the lower bounds that order and prune the candidates. */
+typedef struct tri_ball {
+    double c[3];
+    double r;
+} tri_ball;
+
+static void triangle_ball(tri_ball *b, const st_soup *s, size_t tri)
+{
+    const double *v[3];
+    for (int k = 0; k < 3; k++)
+        v[k] = s->xyz + 3 * (size_t)s->tris[3 * tri + k];
+    for (int a = 0; a < 3; a++) {
+        double lo = MIN2(v[0][a], MIN2(v[1][a], v[2][a]));
+        double hi = MAX2(v[0][a], MAX2(v[1][a], v[2][a]));
+        b->c[a] = 0.5 * (lo + hi);
+    }
+    double r2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double w[3];
+        st_sub3(w, v[k], b->c);
+        r2 = MAX2(r2, st_dot3(w, w));
+    }
+    /* Slightly more than the farthest vertex, so rounding never makes the
+     * ball miss a point of the triangle. */
+    b->r = sqrt(r2) * (1.0 + 1e-12);
+}
+
+static void setup_triangle(tri_setup *t, const st_soup *s, size_t tri)
+{
+    for (int k = 0; k < 3; k++)
+        memcpy(t->v[k], s->xyz + 3 * (size_t)s->tris[3 * tri + k],
+               3 * sizeof(double));
+    double eemax = 0.0;
+    for (int i = 0; i < 3; i++) {
+        st_sub3(t->e[i], t->v[(i + 1) % 3], t->v[i]);
+        double ee = st_dot3(t->e[i], t->e[i]);
+        t->inv_ee[i] = ee > 0.0 ? 1.0 / ee : 0.0;
+        eemax = MAX2(eemax, ee);
+    }
+    double n[3];
+    st_cross3(n, t->e[0], t->e[1]);
+    double nl = st_norm3(n);
+    /* Same rule as st_point_triangle_dist2 (geom.h explains the ratio),
+     * with the longest edge squared as st_norm3 gives it. The plain square
+     * eemax is that within a few ulps, so unless nl is within a 1e-12 of
+     * the threshold (or eemax near the exponent range's ends) it decides
+     * the same way without the three scaled norms. */
+    const double thr = ST_DEGENERATE_AREA_RATIO * eemax;
+    if (eemax > 1e-280 && eemax < 1e280 && nl > thr * (1.0 + 1e-12))
+        t->degenerate = 0;
+    else if (eemax > 1e-280 && eemax < 1e280 && nl < thr * (1.0 - 1e-12))
+        t->degenerate = 1;
+    else {
+        const double emax = fmax(st_norm3(t->e[0]),
+                                 fmax(st_norm3(t->e[1]), st_norm3(t->e[2])));
+        t->degenerate = !(nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
+    }
+    t->dom = 0;
+    if (t->degenerate) {
+        memset(t->nu, 0, sizeof t->nu);
+        memset(t->m, 0, sizeof t->m);
+        memset(t->mo, 0, sizeof t->mo);
+        return;
+    }
+    for (int a = 0; a < 3; a++)
+        t->nu[a] = n[a] / nl;
+    for (int a = 1; a < 3; a++)
+        if (fabs(t->nu[a]) > fabs(t->nu[t->dom]))
+            t->dom = a;
+    for (int i = 0; i < 3; i++) {
+        st_cross3(t->m[i], t->nu, t->e[i]);
+        t->mo[i] = st_dot3(t->m[i], t->v[i]);
+    }
+}
+
+static inline double edge_dist2(const tri_setup *t, int i, const double p[3])
+{
+    double w[3];
+    st_sub3(w, p, t->v[i]);
+    double s = st_dot3(w, t->e[i]) * t->inv_ee[i];
+    s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+    double d[3] = {w[0] - s * t->e[i][0], w[1] - s * t->e[i][1],
+                   w[2] - s * t->e[i][2]};
+    return st_dot3(d, d);
+}
+
+/* Squared distance from p to the triangle; plane_d is n.(p - v0). */
+static inline double tri_dist2(const tri_setup *t, const double p[3],
+                               double plane_d)
+{
+    if (t->degenerate) {
+        double d = edge_dist2(t, 0, p), d1 = edge_dist2(t, 1, p),
+               d2 = edge_dist2(t, 2, p);
+        d = MIN2(d, d1);
+        return MIN2(d, d2);
+    }
+    int out0 = st_dot3(p, t->m[0]) < t->mo[0];
+    int out1 = st_dot3(p, t->m[1]) < t->mo[1];
+    int out2 = st_dot3(p, t->m[2]) < t->mo[2];
+    if (!(out0 | out1 | out2))
+        return plane_d * plane_d;
+    double d = INFINITY, x;
+    if (out0)
+        d = edge_dist2(t, 0, p);
+    if (out1 && (x = edge_dist2(t, 1, p)) < d)
+        d = x;
+    if (out2 && (x = edge_dist2(t, 2, p)) < d)
+        d = x;
+    return d;
+}
+
+/* Bricks: BRICK^3 voxels whose candidate triangles are gathered once. Four
+ * keeps a brick's candidate list short for a band of three voxels while
+ * the per-brick sort is amortised over 64 voxels. */
+#define BRICK 4
+
+typedef struct brick_grid {
+    size_t n[3];        /* bricks per axis */
+    double half_diag;   /* from a brick's center to its farthest voxel center */
+    double *center[3];  /* the centers of the bricks' voxels along each axis */
+} brick_grid;
+
+/* The center of brick b's voxels along axis a. */
+static double brick_center_axis(const st_grid *g, int a, size_t b)
+{
+    const size_t n = a == 0 ? g->nx : a == 1 ? g->ny : g->nz;
+    size_t lo = b * BRICK;
+    size_t hi = lo + BRICK - 1 < n - 1 ? lo + BRICK - 1 : n - 1;
+    return g->origin[a] + g->voxel * 0.5 * (double)(lo + hi);
+}
+
+/* Call visit(b, ctx) for every brick the band around triangle t may reach:
+ * bricks meeting its B-expanded box whose center is within reach of both
+ * its ball and (for a proper triangle) its plane. */
+typedef void (*brick_visit)(size_t brick, void *ctx);
+
+static void triangle_bricks(const st_grid *g, const brick_grid *bg,
+                            const st_soup *s, size_t tri,
+                            const tri_ball *ball, double B,
+                            brick_visit visit, void *ctx)
+{
+    const double h = g->voxel;
+    const size_t n[3] = {g->nx, g->ny, g->nz};
+    const double *v[3];
+    for (int k = 0; k < 3; k++)
+        v[k] = s->xyz + 3 * (size_t)s->tris[3 * tri + k];
+    size_t lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        double mn = MIN2(v[0][a], MIN2(v[1][a], v[2][a])) - B;
+        double mx = MAX2(v[0][a], MAX2(v[1][a], v[2][a])) + B;
+        double l = ceil((mn - g->origin[a]) / h);
+        double u = floor((mx - g->origin[a]) / h);
+        if (u < 0.0 || l > (double)(n[a] - 1) || l > u)
+            return;
+        lo[a] = l < 0.0 ? 0 : (size_t)l;
+        hi[a] = u > (double)(n[a] - 1) ? n[a] - 1 : (size_t)u;
+        lo[a] /= BRICK;
+        hi[a] /= BRICK;
+    }
+    double e1[3], e2[3], e3[3], nrm[3];
+    st_sub3(e1, v[1], v[0]);
+    st_sub3(e2, v[2], v[0]);
+    st_sub3(e3, v[2], v[1]);
+    st_cross3(nrm, e1, e2);
+    double nl = st_norm3(nrm);
+    const double ee = MAX2(st_dot3(e1, e1), MAX2(st_dot3(e2, e2), st_dot3(e3, e3)));
+    /* The plane only for a triangle far from collinear: the rounding in
+     * the normal of a sliver (or of a collinear triangle, whose normal is
+     * rounding alone) tilts it by about 1e-16 * ee / nl radians, so the
+     * triangle's far end leaves that plane; here the tilt is below 1e-9
+     * of the longest edge, which the plane's slack covers. */
+    int use_plane = nl > 1e-6 * ee && isfinite(ee);
+    if (use_plane)
+        for (int a = 0; a < 3; a++)
+            nrm[a] /= nl;
+    /* Small slack: these tests only prune, so erring wide is safe. */
+    const double reach = (B + bg->half_diag) * (1.0 + 1e-9) + 1e-12 * h;
+    const double reach_ball = reach + ball->r;
+    const double reach_plane = reach + 1e-9 * sqrt(ee);
+    /* The sums over the axes are kept as each loop's axis moves: the
+     * tests round a little differently from a dot product, far inside the
+     * slack. */
+    const double rb2 = reach_ball * reach_ball;
+    for (size_t bz = lo[2]; bz <= hi[2]; bz++) {
+        const double cz = bg->center[2][bz];
+        const double bz2 = (cz - ball->c[2]) * (cz - ball->c[2]);
+        const double pz = (cz - v[0][2]) * nrm[2];
+        for (size_t by = lo[1]; by <= hi[1]; by++) {
+            const double cy = bg->center[1][by];
+            const double byz2 = (cy - ball->c[1]) * (cy - ball->c[1]) + bz2;
+            if (byz2 > rb2)
+                continue;
+            const double pyz = (cy - v[0][1]) * nrm[1] + pz;
+            const size_t row = bg->n[0] * (by + bg->n[1] * bz);
+            for (size_t bx = lo[0]; bx <= hi[0]; bx++) {
+                const double cx = bg->center[0][bx];
+                if ((cx - ball->c[0]) * (cx - ball->c[0]) + byz2 > rb2)
+                    continue;
+                if (use_plane && fabs((cx - v[0][0]) * nrm[0] + pyz) > reach_plane)
+                    continue;
+                visit(bx + row, ctx);
+            }
+        }
+    }
+}
+
+typedef struct bin_ctx {
+    size_t *count;     /* per brick (counting pass) */
+    size_t *fill;      /* per brick write position (fill pass) */
+    uint32_t *list;
+    uint32_t tri;
+} bin_ctx;
+
+static void count_visit(size_t brick, void *ctx)
+{
+    ((bin_ctx *)ctx)->count[brick + 1]++;
+}
+
+static void fill_visit(size_t brick, void *ctx)
+{
+    bin_ctx *c = ctx;
+    c->list[c->fill[brick]++] = c->tri;
+}
+
+/* The sort key of a candidate in a full field's brick: (key, tri) is a
+ * total order (a triangle is binned into a brick once), so any correct
+ * sort gives the same order, and with it the same nearest triangle where
+ * several tie. */
+typedef struct cand_key {
+    double key;        /* |brick center - ball center| - ball radius */
+    uint32_t tri;
+    uint32_t at;       /* its position before the sort */
+} cand_key;
+
+static inline int cand_key_less(const cand_key *x, const cand_key *y)
+{
+    return x->key < y->key || (x->key == y->key && x->tri < y->tri);
+}
+
+/* Sort k[0..m) by (key, tri) with tmp[0..m) as scratch: insertion sort of
+ * runs of 16, then bottom-up merges. qsort's indirect comparisons cost
+ * more than the distances of a dense brick; this sorts 16-byte keys with
+ * the comparison inlined, to the same order. */
+static void sort_cand_keys(cand_key *k, cand_key *tmp, size_t m)
+{
+    enum { RUN = 16 };
+    for (size_t a = 0; a < m; a += RUN) {
+        size_t b = a + RUN < m ? a + RUN : m;
+        for (size_t i = a + 1; i < b; i++) {
+            cand_key x = k[i];
+            size_t j = i;
+            while (j > a && cand_key_less(&x, &k[j - 1])) {
+                k[j] = k[j - 1];
+                j--;
+            }
+            k[j] = x;
+        }
+    }
+    cand_key *src = k, *dst = tmp;
+    for (size_t w = RUN; w < m; w *= 2) {
+        for (size_t a = 0; a < m; a += 2 * w) {
+            size_t mid = a + w < m ? a + w : m, b = a + 2 * w < m ? a + 2 * w : m;
+            size_t i = a, j = mid, o = a;
+            while (i < mid && j < b)
+                dst[o++] = cand_key_less(&src[j], &src[i]) ? src[j++] : src[i++];
+            while (i < mid)
+                dst[o++] = src[i++];
+            while (j < b)
+                dst[o++] = src[j++];
+        }
+        cand_key *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != k)
+        memcpy(k, src, m * sizeof *k);
+}
+
+/* Groups. In a band field a brick's voxels are walked in groups of
+ * GROUP^3 (the brick's octants): each group keeps the candidates whose
+ * ball comes within the band of one of its voxels, in NBUCKET buckets by
+ * their lower bound from the group's center. A voxel walks the buckets in
+ * order and stops at the first whose smallest bound, less its offset from
+ * the center, is not below its best so far. The offset is 0.87 voxel
+ * where a brick's is up to 2.6, and a bucket needs a counting pass where
+ * a sorted list needs a sort. The value of a band voxel is a minimum over
+ * the same triangles, so it is the same in any order; a full field also
+ * keeps the nearest triangle, the first of the ties in (key, tri) order,
+ * so it walks the whole brick in that order, each candidate a bucket. */
+#define GROUP 2
+#define NBUCKET 32
+
+/* One group's candidates in walk order: balls, structure of arrays. */
+typedef struct walk_list {
+    double *x, *y, *z, *r;   /* ball center and radius */
+    double *bound;           /* a lower bound of its key, nondecreasing */
+    uint32_t *at;            /* index into the brick's candidates */
+    size_t n;
+} walk_list;
+
+typedef struct brick_scratch {
+    size_t cap;
+    uint32_t *tri;           /* the brick's candidates */
+    uint32_t *slot;          /* where each one's setup is cached, or UINT32_MAX */
+    double *bx, *by, *bz, *br; /* their balls */
+    cand_key *keys;          /* 2 * cap: a full field's keys and the merge's scratch */
+    uint32_t *kept;          /* a group's candidates */
+    uint8_t *bucket;         /* and their buckets */
+    walk_list w;
+    tri_setup *setups;
+    uint32_t nsetup;
+} brick_scratch;
+
+static void scratch_free(brick_scratch *sc)
+{
+    free(sc->tri);
+    free(sc->slot);
+    free(sc->bx);
+    free(sc->by);
+    free(sc->bz);
+    free(sc->br);
+    free(sc->keys);
+    free(sc->w.x);
+    free(sc->w.y);
+    free(sc->w.z);
+    free(sc->w.r);
+    free(sc->w.at);
+    free(sc->w.bound);
+    free(sc->kept);
+    free(sc->bucket);
+    free(sc->setups);
+}
+
+static int scratch_grow(void **p, size_t n, size_t size)
+{
+    void *q = st_realloc_array(*p, n, size);
+    if (!q)
+        return -1;
+    *p = q;
+    return 0;
+}
+
+static int scratch_reserve(brick_scratch *sc, size_t m)
+{
+    if (m <= sc->cap)
+        return 0;
+    size_t cap = m < 64 ? 64 : m;
+    void **d[] = {(void **)&sc->bx, (void **)&sc->by, (void **)&sc->bz,
+                  (void **)&sc->br, (void **)&sc->w.x, (void **)&sc->w.y,
+                  (void **)&sc->w.z, (void **)&sc->w.r, (void **)&sc->w.bound};
+    for (size_t i = 0; i < sizeof d / sizeof d[0]; i++)
+        if (scratch_grow(d[i], cap, sizeof(double)))
+            return -1;
+    void **u[] = {(void **)&sc->tri, (void **)&sc->slot, (void **)&sc->w.at};
+    for (size_t i = 0; i < sizeof u / sizeof u[0]; i++)
+        if (scratch_grow(u[i], cap, sizeof(uint32_t)))
+            return -1;
+    if (scratch_grow((void **)&sc->kept, cap, sizeof(uint32_t)) ||
+        scratch_grow((void **)&sc->bucket, cap, 1) ||
+        scratch_grow((void **)&sc->keys, 2 * cap, sizeof(cand_key)) ||
+        scratch_grow((void **)&sc->setups, cap, sizeof(tri_setup)))
+        return -1;
+    sc->cap = cap;
+    return 0;
+}
+
+/* The voxels of a brick or group: [lo, hi) per axis, and their center. */
+typedef struct voxel_box {
+    size_t lo[3], hi[3];
+    double c[3];
+} voxel_box;
+
+static void box_center(const st_grid *g, voxel_box *v)
+{
+    for (int a = 0; a < 3; a++)
+        v->c[a] = g->origin[a] + g->voxel * 0.5 * (double)(v->lo[a] + v->hi[a] - 1);
+}
+
+/* Exact band distances for the voxels of box v, walking list w (bounds
+ * from v's center). */
+static void walk_box(st_grid *g, int32_t *near, const st_soup *s,
+                     const voxel_box *v, const walk_list *w, double B,
+                     brick_scratch *sc)
+{
+    const float Bf = (float)B;
+    const double B2 = B * B;
+    /* Locals: the stores to the setup cache could otherwise alias them. */
+    const double *const x = w->x, *const y = w->y, *const z = w->z,
+                 *const r = w->r, *const bound = w->bound;
+    const uint32_t *const at = w->at;
+    const size_t n = w->n;
+    const uint32_t *const tri = sc->tri;
+    uint32_t *const slot = sc->slot;
+    tri_setup *const setups = sc->setups;
+    uint32_t nsetup = sc->nsetup;
+    double p[3];
+    for (size_t k = v->lo[2]; k < v->hi[2]; k++) {
+        p[2] = g->origin[2] + g->voxel * (double)k;
+        for (size_t j = v->lo[1]; j < v->hi[1]; j++) {
+            p[1] = g->origin[1] + g->voxel * (double)j;
+            for (size_t i = v->lo[0]; i < v->hi[0]; i++) {
+                p[0] = g->origin[0] + g->voxel * (double)i;
+                double off[3];
+                st_sub3(off, p, v->c);
+                /* |p - c| - r >= bound - |p - center|: once that reaches
+                 * the best distance so far, no later candidate can improve
+                 * it. The relative shave keeps rounding on the safe side. */
+                const double offset = sqrt(st_dot3(off, off)) * (1.0 + 1e-9) +
+                                      1e-12 * g->voxel;
+                double cur = B2, curd = B;
+                int32_t best = -1;
+                for (size_t q = 0; q < n; q++) {
+                    if (bound[q] - offset >= curd)
+                        break;          /* no later one is closer */
+                    {
+                        const double dx = p[0] - x[q], dy = p[1] - y[q],
+                                     dz = p[2] - z[q];
+                        const double reach = curd + r[q];
+                        if (dx * dx + dy * dy + dz * dz >= reach * reach)
+                            continue;   /* its ball is too far */
+                        const uint32_t c = at[q];
+                        if (slot[c] == UINT32_MAX) {
+                            slot[c] = nsetup++;
+                            setup_triangle(&setups[slot[c]], s, tri[c]);
+                        }
+                        const tri_setup *t = &setups[slot[c]];
+                        double pd = 0.0;
+                        if (!t->degenerate) {
+                            double v0p[3];
+                            st_sub3(v0p, p, t->v[0]);
+                            pd = st_dot3(v0p, t->nu);
+                            if (pd * pd >= cur)
+                                continue;   /* its plane is too far */
+                        }
+                        double d2 = tri_dist2(t, p, pd);
+                        if (d2 < cur) {
+                            cur = d2;
+                            curd = sqrt(d2);
+                            best = (int32_t)tri[c];
+                        }
+                    }
+                }
+                const size_t idx = st_grid_index(g, i, j, k);
+                g->data[idx] = cur >= B2 ? Bf : (float)curd;
+                if (near)
+                    near[idx] = cur >= B2 ? -1 : best;
+            }
+        }
+    }
+    sc->nsetup = nsetup;
+}
+
+/* Write `value` (and nearest -1) to every voxel of box v. */
+static void fill_box(st_grid *g, int32_t *near, const voxel_box *v, float value)
+{
+    for (size_t k = v->lo[2]; k < v->hi[2]; k++)
+        for (size_t j = v->lo[1]; j < v->hi[1]; j++) {
+            const size_t at = st_grid_index(g, v->lo[0], j, k);
+            for (size_t i = 0; i < v->hi[0] - v->lo[0]; i++)
+                g->data[at + i] = value;
+            if (near)
+                for (size_t i = 0; i < v->hi[0] - v->lo[0]; i++)
+                    near[at + i] = -1;
+        }
+}
+
+/* A full field's brick: its m candidates by (key, tri), each its own run. */
+static void walk_sorted(st_grid *g, int32_t *near, const st_soup *s,
+                        const voxel_box *v, size_t m, double B,
+                        brick_scratch *sc)
+{
+    cand_key *keys = sc->keys;
+    for (size_t q = 0; q < m; q++) {
+        const double w[3] = {v->c[0] - sc->bx[q], v->c[1] - sc->by[q],
+                             v->c[2] - sc->bz[q]};
+        /* From the brick's center; a voxel subtracts its own offset. */
+        keys[q].key = sqrt(st_dot3(w, w)) - sc->br[q];
+        keys[q].tri = sc->tri[q];
+        keys[q].at = (uint32_t)q;
+    }
+    sort_cand_keys(keys, keys + m, m);
+    walk_list *wl = &sc->w;
+    for (size_t q = 0; q < m; q++) {
+        const uint32_t c = keys[q].at;
+        wl->x[q] = sc->bx[c];
+        wl->y[q] = sc->by[c];
+        wl->z[q] = sc->bz[c];
+        wl->r[q] = sc->br[c];
+        wl->at[q] = c;
+        wl->bound[q] = keys[q].key;
+    }
+    wl->n = m;
+    walk_box(g, near, s, v, wl, B, sc);
+}
+
+/* A band field's group v: the candidates whose ball comes within B of one
+ * of its voxels, bucketed by their bound from its center. */
+static void walk_group(st_grid *g, const st_soup *s, const voxel_box *v,
+                       size_t m, double B, brick_scratch *sc)
+{
+    double half = 0.0;
+    for (int a = 0; a < 3; a++) {
+        const double e = 0.5 * g->voxel * (double)(v->hi[a] - v->lo[a] - 1);
+        half += e * e;
+    }
+    /* Beyond R + r from the center, a ball is beyond B from every voxel
+     * (the slack only keeps more). */
+    const double R = (B + sqrt(half)) * (1.0 + 1e-9) + 1e-12 * g->voxel;
+    const double width = R / (double)(NBUCKET - 1);
+    uint32_t count[NBUCKET + 1] = {0};
+    double lo[NBUCKET];
+    for (int b = 0; b < NBUCKET; b++)
+        lo[b] = INFINITY;
+    /* The kept candidates and their buckets, and the count and smallest
+     * key of each bucket. */
+    uint32_t *kept = sc->kept, nkept = 0;
+    uint8_t *bucket = sc->bucket;
+    const double *bx = sc->bx, *by = sc->by, *bz = sc->bz, *br = sc->br;
+    for (size_t q = 0; q < m; q++) {
+        const double dx = v->c[0] - bx[q], dy = v->c[1] - by[q],
+                     dz = v->c[2] - bz[q];
+        const double dd = dx * dx + dy * dy + dz * dz, reach = R + br[q];
+        if (dd >= reach * reach)
+            continue;
+        const double k = sqrt(dd) - br[q];
+        /* Nondecreasing in k: a later bucket's keys are never below an
+         * earlier one's. */
+        const double f = k / width;
+        const uint32_t b = k <= 0.0 ? 0 : f >= NBUCKET - 2 ? NBUCKET - 1 : 1 + (uint32_t)f;
+        kept[nkept] = (uint32_t)q;
+        bucket[nkept++] = (uint8_t)b;
+        count[b + 1]++;
+        lo[b] = MIN2(lo[b], k);
+    }
+    if (nkept == 0) {
+        fill_box(g, NULL, v, (float)B);
+        return;
+    }
+    for (int b = 0; b < NBUCKET; b++)
+        count[b + 1] += count[b];
+    walk_list *wl = &sc->w;
+    for (uint32_t e = 0; e < nkept; e++) {
+        const uint32_t q = kept[e], at = count[bucket[e]]++;
+        wl->x[at] = bx[q];
+        wl->y[at] = by[q];
+        wl->z[at] = bz[q];
+        wl->r[at] = br[q];
+        wl->bound[at] = lo[bucket[e]];
+        wl->at[at] = q;
+    }
+    wl->n = nkept;
+    walk_box(g, NULL, s, v, wl, B, sc);
+}
+
+/* Exact band distances for the voxels of one brick. */
+static void process_brick(st_grid *g, int32_t *near, const st_soup *s,
+                          const tri_ball *balls, const brick_grid *bg,
+                          size_t brick, const uint32_t *list, size_t m,
+                          double B, brick_scratch *sc)
+{
+    const size_t n[3] = {g->nx, g->ny, g->nz};
+    const size_t b[3] = {brick % bg->n[0], (brick / bg->n[0]) % bg->n[1],
+                         brick / (bg->n[0] * bg->n[1])};
+    voxel_box v;
+    for (int a = 0; a < 3; a++) {
+        v.lo[a] = b[a] * BRICK;
+        v.hi[a] = v.lo[a] + BRICK < n[a] ? v.lo[a] + BRICK : n[a];
+    }
+    if (m == 0) {
+        fill_box(g, near, &v, (float)B);
+        return;
+    }
+    for (size_t q = 0; q < m; q++) {
+        const tri_ball *tb = &balls[list[q]];
+        sc->tri[q] = list[q];
+        sc->slot[q] = UINT32_MAX;
+        sc->bx[q] = tb->c[0];
+        sc->by[q] = tb->c[1];
+        sc->bz[q] = tb->c[2];
+        sc->br[q] = tb->r;
+    }
+    sc->nsetup = 0;
+    if (near) {
+        box_center(g, &v);
+        walk_sorted(g, near, s, &v, m, B, sc);
+        return;
+    }
+    voxel_box u;
+    for (size_t z = v.lo[2]; z < v.hi[2]; z += GROUP)
+        for (size_t y = v.lo[1]; y < v.hi[1]; y += GROUP)
+            for (size_t x = v.lo[0]; x < v.hi[0]; x += GROUP) {
+                const size_t at[3] = {x, y, z};
+                for (int a = 0; a < 3; a++) {
+                    u.lo[a] = at[a];
+                    u.hi[a] = at[a] + GROUP < v.hi[a] ? at[a] + GROUP : v.hi[a];
+                }
+                box_center(g, &u);
+                walk_group(g, s, &u, m, B, sc);
+            }
+}
+
+static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
+                           double B, const st_progress *progress,
+                           st_error *err)
+{
+    if (s->ntris > UINT32_MAX)
+        return st_error_set(err, ST_ELIMIT, NULL, 0,
+                            "too many triangles (%zu)", s->ntris);
+    brick_grid bg;
+    bg.n[0] = (g->nx + BRICK - 1) / BRICK;
+    bg.n[1] = (g->ny + BRICK - 1) / BRICK;
+    bg.n[2] = (g->nz + BRICK - 1) / BRICK;
+    bg.half_diag = 0.5 * sqrt(3.0) * (double)(BRICK - 1) * g->voxel;
+    const size_t nb = bg.n[0] * bg.n[1] * bg.n[2];
+
+    tri_ball *balls = st_malloc_array(s->ntris, sizeof *balls);
+    size_t *start = st_calloc_array(nb + 1, sizeof(size_t));
+    double *centers = st_malloc_array(bg.n[0] + bg.n[1] + bg.n[2], sizeof(double));
+    if (!balls || !start || !centers) {
+        free(balls);
+        free(centers);
+        free(start);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    for (int a = 0; a < 3; a++) {
+        bg.center[a] = centers + (a > 0 ? bg.n[0] : 0) + (a > 1 ? bg.n[1] : 0);
+        for (size_t b = 0; b < bg.n[a]; b++)
+            bg.center[a][b] = brick_center_axis(g, a, b);
+    }
+    #pragma omp parallel for schedule(static)
+    for (size_t t = 0; t < s->ntris; t++)
+        triangle_ball(&balls[t], s, t);
+    /* Counting sort of (brick, triangle) pairs, triangles in input order:
+     * the triangles cut into `chunks` runs, each counted and filled by one
+     * thread into its own part of every brick's list (the runs' parts in
+     * run order), so the lists are the serial ones for any thread count. */
+    int chunks = omp_get_max_threads();
+    chunks = chunks < 1 ? 1 : chunks > 8 ? 8 : chunks;
+    if (s->ntris < 4096)
+        chunks = 1;
+    size_t *cnt = st_calloc_array((size_t)chunks * (nb + 1), sizeof(size_t));
+    if (!cnt) {
+        free(balls);
+        free(centers);
+        free(start);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    #pragma omp parallel for schedule(static, 1) num_threads(chunks)
+    for (int c = 0; c < chunks; c++) {
+        const size_t t0 = s->ntris * (size_t)c / (size_t)chunks;
+        const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)chunks;
+        bin_ctx cc = {cnt + (size_t)c * (nb + 1), NULL, NULL, 0};
+        for (size_t t = t0; t < t1; t++) {
+            if ((t & 4095) == 0 && st_progress_cancelled(progress))
+                break;
+            triangle_bricks(g, &bg, s, t, &balls[t], B, count_visit, &cc);
+        }
+    }
+    if (st_progress_cancelled(progress)) {
+        free(cnt);
+        free(balls);
+        free(centers);
+        free(start);
+        return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+    }
+    /* start[b]: brick b's first slot; cnt[c][b + 1] becomes run c's */
+    size_t at = 0;
+    for (size_t b = 0; b < nb; b++) {
+        start[b] = at;
+        for (int c = 0; c < chunks; c++) {
+            size_t *x = &cnt[(size_t)c * (nb + 1) + b + 1];
+            const size_t k = *x;
+            *x = at;
+            at += k;
+        }
+    }
+    start[nb] = at;
+    const size_t npairs = start[nb];
+    uint32_t *list = st_malloc_array(npairs ? npairs : 1, sizeof(uint32_t));
+    if (!list) {
+        free(cnt);
+        free(balls);
+        free(centers);
+        free(start);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for "
+                            "%zu brick candidates", npairs);
+    }
+    #pragma omp parallel for schedule(static, 1) num_threads(chunks)
+    for (int c = 0; c < chunks; c++) {
+        const size_t t0 = s->ntris * (size_t)c / (size_t)chunks;
+        const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)chunks;
+        bin_ctx cc = {NULL, cnt + (size_t)c * (nb + 1) + 1, list, 0};
+        for (size_t t = t0; t < t1; t++) {
+            if ((t & 4095) == 0 && st_progress_cancelled(progress))
+                break;
+            cc.tri = (uint32_t)t;
+            triangle_bricks(g, &bg, s, t, &balls[t], B, fill_visit, &cc);
+        }
+    }
+    free(cnt);
+
+    int oom = 0;
+    size_t done = 0;
+    /* A cancelled run skips the bricks left (a brick is well under a
+     * millisecond of work). */
+    const int stopped = st_progress_cancelled(progress);
+    #pragma omp parallel if (!stopped)
+    {
+        brick_scratch sc;
+        memset(&sc, 0, sizeof sc);
+        #pragma omp for schedule(dynamic, 16)
+        for (size_t b = 0; b < nb; b++) {
+            if (st_progress_cancelled(progress))
+                continue;
+            size_t m = start[b + 1] - start[b];
+            if (scratch_reserve(&sc, m)) {
+                #pragma omp atomic write
+                oom = 1;
+                continue;
+            }
+            process_brick(g, near, s, balls, &bg, b, list + start[b], m, B,
+                          &sc);
+            size_t now;
+            #pragma omp atomic capture
+            now = ++done;
+#ifdef _OPENMP
+            if (omp_get_thread_num() == 0 && (now & 1023) == 0)
+#endif
+                st_progress_report(progress, "distance band",
+                                   (double)now / (double)nb);
+        }
+        scratch_free(&sc);
+    }
+    free(list);
+    free(start);
+    free(balls);
+    free(centers);
+    if (oom)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    if (st_progress_cancelled(progress))
+        return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+    st_progress_report(progress, "distance band", 1.0);
+    return ST_OK;
+}
+
+/* Distance from p to triangle t of s, squared. */
+static double soup_tri_dist2(const st_soup *s, int32_t t, const double p[3])
+{
+    const uint32_t *v = s->tris + 3 * (size_t)t;
+    return st_point_triangle_dist2(p, s->xyz + 3 * (size_t)v[0],
+                                   s->xyz + 3 * (size_t)v[1],
+                                   s->xyz + 3 * (size_t)v[2], NULL);
+}
+
+/* One raster sweep (forward: dir = +1, backward: -1) over the voxels the
+ * band did not fix: each takes the nearest of the triangles its 13
+ * already-swept neighbours found, measured exactly. */
+static int sweep(st_grid *g, int32_t *near, const uint8_t *fixed,
+                 const st_soup *s, int dir, const st_progress *progress)
+{
+    const long nx = (long)g->nx, ny = (long)g->ny, nz = (long)g->nz;
+    /* The 13 neighbours that precede a voxel in raster order. */
+    static const int off[13][3] = {
+        {-1, 0, 0}, {-1, -1, 0}, {0, -1, 0}, {1, -1, 0},
+        {-1, -1, -1}, {0, -1, -1}, {1, -1, -1},
+        {-1, 0, -1}, {0, 0, -1}, {1, 0, -1},
+        {-1, 1, -1}, {0, 1, -1}, {1, 1, -1}};
+    for (long kk = 0; kk < nz; kk++) {
+        long k = dir > 0 ? kk : nz - 1 - kk;
+        if (st_progress_cancelled(progress))
+            return 0;
+        for (long jj = 0; jj < ny; jj++) {
+            long j = dir > 0 ? jj : ny - 1 - jj;
+            for (long ii = 0; ii < nx; ii++) {
+                long i = dir > 0 ? ii : nx - 1 - ii;
+                size_t idx = (size_t)i + (size_t)nx * ((size_t)j + (size_t)ny * (size_t)k);
+                if (fixed[idx])
+                    continue;
+                double p[3];
+                st_grid_center(g, (size_t)i, (size_t)j, (size_t)k, p);
+                int32_t best = near[idx];
+                double best_d2 = best >= 0 ? soup_tri_dist2(s, best, p) : INFINITY;
+                int32_t tried[13];
+                int ntried = 0;
+                for (int q = 0; q < 13; q++) {
+                    long a = i + dir * off[q][0], b = j + dir * off[q][1],
+                         c = k + dir * off[q][2];
+                    if (a < 0 || a >= nx || b < 0 || b >= ny || c < 0 || c >= nz)
+                        continue;
+                    int32_t t = near[(size_t)a + (size_t)nx * ((size_t)b + (size_t)ny * (size_t)c)];
+                    if (t < 0 || t == best)
+                        continue;
+                    int seen = 0;
+                    for (int r = 0; r < ntried; r++)
+                        seen |= tried[r] == t;
+                    if (seen)
+                        continue;
+                    tried[ntried++] = t;
+                    double d2 = soup_tri_dist2(s, t, p);
+                    /* Ties go to the lower index, so the sweep order does
+                     * not decide which triangle a voxel keeps. */
+                    if (d2 < best_d2 || (d2 == best_d2 && t < best)) {
+                        best_d2 = d2;
+                        best = t;
+                    }
+                }
+                near[idx] = best;
+                g->data[idx] = best >= 0 ? (float)sqrt(best_d2) : INFINITY;
+            }
+        }
+    }
+    return 1;
+}
+
+/* Beyond the band: a vector distance transform over triangles. The band
+ * fixed every voxel within B exactly, with its nearest triangle; sweeps in
+ * raster order and back hand nearest triangles outward, each voxel keeping
+ * the nearest of those its neighbours hold (Danielsson's propagation, with
+ * triangles instead of points: values are exact distances to a real
+ * triangle, so never below the truth; the test suite measures how often
+ * the propagated triangle is not the nearest and by how much). */
+#define SWEEPS 4
+static st_status full_pass(st_grid *g, int32_t *near, const st_soup *s,
+                           double B, const st_progress *progress,
+                           st_error *err)
+{
+    const size_t n = st_grid_count(g);
+    uint8_t *fixed = st_malloc_array(n, 1);
+    if (!fixed)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    const float Bf = (float)B;
+    for (size_t i = 0; i < n; i++) {
+        fixed[i] = g->data[i] < Bf;
+        if (!fixed[i])
+            g->data[i] = INFINITY;
+    }
+    static const char *stage = "distance beyond the band";
+    st_progress_report(progress, stage, 0.0);
+    for (int pass = 0; pass < SWEEPS; pass++) {
+        if (!sweep(g, near, fixed, s, pass % 2 ? -1 : +1, progress)) {
+            free(fixed);
+            return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        }
+        st_progress_report(progress, stage, (double)(pass + 1) / SWEEPS);
+    }
+    free(fixed);
+    return ST_OK;
+}
+
+st_status st_dist_field(st_grid **out, const st_soup *s,
+                        const st_dist_params *p, const st_progress *progress,
+                        st_error *err)
+{
+    *out = NULL;
+    int full = isinf(p->band) && p->band > 0;
+    if (!full && !(p->band >= ST_DIST_MIN_BAND))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "band %g is below the minimum of %g voxels",
+                            p->band, ST_DIST_MIN_BAND);
+    size_t dims[3];
+    double origin[3], h;
+    st_status st = st_dist_layout(s, p, dims, origin, &h, err);
+    if (st)
+        return st;
+    st_grid *g;
+    double band_vox = full ? ST_DIST_DEFAULT_BAND : p->band;
+    double B = band_vox * h;
+    /* The band pass writes every voxel. */
+    st = st_grid_new_unset(&g, dims[0], dims[1], dims[2], origin, h,
+                           p->max_bytes, err);
+    if (st)
+        return st;
+    g->kind = ST_GRID_DISTANCE;
+    int32_t *near = NULL;
+    if (full && !(near = st_malloc_array(st_grid_count(g), sizeof *near))) {
+        st_grid_free(g);
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory for the nearest-triangle map");
+    }
+    st = band_pass(g, near, s, B, progress, err);
+    if (!st && full)
+        st = full_pass(g, near, s, B, progress, err);
+    free(near);
+    if (st) {
+        st_grid_free(g);
+        return st;
+    }
+    g->band = full ? INFINITY : B;
+    char buf[64];
+    snprintf(buf, sizeof buf, "%zu", s->ntris);
+    st = st_meta_set(&g->meta, "triangles", buf);
+    snprintf(buf, sizeof buf, "%zu", s->nverts);
+    st = st ? st : st_meta_set(&g->meta, "vertices", buf);
+    if (full)
+        snprintf(buf, sizeof buf, "full");
+    else
+        snprintf(buf, sizeof buf, "%.17g", band_vox);
+    st = st ? st : st_meta_set(&g->meta, "band_voxels", buf);
+    if (st) {
+        st_grid_free(g);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    *out = g;
+    return ST_OK;
+}
+
+st_status st_dist_lower(st_grid *g, const st_soup *s, double reach,
+                        st_error *err)
+{
+    if (!(reach > 0) || !s->ntris)
+        return ST_OK;
+    const size_t nx = g->nx, ny = g->ny, nz = g->nz;
+    const double h = g->voxel;
+    (void)err;
+    /* A z layer per iteration: every voxel's minimum over the triangles
+     * within reach of it, in any order (a minimum), so the threads never
+     * share a voxel. */
+    #pragma omp parallel for schedule(dynamic, 1)
+    for (size_t k = 0; k < nz; k++) {
+        const double z = g->origin[2] + h * (double)k;
+        for (size_t t = 0; t < s->ntris; t++) {
+            const double *a = s->xyz + 3 * (size_t)s->tris[3 * t],
+                         *b = s->xyz + 3 * (size_t)s->tris[3 * t + 1],
+                         *c = s->xyz + 3 * (size_t)s->tris[3 * t + 2];
+            double lo[3], hi[3];
+            for (int q = 0; q < 3; q++) {
+                lo[q] = fmin(a[q], fmin(b[q], c[q])) - reach;
+                hi[q] = fmax(a[q], fmax(b[q], c[q])) + reach;
+            }
+            if (z < lo[2] || z > hi[2])
+                continue;
+            double fi0 = ceil((lo[0] - g->origin[0]) / h), fi1 = floor((hi[0] - g->origin[0]) / h);
+            double fj0 = ceil((lo[1] - g->origin[1]) / h), fj1 = floor((hi[1] - g->origin[1]) / h);
+            if (fi1 < 0 || fj1 < 0 || fi0 > (double)(nx - 1) || fj0 > (double)(ny - 1))
+                continue;
+            const size_t i0 = fi0 < 0 ? 0 : (size_t)fi0, j0 = fj0 < 0 ? 0 : (size_t)fj0;
+            const size_t i1 = fi1 > (double)(nx - 1) ? nx - 1 : (size_t)fi1;
+            const size_t j1 = fj1 > (double)(ny - 1) ? ny - 1 : (size_t)fj1;
+            for (size_t j = j0; j <= j1; j++)
+                for (size_t i = i0; i <= i1; i++) {
+                    const double p[3] = {g->origin[0] + h * (double)i,
+                                         g->origin[1] + h * (double)j, z};
+                    const double d2 = st_point_triangle_dist2(p, a, b, c, NULL);
+                    if (!(d2 < reach * reach))
+                        continue;
+                    float *v = g->data + st_grid_index(g, i, j, k);
+                    const float d = (float)sqrt(d2);
+                    if (d < *v)
+                        *v = d;
+                }
+        }
+    }
+    return ST_OK;
+}

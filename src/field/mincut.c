@@ -1,0 +1,430 @@
+/*
+ * mincut.c - a minimum cut on a voxel grid (see mincut.h): Boykov and
+ * Kolmogorov's max-flow ("An experimental comparison of min-cut/max-flow
+ * algorithms for energy minimization in vision", PAMI 2004), written here
+ * for the implicit 6-neighbour graph of a grid, integer capacities.
+ *
+ * Two search trees grow from the terminals (S, the inside: voxels with
+ * inside evidence; T, the outside: voxels with outside evidence and the
+ * grid's border) along arcs with residual capacity; where they touch, the
+ * path is augmented, the arcs it saturates cut nodes off their tree
+ * (orphans), and the orphans look for a new parent in their own tree or
+ * become free. When neither tree can grow, the S tree is the inside.
+ *
+ * Only the undecided voxels are nodes (|evidence| below p->fixed, off the
+ * border); a decided neighbour is a terminal, its arc's capacity added to
+ * the node's terminal capacity. The nodes are kept in storage order with
+ * their six neighbours' node numbers (NO_NODE for a decided one), so the
+ * graph costs about 70 bytes per undecided voxel and nothing per decided
+ * one. Arcs are (node, direction): directions 0..5 are +x, -x, +y, -y, +z,
+ * -z, so a ^ 1 is the opposite direction and the arc (v, a)'s sister is
+ * (nbr(v, a), a ^ 1).
+ */
+#include "souptet/mincut.h"
+#include "../base/fpenv.h"
+#include "souptet/mem.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+
+#define TREE_S 0x01u
+#define TREE_T 0x02u
+#define TREES (TREE_S | TREE_T)
+#define F_ACTIVE 0x08u
+
+#define P_TERMINAL 6u
+#define P_ORPHAN 7u
+#define P_NONE 8u
+
+#define NO_NODE UINT32_MAX
+#define INF_D UINT32_MAX
+
+typedef struct bk {
+    size_t n;             /* nodes */
+    uint32_t *nbr;        /* nbr[6 v + a]: the neighbouring node, or NO_NODE */
+    int32_t *rc;          /* residual capacity of arc (v, a): rc[6 v + a] */
+    int32_t *tr;          /* terminal residual: > 0 from S, < 0 to T */
+    uint8_t *tree;        /* TREE_S / TREE_T / free, F_ACTIVE */
+    uint8_t *parent;      /* direction to the parent, or P_* */
+    uint32_t *ts, *dist;  /* the distance-to-root heuristic's marks */
+    uint32_t *active;     /* FIFO ring of n + 1 */
+    size_t ah, at;
+    uint32_t *orphan;     /* FIFO ring of n + 1 */
+    size_t oh, ot;
+    uint32_t time;
+    int64_t flow;
+} bk;
+
+st_mincut_params st_mincut_params_default(void)
+{
+    /* Chosen on the damaged corpus (make bench STAGE=accuracy; the table is in
+     * issue 4's closing note): evidence 100 per vote of margin against 1000
+     * per face of free space (50 and 200 are each worse on some classes);
+     * faces cheap below a voxel from the surface, by its cube; voxels with
+     * a margin of 10 votes of 13 or more decided (12 gives the same IoU on
+     * every corpus entry to four digits, with 8 times the nodes on a
+     * closed model). */
+    st_mincut_params p = {1000.0, 1.0, 3.0, 100.0, 10};
+    return p;
+}
+
+static void set_active(bk *b, uint32_t v)
+{
+    if (b->tree[v] & F_ACTIVE)
+        return;
+    b->tree[v] |= F_ACTIVE;
+    b->active[b->at] = v;
+    b->at = b->at == b->n ? 0 : b->at + 1;
+}
+
+static uint32_t next_active(bk *b)
+{
+    while (b->ah != b->at) {
+        uint32_t v = b->active[b->ah];
+        b->ah = b->ah == b->n ? 0 : b->ah + 1;
+        if (b->tree[v] & TREES)
+            return v;           /* stays flagged while it is the current node */
+        b->tree[v] &= (uint8_t)~F_ACTIVE;
+    }
+    return NO_NODE;
+}
+
+static void set_orphan(bk *b, uint32_t v)
+{
+    b->parent[v] = P_ORPHAN;
+    b->orphan[b->ot] = v;
+    b->ot = b->ot == b->n ? 0 : b->ot + 1;
+}
+
+static inline uint32_t nb(const bk *b, uint32_t v, unsigned a)
+{
+    return b->nbr[6 * (size_t)v + a];
+}
+
+/* Push the bottleneck along S root .. s -> t .. T root (arc (s, a)). */
+static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
+{
+    int32_t m = b->rc[6 * (size_t)s + a];
+    uint32_t x;
+    for (x = s; b->parent[x] != P_TERMINAL;) {
+        unsigned pa = b->parent[x];
+        uint32_t y = nb(b, x, pa);
+        int32_t c = b->rc[6 * (size_t)y + (pa ^ 1u)];
+        if (c < m)
+            m = c;
+        x = y;
+    }
+    if (b->tr[x] < m)
+        m = b->tr[x];
+    for (x = t; b->parent[x] != P_TERMINAL;) {
+        unsigned pa = b->parent[x];
+        int32_t c = b->rc[6 * (size_t)x + pa];
+        if (c < m)
+            m = c;
+        x = nb(b, x, pa);
+    }
+    if (-b->tr[x] < m)
+        m = -b->tr[x];
+
+    b->rc[6 * (size_t)s + a] -= m;
+    b->rc[6 * (size_t)t + (a ^ 1u)] += m;
+    for (x = s; b->parent[x] != P_TERMINAL;) {
+        unsigned pa = b->parent[x];
+        uint32_t y = nb(b, x, pa);
+        b->rc[6 * (size_t)x + pa] += m;
+        if ((b->rc[6 * (size_t)y + (pa ^ 1u)] -= m) == 0)
+            set_orphan(b, x);
+        x = y;
+    }
+    if ((b->tr[x] -= m) == 0)
+        set_orphan(b, x);
+    for (x = t; b->parent[x] != P_TERMINAL;) {
+        unsigned pa = b->parent[x];
+        uint32_t y = nb(b, x, pa);
+        b->rc[6 * (size_t)y + (pa ^ 1u)] += m;
+        if ((b->rc[6 * (size_t)x + pa] -= m) == 0)
+            set_orphan(b, x);
+        x = y;
+    }
+    if ((b->tr[x] += m) == 0)
+        set_orphan(b, x);
+    b->flow += m;
+}
+
+/* Residual capacity that lets v (in tree X) hang below its neighbour
+ * j = v + off[a]: j -> v for S, v -> j for T. */
+static inline int32_t tree_cap(const bk *b, unsigned X, uint32_t v, uint32_t j, unsigned a)
+{
+    return X == TREE_S ? b->rc[6 * (size_t)j + (a ^ 1u)] : b->rc[6 * (size_t)v + a];
+}
+
+static void adopt(bk *b, uint32_t v)
+{
+    const unsigned X = b->tree[v] & TREES;
+    uint32_t d_min = INF_D;
+    unsigned a_min = P_NONE;
+    for (unsigned a = 0; a < 6; a++) {
+        uint32_t j = nb(b, v, a);
+        if (j == NO_NODE || (b->tree[j] & TREES) != X || tree_cap(b, X, v, j, a) <= 0)
+            continue;
+        /* Is j's origin a terminal, and how far? */
+        uint32_t d = 0, k = j;
+        for (;;) {
+            if (b->ts[k] == b->time) {
+                d += b->dist[k];
+                break;
+            }
+            unsigned pk = b->parent[k];
+            d++;
+            if (pk == P_TERMINAL) {
+                b->ts[k] = b->time;
+                b->dist[k] = 1;
+                break;
+            }
+            if (pk == P_ORPHAN) {
+                d = INF_D;
+                break;
+            }
+            k = nb(b, k, pk);
+        }
+        if (d == INF_D)
+            continue;
+        if (d < d_min) {
+            d_min = d;
+            a_min = a;
+        }
+        for (k = j; b->ts[k] != b->time; k = nb(b, k, b->parent[k])) {
+            b->ts[k] = b->time;
+            b->dist[k] = d--;
+        }
+    }
+    if (a_min != P_NONE) {
+        b->parent[v] = (uint8_t)a_min;
+        b->ts[v] = b->time;
+        b->dist[v] = d_min + 1;
+        return;
+    }
+    for (unsigned a = 0; a < 6; a++) {
+        uint32_t j = nb(b, v, a);
+        if (j == NO_NODE || (b->tree[j] & TREES) != X)
+            continue;
+        if (tree_cap(b, X, v, j, a) > 0)
+            set_active(b, j);
+        unsigned pj = b->parent[j];
+        if (pj == (a ^ 1u))
+            set_orphan(b, j);
+    }
+    b->tree[v] &= (uint8_t)~TREES;
+    b->parent[v] = P_NONE;
+}
+
+static void bk_free(bk *b)
+{
+    free(b->nbr);
+    free(b->rc);
+    free(b->tr);
+    free(b->tree);
+    free(b->parent);
+    free(b->ts);
+    free(b->dist);
+    free(b->active);
+    free(b->orphan);
+}
+
+static void maxflow(bk *b)
+{
+    uint32_t cur = NO_NODE;
+    for (;;) {
+        if (cur != NO_NODE && !(b->tree[cur] & TREES)) {
+            b->tree[cur] &= (uint8_t)~F_ACTIVE;
+            cur = NO_NODE;
+        }
+        if (cur == NO_NODE && (cur = next_active(b)) == NO_NODE)
+            break;
+        const unsigned X = b->tree[cur] & TREES;
+        uint32_t s = NO_NODE, t = NO_NODE;
+        unsigned arc = 0;
+        for (unsigned a = 0; a < 6; a++) {
+            uint32_t q = nb(b, cur, a);
+            if (q == NO_NODE)
+                continue;
+            int32_t c = X == TREE_S ? b->rc[6 * (size_t)cur + a] : b->rc[6 * (size_t)q + (a ^ 1u)];
+            if (c <= 0)
+                continue;
+            const unsigned Y = b->tree[q] & TREES;
+            if (!Y) {
+                b->tree[q] |= (uint8_t)X;
+                b->parent[q] = (uint8_t)(a ^ 1u);
+                b->ts[q] = b->ts[cur];
+                b->dist[q] = b->dist[cur] + 1;
+                set_active(b, q);
+            } else if (Y != X) {
+                if (X == TREE_S) {
+                    s = cur;
+                    t = q;
+                    arc = a;
+                } else {
+                    s = q;
+                    t = cur;
+                    arc = a ^ 1u;
+                }
+                break;
+            } else if (b->ts[q] <= b->ts[cur] && b->dist[q] > b->dist[cur]) {
+                b->parent[q] = (uint8_t)(a ^ 1u);
+                b->ts[q] = b->ts[cur];
+                b->dist[q] = b->dist[cur] + 1;
+            }
+        }
+        if (s == NO_NODE) {
+            b->tree[cur] &= (uint8_t)~F_ACTIVE;
+            cur = NO_NODE;
+            continue;
+        }
+        b->time++;
+        augment(b, s, t, arc);
+        while (b->oh != b->ot) {
+            uint32_t v = b->orphan[b->oh];
+            b->oh = b->oh == b->n ? 0 : b->oh + 1;
+            adopt(b, v);
+        }
+    }
+}
+
+/* The node of voxel w among the sorted voxels vox[lo, hi), or NO_NODE. */
+static uint32_t find_node(const uint32_t *vox, size_t lo, size_t hi, uint32_t w)
+{
+    const size_t end = hi;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (vox[mid] < w)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < end && vox[lo] == w ? (uint32_t)lo : NO_NODE;
+}
+
+/* The capacity of the face between two voxels at unsigned distances a, b. */
+static int32_t face_cap(const st_mincut_params *p, double s, float a, float b)
+{
+    double x = (a < b ? a : b) / s;
+    return 1 + (int32_t)(p->free_area * (x >= 1.0 ? 1.0 : pow(x, p->power)) + 0.5);
+}
+
+st_status st_mincut_label(const st_grid *g, int8_t *label,
+                          const st_mincut_params *p, double *flow,
+                          st_error *err)
+{
+    const size_t nx = g->nx, ny = g->ny, nz = g->nz, n = st_grid_count(g);
+    if (n >= UINT32_MAX)
+        return st_error_set(err, ST_ELIMIT, NULL, 0,
+                            "the grid has too many voxels for the cut (%zu)", n);
+    const int fixed = p->fixed_evidence < 1 ? 1 : p->fixed_evidence > 127 ? 127 : p->fixed_evidence;
+    /* Decided: |evidence| >= fixed; the border is decided outside. */
+    /* The undecided voxels, a z layer at a time in parallel (each layer's
+     * count, then their prefix sums: the same node order for any number
+     * of threads). */
+    const size_t layer = nx * ny;
+    size_t *first = malloc((nz + 1) * sizeof *first);
+    if (!first)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the cut");
+    #pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < nz; k++) {
+        size_t cnt = 0;
+        for (size_t j = 0, v = k * layer; j < ny; j++)
+            for (size_t i = 0; i < nx; i++, v++) {
+                if (i == 0 || j == 0 || k == 0 || i == nx - 1 || j == ny - 1 || k == nz - 1)
+                    label[v] = -127;
+                cnt += abs(label[v]) < fixed;
+            }
+        first[k + 1] = cnt;
+    }
+    first[0] = 0;
+    for (size_t k = 0; k < nz; k++)
+        first[k + 1] += first[k];
+    const size_t m = first[nz];
+    bk b = {0};
+    b.n = m;
+    uint32_t *vox = malloc((m ? m : 1) * sizeof *vox);
+    b.nbr = malloc((6 * m + 1) * sizeof *b.nbr);
+    b.rc = malloc((6 * m + 1) * sizeof *b.rc);
+    b.tr = malloc((m + 1) * sizeof *b.tr);
+    b.tree = malloc(m + 1);
+    b.parent = malloc(m + 1);
+    b.ts = calloc(m + 1, sizeof *b.ts);
+    b.dist = malloc((m + 1) * sizeof *b.dist);
+    b.active = malloc((m + 1) * sizeof *b.active);
+    b.orphan = malloc((m + 1) * sizeof *b.orphan);
+    if (!vox || !b.nbr || !b.rc || !b.tr || !b.tree || !b.parent || !b.ts || !b.dist ||
+        !b.active || !b.orphan) {
+        free(first);
+        free(vox);
+        bk_free(&b);
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory for the cut (%zu undecided voxels)", m);
+    }
+    #pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < nz; k++) {
+        size_t c = first[k];
+        for (size_t v = k * layer; v < (k + 1) * layer; v++)
+            if (abs(label[v]) < fixed)
+                vox[c++] = (uint32_t)v;
+    }
+    free(first);
+    const ptrdiff_t off[6] = {1, -1, (ptrdiff_t)nx, -(ptrdiff_t)nx, (ptrdiff_t)layer,
+                              -(ptrdiff_t)layer};
+    const double s = p->surface_voxels * g->voxel;
+    /* Each node's arcs and terminal capacity (a decided neighbour's arc
+     * goes to its terminal), in parallel; then the trees' roots in order. */
+    #pragma omp parallel for schedule(static)
+    for (size_t u = 0; u < m; u++) {
+        const uint32_t v = vox[u];
+        const float dv = fabsf(g->data[v]);
+        int64_t t = (int64_t)llround(label[v] * p->evidence_weight);
+        for (unsigned a = 0; a < 6; a++) {
+            const uint32_t w = (uint32_t)((ptrdiff_t)v + off[a]);
+            uint32_t q;
+            if (a == 0)
+                q = u + 1 < m && vox[u + 1] == w ? (uint32_t)(u + 1) : NO_NODE;
+            else if (a == 1)
+                q = u > 0 && vox[u - 1] == w ? (uint32_t)(u - 1) : NO_NODE;
+            else if (a & 1u)
+                q = find_node(vox, 0, u, w);
+            else
+                q = find_node(vox, u + 1, m, w);
+            const int32_t cap = face_cap(p, s, dv, fabsf(g->data[w]));
+            b.nbr[6 * u + a] = q;
+            b.rc[6 * u + a] = q == NO_NODE ? 0 : cap;
+            if (q == NO_NODE)   /* a decided neighbour: a terminal */
+                t += label[w] >= fixed ? cap : -cap;
+        }
+        if (t > INT32_MAX / 2 || t < -INT32_MAX / 2)
+            t = t > 0 ? INT32_MAX / 2 : -INT32_MAX / 2;
+        b.tr[u] = (int32_t)t;
+        b.dist[u] = 1;
+    }
+    for (size_t u = 0; u < m; u++) {
+        if (b.tr[u]) {
+            b.tree[u] = (b.tr[u] > 0 ? TREE_S : TREE_T) | F_ACTIVE;
+            b.parent[u] = P_TERMINAL;
+            b.active[b.at++] = (uint32_t)u;
+        } else {
+            b.tree[u] = 0;
+            b.parent[u] = P_NONE;
+        }
+    }
+    maxflow(&b);
+    /* Decided voxels keep the side of their evidence (the border: out). */
+    #pragma omp parallel for schedule(static)
+    for (size_t v = 0; v < n; v++)
+        label[v] = label[v] >= fixed;
+    #pragma omp parallel for schedule(static)
+    for (size_t u = 0; u < m; u++)
+        label[vox[u]] = (b.tree[u] & TREE_S) ? 1 : 0;
+    if (flow)
+        *flow = (double)b.flow;
+    free(vox);
+    bk_free(&b);
+    return ST_OK;
+}

@@ -1,0 +1,685 @@
+/*
+ * holes_planes.c - a hole's cap from a corner rebuilt from the planes
+ * around it (holes_internal.h; issue 17, the large holes of CAD parts).
+ * Design notes and measurements: doc/design/holes.md.
+ *
+ * A CAD part's large hole takes whole faces and the corners where they
+ * met: a cap over the loop's own points cannot bring a lost corner back.
+ * The faces along the loop still carry their planes (those of the soup's
+ * triangles on its edges), and extended into the hole three of them meet
+ * at the lost corner, two along the lost edge. The cone from such a point
+ * over the loop (a triangle on each loop edge, all meeting there) lies in
+ * the planes where the loop runs over one face each: a box's lost corner
+ * comes back whole, a lost edge as its two faces.
+ *
+ * The apexes tried: the point where three of the planes meet, and the
+ * point of the line where two meet nearest the loop's centroid, within
+ * the loop's box grown by REACH of its extent; of the planes, once each
+ * (SAME), at most MAX_PLANES, those along most of the loop. A cone is
+ * measured by how well it continues the faces along the loop: the sum
+ * over the loop's edges of length times the dihedral angle between its
+ * triangle there and the soup's (as the caps that bend least are
+ * measured in holes.c, their spokes left out: a lost corner's creases are
+ * no fault). The cone that continues them best (ties by the bend of its
+ * spokes too) is the cap when it does better than the caller's bound
+ * (the cap of the loop's own points, which chamfers a lost corner: a
+ * box's bends along all its loop by 55 degrees, the corner's cone by 0)
+ * and none of its triangles pierces the surviving soup (st_tri_tri_cross
+ * on the BVH; touching it, as at a crease along the loop, is allowed): a
+ * point where far planes meet sends cones through the part. Of the
+ * cones below the bound, the least bent that pierces nothing.
+ *
+ * A large hole spans several corners (a lost edge and both its ends, a
+ * wing of a part): no one point continues all of its loop.
+ * st_holes_planes_fans takes the point that continues the most of it
+ * exactly (its triangle over an edge within FAN_FLAT of the soup's
+ * plane there, on the hole's side, its fan piercing none of the soup),
+ * fans from it over the edges it continues, and replaces each run of
+ * them by the point; the loop left (split into several where it meets
+ * the point more than once) is capped the same way, and one that no
+ * point continues along two edges by the caller's triangulation of its
+ * own points. The caller keeps the fans or the single cone, whichever
+ * continues the soup along the loop better. That last triangulation is
+ * not tested for piercing, and the piercing test's cost and the variants
+ * not kept are measured in doc/design/holes.md.
+ */
+#include "holes_internal.h"
+#include "../base/fpenv.h"
+#include "souptet/geom.h"
+#include "souptet/isect.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Apexes within the loop's box grown by REACH times its extent each way:
+ * a lost corner lies near the loop's box (a box's lost corner at a corner
+ * of it), a point where nearly parallel planes meet far beyond (other
+ * boxes tried: doc/design/holes.md, "REACH"). */
+#define REACH 0.75
+/* Planes whose offsets and normals differ by less than SAME (relative to
+ * the loop's extent) are one face's (its triangles' rounding). */
+#define SAME 1e-9
+/* Triples of planes meeting at a point: |det| of their unit normals above
+ * MIN_DET (three planes within about 6 degrees of a common line meet far
+ * off or nowhere). */
+#define MIN_DET 1e-2
+/* The apexes from at most MAX_PLANES planes (MAX_PLANES^3 / 6 triples,
+ * each cone measured over the loop): a curved face along the loop has a
+ * plane on each edge; the planes along most of the loop are kept. */
+#define MAX_PLANES 24
+
+/* "out of memory" where the holes' scratch is allocated. */
+static st_status oom(st_error *err)
+{
+    return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
+}
+
+typedef struct plane {
+    double n[3], d;     /* unit normal, n . x = d */
+    double len;         /* the length of the loop edges on it */
+} plane;
+
+/* The cone from apex over the loop: its total bend, length times
+ * dihedral over its edges (rim[i]: the unit normal of the soup's triangle
+ * on loop edge i, which passes it the other way from the cone), and in
+ * *rimb that over the loop's edges only; tn[3 n] is scratch. */
+static double cone_bend(const double *apex, const double *const *pts, const double *rim,
+                        size_t n, double *tn, double *rimb)
+{
+    double b = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const double *p = pts[i], *q = pts[(i + 1) % n];
+        unit_normal(tn + 3 * i, p, q, apex);
+        b += dist3(p, q) * bend(tn + 3 * i, rim + 3 * i);
+    }
+    *rimb = b;
+    for (size_t i = 0; i < n; i++)
+        b += dist3(apex, pts[(i + 1) % n]) * bend(tn + 3 * i, tn + 3 * ((i + 1) % n));
+    return b;
+}
+
+/* Solves the 3x3 system rows . x = rhs (Cramer); 0 when |det| < MIN_DET
+ * (unit rows). */
+static int meet3(double *x, const plane *a, const plane *b, const plane *c)
+{
+    double bc[3], ca[3], ab[3];
+    st_cross3(bc, b->n, c->n);
+    st_cross3(ca, c->n, a->n);
+    st_cross3(ab, a->n, b->n);
+    const double det = st_dot3(a->n, bc);
+    if (!(fabs(det) >= MIN_DET))
+        return 0;
+    for (int k = 0; k < 3; k++)
+        x[k] = (a->d * bc[k] + b->d * ca[k] + c->d * ab[k]) / det;
+    return 1;
+}
+
+/* The point of the line where a and b meet nearest o; 0 when they are
+ * nearly parallel. */
+static int meet2(double *x, const plane *a, const plane *b, const double *o)
+{
+    double t[3];
+    st_cross3(t, a->n, b->n);
+    const double tl = st_dot3(t, t);
+    if (!(tl >= MIN_DET * MIN_DET))
+        return 0;
+    /* the third plane: through o, across the line */
+    plane c;
+    const double l = sqrt(tl);
+    for (int k = 0; k < 3; k++)
+        c.n[k] = t[k] / l;
+    c.d = st_dot3(c.n, o);
+    return meet3(x, a, b, &c);
+}
+
+/* The loop's box grown by REACH times its extent each way (lo, hi), its
+ * centroid o and its extent. */
+static void reach_box(double *lo, double *hi, double *o, double *ext, const double *const *pts,
+                      size_t n)
+{
+    *ext = 0.0;
+    for (int k = 0; k < 3; k++)
+        lo[k] = hi[k] = pts[0][k], o[k] = 0.0;
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], pts[i][k]);
+            hi[k] = fmax(hi[k], pts[i][k]);
+            o[k] += pts[i][k] / (double)n;
+        }
+    for (int k = 0; k < 3; k++)
+        *ext = fmax(*ext, hi[k] - lo[k]);
+    for (int k = 0; k < 3; k++) {
+        lo[k] -= REACH * *ext;
+        hi[k] += REACH * *ext;
+    }
+}
+
+/* The planes of the soup's triangles along the loop, once each (either
+ * orientation), the MAX_PLANES with the most loop length on them first
+ * (ties by order along the loop); rim[3 n] gets each loop edge's unit
+ * normal. Returns how many (pl holds n). */
+static size_t loop_planes(plane *pl, double *rim, const double *const *pts,
+                          const double *const *side, size_t n, double ext)
+{
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        unit_normal(rim + 3 * i, pts[i], side[i], pts[(i + 1) % n]);
+        const double *nn = rim + 3 * i;
+        if (st_dot3(nn, nn) == 0.0)
+            continue;
+        const double d = st_dot3(nn, pts[i]), len = dist3(pts[i], pts[(i + 1) % n]);
+        size_t j = 0;
+        for (; j < m; j++) {
+            const double sg = st_dot3(nn, pl[j].n) < 0.0 ? -1.0 : 1.0;
+            double dn = 0.0;
+            for (int k = 0; k < 3; k++)
+                dn += fabs(sg * nn[k] - pl[j].n[k]);
+            if (dn <= SAME && fabs(sg * d - pl[j].d) <= SAME * ext)
+                break;
+        }
+        if (j < m) {
+            pl[j].len += len;
+            continue;
+        }
+        memcpy(pl[m].n, nn, sizeof pl[m].n);
+        pl[m].d = d;
+        pl[m].len = len;
+        m++;
+    }
+    for (size_t i = 1; i < m; i++)      /* insertion sort */
+        for (size_t j = i; j > 0 && pl[j].len > pl[j - 1].len; j--) {
+            plane t = pl[j];
+            pl[j] = pl[j - 1];
+            pl[j - 1] = t;
+        }
+    return m > MAX_PLANES ? MAX_PLANES : m;
+}
+
+/* 1 when triangle (a, b, apex) pierces a kept triangle of guard's soup
+ * (st_tri_tri_cross: touching it, along the loop or at a crease, is no
+ * crossing). */
+typedef struct cross_ctx {
+    const st_holes_guard *g;
+    const double *t[3];
+} cross_ctx;
+
+static int cross_visit(void *ctx, uint32_t tri)
+{
+    const cross_ctx *c = ctx;
+    if (!c->g->kept[tri])
+        return 0;
+    const st_soup *s = c->g->bvh->soup;
+    const uint32_t *v = s->tris + 3 * (size_t)tri;
+    return st_tri_tri_cross(c->t[0], c->t[1], c->t[2], s->xyz + 3 * (size_t)v[0],
+                            s->xyz + 3 * (size_t)v[1], s->xyz + 3 * (size_t)v[2]);
+}
+
+static int crosses(const st_holes_guard *g, const double *a, const double *b, const double *apex)
+{
+    if (!g || !g->bvh)
+        return 0;
+    cross_ctx c = {g, {a, b, apex}};
+    return st_bvh_query_tri(g->bvh, a, b, apex, cross_visit, &c);
+}
+
+/* An apex tried: its point, the planes it is made of (indices into the
+ * loop's planes), its score (key, then tie: least first) and whether it
+ * was taken up. */
+typedef struct cand {
+    double x[3], key, tie;
+    size_t a, b, c;
+    int done;
+} cand;
+
+/* At most this many apexes per loop: triples and pairs of MAX_PLANES. */
+#define MAX_CAND (MAX_PLANES * MAX_PLANES * MAX_PLANES / 6 + MAX_PLANES * MAX_PLANES)
+
+/* The candidate not taken up yet of least (key, tie), the first of equal
+ * ones; NULL when none is left. */
+static cand *least_cand(cand *cs, size_t nc)
+{
+    cand *b = NULL;
+    for (size_t i = 0; i < nc; i++)
+        if (!cs[i].done &&
+            (!b || cs[i].key < b->key || (cs[i].key == b->key && cs[i].tie < b->tie)))
+            b = cs + i;
+    return b;
+}
+
+/* The apex where planes a, b and c meet (c == b: the point of the line of
+ * a and b nearest o), when they meet within [lo, hi]. */
+static int candidate(double *x, const plane *pl, size_t a, size_t b, size_t c, const double *o,
+                     const double *lo, const double *hi)
+{
+    if (!(c == b ? meet2(x, &pl[a], &pl[b], o) : meet3(x, &pl[a], &pl[b], &pl[c])))
+        return 0;
+    int inside = 1;
+    for (int k = 0; k < 3; k++)
+        inside &= x[k] >= lo[k] && x[k] <= hi[k];
+    return inside;
+}
+
+st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
+                              const double *const *side, size_t n, double below,
+                              const st_holes_guard *guard, double *bent, st_error *err)
+{
+    *done = 0;
+    *bent = INFINITY;
+    double *rim = malloc(3 * n * sizeof *rim), *tn = malloc(3 * n * sizeof *tn);
+    plane *pl = malloc(n * sizeof *pl);
+    cand *cs = malloc(MAX_CAND * sizeof *cs);
+    st_status rc = ST_OK;
+    if (!rim || !tn || !pl || !cs) {
+        rc = oom(err);
+        goto out;
+    }
+    double lo[3], hi[3], o[3], ext;
+    reach_box(lo, hi, o, &ext, pts, n);
+    const size_t m = loop_planes(pl, rim, pts, side, n, ext);
+    /* the cones that bend less than below, the least bent first (ties
+     * by the bend of their spokes too): the first whose triangles pierce
+     * none of the soup */
+    size_t nc = 0;
+    for (size_t a = 0; a < m; a++)
+        for (size_t b = a + 1; b < m; b++)
+            for (size_t c = b; c < m; c++) {    /* c == b: the line of a and b */
+                cand *k = cs + nc;
+                double rb;
+                if (!candidate(k->x, pl, a, b, c, o, lo, hi))
+                    continue;
+                const double cb = cone_bend(k->x, pts, rim, n, tn, &rb);
+                if (!(rb < below))
+                    continue;
+                k->key = rb, k->tie = cb, k->a = a, k->b = b, k->c = c, k->done = 0;
+                nc++;
+            }
+    const cand *k = NULL;
+    for (; (k = least_cand(cs, nc)) != NULL; cs[k - cs].done = 1) {
+        size_t i = 0;
+        while (i < n && !crosses(guard, pts[i], pts[(i + 1) % n], k->x))
+            i++;
+        if (i == n)
+            break;
+    }
+    if (!k)
+        goto out;
+    const double best = k->key, *apex = k->x;
+    const size_t base = out->nverts;
+    for (size_t i = 0; i < n; i++)
+        if ((rc = st_soup_add_vertex(out, pts[i][0], pts[i][1], pts[i][2], err)))
+            goto out;
+    if ((rc = st_soup_add_vertex(out, apex[0], apex[1], apex[2], err)))
+        goto out;
+    for (size_t i = 0; i < n; i++)
+        if ((rc = st_soup_add_triangle(out, (uint32_t)(base + i), (uint32_t)(base + (i + 1) % n),
+                                       (uint32_t)(base + n), err)))
+            goto out;
+    *done = 1;
+    *bent = best;
+out:
+    free(rim), free(tn), free(pl), free(cs);
+    return rc;
+}
+
+/* ---- several corners per loop: fans to the points where the planes meet */
+
+/* An apex continues loop edge i when the triangle (p_i, p_i+1, apex) lies
+ * in the plane of the soup's triangle there, on the hole's side: its bend
+ * below FAN_FLAT radians. */
+#define FAN_FLAT 1e-6
+/* At most MAX_APEX apexes per loop. */
+#define MAX_APEX 16
+
+/* One vertex of a loop being capped: its point, the third point of the
+ * triangle beyond its outgoing edge (the soup's or a fan's), and the
+ * original loop edge that outgoing edge is (-1: a new one, to an apex). */
+typedef struct fan_v {
+    const double *p, *side;
+    long orig;
+} fan_v;
+
+/* Which of the loop's edges apex continues (FAN_FLAT): flag[n]. Returns
+ * their length. (All of them are fanned: doc/design/holes.md.) */
+static double fan_flags(const double *apex, const fan_v *v, const double *rim, size_t n,
+                        int *flag)
+{
+    double g = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double t[3];
+        const double *a = v[i].p, *b = v[(i + 1) % n].p;
+        unit_normal(t, a, b, apex);
+        flag[i] = bend(t, rim + 3 * i) < FAN_FLAT;
+        if (flag[i])
+            g += dist3(a, b);
+    }
+    return g;
+}
+
+/* Unflags the edges whose fan from apex pierces guard's soup; returns
+ * the length of those left. */
+static double fans_uncross(const st_holes_guard *g, const double *apex, const fan_v *v, size_t n,
+                           int *flag)
+{
+    double len = 0.0;
+    for (size_t i = 0; i < n; i++)
+        if (flag[i]) {
+            if (crosses(g, v[i].p, v[(i + 1) % n].p, apex))
+                flag[i] = 0;
+            else
+                len += dist3(v[i].p, v[(i + 1) % n].p);
+        }
+    return len;
+}
+
+typedef struct fan_out {
+    const double **tri;     /* 3 points a triangle */
+    long *orig;             /* per triangle edge: the original loop edge or -1 */
+    size_t nt, cap;
+} fan_out;
+
+static st_status fan_push(fan_out *o, const double *a, const double *b, const double *c, long oa,
+                          long ob, long oc, st_error *err)
+{
+    if (o->nt == o->cap) {
+        size_t nc = o->cap ? 2 * o->cap : 64;
+        const double **t = realloc(o->tri, 3 * nc * sizeof *t);
+        if (!t)
+            return oom(err);
+        o->tri = t;
+        long *g = realloc(o->orig, 3 * nc * sizeof *g);
+        if (!g)
+            return oom(err);
+        o->orig = g;
+        o->cap = nc;
+    }
+    o->tri[3 * o->nt] = a, o->tri[3 * o->nt + 1] = b, o->tri[3 * o->nt + 2] = c;
+    o->orig[3 * o->nt] = oa, o->orig[3 * o->nt + 1] = ob, o->orig[3 * o->nt + 2] = oc;
+    o->nt++;
+    return ST_OK;
+}
+
+/* The fans of one loop being built: the loops still to cap, one after
+ * another in stk (each led by its length in lens), the one being capped
+ * (cur, m vertices; lp, ls its points and sides), its planes and apexes,
+ * and the triangles so far (fo). */
+typedef struct fanner {
+    size_t maxv, nloops, napex, top;
+    fan_v *stk, *cur, *nxt;
+    size_t *lens;
+    double *rim;
+    plane *pl;
+    const double **lp, **ls;
+    uint32_t *tri;
+    double (*apx)[3];
+    int *flag;
+    cand *cs;
+    fan_out fo;
+    double lo[3], hi[3], ext;   /* the original loop's reach box, extent */
+    const st_holes_guard *guard;
+} fanner;
+
+static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
+{
+    const size_t maxv = f->maxv = n + 2 * MAX_APEX + 2;
+    f->stk = malloc(2 * maxv * (MAX_APEX + 2) * sizeof *f->stk);
+    f->cur = malloc(maxv * sizeof *f->cur);
+    f->nxt = malloc(2 * maxv * sizeof *f->nxt);
+    f->lens = malloc(maxv * sizeof *f->lens);
+    f->rim = malloc(3 * maxv * sizeof *f->rim);
+    f->pl = malloc(maxv * sizeof *f->pl);
+    f->lp = malloc(maxv * sizeof *f->lp);
+    f->ls = malloc(maxv * sizeof *f->ls);
+    f->tri = malloc(3 * maxv * sizeof *f->tri);
+    f->apx = malloc(MAX_APEX * sizeof *f->apx);
+    f->flag = malloc(maxv * sizeof *f->flag);
+    f->cs = malloc(MAX_CAND * sizeof *f->cs);
+    if (!f->flag || !f->stk || !f->cur || !f->nxt || !f->lens || !f->rim || !f->pl || !f->lp ||
+        !f->ls || !f->tri || !f->apx || !f->cs)
+        return oom(err);
+    return ST_OK;
+}
+
+static void fanner_free(fanner *f)
+{
+    free(f->stk), free(f->cur), free(f->nxt), free(f->lens), free(f->rim), free(f->pl);
+    free(f->lp), free(f->ls), free(f->tri), free(f->apx), free(f->fo.tri), free(f->fo.orig);
+    free(f->flag), free(f->cs);
+}
+
+/* The apex for the loop in f->cur (m vertices, centroid o): by the length
+ * of the loop they continue, the most first, each without the edges
+ * whose fans pierce the soup, until none left could continue more. Its
+ * point in ax and its continued edges in f->flag; returns how many. */
+static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
+{
+    const size_t np = loop_planes(f->pl, f->rim, (const double *const *)f->lp,
+                                  (const double *const *)f->ls, m, f->ext);
+    size_t nc = 0;
+    if (f->napex < MAX_APEX)
+        for (size_t a = 0; a < np; a++)
+            for (size_t b = a + 1; b < np; b++)
+                for (size_t c = b; c < np; c++) {
+                    cand *k = f->cs + nc;
+                    if (!candidate(k->x, f->pl, a, b, c, o, f->lo, f->hi))
+                        continue;
+                    const double g = fan_flags(k->x, f->cur, f->rim, m, f->flag);
+                    if (!(g > 0.0))
+                        continue;
+                    k->key = -g, k->tie = (double)nc, k->done = 0;
+                    nc++;
+                }
+    double best = 0.0;
+    for (cand *k; (k = least_cand(f->cs, nc)) != NULL && -k->key > best; k->done = 1) {
+        fan_flags(k->x, f->cur, f->rim, m, f->flag);
+        const double g = fans_uncross(f->guard, k->x, f->cur, m, f->flag);
+        if (g > best) {
+            best = g;
+            memcpy(ax, k->x, 3 * sizeof *ax);
+        }
+    }
+    size_t ncont = 0;
+    if (best > 0.0) {
+        fan_flags(ax, f->cur, f->rim, m, f->flag);
+        fans_uncross(f->guard, ax, f->cur, m, f->flag);
+        for (size_t i = 0; i < m; i++)
+            ncont += (size_t)f->flag[i];
+    }
+    return ncont;
+}
+
+/* The loop in f->cur (m vertices) by fill, the triangulation of its own
+ * points. */
+static st_status fill_loop(fanner *f, size_t m, st_holes_fill fill, st_error *err)
+{
+    double area;
+    st_status rc = fill(&area, (const double *const *)f->lp, (const double *const *)f->ls, m,
+                        f->tri, err);
+    for (size_t t = 0; !rc && t + 2 < m; t++) {
+        const uint32_t *c = f->tri + 3 * t;
+        long og[3];
+        for (int e = 0; e < 3; e++) {
+            const size_t u = c[e], w = c[(e + 1) % 3];
+            og[e] = (u + 1) % m == w ? f->cur[u].orig : (w + 1) % m == u ? f->cur[w].orig : -1;
+        }
+        rc = fan_push(&f->fo, f->lp[c[0]], f->lp[c[1]], f->lp[c[2]], og[0], og[1], og[2], err);
+    }
+    return rc;
+}
+
+/* The fans from apex A over the flagged edges of f->cur (m vertices),
+ * and in f->nxt (*k vertices) the loop with each run of them replaced by
+ * A, started at an edge A does not continue; *s0 == m when A continues
+ * them all (a cone over the whole loop). */
+static st_status fan_apex(fanner *f, size_t m, const double *A, size_t *k, size_t *s0,
+                          st_error *err)
+{
+    const int *flag = f->flag;
+    fan_v *nxt = f->nxt;
+    size_t s = 0;
+    while (s < m && flag[s])
+        s++;
+    *s0 = s;
+    *k = 0;
+    for (size_t r = 0; r < m; r++) {
+        const size_t i = (s + r) % m;
+        const fan_v *vi = f->cur + i, *vj = f->cur + (i + 1) % m;
+        if (!flag[i]) {
+            nxt[(*k)++] = *vi;
+            continue;
+        }
+        const st_status rc = fan_push(&f->fo, vi->p, vj->p, A, vi->orig, -1, -1, err);
+        if (rc)
+            return rc;
+        const int first = r == 0 || !flag[(i + m - 1) % m];
+        const int last = r + 1 == m || !flag[(i + 1) % m];
+        if (first && s < m) {      /* vi stays, its edge now to the apex */
+            nxt[*k].p = vi->p;
+            nxt[*k].side = vj->p;
+            nxt[*k].orig = -1;
+            (*k)++;
+        }
+        if (last) {
+            nxt[*k].p = A;
+            nxt[*k].side = vi->p;
+            nxt[*k].orig = -1;
+            (*k)++;
+        }
+    }
+    return ST_OK;
+}
+
+/* Pushes the loop in f->nxt (k vertices) onto the stack, split where it
+ * meets apex A more than once: rotated to start at A, cut before each
+ * later occurrence of it. 0 when the stack is full (never on a loop of
+ * this size). */
+static int push_split(fanner *f, size_t k, const double *A)
+{
+    fan_v *nxt = f->nxt;
+    size_t firstA = 0;
+    while (nxt[firstA].p != A)
+        firstA++;
+    for (size_t i = 0; i < k; i++)
+        nxt[k + i] = nxt[(firstA + i) % k];
+    size_t st = k;
+    for (size_t i = k + 1; i <= 2 * k; i++)
+        if (i == 2 * k || nxt[i].p == A) {
+            const size_t len = i - st;
+            if (len >= 3) {
+                if (f->nloops == f->maxv || f->top + len > 2 * f->maxv * (MAX_APEX + 2))
+                    return 0;
+                memcpy(f->stk + f->top, nxt + st, len * sizeof *f->stk);
+                f->top += len;
+                f->lens[f->nloops++] = len;
+            }
+            st = i;
+        }
+    return 1;
+}
+
+/* The caps' bend along the original loop pts[0..n). */
+static double fans_bend(const fan_out *fo, const double *const *pts, const double *const *side,
+                        size_t n)
+{
+    double rb = 0.0;
+    for (size_t t = 0; t < fo->nt; t++) {
+        double nt[3], nr[3];
+        const double **c = fo->tri + 3 * t;
+        unit_normal(nt, c[0], c[1], c[2]);
+        for (int e = 0; e < 3; e++) {
+            const long i = fo->orig[3 * t + e];
+            if (i < 0)
+                continue;
+            unit_normal(nr, pts[i], side[i], pts[((size_t)i + 1) % n]);
+            rb += dist3(pts[i], pts[((size_t)i + 1) % n]) * bend(nt, nr);
+        }
+    }
+    return rb;
+}
+
+/* Caps the loops on f's stack, from the original loop pts[0..n) down:
+ * each by the fans from its best apex, the loop left pushed back, or by
+ * fill when no apex continues two of its edges. *whole 0 when the stack
+ * overflowed (the fans are then not used). */
+static st_status fan_loops(fanner *f, int *whole, st_holes_fill fill, st_error *err)
+{
+    st_status rc = ST_OK;
+    *whole = 1;
+    while (f->nloops && !rc) {
+        /* pop the last loop */
+        const size_t m = f->lens[--f->nloops];
+        f->top -= m;
+        memcpy(f->cur, f->stk + f->top, m * sizeof *f->cur);
+        if (m < 3)
+            continue;
+        double o[3] = {0, 0, 0}, ax[3] = {0, 0, 0};
+        for (size_t i = 0; i < m; i++)
+            for (int k = 0; k < 3; k++)
+                o[k] += f->cur[i].p[k] / (double)m;
+        for (size_t i = 0; i < m; i++) {
+            f->lp[i] = f->cur[i].p;
+            f->ls[i] = f->cur[i].side;
+        }
+        if (best_apex(f, m, o, ax) < 2) {
+            rc = fill_loop(f, m, fill, err);
+            continue;
+        }
+        memcpy(f->apx[f->napex], ax, sizeof ax);
+        const double *A = f->apx[f->napex++];
+        size_t k, s0;
+        rc = fan_apex(f, m, A, &k, &s0, err);
+        if (!rc && s0 < m && !push_split(f, k, A)) {
+            *whole = 0;
+            break;
+        }
+    }
+    return rc;
+}
+
+st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts,
+                               const double *const *side, size_t n, double below,
+                               st_holes_fill fill, const st_holes_guard *guard, double *bent,
+                               st_error *err)
+{
+    *done = 0;
+    *bent = INFINITY;
+    fanner f;
+    memset(&f, 0, sizeof f);
+    f.guard = guard;
+    int whole = 0;
+    st_status rc = fanner_alloc(&f, n, err);
+    if (rc)
+        goto done;
+    double o0[3];
+    reach_box(f.lo, f.hi, o0, &f.ext, pts, n);
+    for (size_t i = 0; i < n; i++) {
+        f.stk[i].p = pts[i];
+        f.stk[i].side = side[i];
+        f.stk[i].orig = (long)i;
+    }
+    f.lens[0] = n;
+    f.top = n;
+    f.nloops = 1;
+    if ((rc = fan_loops(&f, &whole, fill, err)) || !whole)
+        goto done;
+    const double rb = fans_bend(&f.fo, pts, side, n);
+    if (f.napex == 0 || !(rb < below))
+        goto done;
+    for (size_t t = 0; t < f.fo.nt; t++) {
+        const size_t base = out->nverts;
+        for (int c = 0; c < 3; c++) {
+            const double *q = f.fo.tri[3 * t + c];
+            if ((rc = st_soup_add_vertex(out, q[0], q[1], q[2], err)))
+                goto done;
+        }
+        if ((rc = st_soup_add_triangle(out, (uint32_t)base, (uint32_t)(base + 1),
+                                       (uint32_t)(base + 2), err)))
+            goto done;
+    }
+    *done = 1;
+    *bent = rb;
+done:
+    fanner_free(&f);
+    return rc;
+}

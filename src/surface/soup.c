@@ -1,0 +1,198 @@
+/*
+ * soup.c - triangle soups: the type (see soup.h): building, names, bounds,
+ * appending; and the unchecked appends the readers share (soup_internal.h).
+ * Reading files is soupread.c's; the readers' text lexer is lexer.c's.
+ */
+#include "souptet/soup.h"
+#include "../base/fpenv.h"
+#include "souptet/mem.h"
+#include "soup_internal.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- building ---------------------------------------------------------- */
+
+/*
+ * Capacity is implicit in the count, so st_soup needs no capacity field and
+ * a zero-initialised st_soup works too: an array holding n > 0 elements has
+ * room for max(64, the power of two >= n). It is full exactly when n is 0 or
+ * a power of two >= 64, and then doubles.
+ */
+#define MIN_CAP 64
+
+static st_status grow(void **arr, size_t n, size_t elem)
+{
+    if (n != 0 && (n < MIN_CAP || (n & (n - 1)) != 0))
+        return ST_OK;
+    size_t cap;
+    if (n == 0)
+        cap = MIN_CAP;
+    else if (st_size_mul(&cap, n, 2) != 0)
+        return ST_ENOMEM;
+    void *p = st_realloc_array(*arr, cap, elem);
+    if (!p)
+        return ST_ENOMEM;
+    *arr = p;
+    return ST_OK;
+}
+
+st_status st_soup__push_vertex(st_soup *s, double x, double y, double z)
+{
+    if (s->nverts >= UINT32_MAX)
+        return ST_ELIMIT;
+    if (grow((void **)&s->xyz, s->nverts, 3 * sizeof(double)) != 0)
+        return ST_ENOMEM;
+    double *v = s->xyz + 3 * s->nverts;
+    v[0] = x;
+    v[1] = y;
+    v[2] = z;
+    s->nverts++;
+    return ST_OK;
+}
+
+st_status st_soup__push_tri(st_soup *s, uint32_t a, uint32_t b, uint32_t c)
+{
+    if (grow((void **)&s->tris, s->ntris, 3 * sizeof(uint32_t)) != 0)
+        return ST_ENOMEM;
+    uint32_t *t = s->tris + 3 * s->ntris;
+    t[0] = a;
+    t[1] = b;
+    t[2] = c;
+    s->ntris++;
+    return ST_OK;
+}
+
+st_status st_soup__push_failed(st_error *err, st_status st, const char *name,
+                               long long line, long long offset)
+{
+    const char *what = st == ST_ELIMIT
+                           ? "more than 4294967295 vertices"
+                           : "out of memory";
+    if (offset >= 0)
+        return st_error_set_offset(err, st, name, offset, "%s", what);
+    return st_error_set(err, st, name, line, "%s", what);
+}
+
+st_soup *st_soup_new(void)
+{
+    return calloc(1, sizeof(st_soup));
+}
+
+void st_soup_free(st_soup *s)
+{
+    if (!s)
+        return;
+    free(s->xyz);
+    free(s->tris);
+    for (size_t i = 0; i < s->nnames; i++)
+        free(s->names[i].name);
+    free(s->names);
+    free(s);
+}
+
+st_status st_soup_add_vertex(st_soup *s, double x, double y, double z,
+                             st_error *err)
+{
+    st_status st = st_soup__push_vertex(s, x, y, z);
+    if (st)
+        return st_soup__push_failed(err, st, NULL, 0, -1);
+    return ST_OK;
+}
+
+st_status st_soup_add_triangle(st_soup *s, uint32_t a, uint32_t b, uint32_t c,
+                               st_error *err)
+{
+    if (a >= s->nverts || b >= s->nverts || c >= s->nverts)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "triangle (%lu %lu %lu) refers past the %zu "
+                            "vertices", (unsigned long)a, (unsigned long)b,
+                            (unsigned long)c, s->nverts);
+    st_status st = st_soup__push_tri(s, a, b, c);
+    if (st)
+        return st_soup__push_failed(err, st, NULL, 0, -1);
+    return ST_OK;
+}
+
+st_status st_soup__push_name(st_soup *s, int level, const unsigned char *name,
+                             size_t len)
+{
+    if (len > ST_SOUP_NAME_MAX) {
+        /* cut before a UTF-8 sequence, not inside it */
+        len = ST_SOUP_NAME_MAX;
+        while (len > 0 && (name[len] & 0xc0) == 0x80)
+            len--;
+    }
+    if (grow((void **)&s->names, s->nnames, sizeof *s->names) != 0)
+        return ST_ENOMEM;
+    char *c = malloc(len + 1);
+    if (!c)
+        return ST_ENOMEM;
+    if (len)
+        memcpy(c, name, len);
+    c[len] = '\0';
+    /* A NUL inside a name would cut it short in every writer: make it '_'. */
+    for (size_t i = 0; i < len; i++)
+        if (c[i] == '\0')
+            c[i] = '_';
+    s->names[s->nnames].first = s->ntris;
+    s->names[s->nnames].name = c;
+    s->names[s->nnames].level = level;
+    s->nnames++;
+    return ST_OK;
+}
+
+st_status st_soup_add_name(st_soup *s, int level, const char *name, size_t len,
+                           st_error *err)
+{
+    if (st_soup__push_name(s, level, (const unsigned char *)name, len))
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    return ST_OK;
+}
+
+st_status st_soup_bounds(const st_soup *s, double lo[3], double hi[3],
+                         st_error *err)
+{
+    if (!s || s->ntris == 0)
+        return st_error_set(err, ST_EINPUT, NULL, 0, "no triangles");
+    for (int a = 0; a < 3; a++) {
+        lo[a] = INFINITY;
+        hi[a] = -INFINITY;
+    }
+    for (size_t i = 0; i < 3 * s->ntris; i++) {
+        uint32_t v = s->tris[i];
+        if (v >= s->nverts)
+            return st_error_set(err, ST_EINTERNAL, NULL, 0,
+                                "triangle %zu refers to vertex %lu of %zu",
+                                i / 3, (unsigned long)v, s->nverts);
+        const double *p = s->xyz + 3 * (size_t)v;
+        for (int a = 0; a < 3; a++) {
+            if (p[a] < lo[a])
+                lo[a] = p[a];
+            if (p[a] > hi[a])
+                hi[a] = p[a];
+        }
+    }
+    return ST_OK;
+}
+
+st_status st_soup_append(st_soup *dst, const st_soup *src, st_error *err)
+{
+    const size_t base = dst->nverts;
+    for (size_t v = 0; v < src->nverts; v++) {
+        const double *q = src->xyz + 3 * v;
+        st_status st = st_soup_add_vertex(dst, q[0], q[1], q[2], err);
+        if (st)
+            return st;
+    }
+    for (size_t t = 0; t < src->ntris; t++) {
+        const uint32_t *c = src->tris + 3 * t;
+        st_status st = st_soup_add_triangle(dst, (uint32_t)(base + c[0]), (uint32_t)(base + c[1]),
+                                            (uint32_t)(base + c[2]), err);
+        if (st)
+            return st;
+    }
+    return ST_OK;
+}

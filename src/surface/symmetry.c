@@ -1,0 +1,701 @@
+/*
+ * symmetry.c - mirror planes and rotation axes of a soup's surviving
+ * surface (see symmetry.h for the algorithm).
+ *
+ * Reference: N. J. Mitra, L. J. Guibas, M. Pauly, "Partial and approximate
+ * symmetry detection for 3D geometry", SIGGRAPH 2006 (the pair voting).
+ *
+ * Nothing here decides geometry for the output: a symmetry is evidence,
+ * measured by its support, and every measure is a count of samples, so
+ * doubles only rank and threshold.
+ */
+#include "souptet/symmetry.h"
+#include "../base/fpenv.h"
+#include "souptet/geom.h"
+#include "souptet/mem.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI 3.14159265358979323846
+/* Normals of a pair within this angle count as mapped onto each other
+ * (the vote), and an image's normal within MATCH_DEG of the triangle it
+ * lands on (the support). */
+#define VOTE_COS 0.9659258262890683   /* cos 15 degrees */
+#define MATCH_COS 0.8660254037844387  /* cos 30 degrees */
+#define SAME_COS 0.9993908270190958   /* cos 2 degrees: one plane or line */
+#define VOTE_PAIRS 40000
+#define VOTE_DIR_BINS 24              /* per cube face side */
+#define VOTE_CANDIDATES 16
+#define REFINE_ROUNDS 6
+#define REFINE_REACH 3.0              /* tolerances */
+
+st_symmetry_params st_symmetry_params_default(void)
+{
+    st_symmetry_params p = {ST_SYMMETRY_DEFAULT_SAMPLES, 0.0,
+                            ST_SYMMETRY_DEFAULT_MIN_SUPPORT,
+                            ST_SYMMETRY_DEFAULT_MAX_ORDER};
+    return p;
+}
+
+/* ---- maps ----------------------------------------------------------------- */
+
+static void normalize(double v[3])
+{
+    double l = st_norm3(v);
+    if (l > 0.0)
+        for (int a = 0; a < 3; a++)
+            v[a] /= l;
+}
+
+void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
+                       int w, double out[3])
+{
+    const double *n = y->dir;
+    double r[3];
+    for (int a = 0; a < 3; a++)
+        r[a] = x[a] - (w ? y->point[a] : 0.0);
+    if (y->kind == ST_SYMMETRY_MIRROR) {
+        double d = 2.0 * st_dot3(r, n);
+        for (int a = 0; a < 3; a++)
+            r[a] -= d * n[a];
+    } else {
+        /* Rodrigues */
+        double c = cos(angle), s = sin(angle), k[3], d = st_dot3(n, r);
+        st_cross3(k, n, r);
+        for (int a = 0; a < 3; a++)
+            r[a] = r[a] * c + k[a] * s + n[a] * d * (1.0 - c);
+    }
+    for (int a = 0; a < 3; a++)
+        out[a] = r[a] + (w ? y->point[a] : 0.0);
+}
+
+void st_symmetry_describe(const st_symmetry *y, char *buf, size_t size)
+{
+    if (y->kind == ST_SYMMETRY_MIRROR)
+        snprintf(buf, size,
+                 "mirror plane through (%.6g, %.6g, %.6g), normal (%.4f, "
+                 "%.4f, %.4f), support %.3f",
+                 y->point[0], y->point[1], y->point[2], y->dir[0], y->dir[1],
+                 y->dir[2], y->support);
+    else if (y->order == 0)
+        snprintf(buf, size,
+                 "rotation axis through (%.6g, %.6g, %.6g), direction "
+                 "(%.4f, %.4f, %.4f), continuous, support %.3f",
+                 y->point[0], y->point[1], y->point[2], y->dir[0], y->dir[1],
+                 y->dir[2], y->support);
+    else
+        snprintf(buf, size,
+                 "rotation axis through (%.6g, %.6g, %.6g), direction "
+                 "(%.4f, %.4f, %.4f), order %d, support %.3f",
+                 y->point[0], y->point[1], y->point[2], y->dir[0], y->dir[1],
+                 y->dir[2], y->order, y->support);
+}
+
+/* ---- samples -------------------------------------------------------------- */
+
+typedef struct samples {
+    size_t n;
+    double *p;       /* 3n */
+    double *nrm;     /* 3n, unit */
+    double c[3];     /* area centroid */
+    double axes[3][3]; /* principal axes (rows), unit */
+} samples;
+
+static uint64_t mix64(uint64_t x)
+{
+    x ^= x >> 30;
+    x *= 0xbf58476d1ce4e5b9ULL;
+    x ^= x >> 27;
+    x *= 0x94d049bb133111ebULL;
+    return x ^ (x >> 31);
+}
+
+/* Eigenvectors of the symmetric 3x3 m (Jacobi), as rows of v. */
+static void eigen3(double m[3][3], double v[3][3])
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            v[i][j] = i == j;
+    for (int sweep = 0; sweep < 50; sweep++) {
+        double off = fabs(m[0][1]) + fabs(m[0][2]) + fabs(m[1][2]);
+        if (off == 0.0)
+            break;
+        for (int p = 0; p < 2; p++)
+            for (int q = p + 1; q < 3; q++) {
+                if (m[p][q] == 0.0)
+                    continue;
+                double th = 0.5 * (m[q][q] - m[p][p]) / m[p][q];
+                double t = (th >= 0 ? 1.0 : -1.0) /
+                           (fabs(th) + sqrt(th * th + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 3; k++) {
+                    double a = m[k][p], b = m[k][q];
+                    m[k][p] = c * a - s * b;
+                    m[k][q] = s * a + c * b;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double a = m[p][k], b = m[q][k];
+                    m[p][k] = c * a - s * b;
+                    m[q][k] = s * a + c * b;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double a = v[p][k], b = v[q][k];
+                    v[p][k] = c * a - s * b;
+                    v[q][k] = s * a + c * b;
+                }
+            }
+    }
+}
+
+static int samples_make(samples *S, const st_soup *s, size_t want)
+{
+    memset(S, 0, sizeof *S);
+    double *cum = st_malloc_array(s->ntris + 1, sizeof *cum);
+    if (!cum)
+        return -1;
+    cum[0] = 0.0;
+    for (size_t t = 0; t < s->ntris; t++) {
+        const uint32_t *v = s->tris + 3 * t;
+        double u[3], w[3], n[3];
+        st_sub3(u, s->xyz + 3 * (size_t)v[1], s->xyz + 3 * (size_t)v[0]);
+        st_sub3(w, s->xyz + 3 * (size_t)v[2], s->xyz + 3 * (size_t)v[0]);
+        st_cross3(n, u, w);
+        double a = 0.5 * st_norm3(n);
+        cum[t + 1] = cum[t] + (isfinite(a) ? a : 0.0);
+    }
+    double total = cum[s->ntris];
+    if (!(total > 0.0)) {
+        free(cum);
+        return 0;
+    }
+    S->p = st_malloc_array(3 * want, sizeof *S->p);
+    S->nrm = st_malloc_array(3 * want, sizeof *S->nrm);
+    if (!S->p || !S->nrm) {
+        free(cum);
+        return -1;
+    }
+    size_t t = 0;
+    for (size_t k = 0; k < want; k++) {
+        double target = total * ((double)k + 0.5) / (double)want;
+        while (t + 1 < s->ntris && cum[t + 1] <= target)
+            t++;
+        const uint32_t *v = s->tris + 3 * t;
+        const double *a = s->xyz + 3 * (size_t)v[0],
+                     *b = s->xyz + 3 * (size_t)v[1],
+                     *c = s->xyz + 3 * (size_t)v[2];
+        /* a point of the triangle from two hashed uniforms */
+        uint64_t h = mix64(k + 1);
+        double r1 = (double)(h >> 11) * 0x1.0p-53,
+               r2 = (double)(mix64(h) >> 11) * 0x1.0p-53;
+        if (r1 + r2 > 1.0) {
+            r1 = 1.0 - r1;
+            r2 = 1.0 - r2;
+        }
+        double u[3], w[3], n[3];
+        st_sub3(u, b, a);
+        st_sub3(w, c, a);
+        st_cross3(n, u, w);
+        normalize(n);
+        for (int x = 0; x < 3; x++) {
+            S->p[3 * S->n + x] = a[x] + r1 * u[x] + r2 * w[x];
+            S->nrm[3 * S->n + x] = n[x];
+        }
+        S->n++;
+    }
+    free(cum);
+    double m[3][3] = {{0}};
+    for (size_t k = 0; k < S->n; k++)
+        for (int x = 0; x < 3; x++)
+            S->c[x] += S->p[3 * k + x] / (double)S->n;
+    for (size_t k = 0; k < S->n; k++) {
+        double d[3];
+        st_sub3(d, S->p + 3 * k, S->c);
+        for (int x = 0; x < 3; x++)
+            for (int y = 0; y < 3; y++)
+                m[x][y] += d[x] * d[y];
+    }
+    eigen3(m, S->axes);
+    return 0;
+}
+
+static void samples_free(samples *S)
+{
+    free(S->p);
+    free(S->nrm);
+}
+
+/* ---- support -------------------------------------------------------------- */
+
+typedef struct ctx {
+    const st_soup *s;
+    const st_bvh *bvh;
+    const samples *S;
+    double tol;
+    double *tn;      /* unit normal per soup triangle */
+} ctx;
+
+/* Whether the image (q, nq) lands on the soup within reach with a
+ * compatible normal; *closest gets the nearest point. */
+static int lands(const ctx *C, const double q[3], const double nq[3],
+                 double reach, double closest[3])
+{
+    int64_t tri;
+    double d2 = st_bvh_nearest(C->bvh, q, reach * reach, &tri, closest);
+    (void)d2;
+    if (tri < 0)
+        return 0;
+    return fabs(st_dot3(nq, C->tn + 3 * (size_t)tri)) >= MATCH_COS;
+}
+
+/* The share of every stride-th sample whose image lands on the soup,
+ * among the informative ones: those the map moves by more than the
+ * tolerance, not along their own surface (the displacement at least
+ * INFORM_SIN off the tangent plane). A surface sliding along itself (a
+ * bar's sides under a mirror across the bar, a cylinder turned a little)
+ * lands on itself under any such map and says nothing about it. Fewer
+ * than MIN_INFORM of the samples informative: 0. */
+#define INFORM_SIN 0.25881904510252074 /* sin 15 degrees */
+#define MIN_INFORM 0.1
+static double support_stride(const ctx *C, const st_symmetry *y,
+                             double angle, size_t stride)
+{
+    const samples *S = C->S;
+    long hits = 0, n = 0, all = 0;
+#pragma omp parallel for schedule(static) reduction(+ : hits, n, all)
+    for (size_t k = 0; k < S->n; k += stride) {
+        double q[3], nq[3], c[3], d[3];
+        all++;
+        st_symmetry_apply(y, angle, S->p + 3 * k, 1, q);
+        st_sub3(d, q, S->p + 3 * k);
+        double l = st_norm3(d);
+        if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
+            continue;
+        st_symmetry_apply(y, angle, S->nrm + 3 * k, 0, nq);
+        hits += lands(C, q, nq, C->tol, c);
+        n++;
+    }
+    if ((double)n < MIN_INFORM * (double)all)
+        return 0.0;
+    return (double)hits / (double)n;
+}
+
+static double support(const ctx *C, const st_symmetry *y, double angle)
+{
+    return support_stride(C, y, angle, 1);
+}
+
+/* ---- mirrors -------------------------------------------------------------- */
+
+/* The plane's sign made canonical: the largest component of the normal
+ * positive. */
+static void canon_plane(double n[3], double *off)
+{
+    int m = 0;
+    for (int a = 1; a < 3; a++)
+        if (fabs(n[a]) > fabs(n[m]))
+            m = a;
+    if (n[m] < 0) {
+        for (int a = 0; a < 3; a++)
+            n[a] = -n[a];
+        *off = -*off;
+    }
+}
+
+static st_symmetry mirror_of(const double n[3], double off)
+{
+    st_symmetry y;
+    memset(&y, 0, sizeof y);
+    y.kind = ST_SYMMETRY_MIRROR;
+    for (int a = 0; a < 3; a++) {
+        y.dir[a] = n[a];
+        y.point[a] = off * n[a];
+    }
+    return y;
+}
+
+/* ICP rounds: match each sample's image to the nearest point of the soup,
+ * re-estimate the plane from the pairs. */
+static void refine_mirror(const ctx *C, st_symmetry *y)
+{
+    const samples *S = C->S;
+    double *mid = st_malloc_array(3 * S->n, sizeof *mid);
+    if (!mid)
+        return; /* unrefined: only a weaker support */
+    for (int round = 0; round < REFINE_ROUNDS; round++) {
+        double mean[3] = {0, 0, 0};
+        size_t m = 0;
+        /* sequential: the sums are in sample order, independent of
+         * threads */
+        for (size_t k = 0; k < S->n; k++) {
+            double q[3], nq[3], c[3], d[3];
+            const double *p = S->p + 3 * k;
+            st_symmetry_apply(y, 0.0, p, 1, q);
+            st_sub3(d, q, p);
+            double l = st_norm3(d);
+            if (!(l > C->tol) ||
+                fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
+                continue; /* on the plane, or sliding along it */
+            st_symmetry_apply(y, 0.0, S->nrm + 3 * k, 0, nq);
+            if (!lands(C, q, nq, REFINE_REACH * C->tol, c))
+                continue;
+            for (int x = 0; x < 3; x++) {
+                mid[3 * m + x] = 0.5 * (p[x] + c[x]);
+                mean[x] += mid[3 * m + x];
+            }
+            m++;
+        }
+        if (m < 16)
+            break;
+        for (int x = 0; x < 3; x++)
+            mean[x] /= (double)m;
+        /* the midpoints of matched pairs lie on the plane: its normal is
+         * their direction of least spread */
+        double cov[3][3] = {{0}}, ev[3][3];
+        for (size_t k = 0; k < m; k++) {
+            double d[3];
+            st_sub3(d, mid + 3 * k, mean);
+            for (int x = 0; x < 3; x++)
+                for (int z = 0; z < 3; z++)
+                    cov[x][z] += d[x] * d[z];
+        }
+        eigen3(cov, ev);
+        int least = 0;
+        for (int x = 1; x < 3; x++)
+            if (cov[x][x] < cov[least][least])
+                least = x;
+        double n[3] = {ev[least][0], ev[least][1], ev[least][2]};
+        normalize(n);
+        if (fabs(st_dot3(n, y->dir)) < 0.9)
+            break; /* the fit turned away: keep the plane */
+        double off = st_dot3(n, mean);
+        canon_plane(n, &off);
+        *y = mirror_of(n, off);
+    }
+    free(mid);
+}
+
+static int same_plane(const st_symmetry *a, const st_symmetry *b, double tol)
+{
+    double d = st_dot3(a->dir, b->dir);
+    if (fabs(d) < SAME_COS)
+        return 0;
+    double oa = st_dot3(a->point, a->dir), ob = st_dot3(b->point, a->dir);
+    return fabs(oa - ob) < tol;
+}
+
+/* Candidates by voting: cells over the cube map of the direction and the
+ * offset, the heaviest become planes (the cell's mean). */
+typedef struct vote {
+    uint64_t key;
+    double n[3], off;
+    long count;
+} vote;
+
+static int cmp_vote(const void *x, const void *y)
+{
+    const vote *a = x, *b = y;
+    if (a->count != b->count)
+        return a->count < b->count ? 1 : -1;
+    return (a->key > b->key) - (a->key < b->key);
+}
+
+static uint64_t vote_key(const double n[3], double off, double tol)
+{
+    int m = 0;
+    for (int a = 1; a < 3; a++)
+        if (fabs(n[a]) > fabs(n[m]))
+            m = a;
+    int u = (m + 1) % 3, w = (m + 2) % 3;
+    long iu = (long)floor((n[u] / fabs(n[m]) + 1.0) * 0.5 * VOTE_DIR_BINS);
+    long iw = (long)floor((n[w] / fabs(n[m]) + 1.0) * 0.5 * VOTE_DIR_BINS);
+    long io = (long)floor(off / (2.0 * tol));
+    return ((uint64_t)m << 60) ^ ((uint64_t)(iu & 0xff) << 52) ^
+           ((uint64_t)(iw & 0xff) << 44) ^ ((uint64_t)io & 0xfffffffffffULL);
+}
+
+static size_t vote_mirrors(const ctx *C, st_symmetry *out, size_t max)
+{
+    const samples *S = C->S;
+    size_t cap = 1;
+    while (cap < 2 * (size_t)VOTE_PAIRS)
+        cap *= 2;
+    vote *tab = st_calloc_array(cap, sizeof *tab);
+    if (!tab)
+        return 0;
+    uint64_t h = 0x243f6a8885a308d3ULL;
+    for (long k = 0; k < VOTE_PAIRS; k++) {
+        h = mix64(h + (uint64_t)k);
+        size_t i = (size_t)(h % S->n), j = (size_t)((h >> 32) % S->n);
+        double d[3];
+        st_sub3(d, S->p + 3 * i, S->p + 3 * j);
+        double l = st_norm3(d);
+        if (!(l > 2.0 * C->tol))
+            continue;
+        double n[3] = {d[0] / l, d[1] / l, d[2] / l};
+        const double *ni = S->nrm + 3 * i, *nj = S->nrm + 3 * j;
+        /* two points of one surface that slides along itself (a bar's
+         * side, d in its plane) vote for every plane across it */
+        if (fabs(st_dot3(ni, n)) < INFORM_SIN)
+            continue;
+        double r[3], dn = 2.0 * st_dot3(ni, n);
+        for (int a = 0; a < 3; a++)
+            r[a] = ni[a] - dn * n[a];
+        if (fabs(st_dot3(r, nj)) < VOTE_COS)
+            continue;
+        double mid[3];
+        for (int a = 0; a < 3; a++)
+            mid[a] = 0.5 * (S->p[3 * i + a] + S->p[3 * j + a]);
+        double off = st_dot3(mid, n);
+        canon_plane(n, &off);
+        uint64_t key = vote_key(n, off, C->tol) | 1; /* 0 marks empty */
+        size_t slot = (size_t)(mix64(key) & (cap - 1));
+        while (tab[slot].key != 0 && tab[slot].key != key)
+            slot = (slot + 1) & (cap - 1);
+        tab[slot].key = key;
+        for (int a = 0; a < 3; a++)
+            tab[slot].n[a] += n[a];
+        tab[slot].off += off;
+        tab[slot].count++;
+    }
+    qsort(tab, cap, sizeof *tab, cmp_vote);
+    size_t m = 0;
+    for (size_t i = 0; i < cap && m < max && tab[i].count >= 3; i++) {
+        double n[3] = {tab[i].n[0], tab[i].n[1], tab[i].n[2]};
+        normalize(n);
+        out[m++] = mirror_of(n, tab[i].off / (double)tab[i].count);
+    }
+    free(tab);
+    return m;
+}
+
+/* ---- rotations ------------------------------------------------------------ */
+
+static int same_line(const st_symmetry *a, const st_symmetry *b, double tol)
+{
+    if (fabs(st_dot3(a->dir, b->dir)) < SAME_COS)
+        return 0;
+    double d[3], x[3];
+    st_sub3(d, b->point, a->point);
+    st_cross3(x, d, a->dir);
+    return st_norm3(x) < tol;
+}
+
+/* Order of the axis y: 0 continuous, n >= 2, or -1 none; *sup its
+ * support (the least over the angles tested). Continuous: three turns by
+ * angles that are no simple fraction of a full turn all hold. Order n:
+ * the turn by 360/n degrees and the one by (n/2) times that (near a half
+ * turn: a small turn about any axis near a smooth surface slides it along
+ * itself) both hold; the largest such n. Screened on every SCREEN-th
+ * sample, confirmed on all. */
+#define SCREEN 8
+static int axis_order(const ctx *C, const st_symmetry *y, int max_order,
+                      double min_support, double *sup)
+{
+    static const double odd[3] = {0.3819660112501051, 0.1415926535897932,
+                                  0.7071067811865476};
+    double least = 1.0;
+    for (int i = 0; i < 3 && least >= min_support; i++)
+        least = fmin(least, support_stride(C, y, 2.0 * PI * odd[i], SCREEN));
+    if (least >= min_support) {
+        least = 1.0;
+        for (int i = 0; i < 3 && least >= min_support; i++)
+            least = fmin(least, support(C, y, 2.0 * PI * odd[i]));
+        if (least >= min_support) {
+            *sup = least;
+            return 0;
+        }
+    }
+    for (int n = max_order; n >= 2; n--) {
+        /* every turn up to the half: a small turn alone passes on any
+         * axis that a surface nearly slides along */
+        int k = 1;
+        while (k <= n / 2 &&
+               support_stride(C, y, 2.0 * PI * k / (double)n, SCREEN) >=
+                   min_support)
+            k++;
+        if (k <= n / 2)
+            continue;
+        double a1 = 2.0 * PI / (double)n, a2 = a1 * (double)(n / 2);
+        double s = fmin(support(C, y, a1), support(C, y, a2));
+        if (s >= min_support) {
+            *sup = s;
+            return n;
+        }
+    }
+    return -1;
+}
+
+/* The line where mirror planes a and b meet; 0 when they are parallel. */
+static int meet(const st_symmetry *a, const st_symmetry *b, st_symmetry *line)
+{
+    double u[3];
+    st_cross3(u, a->dir, b->dir);
+    double l = st_norm3(u);
+    if (!(l > 0.05))
+        return 0;
+    for (int x = 0; x < 3; x++)
+        u[x] /= l;
+    /* the point of the line nearest the origin: p = (oa (nb x u) + ob
+     * (u x na)) / (u . (na x nb)) */
+    double oa = st_dot3(a->point, a->dir), ob = st_dot3(b->point, b->dir);
+    double t1[3], t2[3];
+    st_cross3(t1, b->dir, u);
+    st_cross3(t2, u, a->dir);
+    memset(line, 0, sizeof *line);
+    line->kind = ST_SYMMETRY_ROTATION;
+    for (int x = 0; x < 3; x++) {
+        line->point[x] = (oa * t1[x] + ob * t2[x]) / l;
+        line->dir[x] = u[x];
+    }
+    return 1;
+}
+
+/* ---- the whole job -------------------------------------------------------- */
+
+static int cmp_sym(const void *x, const void *y)
+{
+    const st_symmetry *a = x, *b = y;
+    if (a->kind != b->kind)
+        return a->kind < b->kind ? -1 : 1;
+    if (a->support != b->support)
+        return a->support < b->support ? 1 : -1;
+    return 0;
+}
+
+static void keep(st_symmetry_set *out, const st_symmetry *y, double tol)
+{
+    for (size_t i = 0; i < out->n; i++) {
+        st_symmetry *o = out->items + i;
+        if (o->kind != y->kind)
+            continue;
+        int same = y->kind == ST_SYMMETRY_MIRROR ? same_plane(o, y, tol)
+                                                 : same_line(o, y, tol);
+        if (!same)
+            continue;
+        if (y->support > o->support)
+            *o = *y;
+        return;
+    }
+    if (out->n < ST_SYMMETRY_MAX) {
+        out->items[out->n++] = *y;
+        return;
+    }
+    /* full: replace the weakest of the same kind if y is better */
+    size_t w = SIZE_MAX;
+    for (size_t i = 0; i < out->n; i++)
+        if (out->items[i].kind == y->kind &&
+            (w == SIZE_MAX || out->items[i].support < out->items[w].support))
+            w = i;
+    if (w != SIZE_MAX && out->items[w].support < y->support)
+        out->items[w] = *y;
+}
+
+st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
+                             const st_bvh *bvh, const st_symmetry_params *p,
+                             st_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!(p->tolerance > 0.0) || !isfinite(p->tolerance) || p->samples < 16 ||
+        p->max_order < 2 || !(p->min_support > 0.0 && p->min_support <= 1.0))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "symmetry: the tolerance must be positive, at "
+                            "least 16 samples, order >= 2, support in (0, "
+                            "1]");
+    samples S;
+    ctx C = {s, bvh, &S, p->tolerance, NULL};
+    C.tn = st_malloc_array(3 * (s->ntris ? s->ntris : 1), sizeof *C.tn);
+    if (!C.tn || samples_make(&S, s, p->samples)) {
+        free(C.tn);
+        samples_free(&S);
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory for the symmetry samples");
+    }
+    if (S.n == 0) {
+        free(C.tn);
+        samples_free(&S);
+        return ST_OK;
+    }
+    for (size_t t = 0; t < s->ntris; t++) {
+        const uint32_t *v = s->tris + 3 * t;
+        double u[3], w[3];
+        st_sub3(u, s->xyz + 3 * (size_t)v[1], s->xyz + 3 * (size_t)v[0]);
+        st_sub3(w, s->xyz + 3 * (size_t)v[2], s->xyz + 3 * (size_t)v[0]);
+        st_cross3(C.tn + 3 * t, u, w);
+        normalize(C.tn + 3 * t);
+    }
+
+    /* mirrors: principal planes and the votes, refined, measured */
+    st_symmetry cand[3 + VOTE_CANDIDATES];
+    size_t nc = 0;
+    for (int a = 0; a < 3; a++) {
+        double n[3] = {S.axes[a][0], S.axes[a][1], S.axes[a][2]};
+        double off = st_dot3(n, S.c);
+        canon_plane(n, &off);
+        cand[nc++] = mirror_of(n, off);
+    }
+    nc += vote_mirrors(&C, cand + nc, VOTE_CANDIDATES);
+    st_symmetry mirrors[3 + VOTE_CANDIDATES];
+    size_t nm = 0;
+    for (size_t i = 0; i < nc; i++) {
+        refine_mirror(&C, cand + i);
+        cand[i].support = support(&C, cand + i, 0.0);
+        out->candidates++;
+        if (cand[i].support >= p->min_support) {
+            size_t j = 0;
+            while (j < nm && !same_plane(mirrors + j, cand + i, p->tolerance))
+                j++;
+            if (j == nm)
+                mirrors[nm++] = cand[i];
+            else if (cand[i].support > mirrors[j].support)
+                mirrors[j] = cand[i];
+        }
+    }
+    for (size_t i = 0; i < nm; i++)
+        keep(out, mirrors + i, p->tolerance);
+
+    /* rotation axes: where two mirrors meet, and the principal axes */
+    st_symmetry axes[3 + (3 + VOTE_CANDIDATES) * (2 + VOTE_CANDIDATES) / 2];
+    size_t na = 0;
+    /* the best mirrors first; the meets of the best six */
+    qsort(mirrors, nm, sizeof *mirrors, cmp_sym);
+    for (size_t i = 0; i < nm && i < 6; i++)
+        for (size_t j = i + 1; j < nm && j < 6; j++) {
+            st_symmetry l;
+            if (meet(mirrors + i, mirrors + j, &l))
+                axes[na++] = l;
+        }
+    for (int a = 0; a < 3; a++) {
+        st_symmetry l;
+        memset(&l, 0, sizeof l);
+        l.kind = ST_SYMMETRY_ROTATION;
+        for (int x = 0; x < 3; x++) {
+            l.point[x] = S.c[x];
+            l.dir[x] = S.axes[a][x];
+        }
+        axes[na++] = l;
+    }
+    for (size_t i = 0; i < na; i++) {
+        int dup = 0;
+        for (size_t j = 0; j < i && !dup; j++)
+            dup = same_line(axes + j, axes + i, p->tolerance);
+        if (dup)
+            continue;
+        double sup = 0.0;
+        out->candidates++;
+        int order = axis_order(&C, axes + i, p->max_order, p->min_support,
+                               &sup);
+        if (order < 0)
+            continue;
+        axes[i].order = order;
+        axes[i].support = sup;
+        keep(out, axes + i, p->tolerance);
+    }
+    qsort(out->items, out->n, sizeof *out->items, cmp_sym);
+    free(C.tn);
+    samples_free(&S);
+    return ST_OK;
+}

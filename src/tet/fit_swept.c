@@ -1,0 +1,134 @@
+/*
+ * fit_swept.c - the fit invariant's point test for a boundary vertex,
+ * without gathering the star's points (issue 23): only the S vertices in
+ * the region the star's boundary faces sweep can leave the star.
+ *
+ * The claim. Let v be a boundary vertex of a mesh in which no face has
+ * more than two tets (fit_ctx.full_check 0, invariant.h), moving from x
+ * to p, its star positive at both (every tet orient3d < 0; sm_move_ok
+ * tests p, the caller x). R(y) is the closed star with v at y; L its
+ * faces not holding v (the link, which does not move); C(y) the boundary
+ * faces holding v, (y, a, b).
+ * Faces holding v shared by two star tets cancel in the boundary chain (two
+ * positive tets on one face lie on its two sides, so they induce opposite
+ * orientations), so the chain boundary of the star is L + C(y), and at a
+ * point off every face the count of star tets holding it (positive tets)
+ * is the winding number of L + C(y). The chain boundary of C(y) has no
+ * edge holding v (it is minus that of L), so C(x) - C(p) is the boundary
+ * of H = sum over the faces of the tets (x, p, a, b): the two counts differ
+ * only inside the union of those closed tets. A point q of R(x) \ R(p) has
+ * near it points inside a tet of R(x) and off R(p) (which is closed), off
+ * every face: there the counts are >= 1 and 0, so they lie in a tet of H,
+ * and so does q (finitely many closed tets). So every S vertex that leaves
+ * the star lies in some closed (x, p, a, b): testing those S vertices alone
+ * decides "every S vertex of R(x) is in R(p)" as the full list does, and
+ * fails on a point that leaves (the blocker only orders the work).
+ *
+ * The sweep is thin for a small move, so most S vertices near the faces
+ * are rejected by one plane test: q strictly on the other side of the plane
+ * (x, a, b) from p, or of (p, a, b) from x, is not in the closed tet (for a
+ * flat tet, p on the plane: q off it). The plane tests are pred.h's
+ * st_plane_filter (orient3d's determinant with the face's two edge vectors
+ * and their cross products computed once per face, filtered by orient3d's
+ * error bound with a margin); a sign the filter cannot certify rejects
+ * nothing. What passes is decided exactly by
+ * st_point_in_tet and the star tests: no decision is taken in floating
+ * point.
+ */
+#include "fit_swept.h"
+#include "../base/fpenv.h"
+
+#include "souptet/isect.h"
+#include "souptet/pred.h"
+
+#include <math.h>
+#include <stddef.h>
+
+/* Boundary faces of a vertex handled here; a vertex with more (none in a
+ * lattice) takes the gathering path. */
+#define SWEPT_MAX_FACES 48
+/* 1 when q lies in the closed star of v with v at y. */
+static int in_closed_star(const sm_mesh *sm, uint32_t v, const double y[3], const double q[3])
+{
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
+        const uint32_t *c = sm->m->tets + 4 * (size_t)sm->vt[j];
+        const double *t[4];
+        for (int k = 0; k < 4; k++)
+            t[k] = c[k] == v ? y : sm->m->xyz + 3 * (size_t)c[k];
+        if (st_point_in_tet(q, t[0], t[1], t[2], t[3]) != ST_OUTSIDE)
+            return 1;
+    }
+    return 0;
+}
+
+int sm_swept_applies(const sm_mesh *sm, uint32_t v)
+{
+    return sm->vf_off[v + 1] - sm->vf_off[v] <= SWEPT_MAX_FACES;
+}
+
+int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[3],
+                  uint32_t *failed)
+{
+    const size_t nf = sm->vf_off[v + 1] - sm->vf_off[v];
+    if (nf > SWEPT_MAX_FACES)
+        return -1;
+    if (g->npts == 0 || nf == 0)
+        return 1;
+    const double *x = sm->m->xyz + 3 * (size_t)v;
+    st_plane_filter in[SWEPT_MAX_FACES], out[SWEPT_MAX_FACES];
+    double box[SWEPT_MAX_FACES][6];
+    const double *ab[SWEPT_MAX_FACES][2];
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = fmin(x[a], p[a]);
+        hi[a] = fmax(x[a], p[a]);
+    }
+    for (size_t i = 0; i < nf; i++) {
+        const uint32_t *k = sm->bf + 3 * (size_t)sm->vf[sm->vf_off[v] + i];
+        int n = 0;
+        for (int j = 0; j < 3; j++)
+            if (k[j] != v)
+                ab[i][n++] = sm->m->xyz + 3 * (size_t)k[j];
+        if (n != 2)
+            return -1;   /* not a face of v: leave it to the full test */
+        st_plane_filter_init(&in[i], x, ab[i][0], ab[i][1], p);
+        st_plane_filter_init(&out[i], p, ab[i][0], ab[i][1], x);
+        for (int a = 0; a < 3; a++) {
+            box[i][a] = fmin(fmin(x[a], p[a]), fmin(ab[i][0][a], ab[i][1][a]));
+            box[i][3 + a] = fmax(fmax(x[a], p[a]), fmax(ab[i][0][a], ab[i][1][a]));
+            lo[a] = fmin(lo[a], box[i][a]);
+            hi[a] = fmax(hi[a], box[i][3 + a]);
+        }
+    }
+    size_t a0[3], a1[3];
+    for (int a = 0; a < 3; a++) {
+        a0[a] = sm_pgrid_coord(g, lo[a], a);
+        a1[a] = sm_pgrid_coord(g, hi[a], a);
+    }
+    for (size_t iz = a0[2]; iz <= a1[2]; iz++)
+        for (size_t iy = a0[1]; iy <= a1[1]; iy++)
+            for (size_t ix = a0[0]; ix <= a1[0]; ix++) {
+                size_t b = ix + g->n[0] * (iy + g->n[1] * iz);
+                for (size_t j = g->off[b]; j < g->off[b + 1]; j++) {
+                    const double *q = g->bpts + 3 * j;
+                    if (q[0] < lo[0] || q[0] > hi[0] || q[1] < lo[1] || q[1] > hi[1] ||
+                        q[2] < lo[2] || q[2] > hi[2])
+                        continue;
+                    int swept = 0;
+                    for (size_t i = 0; i < nf && !swept; i++) {
+                        const double *bx = box[i];
+                        if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] || q[0] > bx[3] ||
+                            q[1] > bx[4] || q[2] > bx[5])
+                            continue;
+                        if (st_plane_filter_rejects(&in[i], q) || st_plane_filter_rejects(&out[i], q))
+                            continue;
+                        swept = st_point_in_tet(q, x, p, ab[i][0], ab[i][1]) != ST_OUTSIDE;
+                    }
+                    if (swept && in_closed_star(sm, v, x, q) && !in_closed_star(sm, v, p, q)) {
+                        *failed = g->idx[j];
+                        return 0;
+                    }
+                }
+            }
+    return 1;
+}

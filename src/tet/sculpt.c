@@ -1,0 +1,868 @@
+/*
+ * sculpt.c - sculpting a lattice down to the tets that overlap the pseudo
+ * volume or the input triangles, and bomb repair with snowflakes.
+ *
+ * Reference: D. A. Stuart, J. A. Levine, B. Jones, A. W. Bargteil,
+ * "Automatic Construction of Coarse, High-Quality Tetrahedralizations that
+ * Enclose and Approximate Surfaces for Animation", MIG 2013, section 3.2.
+ * See sculpt.h for the contracts.
+ *
+ * Bomb repair, the reasoning.
+ *
+ * (1) A snowflake is the star of a lattice vertex v: every lattice tet
+ * incident to v (24 in the BCC lattice). When v is interior to the lattice
+ * (its star is closed; the padding guarantees it for every vertex of a tet
+ * that meets the box), every face through v is shared by two tets of the
+ * star, so once the whole star is kept, each tet of it has at most one
+ * boundary face: the one opposite v. A complete snowflake holds no bomb.
+ *
+ * (2) The candidates of a bomb are therefore its four vertices: completing
+ * the snowflake of a vertex v of bomb b makes every face of b through v
+ * interior and leaves at most the face opposite v on the boundary. With
+ * boundary faces {p q r} and {p q s}, a snowflake at p or q clears both,
+ * one at r or s clears one of them - either way b is no longer a bomb. And
+ * there is nothing to gain outside them: "the vertices of its boundary
+ * faces" are all four vertices (two faces of a tet cover its four
+ * vertices), and a snowflake around a vertex not in b does not contain b,
+ * so it can only clear b's faces by luck of its neighbours, which the
+ * one-per-bomb search does not rely on. This is the paper's "four choices
+ * per bomb" (its 4^n). A vertex on the lattice's outer layer has an
+ * incomplete star and is no candidate (with the padding it never occurs).
+ *
+ * (3) Adding tets never creates a bomb: a kept tet's boundary faces can only
+ * become interior when neighbours are added, and every added tet belongs to
+ * a now complete snowflake, so it has at most one boundary face by (1). So
+ * one round of repair removes every bomb whose candidates include one
+ * complete star; the loop that recounts and repeats is a safeguard, and
+ * stats->repair_rounds says how many rounds ran.
+ *
+ * (4) The cost of a choice (one candidate vertex per bomb, the paper's
+ * search space of 4^n) is the number of tets its snowflakes add, |union of
+ * (star(v_b) minus kept)|. Two bombs interact when some candidate snowflake
+ * of one and some of the other would add a common tet; otherwise their costs
+ * add up and they can be chosen apart. So bombs are grouped into clusters
+ * (union-find over the tets their candidates would add), and each cluster is
+ * solved by a depth-first branch and bound over its 4^n choices: the greedy
+ * choice first gives the bound; a bomb with a candidate that adds nothing
+ * given the choices above it takes that one (it cannot be worse); others try
+ * their candidates cheapest first and prune at the best cost so far. A
+ * cluster larger than cluster_max bombs, or whose search exceeds
+ * search_budget nodes, keeps the best choice found (never worse than
+ * greedy) and is counted in clusters_greedy.
+ */
+#include "souptet/sculpt.h"
+#include "../base/unionfind.h"
+#include "../base/fpenv.h"
+#include "souptet/isect.h"
+#include "souptet/mem.h"
+#include "souptet/progress.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+st_sculpt_params st_sculpt_params_default(void)
+{
+    st_sculpt_params p;
+    p.kind = ST_LATTICE_BCC;
+    p.h = 1.0;
+    p.seed = 0;
+    p.pad = ST_LATTICE_PAD_DEFAULT;
+    p.max_tets = 0;
+    p.repair_bombs = 1;
+    p.repair_manifold = 1;
+    p.cluster_max = 64;
+    p.search_budget = (size_t)1 << 20;
+    p.cancel = NULL;
+    return p;
+}
+
+/* ---- classification ---- */
+
+typedef struct tri_ctx {
+    const st_soup *s;
+    const double *p[4];
+} tri_ctx;
+
+static int visit_tri(void *ctx, uint32_t tri)
+{
+    const tri_ctx *c = ctx;
+    const uint32_t *v = c->s->tris + 3 * (size_t)tri;
+    const double *a = c->s->xyz + 3 * (size_t)v[0];
+    const double *b = c->s->xyz + 3 * (size_t)v[1];
+    const double *d = c->s->xyz + 3 * (size_t)v[2];
+    return st_tri_tet_intersect(a, b, d, c->p[0], c->p[1], c->p[2], c->p[3]);
+}
+
+static st_status classify(unsigned char *keep, st_sculpt_stats *stats,
+                          const st_lattice *L, const st_grid *g,
+                          const st_soup *s, const st_bvh *bvh,
+                          volatile int *cancel, st_error *err);
+
+st_status st_sculpt_classify(unsigned char *keep, st_sculpt_stats *stats,
+                             const st_lattice *L, const st_grid *g,
+                             const st_soup *s, const st_bvh *bvh,
+                             st_error *err)
+{
+    return classify(keep, stats, L, g, s, bvh, NULL, err);
+}
+
+/* st_sculpt_classify; a set cancel flag leaves the tets not yet classified
+ * (keep 0) and returns ST_ECANCELLED. */
+static st_status classify(unsigned char *keep, st_sculpt_stats *stats,
+                          const st_lattice *L, const st_grid *g,
+                          const st_soup *s, const st_bvh *bvh,
+                          volatile int *cancel, st_error *err)
+{
+    const st_progress stop = {NULL, NULL, cancel};
+    if (g->kind != ST_GRID_SIGNED)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "the field is not signed (run soupsign first)");
+    st_bvh *own = NULL;
+    if (s && s->ntris && !bvh) {
+        st_status st = st_bvh_build(&own, s, err);
+        if (st)
+            return st;
+        bvh = own;
+    }
+    st_voxel_summary *sum = NULL;
+    st_status st = st_voxel_summary_build(&sum, g, err);
+    if (st) {
+        st_bvh_free(own);
+        return st;
+    }
+    size_t nvol = 0, nsurf = 0;
+    long long nt = (long long)L->ntets;
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : nvol, nsurf)
+    for (long long t = 0; t < nt; t++) {
+        if ((t & 255) == 0 && st_progress_cancelled(&stop)) {
+            keep[t] = ST_SCULPT_REMOVED;
+            continue;
+        }
+        const uint32_t *v = L->tets + 4 * (size_t)t;
+        const double *p[4];
+        for (int c = 0; c < 4; c++)
+            p[c] = L->xyz + 3 * (size_t)v[c];
+        size_t m, M;
+        int r = st_tet_voxel_count(g, sum, p[0], p[1], p[2], p[3], 1, &m, &M,
+                                   NULL);
+        int vol = r > 0 || (r == 0 && m > 0);
+        if (!vol && r == 0)
+            for (int c = 0; c < 4 && !vol; c++) {
+                size_t ijk[3];
+                if (st_grid_voxel_of(g, p[c], ijk))
+                    vol = g->data[st_grid_index(g, ijk[0], ijk[1], ijk[2])] < 0.0f;
+            }
+        unsigned char k = ST_SCULPT_REMOVED;
+        if (vol) {
+            k = ST_SCULPT_VOLUME;
+            nvol++;
+        } else if (bvh) {
+            tri_ctx ctx;
+            ctx.s = s;
+            for (int c = 0; c < 4; c++)
+                ctx.p[c] = p[c];
+            if (st_bvh_query_tet(bvh, p, visit_tri, &ctx)) {
+                k = ST_SCULPT_SURFACE;
+                nsurf++;
+            }
+        }
+        keep[t] = k;
+    }
+    st_voxel_summary_free(sum);
+    st_bvh_free(own);
+    if (st_progress_cancelled(&stop))
+        return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+    if (stats) {
+        stats->lattice_tets = L->ntets;
+        stats->kept_volume = nvol;
+        stats->kept_surface = nsurf;
+    }
+    return ST_OK;
+}
+
+/* ---- boundary counts and stars ---- */
+
+static int boundary_faces(const st_lattice *L, const unsigned char *keep,
+                          size_t t)
+{
+    int n = 0;
+    for (int i = 0; i < 4; i++) {
+        int64_t o = L->nbr[4 * t + (size_t)i];
+        n += o < 0 || !keep[o];
+    }
+    return n;
+}
+
+size_t st_sculpt_count_bombs(const st_lattice *L, const unsigned char *keep,
+                             size_t hist[5])
+{
+    size_t h[5] = {0, 0, 0, 0, 0};
+    for (size_t t = 0; t < L->ntets; t++)
+        if (keep[t])
+            h[boundary_faces(L, keep, t)]++;
+    if (hist)
+        memcpy(hist, h, sizeof h);
+    return h[2] + h[3] + h[4];
+}
+
+/* 1 when v's star is closed: every face through v has a tet on both
+ * sides, so the snowflake of v is complete in the lattice. */
+static int star_complete(const st_lattice *L, uint32_t v)
+{
+    for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++) {
+        size_t t = L->star[a];
+        for (int i = 0; i < 4; i++)
+            if (L->tets[4 * t + (size_t)i] != v && L->nbr[4 * t + (size_t)i] < 0)
+                return 0;
+    }
+    return L->star_off[v + 1] > L->star_off[v];
+}
+
+/* Add v's snowflake; returns the number of tets added. */
+static size_t add_star(const st_lattice *L, unsigned char *keep, uint32_t v,
+                       unsigned char why)
+{
+    size_t added = 0;
+    for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++)
+        if (!keep[L->star[a]]) {
+            keep[L->star[a]] = why;
+            added++;
+        }
+    return added;
+}
+
+/* ---- bomb repair ---- */
+
+/* One cluster's search state. Option o of bomb i adds the local tets
+ * opt_tets[opt_off[4i+o] .. opt_off[4i+o+1]). */
+typedef struct search {
+    size_t n;                 /* bombs */
+    int *nopt;                /* options per bomb */
+    size_t *opt_off;          /* 4n + 1 */
+    uint32_t *opt_tets;
+    uint32_t *cnt;            /* per local tet: chosen options covering it */
+    int *sel, *best_sel;
+    size_t cost, best_cost;
+    size_t nodes, budget;
+    int exhausted;
+} search;
+
+static size_t opt_gain(const search *S, size_t i, int o)
+{
+    size_t g = 0;
+    for (size_t a = S->opt_off[4 * i + (size_t)o]; a < S->opt_off[4 * i + (size_t)o + 1]; a++)
+        g += S->cnt[S->opt_tets[a]] == 0;
+    return g;
+}
+
+static void opt_apply(search *S, size_t i, int o, int sign)
+{
+    for (size_t a = S->opt_off[4 * i + (size_t)o]; a < S->opt_off[4 * i + (size_t)o + 1]; a++) {
+        uint32_t u = S->opt_tets[a];
+        if (sign > 0) {
+            if (S->cnt[u]++ == 0)
+                S->cost++;
+        } else if (--S->cnt[u] == 0)
+            S->cost--;
+    }
+}
+
+static void dfs(search *S, size_t i)
+{
+    if (S->cost >= S->best_cost)
+        return;
+    if (i == S->n) {
+        S->best_cost = S->cost;
+        memcpy(S->best_sel, S->sel, S->n * sizeof *S->sel);
+        return;
+    }
+    if (++S->nodes > S->budget) {
+        S->exhausted = 1;
+        return;
+    }
+    size_t gain[4];
+    int order[4], no = S->nopt[i];
+    for (int o = 0; o < no; o++) {
+        gain[o] = opt_gain(S, i, o);
+        order[o] = o;
+        if (gain[o] == 0) {   /* free: dominates every other option */
+            S->sel[i] = o;
+            dfs(S, i + 1);
+            return;
+        }
+    }
+    for (int a = 1; a < no; a++)   /* cheapest first, stable */
+        for (int b = a; b > 0 && gain[order[b]] < gain[order[b - 1]]; b--) {
+            int x = order[b];
+            order[b] = order[b - 1];
+            order[b - 1] = x;
+        }
+    for (int k = 0; k < no && !S->exhausted; k++) {
+        int o = order[k];
+        if (S->cost + gain[o] >= S->best_cost)
+            break;   /* sorted: the rest cost no less */
+        opt_apply(S, i, o, +1);
+        S->sel[i] = o;
+        dfs(S, i + 1);
+        opt_apply(S, i, o, -1);
+    }
+}
+
+/* One repair round's bombs (section (2), (4) above): bomb[b] is the
+ * lattice tet of bomb b, optv[4b .. 4b + nopt[b]) its candidate vertices,
+ * parent[] the union-find of its cluster, and order[coff[r] ..
+ * coff[r + 1]) the bombs of the cluster whose root is r. claim[] (per
+ * lattice tet, -1 between rounds) is the first bomb whose candidates
+ * would add the tet, then a cluster's local tet numbering. */
+typedef struct bomb_round {
+    const st_lattice *L;
+    unsigned char *keep;
+    int64_t *claim;
+    size_t nb;
+    size_t *bomb;
+    uint32_t *optv;
+    int *nopt;
+    size_t *parent, *order, *coff;
+} bomb_round;
+
+/* The bombs, their candidates (the vertices with a complete snowflake),
+ * and their clusters: bombs whose candidates would add a common tet. */
+static void round_candidates(bomb_round *R)
+{
+    const st_lattice *L = R->L;
+    for (size_t t = 0; t < L->ntets; t++)
+        if (R->keep[t] && boundary_faces(L, R->keep, t) >= 2)
+            R->bomb[R->nb++] = t;
+    for (size_t b = 0; b < R->nb; b++) {
+        R->parent[b] = b;
+        R->nopt[b] = 0;
+        for (int c = 0; c < 4; c++) {
+            uint32_t v = L->tets[4 * R->bomb[b] + (size_t)c];
+            if (star_complete(L, v))
+                R->optv[4 * b + (size_t)R->nopt[b]++] = v;
+        }
+    }
+    for (size_t b = 0; b < R->nb; b++)
+        for (int o = 0; o < R->nopt[b]; o++) {
+            uint32_t v = R->optv[4 * b + (size_t)o];
+            for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++) {
+                size_t t = L->star[a];
+                if (R->keep[t])
+                    continue;
+                if (R->claim[t] < 0)
+                    R->claim[t] = (int64_t)b;
+                else
+                    uf_join(R->parent, b, (size_t)R->claim[t]);
+            }
+        }
+}
+
+/* Group bombs by cluster root (roots are the smallest members, so
+ * clusters come in order of their first bomb). */
+static st_status round_group(bomb_round *R, st_error *err)
+{
+    const size_t nb = R->nb;
+    for (size_t b = 0; b < nb; b++)
+        R->coff[uf_find(R->parent, b) + 1]++;
+    for (size_t b = 0; b < nb; b++)
+        R->coff[b + 1] += R->coff[b];
+    size_t *fill = st_malloc_array(nb + 1, sizeof *fill);
+    if (!fill)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    memcpy(fill, R->coff, (nb + 1) * sizeof *fill);
+    for (size_t b = 0; b < nb; b++)
+        R->order[fill[uf_find(R->parent, b)]++] = b;
+    free(fill);
+    return ST_OK;
+}
+
+/* Reset the claims of this round. */
+static void round_reset_claims(bomb_round *R)
+{
+    const st_lattice *L = R->L;
+    for (size_t b = 0; b < R->nb; b++)
+        for (int o = 0; o < R->nopt[b]; o++) {
+            uint32_t v = R->optv[4 * b + (size_t)o];
+            for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++)
+                R->claim[L->star[a]] = -1;
+        }
+}
+
+/* The cluster's options as local tets: claim[] becomes the local index
+ * (-2 - index) at a tet's first sight. */
+static void cluster_options(bomb_round *R, search *S, size_t c0)
+{
+    const st_lattice *L = R->L;
+    size_t nloc = 0, k = 0;
+    for (size_t q = 0; q < S->n; q++) {
+        size_t b = R->order[c0 + q];
+        S->nopt[q] = R->nopt[b];
+        for (int o = 0; o < 4; o++) {
+            S->opt_off[4 * q + (size_t)o] = k;
+            if (o >= R->nopt[b])
+                continue;
+            uint32_t v = R->optv[4 * b + (size_t)o];
+            for (size_t a = L->star_off[v]; a < L->star_off[v + 1]; a++) {
+                size_t t = L->star[a];
+                if (R->keep[t])
+                    continue;
+                if (R->claim[t] >= 0)   /* first sight: number it */
+                    R->claim[t] = -2 - (int64_t)nloc++;
+                S->opt_tets[k++] = (uint32_t)(-2 - R->claim[t]);
+            }
+        }
+    }
+    S->opt_off[4 * S->n] = k;
+}
+
+/* Greedy: each bomb, in order, its cheapest candidate. Leaves the choice
+ * in best_sel and best_cost, nothing applied; returns its cost. */
+static size_t search_greedy(search *S)
+{
+    const size_t n = S->n;
+    for (size_t q = 0; q < n; q++) {
+        int bo = -1;
+        size_t bg = 0;
+        for (int o = 0; o < S->nopt[q]; o++) {
+            size_t g = opt_gain(S, q, o);
+            if (bo < 0 || g < bg) {
+                bo = o;
+                bg = g;
+            }
+        }
+        S->sel[q] = bo < 0 ? 0 : bo;
+        if (bo >= 0)
+            opt_apply(S, q, bo, +1);
+    }
+    S->best_cost = S->cost;
+    memcpy(S->best_sel, S->sel, n * sizeof *S->sel);
+    for (size_t q = 0; q < n; q++)
+        if (S->nopt[q] > 0)
+            opt_apply(S, q, S->sel[q], -1);
+    return S->best_cost;
+}
+
+/* The branch and bound from the greedy choice, for a cluster of at most
+ * cluster_max bombs that all have a candidate: 1 when it searched every
+ * choice within the budget (best_sel is then the cheapest), else 0
+ * (best_sel the best found, never worse than greedy). */
+static int search_exact(search *S, const st_sculpt_params *p)
+{
+    const size_t n = S->n;
+    if (n > p->cluster_max)
+        return 0;
+    int searched = 0;
+    S->budget = p->search_budget;
+    S->best_cost++;   /* let the search reach the greedy cost */
+    size_t greedy_cost = S->best_cost - 1;
+    int *greedy_sel = st_malloc_array(n, sizeof *greedy_sel);
+    if (greedy_sel)
+        memcpy(greedy_sel, S->best_sel, n * sizeof *greedy_sel);
+    int any_empty = 0;
+    for (size_t q = 0; q < n; q++)
+        any_empty |= S->nopt[q] == 0;
+    if (greedy_sel && !any_empty) {
+        dfs(S, 0);
+        searched = !S->exhausted;
+        if (S->best_cost > greedy_cost) {   /* nothing better */
+            S->best_cost = greedy_cost;
+            memcpy(S->best_sel, greedy_sel, n * sizeof *greedy_sel);
+        }
+    } else
+        S->best_cost = greedy_cost;
+    free(greedy_sel);
+    return searched;
+}
+
+/* One cluster, the bombs order[c0 .. c0 + n): its options, the greedy
+ * choice, the search, and the snowflakes of the choice added to keep. */
+static st_status solve_cluster(bomb_round *R, size_t c0, size_t n,
+                               const st_sculpt_params *p, st_sculpt_stats *ss,
+                               st_error *err)
+{
+    const st_lattice *L = R->L;
+    st_status st = ST_OK;
+    search S = {.n = n};
+    S.nopt = st_malloc_array(n, sizeof *S.nopt);
+    S.opt_off = st_calloc_array(4 * n + 1, sizeof *S.opt_off);
+    size_t total = 0;
+    for (size_t q = 0; q < n; q++)
+        for (int o = 0; o < R->nopt[R->order[c0 + q]]; o++) {
+            uint32_t v = R->optv[4 * R->order[c0 + q] + (size_t)o];
+            total += L->star_off[v + 1] - L->star_off[v];
+        }
+    S.opt_tets = st_malloc_array(total + 1, sizeof *S.opt_tets);
+    S.cnt = st_calloc_array(total + 1, sizeof *S.cnt);
+    S.sel = st_calloc_array(n, sizeof *S.sel);
+    S.best_sel = st_calloc_array(n, sizeof *S.best_sel);
+    if (!S.nopt || !S.opt_off || !S.opt_tets || !S.cnt || !S.sel || !S.best_sel) {
+        st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        goto done;
+    }
+    cluster_options(R, &S, c0);
+    ss->greedy_tets += search_greedy(&S);
+    if (search_exact(&S, p))
+        ss->clusters_exact++;
+    else
+        ss->clusters_greedy++;
+    /* Apply the choice. */
+    for (size_t q = 0; q < n; q++) {
+        if (S.nopt[q] == 0)
+            continue;
+        uint32_t v = R->optv[4 * R->order[c0 + q] + (size_t)S.best_sel[q]];
+        size_t added = add_star(L, R->keep, v, ST_SCULPT_BOMB);
+        if (added) {
+            ss->snowflakes++;
+            ss->bomb_tets += added;
+        }
+    }
+done:
+    free(S.nopt);
+    free(S.opt_off);
+    free(S.opt_tets);
+    free(S.cnt);
+    free(S.sel);
+    free(S.best_sel);
+    return st;
+}
+
+/* One round of repair over the nbombs bombs of keep: candidates,
+ * clusters, each cluster solved; the claims reset for the next round. */
+static st_status repair_round(unsigned char *keep, int64_t *claim, size_t nbombs,
+                              const st_lattice *L, const st_sculpt_params *p,
+                              st_sculpt_stats *ss, st_error *err)
+{
+    st_status st = ST_OK;
+    bomb_round R = {.L = L, .keep = keep, .claim = claim};
+    R.bomb = st_malloc_array(nbombs, sizeof *R.bomb);
+    R.optv = st_malloc_array(nbombs, 4 * sizeof *R.optv);
+    R.nopt = st_malloc_array(nbombs, sizeof *R.nopt);
+    R.parent = st_malloc_array(nbombs, sizeof *R.parent);
+    R.order = st_malloc_array(nbombs, sizeof *R.order);
+    R.coff = st_calloc_array(nbombs + 1, sizeof *R.coff);
+    if (!R.bomb || !R.optv || !R.nopt || !R.parent || !R.order || !R.coff) {
+        st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        goto done;
+    }
+    round_candidates(&R);
+    st = round_group(&R, err);
+    for (size_t r = 0; r < R.nb && st == ST_OK; r++) {
+        size_t c0 = R.coff[r], n = R.coff[r + 1] - c0;
+        if (n == 0)
+            continue;
+        ss->clusters++;
+        if (n > ss->largest_cluster)
+            ss->largest_cluster = n;
+        st = solve_cluster(&R, c0, n, p, ss, err);
+    }
+    round_reset_claims(&R);
+done:
+    free(R.bomb);
+    free(R.optv);
+    free(R.nopt);
+    free(R.parent);
+    free(R.order);
+    free(R.coff);
+    return st;
+}
+
+st_status st_sculpt_repair_bombs(unsigned char *keep, st_sculpt_stats *stats,
+                                 const st_lattice *L,
+                                 const st_sculpt_params *p, st_error *err)
+{
+    st_sculpt_stats local;
+    memset(&local, 0, sizeof local);
+    st_sculpt_stats *ss = stats ? stats : &local;
+    size_t hist[5];
+    size_t nbombs = st_sculpt_count_bombs(L, keep, hist);
+    ss->bombs = nbombs;
+    ss->bombs_3faces = hist[3];
+    ss->bombs_4faces = hist[4];
+    ss->clusters = ss->clusters_exact = ss->clusters_greedy = 0;
+    ss->largest_cluster = ss->snowflakes = ss->bomb_tets = 0;
+    ss->greedy_tets = 0;
+    ss->repair_rounds = 0;
+    size_t nt = L->ntets;
+    int64_t *claim = st_malloc_array(nt, sizeof *claim);
+    if (!claim)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    for (size_t t = 0; t < nt; t++)
+        claim[t] = -1;
+    st_status st = ST_OK;
+    for (int round = 0; round < 10 && nbombs; round++) {
+        ss->repair_rounds++;
+        if ((st = repair_round(keep, claim, nbombs, L, p, ss, err)))
+            break;
+        nbombs = st_sculpt_count_bombs(L, keep, NULL);
+    }
+    free(claim);
+    ss->bombs_left = st_sculpt_count_bombs(L, keep, NULL);
+    return st;
+}
+
+/* ---- manifold boundary ---- */
+
+/* The non-manifold boundary vertices (ascending) into *list (may be NULL)
+ * and the counts. */
+static st_status nonmanifold(const st_lattice *L, const unsigned char *keep,
+                             uint32_t **list, size_t *nlist, size_t *nedges,
+                             st_error *err)
+{
+    size_t nv = L->nverts, nt = L->ntets;
+    size_t *off = st_calloc_array(nv + 1, sizeof *off);
+    if (!off)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    size_t nf = 0;
+    for (size_t t = 0; t < nt; t++)
+        if (keep[t])
+            for (int i = 0; i < 4; i++) {
+                int64_t o = L->nbr[4 * t + (size_t)i];
+                if (o >= 0 && keep[o])
+                    continue;
+                nf++;
+                for (int c = 0; c < 4; c++)
+                    if (c != i)
+                        off[L->tets[4 * t + (size_t)c] + 1]++;
+            }
+    for (size_t v = 0; v < nv; v++)
+        off[v + 1] += off[v];
+    /* Per vertex: the two other vertices of each incident boundary face. */
+    uint32_t *link = st_malloc_array(off[nv] + 1, 2 * sizeof *link);
+    size_t *fill = st_malloc_array(nv + 1, sizeof *fill);
+    uint32_t *out = st_malloc_array(nv + 1, sizeof *out);
+    if (!link || !fill || !out) {
+        free(off); free(link); free(fill); free(out);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    memcpy(fill, off, (nv + 1) * sizeof *fill);
+    for (size_t t = 0; t < nt; t++)
+        if (keep[t])
+            for (int i = 0; i < 4; i++) {
+                int64_t o = L->nbr[4 * t + (size_t)i];
+                if (o >= 0 && keep[o])
+                    continue;
+                uint32_t f[3];
+                int k = 0;
+                for (int c = 0; c < 4; c++)
+                    if (c != i)
+                        f[k++] = L->tets[4 * t + (size_t)c];
+                for (int c = 0; c < 3; c++) {
+                    size_t s = fill[f[c]]++;
+                    link[2 * s] = f[(c + 1) % 3];
+                    link[2 * s + 1] = f[(c + 2) % 3];
+                }
+            }
+    size_t nout = 0, ne = 0;
+    for (size_t v = 0; v < nv; v++) {
+        size_t a0 = off[v], a1 = off[v + 1], k = a1 - a0;
+        if (k == 0)
+            continue;
+        /* Local link vertices, their degrees and components. */
+        uint32_t lv[128];
+        int deg[128];
+        size_t par[128];
+        size_t nl = 0;
+        int bad = 0;
+        if (2 * k > 128) {
+            bad = 1;   /* cannot happen on a lattice; be safe */
+        } else {
+            for (size_t a = a0; a < a1; a++)
+                for (int e = 0; e < 2; e++) {
+                    uint32_t w = link[2 * a + (size_t)e];
+                    size_t q = 0;
+                    while (q < nl && lv[q] != w)
+                        q++;
+                    if (q == nl) {
+                        lv[nl] = w;
+                        deg[nl] = 0;
+                        par[nl] = nl;
+                        nl++;
+                    }
+                    deg[q]++;
+                }
+            for (size_t a = a0; a < a1; a++) {
+                size_t qa = 0, qb = 0;
+                while (lv[qa] != link[2 * a])
+                    qa++;
+                while (lv[qb] != link[2 * a + 1])
+                    qb++;
+                uf_join(par, qa, qb);
+            }
+            for (size_t q = 0; q < nl; q++) {
+                if (deg[q] != 2)
+                    bad = 1;
+                if (deg[q] > 2 && v < lv[q])
+                    ne++;
+                if (uf_find(par, q) != 0)
+                    bad = 1;
+            }
+        }
+        if (bad)
+            out[nout++] = (uint32_t)v;
+    }
+    free(off);
+    free(link);
+    free(fill);
+    if (list)
+        *list = out;
+    else
+        free(out);
+    *nlist = nout;
+    if (nedges)
+        *nedges = ne;
+    return ST_OK;
+}
+
+st_status st_sculpt_count_nonmanifold(const st_lattice *L,
+                                      const unsigned char *keep,
+                                      size_t *vertices, size_t *edges,
+                                      st_error *err)
+{
+    return nonmanifold(L, keep, NULL, vertices, edges, err);
+}
+
+st_status st_sculpt_repair_manifold(unsigned char *keep,
+                                    st_sculpt_stats *stats,
+                                    const st_lattice *L, st_error *err)
+{
+    size_t nvtx = 0, nedg = 0, added = 0;
+    uint32_t *list = NULL;
+    st_status st = nonmanifold(L, keep, &list, &nvtx, &nedg, err);
+    if (st)
+        return st;
+    if (stats) {
+        stats->nonmanifold_vertices = nvtx;
+        stats->nonmanifold_edges = nedg;
+    }
+    for (int round = 0; round < ST_SCULPT_MANIFOLD_ROUNDS && nvtx; round++) {
+        size_t fixed = 0;
+        for (size_t q = 0; q < nvtx; q++)
+            if (star_complete(L, list[q])) {
+                added += add_star(L, keep, list[q], ST_SCULPT_MANIFOLD);
+                fixed++;
+            }
+        free(list);
+        list = NULL;
+        st = nonmanifold(L, keep, &list, &nvtx, &nedg, err);
+        if (st)
+            return st;
+        if (!fixed)
+            break;
+    }
+    free(list);
+    if (stats) {
+        stats->manifold_tets = added;
+        stats->nonmanifold_vertices_left = nvtx;
+        stats->nonmanifold_edges_left = nedg;
+    }
+    return ST_OK;
+}
+
+/* ---- all of it ---- */
+
+st_status st_sculpt(st_tetmesh **out, st_sculpt_stats *stats,
+                    const st_grid *g, const st_soup *s, const st_bvh *bvh,
+                    const st_sculpt_params *p, st_error *err)
+{
+    *out = NULL;
+    st_sculpt_stats ss;
+    memset(&ss, 0, sizeof ss);
+    if (g->kind != ST_GRID_SIGNED)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "the field is not signed (run soupsign first)");
+    double t0 = omp_get_wtime();
+    double lo[3], hi[3];
+    st_lattice_grid_box(g, lo, hi);
+    if (s && s->ntris) {
+        /* The lattice must reach every triangle for the enclosure
+         * argument, even one outside the field's box. */
+        double slo[3], shi[3];
+        if (st_soup_bounds(s, slo, shi, NULL) == ST_OK)
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fmin(lo[a], slo[a]);
+                hi[a] = fmax(hi[a], shi[a]);
+            }
+    }
+    st_lattice_params lp = st_lattice_params_default();
+    lp.kind = p->kind;
+    lp.h = p->h;
+    lp.seed = p->seed;
+    lp.pad = p->pad;
+    lp.max_tets = p->max_tets;
+    lp.cancel = p->cancel;
+    st_lattice *L = NULL;
+    st_status st = st_lattice_build(&L, lo, hi, &lp, err);
+    if (st)
+        return st;
+    double t1 = omp_get_wtime();
+    unsigned char *keep = st_malloc_array(L->ntets, 1);
+    if (!keep) {
+        st_lattice_free(L);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    const st_progress stop = {NULL, NULL, p->cancel};
+    st = classify(keep, &ss, L, g, s, bvh, p->cancel, err);
+    double t2 = omp_get_wtime();
+    if (!st && st_progress_cancelled(&stop))
+        st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+    if (!st && p->repair_bombs)
+        st = st_sculpt_repair_bombs(keep, &ss, L, p, err);
+    else if (!st) {
+        size_t hist[5];
+        ss.bombs = ss.bombs_left = st_sculpt_count_bombs(L, keep, hist);
+        ss.bombs_3faces = hist[3];
+        ss.bombs_4faces = hist[4];
+    }
+    if (!st && st_progress_cancelled(&stop))
+        st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+    if (!st && p->repair_manifold)
+        st = st_sculpt_repair_manifold(keep, &ss, L, err);
+    else if (!st) {
+        st = st_sculpt_count_nonmanifold(L, keep, &ss.nonmanifold_vertices,
+                                         &ss.nonmanifold_edges, err);
+        ss.nonmanifold_vertices_left = ss.nonmanifold_vertices;
+        ss.nonmanifold_edges_left = ss.nonmanifold_edges;
+    }
+    /* Manifold repair never creates bombs (sculpt.c, point 3); recount to
+     * report what the caller gets. */
+    if (!st)
+        ss.bombs_left = st_sculpt_count_bombs(L, keep, NULL);
+    double t3 = omp_get_wtime();
+    st_tetmesh *m = NULL;
+    if (!st)
+        st = st_lattice_to_tetmesh(&m, L, keep, err);
+    if (!st) {
+        double *a = NULL;
+        st = st_tetmesh_add_array(m, "sculpt", ST_ON_CELLS, 1, &a, err);
+        if (!st) {
+            size_t k = 0;
+            for (size_t t = 0; t < L->ntets; t++)
+                if (keep[t])
+                    a[k++] = (double)keep[t];
+            char buf[64];
+            snprintf(buf, sizeof buf, "%zu found, %zu left", ss.bombs,
+                     ss.bombs_left);
+            if (st_meta_set(&m->meta, "bombs", buf))
+                st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        }
+    }
+    double t4 = omp_get_wtime();
+    free(keep);
+    st_lattice_free(L);
+    if (st) {
+        st_tetmesh_free(m);
+        return st;
+    }
+    ss.tets = m->ntets;
+    ss.t_lattice = t1 - t0;
+    ss.t_classify = t2 - t1;
+    ss.t_repair = t3 - t2;
+    ss.t_mesh = t4 - t3;
+    if (stats)
+        *stats = ss;
+    *out = m;
+    return ST_OK;
+}
