@@ -1,6 +1,7 @@
 # souptet - one non-recursive GNU Makefile.
 #
-#   make                  library and tools into build/ (build/bin/<tool>)
+#   make                  library, tools, tests, Python module, Blender add-on into build/
+#   make tools            the tools alone (build/bin/<tool>)
 #   make check            install missing Debian packages, build, run all tests
 #   make demo             the main job on the bundled model
 #   make demo-sim         the bundled model's cage in a FEM solve (SfePy)
@@ -107,8 +108,13 @@ IO_LIBS   := -lopenvdb -ltbb -lImath-3_1 \
 TOOL_BIN := $(TOOLS:%=$(BUILD)/bin/%)
 TEST_BIN := $(TESTS_C:%=$(BUILD)/tests/%)
 
-.PHONY: all check test demo demo-sim demo-sim-parts bench setup install uninstall clean fuzz
+.PHONY: all tools check test demo demo-sim demo-sim-parts bench setup install uninstall clean fuzz
 all: $(LIBA) $(LIBSO_CORE) $(LIBSO_IO) $(TOOL_BIN) $(TEST_BIN)
+# Objects stay after a build: make would delete the tools' and tests'
+# objects as intermediates, and the next target would compile them again.
+.SECONDARY:
+# The tools alone (what the demos run): no unit tests, Python or Blender.
+tools: $(TOOL_BIN)
 
 # The library's objects are position-independent (they go into the shared
 # libraries too); the tools' and tests' are not.
@@ -267,15 +273,15 @@ endif
 test: check
 
 demo: setup
-	$(MAKE) --no-print-directory all
+	$(MAKE) --no-print-directory tools
 	scripts/demo $(BUILD)/bin
 
 demo-sim: setup
-	$(MAKE) --no-print-directory all
+	$(MAKE) --no-print-directory tools
 	scripts/simulate $(BUILD)/bin demo
 
 demo-sim-parts: setup
-	$(MAKE) --no-print-directory all
+	$(MAKE) --no-print-directory tools
 	scripts/simulate-parts $(BUILD)/bin demo
 
 bench: setup

@@ -351,6 +351,28 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
     return tool_output_check(t, s->co.out);
 }
 
+/* The pseudo volume's settings the options give (pseudo.h). */
+static st_pseudo_params pseudo_params(const soupsign_settings *s)
+{
+    st_pseudo_params pp = st_pseudo_params_default();
+    pp.sign = s->sign;
+    pp.refine = s->refine;
+    pp.fill_holes = s->fill_holes;
+    pp.symmetry = s->symmetry;
+    if (s->bend_caps >= 0) {     /* chosen: on every soup */
+        pp.holes.bend = s->bend_caps & 1;
+        pp.holes.planes = (s->bend_caps & 2) != 0;
+        pp.holes.intact = 1.0;
+        pp.holes.onesided = 0.0;
+    }
+    pp.closed_shells = s->use_shells;
+    pp.sides = s->use_sides;
+    pp.sides_params.past_caps = s->past_caps;
+    if (!s->columns)
+        pp.sides_params.column_ratio = 0.0;
+    return pp;
+}
+
 static int run(tool_ctx *t, void *settings)
 {
     const soupsign_settings *s = settings;
@@ -386,22 +408,7 @@ static int run(tool_ctx *t, void *settings)
             surface = st_meta_get(&g->meta, "source_path");
         t1 = tool_now();
     }
-    st_pseudo_params pp = st_pseudo_params_default();
-    pp.sign = *p;
-    pp.refine = s->refine;
-    pp.fill_holes = s->fill_holes;
-    pp.symmetry = s->symmetry;
-    if (s->bend_caps >= 0) {     /* chosen: on every soup */
-        pp.holes.bend = s->bend_caps & 1;
-        pp.holes.planes = (s->bend_caps & 2) != 0;
-        pp.holes.intact = 1.0;
-        pp.holes.onesided = 0.0;
-    }
-    pp.closed_shells = s->use_shells;
-    pp.sides = s->use_sides;
-    pp.sides_params.past_caps = s->past_caps;
-    if (!s->columns)
-        pp.sides_params.column_ratio = 0.0;
+    const st_pseudo_params pp = pseudo_params(s);
     st_progress prog = tool_progress(t);
     const double c0 = cpu_now();
     /* -v with the soup: its BVH too, for how much of the boundary is a

@@ -159,4 +159,9 @@ else
     ok 1 "a C compiler for the SIGKILL test's preloaded rename()"
 fi
 
+# The report and the key get the mesh's mode (mktemp's 0600 was kept).
+[ "$(stat -c %a out/cube.json)" = "$(stat -c %a out/cube.vtu)" ] &&
+    [ "$(stat -c %a out/cube.key)" = "$(stat -c %a out/cube.vtu)" ]
+ok $? "the .json and .key have the mesh's mode ($(stat -c %a out/cube.json), $(stat -c %a out/cube.vtu))"
+
 done_testing
