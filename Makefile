@@ -192,7 +192,7 @@ $(LIBSO_CORE): $(CORE_OBJ) $(BUILD)/libsouptet.map
 $(LIBSO_IO): $(IO_OBJ) $(LIBSO_CORE) $(BUILD)/libsouptet-io.map
 	$(CXX) -shared $(LDFLAGS_ALL) $(SO_LDFLAGS) -Wl,-soname,libsouptet-io.so.$(SOVERSION) \
 	  -Wl,--version-script=$(BUILD)/libsouptet-io.map $(IO_OBJ) -L$(BUILD) -lsouptet \
-	  $(IO_LIBS) $(CORE_LIBS) -o $@
+	  -Wl,--as-needed $(IO_LIBS) $(CORE_LIBS) -o $@
 	ln -sf $(notdir $@) $(BUILD)/libsouptet-io.so.$(SOVERSION)
 	ln -sf libsouptet-io.so.$(SOVERSION) $(BUILD)/libsouptet-io.so
 

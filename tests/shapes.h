@@ -99,6 +99,7 @@ static inline void add_sphere(st_soup *s, double r, double z_cut)
     int e;
     if (r != 0.3 && (!(r > 0) || frexp(r, &e) != 0.5)) {
         printf("Bail out! add_sphere: no fixture for radius %.17g\n", r);
+        fflush(stdout);   /* LeakSanitizer's exit does not flush it */
         exit(1);
     }
     st_soup *f = NULL;
@@ -106,6 +107,7 @@ static inline void add_sphere(st_soup *s, double r, double z_cut)
     if (st_soup_read(&f, tap_data(name), &err) != ST_OK || f->nverts != 3 * f->ntris) {
         printf("Bail out! add_sphere: %s: %s\n", tap_data(name),
                f ? "not one vertex triple a triangle" : err.msg);
+        fflush(stdout);   /* LeakSanitizer's exit does not flush it */
         exit(1);
     }
     for (size_t t = 0; t < f->ntris; t++) {
