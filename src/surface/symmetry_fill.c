@@ -333,25 +333,30 @@ static double tri_area(const double q[3][3])
     return 0.5 * st_norm3(n);
 }
 
-/* Append the images m of s's triangles flagged in keep. */
+/* A triangle of its own three vertices, appended to out. */
+static st_status add_tri(st_soup *out, const double q[3][3], st_error *err)
+{
+    const size_t base = out->nverts;
+    st_status rc = ST_OK;
+    for (int k = 0; k < 3 && !rc; k++)
+        rc = st_soup_add_vertex(out, q[k][0], q[k][1], q[k][2], err);
+    return rc ? rc : st_soup_add_triangle(out, (uint32_t)base, (uint32_t)(base + 1),
+                                          (uint32_t)(base + 2), err);
+}
+
+/* Append the images m of s's triangles flagged in keep (counted once the
+ * fill is final: fill_of_covered). */
 static st_status append_images(st_soup *fill, const st_soup *s, const map *m,
-                               const uint8_t *keep, st_symmetry_fill_stats *st, st_error *err)
+                               const uint8_t *keep, st_error *err)
 {
     for (size_t t = 0; t < s->ntris; t++) {
         if (!keep[t])
             continue;
         double q[3][3];
         image(s, t, m, q);
-        const size_t base = fill->nverts;
-        st_status rc = ST_OK;
-        for (int k = 0; k < 3 && !rc; k++)
-            rc = st_soup_add_vertex(fill, q[k][0], q[k][1], q[k][2], err);
-        rc = rc ? rc : st_soup_add_triangle(fill, (uint32_t)base, (uint32_t)(base + 1),
-                                            (uint32_t)(base + 2), err);
+        st_status rc = add_tri(fill, q, err);
         if (rc)
             return rc;
-        st->triangles++;
-        st->area += tri_area(q);
     }
     return ST_OK;
 }
@@ -396,8 +401,6 @@ static st_status fill_of_covered(st_soup **fill, const pieces *P, const st_bvh *
     st_soup *in = *fill, *out = st_soup_new();
     if (!out)
         return ST_ENOMEM;
-    st->triangles = 0;
-    st->area = 0.0;
     for (size_t t = 0; t < in->ntris; t++) {
         double q[3][3], c[3] = {0.0, 0.0, 0.0};
         for (int k = 0; k < 3; k++)
@@ -409,12 +412,7 @@ static st_status fill_of_covered(st_soup **fill, const pieces *P, const st_bvh *
         st_bvh_nearest(caps_bvh, c, INFINITY, &tri, NULL);
         if (tri < 0 || !covered[P->of_tri[tri]])
             continue;
-        const size_t base = out->nverts;
-        st_status rc = ST_OK;
-        for (int k = 0; k < 3 && !rc; k++)
-            rc = st_soup_add_vertex(out, q[k][0], q[k][1], q[k][2], err);
-        rc = rc ? rc : st_soup_add_triangle(out, (uint32_t)base, (uint32_t)(base + 1),
-                                            (uint32_t)(base + 2), err);
+        st_status rc = add_tri(out, q, err);
         if (rc) {
             st_soup_free(out);
             return rc;
@@ -490,7 +488,7 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
         }
         if (!any)
             continue;
-        if ((rc = append_images(fill, s, maps + mi, keep, st, err)))
+        if ((rc = append_images(fill, s, maps + mi, keep, err)))
             goto done;
         st_bvh_free(fill_bvh);
         fill_bvh = NULL;
