@@ -180,16 +180,25 @@ $(LIBA_IO): $(IO_OBJ)
 ifneq ($(filter release debug,$(config)),)
   SO_LDFLAGS := -Wl,--no-undefined
 endif
+# The same for what the links are made with ($(BUILD)/linkflags): a new
+# library or link option relinks the libraries, tools and tests of a built
+# tree, which their objects alone would not.
+TOOL_LINK := -Wl,--as-needed
+LINK_NOW := $(LDFLAGS_ALL) | $(SO_LDFLAGS) | $(CORE_LIBS) | $(IO_LIBS) | $(LIBS) | $(TOOL_LINK)
+ifneq ($(LINK_NOW),$(file < $(BUILD)/linkflags))
+  $(shell mkdir -p $(BUILD))
+  $(file > $(BUILD)/linkflags,$(LINK_NOW))
+endif
 $(BUILD)/libsouptet.map: $(CORE_OBJ) $(IO_OBJ) scripts/exports $(wildcard include/souptet/*.h)
 	scripts/exports SOUPTET_0 $(CORE_OBJ) -- $(IO_OBJ) > $@.tmp && mv $@.tmp $@
 $(BUILD)/libsouptet-io.map: $(IO_OBJ) scripts/exports $(wildcard include/souptet/*.h)
 	scripts/exports SOUPTET_IO_0 $(IO_OBJ) -- > $@.tmp && mv $@.tmp $@
-$(LIBSO_CORE): $(CORE_OBJ) $(BUILD)/libsouptet.map
+$(LIBSO_CORE): $(CORE_OBJ) $(BUILD)/libsouptet.map $(BUILD)/linkflags
 	$(CC) -shared $(LDFLAGS_ALL) $(SO_LDFLAGS) -Wl,-soname,libsouptet.so.$(SOVERSION) \
 	  -Wl,--version-script=$(BUILD)/libsouptet.map $(CORE_OBJ) $(CORE_LIBS) -o $@
 	ln -sf $(notdir $@) $(BUILD)/libsouptet.so.$(SOVERSION)
 	ln -sf libsouptet.so.$(SOVERSION) $(BUILD)/libsouptet.so
-$(LIBSO_IO): $(IO_OBJ) $(LIBSO_CORE) $(BUILD)/libsouptet-io.map
+$(LIBSO_IO): $(IO_OBJ) $(LIBSO_CORE) $(BUILD)/libsouptet-io.map $(BUILD)/linkflags
 	$(CXX) -shared $(LDFLAGS_ALL) $(SO_LDFLAGS) -Wl,-soname,libsouptet-io.so.$(SOVERSION) \
 	  -Wl,--version-script=$(BUILD)/libsouptet-io.map $(IO_OBJ) -L$(BUILD) -lsouptet \
 	  -Wl,--as-needed $(IO_LIBS) $(CORE_LIBS) -o $@
@@ -200,10 +209,10 @@ $(LIBSO_IO): $(IO_OBJ) $(LIBSO_CORE) $(BUILD)/libsouptet-io.map
 # A tool keeps only the libraries it calls (--as-needed): one that reads
 # and writes no field or .vtu input (soupmesh) then loads neither OpenVDB
 # nor VTK, whose relocations cost a process about 60 ms (issue 41).
-$(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(CLI_OBJ) $(LIBA)
+$(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(CLI_OBJ) $(LIBA) $(BUILD)/linkflags
 	@mkdir -p $(dir $@)
-	$(CXX) $(LDFLAGS_ALL) $< $(CLI_OBJ) $(LIBA) -Wl,--as-needed $(LIBS) -o $@
-$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA)
+	$(CXX) $(LDFLAGS_ALL) $< $(CLI_OBJ) $(LIBA) $(TOOL_LINK) $(LIBS) -o $@
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA) $(BUILD)/linkflags
 	@mkdir -p $(dir $@)
 	$(CXX) $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
 

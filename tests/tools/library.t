@@ -151,4 +151,21 @@ if [ -d "$BUILD/python/souptet" ]; then
     ok $? "and PREFIX=/usr/local's place (/usr/local/lib/python3.X/dist-packages) is on Debian's python3 path"
 fi
 
+# The link line is recorded like the compile flags ($(BUILD)/linkflags): a
+# built tree relinks when a library or link option changes, and only then.
+# On a tree of symbolic links to this build (make reads the targets' times
+# through them), with the generated records made afresh and dated old.
+cp -as "$BUILD" "$WORK/lb" 2>/dev/null
+rm -f "$WORK/lb/flags" "$WORK/lb/linkflags" "$WORK/lb/gen/souptet_build.h"
+mk() { env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -C "$ROOT" -q --no-print-directory \
+           config=release BUILD="$WORK/lb" "$WORK/lb/bin/soupinfo" "$@" >/dev/null 2>&1; }
+mk
+touch -d 2000-01-01 "$WORK/lb/flags" "$WORK/lb/linkflags" "$WORK/lb/gen/souptet_build.h"
+mk; up=$?
+mk OMPLIB='-lgomp -ldl'; changed=$?
+[ "$up" = 0 ] && [ "$changed" = 1 ]
+ok $? "soupinfo is up to date with the link line it was made with, and relinks when a library changes (make -q: $up, $changed)"
+grep -q -- '-lgomp -ldl' "$WORK/lb/linkflags"
+ok $? "the new link line is recorded in linkflags"
+
 done_testing
