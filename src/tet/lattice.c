@@ -806,6 +806,24 @@ int st_tet_voxel_count(const st_grid *g, const st_voxel_summary *s,
             size_t i0 = q0[0], i1 = q1[0];
             if (f.ok && !row_span(&f, g, j, k, &i0, &i1))
                 continue;
+            if (stop_at_inside) {
+                /* only whether an inside voxel's centre is in the tet:
+                 * test the inside voxels alone (*M counts the tested
+                 * centres that are in it, a lower bound) */
+                for (size_t i = i0; i <= i1; i++) {
+                    if (!(row[i] < 0.0f))
+                        continue;
+                    double c[3];
+                    st_grid_center(g, i, j, k, c);
+                    ct++;
+                    if (!tet_filter_outside(&f, c)) {
+                        cM++;
+                        cm++;
+                        goto out;
+                    }
+                }
+                continue;
+            }
             /* The row's centres share y and z and their x grows with i,
              * so those in the closed (convex) tet are one run: find its
              * ends with the exact-equivalent test, count what lies
@@ -828,11 +846,7 @@ int st_tet_voxel_count(const st_grid *g, const st_voxel_summary *s,
             }
             cM += ir - il + 1;
             for (size_t i = il; i <= ir; i++)
-                if (row[i] < 0.0f) {
-                    cm++;
-                    if (stop_at_inside)
-                        goto out;
-                }
+                cm += row[i] < 0.0f;
         }
 out:
     *m = cm;

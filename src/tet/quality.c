@@ -104,6 +104,7 @@ typedef struct qual_move {
     const double *x;      /* v's position */
     double s0;            /* the lowest score of v's star as it is */
     int tangent_only;     /* no surface, a boundary vertex: fair_boundary */
+    size_t worst;         /* the star's lowest-scoring tet (from vt_off[v]) */
     double gw[3], ga[3];  /* the worst tet's unit score gradient, and the
                              sum over the tets within QUAL_ACTIVE of it */
     double dx, nrm[3];    /* with S: the distance to it and the unit way
@@ -144,13 +145,17 @@ static void qual_gradients(const fit_ctx *c, qual_move *q)
     const sm_mesh *sm = &c->sm;
     const uint32_t v = q->v;
     const double *x = q->x;
-    double ws = q->s0, e = QUAL_GRAD_EPS * c->h, best = INFINITY;
+    double ws = q->s0, e = QUAL_GRAD_EPS * c->h, best = INFINITY, lowest = INFINITY;
     for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
         const uint32_t *k = sm->m->tets + 4 * (size_t)sm->vt[j];
         const double *p[4];
         for (int i = 0; i < 4; i++)
             p[i] = sm->m->xyz + 3 * (size_t)k[i];
         double sc = sm_tet_score(p[0], p[1], p[2], p[3]);
+        if (sc < lowest) {
+            lowest = sc;
+            q->worst = j - sm->vt_off[v];
+        }
         if (sc > ws + QUAL_ACTIVE)
             continue;
         double g[3];
@@ -276,8 +281,12 @@ static int qual_take(const fit_ctx *c, qual_move *q, star_pts *sp, size_t *rejec
     const uint32_t v = q->v;
     if (q->nc == 0)
         return 0;
+    /* a candidate at or below the gain's threshold is never tried, and
+     * any score there sorts it after those that are: the worst tet as it
+     * is, scored first, turns most of them away after one tet */
+    const double thr = q->s0 + QUAL_MIN_GAIN;
     for (int i = 0; i < q->nc; i++) {
-        q->cand[i][0] = sm_star_score(sm, v, q->cand[i] + 1);
+        q->cand[i][0] = sm_star_score_above(sm, v, q->cand[i] + 1, q->worst, thr);
         q->cand[i][4] = i;
     }
     qsort(q->cand, (size_t)q->nc, sizeof q->cand[0], cmp_cand);
@@ -317,6 +326,7 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
     if (q.tangent_only && !c->fair_boundary)
         return 0;
     q.s0 = sm_star_score(sm, v, q.x);
+    q.worst = SIZE_MAX;   /* none: qual_gradients finds it */
     q.nc = 0;
     q.dx = 0.0;
     for (int a = 0; a < 3; a++)
