@@ -346,9 +346,12 @@ static void face_of(const fit_ctx *c, uint32_t v, size_t j, const double p[3], f
  * its bounding box: a face is about h across and S triangles are much
  * smaller, so its box holds hundreds of triangles and the face a few.
  * Most refusals (two in three of the bunny's fit) come from the triangle
- * that refused v's last move: it is tried alone first (the answer is the
- * same, whichever triangle says it). */
-static int faces_clear(const fit_ctx *c, uint32_t v, const double p[3])
+ * that refused v's last move: tblocker_clear tries it alone first, before
+ * the points' test too (the answer is the same, whichever test and
+ * triangle say it). */
+/* 0 when the triangle that last refused v (tblocker) newly meets a
+ * boundary face of v's star with v at p: faces_clear would refuse too. */
+static int tblocker_clear(const fit_ctx *c, uint32_t v, const double p[3])
 {
     const sm_mesh *sm = &c->sm;
     face_query q;
@@ -359,6 +362,14 @@ static int faces_clear(const fit_ctx *c, uint32_t v, const double p[3])
             if (face_visit(&q, tb))
                 return 0;
         }
+    return 1;
+}
+
+/* faces_clear's BVH walks (after tblocker_clear passed). */
+static int faces_clear(const fit_ctx *c, uint32_t v, const double p[3])
+{
+    const sm_mesh *sm = &c->sm;
+    face_query q;
     for (size_t j = sm->vf_off[v]; j < sm->vf_off[v + 1]; j++) {
         face_of(c, v, j, p, &q);
         if (st_bvh_query_tri(c->bvh, q.f[0], q.f[1], q.f[2], face_visit, &q)) {
@@ -424,6 +435,8 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
         if (in_star(&c->sm, v, p, q, -1) < 0 && in_star(&c->sm, v, x, q, -1) >= 0)
             return 0;
     }
+    if (c->s && c->sm.onb[v] && !tblocker_clear(c, v, p))
+        return 0;
     if (!sp->have)
         star_pts_fill(c, sp, 1);
     uint32_t failed;

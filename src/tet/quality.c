@@ -271,6 +271,20 @@ static void qual_axis_steps(const fit_ctx *c, qual_move *q)
             }
 }
 
+/* 1 when candidate p of a boundary vertex is surely within dmax of S:
+ * the distance q->dx at x plus the way to p (the triangle inequality),
+ * with room for the rounding of both distances (far more than it), is
+ * within it. Otherwise the distance decides (qual_take). */
+static int near_enough(const fit_ctx *c, const qual_move *q, const double p[3], double dmax)
+{
+    double w[3] = {p[0] - q->x[0], p[1] - q->x[1], p[2] - q->x[2]};
+    double mag = 0.0;
+    for (int a = 0; a < 3; a++)
+        mag = fmax(mag, fmax(fabs(p[a]), fabs(q->x[a])));
+    double slack = 1e-9 * (c->h + dmax + mag);
+    return q->dx + sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) <= dmax - slack;
+}
+
 /* The candidates by score, best first; the first that raises the star's
  * lowest score by QUAL_MIN_GAIN, keeps a boundary vertex within
  * max(d_offset, its distance) of S and keeps the invariant is taken.
@@ -298,7 +312,7 @@ static int qual_take(const fit_ctx *c, qual_move *q, star_pts *sp, size_t *rejec
         if (!(q->cand[i][0] > q->s0 + QUAL_MIN_GAIN))
             break;
         const double *p = q->cand[i] + 1;
-        if (sm->onb[v] && c->s) {
+        if (sm->onb[v] && c->s && !near_enough(c, q, p, dmax)) {
             int64_t tri;
             double d2 = sm_nearest_d2(c, p, dmax * dmax, &tri, NULL);
             if (tri < 0 || sqrt(d2) > dmax)
