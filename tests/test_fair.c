@@ -223,7 +223,7 @@ static void test_star_score_is_min(void)
     /* windows of the tet list as stars: single tets (each kind alone),
      * a few, exactly a block, past a block, all */
     static const int lens[] = {1, 1, 2, 3, 4, 5, 9, 64, 65, 130, NT};
-    int same = 1, tested = 0, finite_lo = 0;
+    int same = 1, tested = 0, finite_lo = 0, above_ok = 1, above_below = 0;
     for (size_t k = 0; k < sizeof lens / sizeof lens[0]; k++) {
         for (int trial = 0; trial < NTRIAL; trial++) {
             int len = lens[k], start = (int)(rnd() * (NT - len + 1));
@@ -243,11 +243,28 @@ static void test_star_score_is_min(void)
             double got = sm_star_score(&sm, 0, p);
             if (memcmp(&got, &want, sizeof got) != 0)
                 same = 0;
+            /* sm_star_score_above: the score itself above the threshold,
+             * at most the threshold otherwise; thresholds at the score,
+             * an ulp either side, anywhere, and outside (0, 60) */
+            double thr[6] = {want, nextafter(want, -INFINITY), nextafter(want, INFINITY),
+                             60.0 * rnd(), want + 0.5 * (rnd() - 0.5), 90.0};
+            for (int i = 0; i < 6; i++) {
+                size_t first = (size_t)(rnd() * (len + 1));   /* len: none */
+                double a = sm_star_score_above(&sm, 0, p, first, thr[i]);
+                if (want > thr[i] ? memcmp(&a, &want, sizeof a) != 0
+                                  : !(a <= thr[i] && a >= want))
+                    above_ok = 0;
+                above_below += !(want > thr[i]);
+            }
             tested++;
             finite_lo += want > 0.0 && want < 60.0;
         }
     }
     sm.vt = vt;
+    TAP_CHECK(above_ok && above_below > tested && above_below < 5 * tested,
+              "the star score above a threshold is the score, or at most the threshold "
+              "and at least the score (%d of %d thresholds at or above the score)",
+              above_below, 6 * tested);
     TAP_CHECK(same && finite_lo > tested / 8,
               "the star score is the minimum of the tet scores, bit for bit (%d stars, %d "
               "with a non-zero score)", tested, finite_lo);

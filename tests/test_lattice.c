@@ -238,6 +238,62 @@ static st_grid *sphere_grid(double r, size_t n)
     return signed_grid(n, 1.5, sphere_sdf, r);
 }
 
+/* st_tet_voxel_count counts the ends of each row's run and what lies
+ * between, and with stop_at_inside tests only inside voxels: the counts
+ * must be those of a test of every centre (st_point_in_tet), and the stop
+ * must say whether one inside centre is in the tet, for tets of a rotated
+ * lattice over a sphere's field, with and without the summary. */
+static void test_voxel_count_brute(void)
+{
+    st_grid *g = sphere_grid(1.0, 24);
+    double lo[3], hi[3];
+    st_lattice_grid_box(g, lo, hi);
+    st_lattice *L = g ? make(ST_LATTICE_BCC, st_lattice_h_for_cells(lo, hi, 5), 7, 1, lo, hi)
+                      : NULL;
+    st_voxel_summary *sum = NULL;
+    st_error err;
+    int ok = L && st_voxel_summary_build(&sum, g, &err) == ST_OK;
+    size_t counted = 0, mixed = 0, bad = 0;
+    for (size_t t = 0; ok && t < L->ntets; t++) {
+        const double *p0 = P(L, t, 0), *p1 = P(L, t, 1), *p2 = P(L, t, 2), *p3 = P(L, t, 3);
+        size_t wm = 0, wM = 0, b0[3], b1[3], n[3] = {g->nx, g->ny, g->nz};
+        for (int a = 0; a < 3; a++) {   /* the tet's box and a voxel more */
+            double l = fmin(fmin(p0[a], p1[a]), fmin(p2[a], p3[a]));
+            double u = fmax(fmax(p0[a], p1[a]), fmax(p2[a], p3[a]));
+            double f0 = floor((l - g->origin[a]) / g->voxel) - 1;
+            double f1 = ceil((u - g->origin[a]) / g->voxel) + 1;
+            b0[a] = f0 < 0 ? 0 : (size_t)f0;
+            b1[a] = f1 < 0 ? 0 : (f1 > (double)n[a] - 1 ? n[a] - 1 : (size_t)f1);
+        }
+        for (size_t k = b0[2]; k <= b1[2]; k++)
+            for (size_t j = b0[1]; j <= b1[1]; j++)
+                for (size_t i = b0[0]; i <= b1[0]; i++) {
+                    double c[3];
+                    st_grid_center(g, i, j, k, c);
+                    if (st_point_in_tet(c, p0, p1, p2, p3) == ST_OUTSIDE)
+                        continue;
+                    wM++;
+                    wm += g->data[st_grid_index(g, i, j, k)] < 0.0f;
+                }
+        size_t m, M;
+        /* -1 without counting: the tet's box is off the grid */
+        int r = st_tet_voxel_count(g, NULL, p0, p1, p2, p3, 0, &m, &M, NULL);
+        bad += r < 0 ? wM > 0 : (r != 0 || m != wm || M != wM);
+        r = st_tet_voxel_count(g, NULL, p0, p1, p2, p3, 1, &m, &M, NULL);
+        bad += r < 0 ? wM > 0 : (r != 0 || (m > 0) != (wm > 0) || M > wM);
+        r = st_tet_voxel_count(g, sum, p0, p1, p2, p3, 1, &m, &M, NULL);
+        bad += r > 0 ? wm == 0 : (r < 0 ? wm > 0 : (m > 0) != (wm > 0));
+        counted++;
+        mixed += wm > 0 && wm < wM;
+    }
+    TAP_CHECK(ok && bad == 0 && mixed > 10,
+              "voxel counts equal a test of every centre (%zu tets, %zu across the surface, "
+              "%zu wrong)", counted, mixed, bad);
+    st_voxel_summary_free(sum);
+    st_lattice_free(L);
+    st_grid_free(g);
+}
+
 static void test_density(void)
 {
     const double r = 1.0, vs = 4.0 / 3.0 * M_PI;
@@ -332,6 +388,6 @@ static void test_bad(void)
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(cubic5), TAP_TEST(bcc), TAP_TEST(seeded),
-                                     TAP_TEST(density), TAP_TEST(bad), {0}};
+                                     TAP_TEST(density), TAP_TEST(voxel_count_brute), TAP_TEST(bad), {0}};
     return tap_main(argc, argv, tests);
 }

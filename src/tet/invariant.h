@@ -49,6 +49,8 @@ typedef struct fit_ctx {
                             taken (3 each; NaN: not yet) */
     uint32_t *blocker;   /* per vertex: the S vertex that last stopped its
                             move (a point grid index), or UINT32_MAX */
+    uint32_t *tblocker;  /* per vertex: the S triangle that a boundary face
+                            of its star last newly met, or UINT32_MAX */
     double h, d_offset;
     int full_check;   /* non-conforming faces: test S vertices everywhere */
     int cube_steps;      /* the quality pass also tries the 26 cube

@@ -213,10 +213,12 @@ static st_status build_topology(st_lattice *L, const st_progress *stop, st_error
     L->star_off = st_calloc_array(nv + 1, sizeof *L->star_off);
     L->star = st_malloc_array(nf, sizeof *L->star);
     size_t *fill = st_malloc_array(nv + 1, sizeof *fill);
-    if (!off || !slot || !L->nbr || !L->star_off || !L->star || !fill) {
+    uint64_t *key = st_malloc_array(nf ? nf : 1, sizeof *key);
+    if (!off || !slot || !L->nbr || !L->star_off || !L->star || !fill || !key) {
         free(off);
         free(slot);
         free(fill);
+        free(key);
         return st_error_set(err, ST_ENOMEM, NULL, 0,
                             "out of memory for the lattice's adjacency");
     }
@@ -257,6 +259,13 @@ static st_status build_topology(st_lattice *L, const st_progress *stop, st_error
             L->star[fill[L->tets[4 * t + (size_t)i]]++] = (uint32_t)t;
     for (size_t f = 0; f < nf; f++)
         L->nbr[f] = -1;
+    /* Each bucket's faces by their two larger ids, (s1, s2) as one key,
+     * computed once: the pairs of a bucket compare keys. */
+    for (size_t a = 0; a < nf; a++) {
+        uint32_t sa[3];
+        FACE_SORTED((size_t)(slot[a] / 4), (int)(slot[a] % 4), sa);
+        key[a] = (uint64_t)sa[1] << 32 | sa[2];
+    }
     st_status st = ST_OK;
     for (size_t v = 0; v < nv && st == ST_OK; v++) {
         if ((v & 4095) == 0 && st_progress_cancelled(stop)) {
@@ -264,16 +273,8 @@ static st_status build_topology(st_lattice *L, const st_progress *stop, st_error
             break;
         }
         for (size_t a = off[v]; a < off[v + 1]; a++) {
-            uint32_t sa[3];
-            size_t ta = (size_t)(slot[a] / 4);
-            int ia = (int)(slot[a] % 4);
-            FACE_SORTED(ta, ia, sa);
             for (size_t b = a + 1; b < off[v + 1]; b++) {
-                uint32_t sb[3];
-                size_t tb = (size_t)(slot[b] / 4);
-                int ib = (int)(slot[b] % 4);
-                FACE_SORTED(tb, ib, sb);
-                if (sa[1] != sb[1] || sa[2] != sb[2])
+                if (key[a] != key[b])
                     continue;
                 if (L->nbr[slot[a]] >= 0 || L->nbr[slot[b]] >= 0) {
                     st = st_error_set(err, ST_EINTERNAL, NULL, 0,
@@ -281,8 +282,8 @@ static st_status build_topology(st_lattice *L, const st_progress *stop, st_error
                                       "two tets");
                     break;
                 }
-                L->nbr[slot[a]] = (int64_t)tb;
-                L->nbr[slot[b]] = (int64_t)ta;
+                L->nbr[slot[a]] = (int64_t)(slot[b] / 4);
+                L->nbr[slot[b]] = (int64_t)(slot[a] / 4);
             }
         }
     }
@@ -290,6 +291,7 @@ static st_status build_topology(st_lattice *L, const st_progress *stop, st_error
     free(off);
     free(slot);
     free(fill);
+    free(key);
     return st;
 }
 
@@ -622,12 +624,17 @@ void st_voxel_summary_free(st_voxel_summary *s)
  * it, but the bound must hold for every finite input). */
 #define TET_FILTER_ERR (16.0 * 0x1.0p-53)
 #define TET_FILTER_ABS 0x1.0p-960
+/* row_span's slope limit and margin (see there) */
+#define TET_ROW_SLOPE 1024.0
+#define TET_ROW_MARGIN 1.0
 
 typedef struct tet_filter {
     const double *p[4];
     double a[4][3], n[4][3], m[4][3];
     double s[4];     /* +1/-1: the inside side of each face */
     int ok;          /* 0: use the exact test for every point */
+    int row[4];      /* row_span: -1 / +1 the face bounds x below / above,
+                      * 0 it is too near parallel to x to use */
 } tet_filter;
 
 static void tet_filter_init(tet_filter *f, const double *p0, const double *p1,
@@ -666,6 +673,14 @@ static void tet_filter_init(tet_filter *f, const double *p0, const double *p1,
         else
             f->ok = 0;   /* flat or nearly: leave it to the exact test */
     }
+    for (int i = 0; i < 4 && f->ok; i++) {
+        const double *n = f->n[i], *m = f->m[i];
+        double big = fmax(fmax(fmax(fabs(n[0]), fabs(n[1])), fabs(n[2])),
+                          fmax(fmax(m[0], m[1]), m[2]));
+        f->row[i] = 0;
+        if (fabs(n[0]) * TET_ROW_SLOPE >= big)
+            f->row[i] = f->s[i] * n[0] > 0 ? -1 : 1;
+    }
 }
 
 static int tet_filter_outside(const tet_filter *f, const double c[3])
@@ -702,9 +717,6 @@ static int tet_filter_outside(const tet_filter *f, const double c[3])
  * TET_ROW_MARGIN voxels loses no centre that the exact test would accept:
  * this only skips points, every counted point still passes the filtered
  * exact test. Returns 0 when the span is empty. */
-#define TET_ROW_SLOPE 1024.0
-#define TET_ROW_MARGIN 1.0
-
 static int row_span(const tet_filter *f, const st_grid *g, size_t j, size_t k,
                     size_t *i0, size_t *i1)
 {
@@ -712,16 +724,15 @@ static int row_span(const tet_filter *f, const st_grid *g, size_t j, size_t k,
     double z = g->origin[2] + g->voxel * (double)k;
     double xl = -INFINITY, xr = INFINITY;
     for (int i = 0; i < 4; i++) {
-        const double *n = f->n[i], *m = f->m[i], *a = f->a[i];
-        double big = fmax(fmax(fmax(fabs(n[0]), fabs(n[1])), fabs(n[2])),
-                          fmax(fmax(m[0], m[1]), m[2]));
-        if (!(fabs(n[0]) * TET_ROW_SLOPE >= big))
+        if (!f->row[i])
             continue;
+        const double *n = f->n[i], *a = f->a[i];
         double x = a[0] - (n[1] * (y - a[1]) + n[2] * (z - a[2])) / n[0];
-        if (f->s[i] * n[0] > 0)
-            xl = fmax(xl, x);   /* inside where x >= x* */
+        /* fmax / fmin without the calls: a NaN root bounds nothing */
+        if (f->row[i] < 0)
+            xl = x > xl ? x : xl;   /* inside where x >= x* */
         else
-            xr = fmin(xr, x);
+            xr = x < xr ? x : xr;
     }
     double lo = floor((xl - g->origin[0]) / g->voxel - TET_ROW_MARGIN);
     double hi = ceil((xr - g->origin[0]) / g->voxel + TET_ROW_MARGIN);
@@ -795,19 +806,47 @@ int st_tet_voxel_count(const st_grid *g, const st_voxel_summary *s,
             size_t i0 = q0[0], i1 = q1[0];
             if (f.ok && !row_span(&f, g, j, k, &i0, &i1))
                 continue;
-            for (size_t i = i0; i <= i1; i++) {
-                double c[3];
-                st_grid_center(g, i, j, k, c);
-                ct++;
-                if (tet_filter_outside(&f, c))
-                    continue;
-                cM++;
-                if (row[i] < 0.0f) {
-                    cm++;
-                    if (stop_at_inside)
+            if (stop_at_inside) {
+                /* only whether an inside voxel's centre is in the tet:
+                 * test the inside voxels alone (*M counts the tested
+                 * centres that are in it, a lower bound) */
+                for (size_t i = i0; i <= i1; i++) {
+                    if (!(row[i] < 0.0f))
+                        continue;
+                    double c[3];
+                    st_grid_center(g, i, j, k, c);
+                    ct++;
+                    if (!tet_filter_outside(&f, c)) {
+                        cM++;
+                        cm++;
                         goto out;
+                    }
                 }
+                continue;
             }
+            /* The row's centres share y and z and their x grows with i,
+             * so those in the closed (convex) tet are one run: find its
+             * ends with the exact-equivalent test, count what lies
+             * between without testing it. */
+            double c[3];
+            size_t il = i0, ir = i1;
+            for (; il <= i1; il++) {
+                st_grid_center(g, il, j, k, c);
+                ct++;
+                if (!tet_filter_outside(&f, c))
+                    break;
+            }
+            if (il > i1)
+                continue;
+            for (; ir > il; ir--) {
+                st_grid_center(g, ir, j, k, c);
+                ct++;
+                if (!tet_filter_outside(&f, c))
+                    break;
+            }
+            cM += ir - il + 1;
+            for (size_t i = il; i <= ir; i++)
+                cm += row[i] < 0.0f;
         }
 out:
     *m = cm;

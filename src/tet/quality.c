@@ -104,6 +104,7 @@ typedef struct qual_move {
     const double *x;      /* v's position */
     double s0;            /* the lowest score of v's star as it is */
     int tangent_only;     /* no surface, a boundary vertex: fair_boundary */
+    size_t worst;         /* the star's lowest-scoring tet (from vt_off[v]) */
     double gw[3], ga[3];  /* the worst tet's unit score gradient, and the
                              sum over the tets within QUAL_ACTIVE of it */
     double dx, nrm[3];    /* with S: the distance to it and the unit way
@@ -144,13 +145,17 @@ static void qual_gradients(const fit_ctx *c, qual_move *q)
     const sm_mesh *sm = &c->sm;
     const uint32_t v = q->v;
     const double *x = q->x;
-    double ws = q->s0, e = QUAL_GRAD_EPS * c->h, best = INFINITY;
+    double ws = q->s0, e = QUAL_GRAD_EPS * c->h, best = INFINITY, lowest = INFINITY;
     for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
         const uint32_t *k = sm->m->tets + 4 * (size_t)sm->vt[j];
         const double *p[4];
         for (int i = 0; i < 4; i++)
             p[i] = sm->m->xyz + 3 * (size_t)k[i];
         double sc = sm_tet_score(p[0], p[1], p[2], p[3]);
+        if (sc < lowest) {
+            lowest = sc;
+            q->worst = j - sm->vt_off[v];
+        }
         if (sc > ws + QUAL_ACTIVE)
             continue;
         double g[3];
@@ -266,6 +271,20 @@ static void qual_axis_steps(const fit_ctx *c, qual_move *q)
             }
 }
 
+/* 1 when candidate p of a boundary vertex is surely within dmax of S:
+ * the distance q->dx at x plus the way to p (the triangle inequality),
+ * with room for the rounding of both distances (far more than it), is
+ * within it. Otherwise the distance decides (qual_take). */
+static int near_enough(const fit_ctx *c, const qual_move *q, const double p[3], double dmax)
+{
+    double w[3] = {p[0] - q->x[0], p[1] - q->x[1], p[2] - q->x[2]};
+    double mag = 0.0;
+    for (int a = 0; a < 3; a++)
+        mag = fmax(mag, fmax(fabs(p[a]), fabs(q->x[a])));
+    double slack = 1e-9 * (c->h + dmax + mag);
+    return q->dx + sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) <= dmax - slack;
+}
+
 /* The candidates by score, best first; the first that raises the star's
  * lowest score by QUAL_MIN_GAIN, keeps a boundary vertex within
  * max(d_offset, its distance) of S and keeps the invariant is taken.
@@ -276,8 +295,12 @@ static int qual_take(const fit_ctx *c, qual_move *q, star_pts *sp, size_t *rejec
     const uint32_t v = q->v;
     if (q->nc == 0)
         return 0;
+    /* a candidate at or below the gain's threshold is never tried, and
+     * any score there sorts it after those that are: the worst tet as it
+     * is, scored first, turns most of them away after one tet */
+    const double thr = q->s0 + QUAL_MIN_GAIN;
     for (int i = 0; i < q->nc; i++) {
-        q->cand[i][0] = sm_star_score(sm, v, q->cand[i] + 1);
+        q->cand[i][0] = sm_star_score_above(sm, v, q->cand[i] + 1, q->worst, thr);
         q->cand[i][4] = i;
     }
     qsort(q->cand, (size_t)q->nc, sizeof q->cand[0], cmp_cand);
@@ -289,7 +312,7 @@ static int qual_take(const fit_ctx *c, qual_move *q, star_pts *sp, size_t *rejec
         if (!(q->cand[i][0] > q->s0 + QUAL_MIN_GAIN))
             break;
         const double *p = q->cand[i] + 1;
-        if (sm->onb[v] && c->s) {
+        if (sm->onb[v] && c->s && !near_enough(c, q, p, dmax)) {
             int64_t tri;
             double d2 = sm_nearest_d2(c, p, dmax * dmax, &tri, NULL);
             if (tri < 0 || sqrt(d2) > dmax)
@@ -317,6 +340,7 @@ static int quality_vertex(const fit_ctx *c, uint32_t v, star_pts *sp, size_t *re
     if (q.tangent_only && !c->fair_boundary)
         return 0;
     q.s0 = sm_star_score(sm, v, q.x);
+    q.worst = SIZE_MAX;   /* none: qual_gradients finds it */
     q.nc = 0;
     q.dx = 0.0;
     for (int a = 0; a < 3; a++)

@@ -373,8 +373,16 @@ double sm_tet_score(const double *a, const double *b, const double *c,
  * for the tets whose ratio is near the extreme one. The per-tet choice of
  * the extreme edge is sm_tet_score's, so the result is sm_tet_score's
  * minimum bit for bit. */
+/* A threshold for star_block_score: a tet whose ratios come near the
+ * angles where its score is thr (rlo >= lo, rhi <= hi) is scored exactly
+ * at once, and at or below thr ends the block (*below). */
+typedef struct score_cut {
+    double thr, lo, hi;
+    int *below;
+} score_cut;
+
 static double star_block_score(const sm_mesh *sm, uint32_t v, const double p[3],
-                               size_t j0, size_t j1)
+                               size_t j0, size_t j1, const score_cut *cut)
 {
     double ylo[SM_STAR_BLOCK], xlo[SM_STAR_BLOCK], yhi[SM_STAR_BLOCK], xhi[SM_STAR_BLOCK];
     double rlo[SM_STAR_BLOCK], rhi[SM_STAR_BLOCK];
@@ -385,12 +393,26 @@ static double star_block_score(const sm_mesh *sm, uint32_t v, const double p[3],
         star_corners(sm, sm->vt[j], v, p, q);
         if (!tet_extremes(q[0], q[1], q[2], q[3], ylo + n, xlo + n, yhi + n, xhi + n)) {
             double x = degenerate_score(q[0], q[1], q[2], q[3]);
+            if (cut && x <= cut->thr) {
+                *cut->below = 1;
+                return x;
+            }
             if (x < s)
                 s = x;
             continue;
         }
         rlo[n] = xlo[n] / ylo[n];
         rhi[n] = xhi[n] / yhi[n];
+        if (cut && (!(rlo[n] < cut->lo) || !(rhi[n] > cut->hi))) {
+            /* sm_tet_score's value for this tet, bit for bit */
+            double a = atan2(ylo[n], xlo[n]) * SM_RAD2DEG;
+            double b = ST_FIT_MAX_WEIGHT * (180.0 - atan2(yhi[n], xhi[n]) * SM_RAD2DEG);
+            double x = a < b ? a : b;
+            if (x <= cut->thr) {
+                *cut->below = 1;
+                return x;
+            }
+        }
         if (rlo[n] > rlo_max)
             rlo_max = rlo[n];
         if (rhi[n] < rhi_min)
@@ -427,7 +449,44 @@ double sm_star_score(const sm_mesh *sm, uint32_t v, const double p[3])
     double s = INFINITY;
     for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j += SM_STAR_BLOCK) {
         size_t j1 = j + SM_STAR_BLOCK < sm->vt_off[v + 1] ? j + SM_STAR_BLOCK : sm->vt_off[v + 1];
-        double x = star_block_score(sm, v, p, j, j1);
+        double x = star_block_score(sm, v, p, j, j1, NULL);
+        if (x < s)
+            s = x;
+    }
+    return s;
+}
+
+double sm_star_score_above(const sm_mesh *sm, uint32_t v, const double p[3], size_t first,
+                           double thr)
+{
+    size_t n = sm->vt_off[v + 1] - sm->vt_off[v];
+    if (first < n) {
+        const double *q[4];
+        star_corners(sm, sm->vt[sm->vt_off[v] + first], v, p, q);
+        double s = sm_tet_score(q[0], q[1], q[2], q[3]);
+        if (s <= thr)
+            return s;   /* a tet of the star's minimum: at most thr too */
+    }
+    /* The ratios r = x / y at the angles where a tet's score is thr: its
+     * min dihedral is at most thr where r >= cot(thr), its max at least
+     * 180 - thr / W where r <= cot(that); loosened by far more than the
+     * rounding, since the exact score decides (outside (0, 60) degrees,
+     * every tet is scored exactly). */
+    int below = 0;
+    score_cut cut = {thr, -INFINITY, INFINITY, &below};
+    if (thr > 0.0 && thr < 60.0) {
+        const double r = 3.14159265358979323846 / 180.0;
+        double a = thr * r, b = (180.0 - thr / ST_FIT_MAX_WEIGHT) * r;
+        double ca = cos(a) / sin(a), cb = cos(b) / sin(b);
+        cut.lo = ca - 1e-6 * (1.0 + fabs(ca));
+        cut.hi = cb + 1e-6 * (1.0 + fabs(cb));
+    }
+    double s = INFINITY;
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j += SM_STAR_BLOCK) {
+        size_t j1 = j + SM_STAR_BLOCK < sm->vt_off[v + 1] ? j + SM_STAR_BLOCK : sm->vt_off[v + 1];
+        double x = star_block_score(sm, v, p, j, j1, &cut);
+        if (below)
+            return x;
         if (x < s)
             s = x;
     }

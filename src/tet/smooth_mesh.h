@@ -67,6 +67,12 @@ double sm_tet_score(const double *a, const double *b, const double *c,
                     const double *d);
 /* The lowest tet score of v's star with v at p. */
 double sm_star_score(const sm_mesh *sm, uint32_t v, const double p[3]);
+/* sm_star_score when that is above thr; otherwise a value at most thr (the
+ * score of the star's tet `first`, its index from vt_off[v], tried alone
+ * first: the star's minimum is sm_tet_score's per tet, bit for bit, so a
+ * tet at or below thr puts the star there). */
+double sm_star_score_above(const sm_mesh *sm, uint32_t v, const double p[3], size_t first,
+                           double thr);
 
 /* Min and max dihedral over all tets (parallel, deterministic). */
 void sm_dihedral_range(const st_tetmesh *m, double *mind, double *maxd);
