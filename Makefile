@@ -217,7 +217,7 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA) $(BUILD)/linkflags
 	$(CXX) $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
 
 # Peers for make bench (not installed).
-BENCH_BIN := $(BUILD)/bench/vdb_udf $(BUILD)/bench/stream26 $(BUILD)/bench/iou \
+BENCH_BIN := $(BUILD)/bench/vdb_udf $(BUILD)/bench/vdb_dist $(BUILD)/bench/stream26 $(BUILD)/bench/iou \
              $(BUILD)/bench/alpha_wrap $(BUILD)/bench/cgal_mesh3 $(BUILD)/bench/gwn
 # CGAL's exact kernels need GMP and MPFR; its headers want -frounding-math.
 $(BUILD)/bench/alpha_wrap $(BUILD)/bench/cgal_mesh3: LIBS += -lgmp -lmpfr
@@ -226,6 +226,11 @@ $(BUILD)/bench/alpha_wrap $(BUILD)/bench/cgal_mesh3: CXXFLAGS_ALL += -frounding-
 # in make bench, needs libexpat1-dev): make build/bench/vtkxml_expat
 $(BUILD)/bench/vtkxml_expat: LIBS += -lexpat
 $(BUILD)/bench/vtkxml_expat: CFLAGS_ALL += -Isrc
+# soupdist's job through OpenVDB as a whole process: its start links what it
+# uses (--as-needed, as the tools), no VTK.
+$(BUILD)/bench/vdb_dist: bench/vdb_dist.cpp $(LIBA)
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) $< $(LIBA) -Wl,--as-needed $(LIBS) -o $@
 $(BUILD)/bench/%: bench/%.cpp $(LIBA)
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@

@@ -7,7 +7,9 @@
  * boundary vertex within max(d_offset, where the fit left it) of S while
  * it frees the vertices held at the band's edge; peeling keeps the
  * enclosure and a manifold boundary, never lowers the lowest score and
- * spares the tets that overlapped the pseudo volume. */
+ * spares the tets that overlapped the pseudo volume; the swept-region
+ * test (fit_swept.c, which skips whole bins) answers as a brute-force scan
+ * of every S vertex. */
 #include "souptet/bvh.h"
 #include "souptet/enclose.h"
 #include "souptet/isect.h"
@@ -19,6 +21,8 @@
 #include "cubetets.h"
 #include "shapes.h"
 #include "tap.h"
+#include "../src/tet/fit_swept.h"
+#include "../src/tet/pgrid.h"
 #include "../src/tet/smooth_mesh.h"
 
 #include <math.h>
@@ -696,11 +700,103 @@ static void test_fill(void)
     st_soup_free(down);
 }
 
+/* 1 when q lies in the closed star of v with v at y (brute force). */
+static int brute_in_star(const sm_mesh *sm, uint32_t v, const double y[3], const double q[3])
+{
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
+        const uint32_t *c = sm->m->tets + 4 * (size_t)sm->vt[j];
+        const double *t[4];
+        for (int k = 0; k < 4; k++)
+            t[k] = c[k] == v ? y : sm->m->xyz + 3 * (size_t)c[k];
+        if (st_point_in_tet(q, t[0], t[1], t[2], t[3]) != ST_OUTSIDE)
+            return 1;
+    }
+    return 0;
+}
+
+/* sm_swept_kept against every S vertex: a dense cloud of tiny triangles
+ * in the shell the boundary stars cover (many points per bin, so whole
+ * bins are skipped and kept), moves of every size from a hair to a third
+ * of a cell, in and out. The answer must be the brute force's, and a
+ * failed point one that leaves. */
+static void test_swept(void)
+{
+    const double h = 0.5;
+    st_tetmesh *m = ball_mesh(h, 1.6);
+    st_soup *s = st_soup_new();
+    uint64_t seed = 12345;
+    for (int i = 0; i < 3000; i++) {
+        double c[3], a[3], b[3], d[3];
+        double r2;
+        do {
+            for (int k = 0; k < 3; k++) {
+                seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+                c[k] = -1.9 + 3.8 * (double)(seed >> 11) / 9007199254740992.0;
+            }
+            r2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        } while (r2 < 0.8 * 0.8 || r2 > 1.75 * 1.75);
+        for (int k = 0; k < 3; k++) {
+            a[k] = c[k];
+            b[k] = c[k] + (k == 0 ? 1e-3 : 0.0);
+            d[k] = c[k] + (k == 1 ? 1e-3 : 0.0);
+        }
+        add_tri(s, a, b, d, 0);
+    }
+    sm_mesh sm;
+    pgrid g;
+    st_error err;
+    TAP_CHECK(sm_mesh_build(&sm, m, &err) == ST_OK && sm_pgrid_build(&g, s, h / 4.0) == ST_OK,
+              "mesh incidence and point grid");
+    size_t tried = 0, kept = 0, left = 0, wrong = 0, bad_failed = 0;
+    static const double scale[] = {1e-6, 1e-3, 0.02, 0.1, 0.35};
+    for (uint32_t v = 0; v < sm.nv; v++) {
+        const double *x = m->xyz + 3 * (size_t)v;
+        if (!sm.onb[v] || !sm_swept_applies(&sm, v) || !sm_star_positive(&sm, v, x))
+            continue;
+        for (int t = (int)(v % 5); t < (int)(v % 5) + 2; t++) {
+            double p[3];
+            for (int k = 0; k < 3; k++) {
+                seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+                p[k] = x[k] + scale[t % 5] * h * (2.0 * (double)(seed >> 11) / 9007199254740992.0 - 1.0);
+            }
+            if (!sm_star_positive(&sm, v, p))
+                continue;
+            uint32_t failed = UINT32_MAX;
+            int r = sm_swept_kept(&sm, &g, v, p, &failed);
+            int leaves_none = 1;
+            for (size_t i = 0; i < g.npts && leaves_none; i++) {
+                const double *q = g.pts + 3 * i;
+                if (brute_in_star(&sm, v, x, q) && !brute_in_star(&sm, v, p, q))
+                    leaves_none = 0;
+            }
+            tried++;
+            kept += r == 1;
+            left += r == 0;
+            wrong += r != leaves_none;
+            if (r == 0) {
+                const double *q = failed < g.npts ? g.pts + 3 * (size_t)failed : NULL;
+                bad_failed += !q || !brute_in_star(&sm, v, x, q) || brute_in_star(&sm, v, p, q);
+            }
+        }
+    }
+    TAP_CHECK(tried > 200 && kept > 10 && left > 10,
+              "%zu moves of boundary vertices over %zu S vertices: %zu keep, %zu lose a point",
+              tried, g.npts, kept, left);
+    TAP_CHECK(wrong == 0, "the swept test answers as the brute force every time (%zu differ)",
+              wrong);
+    TAP_CHECK(bad_failed == 0, "every failed point named is one that leaves (%zu not)", bad_failed);
+    sm_pgrid_free(&g);
+    sm_mesh_free(&sm);
+    st_tetmesh_free(m);
+    st_soup_free(s);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads),
                                      TAP_TEST(not_enclosing), TAP_TEST(refusals),
                                      TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
-                                     TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), {0}};
+                                     TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill),
+                                     TAP_TEST(swept), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -34,6 +34,17 @@
  * nothing. What passes is decided exactly by
  * st_point_in_tet and the star tests: no decision is taken in floating
  * point.
+ *
+ * Whole bins first. On a large soup a star's box holds hundreds of
+ * thousands of S vertices and the sweep, a few thin slivers, meets few of
+ * its bins. A bin's points lie in a box (the bin's extent widened against
+ * rounding, cut to the scan's box); a face whose box
+ * misses it, or whose plane filter rejects all eight of its corners,
+ * rejects every point in it (the plane's determinant is affine in q, so a
+ * sign the filter certifies at the corners holds inside), and a bin no
+ * face keeps is skipped. Only points every face would have rejected are
+ * skipped, in the same order: the answer and the failed point are the
+ * per-point scan's.
  */
 #include "fit_swept.h"
 #include "../base/fpenv.h"
@@ -59,6 +70,61 @@ static int in_closed_star(const sm_mesh *sm, uint32_t v, const double y[3], cons
             return 1;
     }
     return 0;
+}
+
+/* 1 when the filter certifies every point of the box lo..hi strictly on
+ * the side that rejects (st_plane_filter_rejects at all eight corners:
+ * with r off the plane a rejected corner is on the side opposite r, so all
+ * are on one side; with r on it, corners could straddle it, and nothing is
+ * claimed). */
+static int box_rejected(const st_plane_filter *pl, const double lo[3], const double hi[3])
+{
+    if (pl->side == 0)
+        return 0;
+    for (int c = 0; c < 8; c++) {
+        const double q[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
+        if (!st_plane_filter_rejects(pl, q))
+            return 0;
+    }
+    return 1;
+}
+
+/* The extent of bin i along axis a holding every point the grid puts
+ * there, cut to lo..hi: the bin widened by m = 1e-10 of the grid's
+ * coordinates (sm_pgrid_coord's rounding is a few units of 2^-53 of them),
+ * the end bins open (clamped coordinates). 0 when m is not small beside a
+ * bin (then nothing is skipped). */
+static int bin_extent(const pgrid *g, size_t i, int a, double lo, double hi, double out[2])
+{
+    double m = 1e-10 * (fabs(g->lo[a]) + (double)g->n[a] * g->cell);
+    if (!(m < 0.01 * g->cell))
+        return 0;
+    double b0 = i == 0 ? -INFINITY : g->lo[a] + (double)i * g->cell - m;
+    double b1 = i + 1 >= g->n[a] ? INFINITY : g->lo[a] + (double)(i + 1) * g->cell + m;
+    out[0] = fmax(b0, lo);
+    out[1] = fmin(b1, hi);
+    return 1;
+}
+
+/* The faces (bits) that may hold a point of the bin box blo..bhi; 0 when
+ * none can (or the box is empty). */
+static uint64_t bin_faces(size_t nf, const double (*box)[6], const st_plane_filter *in,
+                          const st_plane_filter *out, const double blo[3], const double bhi[3])
+{
+    uint64_t keep = 0;
+    for (int a = 0; a < 3; a++)
+        if (blo[a] > bhi[a])
+            return 0;
+    for (size_t i = 0; i < nf; i++) {
+        const double *bx = box[i];
+        if (bhi[0] < bx[0] || bhi[1] < bx[1] || bhi[2] < bx[2] || blo[0] > bx[3] ||
+            blo[1] > bx[4] || blo[2] > bx[5])
+            continue;
+        if (box_rejected(&in[i], blo, bhi) || box_rejected(&out[i], blo, bhi))
+            continue;
+        keep |= (uint64_t)1 << i;
+    }
+    return keep;
 }
 
 int sm_swept_applies(const sm_mesh *sm, uint32_t v)
@@ -105,17 +171,30 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
         a0[a] = sm_pgrid_coord(g, lo[a], a);
         a1[a] = sm_pgrid_coord(g, hi[a], a);
     }
+    const uint64_t all = ((uint64_t)1 << nf) - 1;   /* nf <= SWEPT_MAX_FACES < 64 */
+    double ez[2], ey[2], ex[2];
     for (size_t iz = a0[2]; iz <= a1[2]; iz++)
         for (size_t iy = a0[1]; iy <= a1[1]; iy++)
             for (size_t ix = a0[0]; ix <= a1[0]; ix++) {
                 size_t b = ix + g->n[0] * (iy + g->n[1] * iz);
-                for (size_t j = g->off[b]; j < g->off[b + 1]; j++) {
+                if (g->off[b] == g->off[b + 1])
+                    continue;
+                uint64_t keep = all;
+                if (bin_extent(g, ix, 0, lo[0], hi[0], ex) &&
+                    bin_extent(g, iy, 1, lo[1], hi[1], ey) &&
+                    bin_extent(g, iz, 2, lo[2], hi[2], ez)) {
+                    const double blo[3] = {ex[0], ey[0], ez[0]}, bhi[3] = {ex[1], ey[1], ez[1]};
+                    keep = bin_faces(nf, (const double(*)[6])box, in, out, blo, bhi);
+                }
+                for (size_t j = g->off[b]; keep && j < g->off[b + 1]; j++) {
                     const double *q = g->bpts + 3 * j;
                     if (q[0] < lo[0] || q[0] > hi[0] || q[1] < lo[1] || q[1] > hi[1] ||
                         q[2] < lo[2] || q[2] > hi[2])
                         continue;
                     int swept = 0;
                     for (size_t i = 0; i < nf && !swept; i++) {
+                        if (!(keep >> i & 1))
+                            continue;
                         const double *bx = box[i];
                         if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] || q[0] > bx[3] ||
                             q[1] > bx[4] || q[2] > bx[5])
