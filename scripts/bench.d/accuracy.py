@@ -287,6 +287,8 @@ def symmetry_markdown(rows):
         md.append("| %s | %d | %.4f (%.4f) | %.4f (%.4f) | %s | %s | %s | %s |" % (
             dmg, len(sub), mo[0], mo[1], mn[0], mn[1], target, met(mo), met(mn),
             "; ".join(lower) or "none"))
+    fmt = lambda v: "-" if v is None else "%.4f" % v
+    behind = {}
     md += ["", "#### Per input, beside the winding number (same samples)", "",
            "Core IoU at every 4th voxel center (bench/gwn: the generalized winding number of"
            " the oriented damaged soup at 1/2), for the damages where its holes are large"
@@ -294,8 +296,6 @@ def symmetry_markdown(rows):
            " pipe's, off and on (the issue: it stays behind on every symmetric input).", "",
            "| model | damage | pipe off | pipe on | winding number | pipe off (its samples)"
            " | pipe on (its samples) | winding number behind |", "|---|---|--:|--:|--:|--:|--:|---|"]
-    fmt = lambda v: "-" if v is None else "%.4f" % v
-    behind = {}
     for r in rows:
         if r["damage"] not in ("symholes", "largeholes"):
             continue
