@@ -883,7 +883,7 @@ def symmetry_fill(bench, build, pm, tools, work, cells_of):
         return [], "\n### Symmetry (issue 37)\n\nNot measured: soupmesh or tetstat not built.\n"
     t0 = time.time()
     rows = []
-    out = os.path.join(work, "sym.vtu")
+    out = os.path.join(work, "sym-%d.vtu" % os.getpid())   # two runs at once must not share it
     for model, (clean, damaged) in symmetry_inputs(bench).items():
         cells = cells_of.get(model)
         if cells is None:   # as the main table: one retry from 10 for ~1500 tets
@@ -917,6 +917,8 @@ def symmetry_fill(bench, build, pm, tools, work, cells_of):
             _log("symmetry %s %s: inside %s / %s, volume ratio %s / %s" % (
                 model, dmg, _pct(_inside_frac(row["off"])), _pct(_inside_frac(row["on"])),
                 _f(row["off"].get("volume_ratio"), "%.3f"), _f(row["on"].get("volume_ratio"), "%.3f")))
+    if os.path.exists(out):
+        os.remove(out)
     return rows, symmetry_markdown(rows, time.time() - t0)
 
 
