@@ -1,7 +1,14 @@
 """Stage "accuracy": IoU of soupsign's pseudo volume against the undamaged
 solid, per rule (SIGN_RULES), on every model and damage of the damaged
 corpus; the generalized winding number peer (bench/gwn) where the damage
-kept the orientation; the core IoU targets of issue 17.
+kept the orientation; the core IoU targets of issue 17; and (issue 37)
+the plain pipe with --symmetry off and on, per damage and on the
+symmetric parts with large holes (symholes), beside the winding number.
+
+SOUPTET_BENCH_DAMAGES="symholes largeholes holes": only these damages
+("closed": the clean models), a quicker look. SOUPTET_BENCH_SYMMETRY_ONLY=1:
+only default+refine and the pipe off and on (no full field), for the
+symmetry tables alone.
 """
 import json
 import os
@@ -53,13 +60,27 @@ SIGN_RULES = [
     # The pipe: soupsign finds the soup soupdist recorded in the field (no
     # --surface); its signs must be default+refine's, byte for byte.
     ("pipe", "band", []),
+    # Issue 37: the pipe with the symmetric fill off and on, each said
+    # explicitly (whatever the default is).
+    ("pipe, symmetry off", "band", ["--symmetry", "off"]),
+    ("pipe, symmetry on", "band", ["--symmetry", "on"]),
 ]
+SYM_LABELS = ("pipe, symmetry off", "pipe, symmetry on")
+# Issue 37's targets for the core IoU of the pipe: mean and worst per
+# damage (symholes: the symmetric parts with large holes), and every input
+# at least this for these damages.
+SYM_TARGETS = {"symholes": (0.95, 0.92), "largeholes": (0.95, 0.90)}
+SYM_EVERY = {"holes": 0.97, "deleted50": 0.97}
+ONLY_DAMAGES = os.environ.get("SOUPTET_BENCH_DAMAGES", "").replace(",", " ").split()
 DEFAULT_LABEL = "default"
 REFINE_LABEL = "default+refine"
 # The peer that reads orientation (bench/gwn: the generalized winding
 # number of the damaged soup at 1/2, every 4th voxel) where the damage kept
 # the faces' orientation.
-GWN_DAMAGES = ("deleted50", "holes", "interpenetrating", "largeholes", "onesided")
+GWN_DAMAGES = ("deleted50", "holes", "interpenetrating", "largeholes", "onesided", "symholes")
+if os.environ.get("SOUPTET_BENCH_SYMMETRY_ONLY") == "1":
+    SIGN_RULES = [r for r in SIGN_RULES if r[0] in (REFINE_LABEL,) + SYM_LABELS]
+    GWN_DAMAGES = ("largeholes", "symholes")    # the per-input symmetry table's
 TARGETS = {"closed": 0.99, "soup": 0.99, "flipped": 0.99, "interpenetrating": 0.97,
            "deleted50": 0.95, "holes": 0.95, "largeholes": 0.95, "onesided": 0.90}
 # Issue 17: the core IoU (voxels within a voxel of the true boundary left
@@ -81,6 +102,8 @@ def stage_accuracy(build):
                 "truth": [m["file"]]} for m in man["models"]]
     entries += [{"model": d["model"], "damage": d["damage"], "file": d["file"],
                  "truth": d["ground_truth"]["files"]} for d in man["damaged"]]
+    if ONLY_DAMAGES:
+        entries = [e for e in entries if e["damage"] in ONLY_DAMAGES]
     # A directory of this run's own: two runs at once must not share files.
     tmp = os.path.join(bench.RESULTS, "tmp", "accuracy-%d" % os.getpid())
     os.makedirs(tmp, exist_ok=True)
@@ -90,8 +113,9 @@ def stage_accuracy(build):
         src = os.path.join(damaged, e["file"])
         fields = {"band": os.path.join(tmp, "acc-band.vdb"), "full": os.path.join(tmp, "acc-full.vdb")}
         ok = bench.run([os.path.join(bins, "soupdist"), "-r", "128", "-o", fields["band"], src]).returncode == 0
-        ok = ok and bench.run([os.path.join(bins, "soupdist"), "-r", "128", "--band", "full",
-                         "-o", fields["full"], src]).returncode == 0
+        if any(kind == "full" for _, kind, _ in SIGN_RULES):
+            ok = ok and bench.run([os.path.join(bins, "soupdist"), "-r", "128", "--band", "full",
+                                   "-o", fields["full"], src]).returncode == 0
         if not ok:
             sys.stderr.write("bench: soupdist failed on %s\n" % src)
             continue
@@ -112,14 +136,20 @@ def stage_accuracy(build):
             if f and f in res:
                 row["rules"][label] = {k: res[f][k] for k in ("iou", "precision", "recall",
                                                               "core_iou")}
-        refined = signed[[l for l, _, _ in SIGN_RULES].index(REFINE_LABEL)]
+        at = lambda l: signed[[x for x, _, _ in SIGN_RULES].index(l)]
+        refined = at(REFINE_LABEL)
+        sym = [at(l) for l in SYM_LABELS]
         if e["damage"] in GWN_DAMAGES and refined:
-            r = bench.run([os.path.join(build, "bench", "gwn")] + truth + ["--", src, "--", refined])
+            # The pipe off and on, at the winding number's samples too.
+            fields = [refined] + (sym if all(sym) else [])
+            r = bench.run([os.path.join(build, "bench", "gwn")] + truth + ["--", src, "--"] + fields)
             res = [json.loads(l) for l in r.stdout.splitlines() if l.strip()]
-            if r.returncode == 0 and len(res) == 2:
+            if r.returncode == 0 and len(res) == 1 + len(fields):
                 row["gwn"] = {"peer": res[0]["iou"], "refined": res[1]["iou"],
                               "peer_core": res[0].get("core_iou"),
                               "refined_core": res[1].get("core_iou")}
+                for l, x in zip(SYM_LABELS, res[2:]):
+                    row["gwn"][l] = {"iou": x["iou"], "core": x.get("core_iou")}
             else:
                 sys.stderr.write("bench: gwn failed on %s: %s\n" % (src, r.stderr[-500:]))
         rows.append(row)
@@ -212,10 +242,78 @@ def stage_accuracy(build):
         md.append("")
         md.append("%s, core IoU: default+refine ahead of the winding number on %d of %d%s." % (
             dmg, n - len(lost), n, "; not on " + ", ".join(lost) if lost else ""))
+    md += symmetry_markdown(rows)
     for f in os.listdir(tmp):
         os.remove(os.path.join(tmp, f))
     os.rmdir(tmp)
     return rows, "\n".join(md) + "\n"
+
+
+def _mean_worst(v):
+    return (sum(v) / len(v), min(v)) if v else None
+
+
+def symmetry_markdown(rows):
+    """Issue 37: core IoU of the plain pipe, --symmetry off and on, by
+    damage against the issue's targets; per input of the symmetric class
+    (and of largeholes), beside the winding number at its samples."""
+    off, on = SYM_LABELS
+    core = lambda r, l: r["rules"][l]["core_iou"] if l in r["rules"] else None
+    md = ["", "### Symmetry (issue 37): the pipe, `--symmetry off` and `on`", "",
+          "Core IoU at 128 voxels of `soupdist | soupsign --symmetry off|on` (the field"
+          " carries its soup: soupsign caps its holes, and with `on` fills them from the"
+          " soup's own mirror planes and rotation axes). By damage: mean (worst) over its"
+          " inputs, the issue's target, and the inputs whose core IoU `on` is lower than"
+          " `off` (to 3 digits). *symholes*: the symmetric parts with large holes"
+          " (scripts/damage-corpus, scripts/corpus_symmetry.py).", "",
+          "| damage | inputs | off: mean (worst) | on: mean (worst) | target | met off | met on"
+          " | lower with on |", "|---|--:|---|---|---|---|---|---|"]
+    for dmg in sorted(set(r["damage"] for r in rows)):
+        sub = [r for r in rows if r["damage"] == dmg and core(r, off) is not None
+               and core(r, on) is not None]
+        if not sub:
+            continue
+        mo, mn = _mean_worst([core(r, off) for r in sub]), _mean_worst([core(r, on) for r in sub])
+        if dmg in SYM_TARGETS:
+            t = SYM_TARGETS[dmg]
+            target, met = "%.2f (%.2f)" % t, lambda m: "yes" if m[0] >= t[0] and m[1] >= t[1] else "no"
+        elif dmg in SYM_EVERY:
+            t = SYM_EVERY[dmg]
+            target, met = "every >= %.2f" % t, lambda m: "yes" if m[1] >= t else "no"
+        else:
+            target, met = "-", lambda m: "-"
+        lower = ["%s %.3f < %.3f" % (r["model"], core(r, on), core(r, off)) for r in sub
+                 if round(core(r, on), 3) < round(core(r, off), 3)]
+        md.append("| %s | %d | %.4f (%.4f) | %.4f (%.4f) | %s | %s | %s | %s |" % (
+            dmg, len(sub), mo[0], mo[1], mn[0], mn[1], target, met(mo), met(mn),
+            "; ".join(lower) or "none"))
+    fmt = lambda v: "-" if v is None else "%.4f" % v
+    behind = {}
+    md += ["", "#### Per input, beside the winding number (same samples)", "",
+           "Core IoU at every 4th voxel center (bench/gwn: the generalized winding number of"
+           " the oriented damaged soup at 1/2), for the damages where its holes are large"
+           " (symholes, largeholes). *behind*: the winding number's core IoU below the"
+           " pipe's, off and on (the issue: it stays behind on every symmetric input).", "",
+           "| model | damage | pipe off | pipe on | winding number | pipe off (its samples)"
+           " | pipe on (its samples) | winding number behind |", "|---|---|--:|--:|--:|--:|--:|---|"]
+    for r in rows:
+        if r["damage"] not in ("symholes", "largeholes"):
+            continue
+        g = r.get("gwn", {})
+        go, gn = g.get(off, {}).get("core"), g.get(on, {}).get("core")
+        pc = g.get("peer_core")
+        b = None if None in (pc, go, gn) else (pc < go and pc < gn)
+        if b is not None:
+            behind.setdefault(r["damage"], []).append((r["model"], b))
+        md.append("| %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            r["model"], r["damage"], fmt(core(r, off)), fmt(core(r, on)), fmt(pc), fmt(go),
+            fmt(gn), "-" if b is None else ("yes" if b else "**no**")))
+    md.append("")
+    for dmg, v in sorted(behind.items()):
+        md.append("%s: the winding number behind the pipe (off and on) on %d of %d%s." % (
+            dmg, sum(b for _, b in v), len(v),
+            "; not on " + ", ".join(m for m, b in v if not b) if not all(b for _, b in v) else ""))
+    return md
 
 
 def stage(build, b):

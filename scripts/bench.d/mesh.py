@@ -47,6 +47,15 @@ meshes converted to .vtu) when tetstat is built, else bench/peer_mesh.py
 tetstat reports no enclosure (null), VTK's fills it in, and souptet's rows
 also keep soupmesh -v's own exact check (vertices outside, crossing).
 A peer that refuses an input is a row "fails: <its message>".
+
+Issue 37 ("the undamaged solid inside, volume >= 0.95"): on every holes,
+largeholes and symholes input of the damaged corpus (every model that has
+one), soupmesh --tries 1 --seed 1 with `--symmetry off` and `--symmetry
+on` (said explicitly), at the clean model's cell count (for ~1500 tets);
+the undamaged model's vertices inside (tetstat --surface, exact) and the
+volume over that of the clean model's mesh at the same options, off and
+on; the clean models' own meshes off and on ("no change on clean
+inputs"). SOUPTET_BENCH_SYMMETRY_ONLY=1 runs this part alone.
 """
 import json
 import math
@@ -94,6 +103,11 @@ OFFSET_MIN_DIHEDRAL = {0.4: 33.0, 0.25: 30.0}
 OFFSET_MAX_DIHEDRAL = {0.4: 140.0}
 TIMEOUT_OURS = 300          # soupmesh --tries 1 (--tries 8: twice that)
 FULL = os.environ.get("SOUPTET_BENCH_FULL") == "1"
+# Issue 37: the damages whose fill is measured with --symmetry off and on,
+# and its targets (undamaged vertices inside, volume over the clean mesh's).
+SYM_DAMAGES = ("holes", "largeholes", "symholes")
+SYM_INSIDE, SYM_VOLUME = 0.99, 0.95
+SYM_ONLY = os.environ.get("SOUPTET_BENCH_SYMMETRY_ONLY") == "1"
 # SOUPTET_BENCH_MODELS="bunny fandisk": only these (a quick look).
 ONLY = os.environ.get("SOUPTET_BENCH_MODELS", "").split()
 
@@ -686,6 +700,9 @@ def stage(build, bench):
     rows, missing = [], []
     previous = previous_rows(bench)
     lc_of, cgal_size_of, cells_of, h_of, vol_of = {}, {}, {}, {}, {}
+    if SYM_ONLY:
+        srows, smd = symmetry_fill(bench, build, pm, tools, work, cells_of)
+        return srows, smd
     for model, damage, src, truth in inputs(bench):
         if src is None:
             missing.append("%s %s" % (model, damage))
@@ -816,8 +833,141 @@ def stage(build, bench):
     md = markdown(rows, tools, have_peer, versions, missing, time.time() - t_stage, bench)
     md += fill_markdown(rows, previous)
     md += offset_markdown(rows)
+    srows, smd = symmetry_fill(bench, build, pm, tools, work, cells_of)
+    rows += srows
+    md += smd
     rows.append({"versions": versions, "tools": sorted(tools), "missing_inputs": missing})
     return rows, md
+
+
+# --------------------------------------------------------------- symmetry
+
+def _sym_mesh(bench, build, pm, tools, src, out, cells, symmetry):
+    """soupmesh --tries 1 --seed 1 --cells N --symmetry on|off of src:
+    (status, seconds, tetstat of the mesh against src, stderr)."""
+    cmd = [tools["soupmesh"], "-v", "--offset-best-effort", src, "-o", out, "--cells",
+           str(cells), "--tries", "1", "--seed", "1", "--threads", str(bench.THREADS),
+           "--symmetry", symmetry]
+    r, t = pm.timed(cmd, TIMEOUT_OURS)
+    if r is None:
+        return "fails: timeout after %d s" % TIMEOUT_OURS, t, None, ""
+    if r.returncode != 0 or not os.path.exists(out):
+        return "fails: " + pm.last_error(r.stderr, "exit %d" % r.returncode), t, None, r.stderr
+    return "ok", t, tetstat(bench, build, out, surface=src), r.stderr
+
+
+def symmetry_inputs(bench):
+    """{model: (clean source, [(damage, path, truth files)])} for the
+    SYM_DAMAGES inputs of the damaged corpus, in its order."""
+    try:
+        with open(os.path.join(bench.DAMAGED, "manifest.json")) as f:
+            man = json.load(f)
+    except (OSError, ValueError):
+        return {}
+    src = {m["model"]: os.path.join(bench.DAMAGED, m["file"]) for m in man["models"]}
+    out = {}
+    for d in man["damaged"]:
+        if d["damage"] not in SYM_DAMAGES or (ONLY and d["model"] not in ONLY):
+            continue
+        truth = [os.path.normpath(os.path.join(bench.DAMAGED, t))
+                 for t in d["ground_truth"]["files"]]
+        out.setdefault(d["model"], (src[d["model"]], []))[1].append(
+            (d["damage"], os.path.join(bench.DAMAGED, d["file"]), truth))
+    return out
+
+
+def symmetry_fill(bench, build, pm, tools, work, cells_of):
+    """Issue 37's soupmesh table: per SYM_DAMAGES input, the undamaged
+    vertices inside and the volume ratio, --symmetry off and on."""
+    if "soupmesh" not in tools or "tetstat" not in tools:
+        return [], "\n### Symmetry (issue 37)\n\nNot measured: soupmesh or tetstat not built.\n"
+    t0 = time.time()
+    rows = []
+    out = os.path.join(work, "sym-%d.vtu" % os.getpid())   # two runs at once must not share it
+    for model, (clean, damaged) in symmetry_inputs(bench).items():
+        cells = cells_of.get(model)
+        if cells is None:   # as the main table: one retry from 10 for ~1500 tets
+            cells = 10
+            st, _, m, _ = _sym_mesh(bench, build, pm, tools, clean, out, cells, "off")
+            if st == "ok" and m and m.get("tets") and not TET_RANGE[0] <= m["tets"] <= TET_RANGE[1]:
+                cells = max(3, int(round(cells * (TARGET_TETS / float(m["tets"])) ** (1.0 / 3.0))))
+        ref = {}
+        for dmg, src, truth in [("closed", clean, [clean])] + damaged:
+            row = {"model": model, "damage": dmg, "mesher": "souptet", "symmetry_table": True,
+                   "cells": cells}
+            for sym in ("off", "on"):
+                st, t, m, log = _sym_mesh(bench, build, pm, tools, src, out, cells, sym)
+                r = {"status": st, "seconds": t}
+                if st == "ok" and m and "error" not in m:
+                    r.update(tets=m.get("tets"), volume=m.get("volume"),
+                             min_dihedral=m.get("min_dihedral"), encloses=m.get("encloses"))
+                    r.update(fill_measure(bench, build, out, truth, m if dmg == "closed" else None))
+                    if dmg == "closed":
+                        ref[sym] = m.get("volume")
+                    elif ref.get(sym) and m.get("volume") is not None:
+                        r["volume_ratio"] = m["volume"] / ref[sym]
+                    sm = re.search(r"symmetries: (\d+) with support", log or "")
+                    r["symmetries"] = int(sm.group(1)) if sm else None
+                elif st == "ok":
+                    r["status"] = "tetstat: %s" % (m or {}).get("error", "not built")
+                row[sym] = r
+            if dmg == "closed" and ref.get("off") and ref.get("on"):
+                row["on_vs_off"] = ref["on"] / ref["off"]
+            rows.append(row)
+            _log("symmetry %s %s: inside %s / %s, volume ratio %s / %s" % (
+                model, dmg, _pct(_inside_frac(row["off"])), _pct(_inside_frac(row["on"])),
+                _f(row["off"].get("volume_ratio"), "%.3f"), _f(row["on"].get("volume_ratio"), "%.3f")))
+    if os.path.exists(out):
+        os.remove(out)
+    return rows, symmetry_markdown(rows, time.time() - t0)
+
+
+def symmetry_markdown(rows, secs):
+    md = ["", "### soupmesh with the symmetric fill off and on (issue 37)", "",
+          "`soupmesh --tries 1 --seed 1 --cells N --symmetry off|on` (N for ~1500 tets on the"
+          " clean model) on every holes, largeholes and symholes input. *inside*: the"
+          " undamaged model's vertices inside the mesh (tetstat --surface, exact; target"
+          " >= %d%%); *volume*: the mesh's volume over that of the clean model's mesh at the"
+          " same options and the same `--symmetry` (target >= %.2f). Clean rows: the volume"
+          " `on` over `off` (no change asked). %.0f s." % (100 * SYM_INSIDE, SYM_VOLUME, secs), "",
+          "| model | damage | cells | tets off / on | inside off | inside on | volume off"
+          " | volume on | s off / on |", "|---|---|--:|---|--:|--:|--:|--:|---|"]
+    for r in rows:
+        o, n = r["off"], r["on"]
+        cell = lambda x, k, f: _f(x.get(k), f) if x["status"] == "ok" else x["status"][:40]
+        clean = r["damage"] == "closed"
+        md.append("| %s | %s | %d | %s / %s | %s | %s | %s | %s | %.1f / %.1f |" % (
+            r["model"], r["damage"], r["cells"], cell(o, "tets", "%d"), cell(n, "tets", "%d"),
+            _pct(_inside_frac(o)), _pct(_inside_frac(n)),
+            "1 (reference)" if clean else cell(o, "volume_ratio", "%.3f"),
+            ("on/off %s" % _f(r.get("on_vs_off"), "%.4f")) if clean else cell(n, "volume_ratio", "%.3f"),
+            o["seconds"] or 0, n["seconds"] or 0))
+    md += ["", "| damage | inputs | inside >= %d%%: off | on | volume >= %.2f: off | on"
+           " | worst inside off / on | worst volume off / on |" % (100 * SYM_INSIDE, SYM_VOLUME),
+           "|---|--:|--:|--:|--:|--:|---|---|"]
+    for dmg in SYM_DAMAGES:
+        sub = [r for r in rows if r["damage"] == dmg]
+        if not sub:
+            continue
+        cnt = lambda k, ok: sum(1 for r in sub if ok(r[k]))
+        fin = lambda x: (_inside_frac(x) or 0) >= SYM_INSIDE
+        fvo = lambda x: (x.get("volume_ratio") or 0) >= SYM_VOLUME
+        worst_in = lambda k: min(sub, key=lambda r: _inside_frac(r[k]) or 0)
+        worst_vo = lambda k: min(sub, key=lambda r: r[k].get("volume_ratio") or 0)
+        md.append("| %s | %d | %d | %d | %d | %d | %s (%s) / %s (%s) | %s (%s) / %s (%s) |" % (
+            dmg, len(sub), cnt("off", fin), cnt("on", fin), cnt("off", fvo), cnt("on", fvo),
+            _pct(_inside_frac(worst_in("off")["off"])), worst_in("off")["model"],
+            _pct(_inside_frac(worst_in("on")["on"])), worst_in("on")["model"],
+            _f(worst_vo("off")["off"].get("volume_ratio"), "%.3f"), worst_vo("off")["model"],
+            _f(worst_vo("on")["on"].get("volume_ratio"), "%.3f"), worst_vo("on")["model"]))
+    clean = [r for r in rows if r["damage"] == "closed" and r.get("on_vs_off") is not None]
+    if clean:
+        changed = [r for r in clean if abs(r["on_vs_off"] - 1) > 1e-9]
+        md += ["", "Clean models: the volume with `on` equals `off` on %d of %d%s." % (
+            len(clean) - len(changed), len(clean),
+            "; differs on " + ", ".join("%s (%.4f)" % (r["model"], r["on_vs_off"]) for r in changed)
+            if changed else "")]
+    return "\n".join(md) + "\n"
 
 
 # --------------------------------------------------------------- markdown

@@ -15,7 +15,11 @@ deleted50 and soup variants. Every soupwrap output is also checked by CGAL
 (`alpha_wrap check`: a polygon mesh, closed, no degenerate face, no
 self-intersection, outward, by CGAL's exact predicates), independently of
 soupinfo. The CAD parts are in since issue 37 (soupwrap failed on a screw
-with large holes: "degenerate triangles"), their largeholes too.
+with large holes: "degenerate triangles"), their largeholes too; and
+soupwrap with CGAL's check runs on every damaged input of the corpus
+(manifest.json: every model and damage, symholes included), the peers on
+MODELS only; a table counts the outputs that pass, per damage.
+SOUPTET_BENCH_PEERS=0: soupwrap and its checks alone.
 
 Needs the damaged corpus (make bench STAGE=corpus, or scripts/damage-corpus)
 and $(BUILD)/bench/alpha_wrap (bench/alpha_wrap.cpp; CGAL from
@@ -35,6 +39,27 @@ DAMAGES = ("deleted50", "holes", "soup", "flipped", "interpenetrating",
 CELLS = 128
 TETGEN_DAMAGES = ("deleted50", "soup")
 TETGEN_TIMEOUT = 120
+PEERS = os.environ.get("SOUPTET_BENCH_PEERS", "1") != "0"
+
+
+def _inputs(bench):
+    """[(model, damage, path, peers?)]: MODELS clean and damaged (peers
+    run), then every other damaged input of the manifest (soupwrap only)."""
+    out = []
+    for m in MODELS:
+        clean = bench.model_path(m)
+        if clean:
+            out.append((m, "(clean)", clean, PEERS))
+        out += [(m, d, os.path.join(bench.DAMAGED, "%s-%s.off" % (m, d)), PEERS) for d in DAMAGES]
+    try:
+        with open(os.path.join(bench.DAMAGED, "manifest.json")) as f:
+            man = json.load(f)
+    except (OSError, ValueError):
+        return out
+    seen = {(m, d) for m, d, _, _ in out}
+    out += [(e["model"], e["damage"], os.path.join(bench.DAMAGED, e["file"]), False)
+            for e in man["damaged"] if (e["model"], e["damage"]) not in seen]
+    return out
 
 
 def _info(bench, build, path, self_check=True):
@@ -89,6 +114,33 @@ def _tetgen(bench, src, tmp):
     return res
 
 
+def check_table(rows):
+    """Per damage: the soupwrap outputs that CGAL's exact check passes
+    (closed, no degenerate face, no self-intersection, outward) of the
+    inputs, and the ones that fail or that soupwrap refused."""
+    md = ["", "### soupwrap --surface on every damaged input: CGAL's exact check", "",
+          "`soupwrap -q --surface IN -r %d`, then `alpha_wrap check OUT` (CGAL: a closed"
+          " polygon mesh, no degenerate face, no self-intersection, outward); *refused*:"
+          " soupwrap exited non-zero (its own check failed)." % CELLS, "",
+          "| damage | pass / inputs | refused | check fails |", "|---|--:|---|---|"]
+    dmgs = []
+    for r in rows:
+        if r["damage"] != "(clean)" and r["damage"] not in dmgs:
+            dmgs.append(r["damage"])
+    tot = [0, 0]
+    for d in dmgs:
+        sub = [r for r in rows if r["damage"] == d]
+        ok = [r for r in sub if r.get("soupwrap_cgal")]
+        ref = [r["model"] for r in sub if "soupwrap_error" in r]
+        bad = [r["model"] for r in sub if "soupwrap" in r and not r.get("soupwrap_cgal")]
+        tot[0] += len(ok)
+        tot[1] += len(sub)
+        md.append("| %s | %d / %d | %s | %s |" % (d, len(ok), len(sub), ", ".join(ref) or "-",
+                                                  ", ".join(bad) or "-"))
+    md.append("| all damaged | %d / %d | | |" % tuple(tot))
+    return md
+
+
 def stage(build, bench):
     root = bench.ROOT
     damaged = bench.DAMAGED
@@ -97,51 +149,47 @@ def stage(build, bench):
     peer = os.path.join(build, "bench", "alpha_wrap")
     have_peer = os.path.exists(peer)
     rows = []
-    for m in MODELS:
-        clean = bench.model_path(m)
-        inputs = [("(clean)", clean)] if clean else []
-        inputs += [(d, os.path.join(damaged, "%s-%s.off" % (m, d))) for d in DAMAGES]
-        for dmg, src in inputs:
-            if not src or not os.path.exists(src):
-                continue
-            row = {"model": m, "damage": dmg}
-            raw = _info(bench, build, src, self_check=False)
-            voxel = raw["voxel"]
-            out = os.path.join(tmp, "%s-%s-wrap.off" % (m, dmg))
-            t0 = time.time()
-            r = bench.run([os.path.join(build, "bin", "soupwrap"), "-q", "--surface", src,
-                           "-r", str(CELLS), "-o", out])
-            row["soupwrap_s"] = time.time() - t0
-            if r.returncode != 0:
-                row["soupwrap_error"] = r.stderr.strip()[-200:]
-            else:
-                row["soupwrap"] = _info(bench, build, out)
-                if have_peer:
-                    rc = bench.run([peer, "check", out])
-                    row["soupwrap_cgal"] = (json.loads(rc.stdout)["ok"]
-                                            if rc.stdout.strip() else None)
-                    row["soupwrap_to_input"] = _dist(bench, peer, out, src, voxel)
-                    row["input_to_soupwrap"] = _dist(bench, peer, src, out, voxel)
+    for m, dmg, src, peers in _inputs(bench):
+        if not src or not os.path.exists(src):
+            continue
+        row = {"model": m, "damage": dmg}
+        raw = _info(bench, build, src, self_check=False)
+        voxel = raw["voxel"]
+        out = os.path.join(tmp, "%s-%s-wrap.off" % (m, dmg))
+        t0 = time.time()
+        r = bench.run([os.path.join(build, "bin", "soupwrap"), "-q", "--surface", src,
+                       "-r", str(CELLS), "-o", out])
+        row["soupwrap_s"] = time.time() - t0
+        if r.returncode != 0:
+            row["soupwrap_error"] = r.stderr.strip()[-200:]
+        else:
+            row["soupwrap"] = _info(bench, build, out)
             if have_peer:
-                cg = os.path.join(tmp, "%s-%s-cgal.off" % (m, dmg))
-                r = bench.run([peer, "wrap", src, cg, repr(2 * voxel), repr(voxel / 2)])
-                if r.returncode == 0:
-                    o = json.loads(r.stdout)
-                    row["cgal_s"] = o["seconds"]
-                    row["cgal"] = _info(bench, build, cg)
-                    row["cgal_to_input"] = _dist(bench, peer, cg, src, voxel)
-                    row["input_to_cgal"] = _dist(bench, peer, src, cg, voxel)
-                else:
-                    row["cgal_error"] = r.stderr.strip()[-200:]
-                if os.path.exists(cg):
-                    os.remove(cg)
-            if dmg in TETGEN_DAMAGES:
-                row["tetgen_raw"] = _tetgen(bench, src, tmp)
-                row["tetgen_wrap"] = _tetgen(bench, out, tmp) if os.path.exists(out) else "n/a"
-            if os.path.exists(out):
-                os.remove(out)
-            rows.append(row)
-            bench.sys.stderr.write("bench: wrap %s %s done\n" % (m, dmg))
+                rc = bench.run([peer, "check", out])
+                row["soupwrap_cgal"] = (json.loads(rc.stdout)["ok"]
+                                        if rc.stdout.strip() else None)
+                row["soupwrap_to_input"] = _dist(bench, peer, out, src, voxel)
+                row["input_to_soupwrap"] = _dist(bench, peer, src, out, voxel)
+        if have_peer and peers:
+            cg = os.path.join(tmp, "%s-%s-cgal.off" % (m, dmg))
+            r = bench.run([peer, "wrap", src, cg, repr(2 * voxel), repr(voxel / 2)])
+            if r.returncode == 0:
+                o = json.loads(r.stdout)
+                row["cgal_s"] = o["seconds"]
+                row["cgal"] = _info(bench, build, cg)
+                row["cgal_to_input"] = _dist(bench, peer, cg, src, voxel)
+                row["input_to_cgal"] = _dist(bench, peer, src, cg, voxel)
+            else:
+                row["cgal_error"] = r.stderr.strip()[-200:]
+            if os.path.exists(cg):
+                os.remove(cg)
+        if dmg in TETGEN_DAMAGES and peers:
+            row["tetgen_raw"] = _tetgen(bench, src, tmp)
+            row["tetgen_wrap"] = _tetgen(bench, out, tmp) if os.path.exists(out) else "n/a"
+        if os.path.exists(out):
+            os.remove(out)
+        rows.append(row)
+        bench.sys.stderr.write("bench: wrap %s %s done\n" % (m, dmg))
 
     def yn(i):
         if not i:
@@ -186,6 +234,7 @@ def stage(build, bench):
         md.append("CGAL's exact check (closed, no degenerate face, no self-intersection, outward)"
                   " holds on %d of %d soupwrap outputs." % (
                       sum(1 for r in cg_rows if r["soupwrap_cgal"]), len(cg_rows)))
+    md += check_table(rows)
     closed = [r for r in rows if r["damage"] == "(clean)" and r.get("input_to_soupwrap")]
     if closed:
         md.append("On the clean (closed) models: out->in max %.2f voxels (mean %.3f), in->out max %.2f"
