@@ -69,8 +69,8 @@ static st_status shells_only(st_grid *g, const st_shells *shells, const st_pseud
  * tolerance; where they are, *caps becomes the caps the fill does not
  * cover and the fill. */
 static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_soup_edges *edges,
-                                const st_bvh *bvh, st_pseudo_stats *st, st_soup **caps,
-                                st_error *err)
+                                const st_bvh *bvh, const st_pseudo_params *p,
+                                st_pseudo_stats *st, st_soup **caps, st_error *err)
 {
     const double t0 = now_seconds();
     st_symmetry_params sp = st_symmetry_params_default();
@@ -92,6 +92,10 @@ static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_soup_edge
              f->unclosed);
     if (!rc && st_meta_set(&g->meta, "symmetry_fill", buf))
         rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    if (!rc && p->symmetric_fill && fill->ntris) {
+        *p->symmetric_fill = fill;
+        fill = NULL;
+    }
     st_soup_free(fill);
     if (rc) {
         st_soup_free(kept);
@@ -117,7 +121,7 @@ static st_status add_caps(st_grid *g, const st_soup *s, const st_soup_edges *edg
     /* the symmetric fill where there are caps, or loops too large to cap */
     const int open = st->holes.loops > st->holes.filled;
     if (p->symmetry && (caps->ntris || open) &&
-        (rc = symmetric_fill(g, s, edges, bvh, st, &caps, err))) {
+        (rc = symmetric_fill(g, s, edges, bvh, p, st, &caps, err))) {
         st_soup_free(caps);
         return rc;
     }
@@ -210,6 +214,8 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
 {
     if (bvh_out)
         *bvh_out = NULL;
+    if (p && p->symmetric_fill)
+        *p->symmetric_fill = NULL;
     st_pseudo_stats local;
     st_pseudo_stats *st = stats ? stats : &local;
     memset(st, 0, sizeof *st);
@@ -314,6 +320,10 @@ count_inside:;
         bvh = NULL;
     }
 done:
+    if (rc && p->symmetric_fill) {
+        st_soup_free(*p->symmetric_fill);
+        *p->symmetric_fill = NULL;
+    }
     st_bvh_free(bvh);
     if (have_edges)
         st_soup_edges_free(&edges);
