@@ -102,6 +102,8 @@ typedef struct st_symmetry_fill_stats {
     size_t unclosed;      /* pieces (caps or open rims) whose fill ran along
                              the rim but left the hole open (its copy
                              itself holed): no fill there */
+    size_t caps_agree;    /* caps the fill closes but does not depart from
+                             (within tol of the cap): kept, no fill */
 } st_symmetry_fill_stats;
 
 /* Where soup s has holes, the images of s's triangles under the
@@ -114,11 +116,14 @@ typedef struct st_symmetry_fill_stats {
  * there), within reach of a hole (half its piece's box diagonal), and
  * nearer that cap than s, or, for an open rim, with the rim s's nearest
  * part to within tol; and the map puts the hole's rim back on s (at least
- * 0.8 of its length). A hole's fill is kept when it closes the hole: at
- * least 3/4 of the rim's length within 3 tol of the fill, and the fill's
- * own boundary farther than 3 tol from s and from the other maps' fill at
- * most 1/4 of the rim's length. *kept_caps gets the caps minus the pieces
- * the fill closes. Mirror images are re-oriented so the fill keeps s's
+ * 0.8 of its length within 3 tol, and within tol on average: the map's
+ * error there). A hole's fill is kept when it closes the hole: at least
+ * 3/4 of the rim's length within 3 tol of the fill, and the fill's own
+ * boundary farther than 3 tol from s and from the other maps' fill at
+ * most 1/4 of the rim's length; and, for a cap, when the fill departs
+ * from the cap (some corner or centroid farther than tol plus the map's
+ * error): else the cap stays, without fill. *kept_caps gets the caps
+ * minus the pieces the fill closes. Mirror images are re-oriented so the fill keeps s's
  * orientation. Deterministic for any thread count. bvh: st_bvh_build(s).
  * Both outputs are the caller's (st_soup_free); empty soups when set has
  * nothing. ST_EINPUT for a tol that is not positive and finite;

@@ -87,9 +87,9 @@ static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_soup_edge
     char buf[200];
     const st_symmetry_fill_stats *f = &st->symmetry_fill;
     snprintf(buf, sizeof buf, "%zu symmetries, %zu maps: %zu triangles, %zu of %zu caps "
-             "covered, %zu of %zu open holes filled, %zu left open", st->symmetries.n,
-             f->maps, f->triangles, f->caps_covered, f->caps, f->open_filled, f->open,
-             f->unclosed);
+             "covered (%zu agreeing kept), %zu of %zu open holes filled, %zu left open",
+             st->symmetries.n, f->maps, f->triangles, f->caps_covered, f->caps, f->caps_agree,
+             f->open_filled, f->open, f->unclosed);
     if (!rc && st_meta_set(&g->meta, "symmetry_fill", buf))
         rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     if (!rc && p->symmetric_fill && fill->ntris) {

@@ -3,21 +3,30 @@
  * (symmetry.h, st_symmetry_fill; issue 37).
  *
  * A hole's cap guesses the missing surface from the rim alone: flat, or
- * continuing the faces. Where the soup is symmetric, the surviving side
- * mapped across the symmetry says what was there. The fill is every image
+ * continuing the faces; a hole too large to cap gets no guess at all.
+ * Where the soup is symmetric, the surviving side mapped across the
+ * symmetry says what was there. The holes are pieces: each cap's
+ * triangles joined by shared edges (one hole each), and each loop of the
+ * soup's boundary no cap runs along (an open rim). The fill is every image
  * of a soup triangle that lands where the soup is not (its centroid
  * farther than the tolerance from the soup: the soup wins wherever it is)
- * and near a cap (so only holes are filled, never the open air an
- * imprecise map lands in). A cap whose rim the fill runs along is dropped:
- * the fill gives that hole its shape, and a flat cap across it would cut
- * the solid the fill bounds.
+ * and in a hole (near a cap, nearer it than the soup; or with an open rim
+ * the soup's nearest part), through a map that puts the hole's rim back
+ * on the soup (most of its length, and within a voxel on average). A
+ * hole's fill is kept only when it closes the hole: it runs along the rim,
+ * and its own boundary lies on the soup or on another map's fill (a copy
+ * itself holed leaves its holes in the fill, and the cap stays). A cap
+ * the fill closes is dropped where the fill departs from it by more than
+ * the map's error: the fill gives that hole its shape, and a flat cap
+ * across it would cut the solid the fill bounds; where the two agree the
+ * cap stays and the fill is left out.
  *
  * Every decision is a distance compared with a tolerance of a voxel: the
  * fill is evidence for the signs (pseudo.c lowers it into the field as it
  * does the caps), never an output surface, so no exact predicate is
- * needed. Per map, the tests run in parallel into a flag per triangle; the
- * kept images are appended in triangle order, so the fill does not depend
- * on the thread count.
+ * needed. Per map, the tests run in parallel into a value per triangle;
+ * the kept images are appended in triangle order, so the fill does not
+ * depend on the thread count.
  */
 #include "souptet/symmetry.h"
 #include "../base/fpenv.h"
@@ -374,21 +383,21 @@ static int cmp_ends(const void *x, const void *y)
     return 0;
 }
 
-/* The open rims: the soup's boundary edges (edges: s's table) along no
- * cap's rim (the same two end points, exactly), joined into pieces by
- * shared welded ends; each becomes a piece after the caps', its edges rims
- * of R and degenerate triangles of anchors. */
+/* The open rims: the soup's boundary edges (edges: s's table) whose
+ * midpoint is farther than tol from every cap (caps_bvh; NULL: none): a
+ * cap runs along every edge of the loop it closes, joined or not to the
+ * rim's vertices. They are joined into pieces by shared welded ends; each
+ * becomes a piece after the caps', its edges rims of R and degenerate
+ * triangles of anchors. */
 static st_status open_rims(pieces *P, rims *R, st_soup *anchors, const st_soup *s,
-                           const st_soup_edges *E, st_error *err)
+                           const st_soup_edges *E, const st_bvh *caps_bvh, double tol,
+                           st_error *err)
 {
-    const size_t ncaprim = R->n, nw = E->nweld ? E->nweld : 1;
-    double *keys = st_malloc_array(ncaprim ? 6 * ncaprim : 1, sizeof *keys);
+    const size_t nw = E->nweld ? E->nweld : 1;
     size_t *uf = st_malloc_array(nw, sizeof *uf), *id = st_malloc_array(nw, sizeof *id);
-    st_status rc = keys && uf && id ? ST_OK : ST_ENOMEM;
+    st_status rc = uf && id ? ST_OK : ST_ENOMEM;
     if (rc)
         goto done;
-    memcpy(keys, R->ends, 6 * ncaprim * sizeof *keys);
-    qsort(keys, ncaprim, 6 * sizeof *keys, cmp_ends);
     for (size_t w = 0; w < nw; w++) {
         uf[w] = w;
         id[w] = SIZE_MAX;
@@ -404,9 +413,11 @@ static st_status open_rims(pieces *P, rims *R, st_soup *anchors, const st_soup *
         if (ca < 0 || cb < 0)
             continue;
         const double *p = s->xyz + 3 * s->tris[3 * t + ca], *q = s->xyz + 3 * s->tris[3 * t + cb];
-        double k6[6];
-        ends_of(k6, p, q);
-        if (ncaprim && bsearch(k6, keys, ncaprim, 6 * sizeof *keys, cmp_ends))
+        const double m[3] = {0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]), 0.5 * (p[2] + q[2])};
+        int64_t near = -1;
+        if (caps_bvh)
+            st_bvh_nearest(caps_bvh, m, tol * tol, &near, NULL);
+        if (near >= 0)
             continue;
         uf_join(uf, wa, wb);
         rc = rims_add(R, p, q, wa);   /* piece: its welded end, for now */
@@ -456,7 +467,6 @@ static st_status open_rims(pieces *P, rims *R, st_soup *anchors, const st_soup *
         P->reach = reach;
     free(box);
 done:
-    free(keys);
     free(uf);
     free(id);
     return rc;
@@ -503,11 +513,35 @@ static int near_bvh(const void *ctx, const double x[3])
     return tri >= 0;
 }
 
+/* err[i]: the map's error at piece i: the length-weighted mean distance
+ * from the soup of the preimages of the rim's midpoints (back: the map's
+ * inverse), over the rim edges within back's reach (those rim_share
+ * counts). */
+static void rim_error(double *err, size_t npieces, const rims *R, const near_ctx *back,
+                      double *weight)
+{
+    for (size_t i = 0; i < npieces; i++)
+        err[i] = weight[i] = 0.0;
+    for (size_t r = 0; r < R->n; r++) {
+        double q[3];
+        st_symmetry_apply(back->inverse->y, back->inverse->angle, R->mid + 3 * r, 1, q);
+        int64_t tri;
+        const double d2 = st_bvh_nearest(back->bvh, q, back->reach2, &tri, NULL);
+        if (tri < 0)
+            continue;
+        err[R->piece[r]] += R->len[r] * sqrt(d2);
+        weight[R->piece[r]] += R->len[r];
+    }
+    for (size_t i = 0; i < npieces; i++)
+        err[i] = weight[i] > 0.0 ? err[i] / weight[i] : 0.0;
+}
+
 /* ---- the fill ----------------------------------------------------------------- */
 
 typedef struct fill_set {
     st_soup *soup;        /* each triangle of its own three vertices */
     size_t *piece, *map;  /* per triangle */
+    double *err;          /* per triangle: its map's error at its piece */
     size_t cap;
 } fill_set;
 
@@ -536,7 +570,7 @@ static st_status add_tri(st_soup *out, const double q[3][3], st_error *err)
 /* Append the images under map mi of s's triangles whose keep[] names a
  * piece (not SIZE_MAX). */
 static st_status append_images(fill_set *F, const st_soup *s, const map *maps, size_t mi,
-                               const size_t *keep, st_error *err)
+                               const size_t *keep, const double *map_err, st_error *err)
 {
     for (size_t t = 0; t < s->ntris; t++) {
         if (keep[t] == SIZE_MAX)
@@ -549,12 +583,16 @@ static st_status append_images(fill_set *F, const st_soup *s, const map *maps, s
             size_t *m = realloc(F->map, cap * sizeof *m);
             if (m)
                 F->map = m;
-            if (!p || !m)
+            double *e = realloc(F->err, cap * sizeof *e);
+            if (e)
+                F->err = e;
+            if (!p || !m || !e)
                 return ST_ENOMEM;
             F->cap = cap;
         }
         F->piece[F->soup->ntris] = keep[t];
         F->map[F->soup->ntris] = mi;
+        F->err[F->soup->ntris] = map_err[keep[t]];
         double q[3][3];
         image(s, t, maps + mi, q);
         st_status rc = add_tri(F->soup, q, err);
@@ -706,7 +744,7 @@ static st_status fill_of_covered(st_soup **fill, const fill_set *F, const uint8_
  * back on the soup; keeps). */
 static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, const rims *R,
                          const map *maps, size_t nmaps, size_t *keep, uint8_t *ok,
-                         double *share, st_error *err)
+                         double *share, double *map_err, st_error *err)
 {
     const st_soup *s = C0->s;
     const pieces *P = C0->P;
@@ -717,6 +755,14 @@ static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, con
         size_t agree = 0;
         for (size_t i = 0; i < P->n; i++)
             agree += ok[i] = share[i] >= RIM_AGREE;
+        if (!agree)
+            continue;
+        /* and within a voxel there, on average: the issue's "maps onto
+         * itself within about a voxel", at the hole */
+        rim_error(map_err, P->n, R, &back, share);
+        agree = 0;
+        for (size_t i = 0; i < P->n; i++)
+            agree += ok[i] = ok[i] && map_err[i] <= C0->tol;
         if (!agree)
             continue;
         fill_ctx C = *C0;
@@ -733,7 +779,7 @@ static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, con
         }
         if (!any)
             continue;
-        st_status rc = append_images(F, s, maps, mi, keep, err);
+        st_status rc = append_images(F, s, maps, mi, keep, map_err, err);
         st_bvh_free(*fill_bvh);
         *fill_bvh = NULL;
         if (rc || (rc = st_bvh_build(fill_bvh, F->soup, err)))
@@ -742,18 +788,53 @@ static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, con
     return ST_OK;
 }
 
+/* depart[i]: 1 when some corner or centroid of piece i's fill lies
+ * farther from the anchors (a cap's piece: its cap) than tol plus its
+ * map's error there (what the map's own error explains is no evidence). */
+static void departs(uint8_t *depart, size_t npieces, const fill_set *F,
+                    const st_bvh *anchors_bvh, double tol)
+{
+    memset(depart, 0, npieces);
+    const st_soup *f = F->soup;
+    for (size_t t = 0; t < f->ntris; t++) {
+        if (depart[F->piece[t]])
+            continue;
+        double x[4][3];
+        for (int a = 0; a < 3; a++) {
+            x[3][a] = 0.0;
+            for (int k = 0; k < 3; k++) {
+                x[k][a] = f->xyz[3 * f->tris[3 * t + k] + a];
+                x[3][a] += x[k][a] / 3.0;
+            }
+        }
+        for (int k = 0; k < 4 && !depart[F->piece[t]]; k++) {
+            int64_t tri;
+            const double r = tol + F->err[t];
+            st_bvh_nearest(anchors_bvh, x[k], r * r, &tri, NULL);
+            depart[F->piece[t]] = tri < 0;
+        }
+    }
+}
+
 /* covered[i]: piece i's fill closes it: the fill runs along its rim (at
  * least RIM_COVERED of the rim's length within RIM_REACH tol of it) and
  * its own boundary off the soup is at most the rest, 1 - RIM_COVERED of
- * the rim's length (a copy itself holed leaves its holes in the fill). */
+ * the rim's length (a copy itself holed leaves its holes in the fill).
+ * A cap the fill does not depart from (every corner and centroid of it
+ * within tol of the cap, plus the map's error at the rim) is kept, without
+ * fill: the copy agrees with the cap's guess there, and the map's error
+ * would be all it adds. */
 static st_status decide(uint8_t *covered, const pieces *P, const rims *R, const fill_set *F,
-                        const st_bvh *bvh, const st_bvh *fill_bvh, double tol,
-                        st_symmetry_fill_stats *st)
+                        const st_bvh *bvh, const st_bvh *fill_bvh, const st_bvh *anchors_bvh,
+                        double tol, st_symmetry_fill_stats *st)
 {
     const size_t n = P->n ? P->n : 1;
     double *share = st_malloc_array(2 * n, sizeof *share);
     double *total = st_malloc_array(n, sizeof *total), *open = st_malloc_array(n, sizeof *open);
-    st_status rc = share && total && open ? ST_OK : ST_ENOMEM;
+    uint8_t *depart = st_malloc_array(n, 1);
+    st_status rc = share && total && open && depart ? ST_OK : ST_ENOMEM;
+    if (!rc)
+        departs(depart, P->n, F, anchors_bvh, tol);
     if (!rc) {
         const near_ctx on_fill = {fill_bvh, RIM_REACH * tol * RIM_REACH * tol, NULL};
         rim_share(share, P->n, R, near_bvh, &on_fill, total);
@@ -763,6 +844,10 @@ static st_status decide(uint8_t *covered, const pieces *P, const rims *R, const 
         const int along = share[i] >= RIM_COVERED;
         covered[i] = along && (!fill_bvh || open[i] <= (1.0 - RIM_COVERED) * total[i]);
         st->unclosed += along && !covered[i];
+        if (covered[i] && i < P->ncap && !depart[i]) {
+            covered[i] = 0;
+            st->caps_agree++;
+        }
         if (i < P->ncap)
             st->caps_covered += covered[i];
         else
@@ -771,6 +856,7 @@ static st_status decide(uint8_t *covered, const pieces *P, const rims *R, const 
     free(share);
     free(total);
     free(open);
+    free(depart);
     return rc;
 }
 
@@ -787,11 +873,11 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
         return st_error_set(err, ST_EINPUT, NULL, 0,
                             "symmetry fill: the tolerance must be positive and finite");
     st_soup *kept = st_soup_new(), *anchors = st_soup_new(), *fill = NULL;
-    fill_set F = {st_soup_new(), NULL, NULL, 0};
+    fill_set F = {st_soup_new(), NULL, NULL, NULL, 0};
     st_bvh *anchors_bvh = NULL, *fill_bvh = NULL;
     size_t *keep = NULL;
     uint8_t *covered = NULL;
-    double *share = NULL;
+    double *share = NULL, *map_err = NULL;
     pieces P;
     rims R;
     memset(&P, 0, sizeof P);
@@ -807,8 +893,11 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
     const st_soup *cp = caps ? caps : &none;
     if ((rc = pieces_make(&P, cp)) || (rc = rims_make(&R, cp, &P)) ||
         (rc = st_soup_append(anchors, cp, err)) ||
-        (edges && (rc = open_rims(&P, &R, anchors, s, edges, err))))
+        (cp->ntris && (rc = st_bvh_build(&anchors_bvh, cp, err))) ||
+        (edges && (rc = open_rims(&P, &R, anchors, s, edges, anchors_bvh, tol, err))))
         goto done;
+    st_bvh_free(anchors_bvh);   /* the caps' alone: built again with the rims */
+    anchors_bvh = NULL;
     st->caps = P.ncap;
     st->open = P.n - P.ncap;
     if (P.n == 0)
@@ -817,7 +906,8 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
     keep = st_malloc_array(s->ntris, sizeof *keep);
     covered = st_malloc_array(P.n, 1);
     share = st_malloc_array(2 * P.n, sizeof *share);
-    if (!keep || !covered || !share) {
+    map_err = st_malloc_array(P.n, sizeof *map_err);
+    if (!keep || !covered || !share || !map_err) {
         rc = ST_ENOMEM;
         goto done;
     }
@@ -826,8 +916,9 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
     const size_t nmaps = maps_of(set, maps, sizeof maps / sizeof *maps);
     st->maps = nmaps;
     const fill_ctx C = {s, bvh, anchors_bvh, NULL, &P, NULL, tol};
-    if ((rc = map_all(&F, &fill_bvh, &C, &R, maps, nmaps, keep, covered, share, err)) ||
-        (rc = decide(covered, &P, &R, &F, bvh, fill_bvh, tol, st)) ||
+    if ((rc = map_all(&F, &fill_bvh, &C, &R, maps, nmaps, keep, covered, share, map_err,
+                       err)) ||
+        (rc = decide(covered, &P, &R, &F, bvh, fill_bvh, anchors_bvh, tol, st)) ||
         (rc = keep_uncovered(kept, cp, &P, covered, err)))
         goto done;
     rc = fill_of_covered(&fill, &F, covered, st, err);
@@ -840,6 +931,8 @@ done:
     st_soup_free(F.soup);
     free(F.piece);
     free(F.map);
+    free(F.err);
+    free(map_err);
     pieces_free(&P);
     rims_free(&R);
     free(share);
