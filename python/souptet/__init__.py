@@ -213,12 +213,8 @@ def pseudo_volume(V, F, resolution=128, *, fill_holes=True, symmetry=False):
     V, F        as mesh()
     resolution  int, voxels along the longest side of the soup's box
                 (default 128, as soupdist -r; 1..65536)
-    fill_holes  bool, cap the soup's holes for the pseudo volume (default
-                True, as soupsign/soupwrap --fill-holes on; False: the vote
-                alone closes them)
-    symmetry    bool, fill the holes from the soup's own mirror planes and
-                rotation axes, where their images close a hole (default
-                False, as --symmetry off; needs fill_holes)
+    fill_holes, symmetry  as mesh() (soupsign/soupwrap --fill-holes,
+                --symmetry)
     Returns a Field: .inside bool (nx, ny, nz) indexed [i, j, k], .values the
     signed distance (negative inside; exact within 3 voxels of the surface,
     clamped to .band beyond), .origin, .voxel.
@@ -250,12 +246,8 @@ def wrap(V, F, resolution=128, *, fill_holes=True, symmetry=False):
     V, F        as mesh()
     resolution  int, voxels of the field along the longest side (default 128,
                 as soupwrap -r)
-    fill_holes  bool, cap the soup's holes for the pseudo volume (default
-                True, as soupsign/soupwrap --fill-holes on; False: the vote
-                alone closes them)
-    symmetry    bool, fill the holes from the soup's own mirror planes and
-                rotation axes, where their images close a hole (default
-                False, as --symmetry off; needs fill_holes)
+    fill_holes, symmetry  as mesh() (soupsign/soupwrap --fill-holes,
+                --symmetry)
     Returns (V2, F2): float64 (n, 3) (float-representable) and int64 (m, 3).
     """
     return _load_io().wrap(V, F, resolution, fill_holes=fill_holes, symmetry=symmetry)

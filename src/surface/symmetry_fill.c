@@ -300,24 +300,26 @@ static void rims_free(rims *R)
     memset(R, 0, sizeof *R);
 }
 
+/* p reallocated to n items of size bytes, or p itself and *fail set. */
+static void *grown(void *p, size_t n, size_t size, int *fail)
+{
+    void *q = realloc(p, n * size);
+    if (!q)
+        *fail = 1;
+    return q ? q : p;
+}
+
 static st_status rims_grow(rims *R, size_t more)
 {
     if (R->n + more <= R->cap)
         return ST_OK;
     const size_t cap = 2 * (R->n + more);
-    double *e = realloc(R->ends, cap * 6 * sizeof *e);
-    if (e)
-        R->ends = e;
-    double *m = realloc(R->mid, cap * 3 * sizeof *m);
-    if (m)
-        R->mid = m;
-    double *l = realloc(R->len, cap * sizeof *l);
-    if (l)
-        R->len = l;
-    size_t *pc = realloc(R->piece, cap * sizeof *pc);
-    if (pc)
-        R->piece = pc;
-    if (!e || !m || !l || !pc)
+    int fail = 0;
+    R->ends = grown(R->ends, 6 * cap, sizeof *R->ends, &fail);
+    R->mid = grown(R->mid, 3 * cap, sizeof *R->mid, &fail);
+    R->len = grown(R->len, cap, sizeof *R->len, &fail);
+    R->piece = grown(R->piece, cap, sizeof *R->piece, &fail);
+    if (fail)
         return ST_ENOMEM;
     R->cap = cap;
     return ST_OK;
@@ -541,7 +543,11 @@ static void rim_error(double *err, size_t npieces, const rims *R, const near_ctx
 typedef struct fill_set {
     st_soup *soup;        /* each triangle of its own three vertices */
     size_t *piece, *map;  /* per triangle */
+    size_t *src;          /* per triangle: the soup triangle it is the image of */
     double *err;          /* per triangle: its map's error at its piece */
+    uint8_t *rim;         /* per soup triangle: bit k when its edge k (corners
+                             k, k + 1) is a boundary edge (NULL: unknown) */
+    const map *maps;      /* the maps F->map indexes */
     size_t cap;
 } fill_set;
 
@@ -577,21 +583,18 @@ static st_status append_images(fill_set *F, const st_soup *s, const map *maps, s
             continue;
         if (F->soup->ntris >= F->cap) {
             const size_t cap = 2 * F->cap + 64;
-            size_t *p = realloc(F->piece, cap * sizeof *p);
-            if (p)
-                F->piece = p;
-            size_t *m = realloc(F->map, cap * sizeof *m);
-            if (m)
-                F->map = m;
-            double *e = realloc(F->err, cap * sizeof *e);
-            if (e)
-                F->err = e;
-            if (!p || !m || !e)
+            int fail = 0;
+            F->piece = grown(F->piece, cap, sizeof *F->piece, &fail);
+            F->map = grown(F->map, cap, sizeof *F->map, &fail);
+            F->err = grown(F->err, cap, sizeof *F->err, &fail);
+            F->src = grown(F->src, cap, sizeof *F->src, &fail);
+            if (fail)
                 return ST_ENOMEM;
             F->cap = cap;
         }
         F->piece[F->soup->ntris] = keep[t];
         F->map[F->soup->ntris] = mi;
+        F->src[F->soup->ntris] = t;
         F->err[F->soup->ntris] = map_err[keep[t]];
         double q[3][3];
         image(s, t, maps + mi, q);
@@ -607,6 +610,7 @@ static st_status append_images(fill_set *F, const st_soup *s, const map *maps, s
 typedef struct fill_edge {
     double e[6];
     size_t tri;
+    int k;
 } fill_edge;
 
 static int cmp_fill_edge(const void *x, const void *y)
@@ -635,10 +639,43 @@ static int near_other(void *ctx, uint32_t t)
            O->reach2;
 }
 
-/* open[i]: the length of piece i's fill boundary that lies farther than
- * reach from the soup and from every other map's fill: where the fill,
- * its copy itself holed, leaves the hole open. A fill boundary edge is an
- * edge in one fill triangle alone (the images of one map share their
+/* The soup's boundary edges as bits per triangle (fill_set.rim). */
+static uint8_t *rim_bits(const st_soup *s, const st_soup_edges *E)
+{
+    uint8_t *rim = calloc(s->ntris ? s->ntris : 1, 1);
+    if (!rim)
+        return NULL;
+    for (size_t i = 0; i < E->nhalf; i = st_soup_edges_run_end(E, i)) {
+        if (st_soup_edges_run_end(E, i) != i + 1)
+            continue;
+        const uint32_t t = E->he[i].t;
+        const int ca = st_soup_edges_corner(E, s, t, (uint32_t)(E->he[i].key >> 32)),
+                  cb = st_soup_edges_corner(E, s, t, (uint32_t)E->he[i].key);
+        if (ca >= 0 && cb >= 0)
+            rim[t] |= (uint8_t)(1u << ((ca + 1) % 3 == cb ? ca : cb));
+    }
+    return rim;
+}
+
+/* Whether fill triangle t's edge k (image corners k, k + 1) is the image
+ * of a boundary edge of the soup (a hole in the copy); every edge when the
+ * soup's boundary is unknown. */
+static int copy_rim(const fill_set *F, size_t t, int k)
+{
+    if (!F->rim)
+        return 1;
+    const int flip = F->maps[F->map[t]].y->kind == ST_SYMMETRY_MIRROR;
+    const int c1 = flip && k ? 3 - k : k, k2 = (k + 1) % 3, c2 = flip && k2 ? 3 - k2 : k2;
+    const int edge = (c1 + 1) % 3 == c2 ? c1 : c2;
+    return (F->rim[F->src[t]] >> edge) & 1;
+}
+
+/* open[i]: the length of piece i's fill boundary that is the image of the
+ * copy's own rim and lies farther than reach from the soup and from every
+ * other map's fill: where the fill, its copy itself holed, leaves the hole
+ * open (where an image was left out beside the soup or another map's fill,
+ * the fill has an edge too, but no hole of the copy). A fill boundary edge
+ * is an edge in one fill triangle alone (the images of one map share their
  * corners' coordinates exactly where the soup's triangles share them). */
 static st_status open_length(double *open, size_t npieces, const fill_set *F,
                              const st_bvh *bvh, const st_bvh *fill_bvh, double reach)
@@ -657,13 +694,14 @@ static st_status open_length(double *open, size_t npieces, const fill_set *F,
             const uint32_t *c = f->tris + 3 * t;
             ends_of(e[3 * t + k].e, f->xyz + 3 * c[k], f->xyz + 3 * c[(k + 1) % 3]);
             e[3 * t + k].tri = t;
+            e[3 * t + k].k = k;
         }
     qsort(e, ne, sizeof *e, cmp_fill_edge);
     for (size_t i = 0; i < ne;) {
         size_t j = i + 1;
         while (j < ne && cmp_ends(e[j].e, e[i].e) == 0)
             j++;
-        if (j == i + 1) {
+        if (j == i + 1 && copy_rim(F, e[i].tri, e[i].k)) {
             const double *p = e[i].e, *q = e[i].e + 3;
             const double m[3] = {0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]), 0.5 * (p[2] + q[2])};
             const double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
@@ -873,7 +911,8 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
         return st_error_set(err, ST_EINPUT, NULL, 0,
                             "symmetry fill: the tolerance must be positive and finite");
     st_soup *kept = st_soup_new(), *anchors = st_soup_new(), *fill = NULL;
-    fill_set F = {st_soup_new(), NULL, NULL, NULL, 0};
+    map maps[ST_SYMMETRY_MAX * ST_SYMMETRY_DEFAULT_MAX_ORDER];
+    fill_set F = {.soup = st_soup_new(), .maps = maps};
     st_bvh *anchors_bvh = NULL, *fill_bvh = NULL;
     size_t *keep = NULL;
     uint8_t *covered = NULL;
@@ -882,7 +921,6 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
     rims R;
     memset(&P, 0, sizeof P);
     memset(&R, 0, sizeof R);
-    map maps[ST_SYMMETRY_MAX * ST_SYMMETRY_DEFAULT_MAX_ORDER];
     st_status rc = kept && anchors && F.soup ? ST_OK : ST_ENOMEM;
     if (rc || !set || set->n == 0 || s->ntris == 0 || (!(caps && caps->ntris) && !edges)) {
         if (!rc && caps)
@@ -903,6 +941,10 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
     if (P.n == 0)
         goto done;
     pieces_box(&P, anchors);
+    if (edges && !(F.rim = rim_bits(s, edges))) {
+        rc = ST_ENOMEM;
+        goto done;
+    }
     keep = st_malloc_array(s->ntris, sizeof *keep);
     covered = st_malloc_array(P.n, 1);
     share = st_malloc_array(2 * P.n, sizeof *share);
@@ -932,6 +974,8 @@ done:
     free(F.piece);
     free(F.map);
     free(F.err);
+    free(F.src);
+    free(F.rim);
     free(map_err);
     pieces_free(&P);
     rims_free(&R);

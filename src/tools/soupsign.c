@@ -373,6 +373,33 @@ static st_pseudo_params pseudo_params(const soupsign_settings *s)
     return pp;
 }
 
+/* -v: how much of the pseudo volume's boundary has no soup within a voxel
+ * (the fill), and of it the symmetric fill's (sym; NULL: none). */
+static st_status say_fill(const tool_ctx *t, const st_grid *g, const st_bvh *bvh,
+                          const st_soup *sym, st_error *err)
+{
+    st_soup *fill = NULL;
+    st_pseudo_guess gs;
+    st_status rc = st_pseudo_fill(&fill, g, bvh, NULL, err);
+    if (rc)
+        return rc;
+    st_pseudo_guess_measure(&gs, g, fill, bvh);
+    rc = st_pseudo_guess_symmetric(&gs, g, fill, sym, err);
+    st_soup_free(fill);
+    if (rc)
+        return rc;
+    const double all = gs.boundary_faces ? (double)gs.boundary_faces : 1.0;
+    char of_sym[96] = "";
+    if (sym)
+        snprintf(of_sym, sizeof of_sym, "; %zu of them (%.1f%%) from the symmetric fill",
+                 gs.symmetric_faces, 100.0 * (double)gs.symmetric_faces / all);
+    tool_say(t, 2, "fill: %zu of %zu boundary faces (%.1f%%) have no soup within a voxel "
+             "(caps, a far side), up to %.3g voxels (%.6g) from it%s", gs.fill_faces,
+             gs.boundary_faces, 100.0 * (double)gs.fill_faces / all, gs.depth / g->voxel,
+             gs.depth, of_sym);
+    return ST_OK;
+}
+
 static int run(tool_ctx *t, void *settings)
 {
     const soupsign_settings *s = settings;
@@ -485,32 +512,9 @@ static int run(tool_ctx *t, void *settings)
                  "%.3f s", ps.shells, ps.shell_open_triangles,
                  ps.shells && !ps.shell_open_triangles ? ": the signs are their solid" : "",
                  ps.shell_changed, ps.seconds_shells);
-    if (bvh && voted) {
-        st_soup *fill = NULL;
-        st_pseudo_guess gs;
-        if (st_pseudo_fill(&fill, g, bvh, NULL, &err)) {
-            rc = tool_fail(t, &err);
-            goto done;
-        }
-        st_pseudo_guess_measure(&gs, g, fill, bvh);
-        st_status gr = st_pseudo_guess_symmetric(&gs, g, fill, sym, &err);
-        st_soup_free(fill);
-        if (gr) {
-            rc = tool_fail(t, &err);
-            goto done;
-        }
-        char of_sym[96] = "";
-        if (sym)
-            snprintf(of_sym, sizeof of_sym, "; %zu of them (%.1f%%) from the symmetric fill",
-                     gs.symmetric_faces,
-                     gs.boundary_faces ? 100.0 * (double)gs.symmetric_faces /
-                                             (double)gs.boundary_faces : 0.0);
-        tool_say(t, 2, "fill: %zu of %zu boundary faces (%.1f%%) have no soup within a voxel "
-                 "(caps, a far side), up to %.3g voxels (%.6g) from it%s", gs.fill_faces,
-                 gs.boundary_faces,
-                 gs.boundary_faces ? 100.0 * (double)gs.fill_faces / (double)gs.boundary_faces
-                                   : 0.0,
-                 gs.depth / g->voxel, gs.depth, of_sym);
+    if (bvh && voted && say_fill(t, g, bvh, sym, &err)) {
+        rc = tool_fail(t, &err);
+        goto done;
     }
     if (bvh && soup && (rc = tool_report_symmetries(t, soup, bvh, g->voxel, &ps.symmetries,
                                                     &ps.symmetry_fill, ps.seconds_symmetry)))
