@@ -917,7 +917,7 @@ static void test_fill(void)
          * boundary faces, about 1/6 (less the rim within a voxel of the
          * walls), as far from the soup as its middle from the walls' top
          * edges (1/2) */
-        st_pseudo_guess gs = {0, 0, -1.0};
+        st_pseudo_guess gs = {0, 0, -1.0, 0};
         if (ok)
             st_pseudo_guess_measure(&gs, g, f, bvh);
         const double share = gs.boundary_faces ? (double)gs.fill_faces / gs.boundary_faces : -1;
@@ -930,6 +930,21 @@ static void test_fill(void)
                       fabs(gs.depth - 0.5) <= v,
                       "the open box: its top is the guess, %.3f of the boundary, up to %.4f "
                       "from the soup (voxel %g)", share, gs.depth, v);
+        if (!closed) {
+            /* the part a symmetric fill supplied: a triangle over half the
+             * top (x + y <= 1) takes about half the fill's squares, none
+             * without one */
+            st_soup *half = st_soup_new();
+            add_tri(half, (double[3]){0, 0, 1}, (double[3]){1, 0, 1}, (double[3]){0, 1, 1}, 0);
+            st_pseudo_guess gh = gs;
+            int sym_ok = ok && !st_pseudo_guess_symmetric(&gh, g, f, half, &err);
+            const double part = gh.fill_faces ? (double)gh.symmetric_faces / gh.fill_faces : -1;
+            TAP_CHECK(sym_ok && part >= 0.45 && part <= 0.65,
+                      "half the top from a symmetric fill: %.3f of the guess", part);
+            TAP_CHECK(ok && !st_pseudo_guess_symmetric(&gh, g, f, NULL, &err) &&
+                          gh.symmetric_faces == 0, "no symmetric fill: none of it");
+            st_soup_free(half);
+        }
         if (ok) {
             /* an unsigned field has no pseudo volume */
             st_grid *d = NULL;

@@ -83,11 +83,16 @@ typedef struct st_pseudo_params {
     double cap_reach;               /* voxels (3; the field's band if less) */
     int shells_shortcut;            /* the shells alone when they are the
                                        whole soup (1; 0: every step runs) */
-    int symmetry;                   /* step 2: where the soup has caps, its
-                                       symmetries (symmetry.h) fill the holes
-                                       their images cover, and those holes'
-                                       caps are dropped (0: off; measured in
+    int symmetry;                   /* step 2: the soup's symmetries
+                                       (symmetry.h) fill the holes, capped
+                                       or too large to cap, their images
+                                       close, and those holes' caps are
+                                       dropped (0: off; measured in
                                        doc/design/symmetry.md) */
+    st_soup **symmetric_fill;       /* not NULL: *symmetric_fill gets the
+                                       symmetric fill used (the caller's,
+                                       st_soup_free; NULL when none), for
+                                       st_pseudo_guess_symmetric */
 } st_pseudo_params;
 
 /* Every step on, the project's default rule. */
@@ -166,9 +171,20 @@ typedef struct st_pseudo_guess {
     size_t boundary_faces;
     size_t fill_faces;
     double depth;
+    size_t symmetric_faces;   /* of the fill's, those its symmetry filled
+                                 (st_pseudo_guess_symmetric; 0 before) */
 } st_pseudo_guess;
 void st_pseudo_guess_measure(st_pseudo_guess *out, const st_grid *g, const st_soup *fill,
                              const st_bvh *bvh);
+
+/* out->symmetric_faces: the squares of fill (st_pseudo_fill's, for grid g)
+ * whose center lies within one voxel of sym (the symmetric fill the
+ * pseudo volume used: st_pseudo_params.symmetric_fill), as st_pseudo_fill
+ * tells the soup's faces: the part of the guess its symmetric copy
+ * supplied, the rest being caps and far sides. 0 when fill or sym is NULL
+ * or empty. ST_ENOMEM. */
+st_status st_pseudo_guess_symmetric(st_pseudo_guess *out, const st_grid *g,
+                                    const st_soup *fill, const st_soup *sym, st_error *err);
 
 #ifdef __cplusplus
 }

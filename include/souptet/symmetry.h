@@ -21,6 +21,7 @@
 #include <stddef.h>
 
 #include "souptet/bvh.h"
+#include "souptet/edges.h"
 #include "souptet/err.h"
 #include "souptet/soup.h"
 
@@ -95,24 +96,41 @@ typedef struct st_symmetry_fill_stats {
     size_t triangles;     /* fill triangles kept */
     double area;          /* their area, model units squared */
     size_t caps;          /* cap pieces (connected) given */
-    size_t caps_covered;  /* of them, dropped: the fill runs along their rim */
+    size_t caps_covered;  /* of them, dropped: the fill closes them */
+    size_t open;          /* open rims: boundary loops no cap closes */
+    size_t open_filled;   /* of them, closed by the fill */
+    size_t unclosed;      /* pieces (caps or open rims) whose fill ran along
+                             the rim but left the hole open (its copy
+                             itself holed): no fill there */
+    size_t caps_agree;    /* caps the fill closes but does not depart from
+                             (within tol of the cap): kept, no fill */
 } st_symmetry_fill_stats;
 
-/* Where soup s has holes (caps: their caps, holes.h, each piece's
- * triangles joined by shared vertices), the images of s's triangles under
- * the symmetries of set: *fill gets every image whose centroid lies
- * farther than tol from s and from the images kept before it (the soup
- * wins where it is; the first map that covers a place wins there) and
- * within reach of a cap (half its piece's box diagonal). Mirror images
- * are re-oriented so the fill keeps s's orientation. *kept_caps gets the
- * caps minus the pieces whose rim the fill runs along (at least 3/4 of the
- * rim's length within 3 tol of the fill): the fill has the shape there.
- * Deterministic for any thread count. bvh: st_bvh_build(s). Both outputs
- * are the caller's (st_soup_free); empty soups when set has nothing.
- * ST_EINPUT for a tol that is not positive and finite; ST_ENOMEM. */
+/* Where soup s has holes, the images of s's triangles under the
+ * symmetries of set. A hole is a piece of its caps (caps: holes.h, each
+ * piece's triangles joined by shared vertices) or an open rim: a loop of
+ * s's boundary edges (edges: s's table, edges.h; NULL: none) along no
+ * cap's rim (too large or too long to cap). An image is fill when its
+ * centroid lies farther than tol from s and from the images kept before
+ * it (the soup wins where it is; the first map that covers a place wins
+ * there), within reach of a hole (half its piece's box diagonal), and
+ * nearer that cap than s, or, for an open rim, with the rim s's nearest
+ * part to within tol; and the map puts the hole's rim back on s (at least
+ * 0.8 of its length within 3 tol, and within tol on average: the map's
+ * error there). A hole's fill is kept when it closes the hole: at least
+ * 3/4 of the rim's length within 3 tol of the fill, and the fill's own
+ * boundary farther than 3 tol from s and from the other maps' fill at
+ * most 1/4 of the rim's length; and, for a cap, when the fill departs
+ * from the cap (some corner or centroid farther than tol plus the map's
+ * error): else the cap stays, without fill. *kept_caps gets the caps
+ * minus the pieces the fill closes. Mirror images are re-oriented so the fill keeps s's
+ * orientation. Deterministic for any thread count. bvh: st_bvh_build(s).
+ * Both outputs are the caller's (st_soup_free); empty soups when set has
+ * nothing. ST_EINPUT for a tol that is not positive and finite;
+ * ST_ENOMEM. */
 st_status st_symmetry_fill(st_soup **fill, st_soup **kept_caps, const st_soup *s,
-                           const st_bvh *bvh, const st_symmetry_set *set,
-                           const st_soup *caps, double tol,
+                           const st_soup_edges *edges, const st_bvh *bvh,
+                           const st_symmetry_set *set, const st_soup *caps, double tol,
                            st_symmetry_fill_stats *stats, st_error *err);
 
 #ifdef __cplusplus

@@ -120,7 +120,7 @@ def read_parts(path, mode="auto"):
 
 def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
          threads=0, progress=None, float32=False, cancel=None, try_all=False,
-         parts=None, part_names=None):
+         parts=None, part_names=None, fill_holes=True, symmetry=False):
     """Mesh a triangle soup into a coarse tet mesh that encloses it (soupmesh).
 
     V         (n, 3) numbers, the vertices in model units (finite)
@@ -169,13 +169,20 @@ def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
               owning most of its volume, the inner part where one lies in
               another (.parts, .part_share, .part_names; written by write())
     part_names  list of str or None: the parts' names (default part_K)
+    fill_holes  bool, cap the soup's holes for the pseudo volume (default
+              True, as soupsign/soupmesh --fill-holes on; False: the vote
+              alone closes them)
+    symmetry    bool, fill the holes from the soup's own mirror planes and
+              rotation axes, where their images close a hole (default
+              False, as --symmetry off; needs fill_holes)
     Returns a MeshResult. Not enclosing is not an error: see .encloses.
     Raises souptet.Error for bad input or parameters, MemoryError.
     """
     return MeshResult(_core.mesh(V, F, cells=cells, size=size, tets=tets, tries=tries,
                                  seed=seed, offset=offset, threads=threads,
                                  progress=progress, float32=float32, cancel=cancel,
-                                 try_all=try_all, parts=parts, part_names=part_names))
+                                 try_all=try_all, parts=parts, part_names=part_names,
+                                 fill_holes=fill_holes, symmetry=symmetry))
 
 
 class Field:
@@ -200,17 +207,20 @@ class Field:
                                                    self.voxel)
 
 
-def pseudo_volume(V, F, resolution=128):
+def pseudo_volume(V, F, resolution=128, *, fill_holes=True, symmetry=False):
     """The pseudo volume of a soup: which voxels are inside (soupdist -r N | soupsign).
 
     V, F        as mesh()
     resolution  int, voxels along the longest side of the soup's box
                 (default 128, as soupdist -r; 1..65536)
+    fill_holes, symmetry  as mesh() (soupsign/soupwrap --fill-holes,
+                --symmetry)
     Returns a Field: .inside bool (nx, ny, nz) indexed [i, j, k], .values the
     signed distance (negative inside; exact within 3 voxels of the surface,
     clamped to .band beyond), .origin, .voxel.
     """
-    return Field(_core.pseudo_volume(V, F, resolution), True)
+    return Field(_core.pseudo_volume(V, F, resolution, fill_holes=fill_holes,
+                                     symmetry=symmetry), True)
 
 
 def distance(V, F, resolution=128, *, band=3.0):
@@ -229,13 +239,15 @@ def distance(V, F, resolution=128, *, band=3.0):
     return Field(_core.distance(V, F, resolution, band), False)
 
 
-def wrap(V, F, resolution=128):
+def wrap(V, F, resolution=128, *, fill_holes=True, symmetry=False):
     """A closed, oriented, 2-manifold, self-intersection-free surface around the
     soup's pseudo volume (soupwrap --surface; needs souptet._io: OpenVDB).
 
     V, F        as mesh()
     resolution  int, voxels of the field along the longest side (default 128,
                 as soupwrap -r)
+    fill_holes, symmetry  as mesh() (soupsign/soupwrap --fill-holes,
+                --symmetry)
     Returns (V2, F2): float64 (n, 3) (float-representable) and int64 (m, 3).
     """
-    return _load_io().wrap(V, F, resolution)
+    return _load_io().wrap(V, F, resolution, fill_holes=fill_holes, symmetry=symmetry)

@@ -66,6 +66,8 @@ def mesh(
     try_all: bool = ...,
     parts: Union[None, str, npt.ArrayLike] = ...,
     part_names: Optional[List[str]] = ...,
+    fill_holes: bool = ...,
+    symmetry: bool = ...,
 ) -> MeshResult: ...
 
 class Field:
@@ -75,6 +77,8 @@ class Field:
     voxel: float
     band: float
 
-def pseudo_volume(V: npt.ArrayLike, F: npt.ArrayLike, resolution: int = ...) -> Field: ...
+def pseudo_volume(V: npt.ArrayLike, F: npt.ArrayLike, resolution: int = ..., *,
+                  fill_holes: bool = ..., symmetry: bool = ...) -> Field: ...
 def distance(V: npt.ArrayLike, F: npt.ArrayLike, resolution: int = ..., *, band: float = ...) -> Field: ...
-def wrap(V: npt.ArrayLike, F: npt.ArrayLike, resolution: int = ...) -> Tuple[_F64, _I64]: ...
+def wrap(V: npt.ArrayLike, F: npt.ArrayLike, resolution: int = ..., *,
+         fill_holes: bool = ..., symmetry: bool = ...) -> Tuple[_F64, _I64]: ...

@@ -540,26 +540,40 @@ static int opt_size(PyObject *o, const char *name, size_t lo, size_t hi, size_t 
     return 0;
 }
 
+/* A bool keyword into *out (NULL: the default, left as it is). */
+static int opt_flag(PyObject *o, int *out)
+{
+    if (!o)
+        return 0;
+    const int v = PyObject_IsTrue(o);
+    if (v < 0)
+        return -1;
+    *out = v;
+    return 0;
+}
+
 static PyObject *py_mesh(PyObject *self, PyObject *args, PyObject *kw)
 {
     (void)self;
     static char *kwlist[] = {"V", "F", "cells", "size", "tets", "tries", "seed",
                              "offset", "threads", "progress", "float32", "cancel", "try_all",
-                             "parts", "part_names", NULL};
+                             "parts", "part_names", "fill_holes", "symmetry", NULL};
     PyObject *V, *F, *cells_o = NULL, *size_o = Py_None, *tets_o = Py_None, *tries_o = NULL,
                      *seed_o = NULL, *offset_o = NULL, *threads_o = NULL, *progress = Py_None,
                      *f32_o = Py_False, *cancel_o = Py_None, *try_all_o = Py_False,
-                     *parts_o = Py_None, *pnames_o = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|$OOOOOOOOOOOOO:mesh", kwlist, &V, &F, &cells_o,
-                                     &size_o, &tets_o, &tries_o, &seed_o, &offset_o,
+                     *parts_o = Py_None, *pnames_o = Py_None, *holes_o = NULL, *sym_o = NULL;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|$OOOOOOOOOOOOOOO:mesh", kwlist, &V, &F,
+                                     &cells_o, &size_o, &tets_o, &tries_o, &seed_o, &offset_o,
                                      &threads_o, &progress, &f32_o, &cancel_o, &try_all_o,
-                                     &parts_o, &pnames_o))
+                                     &parts_o, &pnames_o, &holes_o, &sym_o))
         return NULL;
     if (cancel_o != Py_None && !PyObject_TypeCheck(cancel_o, &CancelType)) {
         PyErr_SetString(PyExc_TypeError, "cancel must be a souptet.Cancel or None");
         return NULL;
     }
     st_pipeline_params p = st_pipeline_params_default();
+    if (opt_flag(holes_o, &p.fill_holes) || opt_flag(sym_o, &p.symmetry))
+        return NULL;
     size_t threads = 0, seed = (size_t)p.seed;
     if (cells_o && opt_size(cells_o, "cells", 1, ST_PIPELINE_MAX_CELLS, &p.cells))
         return NULL;
@@ -711,10 +725,15 @@ static PyObject *grid_result(const st_grid *g)
 static PyObject *field_call(PyObject *args, PyObject *kw, int signs)
 {
     static char *kwlist_d[] = {"V", "F", "resolution", "band", NULL};
-    static char *kwlist_s[] = {"V", "F", "resolution", NULL};
-    PyObject *V, *F, *res_o = NULL, *band_o = NULL;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, signs ? "OO|O:pseudo_volume" : "OO|OO:distance",
-                                     signs ? kwlist_s : kwlist_d, &V, &F, &res_o, &band_o))
+    static char *kwlist_s[] = {"V", "F", "resolution", "fill_holes", "symmetry", NULL};
+    PyObject *V, *F, *res_o = NULL, *band_o = NULL, *holes_o = NULL, *sym_o = NULL;
+    if (signs ? !PyArg_ParseTupleAndKeywords(args, kw, "OO|O$OO:pseudo_volume", kwlist_s, &V,
+                                             &F, &res_o, &holes_o, &sym_o)
+              : !PyArg_ParseTupleAndKeywords(args, kw, "OO|OO:distance", kwlist_d, &V, &F,
+                                             &res_o, &band_o))
+        return NULL;
+    st_pseudo_params pp = st_pseudo_params_default();
+    if (opt_flag(holes_o, &pp.fill_holes) || opt_flag(sym_o, &pp.symmetry))
         return NULL;
     st_dist_params dp = st_dist_params_default();
     dp.cells = ST_DIST_DEFAULT_CELLS;
@@ -733,7 +752,6 @@ static PyObject *field_call(PyObject *args, PyObject *kw, int signs)
         return NULL;
     volatile int cancel = 0;
     st_progress prog = {NULL, NULL, &cancel};
-    st_pseudo_params pp = st_pseudo_params_default();
     st_grid *g = NULL;
     st_error e;
     st_error_clear(&e);

@@ -18,10 +18,12 @@
 static PyObject *py_wrap(PyObject *self, PyObject *args, PyObject *kw)
 {
     (void)self;
-    static char *kwlist[] = {"V", "F", "resolution", NULL};
+    static char *kwlist[] = {"V", "F", "resolution", "fill_holes", "symmetry", NULL};
     PyObject *V, *F;
     Py_ssize_t cells = ST_DIST_DEFAULT_CELLS;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|n:wrap", kwlist, &V, &F, &cells))
+    int holes = st_pseudo_params_default().fill_holes, sym = st_pseudo_params_default().symmetry;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|n$pp:wrap", kwlist, &V, &F, &cells, &holes,
+                                     &sym))
         return NULL;
     if (cells < 1 || cells > 65536)
         return py_fail("resolution must be in 1..65536, not %zd", cells);
@@ -32,6 +34,8 @@ static PyObject *py_wrap(PyObject *self, PyObject *args, PyObject *kw)
     dp.cells = (size_t)cells;
     dp.max_bytes = py_max_bytes();
     st_pseudo_params pp = st_pseudo_params_default();
+    pp.fill_holes = holes;
+    pp.symmetry = sym;
     st_wrap_params wp = st_wrap_params_default();
     volatile int cancel = 0;
     st_progress prog = {NULL, NULL, &cancel};

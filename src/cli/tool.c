@@ -862,8 +862,11 @@ int tool_report_symmetries(tool_ctx *t, const st_soup *soup, const st_bvh *bvh,
     if (set->candidates > 0) {
         tool_say(t, 2, "symmetries: %zu with support >= %.2f within %.6g (%zu candidates "
                  "measured); fill: %zu triangles from %zu maps, %zu of %zu caps dropped as "
-                 "covered, %.3f s", set->n, sp.min_support, tolerance, set->candidates,
-                 fill->triangles, fill->maps, fill->caps_covered, fill->caps, seconds);
+                 "covered, %zu kept (the fill agrees with them), %zu of %zu holes too large "
+                 "to cap filled, %zu left as they were (the copy itself holed), %.3f s",
+                 set->n, sp.min_support, tolerance, set->candidates, fill->triangles,
+                 fill->maps, fill->caps_covered, fill->caps, fill->caps_agree,
+                 fill->open_filled, fill->open, fill->unclosed, seconds);
     } else {
         st_error err;
         st_bvh *built = NULL;

@@ -68,7 +68,8 @@ static st_status shells_only(st_grid *g, const st_shells *shells, const st_pseud
 /* Step 2's symmetry (pseudo.h): the soup's symmetries at a voxel's
  * tolerance; where they are, *caps becomes the caps the fill does not
  * cover and the fill. */
-static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_bvh *bvh,
+static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_soup_edges *edges,
+                                const st_bvh *bvh, const st_pseudo_params *p,
                                 st_pseudo_stats *st, st_soup **caps, st_error *err)
 {
     const double t0 = now_seconds();
@@ -80,15 +81,21 @@ static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_bvh *bvh,
         return rc;
     }
     st_soup *fill = NULL, *kept = NULL;
-    rc = st_symmetry_fill(&fill, &kept, s, bvh, &st->symmetries, *caps, g->voxel,
+    rc = st_symmetry_fill(&fill, &kept, s, edges, bvh, &st->symmetries, *caps, g->voxel,
                           &st->symmetry_fill, err);
     rc = rc ? rc : st_soup_append(kept, fill, err);
-    char buf[160];
-    snprintf(buf, sizeof buf, "%zu symmetries, %zu maps: %zu triangles, %zu of %zu caps covered",
-             st->symmetries.n, st->symmetry_fill.maps, st->symmetry_fill.triangles,
-             st->symmetry_fill.caps_covered, st->symmetry_fill.caps);
+    char buf[200];
+    const st_symmetry_fill_stats *f = &st->symmetry_fill;
+    snprintf(buf, sizeof buf, "%zu symmetries, %zu maps: %zu triangles, %zu of %zu caps "
+             "covered (%zu agreeing kept), %zu of %zu open holes filled, %zu left open",
+             st->symmetries.n, f->maps, f->triangles, f->caps_covered, f->caps, f->caps_agree,
+             f->open_filled, f->open, f->unclosed);
     if (!rc && st_meta_set(&g->meta, "symmetry_fill", buf))
         rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    if (!rc && p->symmetric_fill && fill->ntris) {
+        *p->symmetric_fill = fill;
+        fill = NULL;
+    }
     st_soup_free(fill);
     if (rc) {
         st_soup_free(kept);
@@ -111,7 +118,10 @@ static st_status add_caps(st_grid *g, const st_soup *s, const st_soup_edges *edg
     st_status rc = st_soup_hole_caps_shared(&caps, s, edges, bvh, &p->holes, &st->holes, err);
     if (rc)
         return rc;
-    if (p->symmetry && caps->ntris && (rc = symmetric_fill(g, s, bvh, st, &caps, err))) {
+    /* the symmetric fill where there are caps, or loops too large to cap */
+    const int open = st->holes.loops > st->holes.filled;
+    if (p->symmetry && (caps->ntris || open) &&
+        (rc = symmetric_fill(g, s, edges, bvh, p, st, &caps, err))) {
         st_soup_free(caps);
         return rc;
     }
@@ -204,6 +214,8 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
 {
     if (bvh_out)
         *bvh_out = NULL;
+    if (p && p->symmetric_fill)
+        *p->symmetric_fill = NULL;
     st_pseudo_stats local;
     st_pseudo_stats *st = stats ? stats : &local;
     memset(st, 0, sizeof *st);
@@ -308,6 +320,10 @@ count_inside:;
         bvh = NULL;
     }
 done:
+    if (rc && p->symmetric_fill) {
+        st_soup_free(*p->symmetric_fill);
+        *p->symmetric_fill = NULL;
+    }
     st_bvh_free(bvh);
     if (have_edges)
         st_soup_edges_free(&edges);

@@ -124,4 +124,32 @@ void st_pseudo_guess_measure(st_pseudo_guess *out, const st_grid *g, const st_so
     out->boundary_faces = all;
     out->fill_faces = (size_t)nsq;
     out->depth = sqrt(depth2);
+    out->symmetric_faces = 0;
+}
+
+st_status st_pseudo_guess_symmetric(st_pseudo_guess *out, const st_grid *g,
+                                    const st_soup *fill, const st_soup *sym, st_error *err)
+{
+    out->symmetric_faces = 0;
+    if (!fill || !sym || !fill->ntris || !sym->ntris)
+        return ST_OK;
+    st_bvh *b = NULL;
+    st_status rc = st_bvh_build(&b, sym, err);
+    if (rc)
+        return rc;
+    const double reach2 = g->voxel * g->voxel;
+    const long long nsq = (long long)(fill->ntris / 2);
+    size_t near = 0;
+    #pragma omp parallel for schedule(dynamic, 256) reduction(+ : near)
+    for (long long q = 0; q < nsq; q++) {
+        const uint32_t *t = fill->tris + 6 * (size_t)q;
+        const double *a = fill->xyz + 3 * (size_t)t[0], *c = fill->xyz + 3 * (size_t)t[2];
+        const double m[3] = {0.5 * (a[0] + c[0]), 0.5 * (a[1] + c[1]), 0.5 * (a[2] + c[2])};
+        int64_t tri;
+        (void)st_bvh_nearest(b, m, reach2, &tri, NULL);
+        near += tri >= 0;
+    }
+    st_bvh_free(b);
+    out->symmetric_faces = near;
+    return ST_OK;
 }

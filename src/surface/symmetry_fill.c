@@ -3,21 +3,30 @@
  * (symmetry.h, st_symmetry_fill; issue 37).
  *
  * A hole's cap guesses the missing surface from the rim alone: flat, or
- * continuing the faces. Where the soup is symmetric, the surviving side
- * mapped across the symmetry says what was there. The fill is every image
+ * continuing the faces; a hole too large to cap gets no guess at all.
+ * Where the soup is symmetric, the surviving side mapped across the
+ * symmetry says what was there. The holes are pieces: each cap's
+ * triangles joined by shared edges (one hole each), and each loop of the
+ * soup's boundary no cap runs along (an open rim). The fill is every image
  * of a soup triangle that lands where the soup is not (its centroid
  * farther than the tolerance from the soup: the soup wins wherever it is)
- * and near a cap (so only holes are filled, never the open air an
- * imprecise map lands in). A cap whose rim the fill runs along is dropped:
- * the fill gives that hole its shape, and a flat cap across it would cut
- * the solid the fill bounds.
+ * and in a hole (near a cap, nearer it than the soup; or with an open rim
+ * the soup's nearest part), through a map that puts the hole's rim back
+ * on the soup (most of its length, and within a voxel on average). A
+ * hole's fill is kept only when it closes the hole: it runs along the rim,
+ * and its own boundary lies on the soup or on another map's fill (a copy
+ * itself holed leaves its holes in the fill, and the cap stays). A cap
+ * the fill closes is dropped where the fill departs from it by more than
+ * the map's error: the fill gives that hole its shape, and a flat cap
+ * across it would cut the solid the fill bounds; where the two agree the
+ * cap stays and the fill is left out.
  *
  * Every decision is a distance compared with a tolerance of a voxel: the
  * fill is evidence for the signs (pseudo.c lowers it into the field as it
  * does the caps), never an output surface, so no exact predicate is
- * needed. Per map, the tests run in parallel into a flag per triangle; the
- * kept images are appended in triangle order, so the fill does not depend
- * on the thread count.
+ * needed. Per map, the tests run in parallel into a value per triangle;
+ * the kept images are appended in triangle order, so the fill does not
+ * depend on the thread count.
  */
 #include "souptet/symmetry.h"
 #include "../base/fpenv.h"
@@ -37,14 +46,19 @@
 #define RIM_AGREE 0.8           /* share of the rim whose preimage is on the
                                    soup: a map that may fill the piece */
 
-/* ---- the caps' pieces ------------------------------------------------------ */
+/* ---- the holes' pieces ------------------------------------------------------ */
 
+/* A piece is a hole the fill may close: a cap's connected triangles, or a
+ * loop of the soup's boundary no cap closes (too large or too long to
+ * cap: the open rims). Each is anchored by its triangles (an open rim by
+ * one degenerate triangle per edge) in one soup, `anchors`. */
 typedef struct pieces {
-    size_t n;            /* pieces */
-    size_t *of_tri;      /* piece of each cap triangle */
+    size_t n;            /* pieces: the caps' [0, ncap), then the open rims' */
+    size_t ncap;
+    size_t *of_tri;      /* piece of each anchor triangle */
     double *reach;       /* per piece: half its box diagonal */
     size_t *vrep;        /* each cap vertex's representative (same position) */
-    double lo[3], hi[3]; /* the caps' box, grown by the largest reach */
+    double lo[3], hi[3]; /* the anchors' box, grown by the largest reach */
 } pieces;
 
 static const double *g_xyz;   /* qsort's context: set just before the call */
@@ -66,18 +80,53 @@ static void pieces_free(pieces *P)
     memset(P, 0, sizeof *P);
 }
 
+typedef struct rim_edge {
+    size_t piece, a, b;   /* a < b: representatives */
+    size_t tri;           /* a cap triangle it bounds (its coordinates) */
+    int ia, ib;           /* corners in it */
+} rim_edge;
+
+static int cmp_edge(const void *x, const void *y)
+{
+    const rim_edge *p = x, *q = y;
+    if (p->a != q->a)
+        return p->a < q->a ? -1 : 1;
+    if (p->b != q->b)
+        return p->b < q->b ? -1 : 1;
+    return p->tri < q->tri ? -1 : p->tri > q->tri;
+}
+
+/* The caps' edges (piece SIZE_MAX), sorted by their ends' representatives. */
+static rim_edge *cap_edges(const st_soup *caps, const size_t *vrep)
+{
+    const size_t nt = caps->ntris, ne = 3 * nt;
+    rim_edge *e = st_malloc_array(ne ? ne : 1, sizeof *e);
+    if (!e)
+        return NULL;
+    for (size_t t = 0; t < nt; t++)
+        for (int k = 0; k < 3; k++) {
+            size_t a = vrep[caps->tris[3 * t + k]], b = vrep[caps->tris[3 * t + (k + 1) % 3]];
+            e[3 * t + k] = (rim_edge){SIZE_MAX, a < b ? a : b, a < b ? b : a, t, k, (k + 1) % 3};
+        }
+    qsort(e, ne, sizeof *e, cmp_edge);
+    return e;
+}
+
 /* Join the caps' vertices that share a position (each cap lists its rim's
- * points again), then the triangles through their vertices. */
+ * points again), then the triangles that share an edge: a piece is one
+ * hole's cap (two holes' caps meet at most at a vertex, where their loops
+ * touch). */
 static st_status pieces_make(pieces *P, const st_soup *caps)
 {
     memset(P, 0, sizeof *P);
-    const size_t nv = caps->nverts, nt = caps->ntris;
+    const size_t nv = caps->nverts, nt = caps->ntris, ne = 3 * nt;
     size_t *order = st_malloc_array(nv ? nv : 1, sizeof *order);
-    size_t *box_of = st_malloc_array(nv ? nv : 1, sizeof *box_of);
-    double *box = st_malloc_array(nv ? 6 * nv : 1, sizeof *box);
+    size_t *uf = st_malloc_array(nt ? nt : 1, sizeof *uf);
+    double *box = st_malloc_array(nt ? 6 * nt : 1, sizeof *box);
     P->vrep = st_malloc_array(nv ? nv : 1, sizeof *P->vrep);
     P->of_tri = st_malloc_array(nt ? nt : 1, sizeof *P->of_tri);
-    st_status rc = order && box_of && box && P->vrep && P->of_tri ? ST_OK : ST_ENOMEM;
+    rim_edge *e = NULL;
+    st_status rc = order && uf && box && P->vrep && P->of_tri ? ST_OK : ST_ENOMEM;
     if (rc)
         goto done;
     for (size_t v = 0; v < nv; v++)
@@ -88,56 +137,67 @@ static st_status pieces_make(pieces *P, const st_soup *caps)
         if (cmp_pos(order + i - 1, order + i) != 0 &&
             memcmp(caps->xyz + 3 * order[i - 1], caps->xyz + 3 * order[i], 3 * sizeof(double)) == 0)
             uf_join(P->vrep, order[i - 1], order[i]);
-    /* the positions' representatives, then the pieces in `order` */
     for (size_t v = 0; v < nv; v++)
-        order[v] = P->vrep[v] = uf_find(P->vrep, v);
-    for (size_t t = 0; t < nt; t++) {
-        const uint32_t *c = caps->tris + 3 * t;
-        uf_join(order, c[0], c[1]);
-        uf_join(order, c[0], c[2]);
+        P->vrep[v] = uf_find(P->vrep, v);
+    if (!(e = cap_edges(caps, P->vrep))) {
+        rc = ST_ENOMEM;
+        goto done;
     }
-    /* pieces numbered by their smallest vertex, in vertex order */
-    for (size_t v = 0; v < nv; v++)
-        box_of[v] = SIZE_MAX;
-    for (size_t v = 0; v < nv; v++) {
-        const size_t r = uf_find(order, v);
-        if (box_of[r] == SIZE_MAX) {
-            box_of[r] = P->n++;
+    for (size_t t = 0; t < nt; t++)
+        uf[t] = t;
+    for (size_t i = 1; i < ne; i++)
+        if (e[i].a == e[i - 1].a && e[i].b == e[i - 1].b)
+            uf_join(uf, e[i - 1].tri, e[i].tri);
+    /* pieces numbered by their smallest triangle, in triangle order */
+    for (size_t t = 0; t < nt; t++) {
+        const size_t r = uf_find(uf, t);
+        if (r == t) {
+            P->of_tri[t] = P->n++;
             for (int k = 0; k < 3; k++)
-                box[6 * box_of[r] + k] = box[6 * box_of[r] + 3 + k] = caps->xyz[3 * v + k];
+                box[6 * P->of_tri[t] + k] = box[6 * P->of_tri[t] + 3 + k] =
+                    caps->xyz[3 * caps->tris[3 * t] + k];
+        } else {
+            P->of_tri[t] = P->of_tri[r];
         }
-        double *b = box + 6 * box_of[r];
-        for (int k = 0; k < 3; k++) {
-            b[k] = fmin(b[k], caps->xyz[3 * v + k]);
-            b[3 + k] = fmax(b[3 + k], caps->xyz[3 * v + k]);
-        }
+        double *b = box + 6 * P->of_tri[t];
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 3; k++) {
+                b[k] = fmin(b[k], caps->xyz[3 * caps->tris[3 * t + c] + k]);
+                b[3 + k] = fmax(b[3 + k], caps->xyz[3 * caps->tris[3 * t + c] + k]);
+            }
     }
     P->reach = st_malloc_array(P->n ? P->n : 1, sizeof *P->reach);
     if (!P->reach) {
         rc = ST_ENOMEM;
         goto done;
     }
-    double most = 0.0;
     for (size_t i = 0; i < P->n; i++) {
         const double *b = box + 6 * i;
         const double d[3] = {b[3] - b[0], b[4] - b[1], b[5] - b[2]};
         P->reach[i] = 0.5 * st_norm3(d);
-        most = fmax(most, P->reach[i]);
     }
-    for (size_t t = 0; t < nt; t++)
-        P->of_tri[t] = box_of[uf_find(order, caps->tris[3 * t])];
-    st_soup_bounds(caps, P->lo, P->hi, NULL);
+    P->ncap = P->n;
+done:
+    free(order);
+    free(uf);
+    free(box);
+    free(e);
+    if (rc)
+        pieces_free(P);
+    return rc;
+}
+
+/* The anchors' box, grown by the largest reach (nothing farther is fill). */
+static void pieces_box(pieces *P, const st_soup *anchors)
+{
+    double most = 0.0;
+    for (size_t i = 0; i < P->n; i++)
+        most = fmax(most, P->reach[i]);
+    st_soup_bounds(anchors, P->lo, P->hi, NULL);
     for (int k = 0; k < 3; k++) {
         P->lo[k] -= most;
         P->hi[k] += most;
     }
-done:
-    free(order);
-    free(box_of);
-    free(box);
-    if (rc)
-        pieces_free(P);
-    return rc;
 }
 
 /* ---- the maps ----------------------------------------------------------------- */
@@ -177,62 +237,55 @@ static void image(const st_soup *s, size_t t, const map *m, double q[3][3])
 
 typedef struct fill_ctx {
     const st_soup *s;
-    const st_bvh *bvh, *caps_bvh, *fill_bvh;   /* fill_bvh: the maps before */
+    const st_bvh *bvh, *anchors_bvh, *fill_bvh;   /* fill_bvh: the maps before */
     const pieces *P;
     const uint8_t *piece_ok;   /* the map agrees with the piece's rim */
-    double tol2;
+    double tol;
 } fill_ctx;
 
-static int keeps(const fill_ctx *C, const double q[3][3])
+/* The piece image q fills, or SIZE_MAX. It must be off the soup (farther
+ * than tol: the soup wins wherever it is) and in a hole: within its
+ * piece's reach and, for a cap, nearer the cap than the soup; for an open
+ * rim (which is on the soup), with the rim the soup's nearest part, to
+ * within tol, so an image beside a wall the rim is not on adds nothing. */
+static size_t keeps(const fill_ctx *C, const double q[3][3])
 {
     double c[3];
     for (int k = 0; k < 3; k++) {
         c[k] = (q[0][k] + q[1][k] + q[2][k]) / 3.0;
         if (c[k] < C->P->lo[k] || c[k] > C->P->hi[k])
-            return 0;
+            return SIZE_MAX;
     }
     int64_t tri;
     const double most = C->P->hi[0] - C->P->lo[0] + C->P->hi[1] - C->P->lo[1] +
                         C->P->hi[2] - C->P->lo[2];
-    const double d2 = st_bvh_nearest(C->caps_bvh, c, most * most, &tri, NULL);
-    if (tri < 0 || !C->piece_ok[C->P->of_tri[tri]] ||
-        d2 > C->P->reach[C->P->of_tri[tri]] * C->P->reach[C->P->of_tri[tri]])
-        return 0;
-    /* off the soup, and nearer the caps than the soup: in a hole */
-    const double bound = fmax(C->tol2, d2);
+    const double d2 = st_bvh_nearest(C->anchors_bvh, c, most * most, &tri, NULL);
+    if (tri < 0)
+        return SIZE_MAX;
+    const size_t i = C->P->of_tri[tri];
+    if (!C->piece_ok[i] || d2 > C->P->reach[i] * C->P->reach[i])
+        return SIZE_MAX;
+    const double tol2 = C->tol * C->tol, near = sqrt(d2) - C->tol;
+    const double bound = i < C->P->ncap ? fmax(tol2, d2) : near > C->tol ? near * near : tol2;
     st_bvh_nearest(C->bvh, c, bound, &tri, NULL);
     if (tri >= 0)
-        return 0;
+        return SIZE_MAX;
     if (C->fill_bvh) {
-        st_bvh_nearest(C->fill_bvh, c, C->tol2, &tri, NULL);
+        st_bvh_nearest(C->fill_bvh, c, tol2, &tri, NULL);
         if (tri >= 0)
-            return 0;
+            return SIZE_MAX;
     }
-    return 1;
+    return i;
 }
 
-/* ---- covered caps ------------------------------------------------------------- */
+/* ---- the rims ------------------------------------------------------------------ */
 
-typedef struct rim_edge {
-    size_t piece, a, b;   /* a < b: representatives */
-    size_t tri;           /* a cap triangle it bounds (its coordinates) */
-    int ia, ib;           /* corners in it */
-} rim_edge;
-
-static int cmp_edge(const void *x, const void *y)
-{
-    const rim_edge *p = x, *q = y;
-    if (p->a != q->a)
-        return p->a < q->a ? -1 : 1;
-    if (p->b != q->b)
-        return p->b < q->b ? -1 : 1;
-    return p->tri < q->tri ? -1 : p->tri > q->tri;
-}
-
-/* The caps' rims: the edges in one cap triangle of their piece alone,
- * by midpoint and length. */
+/* The holes' rims: the caps' (the edges in one cap triangle of their piece
+ * alone), then the open rims' edges; each by its ends (the lexically
+ * smaller first), midpoint, length and piece. */
 typedef struct rims {
-    size_t n;
+    size_t n, cap;
+    double *ends;     /* 6n */
     double *mid;      /* 3n */
     double *len;      /* n */
     size_t *piece;    /* n */
@@ -240,54 +293,193 @@ typedef struct rims {
 
 static void rims_free(rims *R)
 {
+    free(R->ends);
     free(R->mid);
     free(R->len);
     free(R->piece);
     memset(R, 0, sizeof *R);
 }
 
+/* p reallocated to n items of size bytes, or p itself and *fail set. */
+static void *grown(void *p, size_t n, size_t size, int *fail)
+{
+    void *q = realloc(p, n * size);
+    if (!q)
+        *fail = 1;
+    return q ? q : p;
+}
+
+static st_status rims_grow(rims *R, size_t more)
+{
+    if (R->n + more <= R->cap)
+        return ST_OK;
+    const size_t cap = 2 * (R->n + more);
+    int fail = 0;
+    R->ends = grown(R->ends, 6 * cap, sizeof *R->ends, &fail);
+    R->mid = grown(R->mid, 3 * cap, sizeof *R->mid, &fail);
+    R->len = grown(R->len, cap, sizeof *R->len, &fail);
+    R->piece = grown(R->piece, cap, sizeof *R->piece, &fail);
+    if (fail)
+        return ST_ENOMEM;
+    R->cap = cap;
+    return ST_OK;
+}
+
+/* Ends p, q in lexical order into e[6]. */
+static void ends_of(double e[6], const double p[3], const double q[3])
+{
+    int swap = 0;
+    for (int k = 0; k < 3; k++)
+        if (p[k] != q[k]) {
+            swap = q[k] < p[k];
+            break;
+        }
+    memcpy(e, swap ? q : p, 3 * sizeof *e);
+    memcpy(e + 3, swap ? p : q, 3 * sizeof *e);
+}
+
+static st_status rims_add(rims *R, const double p[3], const double q[3], size_t piece)
+{
+    if (rims_grow(R, 1))
+        return ST_ENOMEM;
+    const double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+    ends_of(R->ends + 6 * R->n, p, q);
+    for (int k = 0; k < 3; k++)
+        R->mid[3 * R->n + k] = 0.5 * (p[k] + q[k]);
+    R->len[R->n] = st_norm3(d);
+    R->piece[R->n++] = piece;
+    return ST_OK;
+}
+
 static st_status rims_make(rims *R, const st_soup *caps, const pieces *P)
 {
     memset(R, 0, sizeof *R);
-    const size_t nt = caps->ntris, ne = 3 * nt;
-    rim_edge *e = st_malloc_array(ne ? ne : 1, sizeof *e);
-    R->mid = st_malloc_array(ne ? 3 * ne : 1, sizeof *R->mid);
-    R->len = st_malloc_array(ne ? ne : 1, sizeof *R->len);
-    R->piece = st_malloc_array(ne ? ne : 1, sizeof *R->piece);
-    if (!e || !R->mid || !R->len || !R->piece) {
-        free(e);
-        rims_free(R);
+    const size_t ne = 3 * caps->ntris;
+    rim_edge *e = cap_edges(caps, P->vrep);
+    if (!e)
         return ST_ENOMEM;
-    }
-    for (size_t t = 0; t < nt; t++)
-        for (int k = 0; k < 3; k++) {
-            size_t a = P->vrep[caps->tris[3 * t + k]], b = P->vrep[caps->tris[3 * t + (k + 1) % 3]];
-            e[3 * t + k] = (rim_edge){P->of_tri[t], a < b ? a : b, a < b ? b : a, t, k, (k + 1) % 3};
-        }
-    qsort(e, ne, sizeof *e, cmp_edge);
-    for (size_t i = 0; i < ne;) {
+    st_status rc = ST_OK;
+    for (size_t i = 0; i < ne && !rc;) {
         size_t j = i + 1;
         while (j < ne && e[j].a == e[i].a && e[j].b == e[i].b)
             j++;
         if (j == i + 1 && e[i].a != e[i].b) {
             const uint32_t *c = caps->tris + 3 * e[i].tri;
-            const double *p = caps->xyz + 3 * c[e[i].ia], *q = caps->xyz + 3 * c[e[i].ib];
-            const double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-            for (int k = 0; k < 3; k++)
-                R->mid[3 * R->n + k] = 0.5 * (p[k] + q[k]);
-            R->len[R->n] = st_norm3(d);
-            R->piece[R->n++] = e[i].piece;
+            rc = rims_add(R, caps->xyz + 3 * c[e[i].ia], caps->xyz + 3 * c[e[i].ib],
+                          P->of_tri[e[i].tri]);
         }
         i = j;
     }
     free(e);
-    return ST_OK;
+    if (rc)
+        rims_free(R);
+    return rc;
+}
+
+static int cmp_ends(const void *x, const void *y)
+{
+    const double *p = x, *q = y;
+    for (int k = 0; k < 6; k++)
+        if (p[k] != q[k])
+            return p[k] < q[k] ? -1 : 1;
+    return 0;
+}
+
+/* The open rims: the soup's boundary edges (edges: s's table) whose
+ * midpoint is farther than tol from every cap (caps_bvh; NULL: none): a
+ * cap runs along every edge of the loop it closes, joined or not to the
+ * rim's vertices. They are joined into pieces by shared welded ends; each
+ * becomes a piece after the caps', its edges rims of R and degenerate
+ * triangles of anchors. */
+static st_status open_rims(pieces *P, rims *R, st_soup *anchors, const st_soup *s,
+                           const st_soup_edges *E, const st_bvh *caps_bvh, double tol,
+                           st_error *err)
+{
+    const size_t nw = E->nweld ? E->nweld : 1;
+    size_t *uf = st_malloc_array(nw, sizeof *uf), *id = st_malloc_array(nw, sizeof *id);
+    st_status rc = uf && id ? ST_OK : ST_ENOMEM;
+    if (rc)
+        goto done;
+    for (size_t w = 0; w < nw; w++) {
+        uf[w] = w;
+        id[w] = SIZE_MAX;
+    }
+    /* the open edges: their welded ends joined, then numbered in order */
+    const size_t first = R->n;
+    for (size_t i = 0; i < E->nhalf && !rc; i = st_soup_edges_run_end(E, i)) {
+        if (st_soup_edges_run_end(E, i) != i + 1)
+            continue;
+        const uint32_t t = E->he[i].t, wa = (uint32_t)(E->he[i].key >> 32),
+                       wb = (uint32_t)E->he[i].key;
+        const int ca = st_soup_edges_corner(E, s, t, wa), cb = st_soup_edges_corner(E, s, t, wb);
+        if (ca < 0 || cb < 0)
+            continue;
+        const double *p = s->xyz + 3 * s->tris[3 * t + ca], *q = s->xyz + 3 * s->tris[3 * t + cb];
+        const double m[3] = {0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]), 0.5 * (p[2] + q[2])};
+        int64_t near = -1;
+        if (caps_bvh)
+            st_bvh_nearest(caps_bvh, m, tol * tol, &near, NULL);
+        if (near >= 0)
+            continue;
+        uf_join(uf, wa, wb);
+        rc = rims_add(R, p, q, wa);   /* piece: its welded end, for now */
+    }
+    size_t *of = rc ? NULL : realloc(P->of_tri, (anchors->ntris + R->n - first + 1) * sizeof *of);
+    if (!rc && !of)
+        rc = ST_ENOMEM;
+    else if (of)
+        P->of_tri = of;
+    double *box = NULL;
+    for (size_t r = first; r < R->n && !rc; r++) {
+        const size_t root = uf_find(uf, R->piece[r]);
+        if (id[root] == SIZE_MAX) {
+            double *b2 = realloc(box, 6 * (P->n - P->ncap + 1) * sizeof *b2);
+            if (!b2) {
+                rc = ST_ENOMEM;
+                break;
+            }
+            box = b2;
+            id[root] = P->n++;
+            memcpy(box + 6 * (id[root] - P->ncap), R->ends + 6 * r, 6 * sizeof *box);
+        }
+        const size_t i = R->piece[r] = id[root];
+        double *b = box + 6 * (i - P->ncap);
+        for (int k = 0; k < 3; k++) {
+            b[k] = fmin(b[k], fmin(R->ends[6 * r + k], R->ends[6 * r + 3 + k]));
+            b[3 + k] = fmax(b[3 + k], fmax(R->ends[6 * r + k], R->ends[6 * r + 3 + k]));
+        }
+        const size_t base = anchors->nverts;
+        for (int v = 0; v < 3 && !rc; v++) {
+            const double *x = v == 0 ? R->ends + 6 * r : v == 1 ? R->ends + 6 * r + 3 : R->mid + 3 * r;
+            rc = st_soup_add_vertex(anchors, x[0], x[1], x[2], err);
+        }
+        P->of_tri[anchors->ntris] = i;
+        rc = rc ? rc : st_soup_add_triangle(anchors, (uint32_t)base, (uint32_t)base + 1,
+                                            (uint32_t)base + 2, err);
+    }
+    double *reach = rc ? NULL : realloc(P->reach, (P->n ? P->n : 1) * sizeof *reach);
+    if (!rc && !reach)
+        rc = ST_ENOMEM;
+    for (size_t i = P->ncap; i < P->n && !rc; i++) {
+        const double *b = box + 6 * (i - P->ncap);
+        const double d[3] = {b[3] - b[0], b[4] - b[1], b[5] - b[2]};
+        reach[i] = 0.5 * st_norm3(d);
+    }
+    if (reach)
+        P->reach = reach;
+    free(box);
+done:
+    free(uf);
+    free(id);
+    return rc;
 }
 
 /* share[i]: the share of piece i's rim length whose midpoint `near`
- * holds for; near(ctx, point) says whether a point is covered. */
+ * holds for; near(ctx, point) says whether a point is covered. total (if
+ * not NULL) gets each piece's rim length. */
 static void rim_share(double *share, size_t npieces, const rims *R,
-                      int (*near)(const void *, const double[3]), const void *ctx)
+                      int (*near)(const void *, const double[3]), const void *ctx,
+                      double *total)
 {
     for (size_t i = 0; i < 2 * npieces; i++)
         share[i] = 0.0;
@@ -296,8 +488,11 @@ static void rim_share(double *share, size_t npieces, const rims *R,
         if (near(ctx, R->mid + 3 * r))
             share[2 * R->piece[r] + 1] += R->len[r];
     }
-    for (size_t i = 0; i < npieces; i++)
+    for (size_t i = 0; i < npieces; i++) {
+        if (total)
+            total[i] = share[2 * i];
         share[i] = share[2 * i] > 0.0 ? share[2 * i + 1] / share[2 * i] : 0.0;
+    }
 }
 
 typedef struct near_ctx {
@@ -320,7 +515,41 @@ static int near_bvh(const void *ctx, const double x[3])
     return tri >= 0;
 }
 
+/* err[i]: the map's error at piece i: the length-weighted mean distance
+ * from the soup of the preimages of the rim's midpoints (back: the map's
+ * inverse), over the rim edges within back's reach (those rim_share
+ * counts). */
+static void rim_error(double *err, size_t npieces, const rims *R, const near_ctx *back,
+                      double *weight)
+{
+    for (size_t i = 0; i < npieces; i++)
+        err[i] = weight[i] = 0.0;
+    for (size_t r = 0; r < R->n; r++) {
+        double q[3];
+        st_symmetry_apply(back->inverse->y, back->inverse->angle, R->mid + 3 * r, 1, q);
+        int64_t tri;
+        const double d2 = st_bvh_nearest(back->bvh, q, back->reach2, &tri, NULL);
+        if (tri < 0)
+            continue;
+        err[R->piece[r]] += R->len[r] * sqrt(d2);
+        weight[R->piece[r]] += R->len[r];
+    }
+    for (size_t i = 0; i < npieces; i++)
+        err[i] = weight[i] > 0.0 ? err[i] / weight[i] : 0.0;
+}
+
 /* ---- the fill ----------------------------------------------------------------- */
+
+typedef struct fill_set {
+    st_soup *soup;        /* each triangle of its own three vertices */
+    size_t *piece, *map;  /* per triangle */
+    size_t *src;          /* per triangle: the soup triangle it is the image of */
+    double *err;          /* per triangle: its map's error at its piece */
+    uint8_t *rim;         /* per soup triangle: bit k when its edge k (corners
+                             k, k + 1) is a boundary edge (NULL: unknown) */
+    const map *maps;      /* the maps F->map indexes */
+    size_t cap;
+} fill_set;
 
 static double tri_area(const double q[3][3])
 {
@@ -344,20 +573,149 @@ static st_status add_tri(st_soup *out, const double q[3][3], st_error *err)
                                           (uint32_t)(base + 2), err);
 }
 
-/* Append the images m of s's triangles flagged in keep (counted once the
- * fill is final: fill_of_covered). */
-static st_status append_images(st_soup *fill, const st_soup *s, const map *m,
-                               const uint8_t *keep, st_error *err)
+/* Append the images under map mi of s's triangles whose keep[] names a
+ * piece (not SIZE_MAX). */
+static st_status append_images(fill_set *F, const st_soup *s, const map *maps, size_t mi,
+                               const size_t *keep, const double *map_err, st_error *err)
 {
     for (size_t t = 0; t < s->ntris; t++) {
-        if (!keep[t])
+        if (keep[t] == SIZE_MAX)
             continue;
+        if (F->soup->ntris >= F->cap) {
+            const size_t cap = 2 * F->cap + 64;
+            int fail = 0;
+            F->piece = grown(F->piece, cap, sizeof *F->piece, &fail);
+            F->map = grown(F->map, cap, sizeof *F->map, &fail);
+            F->err = grown(F->err, cap, sizeof *F->err, &fail);
+            F->src = grown(F->src, cap, sizeof *F->src, &fail);
+            if (fail)
+                return ST_ENOMEM;
+            F->cap = cap;
+        }
+        F->piece[F->soup->ntris] = keep[t];
+        F->map[F->soup->ntris] = mi;
+        F->src[F->soup->ntris] = t;
+        F->err[F->soup->ntris] = map_err[keep[t]];
         double q[3][3];
-        image(s, t, m, q);
-        st_status rc = add_tri(fill, q, err);
+        image(s, t, maps + mi, q);
+        st_status rc = add_tri(F->soup, q, err);
         if (rc)
             return rc;
     }
+    return ST_OK;
+}
+
+/* ---- closed: the fill's boundary on the soup --------------------------------- */
+
+typedef struct fill_edge {
+    double e[6];
+    size_t tri;
+    int k;
+} fill_edge;
+
+static int cmp_fill_edge(const void *x, const void *y)
+{
+    const fill_edge *p = x, *q = y;
+    const int c = cmp_ends(p->e, q->e);
+    return c ? c : p->tri < q->tri ? -1 : p->tri > q->tri;
+}
+
+typedef struct other_ctx {
+    const fill_set *F;
+    size_t map;
+    const double *x;
+    double reach2;
+} other_ctx;
+
+/* A fill triangle of another map within reach of x: 1. */
+static int near_other(void *ctx, uint32_t t)
+{
+    const other_ctx *O = ctx;
+    if (O->F->map[t] == O->map)
+        return 0;
+    const double *v = O->F->soup->xyz;
+    const uint32_t *c = O->F->soup->tris + 3 * (size_t)t;
+    return st_point_triangle_dist2(O->x, v + 3 * c[0], v + 3 * c[1], v + 3 * c[2], NULL) <=
+           O->reach2;
+}
+
+/* The soup's boundary edges as bits per triangle (fill_set.rim). */
+static uint8_t *rim_bits(const st_soup *s, const st_soup_edges *E)
+{
+    uint8_t *rim = calloc(s->ntris ? s->ntris : 1, 1);
+    if (!rim)
+        return NULL;
+    for (size_t i = 0; i < E->nhalf; i = st_soup_edges_run_end(E, i)) {
+        if (st_soup_edges_run_end(E, i) != i + 1)
+            continue;
+        const uint32_t t = E->he[i].t;
+        const int ca = st_soup_edges_corner(E, s, t, (uint32_t)(E->he[i].key >> 32)),
+                  cb = st_soup_edges_corner(E, s, t, (uint32_t)E->he[i].key);
+        if (ca >= 0 && cb >= 0)
+            rim[t] |= (uint8_t)(1u << ((ca + 1) % 3 == cb ? ca : cb));
+    }
+    return rim;
+}
+
+/* Whether fill triangle t's edge k (image corners k, k + 1) is the image
+ * of a boundary edge of the soup (a hole in the copy); every edge when the
+ * soup's boundary is unknown. */
+static int copy_rim(const fill_set *F, size_t t, int k)
+{
+    if (!F->rim)
+        return 1;
+    const int flip = F->maps[F->map[t]].y->kind == ST_SYMMETRY_MIRROR;
+    const int c1 = flip && k ? 3 - k : k, k2 = (k + 1) % 3, c2 = flip && k2 ? 3 - k2 : k2;
+    const int edge = (c1 + 1) % 3 == c2 ? c1 : c2;
+    return (F->rim[F->src[t]] >> edge) & 1;
+}
+
+/* open[i]: the length of piece i's fill boundary that is the image of the
+ * copy's own rim and lies farther than reach from the soup and from every
+ * other map's fill: where the fill, its copy itself holed, leaves the hole
+ * open (where an image was left out beside the soup or another map's fill,
+ * the fill has an edge too, but no hole of the copy). A fill boundary edge
+ * is an edge in one fill triangle alone (the images of one map share their
+ * corners' coordinates exactly where the soup's triangles share them). */
+static st_status open_length(double *open, size_t npieces, const fill_set *F,
+                             const st_bvh *bvh, const st_bvh *fill_bvh, double reach)
+{
+    const st_soup *f = F->soup;
+    const size_t ne = 3 * f->ntris;
+    for (size_t i = 0; i < npieces; i++)
+        open[i] = 0.0;
+    if (!ne)
+        return ST_OK;
+    fill_edge *e = st_malloc_array(ne, sizeof *e);
+    if (!e)
+        return ST_ENOMEM;
+    for (size_t t = 0; t < f->ntris; t++)
+        for (int k = 0; k < 3; k++) {
+            const uint32_t *c = f->tris + 3 * t;
+            ends_of(e[3 * t + k].e, f->xyz + 3 * c[k], f->xyz + 3 * c[(k + 1) % 3]);
+            e[3 * t + k].tri = t;
+            e[3 * t + k].k = k;
+        }
+    qsort(e, ne, sizeof *e, cmp_fill_edge);
+    for (size_t i = 0; i < ne;) {
+        size_t j = i + 1;
+        while (j < ne && cmp_ends(e[j].e, e[i].e) == 0)
+            j++;
+        if (j == i + 1 && copy_rim(F, e[i].tri, e[i].k)) {
+            const double *p = e[i].e, *q = e[i].e + 3;
+            const double m[3] = {0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]), 0.5 * (p[2] + q[2])};
+            const double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+            int64_t tri;
+            st_bvh_nearest(bvh, m, reach * reach, &tri, NULL);
+            other_ctx O = {F, F->map[e[i].tri], m, reach * reach};
+            const double lo[3] = {m[0] - reach, m[1] - reach, m[2] - reach};
+            const double hi[3] = {m[0] + reach, m[1] + reach, m[2] + reach};
+            if (tri < 0 && !st_bvh_query_box(fill_bvh, lo, hi, near_other, &O))
+                open[F->piece[e[i].tri]] += st_norm3(d);
+        }
+        i = j;
+    }
+    free(e);
     return ST_OK;
 }
 
@@ -391,27 +749,23 @@ static st_status keep_uncovered(st_soup *kept, const st_soup *caps, const pieces
     return rc;
 }
 
-/* The fill goes all or nothing with its piece: *fill keeps the triangles
- * whose nearest cap is in a covered piece (where a cap stays, a partial
- * fill beside it would cut the solid the cap closes). */
-static st_status fill_of_covered(st_soup **fill, const pieces *P, const st_bvh *caps_bvh,
-                                 const uint8_t *covered, st_symmetry_fill_stats *st,
-                                 st_error *err)
+/* The fill goes all or nothing with its piece: *fill gets the triangles of
+ * the covered pieces (where a cap stays, a partial fill beside it would
+ * cut the solid the cap closes; where a rim stays open, a partial fill
+ * would be a wall the votes cannot read). */
+static st_status fill_of_covered(st_soup **fill, const fill_set *F, const uint8_t *covered,
+                                 st_symmetry_fill_stats *st, st_error *err)
 {
-    st_soup *in = *fill, *out = st_soup_new();
+    st_soup *in = F->soup, *out = st_soup_new();
     if (!out)
         return ST_ENOMEM;
     for (size_t t = 0; t < in->ntris; t++) {
-        double q[3][3], c[3] = {0.0, 0.0, 0.0};
-        for (int k = 0; k < 3; k++)
-            for (int a = 0; a < 3; a++) {
-                q[k][a] = in->xyz[3 * in->tris[3 * t + k] + a];
-                c[a] += q[k][a] / 3.0;
-            }
-        int64_t tri;
-        st_bvh_nearest(caps_bvh, c, INFINITY, &tri, NULL);
-        if (tri < 0 || !covered[P->of_tri[tri]])
+        if (!covered[F->piece[t]])
             continue;
+        double q[3][3];
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++)
+                q[k][a] = in->xyz[3 * in->tris[3 * t + k] + a];
         st_status rc = add_tri(out, q, err);
         if (rc) {
             st_soup_free(out);
@@ -420,14 +774,133 @@ static st_status fill_of_covered(st_soup **fill, const pieces *P, const st_bvh *
         st->triangles++;
         st->area += tri_area(q);
     }
-    st_soup_free(in);
     *fill = out;
     return ST_OK;
 }
 
+/* Each map's images into F (the pieces whose rim the map's inverse puts
+ * back on the soup; keeps). */
+static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, const rims *R,
+                         const map *maps, size_t nmaps, size_t *keep, uint8_t *ok,
+                         double *share, double *map_err, st_error *err)
+{
+    const st_soup *s = C0->s;
+    const pieces *P = C0->P;
+    for (size_t mi = 0; mi < nmaps; mi++) {
+        const map inv = {maps[mi].y, -maps[mi].angle};
+        const near_ctx back = {C0->bvh, RIM_REACH * C0->tol * RIM_REACH * C0->tol, &inv};
+        rim_share(share, P->n, R, near_bvh, &back, NULL);
+        size_t agree = 0;
+        for (size_t i = 0; i < P->n; i++)
+            agree += ok[i] = share[i] >= RIM_AGREE;
+        if (!agree)
+            continue;
+        /* and within a voxel there, on average: the issue's "maps onto
+         * itself within about a voxel", at the hole */
+        rim_error(map_err, P->n, R, &back, share);
+        agree = 0;
+        for (size_t i = 0; i < P->n; i++)
+            agree += ok[i] = ok[i] && map_err[i] <= C0->tol;
+        if (!agree)
+            continue;
+        fill_ctx C = *C0;
+        C.fill_bvh = *fill_bvh;
+        C.piece_ok = ok;
+        const long long nt = (long long)s->ntris;
+        size_t any = 0;
+#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : any)
+        for (long long t = 0; t < nt; t++) {
+            double q[3][3];
+            image(s, (size_t)t, maps + mi, q);
+            keep[t] = keeps(&C, q);
+            any += keep[t] != SIZE_MAX;
+        }
+        if (!any)
+            continue;
+        st_status rc = append_images(F, s, maps, mi, keep, map_err, err);
+        st_bvh_free(*fill_bvh);
+        *fill_bvh = NULL;
+        if (rc || (rc = st_bvh_build(fill_bvh, F->soup, err)))
+            return rc;
+    }
+    return ST_OK;
+}
+
+/* depart[i]: 1 when some corner or centroid of piece i's fill lies
+ * farther from the anchors (a cap's piece: its cap) than tol plus its
+ * map's error there (what the map's own error explains is no evidence). */
+static void departs(uint8_t *depart, size_t npieces, const fill_set *F,
+                    const st_bvh *anchors_bvh, double tol)
+{
+    memset(depart, 0, npieces);
+    const st_soup *f = F->soup;
+    for (size_t t = 0; t < f->ntris; t++) {
+        if (depart[F->piece[t]])
+            continue;
+        double x[4][3];
+        for (int a = 0; a < 3; a++) {
+            x[3][a] = 0.0;
+            for (int k = 0; k < 3; k++) {
+                x[k][a] = f->xyz[3 * f->tris[3 * t + k] + a];
+                x[3][a] += x[k][a] / 3.0;
+            }
+        }
+        for (int k = 0; k < 4 && !depart[F->piece[t]]; k++) {
+            int64_t tri;
+            const double r = tol + F->err[t];
+            st_bvh_nearest(anchors_bvh, x[k], r * r, &tri, NULL);
+            depart[F->piece[t]] = tri < 0;
+        }
+    }
+}
+
+/* covered[i]: piece i's fill closes it: the fill runs along its rim (at
+ * least RIM_COVERED of the rim's length within RIM_REACH tol of it) and
+ * its own boundary off the soup is at most the rest, 1 - RIM_COVERED of
+ * the rim's length (a copy itself holed leaves its holes in the fill).
+ * A cap the fill does not depart from (every corner and centroid of it
+ * within tol of the cap, plus the map's error at the rim) is kept, without
+ * fill: the copy agrees with the cap's guess there, and the map's error
+ * would be all it adds. */
+static st_status decide(uint8_t *covered, const pieces *P, const rims *R, const fill_set *F,
+                        const st_bvh *bvh, const st_bvh *fill_bvh, const st_bvh *anchors_bvh,
+                        double tol, st_symmetry_fill_stats *st)
+{
+    const size_t n = P->n ? P->n : 1;
+    double *share = st_malloc_array(2 * n, sizeof *share);
+    double *total = st_malloc_array(n, sizeof *total), *open = st_malloc_array(n, sizeof *open);
+    uint8_t *depart = st_malloc_array(n, 1);
+    st_status rc = share && total && open && depart ? ST_OK : ST_ENOMEM;
+    if (!rc)
+        departs(depart, P->n, F, anchors_bvh, tol);
+    if (!rc) {
+        const near_ctx on_fill = {fill_bvh, RIM_REACH * tol * RIM_REACH * tol, NULL};
+        rim_share(share, P->n, R, near_bvh, &on_fill, total);
+        rc = fill_bvh ? open_length(open, P->n, F, bvh, fill_bvh, RIM_REACH * tol) : ST_OK;
+    }
+    for (size_t i = 0; i < P->n && !rc; i++) {
+        const int along = share[i] >= RIM_COVERED;
+        covered[i] = along && (!fill_bvh || open[i] <= (1.0 - RIM_COVERED) * total[i]);
+        st->unclosed += along && !covered[i];
+        if (covered[i] && i < P->ncap && !depart[i]) {
+            covered[i] = 0;
+            st->caps_agree++;
+        }
+        if (i < P->ncap)
+            st->caps_covered += covered[i];
+        else
+            st->open_filled += covered[i];
+    }
+    free(share);
+    free(total);
+    free(open);
+    free(depart);
+    return rc;
+}
+
 st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup *s,
-                           const st_bvh *bvh, const st_symmetry_set *set,
-                           const st_soup *caps, double tol,
+                           const st_soup_edges *edges, const st_bvh *bvh,
+                           const st_symmetry_set *set, const st_soup *caps, double tol,
                            st_symmetry_fill_stats *stats, st_error *err)
 {
     st_symmetry_fill_stats local;
@@ -437,83 +910,80 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
     if (!(tol > 0.0) || !isfinite(tol))
         return st_error_set(err, ST_EINPUT, NULL, 0,
                             "symmetry fill: the tolerance must be positive and finite");
-    st_soup *fill = st_soup_new(), *kept = st_soup_new();
-    st_bvh *caps_bvh = NULL, *fill_bvh = NULL;
-    uint8_t *keep = NULL, *covered = NULL;
-    double *share = NULL;
+    st_soup *kept = st_soup_new(), *anchors = st_soup_new(), *fill = NULL;
+    map maps[ST_SYMMETRY_MAX * ST_SYMMETRY_DEFAULT_MAX_ORDER];
+    fill_set F = {.soup = st_soup_new(), .maps = maps};
+    st_bvh *anchors_bvh = NULL, *fill_bvh = NULL;
+    size_t *keep = NULL;
+    uint8_t *covered = NULL;
+    double *share = NULL, *map_err = NULL;
     pieces P;
     rims R;
     memset(&P, 0, sizeof P);
     memset(&R, 0, sizeof R);
-    map maps[ST_SYMMETRY_MAX * ST_SYMMETRY_DEFAULT_MAX_ORDER];
-    st_status rc = fill && kept ? ST_OK : ST_ENOMEM;
-    if (rc || !set || set->n == 0 || !caps || caps->ntris == 0 || s->ntris == 0) {
+    st_status rc = kept && anchors && F.soup ? ST_OK : ST_ENOMEM;
+    if (rc || !set || set->n == 0 || s->ntris == 0 || (!(caps && caps->ntris) && !edges)) {
         if (!rc && caps)
             rc = st_soup_append(kept, caps, err);
         goto done;
     }
-    st->caps = 0;
-    if ((rc = pieces_make(&P, caps)) || (rc = rims_make(&R, caps, &P)) ||
-        (rc = st_bvh_build(&caps_bvh, caps, err)))
+    static const st_soup none;
+    const st_soup *cp = caps ? caps : &none;
+    if ((rc = pieces_make(&P, cp)) || (rc = rims_make(&R, cp, &P)) ||
+        (rc = st_soup_append(anchors, cp, err)) ||
+        (cp->ntris && (rc = st_bvh_build(&anchors_bvh, cp, err))) ||
+        (edges && (rc = open_rims(&P, &R, anchors, s, edges, anchors_bvh, tol, err))))
         goto done;
-    st->caps = P.n;
-    keep = st_malloc_array(s->ntris, 1);
-    covered = st_malloc_array(P.n ? P.n : 1, 1);
-    share = st_malloc_array(P.n ? 2 * P.n : 1, sizeof *share);
-    if (!keep || !covered || !share) {
+    st_bvh_free(anchors_bvh);   /* the caps' alone: built again with the rims */
+    anchors_bvh = NULL;
+    st->caps = P.ncap;
+    st->open = P.n - P.ncap;
+    if (P.n == 0)
+        goto done;
+    pieces_box(&P, anchors);
+    if (edges && !(F.rim = rim_bits(s, edges))) {
         rc = ST_ENOMEM;
         goto done;
     }
+    keep = st_malloc_array(s->ntris, sizeof *keep);
+    covered = st_malloc_array(P.n, 1);
+    share = st_malloc_array(2 * P.n, sizeof *share);
+    map_err = st_malloc_array(P.n, sizeof *map_err);
+    if (!keep || !covered || !share || !map_err) {
+        rc = ST_ENOMEM;
+        goto done;
+    }
+    if ((rc = st_bvh_build(&anchors_bvh, anchors, err)))
+        goto done;
     const size_t nmaps = maps_of(set, maps, sizeof maps / sizeof *maps);
     st->maps = nmaps;
-    for (size_t mi = 0; mi < nmaps; mi++) {
-        /* the pieces whose rim the map's inverse puts back on the soup */
-        const map inv = {maps[mi].y, -maps[mi].angle};
-        const near_ctx back = {bvh, RIM_REACH * tol * RIM_REACH * tol, &inv};
-        rim_share(share, P.n, &R, near_bvh, &back);
-        size_t agree = 0;
-        for (size_t i = 0; i < P.n; i++)
-            agree += covered[i] = share[i] >= RIM_AGREE;
-        if (!agree)
-            continue;
-        const fill_ctx C = {s, bvh, caps_bvh, fill_bvh, &P, covered, tol * tol};
-        const long long nt = (long long)s->ntris;
-        size_t any = 0;
-#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : any)
-        for (long long t = 0; t < nt; t++) {
-            double q[3][3];
-            image(s, (size_t)t, maps + mi, q);
-            keep[t] = (uint8_t)keeps(&C, q);
-            any += keep[t];
-        }
-        if (!any)
-            continue;
-        if ((rc = append_images(fill, s, maps + mi, keep, err)))
-            goto done;
-        st_bvh_free(fill_bvh);
-        fill_bvh = NULL;
-        if ((rc = st_bvh_build(&fill_bvh, fill, err)))
-            goto done;
-    }
-    const near_ctx on_fill = {fill_bvh, RIM_REACH * tol * RIM_REACH * tol, NULL};
-    rim_share(share, P.n, &R, near_bvh, &on_fill);
-    for (size_t i = 0; i < P.n; i++)
-        covered[i] = share[i] >= RIM_COVERED;
-    if ((rc = keep_uncovered(kept, caps, &P, covered, err)) ||
-        (rc = fill_of_covered(&fill, &P, caps_bvh, covered, st, err)))
+    const fill_ctx C = {s, bvh, anchors_bvh, NULL, &P, NULL, tol};
+    if ((rc = map_all(&F, &fill_bvh, &C, &R, maps, nmaps, keep, covered, share, map_err,
+                       err)) ||
+        (rc = decide(covered, &P, &R, &F, bvh, fill_bvh, anchors_bvh, tol, st)) ||
+        (rc = keep_uncovered(kept, cp, &P, covered, err)))
         goto done;
-    for (size_t i = 0; i < P.n; i++)
-        st->caps_covered += covered[i];
+    rc = fill_of_covered(&fill, &F, covered, st, err);
 done:
     if (rc == ST_ENOMEM)
         st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the symmetric fill");
-    st_bvh_free(caps_bvh);
+    st_bvh_free(anchors_bvh);
     st_bvh_free(fill_bvh);
+    st_soup_free(anchors);
+    st_soup_free(F.soup);
+    free(F.piece);
+    free(F.map);
+    free(F.err);
+    free(F.src);
+    free(F.rim);
+    free(map_err);
     pieces_free(&P);
     rims_free(&R);
     free(share);
     free(keep);
     free(covered);
+    if (!rc && !fill && !(fill = st_soup_new()))
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the symmetric fill");
     if (rc) {
         st_soup_free(fill);
         st_soup_free(kept);

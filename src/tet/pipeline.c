@@ -564,8 +564,9 @@ static void run_candidates(st_tetmesh **meshes, st_pipeline_stats *st, const st_
  * the solid is a guess (the closed shells' alone: none, and no call).
  * *fill stays NULL where it does not count. */
 static st_status make_fill(st_soup **fill, st_pipeline_stats *st, const st_grid *g,
-                           const st_bvh *bvh, const st_pipeline_params *p,
-                           const st_progress *prog, st_error *err)
+                           const st_bvh *bvh, const st_soup *sym,
+                           const st_pipeline_params *p, const st_progress *prog,
+                           st_error *err)
 {
     size_t nfill = 0;
     st_progress_report(prog, "fill", 0.0);
@@ -573,6 +574,8 @@ static st_status make_fill(st_soup **fill, st_pipeline_stats *st, const st_grid 
     if (rc)
         return rc;
     st_pseudo_guess_measure(&st->guess, g, *fill, bvh);
+    if ((rc = st_pseudo_guess_symmetric(&st->guess, g, *fill, sym, err)))
+        return rc;
     if (p->density_rho <= 0 && p->fill_counts) {
         st->fill_faces = nfill;
     } else {
@@ -765,8 +768,10 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     st_grid *g = NULL;
     st_bvh *bvh = NULL;
     st_tetmesh **meshes = NULL;
-    st_soup *fill = NULL;
+    st_soup *fill = NULL, *sym = NULL;
+    pp.symmetric_fill = &sym;   /* the guess's symmetric part (make_fill) */
     rc = make_field(&g, &bvh, st, s, &dp, &pp, p, t_start, prog, err);
+    pp.symmetric_fill = NULL;
     if (rc)
         goto done;
     double t_cand = now_seconds();
@@ -793,7 +798,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
         rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
         goto done;
     }
-    if (!st->shells_only && (rc = make_fill(&fill, st, g, bvh, p, prog, err)))
+    if (!st->shells_only && (rc = make_fill(&fill, st, g, bvh, sym, p, prog, err)))
         goto done;
     size_t K = p->tries;
     st->candidates = calloc(K, sizeof *st->candidates);
@@ -834,6 +839,7 @@ done:
     }
     st_bvh_free(bvh);
     st_soup_free(fill);
+    st_soup_free(sym);
     st_grid_free(g);
     return rc;
 }

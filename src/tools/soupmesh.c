@@ -602,10 +602,13 @@ static void print_json(const soupmesh_settings *s, const st_pipeline_stats *st,
                st->fill_faces ? "input and fill" : "input");
     double share = st->guess.boundary_faces
                        ? (double)st->guess.fill_faces / (double)st->guess.boundary_faces : 0.0;
-    printf("  \"guessed_share\": %s, \"guessed_depth_h\": %s,\n"
-           "  \"seconds\": %s, \"exit_status\": %d}\n",
-           tool_json_number(n[6], share), tool_json_number(n[7], st->guess.depth / st->h),
-           tool_json_number(n[8], seconds), rc);
+    double sym = st->guess.boundary_faces
+                     ? (double)st->guess.symmetric_faces / (double)st->guess.boundary_faces : 0.0;
+    printf("  \"guessed_share\": %s, \"guessed_symmetric_share\": %s, "
+           "\"guessed_depth_h\": %s,\n  \"seconds\": %s, \"exit_status\": %d}\n",
+           tool_json_number(n[6], share), tool_json_number(n[9], sym),
+           tool_json_number(n[7], st->guess.depth / st->h), tool_json_number(n[8], seconds),
+           rc);
 }
 
 /* What --float32's rounding did (-v), and a note when the input itself is
@@ -640,14 +643,21 @@ static void say_guess(const tool_ctx *t, const st_pipeline_stats *st, const st_s
      * the input, where the mesh resolves it (its volume, a
      * simulation's mass, rest on it), naming what was guessed. */
     const double depth_h = st->guess.depth / st->h;
-    char what[200];
+    char what[200], sym[120] = "";
     guess_words(what, sizeof what, soup);
+    /* the symmetric fill apart from the caps (issue 37) */
+    if (st->guess.symmetric_faces)
+        snprintf(sym, sizeof sym, "; %.1f%% from the input's own symmetric copy, the "
+                 "rest %.1f%%",
+                 100.0 * (double)st->guess.symmetric_faces / (double)st->guess.boundary_faces,
+                 100.0 * (double)(st->guess.fill_faces - st->guess.symmetric_faces) /
+                     (double)st->guess.boundary_faces);
     tool_say(t, depth_h > 1.0 ? 1 : 2,
              "note: %.1f%% of the solid's boundary is not on the input but guessed "
-             "(%s), up to %.2f h (%.3f of the diagonal) from it; the mesh's volume "
+             "(%s%s), up to %.2f h (%.3f of the diagonal) from it; the mesh's volume "
              "there rests on that guess",
              100.0 * (double)st->guess.fill_faces / (double)st->guess.boundary_faces,
-             what, depth_h, st->guess.depth / diag);
+             what, sym, depth_h, st->guess.depth / diag);
 }
 
 /* The exit status of a run that wrote its mesh: not enclosing (level 0,

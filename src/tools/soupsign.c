@@ -373,6 +373,33 @@ static st_pseudo_params pseudo_params(const soupsign_settings *s)
     return pp;
 }
 
+/* -v: how much of the pseudo volume's boundary has no soup within a voxel
+ * (the fill), and of it the symmetric fill's (sym; NULL: none). */
+static st_status say_fill(const tool_ctx *t, const st_grid *g, const st_bvh *bvh,
+                          const st_soup *sym, st_error *err)
+{
+    st_soup *fill = NULL;
+    st_pseudo_guess gs;
+    st_status rc = st_pseudo_fill(&fill, g, bvh, NULL, err);
+    if (rc)
+        return rc;
+    st_pseudo_guess_measure(&gs, g, fill, bvh);
+    rc = st_pseudo_guess_symmetric(&gs, g, fill, sym, err);
+    st_soup_free(fill);
+    if (rc)
+        return rc;
+    const double all = gs.boundary_faces ? (double)gs.boundary_faces : 1.0;
+    char of_sym[96] = "";
+    if (sym)
+        snprintf(of_sym, sizeof of_sym, "; %zu of them (%.1f%%) from the symmetric fill",
+                 gs.symmetric_faces, 100.0 * (double)gs.symmetric_faces / all);
+    tool_say(t, 2, "fill: %zu of %zu boundary faces (%.1f%%) have no soup within a voxel "
+             "(caps, a far side), up to %.3g voxels (%.6g) from it%s", gs.fill_faces,
+             gs.boundary_faces, 100.0 * (double)gs.fill_faces / all, gs.depth / g->voxel,
+             gs.depth, of_sym);
+    return ST_OK;
+}
+
 static int run(tool_ctx *t, void *settings)
 {
     const soupsign_settings *s = settings;
@@ -384,6 +411,7 @@ static int run(tool_ctx *t, void *settings)
     st_grid *g = NULL;
     st_soup *soup = NULL;
     st_bvh *bvh = NULL;   /* -v with the soup: for the fill's report */
+    st_soup *sym = NULL;  /* -v: the symmetric fill, for the guess's share */
     st_pseudo_stats ps;
     memset(&ps, 0, sizeof ps);
     int rc = TOOL_EXIT_FAIL;
@@ -408,7 +436,9 @@ static int run(tool_ctx *t, void *settings)
             surface = st_meta_get(&g->meta, "source_path");
         t1 = tool_now();
     }
-    const st_pseudo_params pp = pseudo_params(s);
+    st_pseudo_params pp = pseudo_params(s);
+    if (soup && t->verbosity >= 2)
+        pp.symmetric_fill = &sym;
     st_progress prog = tool_progress(t);
     const double c0 = cpu_now();
     /* -v with the soup: its BVH too, for how much of the boundary is a
@@ -482,21 +512,9 @@ static int run(tool_ctx *t, void *settings)
                  "%.3f s", ps.shells, ps.shell_open_triangles,
                  ps.shells && !ps.shell_open_triangles ? ": the signs are their solid" : "",
                  ps.shell_changed, ps.seconds_shells);
-    if (bvh && voted) {
-        st_soup *fill = NULL;
-        st_pseudo_guess gs;
-        if (st_pseudo_fill(&fill, g, bvh, NULL, &err)) {
-            rc = tool_fail(t, &err);
-            goto done;
-        }
-        st_pseudo_guess_measure(&gs, g, fill, bvh);
-        st_soup_free(fill);
-        tool_say(t, 2, "fill: %zu of %zu boundary faces (%.1f%%) have no soup within a voxel "
-                 "(caps, a far side), up to %.3g voxels (%.6g) from it", gs.fill_faces,
-                 gs.boundary_faces,
-                 gs.boundary_faces ? 100.0 * (double)gs.fill_faces / (double)gs.boundary_faces
-                                   : 0.0,
-                 gs.depth / g->voxel, gs.depth);
+    if (bvh && voted && say_fill(t, g, bvh, sym, &err)) {
+        rc = tool_fail(t, &err);
+        goto done;
     }
     if (bvh && soup && (rc = tool_report_symmetries(t, soup, bvh, g->voxel, &ps.symmetries,
                                                     &ps.symmetry_fill, ps.seconds_symmetry)))
@@ -505,6 +523,7 @@ static int run(tool_ctx *t, void *settings)
              t1 - t0, voted ? ps.seconds_vote : ps.seconds_shells, cpu_sign, t3 - t2);
     rc = TOOL_EXIT_OK;
 done:
+    st_soup_free(sym);
     st_bvh_free(bvh);
     st_grid_free(g);
     st_soup_free(soup);

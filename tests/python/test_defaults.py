@@ -125,3 +125,18 @@ def test_float32_parameter():
     m32 = souptet.mesh(V2, F, cells=4, tries=1, float32=True)
     assert m32.encloses
     assert np.array_equal(m32.points.astype(np.float32).astype(np.float64), m32.points)
+
+
+def test_fill_defaults_match_cli():
+    # fill_holes and symmetry: the library's pseudo-volume defaults, as
+    # soupsign --help says them ("default on" / "default off")
+    h = subprocess.run([tool("soupsign"), "--help"], capture_output=True, text=True).stdout
+    said = {}
+    for opt in ("--fill-holes", "--symmetry"):
+        block = h[h.index(opt):]
+        m = re.search(r"default:?\s+(on|off)", block)
+        assert m, opt
+        said[opt] = m.group(1) == "on"
+    for fn in (souptet.mesh, souptet.pseudo_volume, souptet.wrap):
+        assert py_default(fn, "fill_holes") is said["--fill-holes"]
+        assert py_default(fn, "symmetry") is said["--symmetry"]

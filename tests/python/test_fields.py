@@ -74,3 +74,54 @@ def test_wrap_same_as_soupwrap(tmp_path, bunny):
     e = np.concatenate([F2[:, [0, 1]], F2[:, [1, 2]], F2[:, [2, 0]]])
     s = set(map(tuple, e))
     assert len(s) == len(e) and all((j, i) in s for i, j in s)
+
+
+def holed_cylinder(deg):
+    """A closed 64-sided cylinder (radius 1, z in [-1, 1]) without the side's
+    segments whose middle angle is below deg degrees (as soupsign.t's)."""
+    n = 64
+    a = 2 * np.pi * np.arange(n) / n
+    V = np.zeros((2 * n + 2, 3))
+    V[0:2 * n:2] = np.stack([np.cos(a), np.sin(a), -np.ones(n)], 1)
+    V[1:2 * n:2] = np.stack([np.cos(a), np.sin(a), np.ones(n)], 1)
+    V[2 * n] = (0, 0, -1)
+    V[2 * n + 1] = (0, 0, 1)
+    F = []
+    for k in range(n):
+        k2 = (k + 1) % n
+        if not math.degrees(2 * math.pi * (k + 0.5) / n) < deg:
+            F += [(2 * k, 2 * k2, 2 * k2 + 1), (2 * k, 2 * k2 + 1, 2 * k + 1)]
+        F += [(2 * n, 2 * k2, 2 * k), (2 * n + 1, 2 * k + 1, 2 * k2 + 1)]
+    return V, np.array(F)
+
+
+@pytest.mark.parametrize("opts,kw", [(["--symmetry", "on"], {"symmetry": True}),
+                                     (["--fill-holes", "off"], {"fill_holes": False}),
+                                     ([], {"fill_holes": True, "symmetry": False})],
+                         ids=["symmetry", "no-fill-holes", "defaults"])
+def test_pseudo_volume_fill_options_as_soupsign(tmp_path, opts, kw):
+    # fill_holes= and symmetry= give soupsign --fill-holes / --symmetry's signs
+    V, F = holed_cylinder(70)
+    off = str(tmp_path / "c.off")
+    with open(off, "w") as f:
+        f.write("OFF\n%d %d 0\n" % (len(V), len(F)))
+        f.writelines("%.17g %.17g %.17g\n" % tuple(v) for v in V)
+        f.writelines("3 %d %d %d\n" % tuple(t) for t in F)
+    p = str(tmp_path / "s.vti")
+    dist = subprocess.Popen([tool("soupdist"), "-q", "-r", "32", off], stdout=subprocess.PIPE)
+    subprocess.run([tool("soupsign"), "-q", "--surface", off, "-o", p] + opts,
+                   stdin=dist.stdout, check=True)
+    assert dist.wait() == 0
+    a, _, _ = read_vti(p)
+    pv = souptet.pseudo_volume(V, F, resolution=32, **kw)
+    assert np.array_equal(pv.values, a)
+
+
+def test_symmetry_changes_the_holed_cylinder():
+    # the fill is used: the signs differ from the caps' alone
+    V, F = holed_cylinder(70)
+    on = souptet.pseudo_volume(V, F, resolution=32, symmetry=True)
+    off = souptet.pseudo_volume(V, F, resolution=32)
+    assert not np.array_equal(on.inside, off.inside)
+    with pytest.raises(TypeError):
+        souptet.pseudo_volume(V, F, 32, True)   # keyword only

@@ -1,0 +1,211 @@
+/* test_symmetry_fill.c - the lost side filled from its symmetric copy
+ * (symmetry.h, st_symmetry_fill), with the symmetries given (their
+ * detection is test_symmetry's): a 64-sided cylinder missing 110 degrees
+ * of its side, a hole too large to cap, filled from its continuous axis
+ * (the fill is the missing strip, on the cylinder, the same on 1 and 2
+ * threads); a 70-degree hole across a mirror plane whose copy is whole
+ * (its cap dropped, the fill closes it) and whose copy is itself holed
+ * (the fill would leave the hole open: the cap stays, no fill). */
+#include "souptet/bvh.h"
+#include "souptet/edges.h"
+#include "souptet/holes.h"
+#include "souptet/soup.h"
+#include "souptet/symmetry.h"
+#include "shapes.h"
+#include "tap.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#define SIDES 64
+#define TOL 0.03   /* a voxel at 64 along the cylinder's 2 x 2 x 2 box */
+
+/* Degrees a in [lo, hi), both in [0, 360) or lo > hi wrapping past 0. */
+static int in_range(double a, double lo, double hi)
+{
+    return lo <= hi ? a >= lo && a < hi : a >= lo || a < hi;
+}
+
+/* A closed 64-sided cylinder (radius 1, z in [-1, 1], outward) without
+ * the side's segments whose middle angle lies in one of the nr ranges
+ * (degrees, pairs lo, hi); *missing gets how many are gone. */
+static st_soup *cylinder(const double *ranges, int nr, int *missing)
+{
+    st_soup *s = st_soup_new();
+    for (int k = 0; k < SIDES; k++) {
+        const double a = 2.0 * M_PI * k / SIDES;
+        st_soup_add_vertex(s, cos(a), sin(a), -1.0, NULL);
+        st_soup_add_vertex(s, cos(a), sin(a), 1.0, NULL);
+    }
+    st_soup_add_vertex(s, 0, 0, -1.0, NULL);
+    st_soup_add_vertex(s, 0, 0, 1.0, NULL);
+    *missing = 0;
+    for (uint32_t k = 0; k < SIDES; k++) {
+        const uint32_t k2 = (k + 1) % SIDES;
+        const double mid = 360.0 * (k + 0.5) / SIDES;
+        int gone = 0;
+        for (int r = 0; r < nr; r++)
+            gone |= in_range(mid, ranges[2 * r], ranges[2 * r + 1]);
+        *missing += gone;
+        if (!gone) {
+            st_soup_add_triangle(s, 2 * k, 2 * k2, 2 * k2 + 1, NULL);
+            st_soup_add_triangle(s, 2 * k, 2 * k2 + 1, 2 * k + 1, NULL);
+        }
+        st_soup_add_triangle(s, 2 * SIDES, 2 * k2, 2 * k, NULL);
+        st_soup_add_triangle(s, 2 * SIDES + 1, 2 * k + 1, 2 * k2 + 1, NULL);
+    }
+    return s;
+}
+
+typedef struct run {
+    st_soup *caps, *fill, *kept;
+    st_symmetry_fill_stats st;
+} run;
+
+static void run_free(run *r)
+{
+    st_soup_free(r->caps);
+    st_soup_free(r->fill);
+    st_soup_free(r->kept);
+}
+
+/* The caps (holes.h) and the fill of s under set. */
+static int fill_of(run *r, const st_soup *s, const st_symmetry_set *set)
+{
+    memset(r, 0, sizeof *r);
+    st_error err;
+    st_soup_edges e;
+    st_bvh *b = NULL;
+    st_holes_params hp = st_holes_params_default();
+    if (st_soup_edges_build(&e, s, &err))
+        return 1;
+    int rc = st_bvh_build(&b, s, &err) ||
+             st_soup_hole_caps_shared(&r->caps, s, &e, b, &hp, NULL, &err) ||
+             st_symmetry_fill(&r->fill, &r->kept, s, &e, b, set, r->caps, TOL, &r->st, &err);
+    if (rc)
+        printf("#   %s\n", err.msg);
+    else
+        printf("#   %zu cap triangles in %zu pieces, %zu open rims: fill %zu triangles "
+               "(area %.4f), %zu caps dropped, %zu open filled, %zu left open\n",
+               r->caps->ntris, r->st.caps, r->st.open, r->st.triangles, r->st.area,
+               r->st.caps_covered, r->st.open_filled, r->st.unclosed);
+    st_bvh_free(b);
+    st_soup_edges_free(&e);
+    return rc;
+}
+
+static double seg_area(void)
+{
+    return 2.0 * 2.0 * sin(M_PI / SIDES);   /* chord times height */
+}
+
+static void test_open_hole(void)
+{
+    /* 110 degrees of the side: no cap (too large), its rim an open loop */
+    const double hole[2] = {0.0, 110.0};
+    int missing;
+    st_soup *s = cylinder(hole, 1, &missing);
+    const st_symmetry_set set = {{{ST_SYMMETRY_ROTATION, {0, 0, 0}, {0, 0, 1}, 0, 0.74}}, 1, 1};
+    run r;
+    TAP_CHECK(fill_of(&r, s, &set) == 0, "110 degrees missing: the fill runs");
+    TAP_CHECK(r.caps->ntris == 0 && r.st.open == 1,
+              "the hole is too large to cap: one open rim (%zu cap triangles, %zu open)",
+              r.caps->ntris, r.st.open);
+    TAP_CHECK(r.st.open_filled == 1 && r.st.unclosed == 0, "the fill closes it");
+    const double want = missing * seg_area();
+    TAP_NEAR(r.st.area / want, 1.0, 0.05, "fill area %.4f, the strip's %.4f", r.st.area, want);
+    int on_side = 1, in_hole = 1;
+    for (size_t v = 0; v < r.fill->nverts; v++) {
+        const double *p = r.fill->xyz + 3 * v;
+        const double rad = hypot(p[0], p[1]);
+        double a = atan2(p[1], p[0]) * 180.0 / M_PI;
+        a = a < 0 ? a + 360.0 : a;
+        on_side &= fabs(rad - 1.0) < 1e-9 && fabs(p[2]) <= 1.0 + 1e-12;
+        in_hole &= in_range(a, 360.0 - 360.0 / SIDES, 110.0 + 360.0 / SIDES);
+    }
+    TAP_CHECK(on_side, "every fill vertex on the cylinder's side");
+    TAP_CHECK(in_hole, "every fill vertex in the hole (within a segment)");
+    TAP_CHECK(r.kept->ntris == 0, "no caps to keep");
+#ifdef _OPENMP
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(threads == 1 ? 2 : 1);
+    run r2;
+    int same = fill_of(&r2, s, &set) == 0 && r2.fill->ntris == r.fill->ntris &&
+               memcmp(r2.fill->xyz, r.fill->xyz, 3 * r.fill->nverts * sizeof(double)) == 0;
+    TAP_CHECK(same, "the same fill on %d and %d threads", threads, threads == 1 ? 2 : 1);
+    omp_set_num_threads(threads);
+    run_free(&r2);
+#endif
+    run_free(&r);
+    st_soup_free(s);
+}
+
+/* A 70-degree hole centered on angle 0; the mirror x = 0 maps it onto
+ * [145, 215]. copy_holed: [170, 190) is gone too. */
+static void mirror_case(int copy_holed)
+{
+    const double ranges[4] = {325.0, 35.0, 170.0, 190.0};
+    int missing;
+    st_soup *s = cylinder(ranges, copy_holed ? 2 : 1, &missing);
+    const st_symmetry_set set = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8}}, 1, 1};
+    run r;
+    TAP_CHECK(fill_of(&r, s, &set) == 0, "%s: the fill runs",
+              copy_holed ? "copy holed" : "copy whole");
+    TAP_CHECK(r.st.caps == (copy_holed ? 2u : 1u) && r.st.open == 0, "%zu capped holes, no open one",
+              r.st.caps);
+    if (!copy_holed) {
+        TAP_CHECK(r.st.caps_covered == 1 && r.kept->ntris == 0,
+                  "copy whole: the fill closes the hole, its cap is dropped");
+        TAP_NEAR(r.st.area / (missing * seg_area()), 1.0, 0.05, "the fill is the hole (%.4f)",
+                 r.st.area);
+    } else {
+        TAP_CHECK(r.st.caps_covered == 0 && r.st.triangles == 0,
+                  "copy holed: no cap dropped, no fill (%zu dropped, %zu triangles)",
+                  r.st.caps_covered, r.st.triangles);
+        TAP_CHECK(r.st.unclosed == 1, "the fill ran along the rim but left the hole open");
+        TAP_CHECK(r.kept->ntris == r.caps->ntris, "every cap kept (%zu of %zu)",
+                  r.kept->ntris, r.caps->ntris);
+    }
+    run_free(&r);
+    st_soup_free(s);
+}
+
+static void test_copy_whole(void)
+{
+    mirror_case(0);
+}
+
+static void test_copy_holed(void)
+{
+    mirror_case(1);
+}
+
+static void test_no_symmetry(void)
+{
+    const double hole[2] = {0.0, 40.0};
+    int missing;
+    st_soup *s = cylinder(hole, 1, &missing);
+    const st_symmetry_set set = {{{0}}, 0, 0};
+    run r;
+    TAP_CHECK(fill_of(&r, s, &set) == 0 && r.fill->ntris == 0 &&
+                  r.kept->ntris == r.caps->ntris,
+              "no symmetry: no fill, the caps as they were");
+    run_free(&r);
+    st_error err;
+    st_soup *f = NULL, *k = NULL;
+    TAP_CHECK(st_symmetry_fill(&f, &k, s, NULL, NULL, &set, NULL, 0.0, NULL, &err) == ST_EINPUT,
+              "tolerance 0: ST_EINPUT");
+    st_soup_free(s);
+}
+
+int main(int argc, char **argv)
+{
+    static const tap_test tests[] = {TAP_TEST(open_hole), TAP_TEST(copy_whole),
+                                     TAP_TEST(copy_holed), TAP_TEST(no_symmetry), {0}};
+    return tap_main(argc, argv, tests);
+}
