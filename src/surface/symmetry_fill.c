@@ -388,16 +388,20 @@ static int cmp_ends(const void *x, const void *y)
 /* The open rims: the soup's boundary edges (edges: s's table) whose
  * midpoint is farther than tol from every cap (caps_bvh; NULL: none): a
  * cap runs along every edge of the loop it closes, joined or not to the
- * rim's vertices. They are joined into pieces by shared welded ends; each
- * becomes a piece after the caps', its edges rims of R and degenerate
- * triangles of anchors. */
+ * rim's vertices. They are joined into pieces by shared welded ends, and
+ * a piece is kept when it is a loop (two of its edges at every vertex:
+ * a hole too large or too long to cap, not the edges left open where
+ * holes touch); each becomes a piece after the caps', its edges rims of R
+ * and degenerate triangles of anchors. */
 static st_status open_rims(pieces *P, rims *R, st_soup *anchors, const st_soup *s,
                            const st_soup_edges *E, const st_bvh *caps_bvh, double tol,
                            st_error *err)
 {
     const size_t nw = E->nweld ? E->nweld : 1;
     size_t *uf = st_malloc_array(nw, sizeof *uf), *id = st_malloc_array(nw, sizeof *id);
-    st_status rc = uf && id ? ST_OK : ST_ENOMEM;
+    uint32_t *deg = calloc(nw, sizeof *deg);
+    uint8_t *bad = calloc(nw, 1);
+    st_status rc = uf && id && deg && bad ? ST_OK : ST_ENOMEM;
     if (rc)
         goto done;
     for (size_t w = 0; w < nw; w++) {
@@ -422,8 +426,25 @@ static st_status open_rims(pieces *P, rims *R, st_soup *anchors, const st_soup *
         if (near >= 0)
             continue;
         uf_join(uf, wa, wb);
+        deg[wa]++;
+        deg[wb]++;
         rc = rims_add(R, p, q, wa);   /* piece: its welded end, for now */
     }
+    /* a loop: two open edges at every vertex; the edges the holes left
+     * open where loops touch (a vertex of other degree) stay as they are */
+    for (size_t w = 0; w < nw; w++)
+        if (deg[w] && deg[w] != 2)
+            bad[uf_find(uf, w)] = 1;
+    size_t kept = first;
+    for (size_t r = first; r < R->n; r++) {
+        if (bad[uf_find(uf, R->piece[r])])
+            continue;
+        memmove(R->ends + 6 * kept, R->ends + 6 * r, 6 * sizeof *R->ends);
+        memmove(R->mid + 3 * kept, R->mid + 3 * r, 3 * sizeof *R->mid);
+        R->len[kept] = R->len[r];
+        R->piece[kept++] = R->piece[r];
+    }
+    R->n = kept;
     size_t *of = rc ? NULL : realloc(P->of_tri, (anchors->ntris + R->n - first + 1) * sizeof *of);
     if (!rc && !of)
         rc = ST_ENOMEM;
@@ -469,6 +490,8 @@ static st_status open_rims(pieces *P, rims *R, st_soup *anchors, const st_soup *
         P->reach = reach;
     free(box);
 done:
+    free(deg);
+    free(bad);
     free(uf);
     free(id);
     return rc;

@@ -90,7 +90,7 @@ static void usage(void)
 "                       the signs are exactly their solid (default on)\n"
 "      --symmetry on|off  with --surface and --fill-holes: the surface's mirror\n"
 "                       planes and rotation axes fill the holes their images\n"
-"                       cover, in place of those holes' caps (default off)\n"
+"                       close, capped or too large to cap (default off)\n"
 "      --sides on|off   with --surface: the side of the surface's oriented walls\n"
 "                       each voxel near them is on (its pieces oriented by\n"
 "                       propagation, each turned the way the votes read it)\n"
