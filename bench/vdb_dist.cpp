@@ -36,27 +36,25 @@
 
 namespace {
 
-[[noreturn]] void usage()
-{
-    std::fprintf(stderr, "usage: vdb_dist MODEL -r N [--band B] [--threads T] "
-                         "-o OUT.vdb\n");
-    std::exit(2);
-}
-
-[[noreturn]] void fail(const st_error &err)
+// Exit with status 2 and the usage line, or 1 and the error record's text.
+[[noreturn]] void stop(const st_error *err)
 {
     char buf[1200];
-    std::fprintf(stderr, "vdb_dist: %s\n", st_error_format(&err, buf, sizeof buf));
-    std::exit(1);
+    if (err)
+        std::fprintf(stderr, "vdb_dist: %s\n", st_error_format(err, buf, sizeof buf));
+    else
+        std::fputs("usage: vdb_dist MODEL -r N [--band B] [--threads T] -o OUT.vdb\n", stderr);
+    std::exit(err ? 1 : 2);
 }
 
+// A positive number (-r, --band, --threads), or the usage.
 double number_arg(const char *s)
 {
     char *end;
     errno = 0;
-    double v = std::strtod(s, &end);
-    if (errno || *end || !(v > 0))
-        usage();
+    const double v = std::strtod(s, &end);
+    if (errno != 0 || *end != '\0' || !(v > 0))
+        stop(nullptr);
     return v;
 }
 
@@ -83,14 +81,14 @@ int main(int argc, char **argv)
         else if (!std::strcmp(argv[i], "-o") && i + 1 < argc)
             out = argv[++i];
         else if (argv[i][0] == '-' && argv[i][1])
-            usage();
+            stop(nullptr);
         else if (!model)
             model = argv[i];
         else
-            usage();
+            stop(nullptr);
     }
     if (!model || !out || cells < 1)
-        usage();
+        stop(nullptr);
 
     try {
         const double t0 = now();
@@ -98,14 +96,14 @@ int main(int argc, char **argv)
         st_error_clear(&err);
         st_soup *soup = nullptr;
         if (st_soup_read(&soup, model, &err))
-            fail(err);
+            stop(&err);
         st_dist_params dp = st_dist_params_default();
         dp.cells = size_t(cells);
         dp.band = band;
         size_t dims[3];
         double origin[3], voxel;
         if (st_dist_layout(soup, &dp, dims, origin, &voxel, &err))
-            fail(err);
+            stop(&err);
         std::vector<openvdb::Vec3s> points(soup->nverts);
         for (size_t i = 0; i < soup->nverts; i++)
             points[i] = openvdb::Vec3s(float(soup->xyz[3 * i]), float(soup->xyz[3 * i + 1]),
@@ -143,9 +141,8 @@ int main(int argc, char **argv)
         return 0;
     } catch (const std::exception &e) {
         std::fprintf(stderr, "vdb_dist: %s\n", e.what());
-        return 1;
     } catch (...) {
-        std::fprintf(stderr, "vdb_dist: unknown exception\n");
-        return 1;
+        std::fputs("vdb_dist: unknown exception\n", stderr);
     }
+    return 1;
 }

@@ -700,18 +700,25 @@ static void test_fill(void)
     st_soup_free(down);
 }
 
+/* Corner k of tet t of m, with point v at y. */
+static const double *corner_at(const st_tetmesh *m, uint32_t t, int k, uint32_t v,
+                               const double y[3])
+{
+    uint32_t c = m->tets[4 * (size_t)t + (size_t)k];
+    return c == v ? y : m->xyz + 3 * (size_t)c;
+}
+
 /* 1 when q lies in the closed star of v with v at y (brute force). */
 static int brute_in_star(const sm_mesh *sm, uint32_t v, const double y[3], const double q[3])
 {
-    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
-        const uint32_t *c = sm->m->tets + 4 * (size_t)sm->vt[j];
-        const double *t[4];
-        for (int k = 0; k < 4; k++)
-            t[k] = c[k] == v ? y : sm->m->xyz + 3 * (size_t)c[k];
-        if (st_point_in_tet(q, t[0], t[1], t[2], t[3]) != ST_OUTSIDE)
-            return 1;
+    int in = 0;
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1] && !in; j++) {
+        uint32_t t = sm->vt[j];
+        in = st_point_in_tet(q, corner_at(sm->m, t, 0, v, y), corner_at(sm->m, t, 1, v, y),
+                             corner_at(sm->m, t, 2, v, y),
+                             corner_at(sm->m, t, 3, v, y)) != ST_OUTSIDE;
     }
-    return 0;
+    return in;
 }
 
 /* sm_swept_kept against every S vertex: a dense cloud of tiny triangles
