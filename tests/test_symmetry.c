@@ -2,7 +2,9 @@
  * bracket's two planes and not the third, a hexagonal bar's axis of order
  * 6 (not continuous, not 12), the same with a third of the bar's side
  * cut away, none on scattered triangles, the same answer on 1 and 2
- * threads, bad parameters refused. */
+ * threads, bad parameters refused; the near-degenerate cases: three boxes
+ * without symmetry, a bracket with one feature moved by two voxels, a
+ * tetrahedron (four triangles), a flat square. */
 #include "souptet/bvh.h"
 #include "souptet/soup.h"
 #include "souptet/symmetry.h"
@@ -169,8 +171,106 @@ static void test_none(void)
     st_soup_free(s);
 }
 
+/* A solid of three boxes placed so that no plane or axis maps it onto
+ * itself: nothing is accepted. */
+static void test_asymmetric(void)
+{
+    st_soup *s = st_soup_new();
+    add_box(s, (double[3]){0, 0, 0}, (double[3]){4, 1, 1});
+    add_box(s, (double[3]){0, 1, 0}, (double[3]){1, 3, 2.5});
+    add_box(s, (double[3]){2.7, 1, 0}, (double[3]){3.4, 1.6, 0.5});
+    st_symmetry_set set;
+    TAP_CHECK(detect(&set, s, 0.04) == 0 && set.n == 0,
+              "three boxes without symmetry: none accepted (%zu)", set.n);
+    st_soup_free(s);
+}
+
+/* The T bracket with a cube on each arm, one of them moved by two voxels
+ * along x: the plane x = 0.3 still holds over most of the area, stays
+ * where it is (the fit does not tilt or shift to half-match the cubes),
+ * and its support drops below the exact bracket's. */
+static void test_nearly(void)
+{
+    const double tol = 0.04;
+    double sup[2] = {0, 0}, at[2] = {1, 1};
+    for (int moved = 0; moved < 2; moved++) {
+        st_soup *s = st_soup_new();
+        add_box(s, (double[3]){-1.7, 0, 0}, (double[3]){2.3, 1, 1});
+        add_box(s, (double[3]){-0.2, 1, 0}, (double[3]){0.8, 4, 1});
+        double dx = moved ? 2.0 * tol : 0.0;
+        add_box(s, (double[3]){-1.5, 0.2, 1}, (double[3]){-1.1, 0.6, 1.4});
+        add_box(s, (double[3]){1.7 + dx, 0.2, 1}, (double[3]){2.1 + dx, 0.6, 1.4});
+        st_symmetry_set set;
+        TAP_CHECK(detect(&set, s, tol) == 0, "bracket with cubes%s: detection runs",
+                  moved ? ", one moved by 2 voxels" : "");
+        const st_symmetry *mx = mirror_along(&set, 0);
+        sup[moved] = mx ? mx->support : 0.0;
+        at[moved] = mx ? fabs(crossing(mx, 0) - 0.3) : 1.0;
+        st_soup_free(s);
+    }
+    TAP_CHECK(sup[0] > 0.95 && at[0] < 0.5 * tol,
+              "cubes in place: the plane x = 0.3 (%.3f off, support %.3f)", at[0], sup[0]);
+    TAP_CHECK(sup[1] >= ST_SYMMETRY_DEFAULT_MIN_SUPPORT && sup[1] < sup[0] && at[1] < tol,
+              "one cube moved by 2 voxels: the plane holds where it was, weaker (%.3f off, "
+              "support %.3f against %.3f)", at[1], sup[1], sup[0]);
+}
+
+/* A regular tetrahedron (four triangles): every accepted mirror maps the
+ * four corners onto the corners, and at least three of its six planes
+ * are found. */
+static void test_tiny(void)
+{
+    const double v[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
+    st_soup *s = st_soup_new();
+    add_tri(s, v[0], v[1], v[2], 0);
+    add_tri(s, v[0], v[3], v[1], 0);
+    add_tri(s, v[0], v[2], v[3], 0);
+    add_tri(s, v[1], v[3], v[2], 0);
+    st_symmetry_set set;
+    TAP_CHECK(detect(&set, s, 0.02) == 0, "tetrahedron: detection runs");
+    size_t mirrors = 0, wrong = 0;
+    for (size_t i = 0; i < set.n; i++) {
+        if (set.items[i].kind != ST_SYMMETRY_MIRROR)
+            continue;
+        mirrors++;
+        for (int a = 0; a < 4; a++) {
+            double q[3], best = 1e9;
+            st_symmetry_apply(set.items + i, 0.0, v[a], 1, q);
+            for (int b = 0; b < 4; b++)
+                best = fmin(best, hypot(hypot(q[0] - v[b][0], q[1] - v[b][1]),
+                                        q[2] - v[b][2]));
+            wrong += best > 0.02;
+        }
+    }
+    TAP_CHECK(mirrors >= 3 && wrong == 0,
+              "tetrahedron: %zu mirrors, %zu corner images off the corners", mirrors, wrong);
+    st_soup_free(s);
+}
+
+/* A flat square grid in z = 0: every map that keeps the plane moves its
+ * samples along their own surface or not at all, so nothing is
+ * informative and nothing is accepted (the fill would have nothing to
+ * add); detection runs without error. */
+static void test_planar(void)
+{
+    st_soup *s = st_soup_new();
+    for (int i = 0; i < 8; i++)
+        for (int j = 0; j < 8; j++) {
+            double p0[3] = {i, j, 0}, p1[3] = {i + 1, j, 0}, p2[3] = {i + 1, j + 1, 0},
+                   p3[3] = {i, j + 1, 0};
+            add_tri(s, p0, p1, p2, 0);
+            add_tri(s, p0, p2, p3, 0);
+        }
+    st_symmetry_set set;
+    TAP_CHECK(detect(&set, s, 0.06) == 0 && set.n == 0,
+              "flat square: detection runs, nothing accepted (%zu)", set.n);
+    st_soup_free(s);
+}
+
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {TAP_TEST(bracket), TAP_TEST(hex_bar), TAP_TEST(none), {0}};
+    static const tap_test tests[] = {TAP_TEST(bracket), TAP_TEST(hex_bar), TAP_TEST(none),
+                                     TAP_TEST(asymmetric), TAP_TEST(nearly), TAP_TEST(tiny),
+                                     TAP_TEST(planar), {0}};
     return tap_main(argc, argv, tests);
 }

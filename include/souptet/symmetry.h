@@ -5,8 +5,8 @@
  * Units: model units (tolerances, offsets); angles in degrees.
  * Ownership: the caller owns the set *out (a plain struct); the soup and
  * BVH are borrowed.
- * Threads: OpenMP in the support counts; deterministic for any thread count
- * (below).
+ * Threads: OpenMP over the mirror candidates and in the support counts;
+ * deterministic for any thread count (below).
  * Errors: ST_EINPUT (an empty soup, bad parameters), ST_ENOMEM.
  *
  * The algorithm (area samples, mirror candidates from principal axes and
@@ -37,7 +37,10 @@ extern "C" {
  * holes took the parts that disagree 0.439; the true planes of the CAD
  * parts with large holes 0.50 (couplingdown), 0.54 (joint), 0.80-0.90
  * (rotor, anchor, pinion). 0.6 refuses every false one measured and
- * two true ones: a clear majority, as the issue asks. */
+ * two true ones: a clear majority, as the issue asks. A mirror below it
+ * is still accepted when at least 0.4 of the informative samples are
+ * verified and at most 0.2 of what the soup can check contradicts it
+ * (the rest land in the soup's holes): doc/design/symmetry.md. */
 #define ST_SYMMETRY_DEFAULT_MIN_SUPPORT 0.6
 #define ST_SYMMETRY_DEFAULT_MAX_ORDER 48
 #define ST_SYMMETRY_MAX 16          /* symmetries kept, best first */
@@ -58,7 +61,8 @@ typedef struct st_symmetry {
 typedef struct st_symmetry_params {
     size_t samples;      /* area samples (ST_SYMMETRY_DEFAULT_SAMPLES) */
     double tolerance;    /* model units, > 0 (the caller's voxel) */
-    double min_support;  /* accept at or above this share */
+    double min_support;  /* accept at or above this share (mirrors:
+                            or little contradicted, above) */
     int max_order;       /* largest discrete rotation order tested, >= 2 */
 } st_symmetry_params;
 

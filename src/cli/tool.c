@@ -860,8 +860,8 @@ int tool_report_symmetries(tool_ctx *t, const st_soup *soup, const st_bvh *bvh,
     st_symmetry_params sp = st_symmetry_params_default();
     st_symmetry_set own;
     if (set->candidates > 0) {
-        tool_say(t, 2, "symmetries: %zu with support >= %.2f within %.6g (%zu candidates "
-                 "measured); fill: %zu triangles from %zu maps, %zu of %zu caps dropped as "
+        tool_say(t, 2, "symmetries: %zu accepted (support >= %.2f, or a mirror seldom "
+                 "contradicted) within %.6g (%zu candidates measured); fill: %zu triangles from %zu maps, %zu of %zu caps dropped as "
                  "covered, %zu kept (the fill agrees with them), %zu of %zu holes too large "
                  "to cap filled, %zu left as they were (the copy itself holed), %.3f s",
                  set->n, sp.min_support, tolerance, set->candidates, fill->triangles,
@@ -878,8 +878,8 @@ int tool_report_symmetries(tool_ctx *t, const st_soup *soup, const st_bvh *bvh,
         st_bvh_free(built);
         if (st)
             return tool_fail(t, &err);
-        tool_say(t, 2, "symmetries: %zu with support >= %.2f within %.6g (%zu candidates "
-                 "measured, %.3f s); not used (--symmetry on fills capped holes from them)",
+        tool_say(t, 2, "symmetries: %zu accepted (support >= %.2f, or a mirror seldom "
+                 "contradicted) within %.6g (%zu candidates measured, %.3f s); not used (--symmetry on fills capped holes from them)",
                  own.n, sp.min_support, tolerance, own.candidates, tool_now() - t0);
         set = &own;
     }

@@ -11,6 +11,7 @@
  */
 #include "souptet/symmetry.h"
 #include "../base/fpenv.h"
+#include "souptet/edges.h"
 #include "souptet/geom.h"
 #include "souptet/mem.h"
 
@@ -32,6 +33,17 @@
 #define VOTE_CANDIDATES 16
 #define REFINE_ROUNDS 6
 #define REFINE_REACH 3.0              /* tolerances */
+/* The rounds use every REFINE_STRIDE-th sample (a plane from some
+ * hundreds of midpoints), and stop once the plane moves by less than
+ * REFINE_STILL tolerances and turns by less than about REFINE_STILL
+ * radians. */
+#define REFINE_STRIDE 4
+#define REFINE_STILL 1e-3
+/* Candidates are screened on every SCREEN-th sample (and the orders of an
+ * axis first on every 4 SCREEN-th); below SCREEN_SHARE of the share they
+ * must reach there, they are not measured on all. */
+#define SCREEN 8
+#define SCREEN_SHARE 0.5
 
 st_symmetry_params st_symmetry_params_default(void)
 {
@@ -236,10 +248,23 @@ typedef struct ctx {
     const samples *S;
     double tol;
     double *tn;      /* unit normal per soup triangle */
+    uint8_t *rim;    /* per triangle: bit j when its edge j (corners j,
+                        j + 1) is a boundary edge (one triangle) */
 } ctx;
 
 /* Whether the image (q, nq) lands on the soup within reach with a
- * compatible normal; *closest gets the nearest point. */
+ * compatible normal; *closest gets the nearest point, *tri its triangle
+ * (-1: nothing within reach). */
+static int lands_tri(const ctx *C, const double q[3], const double nq[3],
+                     double reach, double closest[3], int64_t *tri)
+{
+    double d2 = st_bvh_nearest(C->bvh, q, reach * reach, tri, closest);
+    if (*tri < 0)
+        return 0;
+    return d2 <= C->tol * C->tol &&
+           fabs(st_dot3(nq, C->tn + 3 * (size_t)*tri)) >= MATCH_COS;
+}
+
 static int lands(const ctx *C, const double q[3], const double nq[3],
                  double reach, double closest[3])
 {
@@ -251,6 +276,41 @@ static int lands(const ctx *C, const double q[3], const double nq[3],
     return fabs(st_dot3(nq, C->tn + 3 * (size_t)tri)) >= MATCH_COS;
 }
 
+/* Whether point c of triangle t lies on one of its boundary edges: the
+ * soup ends there, so what lies beyond it is unknown, not absent. */
+static int on_rim(const ctx *C, int64_t t, const double c[3])
+{
+    uint8_t m = C->rim[t];
+    if (!m)
+        return 0;
+    const uint32_t *v = C->s->tris + 3 * (size_t)t;
+    for (int j = 0; j < 3; j++) {
+        if (!(m >> j & 1))
+            continue;
+        const double *a = C->s->xyz + 3 * (size_t)v[j],
+                     *b = C->s->xyz + 3 * (size_t)v[(j + 1) % 3];
+        double e[3], x[3];
+        st_sub3(e, b, a);
+        double d2 = st_point_segment_dist2(c, a, b, x);
+        if (d2 <= 1e-12 * st_dot3(e, e))
+            return 1;
+    }
+    return 0;
+}
+
+/* What the images of the informative samples (below) find. verified:
+ * on the soup within the tolerance, with a compatible normal. The rest,
+ * with `full`, by the soup's nearest point to the image: unverifiable
+ * when it lies on a boundary edge (a hole's rim: the image lands where
+ * the damage is, and the soup cannot say what was there); contradicted
+ * when it lies inside the surface: the soup was seen all around that
+ * place, and is not where the map puts it (the image is in open space or
+ * across the surface). A closed soup has no rims: there everything not
+ * verified is contradicted. */
+typedef struct tally {
+    long all, informative, verified, contradicted;
+} tally;
+
 /* The share of every stride-th sample whose image lands on the soup,
  * among the informative ones: those the map moves by more than the
  * tolerance, not along their own surface (the displacement at least
@@ -260,12 +320,12 @@ static int lands(const ctx *C, const double q[3], const double nq[3],
  * than MIN_INFORM of the samples informative: 0. */
 #define INFORM_SIN 0.25881904510252074 /* sin 15 degrees */
 #define MIN_INFORM 0.1
-static double support_stride(const ctx *C, const st_symmetry *y,
-                             double angle, size_t stride)
+static tally measure(const ctx *C, const st_symmetry *y, double angle,
+                     size_t stride, int full)
 {
     const samples *S = C->S;
-    long hits = 0, n = 0, all = 0;
-#pragma omp parallel for schedule(static) reduction(+ : hits, n, all)
+    long hits = 0, n = 0, all = 0, contra = 0;
+#pragma omp parallel for schedule(static) reduction(+ : hits, n, all, contra)
     for (size_t k = 0; k < S->n; k += stride) {
         double q[3], nq[3], c[3], d[3];
         all++;
@@ -275,18 +335,59 @@ static double support_stride(const ctx *C, const st_symmetry *y,
         if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
             continue;
         st_symmetry_apply(y, angle, S->nrm + 3 * k, 0, nq);
-        hits += lands(C, q, nq, C->tol, c);
+        int64_t t;
+        int hit = lands_tri(C, q, nq, C->tol, c, &t);
+        hits += hit;
+        if (full && !hit) {
+            st_bvh_nearest(C->bvh, q, INFINITY, &t, c);
+            contra += t >= 0 && !on_rim(C, t, c);
+        }
         n++;
     }
-    if ((double)n < MIN_INFORM * (double)all)
+    tally r = {all, n, hits, full ? contra : 0};
+    return r;
+}
+
+static double share(const tally *t)
+{
+    if ((double)t->informative < MIN_INFORM * (double)t->all)
         return 0.0;
-    return (double)hits / (double)n;
+    return (double)t->verified / (double)t->informative;
+}
+
+/* The contradicted share of what the soup could check (verified or
+ * contradicted); 1 when it could check nothing. */
+static double contradiction(const tally *t)
+{
+    long seen = t->verified + t->contradicted;
+    return seen ? (double)t->contradicted / (double)seen : 1.0;
+}
+
+static double support_stride(const ctx *C, const st_symmetry *y,
+                             double angle, size_t stride)
+{
+    tally t = measure(C, y, angle, stride, 0);
+    return share(&t);
 }
 
 static double support(const ctx *C, const st_symmetry *y, double angle)
 {
     return support_stride(C, y, angle, 1);
 }
+
+/* Accepted: a clear majority of the informative samples verified, or
+ * (a damaged part, whose images fall into its holes) at least
+ * MIN_VERIFIED of them verified and at most MAX_CONTRA of what the soup
+ * could check contradicted. doc/design/symmetry.md has the measurements
+ * behind both. */
+#define MIN_VERIFIED 0.4
+#define MAX_CONTRA 0.2
+static int accepted(const tally *t, double min_support)
+{
+    double v = share(t);
+    return v >= min_support || (v >= MIN_VERIFIED && contradiction(t) <= MAX_CONTRA);
+}
+
 
 /* ---- mirrors -------------------------------------------------------------- */
 
@@ -322,7 +423,7 @@ static st_symmetry mirror_of(const double n[3], double off)
 static void refine_mirror(const ctx *C, st_symmetry *y)
 {
     const samples *S = C->S;
-    double *mid = st_malloc_array(3 * S->n, sizeof *mid);
+    double *mid = st_malloc_array(3 * (S->n / REFINE_STRIDE + 1), sizeof *mid);
     if (!mid)
         return; /* unrefined: only a weaker support */
     for (int round = 0; round < REFINE_ROUNDS; round++) {
@@ -330,7 +431,7 @@ static void refine_mirror(const ctx *C, st_symmetry *y)
         size_t m = 0;
         /* sequential: the sums are in sample order, independent of
          * threads */
-        for (size_t k = 0; k < S->n; k++) {
+        for (size_t k = 0; k < S->n; k += REFINE_STRIDE) {
             double q[3], nq[3], c[3], d[3];
             const double *p = S->p + 3 * k;
             st_symmetry_apply(y, 0.0, p, 1, q);
@@ -348,7 +449,7 @@ static void refine_mirror(const ctx *C, st_symmetry *y)
             }
             m++;
         }
-        if (m < 16)
+        if (m < 16 / REFINE_STRIDE + 4)
             break;
         for (int x = 0; x < 3; x++)
             mean[x] /= (double)m;
@@ -373,7 +474,11 @@ static void refine_mirror(const ctx *C, st_symmetry *y)
             break; /* the fit turned away: keep the plane */
         double off = st_dot3(n, mean);
         canon_plane(n, &off);
+        double moved = fabs(off - st_dot3(y->point, y->dir)) / C->tol,
+               turned = 1.0 - st_dot3(n, y->dir);
         *y = mirror_of(n, off);
+        if (moved < REFINE_STILL && turned < REFINE_STILL * REFINE_STILL)
+            break; /* settled */
     }
     free(mid);
 }
@@ -461,9 +566,15 @@ static size_t vote_mirrors(const ctx *C, st_symmetry *out, size_t max)
         tab[slot].off += off;
         tab[slot].count++;
     }
-    qsort(tab, cap, sizeof *tab, cmp_vote);
+    /* the filled cells alone are sorted (their keys differ: a total
+     * order, so the same ranking as sorting the whole table) */
+    size_t filled = 0;
+    for (size_t i = 0; i < cap; i++)
+        if (tab[i].key != 0)
+            tab[filled++] = tab[i];
+    qsort(tab, filled, sizeof *tab, cmp_vote);
     size_t m = 0;
-    for (size_t i = 0; i < cap && m < max && tab[i].count >= 3; i++) {
+    for (size_t i = 0; i < filled && m < max && tab[i].count >= 3; i++) {
         double n[3] = {tab[i].n[0], tab[i].n[1], tab[i].n[2]};
         normalize(n);
         out[m++] = mirror_of(n, tab[i].off / (double)tab[i].count);
@@ -491,7 +602,6 @@ static int same_line(const st_symmetry *a, const st_symmetry *b, double tol)
  * turn: a small turn about any axis near a smooth surface slides it along
  * itself) both hold; the largest such n. Screened on every SCREEN-th
  * sample, confirmed on all. */
-#define SCREEN 8
 static int axis_order(const ctx *C, const st_symmetry *y, int max_order,
                       double min_support, double *sup)
 {
@@ -512,6 +622,10 @@ static int axis_order(const ctx *C, const st_symmetry *y, int max_order,
     for (int n = max_order; n >= 2; n--) {
         /* every turn up to the half: a small turn alone passes on any
          * axis that a surface nearly slides along */
+        /* the first turn on every 4 SCREEN-th sample, far below: no */
+        if (support_stride(C, y, 2.0 * PI / (double)n, 4 * SCREEN) <
+            SCREEN_SHARE * min_support)
+            continue;
         int k = 1;
         while (k <= n / 2 &&
                support_stride(C, y, 2.0 * PI * k / (double)n, SCREEN) >=
@@ -594,6 +708,64 @@ static void keep(st_symmetry_set *out, const st_symmetry *y, double tol)
         out->items[w] = *y;
 }
 
+/* Each triangle's boundary edges (ctx.rim), read on the welded soup. */
+static st_status rim_make(ctx *C, st_error *err)
+{
+    const st_soup *s = C->s;
+    st_soup_edges e;
+    st_status rc = st_soup_edges_build(&e, s, err);
+    if (rc)
+        return rc;
+    C->rim = st_calloc_array(s->ntris ? s->ntris : 1, sizeof *C->rim);
+    if (!C->rim) {
+        st_soup_edges_free(&e);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's rims");
+    }
+    for (size_t i = 0; i < e.nhalf;) {
+        size_t end = st_soup_edges_run_end(&e, i);
+        if (end - i == 1) {
+            uint32_t t = e.he[i].t, lo = (uint32_t)(e.he[i].key >> 32),
+                     hi = (uint32_t)e.he[i].key;
+            const uint32_t *v = s->tris + 3 * (size_t)t;
+            for (int j = 0; j < 3; j++) {
+                uint32_t a = e.weld[v[j]], b = e.weld[v[(j + 1) % 3]];
+                if ((a == lo && b == hi) || (a == hi && b == lo))
+                    C->rim[t] |= (uint8_t)(1u << j);
+            }
+        }
+        i = end;
+    }
+    st_soup_edges_free(&e);
+    return ST_OK;
+}
+
+/* The samples, each triangle's unit normal and its rims. */
+static st_status ctx_make(ctx *C, const st_soup *s, samples *S, size_t want, st_error *err)
+{
+    memset(S, 0, sizeof *S);
+    C->tn = st_malloc_array(3 * (s->ntris ? s->ntris : 1), sizeof *C->tn);
+    if (!C->tn || samples_make(S, s, want))
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the symmetry samples");
+    if (S->n == 0)
+        return ST_OK;
+    for (size_t t = 0; t < s->ntris; t++) {
+        const uint32_t *v = s->tris + 3 * t;
+        double u[3], w[3];
+        st_sub3(u, s->xyz + 3 * (size_t)v[1], s->xyz + 3 * (size_t)v[0]);
+        st_sub3(w, s->xyz + 3 * (size_t)v[2], s->xyz + 3 * (size_t)v[0]);
+        st_cross3(C->tn + 3 * t, u, w);
+        normalize(C->tn + 3 * t);
+    }
+    return rim_make(C, err);
+}
+
+static void ctx_free(ctx *C, samples *S)
+{
+    free(C->tn);
+    free(C->rim);
+    samples_free(S);
+}
+
 st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
                              const st_bvh *bvh, const st_symmetry_params *p,
                              st_error *err)
@@ -606,26 +778,11 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
                             "least 16 samples, order >= 2, support in (0, "
                             "1]");
     samples S;
-    ctx C = {s, bvh, &S, p->tolerance, NULL};
-    C.tn = st_malloc_array(3 * (s->ntris ? s->ntris : 1), sizeof *C.tn);
-    if (!C.tn || samples_make(&S, s, p->samples)) {
-        free(C.tn);
-        samples_free(&S);
-        return st_error_set(err, ST_ENOMEM, NULL, 0,
-                            "out of memory for the symmetry samples");
-    }
-    if (S.n == 0) {
-        free(C.tn);
-        samples_free(&S);
-        return ST_OK;
-    }
-    for (size_t t = 0; t < s->ntris; t++) {
-        const uint32_t *v = s->tris + 3 * t;
-        double u[3], w[3];
-        st_sub3(u, s->xyz + 3 * (size_t)v[1], s->xyz + 3 * (size_t)v[0]);
-        st_sub3(w, s->xyz + 3 * (size_t)v[2], s->xyz + 3 * (size_t)v[0]);
-        st_cross3(C.tn + 3 * t, u, w);
-        normalize(C.tn + 3 * t);
+    ctx C = {s, bvh, &S, p->tolerance, NULL, NULL};
+    st_status rc = ctx_make(&C, s, &S, p->samples, err);
+    if (rc || S.n == 0) {
+        ctx_free(&C, &S);
+        return rc;
     }
 
     /* mirrors: principal planes and the votes, refined, measured */
@@ -640,11 +797,25 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
     nc += vote_mirrors(&C, cand + nc, VOTE_CANDIDATES);
     st_symmetry mirrors[3 + VOTE_CANDIDATES];
     size_t nm = 0;
-    for (size_t i = 0; i < nc; i++) {
+    /* each candidate on its own: the same result for any thread count */
+    int ok[3 + VOTE_CANDIDATES];
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long i = 0; i < (long)nc; i++) {
         refine_mirror(&C, cand + i);
-        cand[i].support = support(&C, cand + i, 0.0);
+        /* a plane that fails on every SCREEN-th sample by far is not
+         * measured on all: only accepted planes' supports are read */
+        tally t = measure(&C, cand + i, 0.0, SCREEN, 0);
+        if (share(&t) >= SCREEN_SHARE * MIN_VERIFIED)
+            t = measure(&C, cand + i, 0.0, 1, 0);
+        /* the contradictions matter only between the two shares */
+        if (share(&t) >= MIN_VERIFIED && share(&t) < p->min_support)
+            t = measure(&C, cand + i, 0.0, 1, 1);
+        cand[i].support = share(&t);
+        ok[i] = accepted(&t, p->min_support);
+    }
+    for (size_t i = 0; i < nc; i++) {
         out->candidates++;
-        if (cand[i].support >= p->min_support) {
+        if (ok[i]) {
             size_t j = 0;
             while (j < nm && !same_plane(mirrors + j, cand + i, p->tolerance))
                 j++;
@@ -695,7 +866,6 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
         keep(out, axes + i, p->tolerance);
     }
     qsort(out->items, out->n, sizeof *out->items, cmp_sym);
-    free(C.tn);
-    samples_free(&S);
+    ctx_free(&C, &S);
     return ST_OK;
 }
