@@ -82,9 +82,11 @@ static void test_shared(void)
     st_dist_params dist = st_dist_params_default();
     st_pseudo_params ps = st_pseudo_params_default();
 
-    /* soupmesh's field: max(128, 8 * cells) voxels (pipeline.c); soupdist's
-     * default -r must be that at the default cells for the pipe. */
-    size_t field = pl.cells * 8 > 128 ? pl.cells * 8 : 128;
+    /* soupmesh's field: max(8 cells, min(16 cells, 128)) voxels
+     * (pipeline.c); soupdist's default -r must be that at the default cells
+     * for the pipe. */
+    size_t field = pl.cells * 16 < 128 ? pl.cells * 16 : 128;
+    field = pl.cells * 8 > field ? pl.cells * 8 : field;
     TAP_CHECK(dist.cells == field,
               "soupdist's default resolution (%zu) is soupmesh's field at %zu cells (%zu)",
               dist.cells, pl.cells, field);

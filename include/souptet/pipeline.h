@@ -111,7 +111,8 @@ typedef struct st_pipeline_params {
                               resolution then counts ceil(longest side / h)
                               cells */
     size_t field_cells;    /* voxels along the longest side of the field;
-                              0: max(128, 8 * cells) */
+                              0: 16 per cell up to 128, 8 per cell
+                              beyond: max(8 cells, min(16 cells, 128)) */
     size_t target_tets;    /* > 0: choose h for about this many tets: the
                               first candidate's lattice is sculpted at the
                               h of cells (or h) and then at widths stepped

@@ -582,6 +582,17 @@ static st_status make_fill(st_soup **fill, st_pipeline_stats *st, const st_grid 
     return ST_OK;
 }
 
+/* The field's default voxels along the longest side for a lattice of
+ * cells: 16 voxels per lattice cell up to 128 (soupdist's default), 8 per
+ * cell beyond (pipeline.h). The fit and the sculpt read the field per
+ * cell: 8 per cell is what runs at 16 cells and over always had; a coarse
+ * lattice gets twice that, no longer a 128^3 field for 4 cells. */
+static size_t field_voxels(size_t cells)
+{
+    const size_t fine = cells * 16 < 128 ? cells * 16 : 128;
+    return cells * 8 > fine ? cells * 8 : fine;
+}
+
 /* The field and the pseudo volume's settings a run uses (voxels along the
  * longest side of the soup's box, its hole caps and closed shells): one
  * place for st_pipeline_run and st_pipeline_field_of_mesh. */
@@ -749,7 +760,7 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     double t_start = now_seconds();
     st_dist_params dp;
     st_pseudo_params pp;
-    field_params(&dp, &pp, p->field_cells ? p->field_cells : (cells * 8 > 128 ? cells * 8 : 128),
+    field_params(&dp, &pp, p->field_cells ? p->field_cells : field_voxels(cells),
                  p->max_bytes, p->fill_holes, p->closed_shells, p->symmetry);
     st_grid *g = NULL;
     st_bvh *bvh = NULL;
