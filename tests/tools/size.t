@@ -48,7 +48,9 @@ n=$(sed -n 's/.*"tets": \([0-9]*\).*/\1/p' b1.json | head -1)
 [ -n "$est" ] && [ "$est" = "$n" ]
 ok $? "the estimate ($est) is the count the run with one candidate made ($n): the fit keeps every tet"
 h=$(sed -n 's/^h //p' dry.txt)
-soupmesh -q --dry-run --size "$h" "$BUNNY" >dry2.txt
+# the field follows --cells (10 here: 128 voxels) or --size, and --tets
+# keeps the one of --cells: -r 128 gives the --size run that field
+soupmesh -q --dry-run --size "$h" -r 128 "$BUNNY" >dry2.txt
 [ "$(sed -n 's/^estimated_tets //p' dry2.txt)" = "$est" ]
 ok $? "--dry-run --size with that h estimates the same count"
 mkdir -p nothing && (cd nothing && soupmesh -q --dry-run -o x.vtu "$BUNNY" >/dev/null) && [ -z "$(ls nothing)" ]
