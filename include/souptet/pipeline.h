@@ -135,7 +135,7 @@ typedef struct st_pipeline_params {
     int closed_shells;     /* the soup's closed pieces sign their solid
                               exactly (shells.h) (1) */
     int symmetry;          /* with fill_holes: the soup's symmetries fill
-                              the holes they cover (pseudo.h, symmetry.h) (0) */
+                              the holes they cover (pseudo.h, symmetry.h) (1) */
     int fill_counts;       /* the fill counts as surface for the fit's
                               stopping condition (2. below, and the pull):
                               the pseudo volume's boundary where the soup

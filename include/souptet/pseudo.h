@@ -87,7 +87,7 @@ typedef struct st_pseudo_params {
                                        (symmetry.h) fill the holes, capped
                                        or too large to cap, their images
                                        close, and those holes' caps are
-                                       dropped (0: off; measured in
+                                       dropped (1: on; measured in
                                        doc/design/symmetry.md) */
     st_soup **symmetric_fill;       /* not NULL: *symmetric_fill gets the
                                        symmetric fill used (the caller's,

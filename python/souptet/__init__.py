@@ -120,7 +120,7 @@ def read_parts(path, mode="auto"):
 
 def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
          threads=0, progress=None, float32=False, cancel=None, try_all=False,
-         parts=None, part_names=None, fill_holes=True, symmetry=False):
+         parts=None, part_names=None, fill_holes=True, symmetry=True):
     """Mesh a triangle soup into a coarse tet mesh that encloses it (soupmesh).
 
     V         (n, 3) numbers, the vertices in model units (finite)
@@ -174,7 +174,7 @@ def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
               alone closes them)
     symmetry    bool, fill the holes from the soup's own mirror planes and
               rotation axes, where their images close a hole (default
-              False, as --symmetry off; needs fill_holes)
+              True, as --symmetry on; needs fill_holes)
     Returns a MeshResult. Not enclosing is not an error: see .encloses.
     Raises souptet.Error for bad input or parameters, MemoryError.
     """
@@ -207,7 +207,7 @@ class Field:
                                                    self.voxel)
 
 
-def pseudo_volume(V, F, resolution=128, *, fill_holes=True, symmetry=False):
+def pseudo_volume(V, F, resolution=128, *, fill_holes=True, symmetry=True):
     """The pseudo volume of a soup: which voxels are inside (soupdist -r N | soupsign).
 
     V, F        as mesh()
@@ -239,7 +239,7 @@ def distance(V, F, resolution=128, *, band=3.0):
     return Field(_core.distance(V, F, resolution, band), False)
 
 
-def wrap(V, F, resolution=128, *, fill_holes=True, symmetry=False):
+def wrap(V, F, resolution=128, *, fill_holes=True, symmetry=True):
     """A closed, oriented, 2-manifold, self-intersection-free surface around the
     soup's pseudo volume (soupwrap --surface; needs souptet._io: OpenVDB).
 

@@ -39,7 +39,7 @@ st_pseudo_params st_pseudo_params_default(void)
     p.sides = 1;
     p.sides_params = st_sides_params_default();
     p.shells_shortcut = 1;
-    p.symmetry = 0;
+    p.symmetry = 1;
     return p;
 }
 

@@ -38,7 +38,7 @@ st_pipeline_params st_pipeline_params_default(void)
     p.max_bytes = 0;
     p.fill_holes = 1;
     p.closed_shells = 1;
-    p.symmetry = 0;
+    p.symmetry = 1;
     p.fill_counts = 1;
     p.float32 = 0;
     return p;

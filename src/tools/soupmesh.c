@@ -106,7 +106,7 @@ TOOL_HELP_TETFORMAT
 "      --shells on|off  the soup's closed pieces (every edge shared by two\n"
 "                       faces) bound their solid exactly (default on)\n"
 "      --symmetry on|off  fill holes from the soup's symmetries, as soupsign\n"
-"                       --symmetry (default off)\n"
+"                       --symmetry (default on)\n"
 "      --no-quality     skip the quality pass after the fit\n"
 "      --threads T      threads to use (default: all cores)\n"
 "      --max-memory SZ  refuse fields and lattices larger than SZ\n"

@@ -90,7 +90,7 @@ static void usage(void)
 "                       the signs are exactly their solid (default on)\n"
 "      --symmetry on|off  with --surface and --fill-holes: the surface's mirror\n"
 "                       planes and rotation axes fill the holes their images\n"
-"                       close, capped or too large to cap (default off)\n"
+"                       close, capped or too large to cap (default on)\n"
 "      --sides on|off   with --surface: the side of the surface's oriented walls\n"
 "                       each voxel near them is on (its pieces oriented by\n"
 "                       propagation, each turned the way the votes read it)\n"
@@ -536,6 +536,7 @@ int main(int argc, char *argv[])
 {
     soupsign_settings s = {.sign = st_sign_params_default(),
                            .refine = st_sign_refine_params_default(), .fill_holes = 1,
+                           .symmetry = st_pseudo_params_default().symmetry,
                            .bend_caps = -1,
                            .use_shells = 1, .use_sides = 1,
                            .columns = 1};

@@ -55,7 +55,7 @@ static void usage(void)
 "      --shells on|off  with --surface: the soup's closed pieces bound their\n"
 "                       solid exactly, as soupsign --shells (default on)\n"
 "      --symmetry on|off  with --surface: fill holes from the soup's\n"
-"                       symmetries, as soupsign --symmetry (default off)\n"
+"                       symmetries, as soupsign --symmetry (default on)\n"
 "  -r, --voxels N       with --surface: voxels along the longest side\n"
 "                       (default %d)\n"
 "  -o, --output OUT     .obj .off .ply (binary) .stl (binary); '-' or none:\n"
@@ -286,6 +286,7 @@ static const tool_spec spec = {"soupwrap", usage, ":r:o:qv", longopts, option, c
 int main(int argc, char *argv[])
 {
     soupwrap_settings s = {.wrap = st_wrap_params_default(), .dist = st_dist_params_default(),
-                           .format = ST_SOUP_OBJ, .fill_holes = 1, .use_shells = 1};
+                           .format = ST_SOUP_OBJ, .fill_holes = 1, .use_shells = 1,
+                           .symmetry = st_pseudo_params_default().symmetry};
     return tool_main(&spec, argc, argv, &s, &s.co);
 }

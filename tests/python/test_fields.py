@@ -95,10 +95,10 @@ def holed_cylinder(deg):
     return V, np.array(F)
 
 
-@pytest.mark.parametrize("opts,kw", [(["--symmetry", "on"], {"symmetry": True}),
+@pytest.mark.parametrize("opts,kw", [(["--symmetry", "off"], {"symmetry": False}),
                                      (["--fill-holes", "off"], {"fill_holes": False}),
-                                     ([], {"fill_holes": True, "symmetry": False})],
-                         ids=["symmetry", "no-fill-holes", "defaults"])
+                                     ([], {"fill_holes": True, "symmetry": True})],
+                         ids=["no-symmetry", "no-fill-holes", "defaults"])
 def test_pseudo_volume_fill_options_as_soupsign(tmp_path, opts, kw):
     # fill_holes= and symmetry= give soupsign --fill-holes / --symmetry's signs
     V, F = holed_cylinder(70)
@@ -120,8 +120,8 @@ def test_pseudo_volume_fill_options_as_soupsign(tmp_path, opts, kw):
 def test_symmetry_changes_the_holed_cylinder():
     # the fill is used: the signs differ from the caps' alone
     V, F = holed_cylinder(70)
-    on = souptet.pseudo_volume(V, F, resolution=32, symmetry=True)
-    off = souptet.pseudo_volume(V, F, resolution=32)
+    on = souptet.pseudo_volume(V, F, resolution=32)
+    off = souptet.pseudo_volume(V, F, resolution=32, symmetry=False)
     assert not np.array_equal(on.inside, off.inside)
     with pytest.raises(TypeError):
         souptet.pseudo_volume(V, F, 32, True)   # keyword only
