@@ -879,7 +879,7 @@ int tool_report_symmetries(tool_ctx *t, const st_soup *soup, const st_bvh *bvh,
         if (st)
             return tool_fail(t, &err);
         tool_say(t, 2, "symmetries: %zu accepted (support >= %.2f, or a mirror seldom "
-                 "contradicted) within %.6g (%zu candidates measured, %.3f s); not used (--symmetry on fills capped holes from them)",
+                 "contradicted) within %.6g (%zu candidates measured, %.3f s); not used (no holes to fill, or --symmetry off)",
                  own.n, sp.min_support, tolerance, own.candidates, tool_now() - t0);
         set = &own;
     }
