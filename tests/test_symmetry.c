@@ -4,7 +4,11 @@
  * cut away, none on scattered triangles, the same answer on 1 and 2
  * threads, bad parameters refused; the near-degenerate cases: three boxes
  * without symmetry, a bracket with one feature moved by two voxels, a
- * tetrahedron (four triangles), a flat square. */
+ * tetrahedron (four triangles), a flat square. Helices: a threaded rod
+ * (right- and left-handed, whole and with a band of its thread cut away)
+ * gives its helix and pitch, the same on 1 and 2 threads; a plain
+ * cylinder gives its continuous rotation and no helix; a thread whose
+ * pitch is below two voxels gives no helix. */
 #include "souptet/bvh.h"
 #include "souptet/soup.h"
 #include "souptet/symmetry.h"
@@ -48,13 +52,25 @@ static const st_symmetry *mirror_along(const st_symmetry_set *set, int a)
     return NULL;
 }
 
-static const st_symmetry *axis_along(const st_symmetry_set *set, int a)
+static const st_symmetry *kind_along(const st_symmetry_set *set, st_symmetry_kind kind, int a)
 {
     for (size_t i = 0; i < set->n; i++)
-        if (set->items[i].kind == ST_SYMMETRY_ROTATION &&
-            fabs(set->items[i].dir[a]) > 0.9994)
+        if (set->items[i].kind == kind && fabs(set->items[i].dir[a]) > 0.9994)
             return set->items + i;
     return NULL;
+}
+
+static const st_symmetry *axis_along(const st_symmetry_set *set, int a)
+{
+    return kind_along(set, ST_SYMMETRY_ROTATION, a);
+}
+
+static size_t count_kind(const st_symmetry_set *set, st_symmetry_kind kind)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < set->n; i++)
+        n += set->items[i].kind == kind;
+    return n;
 }
 
 /* Where plane y crosses axis a (its normal along a). */
@@ -267,10 +283,124 @@ static void test_planar(void)
     st_soup_free(s);
 }
 
+/* A rod along z (radius 1, length 6, 64 x 96 quads and two end fans)
+ * with a thread of the given pitch (> 0 right-handed, 0: a plain
+ * cylinder) and depth: the radius is 1 + depth times a trapezoid wave of
+ * the phase z - pitch * theta / (2 pi) (flat crests and roots, as a
+ * machine thread). `cut`: the side faces of the band 2 < z < 3 left
+ * out. */
+static st_soup *threaded_rod(double pitch, double depth, int cut)
+{
+    enum { NT = 64, NZ = 96 };
+    const double len = 6.0;
+    st_soup *s = st_soup_new();
+    double ring[NZ + 1][NT][3];
+    for (int j = 0; j <= NZ; j++)
+        for (int i = 0; i < NT; i++) {
+            double th = 2.0 * M_PI * i / NT, z = len * j / NZ, r = 1.0;
+            if (pitch != 0.0) {
+                double u = (z - pitch * th / (2.0 * M_PI)) / fabs(pitch);
+                u -= floor(u);
+                r += depth * fmin(1.0, fmax(0.0, 1.6 * (1.0 - 2.0 * fabs(u - 0.5)) - 0.3));
+            }
+            ring[j][i][0] = r * cos(th);
+            ring[j][i][1] = r * sin(th);
+            ring[j][i][2] = z;
+        }
+    for (int j = 0; j < NZ; j++) {
+        if (cut && len * j / NZ >= 2.0 && len * (j + 1) / NZ <= 3.0)
+            continue;
+        for (int i = 0; i < NT; i++) {
+            int k = (i + 1) % NT;
+            add_tri(s, ring[j][i], ring[j][k], ring[j + 1][k], 0);
+            add_tri(s, ring[j][i], ring[j + 1][k], ring[j + 1][i], 0);
+        }
+    }
+    const double c0[3] = {0, 0, 0}, c1[3] = {0, 0, len};
+    for (int i = 0; i < NT; i++) {
+        int k = (i + 1) % NT;
+        add_tri(s, c0, ring[0][k], ring[0][i], 0);
+        add_tri(s, c1, ring[NZ][i], ring[NZ][k], 0);
+    }
+    return s;
+}
+
+static void test_helix(void)
+{
+    const double tol = 0.05;
+    for (int c = 0; c < 3; c++) {
+        const double pitch = c == 1 ? -0.5 : 0.5;
+        const char *what = c == 0 ? "right-handed" : c == 1 ? "left-handed" : "right-handed, cut";
+        st_soup *s = threaded_rod(pitch, 0.15, c == 2);
+        st_symmetry_set set;
+        TAP_CHECK(detect(&set, s, tol) == 0, "threaded rod, %s: detection runs", what);
+        const st_symmetry *h = kind_along(&set, ST_SYMMETRY_HELIX, 2);
+        double off = h ? hypot(h->point[0], h->point[1]) : 1.0;
+        TAP_CHECK(h && fabs(h->pitch - pitch) < 0.25 * tol && off < 0.5 * tol &&
+                      h->support >= ST_SYMMETRY_DEFAULT_MIN_SUPPORT,
+                  "threaded rod, %s: the helix along z, pitch %.2f within a quarter voxel "
+                  "(pitch %.4f, axis %.4f off, support %.3f)", what, pitch,
+                  h ? h->pitch : 0.0, off, h ? h->support : 0.0);
+        TAP_CHECK(!axis_along(&set, 2) && count_kind(&set, ST_SYMMETRY_HELIX) == 1,
+                  "threaded rod, %s: no rotation along z, one helix", what);
+        /* a map of the helix takes the thread onto itself: a point of the
+         * crest (radius 1.15, phase 1/2) stays on the crest, within a
+         * quarter voxel */
+        if (h) {
+            double q[3], x[3] = {1.15, 0, 0.5 * fabs(pitch)};
+            st_symmetry_apply(h, 2.0, x, 1, q);
+            double th = atan2(q[1], q[0]), u = (q[2] - pitch * th / (2.0 * M_PI)) / fabs(pitch);
+            u -= floor(u);
+            TAP_CHECK(fabs(hypot(q[0], q[1]) - 1.15) < 0.25 * tol &&
+                          fabs(u - 0.5) * fabs(pitch) < 0.25 * tol,
+                      "threaded rod, %s: a turn by 2 radians keeps the crest on the crest "
+                      "(radius %.4f, phase %.4f)", what, hypot(q[0], q[1]), u);
+        }
+#ifdef _OPENMP
+        if (c == 2) {
+            int nt = omp_get_max_threads();
+            st_symmetry_set set1, set2;
+            omp_set_num_threads(1);
+            detect(&set1, s, tol);
+            omp_set_num_threads(2);
+            detect(&set2, s, tol);
+            omp_set_num_threads(nt);
+            TAP_CHECK(memcmp(&set1, &set2, sizeof set1) == 0 &&
+                          memcmp(&set, &set1, sizeof set) == 0,
+                      "threaded rod, cut: the same bytes on 1, 2 and %d threads", nt);
+        }
+#endif
+        st_soup_free(s);
+    }
+}
+
+/* A plain cylinder maps onto itself under a turn about its axis and under
+ * any screw motion about it on its side: the turn is the reading (its end
+ * faces hold only under it), no helix of any pitch. A thread of pitch
+ * 1.5 voxels is below what a helix can be told from a turn by: no helix
+ * either. */
+static void test_not_helix(void)
+{
+    const double tol = 0.05;
+    st_soup *s = threaded_rod(0.0, 0.0, 0);
+    st_symmetry_set set;
+    TAP_CHECK(detect(&set, s, tol) == 0, "plain cylinder: detection runs");
+    const st_symmetry *ax = axis_along(&set, 2);
+    TAP_CHECK(ax && ax->order == 0 && count_kind(&set, ST_SYMMETRY_HELIX) == 0,
+              "plain cylinder: the continuous rotation along z (order %d), no helix (%zu)",
+              ax ? ax->order : -1, count_kind(&set, ST_SYMMETRY_HELIX));
+    st_soup_free(s);
+    s = threaded_rod(1.5 * tol, 0.03, 0);
+    TAP_CHECK(detect(&set, s, tol) == 0 && count_kind(&set, ST_SYMMETRY_HELIX) == 0,
+              "a thread of pitch 1.5 voxels: no helix (%zu)", count_kind(&set, ST_SYMMETRY_HELIX));
+    st_soup_free(s);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(bracket), TAP_TEST(hex_bar), TAP_TEST(none),
                                      TAP_TEST(asymmetric), TAP_TEST(nearly), TAP_TEST(tiny),
-                                     TAP_TEST(planar), {0}};
+                                     TAP_TEST(planar), TAP_TEST(helix),
+                                     TAP_TEST(not_helix), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -110,7 +110,7 @@ static void test_open_hole(void)
     const double hole[2] = {0.0, 110.0};
     int missing;
     st_soup *s = cylinder(hole, 1, &missing);
-    const st_symmetry_set set = {{{ST_SYMMETRY_ROTATION, {0, 0, 0}, {0, 0, 1}, 0, 0.74}}, 1, 1};
+    const st_symmetry_set set = {{{ST_SYMMETRY_ROTATION, {0, 0, 0}, {0, 0, 1}, 0, 0.74, 0.0}}, 1, 1};
     run r;
     TAP_CHECK(fill_of(&r, s, &set) == 0, "110 degrees missing: the fill runs");
     TAP_CHECK(r.caps->ntris == 0 && r.st.open == 1,
@@ -152,7 +152,7 @@ static void mirror_case(int copy_holed)
     const double ranges[4] = {325.0, 35.0, 170.0, 190.0};
     int missing;
     st_soup *s = cylinder(ranges, copy_holed ? 2 : 1, &missing);
-    const st_symmetry_set set = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8}}, 1, 1};
+    const st_symmetry_set set = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8, 0.0}}, 1, 1};
     run r;
     TAP_CHECK(fill_of(&r, s, &set) == 0, "%s: the fill runs",
               copy_holed ? "copy holed" : "copy whole");

@@ -1,8 +1,10 @@
 /*
- * symmetry.h - the mirror planes and rotation axes of a soup's surviving
- * surface (issue 37: a lost side said by its opposite).
+ * symmetry.h - the mirror planes, rotation axes and screw motions
+ * (helices) of a soup's surviving surface (issue 37: a lost side said by
+ * its opposite).
  *
- * Units: model units (tolerances, offsets); angles in degrees.
+ * Units: model units (tolerances, offsets, pitches); angles in radians
+ * (st_symmetry_apply), degrees in reports.
  * Ownership: the caller owns the set *out (a plain struct); the soup and
  * BVH are borrowed.
  * Threads: OpenMP over the mirror candidates and in the support counts;
@@ -11,7 +13,8 @@
  *
  * The algorithm (area samples, mirror candidates from principal axes and
  * the votes of Mitra, Guibas & Pauly 2006, ICP-style refinement, rotation
- * axes, support): doc/design/symmetry.md.
+ * axes, helices from the normals' kinematic condition, support):
+ * doc/design/symmetry.md.
  * Every step is deterministic, and the support counts are integer sums,
  * so the result does not depend on the thread count.
  */
@@ -47,15 +50,22 @@ extern "C" {
 
 typedef enum st_symmetry_kind {
     ST_SYMMETRY_MIRROR = 1,
-    ST_SYMMETRY_ROTATION = 2
+    ST_SYMMETRY_ROTATION = 2,
+    ST_SYMMETRY_HELIX = 3   /* a screw motion: a turn by any angle a about
+                               the axis with a move of a pitch / (2 pi)
+                               along it (a thread); continuous */
 } st_symmetry_kind;
 
 typedef struct st_symmetry {
     st_symmetry_kind kind;
     double point[3];     /* on the plane, or on the axis */
     double dir[3];       /* the plane's unit normal, or the axis' direction */
-    int order;           /* rotation: n >= 2, or 0 continuous; mirror: 0 */
+    int order;           /* rotation: n >= 2, or 0 continuous; mirror and
+                            helix: 0 */
     double support;      /* share of the soup's area that maps onto it */
+    double pitch;        /* helix: the move along dir per full turn, model
+                            units, > 0 right-handed, < 0 left-handed (the
+                            same for -dir); else 0 */
 } st_symmetry;
 
 typedef struct st_symmetry_params {
@@ -71,7 +81,8 @@ st_symmetry_params st_symmetry_params_default(void);
 
 typedef struct st_symmetry_set {
     st_symmetry items[ST_SYMMETRY_MAX];
-    size_t n;            /* accepted, mirrors by support then rotations */
+    size_t n;            /* accepted: mirrors, rotations, then helices,
+                            each by support */
     size_t candidates;   /* planes and axes whose support was measured */
 } st_symmetry_set;
 
@@ -84,19 +95,22 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
 
 /* The image of point x (w 1) or direction x (w 0) under y: its mirror,
  * or its rotation by `angle` radians about the axis (the generator of an
- * order-n axis is 2 pi / n). */
+ * order-n axis is 2 pi / n), for a helix with a move of angle * pitch /
+ * (2 pi) along dir (points only). */
 void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
                        int w, double out[3]);
 
 /* One line for a report: "mirror plane through (x, y, z) normal (a, b,
- * c), support 0.87" or "rotation axis ... order 6 ...". */
+ * c), support 0.87", "rotation axis ... order 6 ..." or "helix axis ...
+ * pitch 0.5 (right-handed) ...". */
 void st_symmetry_describe(const st_symmetry *y, char *buf, size_t size);
 
 /* ---- use: the lost side filled from its symmetric copy ----------------- */
 
 typedef struct st_symmetry_fill_stats {
     size_t maps;          /* maps tried: a mirror is one, a rotation of
-                             order n is n - 1, a continuous one FILL_ANGLES */
+                             order n is n - 1, a continuous one or a helix
+                             FILL_ANGLES - 1 */
     size_t triangles;     /* fill triangles kept */
     double area;          /* their area, model units squared */
     size_t caps;          /* cap pieces (connected) given */

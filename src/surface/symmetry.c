@@ -1,6 +1,6 @@
 /*
  * symmetry.c - mirror planes and rotation axes of a soup's surviving
- * surface (see symmetry.h for the algorithm).
+ * surface, and its screw motions (see symmetry.h for the algorithm).
  *
  * Reference: N. J. Mitra, L. J. Guibas, M. Pauly, "Partial and approximate
  * symmetry detection for 3D geometry", SIGGRAPH 2006 (the pair voting).
@@ -80,6 +80,9 @@ void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
         st_cross3(k, n, r);
         for (int a = 0; a < 3; a++)
             r[a] = r[a] * c + k[a] * s + n[a] * d * (1.0 - c);
+        if (y->kind == ST_SYMMETRY_HELIX && w)
+            for (int a = 0; a < 3; a++)
+                r[a] += n[a] * angle * y->pitch / (2.0 * PI);
     }
     for (int a = 0; a < 3; a++)
         out[a] = r[a] + (w ? y->point[a] : 0.0);
@@ -93,6 +96,13 @@ void st_symmetry_describe(const st_symmetry *y, char *buf, size_t size)
                  "%.4f, %.4f), support %.3f",
                  y->point[0], y->point[1], y->point[2], y->dir[0], y->dir[1],
                  y->dir[2], y->support);
+    else if (y->kind == ST_SYMMETRY_HELIX)
+        snprintf(buf, size,
+                 "helix axis through (%.6g, %.6g, %.6g), direction (%.4f, "
+                 "%.4f, %.4f), pitch %.6g (%s-handed), support %.3f",
+                 y->point[0], y->point[1], y->point[2], y->dir[0], y->dir[1],
+                 y->dir[2], fabs(y->pitch), y->pitch >= 0 ? "right" : "left",
+                 y->support);
     else if (y->order == 0)
         snprintf(buf, size,
                  "rotation axis through (%.6g, %.6g, %.6g), direction "
@@ -602,11 +612,13 @@ static int same_line(const st_symmetry *a, const st_symmetry *b, double tol)
  * turn: a small turn about any axis near a smooth surface slides it along
  * itself) both hold; the largest such n. Screened on every SCREEN-th
  * sample, confirmed on all. */
+/* Turns that are no simple fraction of a full turn. */
+static const double odd[3] = {0.3819660112501051, 0.1415926535897932,
+                              0.7071067811865476};
+
 static int axis_order(const ctx *C, const st_symmetry *y, int max_order,
                       double min_support, double *sup)
 {
-    static const double odd[3] = {0.3819660112501051, 0.1415926535897932,
-                                  0.7071067811865476};
     double least = 1.0;
     for (int i = 0; i < 3 && least >= min_support; i++)
         least = fmin(least, support_stride(C, y, 2.0 * PI * odd[i], SCREEN));
@@ -668,6 +680,327 @@ static int meet(const st_symmetry *a, const st_symmetry *b, st_symmetry *line)
     return 1;
 }
 
+/* ---- helices -------------------------------------------------------------- */
+
+/* A surface that a continuous motion maps onto itself has its normal
+ * across the motion's velocity everywhere (Pottmann & Randrup 1998,
+ * "Rotational and helical surface approximation for reverse
+ * engineering"). The screw motion about the line through a along the unit
+ * c, with pitch 2 pi h, moves x at c x (x - a) + h c; so a sample x with
+ * unit normal m on such a surface has
+ *     h (m . c) + ((x - a) x m) . c = 0,
+ * linear in (c, cbar = a x c + h c): every sample whose normal is not
+ * across the axis says h, and every sample of a turned part (h free, its
+ * normal line meets the axis) says where the axis is. */
+#define AXIS_SIN 0.3420201433256687     /* sin 20 degrees */
+#define AXIS_ROUNDS 4
+#define PITCH_BIN 1.25      /* the ratio of a pitch bin's ends */
+#define PITCH_WINDOW 5      /* bins: pitches within a ratio of about 3 */
+#define PITCH_SHARE 0.1     /* of all samples in that window, at least */
+#define PITCH_STEPS 24      /* the scan of the pitch */
+/* A helix must verify this much more of the informative samples than the
+ * pure rotation about its axis: measured over 264 helix candidates of the
+ * corpus (doc/design/symmetry.md), the false ones (turned parts and tori
+ * read with a short move along the axis) beat the rotation by at most
+ * 0.035, the screw's thread by 0.33 (holed) and 0.58 (whole). */
+#define HELIX_MARGIN 0.1
+
+/* Symmetric 3x3 m's pseudo-inverse: eigenvalues below 1e-6 of the largest
+ * dropped (a turned part says nothing of the move along its axis). */
+static void pinv3(const double m[3][3], double out[3][3])
+{
+    double t[3][3], v[3][3];
+    memcpy(t, m, sizeof t);
+    eigen3(t, v);
+    double big = fmax(fmax(t[0][0], t[1][1]), t[2][2]);
+    memset(out, 0, 9 * sizeof(double));
+    for (int e = 0; e < 3; e++) {
+        if (!(t[e][e] > 1e-6 * big))
+            continue;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                out[i][j] += v[e][i] * v[e][j] / t[e][e];
+    }
+}
+
+/* One round of the axis fit: the line that the normal lines of the
+ * samples near y's surface of revolution best meet (those whose normal is
+ * within 20 degrees of across the axis, off the axis, with the normal
+ * line within REFINE_REACH tolerances of it): minimize the sum of
+ * (m . cbar + ((x - o) x m) . c)^2 over |c| = 1, cbar eliminated through
+ * the pseudo-inverse of sum m m^T (so a pure turn where the samples say
+ * nothing of a move). 0 when too few samples. */
+static int axis_round(const ctx *C, const st_symmetry *y, double c[3], double at[3])
+{
+    const samples *S = C->S;
+    double mm[3][3] = {{0}}, mu[3][3] = {{0}}, uu[3][3] = {{0}};
+    size_t n = 0;
+    for (size_t k = 0; k < S->n; k++) {
+        const double *x = S->p + 3 * k, *m = S->nrm + 3 * k;
+        double r[3], u[3], mc[3];
+        if (fabs(st_dot3(m, y->dir)) >= AXIS_SIN)
+            continue;
+        st_sub3(r, x, y->point);
+        st_cross3(mc, m, y->dir);
+        double along = st_dot3(r, y->dir);
+        if (fabs(st_dot3(r, mc)) > REFINE_REACH * C->tol * st_norm3(mc) ||
+            st_dot3(r, r) - along * along <= C->tol * C->tol)
+            continue;
+        st_cross3(u, r, m);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                mm[i][j] += m[i] * m[j];
+                mu[i][j] += m[i] * u[j];
+                uu[i][j] += u[i] * u[j];
+            }
+        n++;
+    }
+    if (n < 16)
+        return 0;
+    double pm[3][3], pmu[3][3] = {{0}}, k[3][3], v[3][3];
+    pinv3(mm, pm);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            for (int l = 0; l < 3; l++)
+                pmu[i][j] += pm[i][l] * mu[l][j];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            k[i][j] = uu[i][j];
+            for (int l = 0; l < 3; l++)
+                k[i][j] -= mu[l][i] * pmu[l][j];
+        }
+    eigen3(k, v);
+    int least = 0;
+    for (int e = 1; e < 3; e++)
+        if (k[e][e] < k[least][least])
+            least = e;
+    double cbar[3] = {0, 0, 0}, x[3];
+    for (int i = 0; i < 3; i++)
+        c[i] = v[least][i];
+    normalize(c);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            cbar[i] -= pmu[i][j] * c[j];
+    st_cross3(x, c, cbar);    /* the axis' point nearest the old one */
+    for (int i = 0; i < 3; i++)
+        at[i] = y->point[i] + x[i];
+    return 1;
+}
+
+/* y's axis moved onto the line its turned surfaces meet (rounds of
+ * axis_round until it settles); a fit that turns by more than 10 degrees
+ * is not taken. */
+static void fit_axis(const ctx *C, st_symmetry *y)
+{
+    for (int round = 0; round < AXIS_ROUNDS; round++) {
+        double c[3], at[3];
+        if (!axis_round(C, y, c, at))
+            return;
+        double d = st_dot3(c, y->dir);
+        if (fabs(d) < 0.984807753012208) /* cos 10 degrees */
+            return;
+        double moved[3];
+        st_sub3(moved, at, y->point);
+        for (int i = 0; i < 3; i++) {
+            y->dir[i] = d < 0 ? -c[i] : c[i];
+            y->point[i] = at[i];
+        }
+        if (st_norm3(moved) < REFINE_STILL * C->tol && 1.0 - fabs(d) < REFINE_STILL * REFINE_STILL)
+            return;
+    }
+}
+
+/* The pitch most samples of y's axis say (each sample's h above), or 0:
+ * pitches between 2 tolerances (below, a turn by the odd angles moves the
+ * surface by less than a tolerance: a pure rotation says as much) and the
+ * samples' extent along the axis vote in bins whose ends differ by
+ * PITCH_BIN; the heaviest window of PITCH_WINDOW bins of one sign, if it
+ * holds PITCH_SHARE of the samples, gives the least-squares pitch of its
+ * samples. */
+static double vote_pitch(const ctx *C, const st_symmetry *y)
+{
+    const samples *S = C->S;
+    enum { BINS = 64 };
+    double lo = INFINITY, hi = -INFINITY, pmin = 2.0 * C->tol;
+    for (size_t k = 0; k < S->n; k++) {
+        double r[3];
+        st_sub3(r, S->p + 3 * k, y->point);
+        lo = fmin(lo, st_dot3(r, y->dir));
+        hi = fmax(hi, st_dot3(r, y->dir));
+    }
+    int nb = hi - lo > pmin ? (int)ceil(log((hi - lo) / pmin) / log(PITCH_BIN)) : 0;
+    nb = nb < BINS ? nb : BINS;
+    if (nb < 1)
+        return 0.0;
+    long cnt[2][BINS] = {{0}};
+    for (int pass = 0; pass < 2; pass++) {
+        int best_s = 0, best_b = 0;
+        long best = 0;
+        if (pass == 1) {
+            for (int sg = 0; sg < 2; sg++)
+                for (int b = 0; b + PITCH_WINDOW <= nb || b == 0; b++) {
+                    long sum = 0;
+                    for (int i = b; i < b + PITCH_WINDOW && i < nb; i++)
+                        sum += cnt[sg][i];
+                    if (sum > best) {
+                        best = sum;
+                        best_s = sg;
+                        best_b = b;
+                    }
+                }
+            if ((double)best < PITCH_SHARE * (double)S->n)
+                return 0.0;
+        }
+        double num = 0.0, den = 0.0;
+        for (size_t k = 0; k < S->n; k++) {
+            const double *m = S->nrm + 3 * k;
+            double r[3], u[3], mc = st_dot3(m, y->dir);
+            if (fabs(mc) < INFORM_SIN)
+                continue;
+            st_sub3(r, S->p + 3 * k, y->point);
+            st_cross3(u, r, m);
+            double q = st_dot3(u, y->dir), p = -2.0 * PI * q / mc;
+            if (!(fabs(p) >= pmin))
+                continue;
+            int b = (int)floor(log(fabs(p) / pmin) / log(PITCH_BIN)), sg = p < 0;
+            if (b >= nb)
+                continue;
+            if (pass == 0)
+                cnt[sg][b]++;
+            else if (sg == best_s && b >= best_b && b < best_b + PITCH_WINDOW) {
+                num -= mc * q;
+                den += mc * mc;
+            }
+        }
+        if (pass == 1)
+            return den > 0.0 ? 2.0 * PI * num / den : 0.0;
+    }
+    return 0.0;
+}
+
+/* The pitch p0 bracketed: the share of every SCREEN-th sample that a turn
+ * by odd[0] verifies, over pitches from p0 / 2 to 3 p0 / 2 in at most
+ * PITCH_STEPS steps (none finer than half a tolerance); the best, or 0
+ * when nothing matches. The share is flat near the true pitch (a thread's
+ * faces are steep: a move along the axis changes their distance little),
+ * so refine_pitch makes it precise. */
+static double scan_pitch(const ctx *C, st_symmetry *y, double p0)
+{
+    double step = fmax(0.5 * C->tol, fabs(p0) / PITCH_STEPS), sup[PITCH_STEPS + 2];
+    int n = (int)(fabs(p0) / step) + 1, best = 0;
+    if (n > PITCH_STEPS + 2)
+        n = PITCH_STEPS + 2;
+    for (int i = 0; i < n; i++) {
+        y->pitch = 0.5 * p0 + copysign(step * i, p0);
+        sup[i] = fabs(y->pitch) >= 2.0 * C->tol
+                     ? support_stride(C, y, 2.0 * PI * odd[0], SCREEN)
+                     : 0.0;
+        if (sup[i] > sup[best])
+            best = i;
+    }
+    return sup[best] > 0.0 ? 0.5 * p0 + copysign(step * best, p0) : 0.0;
+}
+
+/* ICP rounds on the pitch alone (every REFINE_STRIDE-th sample, turns by
+ * odd[0] and odd[2] - 1): each informative image matched to the soup's
+ * nearest point within REFINE_REACH tolerances with a compatible normal,
+ * and within a tolerance of that triangle's plane (so the faces a move
+ * along the axis takes off themselves, a head's flat ends, do not pull the
+ * pitch to 0); the pitch moved by the least-squares step along the axis
+ * (point to plane). Stops once the move along the axis at the turns is
+ * below REFINE_STILL tolerances. */
+static void refine_pitch(const ctx *C, st_symmetry *y)
+{
+    const samples *S = C->S;
+    const double turn[2] = {2.0 * PI * odd[0], 2.0 * PI * (odd[2] - 1.0)};
+    for (int round = 0; round < REFINE_ROUNDS; round++) {
+        double num = 0.0, den = 0.0;
+        size_t m = 0;
+        /* sequential: the sums in sample order, whatever the threads */
+        for (int j = 0; j < 2; j++)
+            for (size_t k = 0; k < S->n; k += REFINE_STRIDE) {
+                double q[3], nq[3], c[3], d[3];
+                const double *p = S->p + 3 * k;
+                st_symmetry_apply(y, turn[j], p, 1, q);
+                st_sub3(d, q, p);
+                double l = st_norm3(d);
+                if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
+                    continue;
+                st_symmetry_apply(y, turn[j], S->nrm + 3 * k, 0, nq);
+                int64_t t;
+                double reach = REFINE_REACH * C->tol;
+                st_bvh_nearest(C->bvh, q, reach * reach, &t, c);
+                if (t < 0)
+                    continue;
+                const double *tn = C->tn + 3 * (size_t)t;
+                st_sub3(d, c, q);
+                double e = st_dot3(tn, d), g = st_dot3(tn, y->dir) * turn[j] / (2.0 * PI);
+                if (fabs(st_dot3(nq, tn)) < MATCH_COS || fabs(e) > C->tol)
+                    continue;
+                num += g * e;
+                den += g * g;
+                m++;
+            }
+        if (m < 16 || !(den > 0.0))
+            return;
+        double step = num / den;
+        y->pitch += step;
+        if (fabs(step) * fabs(turn[1]) / (2.0 * PI) < REFINE_STILL * C->tol)
+            return;
+    }
+}
+
+/* The helix about axis y, if there is one: y's axis refined, the pitch
+ * voted and scanned, then measured like a continuous rotation (turns by
+ * the odd angles, wrapped to half a turn either way so the moves along
+ * the axis stay short), each turn accepted as a mirror is (accepted());
+ * and it must hold on HELIX_MARGIN more than the pure rotation about the
+ * same axis does (a turned part maps onto itself under any screw motion
+ * about its axis where it is a cylinder, and only under the rotation
+ * elsewhere: the rotation is the reading there). 1 with
+ * *y the helix and its support; *measured 1 when it got as far as a
+ * pitch. */
+static int find_helix(const ctx *C, st_symmetry *y, double min_support, int *measured)
+{
+    *measured = 0;
+    y->kind = ST_SYMMETRY_HELIX;
+    y->order = 0;
+    y->pitch = 0.0;
+    fit_axis(C, y);
+    double p0 = vote_pitch(C, y);
+    if (p0 == 0.0 || !(y->pitch = scan_pitch(C, y, p0)))
+        return 0;
+    refine_pitch(C, y);
+    if (!(fabs(y->pitch) >= 2.0 * C->tol))
+        return 0;
+    *measured = 1;
+    double turn[3];
+    for (int i = 0; i < 3; i++) {
+        turn[i] = 2.0 * PI * (odd[i] > 0.5 ? odd[i] - 1.0 : odd[i]);
+        if (support_stride(C, y, turn[i], SCREEN) < SCREEN_SHARE * MIN_VERIFIED)
+            return 0;
+    }
+    double least = 1.0;
+    for (int i = 0; i < 3; i++) {
+        tally t = measure(C, y, turn[i], 1, 0);
+        if (share(&t) >= MIN_VERIFIED && share(&t) < min_support)
+            t = measure(C, y, turn[i], 1, 1);
+        if (!accepted(&t, min_support))
+            return 0;
+        least = fmin(least, share(&t));
+    }
+    st_symmetry turned = *y;
+    turned.kind = ST_SYMMETRY_ROTATION;
+    turned.pitch = 0.0;
+    double plain = 1.0;
+    for (int i = 0; i < 3 && plain + HELIX_MARGIN > least; i++)
+        plain = fmin(plain, support(C, &turned, turn[i]));
+    if (plain + HELIX_MARGIN > least)
+        return 0;
+    y->support = least;
+    return 1;
+}
+
 /* ---- the whole job -------------------------------------------------------- */
 
 static int cmp_sym(const void *x, const void *y)
@@ -706,6 +1039,28 @@ static void keep(st_symmetry_set *out, const st_symmetry *y, double tol)
             w = i;
     if (w != SIZE_MAX && out->items[w].support < y->support)
         out->items[w] = *y;
+}
+
+/* A continuous rotation and a helix about one line (within REFINE_REACH
+ * tolerances: the helix' axis is refined, the rotation's is not) are two
+ * readings of one turned part: the one with the lower support goes. */
+static void one_screw_per_line(st_symmetry_set *out, double tol)
+{
+    for (size_t i = 0; i < out->n; i++) {
+        st_symmetry *h = out->items + i;
+        if (h->kind != ST_SYMMETRY_HELIX)
+            continue;
+        for (size_t j = 0; j < out->n; j++) {
+            st_symmetry *r = out->items + j;
+            if (r->kind != ST_SYMMETRY_ROTATION || r->order != 0 ||
+                !same_line(h, r, REFINE_REACH * tol))
+                continue;
+            size_t gone = r->support >= h->support ? i : j;
+            out->items[gone] = out->items[--out->n];
+            i = (size_t)-1; /* start over: the set changed */
+            break;
+        }
+    }
 }
 
 /* Each triangle's boundary edges (ctx.rim), read on the welded soup. */
@@ -857,6 +1212,11 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
             continue;
         double sup = 0.0;
         out->candidates++;
+        st_symmetry hx = axes[i];
+        int measured;
+        if (find_helix(&C, &hx, p->min_support, &measured))
+            keep(out, &hx, p->tolerance);
+        out->candidates += (size_t)measured;
         int order = axis_order(&C, axes + i, p->max_order, p->min_support,
                                &sup);
         if (order < 0)
@@ -865,6 +1225,7 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
         axes[i].support = sup;
         keep(out, axes + i, p->tolerance);
     }
+    one_screw_per_line(out, p->tolerance);
     qsort(out->items, out->n, sizeof *out->items, cmp_sym);
     ctx_free(&C, &S);
     return ST_OK;

@@ -208,7 +208,7 @@ typedef struct map {
 } map;
 
 /* Every map of the set: a mirror, each power of a discrete rotation, and
- * FILL_ANGLES - 1 turns of a continuous one. */
+ * FILL_ANGLES - 1 turns of a continuous one or a helix. */
 static size_t maps_of(const st_symmetry_set *set, map *out, size_t max)
 {
     size_t n = 0;
@@ -220,8 +220,14 @@ static size_t maps_of(const st_symmetry_set *set, map *out, size_t max)
             continue;
         }
         const int steps = y->order >= 2 ? y->order : FILL_ANGLES;
+        /* a helix by turns of at most half a turn either way: short moves */
+        const int back = y->kind == ST_SYMMETRY_HELIX ? steps : 0;
         for (int k = 1; k < steps && n < max; k++)
-            out[n++] = (map){y, 2.0 * PI * k / steps};
+            out[n++] = (map){y, 2.0 * PI * (k > steps / 2 ? k - back : k) / steps};
+        /* and by whole turns, nearest first: a thread moved along itself */
+        for (int k = 1; back && k <= FILL_ANGLES / 2; k++)
+            for (int sg = 1; sg >= -1 && n < max; sg -= 2)
+                out[n++] = (map){y, 2.0 * PI * sg * k};
     }
     return n;
 }
