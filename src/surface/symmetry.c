@@ -878,10 +878,11 @@ static double vote_pitch(const ctx *C, const st_symmetry *y)
     return 0.0;
 }
 
-/* The pitch p0 bracketed: the share of every SCREEN-th sample that a turn
- * by odd[0] verifies, over pitches from p0 / 2 to 3 p0 / 2 in at most
+/* The pitch p0 bracketed: the share of every 4 SCREEN-th sample that a
+ * turn by odd[0] verifies, over pitches from p0 / 2 to 3 p0 / 2 in at most
  * PITCH_STEPS steps (none finer than half a tolerance); the best, or 0
- * when nothing matches. The share is flat near the true pitch (a thread's
+ * when it is below the screens' floor (SCREEN_SHARE of MIN_VERIFIED).
+ * The share is flat near the true pitch (a thread's
  * faces are steep: a move along the axis changes their distance little),
  * so refine_pitch makes it precise. */
 static double scan_pitch(const ctx *C, st_symmetry *y, double p0)
@@ -893,12 +894,13 @@ static double scan_pitch(const ctx *C, st_symmetry *y, double p0)
     for (int i = 0; i < n; i++) {
         y->pitch = 0.5 * p0 + copysign(step * i, p0);
         sup[i] = fabs(y->pitch) >= 2.0 * C->tol
-                     ? support_stride(C, y, 2.0 * PI * odd[0], SCREEN)
+                     ? support_stride(C, y, 2.0 * PI * odd[0], 4 * SCREEN)
                      : 0.0;
         if (sup[i] > sup[best])
             best = i;
     }
-    return sup[best] > 0.0 ? 0.5 * p0 + copysign(step * best, p0) : 0.0;
+    return sup[best] >= SCREEN_SHARE * MIN_VERIFIED ? 0.5 * p0 + copysign(step * best, p0)
+                                                    : 0.0;
 }
 
 /* ICP rounds on the pitch alone (every REFINE_STRIDE-th sample, turns by

@@ -809,12 +809,39 @@ static st_status fill_of_covered(st_soup **fill, const fill_set *F, const uint8_
 
 /* Each map's images into F (the pieces whose rim the map's inverse puts
  * back on the soup; keeps). */
+/* held[t]: a helix holds at triangle t: the image of its centroid by a
+ * turn of 0.382 either way (detection's odd turn) lies within tol of s. A
+ * helix may hold on a part only (a thread, not the turned head it
+ * carries), and only there are its whole turns a copy. */
+static void helix_held(uint8_t *held, const st_soup *s, const st_bvh *bvh,
+                       const st_symmetry *y, double tol)
+{
+    const long long nt = (long long)s->ntris;
+#pragma omp parallel for schedule(dynamic, 1024)
+    for (long long t = 0; t < nt; t++) {
+        double c[3] = {0, 0, 0}, q[3];
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++)
+                c[a] += s->xyz[3 * (size_t)s->tris[3 * t + k] + a] / 3.0;
+        held[t] = 0;
+        for (int sg = -1; sg <= 1 && !held[t]; sg += 2) {
+            int64_t tri;
+            st_symmetry_apply(y, sg * 2.0 * PI * 0.3819660112501051, c, 1, q);
+            st_bvh_nearest(bvh, q, tol * tol, &tri, NULL);
+            held[t] = tri >= 0;
+        }
+    }
+}
+
 static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, const rims *R,
                          const map *maps, size_t nmaps, size_t *keep, uint8_t *ok,
                          double *share, double *map_err, st_error *err)
 {
     const st_soup *s = C0->s;
     const pieces *P = C0->P;
+    st_status rc = ST_OK;
+    uint8_t *held = NULL;           /* of held_by, a helix */
+    const st_symmetry *held_by = NULL;
     for (size_t mi = 0; mi < nmaps; mi++) {
         const map inv = {maps[mi].y, -maps[mi].angle};
         const near_ctx back = {C0->bvh, RIM_REACH * C0->tol * RIM_REACH * C0->tol, &inv};
@@ -832,6 +859,14 @@ static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, con
             agree += ok[i] = ok[i] && map_err[i] <= C0->tol;
         if (!agree)
             continue;
+        const int helix = maps[mi].y->kind == ST_SYMMETRY_HELIX;
+        if (helix && held_by != maps[mi].y) {
+            if (!held && !(held = st_malloc_array(s->ntris ? s->ntris : 1, 1))) {
+                rc = ST_ENOMEM; /* said by the caller */
+                goto done;
+            }
+            helix_held(held, s, C0->bvh, held_by = maps[mi].y, C0->tol);
+        }
         fill_ctx C = *C0;
         C.fill_bvh = *fill_bvh;
         C.piece_ok = ok;
@@ -841,18 +876,20 @@ static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, con
         for (long long t = 0; t < nt; t++) {
             double q[3][3];
             image(s, (size_t)t, maps + mi, q);
-            keep[t] = keeps(&C, q);
+            keep[t] = helix && !held[t] ? SIZE_MAX : keeps(&C, q);
             any += keep[t] != SIZE_MAX;
         }
         if (!any)
             continue;
-        st_status rc = append_images(F, s, maps, mi, keep, map_err, err);
+        rc = append_images(F, s, maps, mi, keep, map_err, err);
         st_bvh_free(*fill_bvh);
         *fill_bvh = NULL;
         if (rc || (rc = st_bvh_build(fill_bvh, F->soup, err)))
-            return rc;
+            goto done;
     }
-    return ST_OK;
+done:
+    free(held);
+    return rc;
 }
 
 /* depart[i]: 1 when some corner or centroid of piece i's fill lies
