@@ -172,8 +172,9 @@ def mesh(V, F, *, cells=10, size=None, tets=None, tries=4, seed=1, offset=0.4,
     fill_holes  bool, cap the soup's holes for the pseudo volume (default
               True, as soupsign/soupmesh --fill-holes on; False: the vote
               alone closes them)
-    symmetry    bool, fill the holes from the soup's own mirror planes and
-              rotation axes, where their images close a hole (default
+    symmetry    bool, fill the holes from the soup's own mirror planes,
+              rotation axes and helices (a screw's thread), where their
+              images close a hole (default
               True, as --symmetry on; needs fill_holes)
     Returns a MeshResult. Not enclosing is not an error: see .encloses.
     Raises souptet.Error for bad input or parameters, MemoryError.
