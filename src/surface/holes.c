@@ -112,10 +112,8 @@ static st_status oom(st_error *err)
     return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
 }
 
-/* The least-area triangulation of the polygon pts[0..n) (n >= 3): fills
- * tri[3 (n - 2)] with local indices and *area with its area. ST_ENOMEM. */
-static st_status least_area(double *area, const double *const *pts, size_t n, uint32_t *tri,
-                            st_error *err)
+st_status st_holes_least_area(double *area, const double *const *pts, size_t n, uint32_t *tri,
+                              st_error *err)
 {
     double *w = malloc(n * n * sizeof *w);
     uint16_t *best = malloc(n * n * sizeof *best);
@@ -221,6 +219,11 @@ static int least_area_above(const double *const *pts, size_t n, double lim)
     return cap * (1.0 - SURE_MARGIN) > lim;
 }
 
+int st_holes_area_above(const double *const *pts, size_t n, double lim)
+{
+    return vector_area_above(pts, n, lim) || least_area_above(pts, n, lim);
+}
+
 /* The triangulation of the polygon pts[0..n) (n >= 3) on its own vertices
  * that bends least: the sum over its edges of length times bend (bend()),
  * the discrete total mean curvature, is least; ties by area. The edges
@@ -308,7 +311,7 @@ static st_status fill_area(double *area, const double *const *pts, const double 
                            size_t n, uint32_t *tri, st_error *err)
 {
     (void)side;
-    return least_area(area, pts, n, tri, err);
+    return st_holes_least_area(area, pts, n, tri, err);
 }
 
 /* The bend along the loop of the cap tri[3 (n - 2)] (local indices, as
@@ -1049,12 +1052,12 @@ static st_status cap_loop(capper *c, size_t e0, st_error *err)
     const double lim = p->max_cap_ratio * around_loop(c, e0);
     /* a loop surely too large needs no triangulation (least_area is
      * O(n^3)); else least_area decides, as it always did */
-    if ((vector_area_above(l->pts, n, lim) || least_area_above(l->pts, n, lim)) &&
+    if (st_holes_area_above(l->pts, n, lim) &&
         !flat_hole(c->s, l->pts, n, c->r.t, l->e, p->flat)) {
         c->st.too_large++;
         return ST_OK;
     }
-    st_status rc = least_area(&cap, l->pts, n, l->tri, err);
+    st_status rc = st_holes_least_area(&cap, l->pts, n, l->tri, err);
     if (rc)
         return rc;
     if (!(cap > 0.0) || (cap > lim && !flat_hole(c->s, l->pts, n, c->r.t, l->e, p->flat))) {
