@@ -53,6 +53,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 /* Apexes within the loop's box grown by REACH times its extent each way:
  * a lost corner lies near the loop's box (a box's lost corner at a corner
  * of it), a point where nearly parallel planes meet far beyond (other
@@ -80,6 +84,38 @@ typedef struct plane {
     double n[3], d;     /* unit normal, n . x = d */
     double len;         /* the length of the loop edges on it */
 } plane;
+
+/* 1 when the cone from apex bends surely no less than below along the
+ * loop (cone_bend would say 0), from a lower bound of each term taken
+ * without the arc tangent and the scaled norms: the sine of the angle
+ * between the cone's unscaled normal u and the soup's r (|u x r| / |u|,
+ * where u . r > 0; a right angle where not) is at most the angle, which
+ * bend() rounds to within a few units in the last place (as the lengths
+ * and sums): the margins, a relative 1e-10 and 1e-12 times the loop's
+ * length in radians, are far beyond those. 0 when unsure. */
+static int cone_above(const double *apex, const double *const *pts, const double *rim, size_t n,
+                      double below)
+{
+    double lb = 0.0, len = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const double *p = pts[i], *q = pts[(i + 1) % n], *r = rim + 3 * i;
+        double e[3], f[3], u[3], x[3];
+        st_sub3(e, q, p);
+        st_sub3(f, apex, p);
+        st_cross3(u, e, f);
+        st_cross3(x, u, r);
+        const double ee = st_dot3(e, e), uu = st_dot3(u, u), d = st_dot3(u, r);
+        if (!(ee > 1e-200 && ee < 1e200))
+            return 0;
+        const double l = sqrt(ee);
+        len += l;
+        if (uu > 1e-200 && uu < 1e200)
+            lb += l * (d > 0.0 ? sqrt(st_dot3(x, x) / uu) : 0.5 * M_PI);
+        if (lb * (1.0 - 1e-10) - 1e-12 * len >= below)
+            return 1;
+    }
+    return 0;
+}
 
 /* The cone from apex over the loop, when it bends less than below along
  * the loop: 1, its total bend in *total (length times dihedral over its
@@ -294,7 +330,7 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
             for (size_t c = b; c < m; c++) {    /* c == b: the line of a and b */
                 cand *k = cs + nc;
                 double rb, cb;
-                if (!candidate(k->x, pl, a, b, c, o, lo, hi) ||
+                if (!candidate(k->x, pl, a, b, c, o, lo, hi) || cone_above(k->x, pts, rim, n, below) ||
                     !cone_bend(k->x, pts, rim, n, below, tn, &cb, &rb))
                     continue;
                 k->key = rb, k->tie = cb, k->a = a, k->b = b, k->c = c, k->done = 0;
