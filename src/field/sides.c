@@ -682,14 +682,13 @@ static int8_t winding_sum(const st_bvh *bvh, const double q[3], const double lo[
     return (int8_t)lround(e);
 }
 
-/* winding_sum's evidence (those of ga meeting [lo, hi], when ga holds a
- * box around it with its extent along y and z): scale times the sum of their solid angles, clamped to
- * [-cap, cap], rounded. From the product of mul_angle when rounding is
- * sure: that and add_angle's sum each differ from the true sum by a few
- * units in the last place per term (one argument's rounding; a complex
- * product's), and those on the partial sums, well within DRIFT (m + 4)^2
- * radians for m terms; else by add_angle over the BVH's query, as it
- * always was. */
+/* winding_sum's evidence (from the triangles of ga meeting [lo, hi],
+ * when ga holds a box around it with its extent along y and z), from
+ * the product of mul_angle when rounding is sure: that and add_angle's
+ * sum each differ from the true sum by a few units in the last place per
+ * term (one argument's rounding; a complex product's), and those on the
+ * partial sums, well within DRIFT (m + 4)^2 radians for m terms; else by
+ * winding_sum, as it always was. */
 #define DRIFT 1e-13
 static int8_t winding_at(const st_bvh *bvh, const gather *ga, const double q[3], const double lo[3],
                          const double hi[3], double scale, double cap)

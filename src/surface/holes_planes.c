@@ -330,7 +330,8 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
             for (size_t c = b; c < m; c++) {    /* c == b: the line of a and b */
                 cand *k = cs + nc;
                 double rb, cb;
-                if (!candidate(k->x, pl, a, b, c, o, lo, hi) || cone_above(k->x, pts, rim, n, below) ||
+                if (!candidate(k->x, pl, a, b, c, o, lo, hi) ||
+                    cone_above(k->x, pts, rim, n, below) ||
                     !cone_bend(k->x, pts, rim, n, below, tn, &cb, &rb))
                     continue;
                 k->key = rb, k->tie = cb, k->a = a, k->b = b, k->c = c, k->done = 0;
