@@ -7,6 +7,7 @@
 #include "souptet/isect.h"
 #include "souptet/sign.h"
 #include "souptet/solid.h"
+#include "../src/surface/holes_internal.h"
 #include "shapes.h"
 #include "tap.h"
 
@@ -700,10 +701,51 @@ static void test_corner_pierced(void)
     st_soup_free(cut);
 }
 
+/* The screen that spares least_area on loops surely too large: never
+ * above where least_area's area is not (random loops, planar convex ones
+ * among them, where the vector area is the least area and only rounding
+ * parts them), and above where the area clearly is. */
+static void test_area_screen(void)
+{
+    uint64_t r = 0x9e3779b97f4a7c15ull;
+    size_t wrong = 0, sure = 0, loops = 0;
+    double xyz[64][3];
+    const double *pts[64];
+    uint32_t tri[3 * 64];
+    for (int it = 0; it < 600; it++) {
+        const size_t n = 3 + (size_t)(it % 61);
+        const int kind = it % 3;    /* 0 planar convex, 1 wavy, 2 random */
+        for (size_t i = 0; i < n; i++) {
+            double u[3];
+            for (int k = 0; k < 3; k++) {
+                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+                u[k] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
+            }
+            const double a = 2.0 * M_PI * (double)i / (double)n;
+            xyz[i][0] = kind == 2 ? u[0] : 3.0 * cos(a) + 0.3 * (kind == 1) * u[0];
+            xyz[i][1] = kind == 2 ? u[1] : 2.0 * sin(a) + 0.3 * (kind == 1) * u[1];
+            xyz[i][2] = kind == 0 ? 0.7 * xyz[i][0] + 100.0 : kind == 1 ? sin(3 * a) : u[2];
+            pts[i] = xyz[i];
+        }
+        double cap;
+        if (st_holes_least_area(&cap, pts, n, tri, NULL) != ST_OK)
+            continue;
+        loops++;
+        const double lims[] = {cap, cap * (1 + 1e-15), cap * (1 - 1e-15), cap * (1 + 1e-12),
+                               nextafter(cap, 0.0), cap * 2.0};
+        for (size_t l = 0; l < sizeof lims / sizeof *lims; l++)
+            wrong += st_holes_area_above(pts, n, lims[l]) && !(cap > lims[l]);
+        sure += st_holes_area_above(pts, n, cap * 0.999);
+    }
+    TAP_CHECK(loops == 600 && wrong == 0, "screen never above least_area (%zu wrong, %zu loops)",
+              wrong, loops);
+    TAP_CHECK(sure == loops, "screen above 0.999 of it (%zu of %zu)", sure, loops);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
                                      TAP_TEST(bend), TAP_TEST(corner), TAP_TEST(corner_pierced),
-                                     {0}};
+                                     TAP_TEST(area_screen), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -10,6 +10,7 @@
 #include "souptet/mem.h"
 #include "souptet/pred.h"
 #include "souptet/sign.h"
+#include "sides_internal.h"
 
 #include <math.h>
 #include <omp.h>
@@ -34,20 +35,29 @@ st_sides_params st_sides_params_default(void)
     return p;
 }
 
-/* Signed solid angle of triangle (a, b, c) seen from the origin, positive
- * when the origin is behind it (the triangle counter-clockwise seen from
- * its front). Van Oosterom and Strackee 1983. */
-static double solid_angle(const double a[3], const double b[3], const double c[3])
+/* Van Oosterom and Strackee 1983: the signed solid angle of triangle
+ * (a, b, c) seen from the origin is 2 atan2(*det, *den). */
+static inline void solid_terms(const double a[3], const double b[3], const double c[3],
+                               double *det, double *den)
 {
     const double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     const double lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
     const double lc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                       a[2] * (b[0] * c[1] - b[1] * c[0]);
+    *det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
     const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     const double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
     const double ca = c[0] * a[0] + c[1] * a[1] + c[2] * a[2];
-    const double den = la * lb * lc + ab * lc + bc * la + ca * lb;
+    *den = la * lb * lc + ab * lc + bc * la + ca * lb;
+}
+
+/* Signed solid angle of triangle (a, b, c) seen from the origin, positive
+ * when the origin is behind it (the triangle counter-clockwise seen from
+ * its front). */
+static double solid_angle(const double a[3], const double b[3], const double c[3])
+{
+    double det, den;
+    solid_terms(a, b, c, &det, &den);
     return 2.0 * atan2(det, den);
 }
 
@@ -71,18 +81,86 @@ typedef struct wsum {
     double sum;
 } wsum;
 
+/* Triangle t of o, its corners less p, in a, b, c. */
+static void corners_from(const st_soup *o, uint32_t t, const double *p, double a[3], double b[3],
+                         double c[3])
+{
+    const uint32_t *v = o->tris + 3 * (size_t)t;
+    for (int k = 0; k < 3; k++) {
+        a[k] = o->xyz[3 * (size_t)v[0] + k] - p[k];
+        b[k] = o->xyz[3 * (size_t)v[1] + k] - p[k];
+        c[k] = o->xyz[3 * (size_t)v[2] + k] - p[k];
+    }
+}
+
 static int add_angle(void *ctx, uint32_t t)
 {
     wsum *w = ctx;
-    const uint32_t *v = w->o->tris + 3 * (size_t)t;
     double a[3], b[3], c[3];
-    for (int k = 0; k < 3; k++) {
-        a[k] = w->o->xyz[3 * (size_t)v[0] + k] - w->p[k];
-        b[k] = w->o->xyz[3 * (size_t)v[1] + k] - w->p[k];
-        c[k] = w->o->xyz[3 * (size_t)v[2] + k] - w->p[k];
-    }
+    corners_from(w->o, t, w->p, a, b, c);
     w->sum += solid_angle(a, b, c);
     return 0;
+}
+
+/* The same sum with one arc tangent per query: the half angles
+ * atan2(det, den) are the arguments of the complex numbers den + i det,
+ * and the argument of their product is their sum less the whole turns,
+ * counted as the product goes (turns). The product is kept near 1 by
+ * powers of two (exact). A term on the negative real axis (the point on
+ * the triangle's plane, its angle a sign of zero away from -pi or pi) or
+ * out of [2^-300, 2^300] stops the query: the sum is then taken as
+ * add_angle takes it. */
+typedef struct wprod {
+    const st_soup *o;
+    const double *p;
+    double re, im;      /* the product, scaled */
+    long turns;         /* the whole turns taken off */
+    size_t terms;
+} wprod;
+
+/* The product brought back into [2^-64, 2^64] by powers of two. */
+static void rescale(wprod *w)
+{
+    double r = fabs(w->re) > fabs(w->im) ? fabs(w->re) : fabs(w->im);
+    for (; r > 0x1p64; r *= 0x1p-128)
+        w->re *= 0x1p-128, w->im *= 0x1p-128;
+    for (; r < 0x1p-64; r *= 0x1p128)
+        w->re *= 0x1p128, w->im *= 0x1p128;
+}
+
+/* The triangle (a, b, c) (corners less the point) into the product; 1
+ * when the query must take the sum instead. */
+static inline int prod_term(wprod *w, const double a[3], const double b[3], const double c[3])
+{
+    double det, den;
+    solid_terms(a, b, c, &det, &den);
+    const double m = fabs(den) > fabs(det) ? fabs(den) : fabs(det);
+    if ((det == 0.0 && !(den > 0.0)) || !(m >= 0x1p-300 && m <= 0x1p300))
+        return 1;
+    const double re = w->re * den - w->im * det, im = w->re * det + w->im * den;
+    /* both arguments in [0, pi] (sign bits clear) sum to over pi when the
+     * product's falls below the real axis, both in [-pi, -0] to under -pi
+     * when it rises above: where the products it sums have one sign, no
+     * cancellation can move it, and where they cancel the sum is near
+     * pi (or -pi), where either turn reads the same angle */
+    const int up = !signbit(w->im);
+    if (up == !signbit(det) && up != !signbit(im))
+        w->turns += up ? 1 : -1;
+    w->re = re;
+    w->im = im;
+    const double r = fabs(re) > fabs(im) ? fabs(re) : fabs(im);
+    if (!(r <= 0x1p64 && r >= 0x1p-64))
+        rescale(w);
+    w->terms++;
+    return 0;
+}
+
+static int mul_angle(void *ctx, uint32_t t)
+{
+    wprod *w = ctx;
+    double a[3], b[3], c[3];
+    corners_from(w->o, t, w->p, a, b, c);
+    return prod_term(w, a, b, c);
 }
 
 /* Twice the area vector of triangle t of s. */
@@ -554,8 +632,153 @@ static st_status oriented_soup(st_soup *o, uint8_t *rim, size_t *nview, st_sides
     return ST_OK;
 }
 
+/* The triangles of o whose boxes meet a query box, gathered once for a
+ * run of voxels along a row (st_bvh_query_box's triangles, in its order):
+ * their corners and boxes along x (the BVH's: the least and most of the
+ * corners; along y and z the run's box is each voxel's).
+ * oom: a growth failed (the run's voxels then query the BVH each). */
+typedef struct gather {
+    const st_soup *o;
+    size_t n, cap;
+    double *v;          /* GATHERED a triangle: its box along x, its corners */
+    int oom;
+} gather;
+#define GATHERED 11
+
+static int gather_add(void *ctx, uint32_t t)
+{
+    gather *g = ctx;
+    if (g->n == g->cap) {
+        const size_t c = g->cap ? 2 * g->cap : 256;
+        double *nv = st_realloc_array(g->v, c, GATHERED * sizeof *nv);
+        if (!nv) {
+            g->oom = 1;
+            return 1;
+        }
+        g->v = nv;
+        g->cap = c;
+    }
+    const uint32_t *tv = g->o->tris + 3 * (size_t)t;
+    double *b = g->v + GATHERED * g->n++;
+    for (int c = 0; c < 3; c++)
+        memcpy(b + 2 + 3 * c, g->o->xyz + 3 * (size_t)tv[c], 3 * sizeof *b);
+    /* finite coordinates (soup.h): the BVH's fmin and fmax */
+    const double lo = b[2] < b[5] ? b[2] : b[5], hi = b[2] > b[5] ? b[2] : b[5];
+    b[0] = b[8] < lo ? b[8] : lo;
+    b[1] = b[8] > hi ? b[8] : hi;
+    return 0;
+}
+
+/* The evidence from the triangles of the BVH's soup whose boxes meet
+ * [lo, hi] at point q: scale times the sum of their solid angles (term by
+ * term, in the BVH's order), clamped to [-cap, cap], rounded. */
+static int8_t winding_sum(const st_bvh *bvh, const double q[3], const double lo[3],
+                          const double hi[3], double scale, double cap)
+{
+    wsum s = {bvh->soup, q, 0.0};
+    st_bvh_query_box(bvh, lo, hi, add_angle, &s);
+    double e = scale * s.sum;
+    e = e > cap ? cap : e < -cap ? -cap : e;
+    return (int8_t)lround(e);
+}
+
+/* winding_sum's evidence (from the triangles of ga meeting [lo, hi],
+ * when ga holds a box around it with its extent along y and z), from
+ * the product of mul_angle when rounding is sure: that and add_angle's
+ * sum each differ from the true sum by a few units in the last place per
+ * term (one argument's rounding; a complex product's), and those on the
+ * partial sums, well within DRIFT (m + 4)^2 radians for m terms; else by
+ * winding_sum, as it always was. */
+#define DRIFT 1e-13
+static int8_t winding_at(const st_bvh *bvh, const gather *ga, const double q[3], const double lo[3],
+                         const double hi[3], double scale, double cap)
+{
+    wprod w = {bvh->soup, q, 1.0, 0.0, 0, 0};
+    int exact = 0;
+    if (ga) {   /* its box has [lo, hi]'s extent along y and z */
+        wprod acc = w;  /* kept apart from the BVH's callback, in registers */
+        for (size_t i = 0; i < ga->n && !exact; i++) {
+            const double *b = ga->v + GATHERED * i;
+            if (!(b[0] <= hi[0] && lo[0] <= b[1]))
+                continue;
+            const double u0[3] = {b[2] - q[0], b[3] - q[1], b[4] - q[2]};
+            const double u1[3] = {b[5] - q[0], b[6] - q[1], b[7] - q[2]};
+            const double u2[3] = {b[8] - q[0], b[9] - q[1], b[10] - q[2]};
+            exact = prod_term(&acc, u0, u1, u2);
+        }
+        w = acc;
+    } else {
+        exact = st_bvh_query_box(bvh, lo, hi, mul_angle, &w);
+    }
+    if (!exact) {
+        const double m = (double)w.terms + 4.0;
+        const double sum = 2.0 * (atan2(w.im, w.re) + 2.0 * M_PI * (double)w.turns);
+        const double d = scale * 2.0 * DRIFT * m * m;
+        double e0 = scale * sum - d, e1 = scale * sum + d;
+        e0 = e0 > cap ? cap : e0 < -cap ? -cap : e0;
+        e1 = e1 > cap ? cap : e1 < -cap ? -cap : e1;
+        if (lround(e0) == lround(e1))
+            return (int8_t)lround(e0);
+    }
+    return winding_sum(bvh, q, lo, hi, scale, cap);
+}
+
+/* Voxels along a row whose triangles are gathered at once: at most RUN,
+ * spanning at most RUN voxels. */
+#define RUN 8
+
+/* The evidence at the points (x[k], y, z), k < n, x ascending (see
+ * sides_internal.h): how 2 with ga gathers the triangles near them all
+ * by one query into ga. */
+static void winding_points(int8_t *out, const st_bvh *bvh, gather *ga, const double *x, size_t n,
+                           double y, double z, double r, double scale, double cap, int how)
+{
+    if (how == 2 && ga) {
+        const double glo[3] = {x[0] - r, y - r, z - r}, ghi[3] = {x[n - 1] + r, y + r, z + r};
+        ga->n = 0;
+        ga->oom = 0;
+        st_bvh_query_box(bvh, glo, ghi, gather_add, ga);
+    }
+    for (size_t k = 0; k < n; k++) {
+        const double q[3] = {x[k], y, z};
+        const double lo[3] = {q[0] - r, q[1] - r, q[2] - r};
+        const double hi[3] = {q[0] + r, q[1] + r, q[2] + r};
+        out[k] = how == 0 ? winding_sum(bvh, q, lo, hi, scale, cap)
+                          : winding_at(bvh, how == 2 && ga && !ga->oom ? ga : NULL, q, lo, hi,
+                                       scale, cap);
+    }
+}
+
+void st_sides_winding_points(int8_t *out, const st_bvh *bvh, const double *x, size_t n,
+                             double y, double z, double r, double scale, double cap, int how)
+{
+    gather ga = {bvh->soup, 0, 0, NULL, 0};
+    if (n)
+        winding_points(out, bvh, &ga, x, n, y, z, r, scale, cap, how);
+    free(ga.v);
+}
+
+/* The evidence of the voxels run[0..nr) of row (y, z), by one gathering
+ * query around them all; returns nr. */
+static size_t winding_run(int8_t *evidence, const st_grid *g, const st_bvh *bvh, gather *ga,
+                          const size_t *run, size_t nr, size_t y, size_t z, double r,
+                          double scale, double cap)
+{
+    double x[RUN];
+    int8_t e[RUN];
+    for (size_t k = 0; k < nr; k++)
+        x[k] = g->origin[0] + g->voxel * (double)run[k];
+    winding_points(e, bvh, ga, x, nr, g->origin[1] + g->voxel * (double)y,
+                   g->origin[2] + g->voxel * (double)z, r, scale, cap, 2);
+    for (size_t k = 0; k < nr; k++)
+        evidence[st_grid_index(g, run[k], y, z)] = e[k];
+    return nr;
+}
+
 /* 3. The local winding number of the oriented soup (its BVH) near each
- * undecided voxel in the band, as evidence; returns how many voxels. */
+ * undecided voxel in the band, as evidence; returns how many voxels. The
+ * voxels of a row are taken in runs (RUN), the triangles near a run
+ * gathered by one query of the BVH. */
 static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
                                int decided, const st_bvh *bvh, const st_soup *o,
                                const st_sides_params *p)
@@ -571,24 +794,25 @@ static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t
         const size_t done = __atomic_fetch_add(&slices, 1, __ATOMIC_RELAXED);
         if (omp_get_thread_num() == 0)
             st_progress_report(p->progress, "sides", 0.5 * (double)done / (double)g->nz);
-        for (size_t y = 0; y < g->ny; y++)
-            for (size_t x = 0; x < g->nx; x++) {
-                const size_t i = st_grid_index(g, x, y, z);
-                const int margin = (int)(votes[i] & ST_SIGN_VOTES_COUNT) - 13;
-                if (!(fabsf(g->data[i]) < band) || (decided > 0 && abs(margin) >= decided))
-                    continue;
-                const double q[3] = {g->origin[0] + g->voxel * (double)x,
-                                     g->origin[1] + g->voxel * (double)y,
-                                     g->origin[2] + g->voxel * (double)z};
-                const double lo[3] = {q[0] - r, q[1] - r, q[2] - r};
-                const double hi[3] = {q[0] + r, q[1] + r, q[2] + r};
-                wsum w = {o, q, 0.0};
-                st_bvh_query_box(bvh, lo, hi, add_angle, &w);
-                double e = scale * w.sum;
-                e = e > cap ? cap : e < -cap ? -cap : e;
-                evidence[i] = (int8_t)lround(e);
-                count++;
+        gather ga = {o, 0, 0, NULL, 0};
+        for (size_t y = 0; y < g->ny; y++) {
+            size_t run[RUN], nr = 0;
+            for (size_t x = 0; x <= g->nx; x++) {
+                int take = 0;
+                if (x < g->nx) {
+                    const size_t i = st_grid_index(g, x, y, z);
+                    const int margin = (int)(votes[i] & ST_SIGN_VOTES_COUNT) - 13;
+                    take = fabsf(g->data[i]) < band && !(decided > 0 && abs(margin) >= decided);
+                }
+                if (nr && (x == g->nx || (take && (nr == RUN || x - run[0] >= RUN)))) {
+                    count += winding_run(evidence, g, bvh, &ga, run, nr, y, z, r, scale, cap);
+                    nr = 0;
+                }
+                if (take)
+                    run[nr++] = x;
             }
+        }
+        free(ga.v);
     }
     return count;
 }

@@ -112,10 +112,8 @@ static st_status oom(st_error *err)
     return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the holes");
 }
 
-/* The least-area triangulation of the polygon pts[0..n) (n >= 3): fills
- * tri[3 (n - 2)] with local indices and *area with its area. ST_ENOMEM. */
-static st_status least_area(double *area, const double *const *pts, size_t n, uint32_t *tri,
-                            st_error *err)
+st_status st_holes_least_area(double *area, const double *const *pts, size_t n, uint32_t *tri,
+                              st_error *err)
 {
     double *w = malloc(n * n * sizeof *w);
     uint16_t *best = malloc(n * n * sizeof *best);
@@ -151,6 +149,81 @@ done:
     return rc;
 }
 
+/* The relative margin by which the screens below must clear the limit:
+ * the rounding they can differ from least_area by is about 2 n units in
+ * the last place (n <= 4096: under 1e-12), the margin a hundred times
+ * that. */
+#define SURE_MARGIN 1e-10
+
+/* 1 when least_area's area of the loop pts[0..n) is surely above lim,
+ * from the loop's vector area: every surface spanning it has at least
+ * that area (the vector areas of its triangles sum to the loop's, and
+ * their lengths are at least the sum's). In the loop's centroid frame
+ * the rounding of the sum is below n units in the last place of the sum
+ * of its points' squared distances (each cross product's length at most
+ * the mean of its two squares). */
+static int vector_area_above(const double *const *pts, size_t n, double lim)
+{
+    double o[3] = {0, 0, 0}, v[3] = {0, 0, 0}, r2 = 0.0;
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++)
+            o[k] += pts[i][k] / (double)n;
+    for (size_t i = 0; i < n; i++) {
+        double a[3], b[3], c[3];
+        st_sub3(a, pts[i], o);
+        st_sub3(b, pts[(i + 1) % n], o);
+        st_cross3(c, a, b);
+        for (int k = 0; k < 3; k++)
+            v[k] += c[k];
+        r2 += st_dot3(a, a);
+    }
+    const double area = 0.5 * sqrt(st_dot3(v, v)) - SURE_MARGIN * r2;
+    return area * (1.0 - SURE_MARGIN) > lim;
+}
+
+/* 1 when least_area's area of the loop pts[0..n) is surely above lim:
+ * least_area's dynamic program on a plain square root for each triangle's
+ * length (least_area's scaled one and this differ by a few units in the
+ * last place per triangle, and both programs give the least over all
+ * triangulations of their rounded sums, the additions being monotone),
+ * with no triangulation kept, and an apex skipped once its two sides
+ * alone reach the best so far (the areas are never negative). 0 when
+ * out of memory (least_area then runs, and says so). */
+static int least_area_above(const double *const *pts, size_t n, double lim)
+{
+    double *w = malloc(n * n * sizeof *w);
+    if (!w)
+        return 0;
+    for (size_t i = 0; i + 1 < n; i++)
+        w[i * n + i + 1] = 0.0;
+    for (size_t len = 2; len < n; len++)
+        for (size_t i = 0; i + len < n; i++) {
+            const size_t j = i + len;
+            const double *pi = pts[i], *pj = pts[j];
+            double m = INFINITY, f[3];
+            st_sub3(f, pj, pi);
+            for (size_t k = i + 1; k < j; k++) {
+                const double s = w[i * n + k] + w[k * n + j];
+                if (!(s < m))
+                    continue;
+                double e[3], c[3];
+                st_sub3(e, pts[k], pi);
+                st_cross3(c, e, f);
+                const double t = s + 0.5 * sqrt(st_dot3(c, c));
+                m = t < m ? t : m;
+            }
+            w[i * n + j] = m;
+        }
+    const double cap = w[n - 1];
+    free(w);
+    return cap * (1.0 - SURE_MARGIN) > lim;
+}
+
+int st_holes_area_above(const double *const *pts, size_t n, double lim)
+{
+    return vector_area_above(pts, n, lim) || least_area_above(pts, n, lim);
+}
+
 /* The triangulation of the polygon pts[0..n) (n >= 3) on its own vertices
  * that bends least: the sum over its edges of length times bend (bend()),
  * the discrete total mean curvature, is least; ties by area. The edges
@@ -173,14 +246,17 @@ static st_status least_bend(double *area, const double *const *pts, const double
                             size_t n, uint32_t *tri, st_error *err)
 {
     double *ang = malloc(n * n * sizeof *ang), *w = malloc(n * n * sizeof *w);
-    double *nrm = malloc(3 * n * n * sizeof *nrm);
+    double *nrm = malloc(3 * n * n * sizeof *nrm), *el = malloc(n * n * sizeof *el);
     uint16_t *best = malloc(n * n * sizeof *best);
     size_t *stack = malloc(2 * n * sizeof *stack);
     st_status rc = ST_OK;
-    if (!ang || !w || !nrm || !best || !stack) {
+    if (!ang || !w || !nrm || !el || !best || !stack) {
         rc = oom(err);
         goto done;
     }
+    for (size_t i = 0; i < n; i++)     /* el[i n + k], i < k: dist3(pts[i], pts[k]) */
+        for (size_t k = i + 1; k < n; k++)
+            el[i * n + k] = dist3(pts[i], pts[k]);
     /* (i, i + 1): the soup's triangle across the edge, passed i -> c -> i+1;
      * (i, j) above: the triangle (i, k, j) of its best triangulation */
     for (size_t i = 0; i + 1 < n; i++) {
@@ -196,13 +272,20 @@ static st_status least_bend(double *area, const double *const *pts, const double
             double ba = INFINITY, bw = INFINITY, bn[3] = {0, 0, 0};     /* bend, area, normal */
             size_t mk = i + 1;
             for (size_t k = i + 1; k < j; k++) {
+                /* the bends added are never negative (nor their sum's
+                 * rounding): an apex whose two sides alone bend more than
+                 * the best is not taken */
+                double a = ang[i * n + k] + ang[k * n + j];
+                if (a > ba)
+                    continue;
                 double t[3];
                 unit_normal(t, pts[i], pts[k], pts[j]);
-                double a = ang[i * n + k] + ang[k * n + j];
-                a += dist3(pts[i], pts[k]) * bend(t, nrm + 3 * (i * n + k));
-                a += dist3(pts[k], pts[j]) * bend(t, nrm + 3 * (k * n + j));
+                a += el[i * n + k] * bend(t, nrm + 3 * (i * n + k));
+                a += el[k * n + j] * bend(t, nrm + 3 * (k * n + j));
                 if (j - i == n - 1)     /* the closing edge, passed n-1 -> 0 */
-                    a += dist3(pts[0], pts[n - 1]) * bend(t, last);
+                    a += el[n - 1] * bend(t, last);
+                if (!(a <= ba))         /* the area only breaks ties */
+                    continue;
                 const double c = w[i * n + k] + w[k * n + j] + tri_area(pts[i], pts[k], pts[j]);
                 if (a < ba || (a == ba && c < bw)) {    /* ties keep the first k */
                     ba = a;
@@ -219,7 +302,7 @@ static st_status least_bend(double *area, const double *const *pts, const double
     *area = w[n - 1];
     emit_triangles(best, n, stack, tri);
 done:
-    free(ang), free(w), free(nrm), free(best), free(stack);
+    free(ang), free(w), free(nrm), free(el), free(best), free(stack);
     return rc;
 }
 
@@ -228,7 +311,7 @@ static st_status fill_area(double *area, const double *const *pts, const double 
                            size_t n, uint32_t *tri, st_error *err)
 {
     (void)side;
-    return least_area(area, pts, n, tri, err);
+    return st_holes_least_area(area, pts, n, tri, err);
 }
 
 /* The bend along the loop of the cap tri[3 (n - 2)] (local indices, as
@@ -966,12 +1049,18 @@ static st_status cap_loop(capper *c, size_t e0, st_error *err)
     }
     loop_points(c, 0);
     double cap, bent;
-    st_status rc = least_area(&cap, l->pts, n, l->tri, err);
+    const double lim = p->max_cap_ratio * around_loop(c, e0);
+    /* a loop surely too large needs no triangulation (least_area is
+     * O(n^3)); else least_area decides, as it always did */
+    if (st_holes_area_above(l->pts, n, lim) &&
+        !flat_hole(c->s, l->pts, n, c->r.t, l->e, p->flat)) {
+        c->st.too_large++;
+        return ST_OK;
+    }
+    st_status rc = st_holes_least_area(&cap, l->pts, n, l->tri, err);
     if (rc)
         return rc;
-    const double around = around_loop(c, e0);
-    if (!(cap > 0.0) || (cap > p->max_cap_ratio * around &&
-                         !flat_hole(c->s, l->pts, n, c->r.t, l->e, p->flat))) {
+    if (!(cap > 0.0) || (cap > lim && !flat_hole(c->s, l->pts, n, c->r.t, l->e, p->flat))) {
         c->st.too_large++;
         return ST_OK;
     }

@@ -1,6 +1,7 @@
 /*
  * holes_internal.h - the caps rebuilt from the planes around a hole
- * (holes_planes.c), for holes.c.
+ * (holes_planes.c), for holes.c; holes.c's least-area triangulation and
+ * its screen, for holes_planes.c's callers and the tests.
  */
 #ifndef SOUPTET_HOLES_INTERNAL_H
 #define SOUPTET_HOLES_INTERNAL_H
@@ -47,6 +48,18 @@ static inline double bend(const double *a, const double *b)
     st_cross3(c, a, b);
     return atan2(st_norm3(c), st_dot3(a, b));
 }
+
+/* The least-area triangulation of the polygon pts[0..n) (n >= 3, holes.c):
+ * fills tri[3 (n - 2)] with local indices and *area with its area
+ * (dynamic programming, O(n^3); ties keep the first apex). ST_ENOMEM. */
+st_status st_holes_least_area(double *area, const double *const *pts, size_t n, uint32_t *tri,
+                              st_error *err);
+
+/* 1 when st_holes_least_area's area of the loop pts[0..n) is surely above
+ * lim, told without it where it can be (its vector area, or the same
+ * program rounded otherwise, with a margin; holes.c); 0 when unsure.
+ * Never 1 where that area is at most lim. */
+int st_holes_area_above(const double *const *pts, size_t n, double lim);
 
 /* The surviving soup a rebuilt corner's triangles may not pierce
  * (st_tri_tri_cross; touching it is no crossing): its BVH and which of

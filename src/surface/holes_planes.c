@@ -53,6 +53,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 /* Apexes within the loop's box grown by REACH times its extent each way:
  * a lost corner lies near the loop's box (a box's lost corner at a corner
  * of it), a point where nearly parallel planes meet far beyond (other
@@ -81,23 +85,62 @@ typedef struct plane {
     double len;         /* the length of the loop edges on it */
 } plane;
 
-/* The cone from apex over the loop: its total bend, length times
- * dihedral over its edges (rim[i]: the unit normal of the soup's triangle
- * on loop edge i, which passes it the other way from the cone), and in
- * *rimb that over the loop's edges only; tn[3 n] is scratch. */
-static double cone_bend(const double *apex, const double *const *pts, const double *rim,
-                        size_t n, double *tn, double *rimb)
+/* 1 when the cone from apex bends surely no less than below along the
+ * loop (cone_bend would say 0), from a lower bound of each term taken
+ * without the arc tangent and the scaled norms: the sine of the angle
+ * between the cone's unscaled normal u and the soup's r (|u x r| / |u|,
+ * where u . r > 0; a right angle where not) is at most the angle, which
+ * bend() rounds to within a few units in the last place (as the lengths
+ * and sums): the margins, a relative 1e-10 and 1e-12 times the loop's
+ * length in radians, are far beyond those. 0 when unsure. */
+static int cone_above(const double *apex, const double *const *pts, const double *rim, size_t n,
+                      double below)
+{
+    double lb = 0.0, len = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const double *p = pts[i], *q = pts[(i + 1) % n], *r = rim + 3 * i;
+        double e[3], f[3], u[3], x[3];
+        st_sub3(e, q, p);
+        st_sub3(f, apex, p);
+        st_cross3(u, e, f);
+        st_cross3(x, u, r);
+        const double ee = st_dot3(e, e), uu = st_dot3(u, u), d = st_dot3(u, r);
+        if (!(ee > 1e-200 && ee < 1e200))
+            return 0;
+        const double l = sqrt(ee);
+        len += l;
+        if (uu > 1e-200 && uu < 1e200)
+            lb += l * (d > 0.0 ? sqrt(st_dot3(x, x) / uu) : 0.5 * M_PI);
+        if (lb * (1.0 - 1e-10) - 1e-12 * len >= below)
+            return 1;
+    }
+    return 0;
+}
+
+/* The cone from apex over the loop, when it bends less than below along
+ * the loop: 1, its total bend in *total (length times dihedral over its
+ * edges; rim[i]: the unit normal of the soup's triangle on loop edge i,
+ * which passes it the other way from the cone) and in *rimb that over the
+ * loop's edges only; tn[3 n] is scratch. 0 as soon as the loop's edges
+ * alone reach below: the terms are never negative, so the sum, taken in
+ * the same order, could only grow (a NaN stays one and fails the test
+ * too). */
+static int cone_bend(const double *apex, const double *const *pts, const double *rim, size_t n,
+                     double below, double *tn, double *total, double *rimb)
 {
     double b = 0.0;
     for (size_t i = 0; i < n; i++) {
         const double *p = pts[i], *q = pts[(i + 1) % n];
         unit_normal(tn + 3 * i, p, q, apex);
         b += dist3(p, q) * bend(tn + 3 * i, rim + 3 * i);
+        if (!(b < below))
+            return 0;
     }
     *rimb = b;
     for (size_t i = 0; i < n; i++)
         b += dist3(apex, pts[(i + 1) % n]) * bend(tn + 3 * i, tn + 3 * ((i + 1) % n));
-    return b;
+    *total = b;
+    return 1;
 }
 
 /* Solves the 3x3 system rows . x = rhs (Cramer); 0 when |det| < MIN_DET
@@ -286,11 +329,10 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
         for (size_t b = a + 1; b < m; b++)
             for (size_t c = b; c < m; c++) {    /* c == b: the line of a and b */
                 cand *k = cs + nc;
-                double rb;
-                if (!candidate(k->x, pl, a, b, c, o, lo, hi))
-                    continue;
-                const double cb = cone_bend(k->x, pts, rim, n, tn, &rb);
-                if (!(rb < below))
+                double rb, cb;
+                if (!candidate(k->x, pl, a, b, c, o, lo, hi) ||
+                    cone_above(k->x, pts, rim, n, below) ||
+                    !cone_bend(k->x, pts, rim, n, below, tn, &cb, &rb))
                     continue;
                 k->key = rb, k->tie = cb, k->a = a, k->b = b, k->c = c, k->done = 0;
                 nc++;
@@ -340,6 +382,31 @@ typedef struct fan_v {
     long orig;
 } fan_v;
 
+/* 1 when the triangle (a, b, apex) continues the soup's plane across
+ * edge a -> b, whose unit normal is r: bend() between its unit normal and
+ * r below FAN_FLAT. Most are far from it; those whose unscaled normal u
+ * turns from r by more than FAN_SURE times FAN_FLAT (|u x r| against
+ * u . r, rounding a few units in the last place of |u|, where the angles
+ * compared are a millionth) are told without the normal's scaling and
+ * the arc tangent: the answer is bend()'s. */
+#define FAN_SURE 4.0
+static int fan_flat(const double *a, const double *b, const double *apex, const double *r)
+{
+    double e[3], f[3], u[3], x[3];
+    st_sub3(e, b, a);
+    st_sub3(f, apex, a);
+    st_cross3(u, e, f);
+    st_cross3(x, u, r);
+    const double d = st_dot3(u, r), lim = FAN_SURE * FAN_FLAT * d, uu = st_dot3(u, u);
+    /* |u| between 1e-100 and 1e100: no product below underflows where it
+     * would matter; r is a unit vector or zero (then d is 0: bend() says 4) */
+    if (uu > 1e-200 && uu < 1e200 && (!(d > 0.0) || st_dot3(x, x) > lim * lim))
+        return 0;   /* at least a right angle, or beyond FAN_SURE times FAN_FLAT */
+    double t[3];
+    unit_normal(t, a, b, apex);
+    return bend(t, r) < FAN_FLAT;
+}
+
 /* Which of the loop's edges apex continues (FAN_FLAT): flag[n]. Returns
  * their length. (All of them are fanned: doc/design/holes.md.) */
 static double fan_flags(const double *apex, const fan_v *v, const double *rim, size_t n,
@@ -347,10 +414,8 @@ static double fan_flags(const double *apex, const fan_v *v, const double *rim, s
 {
     double g = 0.0;
     for (size_t i = 0; i < n; i++) {
-        double t[3];
         const double *a = v[i].p, *b = v[(i + 1) % n].p;
-        unit_normal(t, a, b, apex);
-        flag[i] = bend(t, rim + 3 * i) < FAN_FLAT;
+        flag[i] = fan_flat(a, b, apex, rim + 3 * i);
         if (flag[i])
             g += dist3(a, b);
     }
