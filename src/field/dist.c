@@ -17,6 +17,12 @@
  * each voxel's nearest triangle, the first of any ties in a fixed order,
  * so its bricks walk their candidates whole, sorted by (bound, index).
  *
+ * Stored by blocks (st_dist_field_blocks). The same bricks, walked by
+ * the 8^3 blocks that hold them (a brick lies in one block): a block gets
+ * a slot of values only if one of its bricks has candidates, and loses it
+ * when every voxel came out at the band. Each voxel's value is the dense
+ * field's, so no voxel far from the soup is allocated or written.
+ *
  * Full field. Beyond the band, a vector distance transform over
  * triangles: four raster sweeps hand each voxel the nearest of the
  * triangles its already-swept neighbours hold, measured exactly (so never
