@@ -369,6 +369,103 @@ static void test_threads_identical(void)
 #endif
 }
 
+/* How the blocks of b differ from the dense field g of the same soup:
+ * voxels with another value (bitwise), stored blocks of the band alone,
+ * voxels of a stored block beyond the grid not holding the band, a wrong
+ * count of stored blocks. */
+static size_t blocks_differ(const st_grid_blocks *b, const st_grid *g)
+{
+    const st_grid *h = &b->head;
+    size_t bad = 0;
+    if (h->data || h->nx != g->nx || h->ny != g->ny || h->nz != g->nz ||
+        h->voxel != g->voxel || h->band != g->band || h->kind != g->kind ||
+        memcmp(h->origin, g->origin, sizeof g->origin) != 0)
+        return 1;
+    for (size_t k = 0; k < g->nz; k++)
+        for (size_t j = 0; j < g->ny; j++)
+            for (size_t i = 0; i < g->nx; i++) {
+                const float v = st_grid_blocks_value(b, i, j, k);
+                bad += memcmp(&v, &g->data[st_grid_index(g, i, j, k)], sizeof v) != 0;
+            }
+    const float bf = (float)h->band;
+    size_t stored = 0;
+    for (size_t bk = 0; bk < b->nb[2]; bk++)
+        for (size_t bj = 0; bj < b->nb[1]; bj++)
+            for (size_t bi = 0; bi < b->nb[0]; bi++) {
+                const size_t at = b->at[bi + b->nb[0] * (bj + b->nb[1] * bk)];
+                if (at == ST_GRID_NO_BLOCK)
+                    continue;
+                stored++;
+                size_t below = 0;
+                for (size_t q = 0; q < 512; q++) {
+                    const size_t i = bi * 8 + q / 64, j = bj * 8 + q / 8 % 8,
+                                 k = bk * 8 + q % 8;
+                    below += b->values[at + q] != bf;
+                    bad += (i >= g->nx || j >= g->ny || k >= g->nz) &&
+                           b->values[at + q] != bf;
+                }
+                bad += below == 0;
+            }
+    return bad + (stored != b->nstored);
+}
+
+/* The field stored by blocks is the dense one, voxel for voxel, on 1 and
+ * 3 threads: a random soup (some triangles large, some degenerate) on
+ * grids whose sides are not multiples of a block, two bands. */
+static void test_blocks_equal_dense(void)
+{
+    st_soup *s = random_soup(300);
+    const size_t cells[] = {21, 37};
+    const double bands[] = {3.0, 4.5};
+    for (int c = 0; c < 2; c++) {
+        st_dist_params p = st_dist_params_default();
+        p.cells = cells[c];
+        p.band = bands[c];
+        st_grid *g = NULL;
+        st_error err;
+        TAP_CHECK(st_dist_field(&g, s, &p, NULL, &err) == ST_OK, "dense field at %zu cells",
+                  cells[c]);
+        for (int threads = 1; threads <= 3; threads += 2) {
+#ifdef _OPENMP
+            omp_set_num_threads(threads);
+#endif
+            st_grid_blocks *b = NULL;
+            TAP_CHECK(st_dist_field_blocks(&b, s, &p, NULL, &err) == ST_OK,
+                      "blocks at %zu cells, %d threads", cells[c], threads);
+            size_t bad = b && g ? blocks_differ(b, g) : 1;
+            const size_t nb = b ? b->nb[0] * b->nb[1] * b->nb[2] : 0;
+            TAP_CHECK(bad == 0 && b->nstored > 0 && b->nstored < nb,
+                      "%zu cells, band %g, %d threads: blocks equal the dense field "
+                      "(%zu of %zu blocks stored, %zu differences)", cells[c], bands[c],
+                      threads, b ? b->nstored : 0, nb, bad);
+            st_grid *d = NULL;
+            TAP_CHECK(b && st_grid_blocks_dense(&d, b, 0, &err) == ST_OK &&
+                          memcmp(d->data, g->data, st_grid_count(g) * sizeof(float)) == 0 &&
+                          d->meta.count == g->meta.count && d->meta.count == 3 &&
+                          strcmp(d->meta.entries[2].value, g->meta.entries[2].value) == 0,
+                      "st_grid_blocks_dense gives the dense field and its meta");
+            st_grid_free(d);
+            st_grid_blocks_free(b);
+        }
+        st_grid_free(g);
+    }
+#ifdef _OPENMP
+    omp_set_num_threads(2);
+#endif
+    st_dist_params p = st_dist_params_default();
+    p.band = INFINITY;
+    st_grid_blocks *b = NULL;
+    st_error err;
+    TAP_CHECK(st_dist_field_blocks(&b, s, &p, NULL, &err) == ST_EINPUT && !b,
+              "blocks refuse a full field: %s", err.msg);
+    p = st_dist_params_default();
+    p.cells = 2000;
+    p.max_bytes = 1 << 20;
+    TAP_CHECK(st_dist_field_blocks(&b, s, &p, NULL, &err) == ST_ELIMIT && !b,
+              "blocks keep the dense size limit: %s", err.msg);
+    st_soup_free(s);
+}
+
 /* A fine soup: many triangles per voxel near a sphere, a few large and
  * degenerate ones among them. */
 static st_soup *fine_soup(size_t n)
@@ -487,6 +584,7 @@ int main(int argc, char **argv)
     static const tap_test tests[] = {TAP_TEST(layout), TAP_TEST(band_exact_on_random_soup),
                                      TAP_TEST(large_oblique_triangle), TAP_TEST(bvh_nearest),
                                      TAP_TEST(bvh_parallel_layout), TAP_TEST(threads_identical),
-                                     TAP_TEST(fine_soup_exact), TAP_TEST(real_model), {0}};
+                                     TAP_TEST(fine_soup_exact), TAP_TEST(real_model),
+                                     TAP_TEST(blocks_equal_dense), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -82,6 +82,15 @@ st_status st_dist_field(st_grid **out, const st_soup *s,
                         const st_dist_params *p, const st_progress *progress,
                         st_error *err);
 
+/* The same field with a finite band, stored by blocks (grid.h): only the
+ * blocks within reach of the band are computed and stored, so a far
+ * voxel costs nothing. Every voxel's value is st_dist_field's, for any
+ * number of threads. max_bytes limits the dense size, as there. Errors
+ * as st_dist_field's, and ST_EINPUT for band = INFINITY. */
+st_status st_dist_field_blocks(st_grid_blocks **out, const st_soup *s,
+                               const st_dist_params *p,
+                               const st_progress *progress, st_error *err);
+
 /* Lower g's values to the distance to s's triangles where that is below
  * `reach` (model units): the field of the union of g's soup and s, as far
  * as reach (hole caps added to a field from a file). Exact point-triangle

@@ -4,12 +4,12 @@
  * Units: model units for origin, voxel size and distances; indices in
  * voxels.
  * Ownership: the caller owns a grid (st_grid_free, safe on NULL), its data
- * and its meta.
+ * and its meta; a grid stored by blocks likewise (st_grid_blocks_free).
  * Threads: no global state; a grid may be read from many threads, written
  * by one.
  * Errors: st_grid_new: ST_EINPUT (no voxels, a voxel size or origin that
  * is not a finite positive number), ST_ELIMIT (over max_bytes, or sizes
- * that overflow), ST_ENOMEM.
+ * that overflow), ST_ENOMEM; st_grid_blocks_dense likewise.
  *
  * Values live at voxel centers: voxel (i, j, k) is centered at
  * origin + voxel * (i, j, k). Storage is x fastest:
@@ -61,6 +61,50 @@ st_status st_grid_new_unset(st_grid **out, size_t nx, size_t ny, size_t nz,
                             const double origin[3], double voxel,
                             size_t max_bytes, st_error *err);
 void st_grid_free(st_grid *g);   /* safe on NULL */
+
+/* A banded field stored by blocks (st_dist_field_blocks, st_grid_blocks_write):
+ * the grid cut into blocks of ST_GRID_BLOCK^3 voxels at multiples of
+ * ST_GRID_BLOCK (OpenVDB's leaf nodes), a block stored only where one of
+ * its voxels holds less than the band, every other voxel holding the band
+ * (head.band, as a float). head gives the placement, kind, band and meta
+ * as for a dense grid; head.data is NULL. Block (bi, bj, bk) is number
+ * bi + nb[0] * (bj + nb[1] * bk); at[b] is the first of its
+ * ST_GRID_BLOCK^3 values in `values`, or ST_GRID_NO_BLOCK. Within a block,
+ * voxel (i, j, k) is value 64 * (i % 8) + 8 * (j % 8) + k % 8 (z fastest,
+ * as in OpenVDB's leaves); voxels of a block beyond the grid hold the band.
+ * Ownership: st_grid_blocks_free (safe on NULL). */
+#define ST_GRID_BLOCK 8
+#define ST_GRID_NO_BLOCK ((size_t)-1)
+typedef struct st_grid_blocks {
+    st_grid head;         /* placement, kind, band, meta; data NULL */
+    size_t nb[3];         /* blocks per axis: ceil(n / ST_GRID_BLOCK) */
+    size_t *at;           /* nb[0] * nb[1] * nb[2] entries */
+    float *values;        /* the stored blocks' values */
+    size_t nstored;       /* blocks stored (at[b] != ST_GRID_NO_BLOCK) */
+} st_grid_blocks;
+
+/* A grid stored by blocks with no block stored (every voxel the band, set
+ * by the caller in head.band): the checks of st_grid_new, max_bytes
+ * against the dense size, so a field refused dense is refused here too. */
+st_status st_grid_blocks_new(st_grid_blocks **out, size_t nx, size_t ny,
+                             size_t nz, const double origin[3], double voxel,
+                             size_t max_bytes, st_error *err);
+void st_grid_blocks_free(st_grid_blocks *b);   /* safe on NULL */
+/* The value of voxel (i, j, k) of a grid stored by blocks. */
+static inline float st_grid_blocks_value(const st_grid_blocks *b, size_t i,
+                                         size_t j, size_t k)
+{
+    const size_t at = b->at[i / ST_GRID_BLOCK + b->nb[0] *
+                            (j / ST_GRID_BLOCK + b->nb[1] * (k / ST_GRID_BLOCK))];
+    if (at == ST_GRID_NO_BLOCK)
+        return (float)b->head.band;
+    return b->values[at + ST_GRID_BLOCK * ST_GRID_BLOCK * (i % ST_GRID_BLOCK) +
+                     ST_GRID_BLOCK * (j % ST_GRID_BLOCK) + k % ST_GRID_BLOCK];
+}
+/* The same field as a dense grid (a copy of the meta too). Errors as
+ * st_grid_new's. */
+st_status st_grid_blocks_dense(st_grid **out, const st_grid_blocks *b,
+                               size_t max_bytes, st_error *err);
 
 /* The name a field of this kind is stored under in files (gridio.h):
  * "distance", "sdf", else "field". */

@@ -52,6 +52,13 @@ st_grid_format st_grid_format_from_path(const char *path);
  * complete; on failure nothing is left at path. */
 st_status st_grid_write(const st_grid *g, const char *path, st_error *err);
 
+/* Write a field stored by blocks (grid.h) to path, as st_grid_write
+ * writes the same field held densely: the same .vdb or stream, node for
+ * node, built from the stored blocks alone; a .vti goes through a dense
+ * copy. */
+st_status st_grid_blocks_write(const st_grid_blocks *b, const char *path,
+                               st_error *err);
+
 /* Read a field from path; "-" or NULL reads stdin (an OpenVDB stream, or
  * a .vdb file's bytes). Format by extension, else by content.
  * max_bytes limits the dense array (0: none). */
@@ -62,6 +69,8 @@ st_status st_grid_read(st_grid **out, const char *path, size_t max_bytes,
  */
 st_status st_grid_write_vdb(const st_grid *g, const char *path,
                             st_error *err);
+st_status st_grid_blocks_write_vdb(const st_grid_blocks *b,
+                                   const char *path, st_error *err);
 st_status st_grid_read_vdb(st_grid **out, const char *path, size_t max_bytes,
                            st_error *err);
 st_status st_grid_write_vti(const st_grid *g, const char *path,

@@ -93,6 +93,7 @@
 #include <iostream>
 #include <istream>
 #include <limits>
+#include <memory>
 #include <new>
 #include <ostream>
 #include <set>
@@ -917,10 +918,9 @@ st_status guarded(const char *name, const char *what, st_error *err,
     }
 }
 
-st_status check_grid(const st_grid *g, const char *name, st_error *err)
+/* The placement and band of a grid to write (not its values). */
+st_status check_head(const st_grid *g, const char *name, st_error *err)
 {
-    if (!g || !g->data)
-        return st_error_set(err, ST_EINTERNAL, name, 0, "no grid to write");
     const size_t lim = size_t(std::numeric_limits<int32_t>::max());
     if (g->nx < 1 || g->ny < 1 || g->nz < 1 || g->nx > lim || g->ny > lim ||
         g->nz > lim)
@@ -935,19 +935,63 @@ st_status check_grid(const st_grid *g, const char *name, st_error *err)
                             "grid placement is not finite");
     if (std::isnan(g->band))
         return st_error_set(err, ST_EINPUT, name, 0, "grid band is NaN");
+    return ST_OK;
+}
+
+st_status nan_error(const char *name, size_t x, size_t y, size_t z,
+                    st_error *err)
+{
+    return st_error_set(err, ST_EINPUT, name, 0,
+                        "value at voxel (%zu,%zu,%zu) is NaN; "
+                        "OpenVDB cannot store it exactly",
+                        x, y, z);
+}
+
+st_status check_grid(const st_grid *g, const char *name, st_error *err)
+{
+    if (!g || !g->data)
+        return st_error_set(err, ST_EINTERNAL, name, 0, "no grid to write");
+    if (st_status s = check_head(g, name, err))
+        return s;
     // OpenVDB compares values with !(|a - b| > tol), which is true for a
     // NaN: NaN voxels would silently become background. A field with NaN
     // is a bug upstream; say so instead of writing something else.
     size_t n = st_grid_count(g);
     for (size_t i = 0; i < n; i++)
-        if (std::isnan(g->data[i])) {
-            size_t x = i % g->nx, y = i / g->nx % g->ny,
-                   z = i / g->nx / g->ny;
-            return st_error_set(err, ST_EINPUT, name, 0,
-                                "value at voxel (%zu,%zu,%zu) is NaN; "
-                                "OpenVDB cannot store it exactly",
-                                x, y, z);
-        }
+        if (std::isnan(g->data[i]))
+            return nan_error(name, i % g->nx, i / g->nx % g->ny,
+                             i / g->nx / g->ny, err);
+    return ST_OK;
+}
+
+constexpr size_t kBlockValues = ST_GRID_BLOCK * ST_GRID_BLOCK * ST_GRID_BLOCK;
+static_assert(ST_GRID_BLOCK == FloatGrid::TreeType::LeafNodeType::DIM,
+              "a block is an OpenVDB leaf");
+
+/* As check_grid, for a grid stored by blocks: its stored values. */
+st_status check_blocks(const st_grid_blocks *b, const char *name,
+                       st_error *err)
+{
+    if (!b || b->head.data || (b->nstored && !b->values))
+        return st_error_set(err, ST_EINTERNAL, name, 0, "no grid to write");
+    if (st_status s = check_head(&b->head, name, err))
+        return s;
+    if (!std::isfinite(b->head.band) || std::fabs(b->head.band) > FLT_MAX)
+        return st_error_set(err, ST_EINTERNAL, name, 0,
+                            "a grid stored by blocks needs a finite band");
+    const size_t n = b->nb[0] * b->nb[1] * b->nb[2];
+    for (size_t i = 0; i < n; i++) {
+        if (b->at[i] == ST_GRID_NO_BLOCK)
+            continue;
+        const float *v = b->values + b->at[i];
+        for (size_t q = 0; q < kBlockValues; q++)
+            if (std::isnan(v[q]))
+                return nan_error(name,
+                                 i % b->nb[0] * ST_GRID_BLOCK + q / 64,
+                                 i / b->nb[0] % b->nb[1] * ST_GRID_BLOCK + q / 8 % 8,
+                                 i / b->nb[0] / b->nb[1] * ST_GRID_BLOCK + q % 8,
+                                 err);
+    }
     return ST_OK;
 }
 
@@ -962,11 +1006,9 @@ bool finite_background(const st_grid *g, float *bg)
     return false;
 }
 
-FloatGrid::Ptr st_to_grid(const st_grid *g)
+/* A dense grid's values into an empty tree. */
+bool fill_dense(FloatGrid &grid, const st_grid *g)
 {
-    float bg;
-    const bool banded = finite_background(g, &bg);
-    FloatGrid::Ptr grid = FloatGrid::create(bg);
     const openvdb::CoordBBox box(
         openvdb::Coord(0, 0, 0),
         openvdb::Coord(int(g->nx - 1), int(g->ny - 1), int(g->nz - 1)));
@@ -975,14 +1017,79 @@ FloatGrid::Ptr st_to_grid(const st_grid *g)
         box, const_cast<float *>(g->data));
     // Tolerance 0: exactly the voxels equal to the background are left
     // inactive (with the background value), everything else is active.
-    openvdb::tools::copyFromDense(dense, *grid, 0.0f);
+    openvdb::tools::copyFromDense(dense, grid, 0.0f);
+    return false;
+}
+
+/* The stored blocks' values into an empty tree: a leaf per stored block,
+ * its voxels equal to +-background inactive (st_to_grid's rule), the rest
+ * active; nothing for a block not stored (the background alone).
+ * copyFromDense builds the same from the dense field (fill_dense), but
+ * that a block of one active value becomes a tile there; the prune every
+ * banded grid gets (st_to_grid; a grid stored by blocks is banded) makes
+ * it one here, so the trees written are the same node for node. The
+ * leaves are filled in parallel and added in one thread. */
+bool fill_blocks(FloatGrid &grid, const st_grid_blocks *b)
+{
+    using LeafT = FloatGrid::TreeType::LeafNodeType;
+    const float bg = grid.background(), neg = -bg;
+    const size_t n = b->nb[0] * b->nb[1] * b->nb[2];
+    std::vector<size_t> ids;
+    ids.reserve(b->nstored);
+    for (size_t i = 0; i < n; i++)
+        if (b->at[i] != ST_GRID_NO_BLOCK)
+            ids.push_back(i);
+    const auto origin = [&](size_t i) {
+        return openvdb::Coord(int(i % b->nb[0] * ST_GRID_BLOCK),
+                              int(i / b->nb[0] % b->nb[1] * ST_GRID_BLOCK),
+                              int(i / b->nb[0] / b->nb[1] * ST_GRID_BLOCK));
+    };
+    std::vector<std::unique_ptr<LeafT>> leaves(ids.size());
+    bool oom = false;
+    #pragma omp parallel for schedule(dynamic, 64)
+    for (size_t q = 0; q < ids.size(); q++) {
+        LeafT *leaf = new (std::nothrow) LeafT(origin(ids[q]), bg, false);
+        if (!leaf) {
+            #pragma omp atomic write
+            oom = true;
+            continue;
+        }
+        leaves[q].reset(leaf);
+        const float *v = b->values + b->at[ids[q]];
+        float *dst = leaf->buffer().data();
+        LeafT::NodeMaskType mask;
+        for (openvdb::Index i = 0; i < kBlockValues; i++) {
+            dst[i] = v[i];
+            if (v[i] != bg && v[i] != neg)
+                mask.setOn(i);
+        }
+        leaf->setValueMask(mask);
+    }
+    if (oom)
+        throw std::bad_alloc();
+    openvdb::tree::ValueAccessor<FloatGrid::TreeType> acc(grid.tree());
+    for (size_t q = 0; q < ids.size(); q++)
+        acc.addLeaf(leaves[q].release());
+    return true;
+}
+
+/* g's placement, band and meta around a tree filled by fill(grid), which
+ * says whether it left -background inactive already. */
+template <class Fill>
+FloatGrid::Ptr st_to_grid(const st_grid *g, Fill &&fill)
+{
+    float bg;
+    const bool banded = finite_background(g, &bg);
+    FloatGrid::Ptr grid = FloatGrid::create(bg);
+    const bool neg_done = fill(*grid);
     if (banded) {
         // -background (the clamped outside of a signed field) is outside
         // the band too: inactive, value kept. Tiles included.
         const float neg = -bg;
-        for (auto it = grid->tree().beginValueOn(); it; ++it)
-            if (*it == neg)
-                it.setActiveState(false);
+        if (!neg_done)
+            for (auto it = grid->tree().beginValueOn(); it; ++it)
+                if (*it == neg)
+                    it.setActiveState(false);
         openvdb::tools::prune(grid->tree(), 0.0f);
     }
 
@@ -1020,13 +1127,15 @@ FloatGrid::Ptr st_to_grid(const st_grid *g)
     return grid;
 }
 
-st_status write_file(const st_grid *g, const char *path, st_error *err)
+template <class Fill>
+st_status write_file(const st_grid *g, Fill &&fill, const char *path,
+                     st_error *err)
 {
     st_outfile o;
     if (st_status s = st_outfile_begin(&o, path, 0, err))
         return s;
     st_status s = guarded(path, "writing", err, nullptr, [&]() -> st_status {
-        FloatGrid::Ptr grid = st_to_grid(g);
+        FloatGrid::Ptr grid = st_to_grid(g, fill);
         std::ofstream os(o.tmp, std::ios_base::out | std::ios_base::binary |
                                     std::ios_base::trunc);
         if (!os)
@@ -1048,11 +1157,12 @@ st_status write_file(const st_grid *g, const char *path, st_error *err)
     return st_outfile_commit(&o, err);
 }
 
-st_status write_stdout(const st_grid *g, st_error *err)
+template <class Fill>
+st_status write_stdout(const st_grid *g, Fill &&fill, st_error *err)
 {
     const char *name = ST_STDOUT_NAME;
     return guarded(name, "writing", err, nullptr, [&]() -> st_status {
-        FloatGrid::Ptr grid = st_to_grid(g);
+        FloatGrid::Ptr grid = st_to_grid(g, fill);
         // Whatever C stdio holds goes out first. A fresh ostream on
         // cout's buffer (not std::cout itself): OpenVDB leaves a pointer
         // to a destroyed local in the stream's pword after writing, which
@@ -1082,25 +1192,45 @@ st_status write_stdout(const st_grid *g, st_error *err)
     });
 }
 
+/* Check, then write to path or stdout the grid `head` whose tree fill
+ * builds. No exception can leave this function: guarded() catches
+ * everything, and so does this for what happens outside it
+ * (initialize()). */
+template <class Check, class Fill>
+st_status write_vdb(const st_grid *head, const char *path, Check &&check,
+                    Fill &&fill, st_error *err)
+{
+    const bool out = st_path_is_stdio(path);
+    const char *name = out ? ST_STDOUT_NAME : path;
+    try {
+        init_openvdb();
+        if (st_status s = check(name))
+            return s;
+        return out ? write_stdout(head, fill, err) : write_file(head, fill, path, err);
+    } catch (...) {
+        return st_error_set(err, ST_EINTERNAL, name, 0,
+                            "unexpected exception writing OpenVDB");
+    }
+}
+
 } // namespace
 
 extern "C" {
 
 st_status st_grid_write_vdb(const st_grid *g, const char *path, st_error *err)
 {
-    const bool out = st_path_is_stdio(path);
-    const char *name = out ? ST_STDOUT_NAME : path;
-    // No exception can leave this function: guarded() catches everything,
-    // and so does this for what happens outside it (initialize()).
-    try {
-        init_openvdb();
-        if (st_status s = check_grid(g, name, err))
-            return s;
-        return out ? write_stdout(g, err) : write_file(g, path, err);
-    } catch (...) {
-        return st_error_set(err, ST_EINTERNAL, name, 0,
-                            "unexpected exception writing OpenVDB");
-    }
+    return write_vdb(
+        g, path, [&](const char *name) { return check_grid(g, name, err); },
+        [g](FloatGrid &grid) { return fill_dense(grid, g); }, err);
+}
+
+st_status st_grid_blocks_write_vdb(const st_grid_blocks *b, const char *path,
+                                   st_error *err)
+{
+    return write_vdb(
+        b ? &b->head : nullptr, path,
+        [&](const char *name) { return check_blocks(b, name, err); },
+        [b](FloatGrid &grid) { return fill_blocks(grid, b); }, err);
 }
 
 st_status st_gridio_read_vdb_mem(st_grid **out, const unsigned char *data,

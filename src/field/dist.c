@@ -17,6 +17,12 @@
  * each voxel's nearest triangle, the first of any ties in a fixed order,
  * so its bricks walk their candidates whole, sorted by (bound, index).
  *
+ * Stored by blocks (st_dist_field_blocks). The same bricks, walked by
+ * the 8^3 blocks that hold them (a brick lies in one block): a block gets
+ * a slot of values only if one of its bricks has candidates, and loses it
+ * when every voxel came out at the band. Each voxel's value is the dense
+ * field's, so no voxel far from the soup is allocated or written.
+ *
  * Full field. Beyond the band, a vector distance transform over
  * triangles: four raster sweeps hand each voxel the nearest of the
  * triangles its already-swept neighbours hold, measured exactly (so never
@@ -493,9 +499,25 @@ static void box_center(const st_grid *g, voxel_box *v)
         v->c[a] = g->origin[a] + g->voxel * 0.5 * (double)(v->lo[a] + v->hi[a] - 1);
 }
 
+/* Where a brick's values go: voxel (i, j, k) at val[(i - lo[0]) * s[0] +
+ * (j - lo[1]) * s[1] + (k - lo[2]) * s[2]], its nearest triangle (a full
+ * field's) at near[] likewise: a dense grid's rows, or a block's. */
+typedef struct brick_out {
+    float *val;
+    int32_t *near;      /* NULL for a band field */
+    size_t s[3];
+    size_t lo[3];
+} brick_out;
+
+static inline size_t out_index(const brick_out *o, size_t i, size_t j, size_t k)
+{
+    return (i - o->lo[0]) * o->s[0] + (j - o->lo[1]) * o->s[1] +
+           (k - o->lo[2]) * o->s[2];
+}
+
 /* Exact band distances for the voxels of box v, walking list w (bounds
  * from v's center). */
-static void walk_box(st_grid *g, int32_t *near, const st_soup *s,
+static void walk_box(const st_grid *g, const brick_out *o, const st_soup *s,
                      const voxel_box *v, const walk_list *w, double B,
                      brick_scratch *sc)
 {
@@ -557,10 +579,10 @@ static void walk_box(st_grid *g, int32_t *near, const st_soup *s,
                         }
                     }
                 }
-                const size_t idx = st_grid_index(g, i, j, k);
-                g->data[idx] = cur >= B2 ? Bf : (float)curd;
-                if (near)
-                    near[idx] = cur >= B2 ? -1 : best;
+                const size_t idx = out_index(o, i, j, k);
+                o->val[idx] = cur >= B2 ? Bf : (float)curd;
+                if (o->near)
+                    o->near[idx] = cur >= B2 ? -1 : best;
             }
         }
     }
@@ -568,23 +590,22 @@ static void walk_box(st_grid *g, int32_t *near, const st_soup *s,
 }
 
 /* Write `value` (and nearest -1) to every voxel of box v. */
-static void fill_box(st_grid *g, int32_t *near, const voxel_box *v, float value)
+static void fill_box(const brick_out *o, const voxel_box *v, float value)
 {
     for (size_t k = v->lo[2]; k < v->hi[2]; k++)
-        for (size_t j = v->lo[1]; j < v->hi[1]; j++) {
-            const size_t at = st_grid_index(g, v->lo[0], j, k);
-            for (size_t i = 0; i < v->hi[0] - v->lo[0]; i++)
-                g->data[at + i] = value;
-            if (near)
-                for (size_t i = 0; i < v->hi[0] - v->lo[0]; i++)
-                    near[at + i] = -1;
-        }
+        for (size_t j = v->lo[1]; j < v->hi[1]; j++)
+            for (size_t i = v->lo[0]; i < v->hi[0]; i++) {
+                const size_t at = out_index(o, i, j, k);
+                o->val[at] = value;
+                if (o->near)
+                    o->near[at] = -1;
+            }
 }
 
 /* A full field's brick: its m candidates by (key, tri), each its own run. */
-static void walk_sorted(st_grid *g, int32_t *near, const st_soup *s,
-                        const voxel_box *v, size_t m, double B,
-                        brick_scratch *sc)
+static void walk_sorted(const st_grid *g, const brick_out *o,
+                        const st_soup *s, const voxel_box *v, size_t m,
+                        double B, brick_scratch *sc)
 {
     cand_key *keys = sc->keys;
     for (size_t q = 0; q < m; q++) {
@@ -607,13 +628,14 @@ static void walk_sorted(st_grid *g, int32_t *near, const st_soup *s,
         wl->bound[q] = keys[q].key;
     }
     wl->n = m;
-    walk_box(g, near, s, v, wl, B, sc);
+    walk_box(g, o, s, v, wl, B, sc);
 }
 
 /* A band field's group v: the candidates whose ball comes within B of one
  * of its voxels, bucketed by their bound from its center. */
-static void walk_group(st_grid *g, const st_soup *s, const voxel_box *v,
-                       size_t m, double B, brick_scratch *sc)
+static void walk_group(const st_grid *g, const brick_out *o,
+                       const st_soup *s, const voxel_box *v, size_t m,
+                       double B, brick_scratch *sc)
 {
     double half = 0.0;
     for (int a = 0; a < 3; a++) {
@@ -650,7 +672,7 @@ static void walk_group(st_grid *g, const st_soup *s, const voxel_box *v,
         lo[b] = MIN2(lo[b], k);
     }
     if (nkept == 0) {
-        fill_box(g, NULL, v, (float)B);
+        fill_box(o, v, (float)B);
         return;
     }
     for (int b = 0; b < NBUCKET; b++)
@@ -666,15 +688,39 @@ static void walk_group(st_grid *g, const st_soup *s, const voxel_box *v,
         wl->at[at] = q;
     }
     wl->n = nkept;
-    walk_box(g, NULL, s, v, wl, B, sc);
+    walk_box(g, o, s, v, wl, B, sc);
 }
 
-/* Exact band distances for the voxels of one brick. */
-static void process_brick(st_grid *g, int32_t *near, const st_soup *s,
-                          const tri_ball *balls, const brick_grid *bg,
-                          size_t brick, const uint32_t *list, size_t m,
+/* The triangles binned into the bricks their band may reach. */
+typedef struct band_bins {
+    brick_grid bg;
+    size_t nb;          /* bricks */
+    tri_ball *balls;    /* per triangle */
+    size_t *start;      /* brick b's candidates: list[start[b] .. start[b + 1]) */
+    uint32_t *list;
+    double *centers;    /* bg.center's storage */
+} band_bins;
+
+static void bins_free(band_bins *bb)
+{
+    void *owned[] = {bb->balls, bb->start, bb->list, bb->centers};
+    for (size_t i = 0; i < sizeof owned / sizeof owned[0]; i++)
+        free(owned[i]);
+}
+
+static size_t bin_count(const band_bins *bb, size_t brick)
+{
+    return bb->start[brick + 1] - bb->start[brick];
+}
+
+/* Exact band distances for the voxels of one brick, written through o. */
+static void process_brick(const st_grid *g, const brick_out *o,
+                          const st_soup *s, const band_bins *bb, size_t brick,
                           double B, brick_scratch *sc)
 {
+    const brick_grid *bg = &bb->bg;
+    const uint32_t *list = bb->list + bb->start[brick];
+    const size_t m = bin_count(bb, brick);
     const size_t n[3] = {g->nx, g->ny, g->nz};
     const size_t b[3] = {brick % bg->n[0], (brick / bg->n[0]) % bg->n[1],
                          brick / (bg->n[0] * bg->n[1])};
@@ -684,11 +730,11 @@ static void process_brick(st_grid *g, int32_t *near, const st_soup *s,
         v.hi[a] = v.lo[a] + BRICK < n[a] ? v.lo[a] + BRICK : n[a];
     }
     if (m == 0) {
-        fill_box(g, near, &v, (float)B);
+        fill_box(o, &v, (float)B);
         return;
     }
     for (size_t q = 0; q < m; q++) {
-        const tri_ball *tb = &balls[list[q]];
+        const tri_ball *tb = &bb->balls[list[q]];
         sc->tri[q] = list[q];
         sc->slot[q] = UINT32_MAX;
         sc->bx[q] = tb->c[0];
@@ -697,9 +743,9 @@ static void process_brick(st_grid *g, int32_t *near, const st_soup *s,
         sc->br[q] = tb->r;
     }
     sc->nsetup = 0;
-    if (near) {
+    if (o->near) {
         box_center(g, &v);
-        walk_sorted(g, near, s, &v, m, B, sc);
+        walk_sorted(g, o, s, &v, m, B, sc);
         return;
     }
     voxel_box u;
@@ -712,56 +758,52 @@ static void process_brick(st_grid *g, int32_t *near, const st_soup *s,
                     u.hi[a] = at[a] + GROUP < v.hi[a] ? at[a] + GROUP : v.hi[a];
                 }
                 box_center(g, &u);
-                walk_group(g, s, &u, m, B, sc);
+                walk_group(g, o, s, &u, m, B, sc);
             }
 }
 
-static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
-                           double B, const st_progress *progress,
-                           st_error *err)
+/* Bin s's triangles into the bricks of g (see triangle_bricks): bb gets
+ * the balls, and each brick's candidates in input order. */
+static st_status bin_triangles(band_bins *bb, const st_grid *g,
+                               const st_soup *s, double B,
+                               const st_progress *progress, st_error *err)
 {
+    memset(bb, 0, sizeof *bb);
     if (s->ntris > UINT32_MAX)
         return st_error_set(err, ST_ELIMIT, NULL, 0,
                             "too many triangles (%zu)", s->ntris);
-    brick_grid bg;
-    bg.n[0] = (g->nx + BRICK - 1) / BRICK;
-    bg.n[1] = (g->ny + BRICK - 1) / BRICK;
-    bg.n[2] = (g->nz + BRICK - 1) / BRICK;
-    bg.half_diag = 0.5 * sqrt(3.0) * (double)(BRICK - 1) * g->voxel;
-    const size_t nb = bg.n[0] * bg.n[1] * bg.n[2];
-
-    tri_ball *balls = st_malloc_array(s->ntris, sizeof *balls);
-    size_t *start = st_calloc_array(nb + 1, sizeof(size_t));
-    double *centers = st_malloc_array(bg.n[0] + bg.n[1] + bg.n[2], sizeof(double));
-    if (!balls || !start || !centers) {
-        free(balls);
-        free(centers);
-        free(start);
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
-    }
-    for (int a = 0; a < 3; a++) {
-        bg.center[a] = centers + (a > 0 ? bg.n[0] : 0) + (a > 1 ? bg.n[1] : 0);
-        for (size_t b = 0; b < bg.n[a]; b++)
-            bg.center[a][b] = brick_center_axis(g, a, b);
-    }
-    #pragma omp parallel for schedule(static)
-    for (size_t t = 0; t < s->ntris; t++)
-        triangle_ball(&balls[t], s, t);
-    /* Counting sort of (brick, triangle) pairs, triangles in input order:
-     * the triangles cut into `chunks` runs, each counted and filled by one
-     * thread into its own part of every brick's list (the runs' parts in
-     * run order), so the lists are the serial ones for any thread count. */
+    brick_grid *bg = &bb->bg;
+    bg->n[0] = (g->nx + BRICK - 1) / BRICK;
+    bg->n[1] = (g->ny + BRICK - 1) / BRICK;
+    bg->n[2] = (g->nz + BRICK - 1) / BRICK;
+    bg->half_diag = 0.5 * sqrt(3.0) * (double)(BRICK - 1) * g->voxel;
+    const size_t nb = bb->nb = bg->n[0] * bg->n[1] * bg->n[2];
+    /* The triangles cut into `chunks` runs (below). */
     int chunks = omp_get_max_threads();
     chunks = chunks < 1 ? 1 : chunks > 8 ? 8 : chunks;
     if (s->ntris < 4096)
         chunks = 1;
+    bb->balls = st_malloc_array(s->ntris, sizeof *bb->balls);
+    bb->start = st_malloc_array(nb + 1, sizeof(size_t));
+    bb->centers = st_malloc_array(bg->n[0] + bg->n[1] + bg->n[2], sizeof(double));
     size_t *cnt = st_calloc_array((size_t)chunks * (nb + 1), sizeof(size_t));
-    if (!cnt) {
-        free(balls);
-        free(centers);
-        free(start);
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    st_status st = ST_OK;
+    if (!bb->balls || !bb->start || !bb->centers || !cnt) {
+        st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+        goto done;
     }
+    for (int a = 0; a < 3; a++) {
+        bg->center[a] = bb->centers + (a > 0 ? bg->n[0] : 0) + (a > 1 ? bg->n[1] : 0);
+        for (size_t b = 0; b < bg->n[a]; b++)
+            bg->center[a][b] = brick_center_axis(g, a, b);
+    }
+    #pragma omp parallel for schedule(static)
+    for (size_t t = 0; t < s->ntris; t++)
+        triangle_ball(&bb->balls[t], s, t);
+    /* Counting sort of (brick, triangle) pairs, triangles in input order:
+     * each run counted and filled by one thread into its own part of
+     * every brick's list (the runs' parts in run order), so the lists are
+     * the serial ones for any thread count. */
     #pragma omp parallel for schedule(static, 1) num_threads(chunks)
     for (int c = 0; c < chunks; c++) {
         const size_t t0 = s->ntris * (size_t)c / (size_t)chunks;
@@ -770,20 +812,17 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
         for (size_t t = t0; t < t1; t++) {
             if ((t & 4095) == 0 && st_progress_cancelled(progress))
                 break;
-            triangle_bricks(g, &bg, s, t, &balls[t], B, count_visit, &cc);
+            triangle_bricks(g, bg, s, t, &bb->balls[t], B, count_visit, &cc);
         }
     }
     if (st_progress_cancelled(progress)) {
-        free(cnt);
-        free(balls);
-        free(centers);
-        free(start);
-        return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        goto done;
     }
     /* start[b]: brick b's first slot; cnt[c][b + 1] becomes run c's */
     size_t at = 0;
     for (size_t b = 0; b < nb; b++) {
-        start[b] = at;
+        bb->start[b] = at;
         for (int c = 0; c < chunks; c++) {
             size_t *x = &cnt[(size_t)c * (nb + 1) + b + 1];
             const size_t k = *x;
@@ -791,31 +830,118 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
             at += k;
         }
     }
-    start[nb] = at;
-    const size_t npairs = start[nb];
-    uint32_t *list = st_malloc_array(npairs ? npairs : 1, sizeof(uint32_t));
-    if (!list) {
-        free(cnt);
-        free(balls);
-        free(centers);
-        free(start);
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for "
-                            "%zu brick candidates", npairs);
+    bb->start[nb] = at;
+    bb->list = st_malloc_array(at ? at : 1, sizeof(uint32_t));
+    if (!bb->list) {
+        st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for "
+                          "%zu brick candidates", at);
+        goto done;
     }
     #pragma omp parallel for schedule(static, 1) num_threads(chunks)
     for (int c = 0; c < chunks; c++) {
         const size_t t0 = s->ntris * (size_t)c / (size_t)chunks;
         const size_t t1 = s->ntris * (size_t)(c + 1) / (size_t)chunks;
-        bin_ctx cc = {NULL, cnt + (size_t)c * (nb + 1) + 1, list, 0};
+        bin_ctx cc = {NULL, cnt + (size_t)c * (nb + 1) + 1, bb->list, 0};
         for (size_t t = t0; t < t1; t++) {
             if ((t & 4095) == 0 && st_progress_cancelled(progress))
                 break;
             cc.tri = (uint32_t)t;
-            triangle_bricks(g, &bg, s, t, &balls[t], B, fill_visit, &cc);
+            triangle_bricks(g, bg, s, t, &bb->balls[t], B, fill_visit, &cc);
         }
     }
+    if (st_progress_cancelled(progress))
+        st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+done:
     free(cnt);
+    if (st)
+        bins_free(bb);
+    return st;
+}
 
+/* Bricks per block along an axis: a brick lies in one block. */
+#define BRICKS_PER_BLOCK (ST_GRID_BLOCK / BRICK)
+_Static_assert(ST_GRID_BLOCK % BRICK == 0, "a brick must lie in one block");
+
+/* One block of a field stored by blocks: its bricks' values into its
+ * slot; then, if every voxel holds the band, no slot. A block whose
+ * bricks have no candidates has none to begin with. -1: out of memory. */
+static int process_block(st_grid_blocks *bk, const st_soup *s,
+                         const band_bins *bb, size_t block, double B,
+                         brick_scratch *sc)
+{
+    const size_t at = bk->at[block];
+    if (at == ST_GRID_NO_BLOCK)
+        return 0;
+    const st_grid *g = &bk->head;
+    const size_t n[3] = {g->nx, g->ny, g->nz};
+    const size_t b[3] = {block % bk->nb[0], (block / bk->nb[0]) % bk->nb[1],
+                         block / (bk->nb[0] * bk->nb[1])};
+    enum { E = ST_GRID_BLOCK * ST_GRID_BLOCK * ST_GRID_BLOCK };
+    const brick_out o = {bk->values + at, NULL,
+                         {ST_GRID_BLOCK * ST_GRID_BLOCK, ST_GRID_BLOCK, 1},
+                         {b[0] * ST_GRID_BLOCK, b[1] * ST_GRID_BLOCK,
+                          b[2] * ST_GRID_BLOCK}};
+    const float Bf = (float)B;
+    /* Voxels beyond the grid hold the band; the bricks write the rest. */
+    if (o.lo[0] + ST_GRID_BLOCK > n[0] || o.lo[1] + ST_GRID_BLOCK > n[1] ||
+        o.lo[2] + ST_GRID_BLOCK > n[2])
+        for (size_t q = 0; q < E; q++)
+            o.val[q] = Bf;
+    const brick_grid *bg = &bb->bg;
+    for (size_t z = 0; z < BRICKS_PER_BLOCK; z++)
+        for (size_t y = 0; y < BRICKS_PER_BLOCK; y++)
+            for (size_t x = 0; x < BRICKS_PER_BLOCK; x++) {
+                const size_t c[3] = {b[0] * BRICKS_PER_BLOCK + x,
+                                     b[1] * BRICKS_PER_BLOCK + y,
+                                     b[2] * BRICKS_PER_BLOCK + z};
+                if (c[0] >= bg->n[0] || c[1] >= bg->n[1] || c[2] >= bg->n[2])
+                    continue;
+                const size_t brick = c[0] + bg->n[0] * (c[1] + bg->n[1] * c[2]);
+                if (scratch_reserve(sc, bin_count(bb, brick)))
+                    return -1;
+                process_brick(g, &o, s, bb, brick, B, sc);
+            }
+    size_t q = 0;
+    while (q < E && o.val[q] == Bf)
+        q++;
+    if (q == E)
+        bk->at[block] = ST_GRID_NO_BLOCK;
+    return 0;
+}
+
+/* Give every block a brick of which has candidates a slot of values. */
+static st_status block_slots(st_grid_blocks *bk, const band_bins *bb,
+                             st_error *err)
+{
+    const brick_grid *bg = &bb->bg;
+    const size_t E = ST_GRID_BLOCK * ST_GRID_BLOCK * ST_GRID_BLOCK;
+    size_t nslots = 0;
+    for (size_t k = 0; k < bg->n[2]; k++)
+        for (size_t j = 0; j < bg->n[1]; j++)
+            for (size_t i = 0; i < bg->n[0]; i++) {
+                const size_t brick = i + bg->n[0] * (j + bg->n[1] * k);
+                const size_t block = i / BRICKS_PER_BLOCK + bk->nb[0] *
+                    (j / BRICKS_PER_BLOCK + bk->nb[1] * (k / BRICKS_PER_BLOCK));
+                if (bin_count(bb, brick) && bk->at[block] == ST_GRID_NO_BLOCK)
+                    bk->at[block] = E * nslots++;
+            }
+    size_t bytes;
+    if (st_size_mul(&bytes, nslots, E * sizeof(float)) ||
+        !(bk->values = st_malloc_big(bytes ? bytes : 1)))
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for "
+                            "%zu blocks of the band", nslots);
+    return ST_OK;
+}
+
+/* The band's exact distances for every brick of g (dense: through near as
+ * well, if given), or of every block of bk (then g is bk's head). */
+static st_status band_bricks(const st_grid *g, int32_t *near,
+                             st_grid_blocks *bk, const st_soup *s,
+                             const band_bins *bb, double B,
+                             const st_progress *progress, st_error *err)
+{
+    const size_t nunits = bk ? bk->nb[0] * bk->nb[1] * bk->nb[2] : bb->nb;
+    const brick_out dense = {g->data, near, {1, g->nx, g->nx * g->ny}, {0, 0, 0}};
     int oom = 0;
     size_t done = 0;
     /* A cancelled run skips the bricks left (a brick is well under a
@@ -825,18 +951,20 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
     {
         brick_scratch sc;
         memset(&sc, 0, sizeof sc);
-        #pragma omp for schedule(dynamic, 16)
-        for (size_t b = 0; b < nb; b++) {
+        #pragma omp for schedule(dynamic, bk ? 4 : 16)
+        for (size_t u = 0; u < nunits; u++) {
             if (st_progress_cancelled(progress))
                 continue;
-            size_t m = start[b + 1] - start[b];
-            if (scratch_reserve(&sc, m)) {
+            int bad;
+            if (bk)
+                bad = process_block(bk, s, bb, u, B, &sc);
+            else if (!(bad = scratch_reserve(&sc, bin_count(bb, u))))
+                process_brick(g, &dense, s, bb, u, B, &sc);
+            if (bad) {
                 #pragma omp atomic write
                 oom = 1;
                 continue;
             }
-            process_brick(g, near, s, balls, &bg, b, list + start[b], m, B,
-                          &sc);
             size_t now;
             #pragma omp atomic capture
             now = ++done;
@@ -844,19 +972,40 @@ static st_status band_pass(st_grid *g, int32_t *near, const st_soup *s,
             if (omp_get_thread_num() == 0 && (now & 1023) == 0)
 #endif
                 st_progress_report(progress, "distance band",
-                                   (double)now / (double)nb);
+                                   (double)now / (double)nunits);
         }
         scratch_free(&sc);
     }
-    free(list);
-    free(start);
-    free(balls);
-    free(centers);
     if (oom)
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     if (st_progress_cancelled(progress))
         return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
     st_progress_report(progress, "distance band", 1.0);
+    return ST_OK;
+}
+
+/* The band pass: every voxel of g (a dense grid, with near for a full
+ * field), or of bk's blocks, gets its exact distance where it is below B,
+ * else B. */
+static st_status band_pass(st_grid *g, int32_t *near, st_grid_blocks *bk,
+                           const st_soup *s, double B,
+                           const st_progress *progress, st_error *err)
+{
+    band_bins bb;
+    st_status st = bin_triangles(&bb, g, s, B, progress, err);
+    if (st)
+        return st;
+    if (bk)
+        st = block_slots(bk, &bb, err);
+    if (!st)
+        st = band_bricks(g, near, bk, s, &bb, B, progress, err);
+    bins_free(&bb);
+    if (st || !bk)
+        return st;
+    bk->nstored = 0;
+    const size_t n = bk->nb[0] * bk->nb[1] * bk->nb[2];
+    for (size_t b = 0; b < n; b++)
+        bk->nstored += bk->at[b] != ST_GRID_NO_BLOCK;
     return ST_OK;
 }
 
@@ -964,27 +1113,61 @@ static st_status full_pass(st_grid *g, int32_t *near, const st_soup *s,
     return ST_OK;
 }
 
+/* A field's layout and band. */
+typedef struct dist_plan {
+    int full;            /* band = INFINITY */
+    size_t dims[3];
+    double origin[3], h;
+    double band_vox;     /* the exact band in voxels (the default if full) */
+} dist_plan;
+
+/* The parameters' checks and the layout. */
+static st_status dist_setup(dist_plan *pl, const st_soup *s,
+                            const st_dist_params *p, st_error *err)
+{
+    pl->full = isinf(p->band) && p->band > 0;
+    if (!pl->full && !(p->band >= ST_DIST_MIN_BAND))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "band %g is below the minimum of %g voxels",
+                            p->band, ST_DIST_MIN_BAND);
+    pl->band_vox = pl->full ? ST_DIST_DEFAULT_BAND : p->band;
+    return st_dist_layout(s, p, pl->dims, pl->origin, &pl->h, err);
+}
+
+/* The metadata every distance field carries (dist.h). */
+static st_status dist_meta(st_meta *m, const st_soup *s, int full,
+                           double band_vox, st_error *err)
+{
+    char buf[64];
+    snprintf(buf, sizeof buf, "%zu", s->ntris);
+    st_status st = st_meta_set(m, "triangles", buf);
+    snprintf(buf, sizeof buf, "%zu", s->nverts);
+    st = st ? st : st_meta_set(m, "vertices", buf);
+    if (full)
+        snprintf(buf, sizeof buf, "full");
+    else
+        snprintf(buf, sizeof buf, "%.17g", band_vox);
+    st = st ? st : st_meta_set(m, "band_voxels", buf);
+    if (st)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    return ST_OK;
+}
+
 st_status st_dist_field(st_grid **out, const st_soup *s,
                         const st_dist_params *p, const st_progress *progress,
                         st_error *err)
 {
     *out = NULL;
-    int full = isinf(p->band) && p->band > 0;
-    if (!full && !(p->band >= ST_DIST_MIN_BAND))
-        return st_error_set(err, ST_EINPUT, NULL, 0,
-                            "band %g is below the minimum of %g voxels",
-                            p->band, ST_DIST_MIN_BAND);
-    size_t dims[3];
-    double origin[3], h;
-    st_status st = st_dist_layout(s, p, dims, origin, &h, err);
+    dist_plan pl;
+    st_status st = dist_setup(&pl, s, p, err);
     if (st)
         return st;
+    const int full = pl.full;
     st_grid *g;
-    double band_vox = full ? ST_DIST_DEFAULT_BAND : p->band;
-    double B = band_vox * h;
+    double B = pl.band_vox * pl.h;
     /* The band pass writes every voxel. */
-    st = st_grid_new_unset(&g, dims[0], dims[1], dims[2], origin, h,
-                           p->max_bytes, err);
+    st = st_grid_new_unset(&g, pl.dims[0], pl.dims[1], pl.dims[2], pl.origin,
+                           pl.h, p->max_bytes, err);
     if (st)
         return st;
     g->kind = ST_GRID_DISTANCE;
@@ -994,30 +1177,48 @@ st_status st_dist_field(st_grid **out, const st_soup *s,
         return st_error_set(err, ST_ENOMEM, NULL, 0,
                             "out of memory for the nearest-triangle map");
     }
-    st = band_pass(g, near, s, B, progress, err);
+    st = band_pass(g, near, NULL, s, B, progress, err);
     if (!st && full)
         st = full_pass(g, near, s, B, progress, err);
     free(near);
+    g->band = full ? INFINITY : B;
+    if (!st)
+        st = dist_meta(&g->meta, s, full, pl.band_vox, err);
     if (st) {
         st_grid_free(g);
         return st;
     }
-    g->band = full ? INFINITY : B;
-    char buf[64];
-    snprintf(buf, sizeof buf, "%zu", s->ntris);
-    st = st_meta_set(&g->meta, "triangles", buf);
-    snprintf(buf, sizeof buf, "%zu", s->nverts);
-    st = st ? st : st_meta_set(&g->meta, "vertices", buf);
-    if (full)
-        snprintf(buf, sizeof buf, "full");
-    else
-        snprintf(buf, sizeof buf, "%.17g", band_vox);
-    st = st ? st : st_meta_set(&g->meta, "band_voxels", buf);
-    if (st) {
-        st_grid_free(g);
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
-    }
     *out = g;
+    return ST_OK;
+}
+
+st_status st_dist_field_blocks(st_grid_blocks **out, const st_soup *s,
+                               const st_dist_params *p,
+                               const st_progress *progress, st_error *err)
+{
+    *out = NULL;
+    if (isinf(p->band))
+        return st_error_set(err, ST_EINPUT, NULL, 0, "a field stored by "
+                            "blocks needs a finite band");
+    dist_plan pl;
+    st_status st = dist_setup(&pl, s, p, err);
+    st_grid_blocks *bk = NULL;
+    if (!st)
+        st = st_grid_blocks_new(&bk, pl.dims[0], pl.dims[1], pl.dims[2],
+                                pl.origin, pl.h, p->max_bytes, err);
+    if (st)
+        return st;
+    const double B = pl.band_vox * pl.h;
+    bk->head.kind = ST_GRID_DISTANCE;
+    bk->head.band = B;
+    st = band_pass(&bk->head, NULL, bk, s, B, progress, err);
+    if (!st)
+        st = dist_meta(&bk->head.meta, s, 0, pl.band_vox, err);
+    if (st) {
+        st_grid_blocks_free(bk);
+        return st;
+    }
+    *out = bk;
     return ST_OK;
 }
 

@@ -32,6 +32,27 @@ st_status st_grid_write(const st_grid *g, const char *path, st_error *err)
                         "unknown field format (use .vdb or .vti)");
 }
 
+st_status st_grid_blocks_write(const st_grid_blocks *b, const char *path,
+                               st_error *err)
+{
+    if (st_path_is_stdio(path))
+        return st_grid_blocks_write_vdb(b, NULL, err);
+    switch (st_grid_format_from_path(path)) {
+    case ST_GRID_FMT_VDB: return st_grid_blocks_write_vdb(b, path, err);
+    case ST_GRID_FMT_VTI: {
+        st_grid *g;
+        st_status s = st_grid_blocks_dense(&g, b, 0, err);
+        if (!s)
+            s = st_grid_write_vti(g, path, err);
+        st_grid_free(g);
+        return s;
+    }
+    default: break;
+    }
+    return st_error_set(err, ST_EINPUT, path, 0,
+                        "unknown field format (use .vdb or .vti)");
+}
+
 /* OpenVDB files and streams begin with the 64-bit magic number 0x56444220
  * ("VDB " read as a little-endian integer), the high half zero. */
 static int looks_like_vdb(const unsigned char *p, size_t n)

@@ -143,6 +143,43 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
     return TOOL_CONTINUE;
 }
 
+/* A banded field goes to a .vdb or a stream stored by blocks: no dense
+ * grid is allocated, and the file is the same. */
+static int use_blocks(const soupdist_settings *s)
+{
+    return isfinite(s->dist.band) &&
+           (st_path_is_stdio(s->co.out) ||
+            st_grid_format_from_path(s->co.out) == ST_GRID_FMT_VDB);
+}
+
+/* The field, dense (*g) or stored by blocks (*b, then (*b)->head is its
+ * grid head); a failure's message names the input and the fix. */
+static int compute(tool_ctx *t, const soupdist_settings *s,
+                   const st_soup *soup, st_grid **g, st_grid_blocks **b)
+{
+    st_error err;
+    st_error_clear(&err);
+    st_progress prog = tool_progress(t);
+    st_status st = use_blocks(s) ? st_dist_field_blocks(b, soup, &s->dist, &prog, &err)
+                                 : st_dist_field(g, soup, &s->dist, &prog, &err);
+    if (!st) {
+        tool_progress_end(t);
+        return TOOL_EXIT_OK;
+    }
+    if (!err.file[0])
+        snprintf(err.file, sizeof err.file, "%s", s->in);
+    size_t fit = err.status == ST_ELIMIT ? tool_dist_cells_that_fit(soup, &s->dist) : 0;
+    char hint[160];
+    if (fit)
+        snprintf(hint, sizeof hint, "use -r %zu or less, a larger -s, or raise "
+                 "--max-memory", fit);
+    else
+        snprintf(hint, sizeof hint, "use a smaller -r or a larger -s, or raise "
+                 "--max-memory");
+    tool_limit_hint(&err, hint);
+    return tool_fail(t, &err);
+}
+
 static int run(tool_ctx *t, void *settings)
 {
     const soupdist_settings *s = settings;
@@ -151,7 +188,8 @@ static int run(tool_ctx *t, void *settings)
     st_error err;
     st_error_clear(&err);
     st_soup *soup = NULL;
-    st_grid *g = NULL;
+    st_grid *dense = NULL;
+    st_grid_blocks *blocks = NULL;
     int rc = TOOL_EXIT_FAIL;
     double t_read = tool_now();
     st_soup_source src;
@@ -160,23 +198,11 @@ static int run(tool_ctx *t, void *settings)
         goto done;
     }
     double t_dist = tool_now();
-    st_progress prog = tool_progress(t);
-    if (st_dist_field(&g, soup, &s->dist, &prog, &err)) {
-        if (!err.file[0])
-            snprintf(err.file, sizeof err.file, "%s", in);
-        size_t fit = err.status == ST_ELIMIT ? tool_dist_cells_that_fit(soup, &s->dist) : 0;
-        char hint[160];
-        if (fit)
-            snprintf(hint, sizeof hint, "use -r %zu or less, a larger -s, or raise "
-                     "--max-memory", fit);
-        else
-            snprintf(hint, sizeof hint, "use a smaller -r or a larger -s, or raise "
-                     "--max-memory");
-        tool_limit_hint(&err, hint);
-        rc = tool_fail(t, &err);
+    rc = compute(t, s, soup, &dense, &blocks);
+    if (rc != TOOL_EXIT_OK)
         goto done;
-    }
-    tool_progress_end(t);
+    rc = TOOL_EXIT_FAIL;
+    st_grid *g = blocks ? &blocks->head : dense;
     double t_write = tool_now();
     if (st_meta_set(&g->meta, "source", tool_in_name(in)) ||
         record_source(g, in, &src) ||
@@ -184,7 +210,8 @@ static int run(tool_ctx *t, void *settings)
         rc = tool_fail_nomem(t, &err);
         goto done;
     }
-    if (st_grid_write(g, s->co.out, &err)) {
+    if (blocks ? st_grid_blocks_write(blocks, s->co.out, &err)
+               : st_grid_write(g, s->co.out, &err)) {
         rc = tool_fail(t, &err);
         goto done;
     }
@@ -201,7 +228,8 @@ static int run(tool_ctx *t, void *settings)
              t_dist - t_read, t_write - t_dist, t_end - t_write);
     rc = TOOL_EXIT_OK;
 done:
-    st_grid_free(g);
+    st_grid_free(dense);
+    st_grid_blocks_free(blocks);
     st_soup_free(soup);
     return rc;
 }
