@@ -135,14 +135,18 @@ typedef struct st_symmetry_fill_stats {
  * nearer that cap than s, or, for an open rim, with the rim s's nearest
  * part to within tol; and the map puts the hole's rim back on s (at least
  * 0.8 of its length within 3 tol, and within tol on average: the map's
- * error there). A hole's fill is kept when it closes the hole: at least
- * 3/4 of the rim's length within 3 tol of the fill, and the fill's own
- * boundary farther than 3 tol from s and from the other maps' fill at
- * most 1/4 of the rim's length; and, for a cap, when the fill departs
- * from the cap (some corner or centroid farther than tol plus the map's
- * error): else the cap stays, without fill. *kept_caps gets the caps
- * minus the pieces the fill closes. Mirror images are re-oriented so the fill keeps s's
- * orientation. Deterministic for any thread count. bvh: st_bvh_build(s).
+ * error there). Maps run in two rounds, those that verify the most rim
+ * first in each: where the first round's fill does not close a hole too
+ * large to cap, the second adds the maps that verify 0.8 of what s can
+ * check of the rim (a preimage whose nearest point of s is on s's
+ * boundary lies in a hole, unchecked) and 0.4 of the whole rim. A hole's
+ * fill is kept when it closes the hole: at least 3/4 of the rim's length
+ * within 3 tol of the fill, and the fill's own boundary farther than 3
+ * tol from s and from the other maps' fill at most 1/4 of the rim's
+ * length; and, for a cap, when the fill departs from the cap (some corner
+ * or centroid farther than tol plus the map's error): else the cap stays,
+ * without fill. *kept_caps gets the caps minus the pieces the fill closes. Mirror
+ * images are re-oriented so the fill keeps s's orientation. Deterministic for any thread count. bvh: st_bvh_build(s).
  * Both outputs are the caller's (st_soup_free); empty soups when set has
  * nothing. ST_EINPUT for a tol that is not positive and finite;
  * ST_ENOMEM. */
