@@ -272,6 +272,70 @@ static void test_bvh_nearest(void)
     st_soup_free(s);
 }
 
+/* The leaf triangles' box test and st_bvh_within change no answer: over
+ * points on, near and off a soup with slivers and degenerate triangles,
+ * and bounds from none to everything, st_bvh_nearest gives bit for bit
+ * the least st_point_triangle_dist2 of all triangles below the bound (its
+ * closest point that triangle's), and st_bvh_within says whether there is
+ * one. */
+static void test_bvh_nearest_exact(void)
+{
+    st_soup *s = random_soup(400);
+    for (int k = 0; k < 40; k++) {   /* slivers: a long edge, a tiny height */
+        double c[3] = {urand(), urand(), urand()}, h = k % 2 ? 1e-7 : 1e-3;
+        st_soup_add_vertex(s, c[0], c[1], c[2], NULL);
+        st_soup_add_vertex(s, c[0] + 0.3, c[1] + 0.2 * urand(), c[2], NULL);
+        st_soup_add_vertex(s, c[0] + 0.15, c[1] + 0.1 * urand(), c[2] + h, NULL);
+        uint32_t v = (uint32_t)(s->nverts - 3);
+        st_soup_add_triangle(s, v, v + 1, v + 2, NULL);
+    }
+    st_bvh *b;
+    st_error err;
+    TAP_CHECK(st_bvh_build(&b, s, &err) == ST_OK, "bvh build (slivers)");
+    static const double bounds[] = {INFINITY, 1e-2, 1e-4, 1e-8, 1e-14, 0.0};
+    size_t bad = 0, bad_within = 0, found = 0, queries = 0;
+    for (int i = 0; i < 3000; i++) {
+        double p[3];
+        const uint32_t *v = s->tris + 3 * ((size_t)i % s->ntris);
+        double r1 = urand(), r2 = urand() * (1.0 - r1), off = i % 3 == 0 ? 0.0 : 1e-3 * urand();
+        for (int a = 0; a < 3; a++) {   /* on a triangle, a little off it, or anywhere */
+            const double *x = s->xyz + 3 * (size_t)v[0], *y = s->xyz + 3 * (size_t)v[1],
+                         *z = s->xyz + 3 * (size_t)v[2];
+            p[a] = i % 5 == 4 ? urand() * 1.6 - 0.3
+                              : x[a] + r1 * (y[a] - x[a]) + r2 * (z[a] - x[a]) + off;
+        }
+        for (size_t j = 0; j < sizeof bounds / sizeof *bounds; j++, queries++) {
+            double want = bounds[j], wq[3] = {0, 0, 0}, q[3] = {0, 0, 0};
+            int64_t wt = -1, tri;
+            for (size_t t = 0; t < s->ntris; t++) {
+                const uint32_t *u = s->tris + 3 * t;
+                double c[3];
+                double d2 = st_point_triangle_dist2(p, s->xyz + 3 * (size_t)u[0],
+                                                    s->xyz + 3 * (size_t)u[1],
+                                                    s->xyz + 3 * (size_t)u[2], c);
+                if (d2 < want) {
+                    want = d2;
+                    wt = (int64_t)t;
+                    memcpy(wq, c, sizeof c);
+                }
+            }
+            double got = st_bvh_nearest(b, p, bounds[j], &tri, q);
+            if (memcmp(&got, &want, sizeof got) != 0 || (tri < 0) != (wt < 0) ||
+                (wt >= 0 && memcmp(q, wq, sizeof q) != 0))
+                bad++;
+            bad_within += st_bvh_within(b, p, bounds[j]) != (tri >= 0);
+            found += tri >= 0;
+        }
+    }
+    TAP_CHECK(bad == 0, "bvh nearest: bit for bit the brute force least distance (%zu of %zu "
+              "differ)", bad, queries);
+    TAP_CHECK(bad_within == 0 && found > queries / 3 && found < queries,
+              "bvh within: whether nearest finds a triangle (%zu of %zu differ; %zu found)",
+              bad_within, queries, found);
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
 /* A BVH over enough triangles to be built by parallel tasks has the
  * serial build's layout: inner nodes numbered depth first, the right
  * child's subtree before the left's, leaves of at most ST_BVH_LEAF slots
@@ -583,8 +647,8 @@ int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(layout), TAP_TEST(band_exact_on_random_soup),
                                      TAP_TEST(large_oblique_triangle), TAP_TEST(bvh_nearest),
-                                     TAP_TEST(bvh_parallel_layout), TAP_TEST(threads_identical),
-                                     TAP_TEST(fine_soup_exact), TAP_TEST(real_model),
-                                     TAP_TEST(blocks_equal_dense), {0}};
+                                     TAP_TEST(bvh_nearest_exact), TAP_TEST(bvh_parallel_layout),
+                                     TAP_TEST(threads_identical), TAP_TEST(fine_soup_exact),
+                                     TAP_TEST(real_model), TAP_TEST(blocks_equal_dense), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -53,6 +53,11 @@ void st_bvh_free(st_bvh *b);   /* safe on NULL */
 double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
                       int64_t *tri, double closest[3]);
 
+/* Whether some triangle is closer to p than sqrt(max_d2): exactly when
+ * st_bvh_nearest(b, p, max_d2, ...) sets *tri >= 0, found at the first
+ * such triangle (much faster where the soup is dense). Thread-safe. */
+int st_bvh_within(const st_bvh *b, const double p[3], double max_d2);
+
 /* Call visit(ctx, tri) for every triangle whose bounding box meets the
  * closed box [lo, hi] (a superset of the triangles that meet the box: the
  * caller decides exactly). Stops at the first nonzero return of visit and

@@ -328,36 +328,92 @@ void st_bvh_free(st_bvh *b)
     free(b);
 }
 
-static double box_dist2(const st_bvh_node *n, const double p[3])
+/* The squared distance from p to the box [lo, hi]: per axis the larger of
+ * lo - p, p - hi and 0 (at most one is positive, so the sum is exact and
+ * the same as choosing the positive one), without branches. */
+static double lohi_dist2(const double lo[3], const double hi[3], const double p[3])
 {
     double d2 = 0.0;
     for (int a = 0; a < 3; a++) {
-        double d = 0.0;
-        if (p[a] < n->lo[a])
-            d = n->lo[a] - p[a];
-        else if (p[a] > n->hi[a])
-            d = p[a] - n->hi[a];
+        const double below = lo[a] - p[a], above = p[a] - hi[a];
+        const double d = (below > 0.0 ? below : 0.0) + (above > 0.0 ? above : 0.0);
         d2 += d * d;
     }
     return d2;
 }
 
-double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
-                      int64_t *tri, double closest[3])
+static double box_dist2(const st_bvh_node *n, const double p[3])
+{
+    return lohi_dist2(n->lo, n->hi, p);
+}
+
+/* A leaf's triangle is skipped when its own box lies so far beyond the
+ * best distance so far that st_point_triangle_dist2 cannot return less,
+ * rounding included, so the answer is the one without the test. What the
+ * computed distance can fall short of the true one (which is at least the
+ * box's): the closest point on an edge is off the segment by a few
+ * rounding units of the coordinates (at most the soup's magnitude m); an
+ * interior one (the plane's distance, along the computed unit normal of a
+ * triangle whose area is above ST_DEGENERATE_AREA_RATIO of its longest
+ * edge squared, so the normal is off by under 2e-7 radians) by under 4e-7
+ * of the distance plus 2e-6 of the triangle's box side. TRI_SKIP_REL and
+ * TRI_SKIP_SIDE are those bounds times 250 and 50; TRI_SKIP_ABS, 2^7
+ * rounding units. The test costs a box distance and spares the triangle's
+ * three square roots. */
+#define TRI_SKIP_REL 1e-4
+#define TRI_SKIP_SIDE 1e-4
+#define TRI_SKIP_ABS 3e-14
+static int tri_beyond(const double *tb, const double p[3], double reach, double m)
+{
+    double side = tb[3] - tb[0];
+    side = tb[4] - tb[1] > side ? tb[4] - tb[1] : side;
+    side = tb[5] - tb[2] > side ? tb[5] - tb[2] : side;
+    const double lim = (reach + TRI_SKIP_SIDE * side + TRI_SKIP_ABS * m) * (1.0 + TRI_SKIP_REL);
+    return lohi_dist2(tb, tb + 3, p) > lim * lim;
+}
+
+/* The largest coordinate magnitude of the soup (its root box's). */
+static double magnitude(const st_bvh *b)
+{
+    double m = 0.0;
+    for (int a = 0; a < 3; a++) {
+        m = fabs(b->nodes[0].lo[a]) > m ? fabs(b->nodes[0].lo[a]) : m;
+        m = fabs(b->nodes[0].hi[a]) > m ? fabs(b->nodes[0].hi[a]) : m;
+    }
+    return m;
+}
+
+/* The walk of st_bvh_nearest and st_bvh_within: depth first, the nearer
+ * child first, each node on the stack with its box distance (computed
+ * once: a node is skipped when that is no longer below the best). With
+ * `any`, it stops at the first triangle closer than sqrt(max_d2): the
+ * walk to it is the nearest search's while best is still max_d2, so it
+ * finds a triangle exactly when that search does. */
+static double nearest_walk(const st_bvh *b, const double p[3], double max_d2, int any,
+                           int64_t *tri, double closest[3])
 {
     const st_soup *s = b->soup;
     double best = max_d2;
     int64_t best_tri = -1;
     uint32_t stack[STACK_DEPTH];
+    double sd2[STACK_DEPTH];
     int sp = 0;
-    if (box_dist2(&b->nodes[0], p) < best)
+    const double d0 = box_dist2(&b->nodes[0], p);
+    if (d0 < best) {
+        sd2[sp] = d0;
         stack[sp++] = 0;
+    }
+    const double m = magnitude(b);
+    double reach = sqrt(best);   /* of best, for tri_beyond */
     while (sp > 0) {
-        const st_bvh_node *n = &b->nodes[stack[--sp]];
-        if (box_dist2(n, p) >= best)
+        sp--;
+        if (sd2[sp] >= best)
             continue;           /* best shrank since this was pushed */
+        const st_bvh_node *n = &b->nodes[stack[sp]];
         if (n->count) {
             for (uint32_t i = 0; i < n->count; i++) {
+                if (tri_beyond(b->tbox + 6 * (size_t)(n->start + i), p, reach, m))
+                    continue;
                 uint32_t t = b->order[n->start + i];
                 const uint32_t *v = s->tris + 3 * (size_t)t;
                 double q[3];
@@ -366,9 +422,14 @@ double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
                     s->xyz + 3 * (size_t)v[2], q);
                 if (d2 < best) {
                     best = d2;
+                    reach = sqrt(best);
                     best_tri = t;
                     if (closest)
                         memcpy(closest, q, sizeof q);
+                    if (any) {
+                        *tri = best_tri;
+                        return best;
+                    }
                 }
             }
             continue;
@@ -380,13 +441,30 @@ double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
             uint32_t t = l; l = r; r = t;
             double d = dl; dl = dr; dr = d;
         }
-        if (dr < best)
+        if (dr < best) {
+            sd2[sp] = dr;
             stack[sp++] = r;
-        if (dl < best)
+        }
+        if (dl < best) {
+            sd2[sp] = dl;
             stack[sp++] = l;
+        }
     }
     *tri = best_tri;
     return best;
+}
+
+double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
+                      int64_t *tri, double closest[3])
+{
+    return nearest_walk(b, p, max_d2, 0, tri, closest);
+}
+
+int st_bvh_within(const st_bvh *b, const double p[3], double max_d2)
+{
+    int64_t tri;
+    (void)nearest_walk(b, p, max_d2, 1, &tri, NULL);
+    return tri >= 0;
 }
 
 static int boxes_meet(const double alo[3], const double ahi[3],

@@ -330,32 +330,63 @@ typedef struct tally {
  * than MIN_INFORM of the samples informative: 0. */
 #define INFORM_SIN 0.25881904510252074 /* sin 15 degrees */
 #define MIN_INFORM 0.1
-static tally measure(const ctx *C, const st_symmetry *y, double angle,
-                     size_t stride, int full)
+/* measure_need's blocks, in strided samples */
+#define MEASURE_BLOCK 32
+/* With need > 0, the samples go in blocks of MEASURE_BLOCK, and after
+ * each the count stops once even the rest all landing (each informative
+ * and verified) would leave the share below need (times 1 - 1e-9, so no
+ * rounding of the share can reach it): the tally is then one whose share
+ * is 0. Callers compare the share with thresholds of at least need, so
+ * they decide as on the whole count. The counts at the block ends are
+ * sums, the same for any thread count. */
+static tally measure_need(const ctx *C, const st_symmetry *y, double angle,
+                          size_t stride, int full, double need)
 {
     const samples *S = C->S;
+    const size_t total = (S->n + stride - 1) / stride;
+    const size_t block = need > 0.0 ? MEASURE_BLOCK : (total ? total : 1);
     long hits = 0, n = 0, all = 0, contra = 0;
-#pragma omp parallel for schedule(static) reduction(+ : hits, n, all, contra)
-    for (size_t k = 0; k < S->n; k += stride) {
-        double q[3], nq[3], c[3], d[3];
-        all++;
-        st_symmetry_apply(y, angle, S->p + 3 * k, 1, q);
-        st_sub3(d, q, S->p + 3 * k);
-        double l = st_norm3(d);
-        if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
-            continue;
-        st_symmetry_apply(y, angle, S->nrm + 3 * k, 0, nq);
-        int64_t t;
-        int hit = lands_tri(C, q, nq, C->tol, c, &t);
-        hits += hit;
-        if (full && !hit) {
-            st_bvh_nearest(C->bvh, q, INFINITY, &t, c);
-            contra += t >= 0 && !on_rim(C, t, c);
+    for (size_t j0 = 0; j0 < total; j0 += block) {
+        const size_t j1 = total - j0 > block ? j0 + block : total;
+        long h = 0, m = 0, a = 0, c = 0;
+#pragma omp parallel for schedule(static) reduction(+ : h, m, a, c)
+        for (size_t j = j0; j < j1; j++) {
+            const size_t k = j * stride;
+            double q[3], nq[3], cl[3], d[3];
+            a++;
+            st_symmetry_apply(y, angle, S->p + 3 * k, 1, q);
+            st_sub3(d, q, S->p + 3 * k);
+            double l = st_norm3(d);
+            if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
+                continue;
+            st_symmetry_apply(y, angle, S->nrm + 3 * k, 0, nq);
+            int64_t t;
+            int hit = lands_tri(C, q, nq, C->tol, cl, &t);
+            h += hit;
+            if (full && !hit) {
+                st_bvh_nearest(C->bvh, q, INFINITY, &t, cl);
+                c += t >= 0 && !on_rim(C, t, cl);
+            }
+            m++;
         }
-        n++;
+        hits += h;
+        n += m;
+        all += a;
+        contra += c;
+        const double rest = (double)(total - j1);
+        if ((double)hits + rest < need * (1.0 - 1e-9) * ((double)n + rest)) {
+            tally none = {(long)total, 0, 0, 0};
+            return none;
+        }
     }
     tally r = {all, n, hits, full ? contra : 0};
     return r;
+}
+
+static tally measure(const ctx *C, const st_symmetry *y, double angle,
+                     size_t stride, int full)
+{
+    return measure_need(C, y, angle, stride, full, 0.0);
 }
 
 static double share(const tally *t)
@@ -373,16 +404,14 @@ static double contradiction(const tally *t)
     return seen ? (double)t->contradicted / (double)seen : 1.0;
 }
 
-static double support_stride(const ctx *C, const st_symmetry *y,
-                             double angle, size_t stride)
+/* The share of every stride-th sample's images verified (measure), where
+ * only whether it reaches need matters (measure_need): below need it may
+ * be 0 instead. */
+static double support_need(const ctx *C, const st_symmetry *y, double angle,
+                           size_t stride, double need)
 {
-    tally t = measure(C, y, angle, stride, 0);
+    tally t = measure_need(C, y, angle, stride, 0, need);
     return share(&t);
-}
-
-static double support(const ctx *C, const st_symmetry *y, double angle)
-{
-    return support_stride(C, y, angle, 1);
 }
 
 /* Accepted: a clear majority of the informative samples verified, or
@@ -621,11 +650,11 @@ static int axis_order(const ctx *C, const st_symmetry *y, int max_order,
 {
     double least = 1.0;
     for (int i = 0; i < 3 && least >= min_support; i++)
-        least = fmin(least, support_stride(C, y, 2.0 * PI * odd[i], SCREEN));
+        least = fmin(least, support_need(C, y, 2.0 * PI * odd[i], SCREEN, min_support));
     if (least >= min_support) {
         least = 1.0;
         for (int i = 0; i < 3 && least >= min_support; i++)
-            least = fmin(least, support(C, y, 2.0 * PI * odd[i]));
+            least = fmin(least, support_need(C, y, 2.0 * PI * odd[i], 1, min_support));
         if (least >= min_support) {
             *sup = least;
             return 0;
@@ -635,18 +664,19 @@ static int axis_order(const ctx *C, const st_symmetry *y, int max_order,
         /* every turn up to the half: a small turn alone passes on any
          * axis that a surface nearly slides along */
         /* the first turn on every 4 SCREEN-th sample, far below: no */
-        if (support_stride(C, y, 2.0 * PI / (double)n, 4 * SCREEN) <
-            SCREEN_SHARE * min_support)
+        if (support_need(C, y, 2.0 * PI / (double)n, 4 * SCREEN,
+                         SCREEN_SHARE * min_support) < SCREEN_SHARE * min_support)
             continue;
         int k = 1;
         while (k <= n / 2 &&
-               support_stride(C, y, 2.0 * PI * k / (double)n, SCREEN) >=
+               support_need(C, y, 2.0 * PI * k / (double)n, SCREEN, min_support) >=
                    min_support)
             k++;
         if (k <= n / 2)
             continue;
         double a1 = 2.0 * PI / (double)n, a2 = a1 * (double)(n / 2);
-        double s = fmin(support(C, y, a1), support(C, y, a2));
+        double s = fmin(support_need(C, y, a1, 1, min_support),
+                        support_need(C, y, a2, 1, min_support));
         if (s >= min_support) {
             *sup = s;
             return n;
@@ -894,7 +924,8 @@ static double scan_pitch(const ctx *C, st_symmetry *y, double p0)
     for (int i = 0; i < n; i++) {
         y->pitch = 0.5 * p0 + copysign(step * i, p0);
         sup[i] = fabs(y->pitch) >= 2.0 * C->tol
-                     ? support_stride(C, y, 2.0 * PI * odd[0], 4 * SCREEN)
+                     ? support_need(C, y, 2.0 * PI * odd[0], 4 * SCREEN,
+                                    SCREEN_SHARE * MIN_VERIFIED)
                      : 0.0;
         if (sup[i] > sup[best])
             best = i;
@@ -979,7 +1010,8 @@ static int find_helix(const ctx *C, st_symmetry *y, double min_support, int *mea
     double turn[3];
     for (int i = 0; i < 3; i++) {
         turn[i] = 2.0 * PI * (odd[i] > 0.5 ? odd[i] - 1.0 : odd[i]);
-        if (support_stride(C, y, turn[i], SCREEN) < SCREEN_SHARE * MIN_VERIFIED)
+        if (support_need(C, y, turn[i], SCREEN, SCREEN_SHARE * MIN_VERIFIED) <
+            SCREEN_SHARE * MIN_VERIFIED)
             return 0;
     }
     double least = 1.0;
@@ -996,7 +1028,7 @@ static int find_helix(const ctx *C, st_symmetry *y, double min_support, int *mea
     turned.pitch = 0.0;
     double plain = 1.0;
     for (int i = 0; i < 3 && plain + HELIX_MARGIN > least; i++)
-        plain = fmin(plain, support(C, &turned, turn[i]));
+        plain = fmin(plain, support_need(C, &turned, turn[i], 1, 0.0));
     if (plain + HELIX_MARGIN > least)
         return 0;
     y->support = least;
@@ -1161,9 +1193,12 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
         refine_mirror(&C, cand + i);
         /* a plane that fails on every SCREEN-th sample by far is not
          * measured on all: only accepted planes' supports are read */
-        tally t = measure(&C, cand + i, 0.0, SCREEN, 0);
+        /* (below the needs, measure_need may stop early: a share that
+         * low is refused either way, and only accepted ones are read) */
+        tally t = measure_need(&C, cand + i, 0.0, SCREEN, 0,
+                               fmin(SCREEN_SHARE * MIN_VERIFIED, p->min_support));
         if (share(&t) >= SCREEN_SHARE * MIN_VERIFIED)
-            t = measure(&C, cand + i, 0.0, 1, 0);
+            t = measure_need(&C, cand + i, 0.0, 1, 0, fmin(MIN_VERIFIED, p->min_support));
         /* the contradictions matter only between the two shares */
         if (share(&t) >= MIN_VERIFIED && share(&t) < p->min_support)
             t = measure(&C, cand + i, 0.0, 1, 1);

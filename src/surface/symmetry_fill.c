@@ -279,15 +279,9 @@ static size_t keeps(const fill_ctx *C, const double q[3][3])
         return SIZE_MAX;
     const double tol2 = C->tol * C->tol, near = sqrt(d2) - C->tol;
     const double bound = i < C->P->ncap ? fmax(tol2, d2) : near > C->tol ? near * near : tol2;
-    st_bvh_nearest(C->bvh, c, bound, &tri, NULL);
-    if (tri >= 0)
+    if (st_bvh_within(C->bvh, c, bound))
         return SIZE_MAX;
-    if (C->fill_bvh) {
-        st_bvh_nearest(C->fill_bvh, c, tol2, &tri, NULL);
-        if (tri >= 0)
-            return SIZE_MAX;
-    }
-    return i;
+    return C->fill_bvh && st_bvh_within(C->fill_bvh, c, tol2) ? SIZE_MAX : i;
 }
 
 /* ---- the rims ------------------------------------------------------------------ */
@@ -577,10 +571,7 @@ static int near_bvh(const void *ctx, const double x[3])
         st_symmetry_apply(N->inverse->y, N->inverse->angle, x, 1, q);
     else
         memcpy(q, x, sizeof q);
-    int64_t tri = -1;
-    if (N->bvh)
-        st_bvh_nearest(N->bvh, q, N->reach2, &tri, NULL);
-    return tri >= 0;
+    return N->bvh && st_bvh_within(N->bvh, q, N->reach2);
 }
 
 /* err[i]: the map's error at piece i: the length-weighted mean distance
