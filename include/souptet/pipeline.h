@@ -35,9 +35,11 @@
  *   2. the fit's stopping condition met (every boundary vertex within
  *      offset_ratio * h of the soup, or of the fill with fill_counts)
  *      before not met;
- *   3. larger minimum dihedral angle;
- *   4. smaller maximum dihedral angle;
- *   5. smaller k.
+ *   3. the angle goals met (min dihedral >= 35, max <= 133, as above)
+ *      before not met;
+ *   4. larger minimum dihedral angle;
+ *   5. smaller maximum dihedral angle;
+ *   6. smaller k.
  * Every stage is deterministic for any thread count, so the output depends
  * only on the soup and the parameters.
  *

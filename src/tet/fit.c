@@ -11,9 +11,10 @@
  *                 a boundary vertex beyond d_offset also toward the band's
  *                 middle (FIT_GOAL_FRACTION); a refused move is halved
  *                 FIT_HALVINGS times, then skipped; they stop when every
- *                 boundary vertex is within d_offset, nothing moves,
- *                 FIT_STALL_ITERS bring none new into the band, or at
- *                 max_iters;
+ *                 boundary vertex is within d_offset (or a rescue pass
+ *                 tried early, early_rescue, brings them there), nothing
+ *                 moves, FIT_STALL_ITERS bring none new into the band, or
+ *                 at max_iters;
  *   rescue_pass   the vertices still beyond, held by S near their star,
  *                 try other directions that still bring them closer
  *                 (rescue_vertex), or, for the last few, a neighbour's
@@ -50,6 +51,18 @@
  * fit gives up on the rest: past this the remaining ones are held by the
  * invariant (thin gaps), and more ODT steps only wear the angles down. */
 #define FIT_STALL_ITERS 10
+/* The early rescue: after FIT_EARLY_RESCUE iterations without a new
+ * boundary vertex in the band, or when an iteration leaves at most
+ * FIT_EARLY_FEW beyond it, the fit tries the rescue pass: when it brings
+ * every boundary vertex into the band, the fit stops there (the stall's
+ * ODT steps only wear the angles down to the sliver floor); otherwise its
+ * moves are undone and the iterations go on exactly as before. After
+ * FIT_EARLY_TRIALS such failures no more are tried: where the count
+ * within oscillates (armadillo at 7 cells), each costs a rescue pass over
+ * some 20 vertices and brings nothing. */
+#define FIT_EARLY_RESCUE 1
+#define FIT_EARLY_FEW 4
+#define FIT_EARLY_TRIALS 2
 /* A fit move may not bring the score of its star (smooth.h) below this
  * many degrees, or below what it already was if lower: next to vertices
  * the invariant holds back, unconstrained ODT steps flatten tets to 0
@@ -85,6 +98,7 @@ typedef struct fit_run {
     dirty dy;             /* the fit moves' dirty set */
     double *dist;         /* per vertex: its distance to S (boundary) */
     dist_summary ds;      /* of dist, as it stands */
+    double *save;         /* the early rescue's undo: positions, then dist */
     double t0;            /* when st_fit began (sm_now) */
 } fit_run;
 
@@ -610,6 +624,7 @@ static st_status fit_open(fit_run *r, st_tetmesh *m, const st_soup *s, const st_
 
 static void fit_close(fit_run *r)
 {
+    free(r->save);
     free(r->dist);
     sm_dirty_free(&r->dy);
     sm_fit_ctx_close(&r->c);
@@ -645,14 +660,40 @@ static void fit_colour(fit_run *r, size_t col, fit_counts *n)
     n->skipped += skipped;
 }
 
-/* The paper's iterations until every boundary vertex is within d_offset,
- * an iteration moves nothing, FIT_STALL_ITERS bring no new vertex into
- * the band, or max_iters; then a rescue pass. */
+/* The rescue pass tried in the middle of the fit (FIT_EARLY_RESCUE):
+ * 1 when it brought every boundary vertex within d_offset, and the fit
+ * stops; 0 when it did not, and the positions and distances are as they
+ * were (so the fit goes on exactly as without the trial: the dirty set
+ * still holds), or when there is no memory for the undo. */
+static int early_rescue(fit_run *r)
+{
+    fit_ctx *c = &r->c;
+    const size_t np = c->sm.m->npoints;
+    if (!r->save && !(r->save = st_malloc_array(np, 4 * sizeof *r->save)))
+        return 0;   /* no undo, no trial: the fit goes on as it would */
+    memcpy(r->save, c->sm.m->xyz, 3 * np * sizeof *r->save);
+    memcpy(r->save + 3 * np, r->dist, np * sizeof *r->save);
+    if (rescue_pass(c, r->dist, 0) > 0) {
+        dist_summary ds = sm_boundary_distances(c, r->dist);
+        if (ds.within == c->sm.nbv) {
+            r->ds = ds;
+            return 1;
+        }
+    }
+    memcpy(c->sm.m->xyz, r->save, 3 * np * sizeof *r->save);
+    memcpy(r->dist, r->save + 3 * np, np * sizeof *r->save);
+    return 0;
+}
+
+/* The paper's iterations until every boundary vertex is within d_offset
+ * (or an early rescue pass brings them there), an iteration moves
+ * nothing, FIT_STALL_ITERS bring no new vertex into the band, or
+ * max_iters; then a rescue pass. */
 static st_status fit_iterate(fit_run *r, st_error *err)
 {
     fit_ctx *c = &r->c;
     size_t best_within = r->ds.within;
-    int since_best = 0;
+    int since_best = 0, failed_trials = 0;
     for (int it = 0; it < r->p.max_iters && r->ds.within < c->sm.nbv; it++) {
         if (st_progress_cancelled(c->prog))
             return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
@@ -674,6 +715,13 @@ static st_status fit_iterate(fit_run *r, st_error *err)
             since_best = 0;
         } else if (++since_best >= FIT_STALL_ITERS) {
             break;   /* the rest are held back: thin gaps or blocked moves */
+        }
+        if (failed_trials < FIT_EARLY_TRIALS &&
+            (since_best == FIT_EARLY_RESCUE ||
+             (since_best == 0 && c->sm.nbv - r->ds.within <= FIT_EARLY_FEW))) {
+            if (early_rescue(r))
+                break;   /* every boundary vertex within: no stall to wait out */
+            failed_trials++;
         }
     }
     if (r->ds.within < c->sm.nbv) {

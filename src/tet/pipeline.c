@@ -436,6 +436,17 @@ static st_status run_density_candidate(st_tetmesh **out,
     return ST_OK;
 }
 
+/* 1 when every tet of candidate c scores at least the quality pass's goal
+ * (smooth.h: min dihedral >= 35 degrees by default) with its max dihedral
+ * bound (180 - 35 / 0.75 = 133.3) rounded down to a whole degree, 133,
+ * the bound the project holds its meshes to. */
+static int angles_met(const st_pipeline_candidate *c)
+{
+    const double goal = st_fit_params_default().quality_goal;
+    return c->min_dihedral >= goal &&
+           c->max_dihedral <= 180.0 - ceil(goal / ST_FIT_MAX_WEIGHT);
+}
+
 /* 1 when candidate a is better than candidate b (see pipeline.h). */
 static int better(const st_pipeline_candidate *a, size_t ka,
                   const st_pipeline_candidate *b, size_t kb)
@@ -446,9 +457,13 @@ static int better(const st_pipeline_candidate *a, size_t ka,
     int eb = b->verts_outside == 0 && b->tris_crossing == 0;
     if (ea != eb)
         return ea;
-    /* then the stopping condition (the fit's promise), then angles */
+    /* then the stopping condition (the fit's promise), then the angle
+     * goals met (35.05..133.3 does not beat 35.03..131.5), then angles */
     if (a->converged != b->converged)
         return a->converged;
+    int ga = angles_met(a), gb = angles_met(b);
+    if (ga != gb)
+        return ga;
     if (a->min_dihedral != b->min_dihedral)
         return a->min_dihedral > b->min_dihedral;
     if (a->max_dihedral != b->max_dihedral)
@@ -457,20 +472,15 @@ static int better(const st_pipeline_candidate *a, size_t ka,
 }
 
 /* 1 when candidate c meets every goal: it encloses, meets the fit's
- * stopping condition, and every tet scores at least the quality pass's
- * goal (smooth.h: min dihedral >= 35 degrees by default) with its max
- * dihedral bound (180 - 35 / 0.75 = 133.3) rounded down to a whole degree,
- * 133, the bound the project holds its meshes to. A better one could only
- * have larger angles within these. */
+ * stopping condition, and its angles meet the goals (angles_met). A
+ * better one could only have larger angles within these. */
 static int meets_goals(const st_pipeline_candidate *c, const st_pipeline_params *p)
 {
-    const double goal = st_fit_params_default().quality_goal;
     if (c->failed || c->verts_outside || c->tris_crossing || !c->converged)
         return 0;
     if (p->density_rho > 0)
         return 0;   /* the Spillmann mesher has no such goal */
-    return c->min_dihedral >= goal &&
-           c->max_dihedral <= 180.0 - ceil(goal / ST_FIT_MAX_WEIGHT);
+    return angles_met(c);
 }
 
 /* Candidate k, start to end, its event included. */
