@@ -253,9 +253,11 @@ if (ulimit -v $VLIM && soupdist -q -r 16 -o v.vdb "$BUNNY") 2>/dev/null; then
     # 710x695x545 floats: 1026 MiB
     expect_fail "capped: soupdist -r 700 --max-memory 1000M: refused by the limit" 1 \
         "over the limit of 1000.0 MiB" capped soupdist -r 700 --max-memory 1000M -o x.vdb "$BUNNY"
-    expect_fail "capped: soupdist -r 700 --max-memory 2G: the allocation fails, naming ulimit -v" 1 \
+    # --band full: the dense grid (a finite band into .vdb is built by
+    # blocks and fits under the cap)
+    expect_fail "capped: soupdist -r 700 --band full --max-memory 2G: the allocation fails, naming ulimit -v" 1 \
         "out of memory.*ulimit -v caps this process's address space at [0-9]+ MiB" \
-        capped soupdist -r 700 --max-memory 2G -o x.vdb "$BUNNY"
+        capped soupdist -r 700 --band full --max-memory 2G -o x.vdb "$BUNNY"
     # With no --max-memory the default is what ulimit -v leaves, so the
     # estimate refuses the job and names the options, where it was 80% of
     # the RAM and the allocation failed midway ("out of memory").
