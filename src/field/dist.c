@@ -1222,51 +1222,186 @@ st_status st_dist_field_blocks(st_grid_blocks **out, const st_soup *s,
     return ST_OK;
 }
 
+/* st_dist_lower's triangles: each one's voxel range within reach (its
+ * box grown by reach, clipped to the grid), its own box, its unit normal
+ * (zero for a triangle st_point_triangle_dist2 takes as degenerate) and
+ * the slack of a lower bound on its distance. */
+typedef struct lower_tri {
+    uint32_t t;
+    size_t i0, i1, j0, j1;
+    double zlo, zhi;
+    double lo[3], hi[3], n[3];
+    double slack;
+} lower_tri;
+
+/* Cull bounds (bvh.c's tri_beyond gives the analysis): a voxel whose
+ * distance from the triangle's box or plane exceeds (lim + slack) (1 +
+ * LOWER_REL) is farther than lim by st_point_triangle_dist2 too, rounding
+ * included, where slack is LOWER_SIDE of the triangle's box side plus
+ * LOWER_ABS of the coordinates' magnitude. */
+#define LOWER_REL 1e-4
+#define LOWER_SIDE 1e-4
+#define LOWER_ABS 3e-14
+
+static void lower_shape(lower_tri *r, const double *a, const double *b, const double *c,
+                        double m)
+{
+    double e0[3], e1[3], e2[3];
+    st_sub3(e0, b, a);
+    st_sub3(e1, c, b);
+    st_sub3(e2, a, c);
+    st_cross3(r->n, e0, e1);
+    const double emax = fmax(st_norm3(e0), fmax(st_norm3(e1), st_norm3(e2)));
+    const double nl = st_norm3(r->n);
+    for (int q = 0; q < 3; q++)
+        r->n[q] = nl > ST_DEGENERATE_AREA_RATIO * emax * emax ? r->n[q] / nl : 0.0;
+    double side = 0.0;
+    for (int q = 0; q < 3; q++) {
+        r->lo[q] = fmin(a[q], fmin(b[q], c[q]));
+        r->hi[q] = fmax(a[q], fmax(b[q], c[q]));
+        side = fmax(side, r->hi[q] - r->lo[q]);
+    }
+    r->slack = LOWER_SIDE * side + LOWER_ABS * m;
+}
+
+/* r[0..n): the triangles of s whose columns meet the grid's; returns n. */
+static size_t lower_ranges(lower_tri *r, const st_grid *g, const st_soup *s, double reach)
+{
+    const size_t nx = g->nx, ny = g->ny;
+    const double h = g->voxel;
+    double m = 0.0;   /* the magnitude of the soup's and the grid's coordinates */
+    for (size_t v = 0; v < 3 * s->nverts; v++)
+        m = fmax(m, fabs(s->xyz[v]));
+    const size_t nn[3] = {g->nx, g->ny, g->nz};
+    for (int q = 0; q < 3; q++)
+        m = fmax(m, fabs(g->origin[q]) + h * (double)nn[q]);
+    size_t n = 0;
+    for (size_t t = 0; t < s->ntris; t++) {
+        const double *a = s->xyz + 3 * (size_t)s->tris[3 * t],
+                     *b = s->xyz + 3 * (size_t)s->tris[3 * t + 1],
+                     *c = s->xyz + 3 * (size_t)s->tris[3 * t + 2];
+        double lo[3], hi[3];
+        for (int q = 0; q < 3; q++) {
+            lo[q] = fmin(a[q], fmin(b[q], c[q])) - reach;
+            hi[q] = fmax(a[q], fmax(b[q], c[q])) + reach;
+        }
+        double fi0 = ceil((lo[0] - g->origin[0]) / h), fi1 = floor((hi[0] - g->origin[0]) / h);
+        double fj0 = ceil((lo[1] - g->origin[1]) / h), fj1 = floor((hi[1] - g->origin[1]) / h);
+        if (fi1 < 0 || fj1 < 0 || fi0 > (double)(nx - 1) || fj0 > (double)(ny - 1) ||
+            fi0 > fi1 || fj0 > fj1)
+            continue;
+        r[n].t = (uint32_t)t;
+        r[n].zlo = lo[2];
+        r[n].zhi = hi[2];
+        r[n].i0 = fi0 < 0 ? 0 : (size_t)fi0;
+        r[n].j0 = fj0 < 0 ? 0 : (size_t)fj0;
+        r[n].i1 = fi1 > (double)(nx - 1) ? nx - 1 : (size_t)fi1;
+        r[n].j1 = fj1 > (double)(ny - 1) ? ny - 1 : (size_t)fj1;
+        lower_shape(r + n, a, b, c, m);
+        n++;
+    }
+    return n;
+}
+
+/* Whether p is certainly farther than lim from triangle r: from its box
+ * or, when it has a normal, its plane through a. */
+static int lower_beyond(const lower_tri *r, const double *a, const double p[3], double lim)
+{
+    const double x = (lim + r->slack) * (1.0 + LOWER_REL), x2 = x * x;
+    double d2 = 0.0;
+    for (int q = 0; q < 3; q++) {
+        const double below = r->lo[q] - p[q], above = p[q] - r->hi[q];
+        const double d = below > 0.0 ? below : above > 0.0 ? above : 0.0;
+        d2 += d * d;
+    }
+    if (d2 > x2)
+        return 1;
+    const double w = r->n[0] * (p[0] - a[0]) + r->n[1] * (p[1] - a[1]) + r->n[2] * (p[2] - a[2]);
+    return w * w > x2;
+}
+
+/* The columns [*i0, *i1] of row (y, z) where triangle r may be within
+ * reach: its box and its plane (when the plane is not nearly along the
+ * row) by the bounds of lower_beyond, a voxel wider on each side than
+ * computed, so every voxel left out is one lower_beyond skips. Returns 0
+ * when none is. */
+static int lower_span(const lower_tri *r, const double *a, const st_grid *g, double y, double z,
+                      double reach, size_t *i0, size_t *i1)
+{
+    const double x = (reach + r->slack) * (1.0 + LOWER_REL), h = g->voxel, o = g->origin[0];
+    const double dy = y < r->lo[1] ? r->lo[1] - y : y > r->hi[1] ? y - r->hi[1] : 0.0;
+    const double dz = z < r->lo[2] ? r->lo[2] - z : z > r->hi[2] ? z - r->hi[2] : 0.0;
+    const double left = x * x - dy * dy - dz * dz;
+    if (left < 0.0)
+        return 0;
+    double xlo = r->lo[0] - sqrt(left), xhi = r->hi[0] + sqrt(left);
+    if (fabs(r->n[0]) * h > 1e-3 * x) {
+        /* |n0 (px - a0) + w| <= x, w the rest of the plane's distance */
+        const double w = r->n[1] * (y - a[1]) + r->n[2] * (z - a[2]);
+        const double p0 = a[0] + (-x - w) / r->n[0], p1 = a[0] + (x - w) / r->n[0];
+        xlo = fmax(xlo, fmin(p0, p1));
+        xhi = fmin(xhi, fmax(p0, p1));
+    }
+    const double f0 = floor((xlo - o) / h) - 1.0, f1 = ceil((xhi - o) / h) + 1.0;
+    if (f1 < (double)r->i0 || f0 > (double)r->i1 || f0 > f1)
+        return 0;
+    *i0 = f0 > (double)r->i0 ? (size_t)f0 : r->i0;
+    *i1 = f1 < (double)r->i1 ? (size_t)f1 : r->i1;
+    return 1;
+}
+
+/* Layer k of st_dist_lower: each triangle's voxels in reach get its
+ * distance where that is below reach and lowers them. A voxel is skipped
+ * where the triangle is certainly farther than reach or than its value
+ * (neither would change it), so the value is the same minimum. */
+static void lower_layer(st_grid *g, const st_soup *s, const lower_tri *r, size_t n,
+                        size_t k, double reach)
+{
+    const double h = g->voxel, z = g->origin[2] + h * (double)k;
+    for (size_t u = 0; u < n; u++) {
+        if (z < r[u].zlo || z > r[u].zhi)
+            continue;
+        const uint32_t *c = s->tris + 3 * (size_t)r[u].t;
+        const double *a = s->xyz + 3 * (size_t)c[0], *b = s->xyz + 3 * (size_t)c[1],
+                     *cc = s->xyz + 3 * (size_t)c[2];
+        for (size_t j = r[u].j0; j <= r[u].j1; j++) {
+            const double y = g->origin[1] + h * (double)j;
+            size_t i0, i1;
+            if (!lower_span(r + u, a, g, y, z, reach, &i0, &i1))
+                continue;
+            for (size_t i = i0; i <= i1; i++) {
+                float *v = g->data + st_grid_index(g, i, j, k);
+                if (!(*v > 0.0f))
+                    continue;   /* no distance is below it */
+                const double p[3] = {g->origin[0] + h * (double)i, y, z};
+                if (lower_beyond(r + u, a, p, fmin(reach, (double)*v)))
+                    continue;
+                const double d2 = st_point_triangle_dist2(p, a, b, cc, NULL);
+                if (!(d2 < reach * reach))
+                    continue;
+                const float d = (float)sqrt(d2);
+                if (d < *v)
+                    *v = d;
+            }
+        }
+    }
+}
+
 st_status st_dist_lower(st_grid *g, const st_soup *s, double reach,
                         st_error *err)
 {
     if (!(reach > 0) || !s->ntris)
         return ST_OK;
-    const size_t nx = g->nx, ny = g->ny, nz = g->nz;
-    const double h = g->voxel;
-    (void)err;
+    lower_tri *r = st_malloc_array(s->ntris, sizeof *r);
+    if (!r)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the caps' distances");
+    const size_t n = lower_ranges(r, g, s, reach), nz = g->nz;
     /* A z layer per iteration: every voxel's minimum over the triangles
      * within reach of it, in any order (a minimum), so the threads never
      * share a voxel. */
     #pragma omp parallel for schedule(dynamic, 1)
-    for (size_t k = 0; k < nz; k++) {
-        const double z = g->origin[2] + h * (double)k;
-        for (size_t t = 0; t < s->ntris; t++) {
-            const double *a = s->xyz + 3 * (size_t)s->tris[3 * t],
-                         *b = s->xyz + 3 * (size_t)s->tris[3 * t + 1],
-                         *c = s->xyz + 3 * (size_t)s->tris[3 * t + 2];
-            double lo[3], hi[3];
-            for (int q = 0; q < 3; q++) {
-                lo[q] = fmin(a[q], fmin(b[q], c[q])) - reach;
-                hi[q] = fmax(a[q], fmax(b[q], c[q])) + reach;
-            }
-            if (z < lo[2] || z > hi[2])
-                continue;
-            double fi0 = ceil((lo[0] - g->origin[0]) / h), fi1 = floor((hi[0] - g->origin[0]) / h);
-            double fj0 = ceil((lo[1] - g->origin[1]) / h), fj1 = floor((hi[1] - g->origin[1]) / h);
-            if (fi1 < 0 || fj1 < 0 || fi0 > (double)(nx - 1) || fj0 > (double)(ny - 1))
-                continue;
-            const size_t i0 = fi0 < 0 ? 0 : (size_t)fi0, j0 = fj0 < 0 ? 0 : (size_t)fj0;
-            const size_t i1 = fi1 > (double)(nx - 1) ? nx - 1 : (size_t)fi1;
-            const size_t j1 = fj1 > (double)(ny - 1) ? ny - 1 : (size_t)fj1;
-            for (size_t j = j0; j <= j1; j++)
-                for (size_t i = i0; i <= i1; i++) {
-                    const double p[3] = {g->origin[0] + h * (double)i,
-                                         g->origin[1] + h * (double)j, z};
-                    const double d2 = st_point_triangle_dist2(p, a, b, c, NULL);
-                    if (!(d2 < reach * reach))
-                        continue;
-                    float *v = g->data + st_grid_index(g, i, j, k);
-                    const float d = (float)sqrt(d2);
-                    if (d < *v)
-                        *v = d;
-                }
-        }
-    }
+    for (size_t k = 0; k < nz; k++)
+        lower_layer(g, s, r, n, k, reach);
+    free(r);
     return ST_OK;
 }
