@@ -246,6 +246,17 @@ static void image(const st_soup *s, size_t t, const map *m, double q[3][3])
         st_symmetry_apply(m->y, m->angle, s->xyz + 3 * c[flip && k ? 3 - k : k], 1, q[k]);
 }
 
+/* image()'s corners taken from vimg, the images of s's vertices under m
+ * (the same values: each corner's image is its vertex's). */
+static void image_from(const st_soup *s, size_t t, const map *m, const double *vimg,
+                       double q[3][3])
+{
+    const uint32_t *c = s->tris + 3 * t;
+    const int flip = m->y->kind == ST_SYMMETRY_MIRROR;
+    for (int k = 0; k < 3; k++)
+        memcpy(q[k], vimg + 3 * (size_t)c[flip && k ? 3 - k : k], 3 * sizeof(double));
+}
+
 typedef struct fill_ctx {
     const st_soup *s;
     const st_bvh *bvh, *anchors_bvh, *fill_bvh;   /* fill_bvh: the maps before */
@@ -253,6 +264,8 @@ typedef struct fill_ctx {
     const pieces *P;
     const uint8_t *piece_ok;   /* the map agrees with the piece's rim */
     double tol;
+    double reach2;             /* above the largest piece_ok reach squared
+                                  (0: the anchors' whole box) */
 } fill_ctx;
 
 /* The piece image q fills, or SIZE_MAX. It must be off the soup (farther
@@ -268,20 +281,26 @@ static size_t keeps(const fill_ctx *C, const double q[3][3])
         if (c[k] < C->P->lo[k] || c[k] > C->P->hi[k])
             return SIZE_MAX;
     }
+    /* the soup wins wherever it is: the tests below (bound >= tol2) */
+    const double tol2 = C->tol * C->tol;
+    if (st_bvh_within(C->bvh, c, tol2) || (C->fill_bvh && st_bvh_within(C->fill_bvh, c, tol2)))
+        return SIZE_MAX;
     int64_t tri;
     const double most = C->P->hi[0] - C->P->lo[0] + C->P->hi[1] - C->P->lo[1] +
                         C->P->hi[2] - C->P->lo[2];
-    const double d2 = st_bvh_nearest(C->anchors_bvh, c, most * most, &tri, NULL);
+    /* an anchor no nearer than every reach the map may fill leaves the
+     * image out whichever it is: the search stops there (the nearest
+     * within it is the one the whole search finds) */
+    const double far2 = C->reach2 > 0.0 && C->reach2 < most * most ? C->reach2 : most * most;
+    const double d2 = st_bvh_nearest(C->anchors_bvh, c, far2, &tri, NULL);
     if (tri < 0)
         return SIZE_MAX;
     const size_t i = C->P->of_tri[tri];
     if (!C->piece_ok[i] || d2 > C->P->reach[i] * C->P->reach[i])
         return SIZE_MAX;
-    const double tol2 = C->tol * C->tol, near = sqrt(d2) - C->tol;
+    const double near = sqrt(d2) - C->tol;
     const double bound = i < C->P->ncap ? fmax(tol2, d2) : near > C->tol ? near * near : tol2;
-    if (st_bvh_within(C->bvh, c, bound))
-        return SIZE_MAX;
-    return C->fill_bvh && st_bvh_within(C->fill_bvh, c, tol2) ? SIZE_MAX : i;
+    return st_bvh_within(C->bvh, c, bound) ? SIZE_MAX : i;
 }
 
 /* ---- the rims ------------------------------------------------------------------ */
@@ -616,7 +635,10 @@ static void rim_checks(double *ver, double *con, size_t npieces, const rims *R,
         double q[3];
         st_symmetry_apply(back->inverse->y, back->inverse->angle, R->mid + 3 * r, 1, q);
         int64_t tri, edge = -1;
-        const double d2 = st_bvh_nearest(back->bvh, q, INFINITY, &tri, NULL);
+        /* without bounds, a preimage beyond reach is contradicted however
+         * far: the search stops at the reach */
+        const double d2 = st_bvh_nearest(back->bvh, q, bounds ? INFINITY : back->reach2, &tri,
+                                         NULL);
         const size_t i = R->piece[r];
         total[i] += R->len[r];
         if (tri >= 0 && d2 < back->reach2) {
@@ -957,12 +979,25 @@ static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, con
     const st_symmetry *held_by = NULL;
     double score[ST_SYMMETRY_MAX * ST_SYMMETRY_DEFAULT_MAX_ORDER];
     size_t order[ST_SYMMETRY_MAX * ST_SYMMETRY_DEFAULT_MAX_ORDER];
-    for (size_t mi = 0; mi < nmaps; mi++)
+    /* each map's ok and map_err, kept from its score for its images */
+    const size_t np = C0->P->n ? C0->P->n : 1;
+    uint8_t *oks = st_malloc_array(nmaps ? nmaps * np : 1, 1);
+    double *errs = st_malloc_array(nmaps ? nmaps * np : 1, sizeof *errs);
+    double *vimg = st_malloc_array(s->nverts ? 3 * s->nverts : 1, sizeof *vimg);
+    if (!oks || !errs || !vimg) {
+        rc = ST_ENOMEM; /* said by the caller */
+        goto done;
+    }
+    for (size_t mi = 0; mi < nmaps; mi++) {
         score[mi] = map_agrees(ok, map_err, share, C0, R, maps + mi, open);
+        memcpy(oks + mi * np, ok, C0->P->n);
+        memcpy(errs + mi * np, map_err, C0->P->n * sizeof *errs);
+    }
     by_score(order, score, nmaps);
     for (size_t oi = 0; oi < nmaps && score[order[oi]] > 0.0; oi++) {
         const size_t mi = order[oi];
-        map_agrees(ok, map_err, share, C0, R, maps + mi, open);
+        memcpy(ok, oks + mi * np, C0->P->n);
+        memcpy(map_err, errs + mi * np, C0->P->n * sizeof *errs);
         const int helix = maps[mi].y->kind == ST_SYMMETRY_HELIX;
         if (helix && held_by != maps[mi].y) {
             if (!held && !(held = st_malloc_array(s->ntris ? s->ntris : 1, 1))) {
@@ -974,12 +1009,19 @@ static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, con
         fill_ctx C = *C0;
         C.fill_bvh = *fill_bvh;
         C.piece_ok = ok;
-        const long long nt = (long long)s->ntris;
+        for (size_t i = 0; i < C0->P->n; i++)
+            if (ok[i])
+                C.reach2 = fmax(C.reach2, C0->P->reach[i] * C0->P->reach[i]);
+        C.reach2 = nextafter(C.reach2, INFINITY);
+        const long long nt = (long long)s->ntris, nv = (long long)s->nverts;
+#pragma omp parallel for schedule(static)
+        for (long long v = 0; v < nv; v++)
+            st_symmetry_apply(maps[mi].y, maps[mi].angle, s->xyz + 3 * v, 1, vimg + 3 * v);
         size_t any = 0;
 #pragma omp parallel for schedule(dynamic, 1024) reduction(+ : any)
         for (long long t = 0; t < nt; t++) {
             double q[3][3];
-            image(s, (size_t)t, maps + mi, q);
+            image_from(s, (size_t)t, maps + mi, vimg, q);
             keep[t] = helix && !held[t] ? SIZE_MAX : keeps(&C, q);
             any += keep[t] != SIZE_MAX;
         }
@@ -993,6 +1035,9 @@ static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, con
     }
 done:
     free(held);
+    free(oks);
+    free(errs);
+    free(vimg);
     return rc;
 }
 
@@ -1169,7 +1214,7 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
     if (edges && ((rc = bounds_make(bounds, s, edges, err)) ||
                   (bounds->ntris && (rc = st_bvh_build(&bounds_bvh, bounds, err)))))
         goto done;
-    const fill_ctx C = {s, bvh, anchors_bvh, NULL, bounds_bvh, &P, NULL, tol};
+    const fill_ctx C = {s, bvh, anchors_bvh, NULL, bounds_bvh, &P, NULL, tol, 0.0};
     if ((rc = fill_rounds(covered, &F, &fill_bvh, &C, &R, maps, nmaps, keep, ok, share,
                           map_err, st, err)) ||
         (rc = keep_uncovered(kept, cp, &P, covered, err)))
