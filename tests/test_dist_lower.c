@@ -22,13 +22,18 @@ static void plain_lower(st_grid *g, const st_soup *s, double reach)
     for (size_t k = 0; k < g->nz; k++) {
         const double z = g->origin[2] + h * (double)k;
         for (size_t t = 0; t < s->ntris; t++) {
-            const double *a = s->xyz + 3 * (size_t)s->tris[3 * t],
-                         *b = s->xyz + 3 * (size_t)s->tris[3 * t + 1],
-                         *c = s->xyz + 3 * (size_t)s->tris[3 * t + 2];
-            double lo[3], hi[3];
+            const double *v[3];   /* corners; the box grown by reach */
+            double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            for (int corner = 0; corner < 3; corner++) {
+                v[corner] = s->xyz + 3 * (size_t)s->tris[3 * t + corner];
+                for (int q = 0; q < 3; q++) {
+                    lo[q] = fmin(lo[q], v[corner][q]);
+                    hi[q] = fmax(hi[q], v[corner][q]);
+                }
+            }
             for (int q = 0; q < 3; q++) {
-                lo[q] = fmin(a[q], fmin(b[q], c[q])) - reach;
-                hi[q] = fmax(a[q], fmax(b[q], c[q])) + reach;
+                lo[q] -= reach;
+                hi[q] += reach;
             }
             if (z < lo[2] || z > hi[2])
                 continue;
@@ -39,10 +44,10 @@ static void plain_lower(st_grid *g, const st_soup *s, double reach)
             for (double j = j0; j <= j1; j++)
                 for (double i = i0; i <= i1; i++) {
                     const double p[3] = {g->origin[0] + h * i, g->origin[1] + h * j, z};
-                    const double d2 = st_point_triangle_dist2(p, a, b, c, NULL);
-                    float *v = g->data + st_grid_index(g, (size_t)i, (size_t)j, k);
-                    if (d2 < reach * reach && (float)sqrt(d2) < *v)
-                        *v = (float)sqrt(d2);
+                    const double d2 = st_point_triangle_dist2(p, v[0], v[1], v[2], NULL);
+                    float *val = g->data + st_grid_index(g, (size_t)i, (size_t)j, k);
+                    if (d2 < reach * reach && (float)sqrt(d2) < *val)
+                        *val = (float)sqrt(d2);
                 }
         }
     }
