@@ -311,6 +311,46 @@ static st_soup *big_sphere(void)
     return s;
 }
 
+/* The vertex flags where big tets hold whole BVH subtrees (enclose.c
+ * marks those vertices without a per-vertex test): the same as a
+ * brute-force test of every vertex against every tet, with the wavy
+ * sphere (radius 0.95..1.05) in a lattice of 0.6-wide cubes with every
+ * third tet left out, so that subtrees are held, cut and missed. */
+static void test_subtree_flags_brute_force(void)
+{
+    st_soup *s = big_sphere();
+    const double o[3] = {-1.2, -1.2, -1.2};
+    st_tetmesh *full = kuhn_lattice(o, 0.6, 4, 4, 4), *m = st_tetmesh_new();
+    for (size_t i = 0; i < full->npoints; i++)
+        st_tetmesh_add_point(m, full->xyz + 3 * i, NULL);
+    for (size_t t = 0; t < full->ntets; t++)
+        if (t % 3 != 0)
+            st_tetmesh_add_tet(m, full->tets[4 * t], full->tets[4 * t + 1],
+                               full->tets[4 * t + 2], full->tets[4 * t + 3], NULL);
+    st_error err = {0};
+    unsigned char *vin = malloc(s->nverts);
+    st_enclosure e;
+    TAP_CHECK(vin && st_enclosure_compute(&e, m, s, NULL, vin, NULL, &err) == ST_OK,
+              "enclosure of %zu triangles by %zu tets", s->ntris, m->ntets);
+    size_t bad = 0, in = 0;
+    for (size_t i = 0; i < s->nverts; i++) {
+        int want = 0;
+        for (size_t t = 0; t < m->ntets && !want; t++) {
+            const uint32_t *q = m->tets + 4 * t;
+            want = st_point_in_tet(s->xyz + 3 * i, m->xyz + 3 * q[0], m->xyz + 3 * q[1],
+                                   m->xyz + 3 * q[2], m->xyz + 3 * q[3]) != ST_OUTSIDE;
+        }
+        bad += vin[i] != want;
+        in += (size_t)want;
+    }
+    TAP_CHECK(bad == 0 && in == e.vertices_inside && in > s->nverts / 2 && in < s->nverts,
+              "flags = brute force (%zu of %zu inside, %zu wrong)", in, s->nverts, bad);
+    free(vin);
+    st_tetmesh_free(full);
+    st_tetmesh_free(m);
+    st_soup_free(s);
+}
+
 static void test_threads_and_speed(void)
 {
     st_soup *s = big_sphere();
@@ -656,6 +696,7 @@ int main(int argc, char **argv)
                                      TAP_TEST(inverted_and_flat),
                                      TAP_TEST(empty_mesh),
                                      TAP_TEST(locator_brute_force),
+                                     TAP_TEST(subtree_flags_brute_force),
                                      TAP_TEST(threads_and_speed),
                                      TAP_TEST(float32_face),
                                      TAP_TEST(float32_rotated),

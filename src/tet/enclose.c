@@ -11,15 +11,22 @@
  * point, so a point inside a tet's box always falls in one of the bins the
  * tet was listed in: the grid only prunes, it never decides.
  *
- * Enclosure: every used soup vertex through the locator (the tet that
- * held the vertex before tried first: any tet will do); every boundary
+ * Enclosure: the vertices of every BVH subtree (of WALK_MIN_TRIS
+ * triangles or more) whose box one tet holds (its eight corners in the
+ * closed tet, exactly: a large soup under a coarse mesh has most of its
+ * vertices deep inside tets); every other
+ * used soup vertex through the locator (the tet that held the vertex
+ * before tried first: any tet will do); every boundary
  * face of the mesh against the soup triangles a BVH triangle query
- * returns, with st_tri_tri_intersect. Both loops write per-item flags or integer
- * reductions only, so the results do not depend on the thread count.
+ * returns, with st_tri_tri_intersect. The loops write per-item flags
+ * (the same value from any thread) or integer reductions only, and each
+ * flag is an exact answer, so the results do not depend on the thread
+ * count or on which test gave them.
  */
 #include "souptet/enclose.h"
 #include "../base/fpenv.h"
 #include "souptet/mem.h"
+#include "souptet/pred.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -232,6 +239,102 @@ static int locate_any(const st_locator *l, const double p[3], int64_t *hint)
     return t >= 0;
 }
 
+/* A tet that holds the whole box lo..hi, or -1 when none is found: the
+ * first tet holding the corner lo (st_locator_find), if it holds the
+ * other seven corners too (a closed tet is convex; the corners are exact
+ * doubles, coordinates of the box's points, tested with
+ * st_point_in_tet). Another tet holding lo could hold the box when lo is
+ * on a face: missing it only leaves the points to the per-vertex test. */
+static int64_t box_tet(const st_locator *l, const double lo[3], const double hi[3])
+{
+    if (l->empty)
+        return -1;
+    for (int a = 0; a < 3; a++)
+        if (!(lo[a] >= l->lo[a] && hi[a] <= l->hi[a]))
+            return -1;
+    int64_t t = st_locator_find(l, lo, NULL);
+    if (t < 0)
+        return -1;
+    const double *b = l->tbox + 6 * (size_t)t;
+    if (hi[0] > b[3] || hi[1] > b[4] || hi[2] > b[5])
+        return -1;
+    const st_tetmesh *m = l->m;
+    const uint32_t *q = m->tets + 4 * (size_t)t;
+    const double *c0 = m->xyz + 3 * (size_t)q[0], *c1 = m->xyz + 3 * (size_t)q[1],
+                 *c2 = m->xyz + 3 * (size_t)q[2], *c3 = m->xyz + 3 * (size_t)q[3];
+    for (int k = 1; k < 8; k++) {
+        const double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1],
+                             k & 4 ? hi[2] : lo[2]};
+        if (st_point_in_tet(p, c0, c1, c2, c3) == ST_OUTSIDE)
+            return -1;
+    }
+    return t;
+}
+
+/* Subtrees of fewer triangles are left to the per-vertex test: a few
+ * vertices cost less to locate than a box's eight corners. */
+#define WALK_MIN_TRIS 64
+
+/* Nodes down to this depth are split before the parallel walk. */
+#define WALK_SPLIT_DEPTH 8
+
+/* The slots order[*first..*end) of node i's subtree (children numbered
+ * left then right, holding the lower and upper part of the parent's). */
+static void subtree_slots(const st_bvh *b, uint32_t i, size_t *first, size_t *end)
+{
+    uint32_t a = i, z = i;
+    while (b->nodes[a].count == 0)
+        a = b->nodes[a].start;
+    while (b->nodes[z].count == 0)
+        z = b->nodes[z].start + 1;
+    *first = b->nodes[a].start;
+    *end = (size_t)b->nodes[z].start + b->nodes[z].count;
+}
+
+/* Under node `root`: every subtree whose box one tet holds marks the
+ * vertices of its triangles inside (vin 1); the rest are left as they
+ * are. Writes only 1s (atomically), so the flags are the same whichever
+ * thread reaches them. */
+static void mark_covered(const st_locator *l, const st_bvh *b, uint32_t root,
+                         unsigned char *vin)
+{
+    uint32_t stack[128];
+    int sp = 0;
+    stack[sp++] = root;
+    while (sp > 0) {
+        uint32_t i = stack[--sp];
+        const st_bvh_node *n = &b->nodes[i];
+        size_t first, end;
+        subtree_slots(b, i, &first, &end);
+        if (end - first < WALK_MIN_TRIS)
+            continue;
+        if (box_tet(l, n->lo, n->hi) >= 0) {
+            const uint32_t *tris = b->soup->tris;
+            for (size_t j = first; j < end; j++)
+                for (int k = 0; k < 3; k++) {
+                    uint32_t v = tris[3 * (size_t)b->order[j] + (size_t)k];
+#pragma omp atomic write
+                    vin[v] = 1;
+                }
+        } else if (n->count == 0 && sp + 2 <= 128) {
+            stack[sp++] = n->start + 1;
+            stack[sp++] = n->start;
+        }
+    }
+}
+
+/* The nodes at depth WALK_SPLIT_DEPTH (and leaves above it) into *list
+ * (room for 2^WALK_SPLIT_DEPTH). */
+static void split_nodes(const st_bvh *b, uint32_t i, int depth, uint32_t *list, size_t *n)
+{
+    if (depth == WALK_SPLIT_DEPTH || b->nodes[i].count != 0) {
+        list[(*n)++] = i;
+        return;
+    }
+    split_nodes(b, b->nodes[i].start, depth + 1, list, n);
+    split_nodes(b, b->nodes[i].start + 1, depth + 1, list, n);
+}
+
 typedef struct cross_ctx {
     const st_soup *s;
     const double *f[3];
@@ -289,10 +392,25 @@ st_status st_enclosure_compute(st_enclosure *out, const st_tetmesh *m,
     if ((rc = st_locator_new(&loc, m, err)))
         goto out;
 
-    /* (a) used vertices in the closed union of the tets. */
+    /* (a) used vertices in the closed union of the tets: first those of
+     * the BVH subtrees whose box lies in one tet (most of a large soup
+     * under a coarse mesh), then each other one through the locator. */
     memset(vin, 2, s->nverts);
     for (size_t i = 0; i < 3 * s->ntris; i++)
         vin[s->tris[i]] = 0;
+    if (!bvh && s->ntris > 0 && m->ntets > 0 && (rc = st_bvh_build(&own, s, err)))
+        goto out;
+    if (!bvh)
+        bvh = own;
+    if (bvh && m->ntets > 0) {
+        uint32_t split[1u << WALK_SPLIT_DEPTH];
+        size_t ns = 0;
+        split_nodes(bvh, 0, 0, split, &ns);
+        const long long n = (long long)ns;
+#pragma omp parallel for schedule(dynamic, 1)
+        for (long long k = 0; k < n; k++)
+            mark_covered(loc, bvh, split[k], vin);
+    }
     size_t used = 0, inside = 0;
     {
         const long long nv = (long long)s->nverts;
@@ -304,7 +422,7 @@ st_status st_enclosure_compute(st_enclosure *out, const st_tetmesh *m,
                 if (vin[i] == 2)
                     continue;
                 used++;
-                int in = locate_any(loc, s->xyz + 3 * (size_t)i, &hint);
+                int in = vin[i] == 1 || locate_any(loc, s->xyz + 3 * (size_t)i, &hint);
                 vin[i] = (unsigned char)in;
                 inside += (size_t)in;
             }
@@ -321,11 +439,6 @@ st_status st_enclosure_compute(st_enclosure *out, const st_tetmesh *m,
         goto out;
     out->boundary_faces = nf;
     if (nf > 0 && s->ntris > 0) {
-        if (!bvh) {
-            if ((rc = st_bvh_build(&own, s, err)))
-                goto out;
-            bvh = own;
-        }
         const long long n = (long long)nf;
 #pragma omp parallel for schedule(dynamic, 16)
         for (long long f = 0; f < n; f++) {

@@ -576,7 +576,8 @@ st_status sm_fit_ctx_open(fit_ctx *c, st_tetmesh *m, const st_soup *s, const st_
         (rc = st_tetmesh_neighbors(m, &nbr, &nonmanifold, err)))
         goto done;
     c->full_check = nonmanifold > 0;
-    /* the point grid's bins a quarter of the cell: the swept test and the
+    /* the point grid's bins a quarter of the cell at most (finer on dense
+     * soups: pgrid.c): the swept test and the
      * star scans visit whole bins (doc/design/fit.md, Cost) */
     if (sm_pgrid_build(&c->pg, s, h / 4.0) ||
         !(c->blocker = st_malloc_array(m->npoints, sizeof *c->blocker)) ||

@@ -29,8 +29,9 @@ typedef struct pgrid {
                              pts + 3 idx[j] (fit_swept.c's scans) */
 } pgrid;
 
-/* The distinct vertices of s's triangles, in bins of at least `cell`
- * (at most 256 per axis). */
+/* The distinct vertices of s's triangles, in bins of at most `cell`,
+ * finer (down to cell / 8) where the points are dense, and at most 256
+ * per axis. */
 st_status sm_pgrid_build(pgrid *g, const st_soup *s, double cell);
 void sm_pgrid_free(pgrid *g);
 
