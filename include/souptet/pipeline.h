@@ -142,8 +142,10 @@ typedef struct st_pipeline_params {
                               stopping condition (2. below, and the pull):
                               the pseudo volume's boundary where the soup
                               has none (st_pseudo_fill, st_fit_params.fill);
-                              the mesh still encloses the soup alone. 0:
-                              the soup alone (1) */
+                              and the mesh encloses it as it encloses the
+                              soup (st_pipeline_enclosed): a filled hole's
+                              boundary is not cut inside the pseudo volume.
+                              0: the soup alone (1) */
     int float32;           /* 1: the chosen mesh's points are rounded to
                               float32 so that it encloses the soup once
                               stored as float (Blender, glTF, STL, game
@@ -266,6 +268,17 @@ double st_pipeline_lattice_bytes(const st_soup *s, double h, size_t tries,
 st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
                           const st_soup *s, const st_pipeline_params *p,
                           const st_progress *prog, st_error *err);
+
+/* The surface a mesh must enclose when the fill counts (fill_counts):
+ * s and fill (st_pseudo_fill's for the pseudo volume of s) as one soup,
+ * s's triangles first, and its BVH. The candidates are sculpted and
+ * fitted to it, so the mesh holds the pseudo volume's guessed boundary
+ * (a filled hole, a far side) as exactly as the soup; latticetet --sculpt
+ * and tetsmooth --fit with a field do the same. With fill NULL or empty,
+ * *out and *bvh are NULL: s alone. ST_ENOMEM, ST_ELIMIT; both NULL on
+ * failure. */
+st_status st_pipeline_enclosed(st_soup **out, st_bvh **bvh, const st_soup *s,
+                               const st_soup *fill, st_error *err);
 
 /* The pseudo volume a mesh of st_pipeline_run was fitted against: the
  * same field over s (its meta "field_voxels", "fill_holes",

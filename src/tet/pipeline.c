@@ -595,6 +595,29 @@ static st_status make_fill(st_soup **fill, st_pipeline_stats *st, const st_grid 
     return ST_OK;
 }
 
+st_status st_pipeline_enclosed(st_soup **out, st_bvh **bvh, const st_soup *s,
+                               const st_soup *fill, st_error *err)
+{
+    *out = NULL;
+    *bvh = NULL;
+    if (!fill || fill->ntris == 0)
+        return ST_OK;
+    st_soup *u = st_soup_new();
+    if (!u)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    st_status rc = st_soup_append(u, s, err);
+    if (!rc)
+        rc = st_soup_append(u, fill, err);
+    if (!rc)
+        rc = st_bvh_build(bvh, u, err);
+    if (rc) {
+        st_soup_free(u);
+        return rc;
+    }
+    *out = u;
+    return ST_OK;
+}
+
 /* The field's default voxels along the longest side for a lattice of
  * cells: 16 voxels per lattice cell up to 128 (soupdist's default), 8 per
  * cell beyond (pipeline.h). The fit and the sculpt read the field per
@@ -730,11 +753,14 @@ static st_status make_field(st_grid **g, st_bvh **bvh, st_pipeline_stats *st,
 }
 
 /* The best of the candidates that ran (better) into st->best, and
- * whether it encloses; with float32, its counts, angles and enclosure as
- * a float32 consumer will hold it (the rounded mesh's). All failed: the
- * first one's message. */
+ * whether it encloses s; with float32, its counts, angles and enclosure as
+ * a float32 consumer will hold it (the rounded mesh's). with_fill: the
+ * candidates' counts are of s and the fill (st_pipeline_enclosed); where
+ * the best one misses those, its counts become s's alone, the input's,
+ * which is what the run reports. All failed: the first one's message. */
 static st_status choose_best(st_pipeline_stats *st, st_tetmesh **meshes, const st_soup *s,
-                             const st_bvh *bvh, const st_pipeline_params *p, st_error *err)
+                             const st_bvh *bvh, int with_fill,
+                             const st_pipeline_params *p, st_error *err)
 {
     size_t best = 0;
     for (size_t k = 1; k < st->ncandidates; k++)
@@ -743,6 +769,13 @@ static st_status choose_best(st_pipeline_stats *st, st_tetmesh **meshes, const s
     if (st->candidates[best].failed)
         return st_error_set(err, ST_EINPUT, NULL, 0, "%s", st->candidates[0].message);
     st->best = best;
+    st_pipeline_candidate *b = &st->candidates[best];
+    if (with_fill && (b->verts_outside || b->tris_crossing)) {
+        st_status rc = st_enclosure_count(meshes[best], s, bvh, &b->verts_outside,
+                                          &b->tris_crossing, err);
+        if (rc)
+            return rc;
+    }
     st->encloses = st->candidates[best].verts_outside == 0 &&
                    st->candidates[best].tris_crossing == 0;
     if (p->float32) {
@@ -778,7 +811,8 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     st_grid *g = NULL;
     st_bvh *bvh = NULL;
     st_tetmesh **meshes = NULL;
-    st_soup *fill = NULL, *sym = NULL;
+    st_soup *fill = NULL, *sym = NULL, *enc = NULL;
+    st_bvh *enc_bvh = NULL;
     pp.symmetric_fill = &sym;   /* the guess's symmetric part (make_fill) */
     rc = make_field(&g, &bvh, st, s, &dp, &pp, p, t_start, prog, err);
     pp.symmetric_fill = NULL;
@@ -821,14 +855,17 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     for (size_t k = 0; k < K; k++)
         st->candidates[k].seed = st_pipeline_candidate_seed(p->seed, k);
 
-    run_candidates(meshes, st, g, s, bvh, fill, h, p, prog);
+    /* the fill is enclosed as the soup is (st_pipeline_enclosed) */
+    if ((rc = st_pipeline_enclosed(&enc, &enc_bvh, s, fill, err)))
+        goto done;
+    run_candidates(meshes, st, g, enc ? enc : s, enc ? enc_bvh : bvh, fill, h, p, prog);
     st->seconds_candidates = now_seconds() - t_cand;
     if (st_progress_cancelled(prog)) {
         rc = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
         goto done;
     }
 
-    if ((rc = choose_best(st, meshes, s, bvh, p, err)))
+    if ((rc = choose_best(st, meshes, s, bvh, enc != NULL, p, err)))
         goto done;
     const size_t best = st->best;
     rc = set_meta(meshes[best], p, st, dp.cells, err);
@@ -850,6 +887,8 @@ done:
     st_bvh_free(bvh);
     st_soup_free(fill);
     st_soup_free(sym);
+    st_bvh_free(enc_bvh);
+    st_soup_free(enc);
     st_grid_free(g);
     return rc;
 }

@@ -14,10 +14,13 @@
  */
 #define _GNU_SOURCE
 #include "../cli/tool.h"
+#include "souptet/bvh.h"
 #include "souptet/gridio.h"
 #include "souptet/lattice.h"
 #include "souptet/outfile.h"
 #include "souptet/parts.h"
+#include "souptet/pipeline.h"
+#include "souptet/pseudo.h"
 #include "souptet/sculpt.h"
 #include "souptet/soup.h"
 #include "souptet/tetio.h"
@@ -416,7 +419,22 @@ static int sculpt_mesh(tool_ctx *t, lt_run *R, st_error *err)
     sp.max_tets = R->max_tets;
     sp.repair_bombs = sp.repair_manifold = s->repair;
     st_sculpt_stats ss;
-    if (st_sculpt(&R->m, &ss, R->g, R->soup, NULL, &sp, err)) {
+    /* the fill is enclosed as the surface is (st_pipeline_enclosed):
+     * what soupmesh sculpts, and tetsmooth --fit --field fits */
+    st_bvh *bvh = NULL, *enc_bvh = NULL;
+    st_soup *fill = NULL, *enc = NULL;
+    st_status rc = st_bvh_build(&bvh, R->soup, err);
+    if (!rc)
+        rc = st_pseudo_fill(&fill, R->g, bvh, NULL, err);
+    if (!rc)
+        rc = st_pipeline_enclosed(&enc, &enc_bvh, R->soup, fill, err);
+    if (!rc)
+        rc = st_sculpt(&R->m, &ss, R->g, enc ? enc : R->soup, enc_bvh, &sp, err);
+    st_bvh_free(enc_bvh);
+    st_soup_free(enc);
+    st_soup_free(fill);
+    st_bvh_free(bvh);
+    if (rc) {
         if (!err->file[0])
             snprintf(err->file, sizeof err->file, "%s", R->in_name);
         tool_limit_hint(err, limit_hint);

@@ -12,9 +12,11 @@
 #define _GNU_SOURCE
 #include "../cli/tool.h"
 #include "souptet/bvh.h"
+#include "souptet/enclose.h"
 #include "souptet/gridio.h"
 #include "souptet/pseudo.h"
 #include "souptet/outfile.h"
+#include "souptet/pipeline.h"
 #include "souptet/smooth.h"
 #include "souptet/soup.h"
 #include "souptet/tetio.h"
@@ -237,6 +239,35 @@ static int check(tool_ctx *t, int argc, char *argv[], void *settings)
     return tool_output_check(t, s->co.out);
 }
 
+/* With --field: the fill of the field's pseudo volume (pseudo.h), which
+ * counts as surface for --offset, and S with it as one soup (*enc, NULL
+ * without a fill), which the mesh encloses as it does S
+ * (st_pipeline_enclosed). 0, or the exit status. */
+static int field_fill(tool_ctx *t, tetsmooth_settings *s, const st_soup *soup,
+                      const st_bvh *bvh, st_soup **fill, st_soup **enc, st_bvh **enc_bvh,
+                      st_error *err)
+{
+    if (!s->field)
+        return 0;
+    st_grid *g = NULL;
+    size_t nfill = 0;
+    if (st_grid_read(&g, s->field, s->co.max_bytes, err) ||
+        st_pseudo_fill(fill, g, bvh, &nfill, err)) {
+        if (g && g->kind == ST_GRID_DISTANCE)
+            st_error_set(err, ST_EINPUT, tool_in_name(s->field), 0,
+                         "the field is distance, not signed (run soupsign first)");
+        st_grid_free(g);
+        return tool_fail(t, err);
+    }
+    st_grid_free(g);
+    s->fit.fill = *fill;
+    tool_say(t, 2, "fill: %zu voxel faces of the pseudo volume's boundary where S has "
+             "no surface count as surface for --offset", nfill);
+    if (st_pipeline_enclosed(enc, enc_bvh, soup, *fill, err))
+        return tool_fail(t, err);
+    return 0;
+}
+
 static int run(tool_ctx *t, void *settings)
 {
     tetsmooth_settings *s = settings;
@@ -245,8 +276,8 @@ static int run(tool_ctx *t, void *settings)
     st_error err;
     st_error_clear(&err);
     st_tetmesh *m = NULL;
-    st_soup *soup = NULL, *fill = NULL;
-    st_bvh *bvh = NULL;
+    st_soup *soup = NULL, *fill = NULL, *enc = NULL;
+    st_bvh *bvh = NULL, *enc_bvh = NULL;
     int rc = TOOL_EXIT_FAIL;
     int not_enclosing = 0;
     st_fit_stats fst;
@@ -287,31 +318,19 @@ static int run(tool_ctx *t, void *settings)
             rc = tool_fail(t, &err);
             goto done;
         }
-        if (s->field) {
-            /* the fill of the field's pseudo volume (pseudo.h) */
-            st_grid *g = NULL;
-            size_t nfill = 0;
-            if (st_grid_read(&g, s->field, s->co.max_bytes, &err) ||
-                st_pseudo_fill(&fill, g, bvh, &nfill, &err)) {
-                if (g && g->kind == ST_GRID_DISTANCE)
-                    st_error_set(&err, ST_EINPUT, tool_in_name(s->field), 0,
-                                 "the field is distance, not signed (run soupsign first)");
-                st_grid_free(g);
-                rc = tool_fail(t, &err);
-                goto done;
-            }
-            st_grid_free(g);
-            s->fit.fill = fill;
-            tool_say(t, 2, "fill: %zu voxel faces of the pseudo volume's boundary where S has "
-                     "no surface count as surface for --offset", nfill);
-        }
+        if ((rc = field_fill(t, s, soup, bvh, &fill, &enc, &enc_bvh, &err)))
+            goto done;
+        rc = TOOL_EXIT_FAIL;
         iter_ctx ic = {t};
         if (t->verbosity >= 2) {
             s->fit.on_iter = on_iter;
             s->fit.on_iter_ctx = &ic;
         }
         st_fit_stats st;
-        st_status s2 = st_fit(m, soup, bvh, &s->fit, &st, &prog, &err);
+        st_status s2 = st_fit(m, enc ? enc : soup, enc ? enc_bvh : bvh, &s->fit, &st, &prog,
+                              &err);
+        if (!s2 && enc && (st.outside_after || st.crossing_after))
+            s2 = st_enclosure_count(m, soup, bvh, &st.outside_after, &st.crossing_after, &err);
         tool_progress_end(t);
         if (s2) {
             rc = tool_fail_file(t, &err, inname);
@@ -373,6 +392,8 @@ static int run(tool_ctx *t, void *settings)
             rc = TOOL_EXIT_OFFSET_NOT_MET;
     }
 done:
+    st_bvh_free(enc_bvh);
+    st_soup_free(enc);
     st_bvh_free(bvh);
     st_soup_free(fill);
     st_soup_free(soup);
