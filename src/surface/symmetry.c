@@ -41,6 +41,7 @@
  * crosses the true plane would match. */
 #define REFINE_COARSE 3
 #define REFINE_WIDE 8.0
+#define REFINE_COARSE_STRIDE (4 * REFINE_STRIDE) /* the wide rounds: every 16th sample */
 /* The rounds use every REFINE_STRIDE-th sample (a plane from some
  * hundreds of midpoints), and stop once the plane moves by less than
  * REFINE_STILL tolerances and turns by less than about REFINE_STILL
@@ -479,7 +480,7 @@ static void refine_mirror(const ctx *C, st_symmetry *y, int coarse_rounds)
         size_t m = 0;
         /* sequential: the sums are in sample order, independent of
          * threads */
-        for (size_t k = 0; k < S->n; k += REFINE_STRIDE) {
+        for (size_t k = 0; k < S->n; k += coarse ? REFINE_COARSE_STRIDE : REFINE_STRIDE) {
             double q[3], nq[3], c[3], d[3];
             const double *p = S->p + 3 * k;
             st_symmetry_apply(y, 0.0, p, 1, q);
