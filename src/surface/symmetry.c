@@ -31,8 +31,17 @@
 #define VOTE_PAIRS 40000
 #define VOTE_DIR_BINS 24              /* per cube face side */
 #define VOTE_CANDIDATES 16
+#define VOTE_PEAKS 8                  /* more, from the windows (vote_mirrors) */
 #define REFINE_ROUNDS 6
 #define REFINE_REACH 3.0              /* tolerances */
+/* A peak's plane (the mean of a window of cells, a few degrees wide)
+ * starts with up to REFINE_COARSE rounds that match within REFINE_WIDE
+ * tolerances: a plane a few degrees off moves the images of the far
+ * samples by more than REFINE_REACH, and only the samples near where it
+ * crosses the true plane would match. */
+#define REFINE_COARSE 3
+#define REFINE_WIDE 8.0
+#define REFINE_COARSE_STRIDE (4 * REFINE_STRIDE) /* the wide rounds: every 16th sample */
 /* The rounds use every REFINE_STRIDE-th sample (a plane from some
  * hundreds of midpoints), and stop once the plane moves by less than
  * REFINE_STILL tolerances and turns by less than about REFINE_STILL
@@ -459,18 +468,19 @@ static st_symmetry mirror_of(const double n[3], double off)
 
 /* ICP rounds: match each sample's image to the nearest point of the soup,
  * re-estimate the plane from the pairs. */
-static void refine_mirror(const ctx *C, st_symmetry *y)
+static void refine_mirror(const ctx *C, st_symmetry *y, int coarse_rounds)
 {
     const samples *S = C->S;
     double *mid = st_malloc_array(3 * (S->n / REFINE_STRIDE + 1), sizeof *mid);
     if (!mid)
         return; /* unrefined: only a weaker support */
-    for (int round = 0; round < REFINE_ROUNDS; round++) {
+    for (int round = 0; round < coarse_rounds + REFINE_ROUNDS; round++) {
+        const int coarse = round < coarse_rounds;
         double mean[3] = {0, 0, 0};
         size_t m = 0;
         /* sequential: the sums are in sample order, independent of
          * threads */
-        for (size_t k = 0; k < S->n; k += REFINE_STRIDE) {
+        for (size_t k = 0; k < S->n; k += coarse ? REFINE_COARSE_STRIDE : REFINE_STRIDE) {
             double q[3], nq[3], c[3], d[3];
             const double *p = S->p + 3 * k;
             st_symmetry_apply(y, 0.0, p, 1, q);
@@ -480,7 +490,7 @@ static void refine_mirror(const ctx *C, st_symmetry *y)
                 fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
                 continue; /* on the plane, or sliding along it */
             st_symmetry_apply(y, 0.0, S->nrm + 3 * k, 0, nq);
-            if (!lands(C, q, nq, REFINE_REACH * C->tol, c))
+            if (!lands(C, q, nq, (coarse ? REFINE_WIDE : REFINE_REACH) * C->tol, c))
                 continue;
             for (int x = 0; x < 3; x++) {
                 mid[3 * m + x] = 0.5 * (p[x] + c[x]);
@@ -488,8 +498,13 @@ static void refine_mirror(const ctx *C, st_symmetry *y)
             }
             m++;
         }
-        if (m < 16 / REFINE_STRIDE + 4)
-            break;
+        /* (a wide round that fails leaves the plane to the close ones) */
+        if (m < 16 / REFINE_STRIDE + 4) {
+            if (!coarse)
+                break;
+            round = coarse_rounds - 1;
+            continue;
+        }
         for (int x = 0; x < 3; x++)
             mean[x] /= (double)m;
         /* the midpoints of matched pairs lie on the plane: its normal is
@@ -509,15 +524,22 @@ static void refine_mirror(const ctx *C, st_symmetry *y)
                 least = x;
         double n[3] = {ev[least][0], ev[least][1], ev[least][2]};
         normalize(n);
-        if (fabs(st_dot3(n, y->dir)) < 0.9)
-            break; /* the fit turned away: keep the plane */
+        if (fabs(st_dot3(n, y->dir)) < 0.9) {
+            if (!coarse)
+                break; /* the fit turned away: keep the plane */
+            round = coarse_rounds - 1;
+            continue;
+        }
         double off = st_dot3(n, mean);
         canon_plane(n, &off);
         double moved = fabs(off - st_dot3(y->point, y->dir)) / C->tol,
                turned = 1.0 - st_dot3(n, y->dir);
         *y = mirror_of(n, off);
-        if (moved < REFINE_STILL && turned < REFINE_STILL * REFINE_STILL)
-            break; /* settled */
+        if (moved < REFINE_STILL && turned < REFINE_STILL * REFINE_STILL) {
+            if (!coarse)
+                break; /* settled */
+            round = coarse_rounds - 1; /* settled at the wide reach */
+        }
     }
     free(mid);
 }
@@ -531,12 +553,20 @@ static int same_plane(const st_symmetry *a, const st_symmetry *b, double tol)
     return fabs(oa - ob) < tol;
 }
 
-/* Candidates by voting: cells over the cube map of the direction and the
- * offset, the heaviest become planes (the cell's mean). */
+/* Candidates by voting: each pair votes for the cell of its plane, over
+ * the cube map of the direction and the offset; the heaviest cells
+ * become planes (the cell's mean). A plane whose votes are few spreads
+ * them over the cells around it (the plane of an axis-aligned part
+ * through the origin lies on a corner of eight cells), and loses to
+ * cells of sharper false planes: so the cells are also ranked by the
+ * votes of their window (the cell and its neighbours, 3 x 3 x 3 cells of
+ * one cube face), and the cells that rank above every other in their
+ * window (the peaks) become planes too: the window's mean. */
 typedef struct vote {
-    uint64_t key;
+    uint64_t key;    /* 0: an empty slot */
     double n[3], off;
     long count;
+    long win;        /* the window's votes */
 } vote;
 
 static int cmp_vote(const void *x, const void *y)
@@ -545,6 +575,23 @@ static int cmp_vote(const void *x, const void *y)
     if (a->count != b->count)
         return a->count < b->count ? 1 : -1;
     return (a->key > b->key) - (a->key < b->key);
+}
+
+static int cmp_peak(const void *x, const void *y)
+{
+    const vote *a = x, *b = y;
+    if (a->win != b->win)
+        return a->win < b->win ? 1 : -1;
+    return (a->key > b->key) - (a->key < b->key);
+}
+
+/* A cell's key from its face m, direction cells (iu, iw) and offset io
+ * (in 2 tolerances, odd: an offset cell spans 4 tolerances, and the key
+ * is never 0). */
+static uint64_t cell_key(int m, long iu, long iw, long io)
+{
+    return ((uint64_t)m << 60) ^ ((uint64_t)(iu & 0xff) << 52) ^
+           ((uint64_t)(iw & 0xff) << 44) ^ ((uint64_t)io & 0xfffffffffffULL);
 }
 
 static uint64_t vote_key(const double n[3], double off, double tol)
@@ -557,19 +604,22 @@ static uint64_t vote_key(const double n[3], double off, double tol)
     long iu = (long)floor((n[u] / fabs(n[m]) + 1.0) * 0.5 * VOTE_DIR_BINS);
     long iw = (long)floor((n[w] / fabs(n[m]) + 1.0) * 0.5 * VOTE_DIR_BINS);
     long io = (long)floor(off / (2.0 * tol));
-    return ((uint64_t)m << 60) ^ ((uint64_t)(iu & 0xff) << 52) ^
-           ((uint64_t)(iw & 0xff) << 44) ^ ((uint64_t)io & 0xfffffffffffULL);
+    return cell_key(m, iu, iw, io | 1);
 }
 
-static size_t vote_mirrors(const ctx *C, st_symmetry *out, size_t max)
+static vote *vote_find(vote *tab, size_t cap, uint64_t key)
+{
+    size_t slot = (size_t)(mix64(key) & (cap - 1));
+    while (tab[slot].key != 0 && tab[slot].key != key)
+        slot = (slot + 1) & (cap - 1);
+    return tab + slot;
+}
+
+/* The pairs' votes into tab (cap slots, a power of two, over twice the
+ * pairs). */
+static void vote_pairs(const ctx *C, vote *tab, size_t cap)
 {
     const samples *S = C->S;
-    size_t cap = 1;
-    while (cap < 2 * (size_t)VOTE_PAIRS)
-        cap *= 2;
-    vote *tab = st_calloc_array(cap, sizeof *tab);
-    if (!tab)
-        return 0;
     uint64_t h = 0x243f6a8885a308d3ULL;
     for (long k = 0; k < VOTE_PAIRS; k++) {
         h = mix64(h + (uint64_t)k);
@@ -595,31 +645,152 @@ static size_t vote_mirrors(const ctx *C, st_symmetry *out, size_t max)
             mid[a] = 0.5 * (S->p[3 * i + a] + S->p[3 * j + a]);
         double off = st_dot3(mid, n);
         canon_plane(n, &off);
-        uint64_t key = vote_key(n, off, C->tol) | 1; /* 0 marks empty */
-        size_t slot = (size_t)(mix64(key) & (cap - 1));
-        while (tab[slot].key != 0 && tab[slot].key != key)
-            slot = (slot + 1) & (cap - 1);
-        tab[slot].key = key;
+        uint64_t key = vote_key(n, off, C->tol);
+        vote *v = vote_find(tab, cap, key);
+        v->key = key;
         for (int a = 0; a < 3; a++)
-            tab[slot].n[a] += n[a];
-        tab[slot].off += off;
-        tab[slot].count++;
+            v->n[a] += n[a];
+        v->off += off;
+        v->count++;
     }
+}
+
+/* Cell c's window: its votes (into c->win), and with `plane` its mean
+ * plane (into n, off). 1 when no cell of the window ranks above c
+ * (cmp_peak, on the windows' votes set before). */
+static int vote_window(vote *tab, size_t cap, vote *c, int plane, double n[3],
+                       double *off)
+{
+    const int m = (int)(c->key >> 60 & 3);
+    const long iu = (long)(c->key >> 52 & 0xff), iw = (long)(c->key >> 44 & 0xff);
+    long io = (long)(c->key & 0xfffffffffffULL);
+    if (io >= 1L << 43)
+        io -= 1L << 44; /* sign-extended from its 44 bits */
+    long win = 0;
+    int peak = 1;
+    double sn[3] = {0, 0, 0}, so = 0.0;
+    for (long du = -1; du <= 1; du++)
+        for (long dw = -1; dw <= 1; dw++)
+            for (long dof = -2; dof <= 2; dof += 2) {
+                const vote *v = vote_find(tab, cap, cell_key(m, iu + du, iw + dw, io + dof));
+                if (v->key == 0)
+                    continue;
+                if (plane)
+                    peak &= v == c || cmp_peak(c, v) < 0;
+                for (int a = 0; a < 3; a++)
+                    sn[a] += v->n[a];
+                so += v->off;
+                win += v->count;
+            }
+    c->win = win;
+    if (plane) {
+        for (int a = 0; a < 3; a++)
+            n[a] = sn[a];
+        normalize(n);
+        *off = so / (double)win;
+    }
+    return peak;
+}
+
+/* Up to max planes of the heaviest cells into out (*nout), then up to
+ * peaks planes of the peaks (*npeak) after them. */
+static void vote_mirrors(const ctx *C, st_symmetry *out, size_t max, size_t peaks,
+                         size_t *nout, size_t *npeak)
+{
+    *nout = *npeak = 0;
+    size_t cap = 1;
+    while (cap < 2 * (size_t)VOTE_PAIRS)
+        cap *= 2;
+    vote *tab = st_calloc_array(cap, sizeof *tab);
+    vote *cells = st_malloc_array(cap, sizeof *cells);
+    if (!tab || !cells) {
+        free(tab);
+        free(cells);
+        return;
+    }
+    vote_pairs(C, tab, cap);
     /* the filled cells alone are sorted (their keys differ: a total
      * order, so the same ranking as sorting the whole table) */
     size_t filled = 0;
     for (size_t i = 0; i < cap; i++)
-        if (tab[i].key != 0)
-            tab[filled++] = tab[i];
-    qsort(tab, filled, sizeof *tab, cmp_vote);
+        if (tab[i].key != 0) {
+            vote_window(tab, cap, tab + i, 0, NULL, NULL);
+            cells[filled++] = tab[i];
+        }
+    qsort(cells, filled, sizeof *cells, cmp_vote);
     size_t m = 0;
-    for (size_t i = 0; i < filled && m < max && tab[i].count >= 3; i++) {
-        double n[3] = {tab[i].n[0], tab[i].n[1], tab[i].n[2]};
+    for (size_t i = 0; i < filled && m < max && cells[i].count >= 3; i++) {
+        double n[3] = {cells[i].n[0], cells[i].n[1], cells[i].n[2]};
         normalize(n);
-        out[m++] = mirror_of(n, tab[i].off / (double)tab[i].count);
+        out[m++] = mirror_of(n, cells[i].off / (double)cells[i].count);
+    }
+    *nout = m;
+    /* the peaks, by their windows' votes */
+    size_t np = 0;
+    for (size_t i = 0; i < cap; i++) {
+        double n[3], off;
+        if (tab[i].key != 0 && tab[i].win >= 3 &&
+            vote_window(tab, cap, tab + i, 1, n, &off)) {
+            cells[np] = tab[i];
+            for (int a = 0; a < 3; a++)
+                cells[np].n[a] = n[a];
+            cells[np++].off = off;
+        }
+    }
+    qsort(cells, np, sizeof *cells, cmp_peak);
+    for (size_t i = 0; i < np && *npeak < peaks; i++) {
+        st_symmetry y = mirror_of(cells[i].n, cells[i].off);
+        int dup = 0;
+        for (size_t j = 0; j < m + *npeak && !dup; j++)
+            dup = same_plane(out + j, &y, C->tol);
+        if (!dup)
+            out[m + (*npeak)++] = y;
     }
     free(tab);
-    return m;
+    free(cells);
+}
+
+/* Candidates [from, to) refined (after `coarse` wide rounds), their
+ * supports set, ok[i] whether accepted. Each candidate on its own: the
+ * same result for any thread count. */
+static void measure_mirrors(const ctx *C, const st_symmetry_params *p, st_symmetry *cand,
+                            int *ok, size_t from, size_t to, int coarse)
+{
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long i = (long)from; i < (long)to; i++) {
+        refine_mirror(C, cand + i, coarse);
+        /* a plane that fails on every SCREEN-th sample by far is not
+         * measured on all: only accepted planes' supports are read */
+        /* (below the needs, measure_need may stop early: a share that
+         * low is refused either way, and only accepted ones are read) */
+        tally t = measure_need(C, cand + i, 0.0, SCREEN, 0,
+                               fmin(SCREEN_SHARE * MIN_VERIFIED, p->min_support));
+        if (share(&t) >= SCREEN_SHARE * MIN_VERIFIED)
+            t = measure_need(C, cand + i, 0.0, 1, 0, fmin(MIN_VERIFIED, p->min_support));
+        /* the contradictions matter only between the two shares */
+        if (share(&t) >= MIN_VERIFIED && share(&t) < p->min_support)
+            t = measure(C, cand + i, 0.0, 1, 1);
+        cand[i].support = share(&t);
+        ok[i] = accepted(&t, p->min_support);
+    }
+}
+
+/* The accepted candidates of [from, to) into mirrors (*nm), one per
+ * plane: the best supported. */
+static void collect_mirrors(const st_symmetry *cand, const int *ok, size_t from,
+                            size_t to, double tol, st_symmetry *mirrors, size_t *nm)
+{
+    for (size_t i = from; i < to; i++) {
+        if (!ok[i])
+            continue;
+        size_t j = 0;
+        while (j < *nm && !same_plane(mirrors + j, cand + i, tol))
+            j++;
+        if (j == *nm)
+            mirrors[(*nm)++] = cand[i];
+        else if (cand[i].support > mirrors[j].support)
+            mirrors[j] = cand[i];
+    }
 }
 
 /* ---- rotations ------------------------------------------------------------ */
@@ -1175,53 +1346,36 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
     }
 
     /* mirrors: principal planes and the votes, refined, measured */
-    st_symmetry cand[3 + VOTE_CANDIDATES];
-    size_t nc = 0;
+    st_symmetry cand[3 + VOTE_CANDIDATES + VOTE_PEAKS];
+    size_t nc = 0, nv, npeak;
     for (int a = 0; a < 3; a++) {
         double n[3] = {S.axes[a][0], S.axes[a][1], S.axes[a][2]};
         double off = st_dot3(n, S.c);
         canon_plane(n, &off);
         cand[nc++] = mirror_of(n, off);
     }
-    nc += vote_mirrors(&C, cand + nc, VOTE_CANDIDATES);
-    st_symmetry mirrors[3 + VOTE_CANDIDATES];
+    vote_mirrors(&C, cand + nc, VOTE_CANDIDATES, VOTE_PEAKS, &nv, &npeak);
+    nc += nv;
+    const size_t first_peak = nc;
+    nc += npeak;
+    st_symmetry mirrors[3 + VOTE_CANDIDATES + VOTE_PEAKS];
     size_t nm = 0;
-    /* each candidate on its own: the same result for any thread count */
-    int ok[3 + VOTE_CANDIDATES];
-#pragma omp parallel for schedule(dynamic, 1)
-    for (long i = 0; i < (long)nc; i++) {
-        refine_mirror(&C, cand + i);
-        /* a plane that fails on every SCREEN-th sample by far is not
-         * measured on all: only accepted planes' supports are read */
-        /* (below the needs, measure_need may stop early: a share that
-         * low is refused either way, and only accepted ones are read) */
-        tally t = measure_need(&C, cand + i, 0.0, SCREEN, 0,
-                               fmin(SCREEN_SHARE * MIN_VERIFIED, p->min_support));
-        if (share(&t) >= SCREEN_SHARE * MIN_VERIFIED)
-            t = measure_need(&C, cand + i, 0.0, 1, 0, fmin(MIN_VERIFIED, p->min_support));
-        /* the contradictions matter only between the two shares */
-        if (share(&t) >= MIN_VERIFIED && share(&t) < p->min_support)
-            t = measure(&C, cand + i, 0.0, 1, 1);
-        cand[i].support = share(&t);
-        ok[i] = accepted(&t, p->min_support);
+    int ok[3 + VOTE_CANDIDATES + VOTE_PEAKS];
+    measure_mirrors(&C, p, cand, ok, 0, first_peak, 0);
+    collect_mirrors(cand, ok, 0, first_peak, p->tolerance, mirrors, &nm);
+    /* the peaks: a second look where the sharpest cells give no plane */
+    if (nm == 0 && nc > first_peak) {
+        measure_mirrors(&C, p, cand, ok, first_peak, nc, REFINE_COARSE);
+        collect_mirrors(cand, ok, first_peak, nc, p->tolerance, mirrors, &nm);
+    } else {
+        nc = first_peak;
     }
-    for (size_t i = 0; i < nc; i++) {
-        out->candidates++;
-        if (ok[i]) {
-            size_t j = 0;
-            while (j < nm && !same_plane(mirrors + j, cand + i, p->tolerance))
-                j++;
-            if (j == nm)
-                mirrors[nm++] = cand[i];
-            else if (cand[i].support > mirrors[j].support)
-                mirrors[j] = cand[i];
-        }
-    }
+    out->candidates += nc;
     for (size_t i = 0; i < nm; i++)
         keep(out, mirrors + i, p->tolerance);
 
     /* rotation axes: where two mirrors meet, and the principal axes */
-    st_symmetry axes[3 + (3 + VOTE_CANDIDATES) * (2 + VOTE_CANDIDATES) / 2];
+    st_symmetry axes[3 + 15]; /* the meets of the best six mirrors */
     size_t na = 0;
     /* the best mirrors first; the meets of the best six */
     qsort(mirrors, nm, sizeof *mirrors, cmp_sym);
