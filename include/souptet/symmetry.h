@@ -168,7 +168,10 @@ typedef struct st_symmetry_fill_gate {
     double reach;         /* the groups' largest reach: half a box
                              diagonal */
     double spread;        /* the largest distance from one of s's
-                             triangles' centroid to a corner */
+                             triangles' centroid to a corner (INFINITY:
+                             not needed, the first test held at every
+                             group; NaN: an open rim settled it, and
+                             pieces, active and reach are 0 then) */
     double margin;        /* the images' rounding allowed for */
 } st_symmetry_fill_gate;
 
@@ -190,8 +193,9 @@ typedef struct st_symmetry_fill_gate {
  * Each test is a strict inequality with a margin of 2^-30 of the soup's
  * coordinates for the images' rounding. gate (may be NULL) gets the
  * figures. bvh: st_bvh_build(s); edges: s's table (NULL: none, as for
- * the fill). Cost: a sort of the caps' vertices, a nearest point of s per
- * cap corner, one pass over s and over its boundary. ST_EINPUT (no soup or
+ * the fill). Cost: a pass over s's edges; where no open rim settles it,
+ * a sort of the caps' vertices and a nearest point of s per cap corner
+ * (and a pass over s for the spread where the first test fails). ST_EINPUT (no soup or
  * BVH, a tol not positive and finite); ST_ENOMEM. The proof:
  * doc/design/symmetry.md, "The gate". */
 st_status st_symmetry_fill_may_act(int *may, st_symmetry_fill_gate *gate, const st_soup *s,

@@ -85,8 +85,8 @@ static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_soup_edge
         st->symmetry_fill.caps = gate.pieces;   /* considered, not searched */
         char why[200];
         snprintf(why, sizeof why, "not searched: no fill could change any of the %zu caps "
-                 "by a voxel (%.6g; their reach %.6g, triangles' spread %.6g) and no hole is "
-                 "too large to cap", gate.pieces, g->voxel, gate.reach, gate.spread);
+                 "by a voxel (%.6g; their largest reach %.6g) and no hole is too large to cap",
+                 gate.pieces, g->voxel, gate.reach);
         if (st_meta_set(&g->meta, "symmetry_fill", why))
             rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     }

@@ -1343,10 +1343,10 @@ static double triangle_spread(const st_soup *s)
             c[a] = (x[0][a] + x[1][a] + x[2][a]) / 3.0;
         for (int k = 0; k < 3; k++) {
             const double d[3] = {x[k][0] - c[0], x[k][1] - c[1], x[k][2] - c[2]};
-            most = fmax(most, st_norm3(d));
+            most = fmax(most, st_dot3(d, d));
         }
     }
-    return most;
+    return sqrt(most);
 }
 
 /* The largest distance from a point of triangle x to its nearest corner.
@@ -1429,11 +1429,14 @@ static st_status loops_off_caps(size_t *n, const st_soup *s, const st_soup_edges
     for (size_t w = 0; w < nw && !rc; w++)
         uf[w] = w;
     size_t m = 0;
-    for (size_t i = 0; i < E->nhalf && !rc; i = st_soup_edges_run_end(E, i)) {
+    for (size_t i = 0, next; i < E->nhalf && !rc; i = next) {
+        next = st_soup_edges_run_end(E, i);
+        if (next != i + 1)
+            continue;   /* not a boundary edge */
         const uint32_t t = E->he[i].t, wa = (uint32_t)(E->he[i].key >> 32);
         const uint32_t wb = (uint32_t)E->he[i].key;
         const int a = st_soup_edges_corner(E, s, t, wa), b = st_soup_edges_corner(E, s, t, wb);
-        if (st_soup_edges_run_end(E, i) != i + 1 || a < 0 || b < 0)
+        if (a < 0 || b < 0)
             continue;
         const double *p = s->xyz + 3 * s->tris[3 * t + a], *q = s->xyz + 3 * s->tris[3 * t + b];
         const double mid[3] = {0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]), 0.5 * (p[2] + q[2])};
@@ -1481,8 +1484,9 @@ st_status st_symmetry_fill_may_act(int *may, st_symmetry_fill_gate *gate, const 
     rc = rc || !any ? rc : caps_groups(group, reach, caps);
     rc = rc || !any || !edges ? rc : st_bvh_build(&caps_bvh, caps, err);
     rc = rc || !edges ? rc : loops_off_caps(&g->open_edges, s, edges, caps_bvh, tol);
-    if (!rc) {
-        g->spread = triangle_spread(s);
+    if (!rc && g->open_edges) {
+        g->spread = NAN;   /* not needed: an open rim is enough */
+    } else if (!rc) {
         /* the images' rounding: a few units in the last place of
          * coordinates of the soup's size, far below 2^-30 of them */
         double lo[3], hi[3], big = 0.0;
@@ -1494,9 +1498,17 @@ st_status st_symmetry_fill_may_act(int *may, st_symmetry_fill_gate *gate, const 
                 g->reach = fmax(g->reach, reach[v]);
                 g->pieces++;
             }
-        g->margin = ldexp(big + g->spread + g->reach, -30);
-        g->active = any ? groups_active(bad, group, reach, caps, bvh, g->spread, g->margin, tol)
+        /* the first test alone; the second needs the spread, a pass over
+         * s, and runs only where the first fails */
+        g->spread = INFINITY;
+        g->margin = ldexp(big + g->reach, -30);
+        g->active = any ? groups_active(bad, group, reach, caps, bvh, INFINITY, g->margin, tol)
                         : 0;
+        if (g->active) {
+            g->spread = triangle_spread(s);
+            g->margin = ldexp(big + g->spread + g->reach, -30);
+            g->active = groups_active(bad, group, reach, caps, bvh, g->spread, g->margin, tol);
+        }
         *may = g->open_edges > 0 || g->active > 0;
     }
     st_bvh_free(caps_bvh);
