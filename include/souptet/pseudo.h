@@ -105,7 +105,10 @@ typedef struct st_pseudo_stats {
     st_holes_stats holes;
     size_t cap_triangles;           /* the caps', and the symmetric fill's */
     st_symmetry_set symmetries;     /* found (step 2 with symmetry on and caps) */
-    st_symmetry_fill_stats symmetry_fill;
+    st_symmetry_fill_stats symmetry_fill;   /* where the gate
+                                       (st_symmetry_fill_may_act) skipped
+                                       the search: caps the cap groups it
+                                       tested, no candidates above */
     double seconds_symmetry;        /* detection and fill, within seconds_holes */
     st_sides_stats sides;
     size_t mirrored;                /* voxels a one-sided view's mirror added */

@@ -155,6 +155,53 @@ st_status st_symmetry_fill(st_soup **fill, st_soup **kept_caps, const st_soup *s
                            const st_symmetry_set *set, const st_soup *caps, double tol,
                            st_symmetry_fill_stats *stats, st_error *err);
 
+/* ---- the gate: where no fill can matter --------------------------------- */
+
+typedef struct st_symmetry_fill_gate {
+    size_t pieces;        /* the caps' groups: triangles joined by a shared
+                             point (each holds one or more of the fill's
+                             pieces) */
+    size_t active;        /* of them, those an image might fill */
+    size_t open_edges;    /* boundary edges of s (edges) farther than tol
+                             from every cap that close into loops: the
+                             fill's open rims */
+    double reach;         /* the groups' largest reach: half a box
+                             diagonal */
+    double spread;        /* the largest distance from one of s's
+                             triangles' centroid to a corner (INFINITY:
+                             not needed, the first test held at every
+                             group; NaN: an open rim settled it, and
+                             pieces, active and reach are 0 then) */
+    double margin;        /* the images' rounding allowed for */
+} st_symmetry_fill_gate;
+
+/* Whether st_symmetry_fill(.., s, edges, bvh, set, caps, tol, ..) may
+ * return a fill or drop a cap, for any set of symmetries, told without
+ * searching for them: *may 0 when it provably can do neither, else 1.
+ * It can do neither when there is no open rim (every boundary loop of s
+ * runs within tol of a cap) and at each cap piece either no image is
+ * kept or none departs from the cap. Every image is one of s's triangles
+ * moved by a rigid map (mirror, turn, screw); one kept for a cap piece
+ * has its centroid within the piece's reach (half its box diagonal) of
+ * the caps, nearest that piece, and farther than tol from s. So:
+ * - none is kept where each cap triangle's corners lie within e of s and
+ *   sqrt(reach^2 + h^2) + e < tol (h: the farthest any point of the
+ *   triangle lies from its nearest corner);
+ * - none departs (every corner and centroid within tol of the caps: the
+ *   cap is kept, without fill) where reach + spread < tol (spread: the
+ *   farthest a corner of one of s's triangles lies from its centroid).
+ * Each test is a strict inequality with a margin of 2^-30 of the soup's
+ * coordinates for the images' rounding. gate (may be NULL) gets the
+ * figures. bvh: st_bvh_build(s); edges: s's table (NULL: none, as for
+ * the fill). Cost: a pass over s's edges; where no open rim settles it,
+ * a sort of the caps' vertices and a nearest point of s per cap corner
+ * (and a pass over s for the spread where the first test fails). ST_EINPUT (no soup or
+ * BVH, a tol not positive and finite); ST_ENOMEM. The proof:
+ * doc/design/symmetry.md, "The gate". */
+st_status st_symmetry_fill_may_act(int *may, st_symmetry_fill_gate *gate, const st_soup *s,
+                                   const st_soup_edges *edges, const st_bvh *bvh,
+                                   const st_soup *caps, double tol, st_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -878,9 +878,14 @@ int tool_report_symmetries(tool_ctx *t, const st_soup *soup, const st_bvh *bvh,
         st_bvh_free(built);
         if (st)
             return tool_fail(t, &err);
+        /* fill->caps without candidates: the gate (symmetry.h) skipped the search */
+        char why[160];
+        snprintf(why, sizeof why, fill->caps ? "not searched by the signs (no fill could change "
+                 "any of the %zu caps by a voxel, and no hole is too large to cap)"
+                 : "not used (no holes to fill, or --symmetry off)", fill->caps);
         tool_say(t, 2, "symmetries: %zu accepted (support >= %.2f, or a mirror seldom "
-                 "contradicted) within %.6g (%zu candidates measured, %.3f s); not used (no holes to fill, or --symmetry off)",
-                 own.n, sp.min_support, tolerance, own.candidates, tool_now() - t0);
+                 "contradicted) within %.6g (%zu candidates measured, %.3f s); %s",
+                 own.n, sp.min_support, tolerance, own.candidates, tool_now() - t0, why);
         set = &own;
     }
     for (size_t i = 0; i < set->n; i++) {

@@ -66,8 +66,9 @@ static st_status shells_only(st_grid *g, const st_shells *shells, const st_pseud
 }
 
 /* Step 2's symmetry (pseudo.h): the soup's symmetries at a voxel's
- * tolerance; where they are, *caps becomes the caps the fill does not
- * cover and the fill. */
+ * tolerance, searched only where a fill could change something (the
+ * gate); where they are, *caps becomes the caps the fill does not cover
+ * and the fill. */
 static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_soup_edges *edges,
                                 const st_bvh *bvh, const st_pseudo_params *p,
                                 st_pseudo_stats *st, st_soup **caps, st_error *err)
@@ -75,7 +76,21 @@ static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_soup_edge
     const double t0 = now_seconds();
     st_symmetry_params sp = st_symmetry_params_default();
     sp.tolerance = g->voxel;
-    st_status rc = st_symmetry_detect(&st->symmetries, s, bvh, &sp, err);
+    /* the gate (symmetry.h): where no fill can drop a cap or close an open
+     * rim, the search would change nothing; its record says why */
+    int may = 1;
+    st_symmetry_fill_gate gate;
+    st_status rc = st_symmetry_fill_may_act(&may, &gate, s, edges, bvh, *caps, g->voxel, err);
+    if (!rc && !may) {
+        st->symmetry_fill.caps = gate.pieces;   /* considered, not searched */
+        char why[200];
+        snprintf(why, sizeof why, "not searched: no fill could change any of the %zu caps "
+                 "by a voxel (%.6g; their largest reach %.6g) and no hole is too large to cap",
+                 gate.pieces, g->voxel, gate.reach);
+        if (st_meta_set(&g->meta, "symmetry_fill", why))
+            rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
+    rc = rc || !may ? rc : st_symmetry_detect(&st->symmetries, s, bvh, &sp, err);
     if (rc || st->symmetries.n == 0) {
         st->seconds_symmetry = now_seconds() - t0;
         return rc;

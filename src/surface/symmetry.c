@@ -14,6 +14,7 @@
 #include "souptet/edges.h"
 #include "souptet/geom.h"
 #include "souptet/mem.h"
+#include "../base/unionfind.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -1420,4 +1421,255 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
     qsort(out->items, out->n, sizeof *out->items, cmp_sym);
     ctx_free(&C, &S);
     return ST_OK;
+}
+
+/* ---- the gate: where no fill can matter (st_symmetry_fill_may_act) -------- */
+
+typedef struct gate_point {
+    double x[3];
+    size_t v;
+} gate_point;
+
+static int cmp_gate_point(const void *a, const void *b)
+{
+    const gate_point *p = a, *q = b;
+    for (int k = 0; k < 3; k++)
+        if (p->x[k] != q->x[k])
+            return p->x[k] < q->x[k] ? -1 : 1;
+    return p->v < q->v ? -1 : p->v > q->v;
+}
+
+/* group[v]: the caps' groups, each named by its smallest vertex:
+ * triangles joined by a shared vertex or position (coarser than the
+ * fill's pieces, which share an edge, so no piece's reach exceeds its
+ * group's); reach[g]: half group g's box diagonal. ST_ENOMEM. */
+static st_status caps_groups(size_t *group, double *reach, const st_soup *caps)
+{
+    const size_t nv = caps->nverts;
+    gate_point *pt = st_malloc_array(nv ? nv : 1, sizeof *pt);
+    double *box = st_malloc_array(nv ? 6 * nv : 1, sizeof *box);
+    if (!pt || !box) {
+        free(pt);
+        free(box);
+        return ST_ENOMEM;
+    }
+    for (size_t v = 0; v < nv; v++) {
+        memcpy(pt[v].x, caps->xyz + 3 * v, sizeof pt[v].x);
+        pt[v].v = group[v] = v;
+    }
+    qsort(pt, nv, sizeof *pt, cmp_gate_point);
+    for (size_t i = 1; i < nv; i++)
+        if (memcmp(pt[i - 1].x, pt[i].x, sizeof pt[i].x) == 0)
+            uf_join(group, pt[i - 1].v, pt[i].v);
+    for (size_t t = 0; t < caps->ntris; t++) {
+        uf_join(group, caps->tris[3 * t], caps->tris[3 * t + 1]);
+        uf_join(group, caps->tris[3 * t], caps->tris[3 * t + 2]);
+    }
+    /* each group's box at its name, which comes first */
+    for (size_t v = 0; v < nv; v++) {
+        const size_t g = group[v] = uf_find(group, v);
+        const double *x = caps->xyz + 3 * v;
+        for (int k = 0; k < 3; k++) {
+            box[6 * g + k] = g == v ? x[k] : fmin(box[6 * g + k], x[k]);
+            box[6 * g + 3 + k] = g == v ? x[k] : fmax(box[6 * g + 3 + k], x[k]);
+        }
+    }
+    for (size_t v = 0; v < nv; v++) {
+        const double *b = box + 6 * v;
+        const double d[3] = {b[3] - b[0], b[4] - b[1], b[5] - b[2]};
+        reach[v] = group[v] == v ? 0.5 * st_norm3(d) : 0.0;
+    }
+    free(pt);
+    free(box);
+    return ST_OK;
+}
+
+/* The largest distance from a triangle's centroid to its corners, over s. */
+static double triangle_spread(const st_soup *s)
+{
+    double most = 0.0;
+    for (size_t t = 0; t < s->ntris; t++) {
+        const double *x[3];
+        double c[3];
+        for (int k = 0; k < 3; k++)
+            x[k] = s->xyz + 3 * s->tris[3 * t + k];
+        for (int a = 0; a < 3; a++)
+            c[a] = (x[0][a] + x[1][a] + x[2][a]) / 3.0;
+        for (int k = 0; k < 3; k++) {
+            const double d[3] = {x[k][0] - c[0], x[k][1] - c[1], x[k][2] - c[2]};
+            most = fmax(most, st_dot3(d, d));
+        }
+    }
+    return sqrt(most);
+}
+
+/* The largest distance from a point of triangle x to its nearest corner.
+ * That distance, over a cell of the corners' Voronoi diagram within the
+ * triangle, is convex, so it peaks at a vertex of the cell: on the
+ * triangle's boundary, within half its edge of an end of that edge, or at
+ * the circumcentre, inside where x is acute. So: the circumradius (with
+ * 2^-20 of it for rounding) where x is acute, else half the longest edge. */
+static double corner_reach(const double *x[3])
+{
+    double e[3][3], l2[3];
+    for (int k = 0; k < 3; k++) {
+        const double *a = x[(k + 1) % 3], *b = x[(k + 2) % 3];
+        for (int c = 0; c < 3; c++)
+            e[k][c] = b[c] - a[c];
+        l2[k] = st_dot3(e[k], e[k]);
+    }
+    const double most = fmax(l2[0], fmax(l2[1], l2[2]));
+    double n[3];
+    st_cross3(n, e[0], e[1]);
+    const double twice_area = st_norm3(n);
+    if (2.0 * most < l2[0] + l2[1] + l2[2] && twice_area > 0.0) {
+        const double r = sqrt(l2[0]) * sqrt(l2[1]) * sqrt(l2[2]) / (2.0 * twice_area);
+        return fmax(r * (1.0 + ldexp(1.0, -20)), 0.5 * sqrt(most));
+    }
+    return 0.5 * sqrt(most);
+}
+
+/* How many of the caps' groups an image may fill: those where neither
+ * holds, for every cap triangle t of the group:
+ * - no image is kept: t's corners lie within `on` of s, and a point
+ *   within the group's reach of t (the centroid of an image the fill
+ *   keeps for it: within its piece's reach of the caps, nearest t) is
+ *   within sqrt(reach^2 + h^2) of a corner (h: corner_reach; t is convex
+ *   and the point's nearest in t is a foot), so within tol of s, where
+ *   the fill keeps no image;
+ * - no image kept departs from the caps: reach + spread < tol.
+ * bad[g] (g: the group's name, size caps->nverts) is scratch. */
+static size_t groups_active(uint8_t *bad, const size_t *group, const double *reach,
+                            const st_soup *caps, const st_bvh *bvh, double spread,
+                            double margin, double tol)
+{
+    memset(bad, 0, caps->nverts);
+    for (size_t t = 0; t < caps->ntris; t++) {
+        const size_t g = group[caps->tris[3 * t]];
+        if (bad[g] || reach[g] + spread + margin < tol)
+            continue;
+        const double *x[3];
+        double on = 0.0;
+        for (int k = 0; k < 3; k++) {
+            x[k] = caps->xyz + 3 * caps->tris[3 * t + k];
+            int64_t tri;
+            const double d2 = st_bvh_nearest(bvh, x[k], tol * tol, &tri, NULL);
+            on = tri < 0 ? INFINITY : fmax(on, sqrt(d2));
+        }
+        const double h = corner_reach(x);
+        bad[g] = !(sqrt(reach[g] * reach[g] + h * h) + on + margin < tol);
+    }
+    size_t n = 0;
+    for (size_t v = 0; v < caps->nverts; v++)
+        n += bad[v];
+    return n;
+}
+
+/* The boundary edges of s (in one triangle alone; E: its table) whose
+ * midpoint lies farther than tol from every cap (caps_bvh; NULL: no
+ * caps) and that close into loops: two such edges at each welded end of
+ * theirs, as st_symmetry_fill's open rims (an open rim is such a loop).
+ * *n gets their number. ST_ENOMEM. */
+static st_status loops_off_caps(size_t *n, const st_soup *s, const st_soup_edges *E,
+                                const st_bvh *caps_bvh, double tol)
+{
+    *n = 0;
+    const size_t nw = E->nweld ? E->nweld : 1;
+    size_t *uf = st_malloc_array(nw, sizeof *uf);
+    uint32_t *deg = calloc(nw, sizeof *deg);
+    uint64_t *off = st_malloc_array(E->nhalf ? E->nhalf : 1, sizeof *off);
+    uint8_t *pinched = calloc(nw, 1);
+    st_status rc = uf && deg && off && pinched ? ST_OK : ST_ENOMEM;
+    for (size_t w = 0; w < nw && !rc; w++)
+        uf[w] = w;
+    size_t m = 0;
+    for (size_t i = 0, next; i < E->nhalf && !rc; i = next) {
+        next = st_soup_edges_run_end(E, i);
+        if (next != i + 1)
+            continue;   /* not a boundary edge */
+        const uint32_t t = E->he[i].t, wa = (uint32_t)(E->he[i].key >> 32);
+        const uint32_t wb = (uint32_t)E->he[i].key;
+        const int a = st_soup_edges_corner(E, s, t, wa), b = st_soup_edges_corner(E, s, t, wb);
+        if (a < 0 || b < 0)
+            continue;
+        const double *p = s->xyz + 3 * s->tris[3 * t + a], *q = s->xyz + 3 * s->tris[3 * t + b];
+        const double mid[3] = {0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]), 0.5 * (p[2] + q[2])};
+        if (caps_bvh && st_bvh_within(caps_bvh, mid, tol * tol))
+            continue;
+        off[m++] = E->he[i].key;
+        uf_join(uf, wa, wb);
+        deg[wa]++;
+        deg[wb]++;
+    }
+    for (size_t w = 0; w < nw && !rc; w++)
+        if (deg[w] && deg[w] != 2)
+            pinched[uf_find(uf, w)] = 1;
+    for (size_t k = 0; k < m; k++)
+        *n += !pinched[uf_find(uf, (size_t)(off[k] >> 32))];
+    free(uf);
+    free(deg);
+    free(off);
+    free(pinched);
+    return rc;
+}
+
+st_status st_symmetry_fill_may_act(int *may, st_symmetry_fill_gate *gate, const st_soup *s,
+                                   const st_soup_edges *edges, const st_bvh *bvh,
+                                   const st_soup *caps, double tol, st_error *err)
+{
+    st_symmetry_fill_gate local;
+    st_symmetry_fill_gate *g = gate ? gate : &local;
+    memset(g, 0, sizeof *g);
+    *may = 1;
+    if (!s || !bvh || !(tol > 0.0) || !isfinite(tol))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "symmetry gate: no soup, or a tolerance not positive and finite");
+    if (s->ntris == 0) {
+        *may = 0;   /* the fill has nothing to map */
+        return ST_OK;
+    }
+    const size_t nv = caps ? caps->nverts : 0;
+    size_t *group = st_malloc_array(nv ? nv : 1, sizeof *group);
+    double *reach = st_malloc_array(nv ? nv : 1, sizeof *reach);
+    uint8_t *bad = st_malloc_array(nv ? nv : 1, 1);
+    st_bvh *caps_bvh = NULL;
+    st_status rc = group && reach && bad ? ST_OK : ST_ENOMEM;
+    const int any = caps && caps->ntris;
+    rc = rc || !any ? rc : caps_groups(group, reach, caps);
+    rc = rc || !any || !edges ? rc : st_bvh_build(&caps_bvh, caps, err);
+    rc = rc || !edges ? rc : loops_off_caps(&g->open_edges, s, edges, caps_bvh, tol);
+    if (!rc && g->open_edges) {
+        g->spread = NAN;   /* not needed: an open rim is enough */
+    } else if (!rc) {
+        /* the images' rounding: a few units in the last place of
+         * coordinates of the soup's size, far below 2^-30 of them */
+        double lo[3], hi[3], big = 0.0;
+        st_soup_bounds(s, lo, hi, NULL);
+        for (int k = 0; k < 3; k++)
+            big = fmax(big, fmax(fabs(lo[k]), fabs(hi[k])));
+        for (size_t v = 0; v < nv && any; v++)
+            if (group[v] == v) {
+                g->reach = fmax(g->reach, reach[v]);
+                g->pieces++;
+            }
+        /* the first test alone; the second needs the spread, a pass over
+         * s, and runs only where the first fails */
+        g->spread = INFINITY;
+        g->margin = ldexp(big + g->reach, -30);
+        g->active = any ? groups_active(bad, group, reach, caps, bvh, INFINITY, g->margin, tol)
+                        : 0;
+        if (g->active) {
+            g->spread = triangle_spread(s);
+            g->margin = ldexp(big + g->spread + g->reach, -30);
+            g->active = groups_active(bad, group, reach, caps, bvh, g->spread, g->margin, tol);
+        }
+        *may = g->open_edges > 0 || g->active > 0;
+    }
+    st_bvh_free(caps_bvh);
+    free(group);
+    free(reach);
+    free(bad);
+    if (rc == ST_ENOMEM)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the symmetry gate");
+    return rc;
 }
