@@ -864,19 +864,25 @@ static void walk_group(const st_grid *g, const brick_out *o,
     uint32_t *kept = sc->kept, nkept = 0;
     uint8_t *bucket = sc->bucket;
     const double *bx = sc->bx, *by = sc->by, *bz = sc->bz, *br = sc->br;
+    /* First the kept ones, without a branch (about half are kept, in no
+     * pattern a predictor learns), their squared distances in the walk
+     * list's bounds until the scatter below sets them. */
+    double *dd2 = sc->w.bound;
     for (size_t q = 0; q < m; q++) {
         const double dx = v->c[0] - bx[q], dy = v->c[1] - by[q],
                      dz = v->c[2] - bz[q];
         const double dd = dx * dx + dy * dy + dz * dz, reach = R + br[q];
-        if (dd >= reach * reach)
-            continue;
-        const double k = sqrt(dd) - br[q];
+        kept[nkept] = (uint32_t)q;
+        dd2[nkept] = dd;
+        nkept += dd < reach * reach;
+    }
+    for (uint32_t e = 0; e < nkept; e++) {
+        const double k = sqrt(dd2[e]) - br[kept[e]];
         /* Nondecreasing in k: a later bucket's keys are never below an
          * earlier one's. */
         const double f = k / width;
         const uint32_t b = k <= 0.0 ? 0 : f >= NBUCKET - 2 ? NBUCKET - 1 : 1 + (uint32_t)f;
-        kept[nkept] = (uint32_t)q;
-        bucket[nkept++] = (uint8_t)b;
+        bucket[e] = (uint8_t)b;
         count[b + 1]++;
         lo[b] = MIN2(lo[b], k);
     }
