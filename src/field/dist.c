@@ -38,6 +38,9 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 #include <string.h>
 #ifdef _OPENMP
 #include <omp.h>
@@ -432,6 +435,14 @@ typedef struct brick_scratch {
     walk_list w;
     tri_setup *setups;
     uint32_t nsetup;
+    /* A block's bricks share their setups (a field stored by blocks):
+     * table maps a triangle to its setup, open addressing, 2 * tcap
+     * entries (triangle, slot), empty UINT32_MAX; spos[slot] is where
+     * each setup's entry is, to clear the table after the block. */
+    int shared;
+    size_t tcap, scap;
+    uint32_t *table;
+    size_t *spos;
 } brick_scratch;
 
 static void scratch_free(brick_scratch *sc)
@@ -452,6 +463,8 @@ static void scratch_free(brick_scratch *sc)
     free(sc->kept);
     free(sc->bucket);
     free(sc->setups);
+    free(sc->table);
+    free(sc->spos);
 }
 
 static int scratch_grow(void **p, size_t n, size_t size)
@@ -480,11 +493,52 @@ static int scratch_reserve(brick_scratch *sc, size_t m)
             return -1;
     if (scratch_grow((void **)&sc->kept, cap, sizeof(uint32_t)) ||
         scratch_grow((void **)&sc->bucket, cap, 1) ||
-        scratch_grow((void **)&sc->keys, 2 * cap, sizeof(cand_key)) ||
-        scratch_grow((void **)&sc->setups, cap, sizeof(tri_setup)))
+        scratch_grow((void **)&sc->keys, 2 * cap, sizeof(cand_key)))
         return -1;
     sc->cap = cap;
     return 0;
+}
+
+/* Room for n setups (and, shared, their table). -1: out of memory. */
+static int scratch_setups(brick_scratch *sc, size_t n)
+{
+    if (n > sc->scap) {
+        size_t cap = n < 64 ? 64 : n;
+        if (scratch_grow((void **)&sc->setups, cap, sizeof(tri_setup)) ||
+            scratch_grow((void **)&sc->spos, cap, sizeof(size_t)))
+            return -1;
+        sc->scap = cap;
+    }
+    if (sc->shared && 2 * n > sc->tcap) {
+        size_t t = 128;
+        while (t < 2 * n)
+            t *= 2;
+        if (scratch_grow((void **)&sc->table, t, 2 * sizeof(uint32_t)))
+            return -1;
+        for (size_t i = 0; i < 2 * t; i++)
+            sc->table[i] = UINT32_MAX;
+        sc->tcap = t;
+    }
+    return 0;
+}
+
+/* The index in the table of triangle tri's entry: its own, or the empty
+ * one where it would go. */
+static inline size_t setup_entry(const brick_scratch *sc, uint32_t tri)
+{
+    size_t h = ((size_t)tri * 2654435761u) & (sc->tcap - 1);
+    while (sc->table[2 * h] != UINT32_MAX && sc->table[2 * h] != tri)
+        h = (h + 1) & (sc->tcap - 1);
+    return 2 * h;
+}
+
+/* Empty the table: the entries of the setups made. */
+static void setups_clear(brick_scratch *sc)
+{
+    if (sc->shared)
+        for (uint32_t i = 0; i < sc->nsetup; i++)
+            sc->table[sc->spos[i]] = UINT32_MAX;
+    sc->nsetup = 0;
 }
 
 /* The voxels of a brick or group: [lo, hi) per axis, and their center. */
@@ -515,8 +569,9 @@ static inline size_t out_index(const brick_out *o, size_t i, size_t j, size_t k)
            (k - o->lo[2]) * o->s[2];
 }
 
-/* Exact band distances for the voxels of box v, walking list w (bounds
- * from v's center). */
+/* Exact distances, and nearest triangles, for the voxels of a full
+ * field's box v, walking list w (bounds from v's center) voxel by voxel.
+ * A band field's groups are walked by walk_band. */
 static void walk_box(const st_grid *g, const brick_out *o, const st_soup *s,
                      const voxel_box *v, const walk_list *w, double B,
                      brick_scratch *sc)
@@ -589,6 +644,160 @@ static void walk_box(const st_grid *g, const brick_out *o, const st_soup *s,
     sc->nsetup = nsetup;
 }
 
+/* One band voxel's candidate: set up (once per brick) and measured, its
+ * plane first. Keeps the smaller squared distance in *cur, its root in
+ * *curd. */
+static inline void band_try(const st_soup *s, brick_scratch *sc,
+                            uint32_t *nsetup, uint32_t c, const double p[3],
+                            double *cur, double *curd)
+{
+    if (sc->slot[c] == UINT32_MAX) {
+        const uint32_t at = (*nsetup)++;
+        sc->slot[c] = at;
+        setup_triangle(&sc->setups[at], s, sc->tri[c]);
+        if (sc->shared) {
+            const size_t e = setup_entry(sc, sc->tri[c]);
+            sc->table[e] = sc->tri[c];
+            sc->table[e + 1] = at;
+            sc->spos[at] = e;
+        }
+    }
+    const tri_setup *t = &sc->setups[sc->slot[c]];
+    double pd = 0.0;
+    if (!t->degenerate) {
+        double v0p[3];
+        st_sub3(v0p, p, t->v[0]);
+        pd = st_dot3(v0p, t->nu);
+        if (pd * pd >= *cur)
+            return;         /* its plane is too far */
+    }
+    const double d2 = tri_dist2(t, p, pd);
+    if (d2 < *cur) {
+        *cur = d2;
+        *curd = sqrt(d2);
+    }
+}
+
+enum { BAND_NV = GROUP * GROUP * GROUP };
+
+/* For candidate q of w and the voxels e of a band group: bit e of *live
+ * when walk_box's stop test lets voxel e go on (its bound, less the
+ * voxel's offset, below its best distance), and of *pass when it is live
+ * and the candidate's ball comes within its best distance too. The same
+ * IEEE operations in the same order as walk_box's, two voxels at a time
+ * where SSE2 is there. */
+static inline void band_masks(const double *px, const double *py,
+                              const double *pz, const double *off,
+                              const double *curd, const walk_list *w,
+                              size_t q, unsigned *live, unsigned *pass)
+{
+#ifdef __SSE2__
+    const __m128d bq = _mm_set1_pd(w->bound[q]), xq = _mm_set1_pd(w->x[q]),
+                  yq = _mm_set1_pd(w->y[q]), zq = _mm_set1_pd(w->z[q]),
+                  rq = _mm_set1_pd(w->r[q]);
+    unsigned l = 0, p = 0;
+    /* Unrolled: the shifts are constants. */
+#define BAND_PAIR(e)                                                          \
+    do {                                                                      \
+        const __m128d dx = _mm_sub_pd(_mm_loadu_pd(px + (e)), xq),            \
+                      dy = _mm_sub_pd(_mm_loadu_pd(py + (e)), yq),            \
+                      dz = _mm_sub_pd(_mm_loadu_pd(pz + (e)), zq);            \
+        const __m128d cd = _mm_loadu_pd(curd + (e));                          \
+        const __m128d dd = _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx),          \
+                                                 _mm_mul_pd(dy, dy)),         \
+                                      _mm_mul_pd(dz, dz));                    \
+        const __m128d reach = _mm_add_pd(cd, rq);                             \
+        const __m128d a =                                                     \
+            _mm_cmplt_pd(_mm_sub_pd(bq, _mm_loadu_pd(off + (e))), cd);        \
+        const __m128d b =                                                     \
+            _mm_and_pd(a, _mm_cmplt_pd(dd, _mm_mul_pd(reach, reach)));       \
+        l |= (unsigned)_mm_movemask_pd(a) << (e);                             \
+        p |= (unsigned)_mm_movemask_pd(b) << (e);                             \
+    } while (0)
+    _Static_assert(BAND_NV == 8, "four pairs of voxels");
+    BAND_PAIR(0);
+    BAND_PAIR(2);
+    BAND_PAIR(4);
+    BAND_PAIR(6);
+#undef BAND_PAIR
+    *live = l;
+    *pass = p;
+#else
+    const double bq = w->bound[q], xq = w->x[q], yq = w->y[q], zq = w->z[q],
+                 rq = w->r[q];
+    unsigned l = 0, p = 0;
+    for (unsigned e = 0; e < BAND_NV; e++) {
+        const double dx = px[e] - xq, dy = py[e] - yq, dz = pz[e] - zq;
+        const double reach = curd[e] + rq;
+        const unsigned a = bq - off[e] < curd[e];
+        l |= a << e;
+        p |= (a & (dx * dx + dy * dy + dz * dz < reach * reach)) << e;
+    }
+    *live = l;
+    *pass = p;
+#endif
+}
+
+/* A band field's group v (at most GROUP^3 voxels), walking list w
+ * candidate by candidate for all its voxels at once: the stop and ball
+ * tests of walk_box for every voxel, without branches (the compiler may
+ * do them side by side), then the voxels that pass measure the triangle.
+ * A band value is a minimum over the same triangles as walk_box's, in
+ * another order, so it is the same: each voxel keeps a candidate exactly
+ * when walk_box keeps it, or after walk_box would have stopped (a
+ * triangle past the stop is never closer). */
+static void walk_band(const st_grid *g, const brick_out *o, const st_soup *s,
+                      const voxel_box *v, const walk_list *w, double B,
+                      brick_scratch *sc)
+{
+    const double B2 = B * B;
+    double px[BAND_NV], py[BAND_NV], pz[BAND_NV], off[BAND_NV], cur[BAND_NV],
+           curd[BAND_NV];
+    size_t idx[BAND_NV];
+    unsigned nv = 0;
+    for (size_t k = v->lo[2]; k < v->hi[2]; k++)
+        for (size_t j = v->lo[1]; j < v->hi[1]; j++)
+            for (size_t i = v->lo[0]; i < v->hi[0]; i++) {
+                const double p[3] = {g->origin[0] + g->voxel * (double)i,
+                                     g->origin[1] + g->voxel * (double)j,
+                                     g->origin[2] + g->voxel * (double)k};
+                double d[3];
+                st_sub3(d, p, v->c);
+                px[nv] = p[0];
+                py[nv] = p[1];
+                pz[nv] = p[2];
+                /* As walk_box's offset. */
+                off[nv] = sqrt(st_dot3(d, d)) * (1.0 + 1e-9) + 1e-12 * g->voxel;
+                cur[nv] = B2;
+                curd[nv] = B;
+                idx[nv++] = out_index(o, i, j, k);
+            }
+    /* Missing voxels of a group at the grid's edge: never active. */
+    for (unsigned e = nv; e < BAND_NV; e++) {
+        px[e] = py[e] = pz[e] = 0.0;
+        off[e] = 0.0;
+        cur[e] = 0.0;
+        curd[e] = -INFINITY;
+    }
+    uint32_t nsetup = sc->nsetup;
+    for (size_t q = 0; q < w->n; q++) {
+        unsigned live, pass;
+        band_masks(px, py, pz, off, curd, w, q, &live, &pass);
+        if (!live)
+            break;              /* no later one is closer to any voxel */
+        while (pass) {
+            const unsigned e = (unsigned)__builtin_ctz(pass);
+            pass &= pass - 1;
+            const double p[3] = {px[e], py[e], pz[e]};
+            band_try(s, sc, &nsetup, w->at[q], p, &cur[e], &curd[e]);
+        }
+    }
+    sc->nsetup = nsetup;
+    const float Bf = (float)B;
+    for (unsigned e = 0; e < nv; e++)
+        o->val[idx[e]] = cur[e] >= B2 ? Bf : (float)curd[e];
+}
+
 /* Write `value` (and nearest -1) to every voxel of box v. */
 static void fill_box(const brick_out *o, const voxel_box *v, float value)
 {
@@ -655,19 +864,25 @@ static void walk_group(const st_grid *g, const brick_out *o,
     uint32_t *kept = sc->kept, nkept = 0;
     uint8_t *bucket = sc->bucket;
     const double *bx = sc->bx, *by = sc->by, *bz = sc->bz, *br = sc->br;
+    /* First the kept ones, without a branch (about half are kept, in no
+     * pattern a predictor learns), their squared distances in the walk
+     * list's bounds until the scatter below sets them. */
+    double *dd2 = sc->w.bound;
     for (size_t q = 0; q < m; q++) {
         const double dx = v->c[0] - bx[q], dy = v->c[1] - by[q],
                      dz = v->c[2] - bz[q];
         const double dd = dx * dx + dy * dy + dz * dz, reach = R + br[q];
-        if (dd >= reach * reach)
-            continue;
-        const double k = sqrt(dd) - br[q];
+        kept[nkept] = (uint32_t)q;
+        dd2[nkept] = dd;
+        nkept += dd < reach * reach;
+    }
+    for (uint32_t e = 0; e < nkept; e++) {
+        const double k = sqrt(dd2[e]) - br[kept[e]];
         /* Nondecreasing in k: a later bucket's keys are never below an
          * earlier one's. */
         const double f = k / width;
         const uint32_t b = k <= 0.0 ? 0 : f >= NBUCKET - 2 ? NBUCKET - 1 : 1 + (uint32_t)f;
-        kept[nkept] = (uint32_t)q;
-        bucket[nkept++] = (uint8_t)b;
+        bucket[e] = (uint8_t)b;
         count[b + 1]++;
         lo[b] = MIN2(lo[b], k);
     }
@@ -688,7 +903,7 @@ static void walk_group(const st_grid *g, const brick_out *o,
         wl->at[at] = q;
     }
     wl->n = nkept;
-    walk_box(g, o, s, v, wl, B, sc);
+    walk_band(g, o, s, v, wl, B, sc);
 }
 
 /* The triangles binned into the bricks their band may reach. */
@@ -736,13 +951,18 @@ static void process_brick(const st_grid *g, const brick_out *o,
     for (size_t q = 0; q < m; q++) {
         const tri_ball *tb = &bb->balls[list[q]];
         sc->tri[q] = list[q];
-        sc->slot[q] = UINT32_MAX;
+        if (sc->shared) {
+            const size_t e = setup_entry(sc, list[q]);
+            sc->slot[q] = sc->table[e] == UINT32_MAX ? UINT32_MAX : sc->table[e + 1];
+        } else
+            sc->slot[q] = UINT32_MAX;
         sc->bx[q] = tb->c[0];
         sc->by[q] = tb->c[1];
         sc->bz[q] = tb->c[2];
         sc->br[q] = tb->r;
     }
-    sc->nsetup = 0;
+    if (!sc->shared)
+        sc->nsetup = 0;
     if (o->near) {
         box_center(g, &v);
         walk_sorted(g, o, s, &v, m, B, sc);
@@ -887,7 +1107,11 @@ static int process_block(st_grid_blocks *bk, const st_soup *s,
         o.lo[2] + ST_GRID_BLOCK > n[2])
         for (size_t q = 0; q < E; q++)
             o.val[q] = Bf;
+    /* The block's bricks, and room for the setups of all their
+     * candidates: the bricks share them (see brick_scratch). */
     const brick_grid *bg = &bb->bg;
+    size_t bricks[BRICKS_PER_BLOCK * BRICKS_PER_BLOCK * BRICKS_PER_BLOCK];
+    size_t nbricks = 0, total = 0;
     for (size_t z = 0; z < BRICKS_PER_BLOCK; z++)
         for (size_t y = 0; y < BRICKS_PER_BLOCK; y++)
             for (size_t x = 0; x < BRICKS_PER_BLOCK; x++) {
@@ -897,10 +1121,19 @@ static int process_block(st_grid_blocks *bk, const st_soup *s,
                 if (c[0] >= bg->n[0] || c[1] >= bg->n[1] || c[2] >= bg->n[2])
                     continue;
                 const size_t brick = c[0] + bg->n[0] * (c[1] + bg->n[1] * c[2]);
-                if (scratch_reserve(sc, bin_count(bb, brick)))
-                    return -1;
-                process_brick(g, &o, s, bb, brick, B, sc);
+                bricks[nbricks++] = brick;
+                total += bin_count(bb, brick);
             }
+    sc->shared = 1;
+    sc->nsetup = 0;
+    if (total > UINT32_MAX || scratch_setups(sc, total))
+        return -1;
+    for (size_t i = 0; i < nbricks; i++) {
+        if (scratch_reserve(sc, bin_count(bb, bricks[i])))
+            return -1;
+        process_brick(g, &o, s, bb, bricks[i], B, sc);
+    }
+    setups_clear(sc);
     size_t q = 0;
     while (q < E && o.val[q] == Bf)
         q++;
@@ -958,7 +1191,8 @@ static st_status band_bricks(const st_grid *g, int32_t *near,
             int bad;
             if (bk)
                 bad = process_block(bk, s, bb, u, B, &sc);
-            else if (!(bad = scratch_reserve(&sc, bin_count(bb, u))))
+            else if (!(bad = scratch_reserve(&sc, bin_count(bb, u)) ||
+                             scratch_setups(&sc, bin_count(bb, u))))
                 process_brick(g, &dense, s, bb, u, B, &sc);
             if (bad) {
                 #pragma omp atomic write
