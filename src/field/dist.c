@@ -1128,12 +1128,13 @@ static int process_block(st_grid_blocks *bk, const st_soup *s,
     sc->nsetup = 0;
     if (total > UINT32_MAX || scratch_setups(sc, total))
         return -1;
-    for (size_t i = 0; i < nbricks; i++) {
-        if (scratch_reserve(sc, bin_count(bb, bricks[i])))
-            return -1;
-        process_brick(g, &o, s, bb, bricks[i], B, sc);
-    }
+    int bad = 0;
+    for (size_t i = 0; i < nbricks && !bad; i++)
+        if (!(bad = scratch_reserve(sc, bin_count(bb, bricks[i]))))
+            process_brick(g, &o, s, bb, bricks[i], B, sc);
     setups_clear(sc);
+    if (bad)
+        return -1;
     size_t q = 0;
     while (q < E && o.val[q] == Bf)
         q++;
