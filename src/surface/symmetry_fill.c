@@ -285,16 +285,64 @@ static int composed(st_symmetry *rot, double *angle, const st_symmetry *a, const
     return 1;
 }
 
+static double tri_area(const double q[3][3]);
+
+#define TURN_SAMPLES 2048      /* soup triangles a turn is checked on */
+#define TURN_CONTRADICTED 0.07 /* at most this share of what the soup can
+                                  check contradicts a turn (measured:
+                                  pinion-symholes' turns 0.004-0.063;
+                                  rotor-deleted50's and couplingdown-
+                                  onesided's, their planes a few degrees
+                                  apart, 0.075 and more) */
+
+/* Whether turn m holds on soup s (bvh: its tree; bounds: its boundary
+ * edges', NULL: none): of s's triangles (at most TURN_SAMPLES, evenly by
+ * index), by area, those whose centroid m puts within tol of s are
+ * verified, the others contradicted where s's nearest point is off its
+ * boundary (else in a hole, unchecked); at most TURN_CONTRADICTED of the
+ * verified and contradicted area. The turn of two exact mirrors is
+ * exact; of two approximate ones, it may not be. */
+static int turn_holds(const st_soup *s, const st_bvh *bvh, const st_bvh *bounds, const map *m,
+                      double tol)
+{
+    const size_t step = s->ntris / TURN_SAMPLES + 1;
+    double on = 0.0, con = 0.0;
+    for (size_t t = 0; t < s->ntris; t += step) {
+        double q[3][3], c[3], p[3];
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++)
+                q[k][a] = s->xyz[3 * (size_t)s->tris[3 * t + k] + a];
+        for (int a = 0; a < 3; a++)
+            c[a] = (q[0][a] + q[1][a] + q[2][a]) / 3.0;
+        st_symmetry_apply(m->y, m->angle, c, 1, p);
+        const double w = tri_area(q);
+        if (st_bvh_within(bvh, p, tol * tol)) {
+            on += w;
+            continue;
+        }
+        int64_t tri, edge = -1;
+        const double d2 = st_bvh_nearest(bvh, p, INFINITY, &tri, NULL);
+        if (bounds && tri >= 0) {
+            const double slack = sqrt(d2) + 1e-6 * tol;
+            st_bvh_nearest(bounds, p, slack * slack, &edge, NULL);
+        }
+        con += edge < 0 ? w : 0.0;
+    }
+    return on > 0.0 && con <= TURN_CONTRADICTED * (on + con);
+}
+
 /* Where the set has mirrors and no rotation (a gear whose axis detection
  * missed: pinion-symholes finds 5 of its 10 planes and no axis), the
  * turns two mirrors make, each way: a mirror's copy of a large hole
  * overlaps the hole (its own holes would stay in the fill), a turn's can
  * clear it. Rotations into rot (room for ST_SYMMETRY_MAX^2 / 2), maps
  * into out after its n; each new map at least tol away from the others
- * over the box lo..hi. Returns the new n. */
+ * over the box lo..hi, and holding on soup s (turn_holds). Returns the
+ * new n. */
 static size_t mirror_turns(st_symmetry *rot, map *out, size_t n, size_t max,
                            const st_symmetry_set *set, const double lo[3], const double hi[3],
-                           double tol)
+                           double tol, const st_soup *s, const st_bvh *bvh,
+                           const st_bvh *bounds)
 {
     for (size_t i = 0; i < set->n; i++)
         if (set->items[i].kind != ST_SYMMETRY_MIRROR)
@@ -311,7 +359,7 @@ static size_t mirror_turns(st_symmetry *rot, map *out, size_t n, size_t max,
                 int seen = 0;
                 for (size_t m = 0; m < n && !seen; m++)
                     seen = same_map(out + m, two + w, lo, hi, tol);
-                if (!seen) {
+                if (!seen && turn_holds(s, bvh, bounds, two + w, tol)) {
                     out[n++] = two[w];
                     fresh = 1;
                 }
@@ -1314,7 +1362,7 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
         goto done;
     const size_t nset = maps_of(set, maps, sizeof maps / sizeof *maps);
     const size_t nmaps = mirror_turns(turns, maps, nset, sizeof maps / sizeof *maps, set, P.lo,
-                                      P.hi, tol);
+                                      P.hi, tol, s, bvh, bounds_bvh);
     st->maps = nmaps;
     const fill_ctx C = {s, bvh, anchors_bvh, NULL, bounds_bvh, &P, NULL, tol};
     if ((rc = fill_rounds(covered, &F, &fill_bvh, &C, &R, maps, nset, nmaps, keep, ok, share,
