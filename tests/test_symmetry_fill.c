@@ -261,6 +261,37 @@ static void test_copy_holed(void)
     mirror_case(1);
 }
 
+/* A 120-degree hole centered on angle 0, and two of the cylinder's
+ * mirror planes (a gear's planes through its teeth), at -5.625 and 28.125
+ * degrees: each mirror's copy of the hole overlaps the hole itself, and
+ * the two copies together leave [-3.75, 48.75] open (the fill's boundary
+ * there is the image of the hole's own rim), so without more the fill did
+ * not close the hole and nothing was filled. The turns the two mirrors
+ * make, by 67.5 degrees either way, each clear half of it. */
+static void test_mirror_turn(void)
+{
+    const double hole[2] = {300.0, 60.0};
+    int missing;
+    st_soup *s = cylinder(hole, 1, &missing);
+    const double b1 = -5.625 * M_PI / 180.0, b2 = 28.125 * M_PI / 180.0;
+    const st_symmetry_set set = {
+        {{ST_SYMMETRY_MIRROR, {0, 0, 0}, {-sin(b1), cos(b1), 0}, 0, 0.8, 0.0},
+         {ST_SYMMETRY_MIRROR, {0, 0, 0}, {-sin(b2), cos(b2), 0}, 0, 0.8, 0.0}},
+        2, 2};
+    run r;
+    TAP_CHECK(fill_of(&r, s, &set) == 0, "120 degrees missing, two mirrors: the fill runs");
+    TAP_CHECK(r.st.maps == 4, "the two mirrors and their turn either way: %zu maps", r.st.maps);
+    TAP_CHECK(r.st.caps_covered + r.st.open_filled == 1 && r.st.unclosed == 0,
+              "the turns close the hole (%zu caps dropped, %zu open filled, %zu left open)",
+              r.st.caps_covered, r.st.open_filled, r.st.unclosed);
+    const double cover = side_covered(r.fill, s, 1.0, -60.0, 60.0);
+    TAP_CHECK(cover == 1.0, "the fill covers the hole within a tolerance (%.4f of it; area %.4f, "
+              "the strip's %.4f)", cover, r.st.area, missing * seg_area());
+    TAP_CHECK(on_side_in(r.fill, 1.0, 300.0, 60.0), "every fill vertex on the side, in the hole");
+    run_free(&r);
+    st_soup_free(s);
+}
+
 static void test_no_symmetry(void)
 {
     const double hole[2] = {0.0, 40.0};
@@ -283,6 +314,7 @@ int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(open_hole), TAP_TEST(rim_in_hole),
                                      TAP_TEST(copy_whole),
-                                     TAP_TEST(copy_holed), TAP_TEST(no_symmetry), {0}};
+                                     TAP_TEST(copy_holed), TAP_TEST(mirror_turn),
+                                     TAP_TEST(no_symmetry), {0}};
     return tap_main(argc, argv, tests);
 }

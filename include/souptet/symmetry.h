@@ -110,7 +110,8 @@ void st_symmetry_describe(const st_symmetry *y, char *buf, size_t size);
 typedef struct st_symmetry_fill_stats {
     size_t maps;          /* maps tried: a mirror is one, a rotation of
                              order n is n - 1, a continuous one or a helix
-                             FILL_ANGLES - 1 */
+                             FILL_ANGLES - 1; with mirrors alone, also the
+                             turn two mirrors make, each way */
     size_t triangles;     /* fill triangles kept */
     double area;          /* their area, model units squared */
     size_t caps;          /* cap pieces (connected) given */
@@ -145,7 +146,9 @@ typedef struct st_symmetry_fill_stats {
  * tol from s and from the other maps' fill at most 1/4 of the rim's
  * length; and, for a cap, when the fill departs from the cap (some corner
  * or centroid farther than tol plus the map's error): else the cap stays,
- * without fill. *kept_caps gets the caps minus the pieces the fill closes. Mirror
+ * without fill. Where a set of mirrors alone leaves a hole unclosed, a
+ * third round tries the turns two mirrors make (about the line where
+ * their planes meet, by twice their angle) for it. *kept_caps gets the caps minus the pieces the fill closes. Mirror
  * images are re-oriented so the fill keeps s's orientation. Deterministic for any thread count. bvh: st_bvh_build(s).
  * Both outputs are the caller's (st_soup_free); empty soups when set has
  * nothing. ST_EINPUT for a tol that is not positive and finite;
