@@ -173,9 +173,8 @@ static void test_cases(void)
     st_soup_free(s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_claim();
-    test_cases();
-    return tap_done();
+    static const tap_test tests[] = {TAP_TEST(claim), TAP_TEST(cases), {0}};
+    return tap_main(argc, argv, tests);
 }

@@ -75,7 +75,9 @@ CHILD = textwrap.dedent("""
     t0 = time.monotonic()
     try:
         if call == "mesh":
-            souptet.mesh(V, F, cells=20, tries=1)
+            # about 6 s of work (cells 20 took 0.5 s once the fit got
+            # faster, and finished before the signal came)
+            souptet.mesh(V, F, cells=40, tries=2)
         elif call == "pseudo_volume":
             souptet.pseudo_volume(V, F, resolution=520)
         else:
