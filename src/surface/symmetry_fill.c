@@ -13,7 +13,7 @@
  * and in a hole (near a cap, nearer it than the soup; or with an open rim
  * the soup's nearest part), through a map that puts the hole's rim back
  * on the soup (most of its length, and within a voxel on average; where
- * those maps leave a hole too large to cap open, a second round adds the
+ * those maps leave a hole open or capped, a second round adds the
  * maps that put back most of what the soup can check of the rim: a large
  * hole's rim, turned, falls partly into the hole itself). A
  * hole's fill is kept only when it closes the hole: it runs along the rim,
@@ -24,7 +24,9 @@
  * the fill closes is dropped where the fill departs from it by more than
  * the map's error: the fill gives that hole its shape, and a flat cap
  * across it would cut the solid the fill bounds; where the two agree the
- * cap stays and the fill is left out.
+ * cap stays and the fill is left out. A cap whose fill does not close it
+ * is dropped all the same where the fill lies behind it (contradicted:
+ * the cap encloses space the copy shows empty).
  *
  * Every decision is a distance compared with a tolerance of a voxel: the
  * fill is evidence for the signs (pseudo.c lowers it into the field as it
@@ -1222,7 +1224,7 @@ static void departs(uint8_t *depart, size_t npieces, const fill_set *F,
 }
 
 /* What became of a piece. */
-enum { PIECE_LEFT, PIECE_CLOSED, PIECE_UNCLOSED, PIECE_AGREES };
+enum { PIECE_LEFT, PIECE_CLOSED, PIECE_UNCLOSED, PIECE_AGREES, PIECE_CONTRADICTED };
 
 /* state[i] (for the pieces where todo[i]; NULL: all): PIECE_CLOSED when
  * piece i's fill closes it: the fill runs along its rim (at least
@@ -1304,13 +1306,66 @@ static st_status turn_round(uint8_t *state, uint8_t *only, fill_set *F, st_bvh *
     return rc ? rc : decide(state, only, P, R, F, C->bvh, *fill_bvh, C->anchors_bvh, C->tol);
 }
 
+/* A cap the rounds leave in place (its fill runs along too little of the
+ * rim, or leaves the copy's own holes open) while its fill lies behind it:
+ * the copy, through a map its rim verified, puts the surface deeper than
+ * the cap, so the cap encloses space the part does not have (a cap guessed
+ * across a concave corner). By area, of the fill's triangles whose
+ * centroid departs from the cap (beyond tol and the map's error: what the
+ * map's own error explains is no evidence), more lie behind the cap than
+ * before it (the cap's nearest point on the side the fill faces: an
+ * image keeps its triangle's orientation, a mirror's re-oriented). The
+ * cap is dropped and the partial fill kept (PIECE_CONTRADICTED); what the
+ * fill leaves open the votes decide, as for a hole too large to cap.
+ * Where the fill lies before the cap (the cap cuts into the solid), the
+ * cap stays: it is a guess on the side of too little, and a partial fill
+ * without it leaves an opening the votes may carve. Open rims keep the
+ * rule all or nothing: there is no guess to contradict. */
+static st_status contradicted(uint8_t *state, const pieces *P, const fill_set *F,
+                              const st_bvh *anchors_bvh, double tol)
+{
+    double *side = calloc(2 * (P->n ? P->n : 1), sizeof *side);   /* behind, before */
+    if (!side)
+        return ST_ENOMEM;
+    const st_soup *f = F->soup;
+    for (size_t t = 0; t < f->ntris; t++) {
+        const size_t i = F->piece[t];
+        if (i >= P->ncap || (state[i] != PIECE_LEFT && state[i] != PIECE_UNCLOSED))
+            continue;
+        double q[3][3], c[3], u[3], v[3], n[3], p[3], d[3];
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++)
+                q[k][a] = f->xyz[3 * f->tris[3 * t + k] + a];
+        for (int a = 0; a < 3; a++) {
+            c[a] = (q[0][a] + q[1][a] + q[2][a]) / 3.0;
+            u[a] = q[1][a] - q[0][a];
+            v[a] = q[2][a] - q[0][a];
+        }
+        int64_t tri;
+        const double r = tol + F->err[t];
+        const double d2 = st_bvh_nearest(anchors_bvh, c, INFINITY, &tri, p);
+        if (tri < 0 || !(d2 > r * r))
+            continue;
+        st_cross3(n, u, v);
+        for (int a = 0; a < 3; a++)
+            d[a] = p[a] - c[a];
+        side[2 * i + (st_dot3(d, n) > 0.0 ? 0 : 1)] += 0.5 * st_norm3(n);
+    }
+    for (size_t i = 0; i < P->ncap; i++)
+        if ((state[i] == PIECE_LEFT || state[i] == PIECE_UNCLOSED) && side[2 * i] > side[2 * i + 1])
+            state[i] = PIECE_CONTRADICTED;
+    free(side);
+    return ST_OK;
+}
+
 /* The fill in two rounds: the maps that put a piece's whole rim back on
- * the soup; then, for the holes too large to cap they left open (no
- * fill, or one that does not close), also the maps that put back what
- * the soup can check of the rim: there the fill is the only guess, where
- * a cap is one already (cheese-deleted50, second round for caps too: 9
- * more caps dropped, core IoU 0.981 -> 0.980); then turn_round with the
- * mirrors' turns (maps[nset, nmaps)). covered[i]: piece i closed. */
+ * the soup; then, for the holes they left open or uncapped (no fill, or
+ * one that does not close), also the maps that put back what the soup can
+ * check of the rim: a rim whose preimage falls in the copy's own holes
+ * (the damage removed the faces that would verify it) is judged on the
+ * rest; then turn_round with the mirrors' turns (maps[nset, nmaps)); then
+ * the caps the fill contradicts (contradicted). covered[i]: piece i's cap
+ * dropped and its fill kept. */
 static st_status fill_rounds(uint8_t *covered, fill_set *F, st_bvh **fill_bvh, const fill_ctx *C,
                              const rims *R, const map *maps, size_t nset, size_t nmaps,
                              size_t *keep, uint8_t *ok, double *share, double *map_err,
@@ -1324,15 +1379,16 @@ static st_status fill_rounds(uint8_t *covered, fill_set *F, st_bvh **fill_bvh, c
     rc = rc ? rc : decide(state, NULL, P, R, F, C->bvh, *fill_bvh, C->anchors_bvh, C->tol);
     size_t left = 0;
     for (size_t i = 0; i < P->n && !rc; i++)
-        left += open[i] = i >= P->ncap && (state[i] == PIECE_LEFT || state[i] == PIECE_UNCLOSED);
+        left += open[i] = state[i] == PIECE_LEFT || state[i] == PIECE_UNCLOSED;
     if (!rc && left && C->bounds) {
         rc = map_all(F, fill_bvh, C, R, maps, 0, nset, open, NULL, keep, ok, share, map_err, err);
         rc = rc ? rc : decide(state, open, P, R, F, C->bvh, *fill_bvh, C->anchors_bvh, C->tol);
     }
     rc = rc ? rc : turn_round(state, open, F, fill_bvh, C, R, maps, nset, nmaps, keep, ok, share,
                               map_err, err);
+    rc = rc ? rc : contradicted(state, P, F, C->anchors_bvh, C->tol);
     for (size_t i = 0; i < P->n && !rc; i++) {
-        covered[i] = state[i] == PIECE_CLOSED;
+        covered[i] = state[i] == PIECE_CLOSED || state[i] == PIECE_CONTRADICTED;
         st->unclosed += state[i] == PIECE_UNCLOSED;
         st->caps_agree += state[i] == PIECE_AGREES;
         if (i < P->ncap)
