@@ -9,7 +9,11 @@
  * (right- and left-handed, whole and with a band of its thread cut away)
  * gives its helix and pitch, the same on 1 and 2 threads; a plain
  * cylinder gives its continuous rotation and no helix; a thread whose
- * pitch is below two voxels gives no helix. */
+ * pitch is below two voxels gives no helix. The early exit of the
+ * measurement: a plane that reaches its threshold only with the last
+ * samples is accepted (late_support). The near grid (large slanted
+ * triangles): the same set as the same part with its triangles split
+ * fine enough that no grid is built (slanted). */
 #include "souptet/bvh.h"
 #include "souptet/soup.h"
 #include "souptet/symmetry.h"
@@ -452,11 +456,84 @@ static void test_not_helix(void)
     st_soup_free(s);
 }
 
+/* A box symmetric about x = 0 after a unit plate at x = 2.5 (facing x,
+ * first in the soup: the samples go by area in the soup's order, so the
+ * first third of them are the plate's). Under x = 0 the plate's images
+ * land in open space and the box's x faces on each other (the other
+ * faces slide along themselves: not informative), so the plane holds on
+ * about 2/3 of its informative samples, all of them in the last two
+ * thirds: an exit that judged a candidate by its first blocks (or by its
+ * share so far) would refuse it. */
+static void test_late_support(void)
+{
+    st_soup *s = st_soup_new();
+    add_tri(s, (double[3]){2.5, 0, 0}, (double[3]){2.5, 1, 0}, (double[3]){2.5, 1, 1}, 0);
+    add_tri(s, (double[3]){2.5, 0, 0}, (double[3]){2.5, 1, 1}, (double[3]){2.5, 0, 1}, 0);
+    add_box(s, (double[3]){-1, 0, 0}, (double[3]){1, 1, 1});
+    st_symmetry_set set;
+    TAP_CHECK(detect(&set, s, 0.03) == 0, "late support: detection runs");
+    const st_symmetry *mx = mirror_along(&set, 0);
+    TAP_CHECK(mx && fabs(crossing(mx, 0)) < 0.03 && mx->support >= 0.6 && mx->support < 0.75,
+              "the plane x = 0, reached with the last samples (support %.3f, about 2/3)",
+              mx ? mx->support : 0.0);
+    st_soup_free(s);
+}
+
+/* A square plate turned 30 degrees about z and 20 about x (its boxes
+ * overlap far beyond its triangles): each face one large triangle pair
+ * (the near grid's case), or split into n x n squares (small triangles:
+ * no grid). */
+static st_soup *slanted_slab(int n)
+{
+    st_soup *s = st_soup_new();
+    const double a = M_PI / 6, b = M_PI / 9, lo[3] = {-1, -0.6, -0.15}, hi[3] = {1, 0.6, 0.15};
+    for (int f = 0; f < 6; f++) {
+        const int ax = f / 2, u = (ax + 1) % 3, w = (ax + 2) % 3;
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                double c[4][3];
+                for (int k = 0; k < 4; k++) {
+                    double x[3];
+                    x[ax] = f % 2 ? hi[ax] : lo[ax];
+                    x[u] = lo[u] + (hi[u] - lo[u]) * (i + (k == 1 || k == 2)) / n;
+                    x[w] = lo[w] + (hi[w] - lo[w]) * (j + (k >= 2)) / n;
+                    double y[3] = {x[0] * cos(a) - x[1] * sin(a), x[0] * sin(a) + x[1] * cos(a), x[2]};
+                    c[k][0] = y[0];
+                    c[k][1] = y[1] * cos(b) - y[2] * sin(b);
+                    c[k][2] = y[1] * sin(b) + y[2] * cos(b);
+                }
+                add_tri(s, c[0], c[1], c[2], f % 2);
+                add_tri(s, c[0], c[2], c[3], f % 2);
+            }
+    }
+    return s;
+}
+
+static void test_slanted(void)
+{
+    st_symmetry_set coarse, fine;
+    st_soup *s = slanted_slab(1), *t = slanted_slab(32);
+    TAP_CHECK(detect(&coarse, s, 0.02) == 0 && detect(&fine, t, 0.02) == 0,
+              "slanted slab: detection runs on 12 and 12288 triangles");
+    size_t same = coarse.n == fine.n && coarse.n >= 3;
+    for (size_t i = 0; same && i < coarse.n; i++) {
+        const st_symmetry *x = coarse.items + i, *y = fine.items + i;
+        same = x->kind == y->kind && x->order == y->order &&
+               fabs(x->dir[0] * y->dir[0] + x->dir[1] * y->dir[1] + x->dir[2] * y->dir[2]) > 0.9994 &&
+               fabs(x->support - y->support) < 0.05;
+    }
+    TAP_CHECK(same, "slanted slab: the same %zu symmetries with large and small triangles (%zu)",
+              coarse.n, fine.n);
+    st_soup_free(s);
+    st_soup_free(t);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(bracket), TAP_TEST(hex_bar), TAP_TEST(none),
                                      TAP_TEST(asymmetric), TAP_TEST(nearly), TAP_TEST(tiny),
                                      TAP_TEST(planar), TAP_TEST(helix),
-                                     TAP_TEST(not_helix), TAP_TEST(lost_third), {0}};
+                                     TAP_TEST(not_helix), TAP_TEST(lost_third),
+                                     TAP_TEST(late_support), TAP_TEST(slanted), {0}};
     return tap_main(argc, argv, tests);
 }

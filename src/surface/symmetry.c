@@ -134,6 +134,7 @@ typedef struct samples {
     double *p;       /* 3n */
     double *nrm;     /* 3n, unit */
     double c[3];     /* area centroid */
+    double area;     /* the soup's (its finite triangles') */
     double axes[3][3]; /* principal axes (rows), unit */
 } samples;
 
@@ -200,6 +201,7 @@ static int samples_make(samples *S, const st_soup *s, size_t want)
         cum[t + 1] = cum[t] + (isfinite(a) ? a : 0.0);
     }
     double total = cum[s->ntris];
+    S->area = total;
     if (!(total > 0.0)) {
         free(cum);
         return 0;
@@ -260,7 +262,42 @@ static void samples_free(samples *S)
     free(S->nrm);
 }
 
-/* ---- support -------------------------------------------------------------- */
+/* ---- the near grid and the support ---------------------------------------- */
+
+/* On a CAD part whose long, thin triangles lie slanted to the axes (a
+ * gear's teeth, a screw's thread), the BVH's boxes overlap far beyond the
+ * triangles, and a query within a tolerance scans most of the leaves
+ * (pinion-symholes: about 25,000 instructions a query, 96 % of the
+ * detection). So the queries within GRID_REACH tolerances go first to a
+ * grid of cells GRID_CELL tolerances wide, each listing every triangle
+ * that comes within GRID_REACH tolerances of it (from pieces of the
+ * triangle no longer than a cell, each piece's box grown by the reach).
+ * A query scans its cell's list with the BVH's own distance
+ * (st_point_triangle_dist2, the same arguments): the least distance, its
+ * triangle and point are the BVH's whenever that least is clear. Where
+ * another triangle comes within GRID_TIE of it (a shared edge or corner:
+ * the BVH takes the first it meets), or it lies within GRID_TIE of the
+ * reach (the BVH's pruning by boxes then decides), the query goes to the
+ * BVH: so every answer is the BVH's. Not built (the BVH alone) when the
+ * lists would be long (a dense scan, whose BVH boxes are tight) or the
+ * grid large. */
+#define GRID_REACH REFINE_REACH
+#define GRID_CELL 3.0
+#define GRID_MIN_AREA 4.0    /* mean triangle area, tolerances squared */
+#define GRID_TIE 1e-6
+#define GRID_MAX_CELLS (1L << 22)
+#define GRID_MAX_LIST 24.0   /* mean entries per filled cell, at most */
+#define GRID_MAX_DEPTH 40    /* of the pieces' bisection */
+
+typedef struct near_grid {
+    double lo[3], h, reach, slack; /* slack: rounding units of the soup's size */
+    long dim[3];
+    uint32_t *start;   /* dim[0] dim[1] dim[2] + 1 offsets into tri; NULL: no grid */
+    uint32_t *tri;
+    uint32_t *stamp;   /* the build's: the last triangle + 1 put in each cell */
+    double *tbox;      /* 6 per triangle: its box */
+} near_grid;
+
 
 typedef struct ctx {
     const st_soup *s;
@@ -270,7 +307,245 @@ typedef struct ctx {
     double *tn;      /* unit normal per soup triangle */
     uint8_t *rim;    /* per triangle: bit j when its edge j (corners j,
                         j + 1) is a boundary edge (one triangle) */
+    near_grid grid;
 } ctx;
+
+/* The cells of the box [lo, hi] grown by the reach, as index ranges. */
+static void grid_range(const near_grid *G, const double lo[3], const double hi[3],
+                       long a[3], long b[3])
+{
+    for (int k = 0; k < 3; k++) {
+        const double g = G->reach * (1.0 + GRID_TIE) + G->slack;
+        a[k] = (long)floor((lo[k] - g - G->lo[k]) / G->h);
+        b[k] = (long)floor((hi[k] + g - G->lo[k]) / G->h);
+        a[k] = a[k] < 0 ? 0 : a[k];
+        b[k] = b[k] >= G->dim[k] ? G->dim[k] - 1 : b[k];
+    }
+}
+
+/* The build's pairs (cell, triangle), each once. */
+typedef struct grid_pairs {
+    uint64_t *v;    /* cell << 32 | triangle */
+    size_t n, cap;
+    int failed;
+} grid_pairs;
+
+/* x appended to P (P->failed when memory is short: nothing more goes in). */
+static void pairs_push(grid_pairs *P, uint64_t x)
+{
+    if (P->n == P->cap && !P->failed) {
+        /* doubling: amortized constant */
+        uint64_t *grown = st_realloc_array(P->v, P->cap < 4096 ? 4096 : 2 * P->cap, sizeof *grown);
+        P->failed = !grown;
+        P->v = grown ? grown : P->v;
+        P->cap = grown ? (P->cap < 4096 ? 4096 : 2 * P->cap) : P->cap;
+    }
+    if (!P->failed)
+        P->v[P->n++] = x;
+}
+
+/* Triangle t (piece x of it) into the cells its piece's grown box meets,
+ * once per cell (G->stamp). */
+static void grid_put(near_grid *G, grid_pairs *P, uint32_t t, const double *x[3], int depth)
+{
+    double e[3];
+    int m = 0;
+    for (int k = 0; k < 3; k++) {
+        double d[3];
+        st_sub3(d, x[(k + 1) % 3], x[k]);
+        e[k] = st_dot3(d, d);
+        m = e[k] > e[m] ? k : m;
+    }
+    if (e[m] > G->h * G->h && depth < GRID_MAX_DEPTH) {
+        /* bisect the longest edge, x[m] x[m + 1] */
+        double mid[3];
+        const double *p = x[m], *q = x[(m + 1) % 3], *r = x[(m + 2) % 3];
+        for (int k = 0; k < 3; k++)
+            mid[k] = 0.5 * (p[k] + q[k]);
+        const double *one[3] = {p, mid, r}, *two[3] = {mid, q, r};
+        grid_put(G, P, t, one, depth + 1);
+        grid_put(G, P, t, two, depth + 1);
+        return;
+    }
+    double lo[3], hi[3];
+    long a[3], b[3];
+    for (int k = 0; k < 3; k++) {
+        lo[k] = fmin(x[0][k], fmin(x[1][k], x[2][k]));
+        hi[k] = fmax(x[0][k], fmax(x[1][k], x[2][k]));
+    }
+    grid_range(G, lo, hi, a, b);
+    for (long i = a[0]; i <= b[0]; i++)
+        for (long j = a[1]; j <= b[1]; j++)
+            for (long k = a[2]; k <= b[2]; k++) {
+                const size_t c = (size_t)((i * G->dim[1] + j) * G->dim[2] + k);
+                if (G->stamp[c] == t + 1 || P->failed)
+                    continue;
+                G->stamp[c] = t + 1;
+                pairs_push(P, (uint64_t)c << 32 | t);
+            }
+}
+
+static void grid_free(near_grid *G)
+{
+    free(G->start);
+    free(G->tri);
+    free(G->stamp);
+    free(G->tbox);
+    G->start = G->tri = G->stamp = NULL;
+    G->tbox = NULL;
+}
+
+/* Each triangle's box into G->tbox, the soup's into lo, hi. */
+static void grid_boxes(near_grid *G, const st_soup *s, double lo[3], double hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        lo[k] = INFINITY;
+        hi[k] = -INFINITY;
+    }
+    for (size_t t = 0; t < s->ntris; t++) {
+        const double *x[3];
+        double *b = G->tbox + 6 * t;
+        for (int v = 0; v < 3; v++)
+            x[v] = s->xyz + 3 * (size_t)s->tris[3 * t + v];
+        for (int k = 0; k < 3; k++) {
+            b[k] = fmin(x[0][k], fmin(x[1][k], x[2][k]));
+            b[k + 3] = fmax(x[0][k], fmax(x[1][k], x[2][k]));
+            lo[k] = fmin(lo[k], b[k]);
+            hi[k] = fmax(hi[k], b[k + 3]);
+        }
+    }
+}
+
+/* The lists from the pairs (sorted by cell: the triangles of a cell in
+ * their order); 0 when they would be long on average, or memory short. */
+static int grid_lists(near_grid *G, grid_pairs *P, size_t ncell)
+{
+    G->start = st_calloc_array(ncell + 1, sizeof *G->start);
+    G->tri = st_malloc_array(P->n ? P->n : 1, sizeof *G->tri);
+    if (!G->start || !G->tri)
+        return 0;
+    for (size_t i = 0; i < P->n; i++)
+        G->start[(P->v[i] >> 32) + 1]++;
+    size_t filled = 0;
+    for (size_t c = 0; c < ncell; c++) {
+        filled += G->start[c + 1] > 0;
+        G->start[c + 1] += G->start[c];
+    }
+    if ((double)P->n > GRID_MAX_LIST * (double)filled)
+        return 0;
+    /* the pairs come by triangle: placed in order, each cell's list is
+     * sorted by triangle */
+    for (size_t i = 0; i < P->n; i++)
+        G->tri[G->start[P->v[i] >> 32]++] = (uint32_t)P->v[i];
+    for (size_t c = ncell; c > 0; c--)
+        G->start[c] = G->start[c - 1];
+    G->start[0] = 0;
+    return 1;
+}
+
+/* The grid for tolerance tol, or none (G->start NULL: the queries go to
+ * the BVH) when its lists would be long (mean triangle area below
+ * GRID_MIN_AREA tolerances squared: a fine mesh, whose BVH boxes are
+ * tight; or over GRID_MAX_LIST entries a cell), the grid large, or memory
+ * short. */
+static void grid_make(near_grid *G, const st_soup *s, double tol, double area)
+{
+    memset(G, 0, sizeof *G);
+    if (s->ntris == 0 || s->ntris >= UINT32_MAX ||
+        !(area >= GRID_MIN_AREA * tol * tol * (double)s->ntris))
+        return;
+    double lo[3], hi[3];
+    G->tbox = st_malloc_array(6 * s->ntris, sizeof *G->tbox);
+    if (!G->tbox)
+        return;
+    grid_boxes(G, s, lo, hi);
+    double big = 0.0, cells = 1.0;
+    for (int k = 0; k < 3; k++)
+        big = fmax(big, fmax(fabs(lo[k]), fabs(hi[k])));
+    G->h = GRID_CELL * tol;
+    G->reach = GRID_REACH * tol;
+    G->slack = ldexp(big, -40);
+    for (int k = 0; k < 3; k++) {
+        G->lo[k] = lo[k] - G->reach - G->h;
+        G->dim[k] = (long)floor((hi[k] + G->reach + G->h - G->lo[k]) / G->h) + 1;
+        cells *= (double)G->dim[k];
+    }
+    if (!isfinite(cells) || cells > (double)GRID_MAX_CELLS) {
+        grid_free(G);
+        return;
+    }
+    const size_t ncell = (size_t)cells;
+    grid_pairs P = {NULL, 0, 0, 0};
+    G->stamp = st_calloc_array(ncell, sizeof *G->stamp);
+    for (size_t t = 0; t < s->ntris && G->stamp && !P.failed; t++) {
+        const double *x[3];
+        for (int k = 0; k < 3; k++)
+            x[k] = s->xyz + 3 * (size_t)s->tris[3 * t + k];
+        grid_put(G, &P, (uint32_t)t, x, 0);
+    }
+    free(G->stamp);
+    G->stamp = NULL;
+    if (P.failed || !grid_lists(G, &P, ncell))
+        grid_free(G);
+    free(P.v);
+}
+
+/* st_bvh_nearest(C->bvh, p, reach * reach, tri, closest), answered by the
+ * grid where it can be (see above), else by the BVH. */
+static double nearest(const ctx *C, const double p[3], double reach, int64_t *tri,
+                      double closest[3])
+{
+    const near_grid *G = &C->grid;
+    const double r2 = reach * reach;
+    if (!G->start || !(reach <= G->reach))
+        return st_bvh_nearest(C->bvh, p, r2, tri, closest);
+    long c[3];
+    for (int k = 0; k < 3; k++) {
+        const double f = floor((p[k] - G->lo[k]) / G->h);
+        if (!(f >= 0.0 && f < (double)G->dim[k])) {
+            *tri = -1; /* beyond the grown box of every triangle */
+            return r2;
+        }
+        c[k] = (long)f;
+    }
+    const size_t cell = (size_t)((c[0] * G->dim[1] + c[1]) * G->dim[2] + c[2]);
+    const double lim = reach * (1.0 + GRID_TIE) + G->slack;
+    double best = INFINITY, second = INFINITY, q[3], bq[3];
+    int64_t bt = -1;
+    for (uint32_t i = G->start[cell]; i < G->start[cell + 1]; i++) {
+        const uint32_t t = G->tri[i];
+        const double *b = G->tbox + 6 * (size_t)t;
+        double d2 = 0.0;
+        for (int k = 0; k < 3; k++) {
+            const double d = p[k] < b[k] ? b[k] - p[k] : p[k] > b[k + 3] ? p[k] - b[k + 3] : 0.0;
+            d2 += d * d;
+        }
+        if (d2 > lim * lim)
+            continue;
+        const uint32_t *v = C->s->tris + 3 * (size_t)t;
+        d2 = st_point_triangle_dist2(p, C->s->xyz + 3 * (size_t)v[0], C->s->xyz + 3 * (size_t)v[1],
+                                     C->s->xyz + 3 * (size_t)v[2], q);
+        if (d2 < best) {
+            second = best;
+            best = d2;
+            bt = t;
+            memcpy(bq, q, sizeof q);
+        } else if (d2 < second) {
+            second = d2;
+        }
+    }
+    const double s2 = G->slack * G->slack;
+    if (!(best < r2 + GRID_TIE * r2 + s2)) {
+        *tri = -1; /* every triangle of the list clearly beyond the reach */
+        return r2;
+    }
+    if (second <= best + GRID_TIE * best + s2 || !(best < r2 - GRID_TIE * r2 - s2))
+        return st_bvh_nearest(C->bvh, p, r2, tri, closest);
+    *tri = bt;
+    if (closest)
+        memcpy(closest, bq, sizeof bq);
+    return best;
+}
 
 /* Whether the image (q, nq) lands on the soup within reach with a
  * compatible normal; *closest gets the nearest point, *tri its triangle
@@ -278,7 +553,7 @@ typedef struct ctx {
 static int lands_tri(const ctx *C, const double q[3], const double nq[3],
                      double reach, double closest[3], int64_t *tri)
 {
-    double d2 = st_bvh_nearest(C->bvh, q, reach * reach, tri, closest);
+    double d2 = nearest(C, q, reach, tri, closest);
     if (*tri < 0)
         return 0;
     return d2 <= C->tol * C->tol &&
@@ -289,7 +564,7 @@ static int lands(const ctx *C, const double q[3], const double nq[3],
                  double reach, double closest[3])
 {
     int64_t tri;
-    double d2 = st_bvh_nearest(C->bvh, q, reach * reach, &tri, closest);
+    double d2 = nearest(C, q, reach, &tri, closest);
     (void)d2;
     if (tri < 0)
         return 0;
@@ -1134,7 +1409,7 @@ static void refine_pitch(const ctx *C, st_symmetry *y)
                 st_symmetry_apply(y, turn[j], S->nrm + 3 * k, 0, nq);
                 int64_t t;
                 double reach = REFINE_REACH * C->tol;
-                st_bvh_nearest(C->bvh, q, reach * reach, &t, c);
+                nearest(C, q, reach, &t, c);
                 if (t < 0)
                     continue;
                 const double *tn = C->tn + 3 * (size_t)t;
@@ -1317,11 +1592,13 @@ static st_status ctx_make(ctx *C, const st_soup *s, samples *S, size_t want, st_
         st_cross3(C->tn + 3 * t, u, w);
         normalize(C->tn + 3 * t);
     }
+    grid_make(&C->grid, s, C->tol, S->area);
     return rim_make(C, err);
 }
 
 static void ctx_free(ctx *C, samples *S)
 {
+    grid_free(&C->grid);
     free(C->tn);
     free(C->rim);
     samples_free(S);
@@ -1339,7 +1616,7 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
                             "least 16 samples, order >= 2, support in (0, "
                             "1]");
     samples S;
-    ctx C = {s, bvh, &S, p->tolerance, NULL, NULL};
+    ctx C = {.s = s, .bvh = bvh, .S = &S, .tol = p->tolerance};
     st_status rc = ctx_make(&C, s, &S, p->samples, err);
     if (rc || S.n == 0) {
         ctx_free(&C, &S);
