@@ -12,6 +12,11 @@ against log(size):
   - against --cells (5 10 20 40 by default, SOUPTET_BENCH_SCALE_CELLS) on
     dragon_res2.
 
+The copies are written once and reused: into SOUPTET_BENCH_SCALE_DIR
+when set (a folder kept between runs, e.g. /tmp/souptet-scale: the 12
+copies are 199 MB and take minutes to write), else into the results' tmp
+folder.
+
 SOUPTET_BENCH_SCALE_MODELS picks the corpus models of the first table,
 SOUPTET_BENCH_SCALE_PEER the OpenVDB repeats (0: none).
 
@@ -193,8 +198,11 @@ def stage(build, bench):
     tri_rows, cell_rows = [], []
     inputs = [(m, bench.model_path(m)) for m in TRI_MODELS]
     dragon = bench.model_path("dragon") if COPIES or PEER_REPEAT > 0 else None
+    copies_dir = os.environ.get("SOUPTET_BENCH_SCALE_DIR") or tmp
+    if COPIES:
+        os.makedirs(copies_dir, exist_ok=True)
     for k in COPIES:
-        p = os.path.join(tmp, "dragon_x%d.ply" % k)   # generated: not in the corpus cache
+        p = os.path.join(copies_dir, "dragon_x%d.ply" % k)   # generated: not in the corpus cache
         if not os.path.exists(p) and dragon:
             _log("writing %d copies of the dragon to %s" % (k, p))
             write_copies(dragon, k, p)

@@ -271,11 +271,14 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
                             "too many triangles for the BVH (%zu)", s->ntris);
     build_ctx c = {0};
     c.s = s;
+    c.nnodes = 1 + subtree_nodes(s->ntris);
+    /* every array is touched in full, most at random: huge pages past a
+     * few MB (st_malloc_big; ntris < 2^31 keeps the products in range) */
     st_bvh *b = calloc(1, sizeof *b);
-    c.cent = st_malloc_array(s->ntris, 3 * sizeof(double));
-    c.order = st_malloc_array(s->ntris, sizeof(uint32_t));
-    c.nodes = st_malloc_array(2 * s->ntris, sizeof(st_bvh_node));
-    double *tbox = st_malloc_array(s->ntris, 6 * sizeof(double));
+    c.cent = st_malloc_big(s->ntris * 3 * sizeof(double));
+    c.order = st_malloc_big(s->ntris * sizeof(uint32_t));
+    c.nodes = st_malloc_big(c.nnodes * sizeof(st_bvh_node));
+    double *tbox = st_malloc_big(s->ntris * 6 * sizeof(double));
     if (!b || !c.cent || !c.order || !c.nodes || !tbox) {
         free(b);
         free(c.cent);
@@ -296,7 +299,6 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
             c.cent[3 * t + a] = sum / 3.0;
         }
     }
-    c.nnodes = 1 + subtree_nodes(s->ntris);
     if (s->ntris < PARALLEL_MIN)
         build_serial(&c, 0, 0, s->ntris, 1);
     else {

@@ -99,14 +99,17 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
                             "%zu triangles: the soup's edges are read for at most 2^31",
                             s->ntris);
     const size_t nt = s->ntris;
-    tri_key *keys = st_malloc_array(nt ? nt : 1, sizeof *keys);
-    e->weld = st_malloc_array(s->nverts ? s->nverts : 1, sizeof *e->weld);
-    e->kept = st_calloc_array(nt ? nt : 1, 1);
-    e->he = st_malloc_array(3 * nt + 1, sizeof *e->he);
-    e->piece = st_malloc_array(nt ? nt : 1, sizeof *e->piece);
-    size_t *uf = st_malloc_array(nt ? nt : 1, sizeof *uf);
+    /* arrays over every triangle or vertex, sorted and read at random:
+     * huge pages past a few MB (st_malloc_big; nt < 2^31 and the vertex
+     * count below 2^32 keep the products in range) */
+    tri_key *keys = st_malloc_big((nt + 1) * sizeof *keys);
+    e->weld = st_malloc_big((s->nverts + 1) * sizeof *e->weld);
+    e->kept = st_calloc_big(nt + 1);
+    e->he = st_malloc_big((3 * nt + 1) * sizeof *e->he);
+    e->piece = st_malloc_big((nt + 1) * sizeof *e->piece);
+    size_t *uf = st_malloc_big((nt + 1) * sizeof *uf);
     /* the radix sorts' scratch: the half-edges */
-    st_half_edge *tmp = st_malloc_array(3 * nt + 1, sizeof *tmp);
+    st_half_edge *tmp = st_malloc_big((3 * nt + 1) * sizeof *tmp);
     if (!keys || !e->weld || st_weld_vertices(e->weld, &e->nweld, s, err) ||
         !e->kept || !e->he || !e->piece || !uf || !tmp) {
         free(keys);

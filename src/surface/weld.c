@@ -56,8 +56,9 @@ st_status st_weld_vertices(uint32_t *weld, size_t *nweld, const st_soup *s,
     size_t cap = 16;
     while (cap < 2 * nref)
         cap *= 2;
-    uint32_t *table = st_malloc_array(cap, sizeof *table);
-    uint32_t *rep = st_malloc_array(nref ? nref : 1, sizeof *rep);
+    /* the table is probed at random: huge pages past a few MB */
+    uint32_t *table = st_malloc_big(cap * sizeof *table);
+    uint32_t *rep = st_malloc_big((nref + 1) * sizeof *rep);
     if (!table || !rep) {
         free(table);
         free(rep);

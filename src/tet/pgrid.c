@@ -41,7 +41,7 @@ ST_RADIX_SORT_DEFINE(sort_by_x, 3 * sizeof(double), pt_x_digit)
  * (glibc's qsort is a stable merge sort at these sizes). */
 static st_status sort_points(double *pts, size_t n)
 {
-    double *tmp = st_malloc_array(n ? n : 1, 3 * sizeof *tmp);
+    double *tmp = st_malloc_big((n + 1) * 3 * sizeof *tmp);
     if (!tmp || sort_by_x(pts, tmp, n, 4, 0)) {
         free(tmp);
         return ST_ENOMEM;
@@ -80,7 +80,7 @@ static st_status pgrid_points(pgrid *g, const st_soup *s)
             used[s->tris[i]] = 1;
             n++;
         }
-    g->pts = st_malloc_array(n ? n : 1, 3 * sizeof *g->pts);
+    g->pts = st_malloc_big((n + 1) * 3 * sizeof *g->pts);
     if (!g->pts)
         goto done;
     for (size_t v = 0, i = 0; v < s->nverts; v++)
@@ -162,9 +162,11 @@ st_status sm_pgrid_build(pgrid *g, const st_soup *s, double cell)
     const size_t k = g->npts, nb = pgrid_extent(g, cell);
     rc = ST_ENOMEM;
     g->off = st_calloc_array(nb + 1, sizeof *g->off);
-    g->idx = st_malloc_array(k ? k : 1, sizeof *g->idx);
-    g->bpts = st_malloc_array(k ? k : 1, 3 * sizeof *g->bpts);
-    bin = st_malloc_array(k ? k : 1, sizeof *bin);
+    /* arrays over every point (a vertex count: the products are in
+     * range): huge pages past a few MB */
+    g->idx = st_malloc_big((k + 1) * sizeof *g->idx);
+    g->bpts = st_malloc_big((k + 1) * 3 * sizeof *g->bpts);
+    bin = st_malloc_big((k + 1) * sizeof *bin);
     fill = st_malloc_array(nb, sizeof *fill);
     if (!g->off || !g->idx || !g->bpts || !bin || !fill)
         goto done;

@@ -226,6 +226,10 @@ check "a small cap: the note only under -v" sh -c \
     "soupmesh -o hn.vtu holed.obj 2> hn.log && grep -q 'encloses the input' hn.log && ! grep -q 'guessed' hn.log && soupmesh -v -o hn.vtu holed.obj 2>&1 | grep -q 'guessed'"
 check "the closed bunny: nothing guessed, even under -v" sh -c \
     "soupmesh -v --cells 6 -o bn.vtu '$BUNNY' 2> bn.log && grep -q 'encloses the input' bn.log && ! grep -q 'guessed' bn.log"
+check "the closed bunny: -v says the signs did not search for symmetries, and does not search itself" \
+    grep -q "symmetries: not searched by the signs (no holes to fill)$" bn.log
+check "--symmetry off: -v says so" sh -c \
+    "soupmesh -v --symmetry off --cells 6 -o bn.vtu '$BUNNY' 2>&1 | grep -q 'symmetries: not searched (--symmetry off)'"
 
 # --float32 (issue 42): the points written are floats, and the mesh still
 # encloses the input, exactly (tetstat --surface on the file as written);
