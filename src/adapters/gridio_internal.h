@@ -65,6 +65,15 @@ const st_vtk_plugin *st_vtk_plugin_entry(void);
  * another build's. */
 st_status st_vtk_plugin_get(const st_vtk_plugin **out, const char *name, st_error *err);
 
+/* A forwarder's body: return the plugin's `call` (a member and its
+ * arguments), or the failure to load it. */
+#define ST_VTK_FORWARD(name, err, call)                                       \
+    do {                                                                      \
+        const st_vtk_plugin *fwd_p;                                           \
+        st_status fwd_s = st_vtk_plugin_get(&fwd_p, name, err);               \
+        return fwd_s ? fwd_s : fwd_p->call;                                   \
+    } while (0)
+
 /* Test hook: write a .vdb that souptet did not make, to exercise the
  * reader's foreign paths. which = 0: only a Vec3s grid (no float grid);
  * 1: a FloatGrid "density" without souptet metadata, background -1,

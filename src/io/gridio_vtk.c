@@ -57,26 +57,21 @@ st_status st_vtk_plugin_get(const st_vtk_plugin **out, const char *name, st_erro
 
 st_status st_grid_write_vti(const st_grid *g, const char *path, st_error *err)
 {
-    const st_vtk_plugin *p;
-    st_status s = st_vtk_plugin_get(&p, path, err);
-    return s ? s : p->grid_write_vti(g, path, err);
+    ST_VTK_FORWARD(path, err, grid_write_vti(g, path, err));
 }
 
 st_status st_grid_read_vti(st_grid **out, const char *path, size_t max_bytes, st_error *err)
 {
-    const st_vtk_plugin *p;
     *out = NULL;
-    st_status s = st_vtk_plugin_get(&p, st_path_is_stdio(path) ? ST_STDIN_NAME : path, err);
-    return s ? s : p->grid_read_vti(out, path, max_bytes, err);
+    ST_VTK_FORWARD(st_path_is_stdio(path) ? ST_STDIN_NAME : path, err,
+                   grid_read_vti(out, path, max_bytes, err));
 }
 
 st_status st_gridio_read_vti_mem(st_grid **out, const unsigned char *data, size_t size,
                                  const char *name, size_t max_bytes, st_error *err)
 {
-    const st_vtk_plugin *p;
     *out = NULL;
-    st_status s = st_vtk_plugin_get(&p, name, err);
-    return s ? s : p->grid_read_vti_mem(out, data, size, name, max_bytes, err);
+    ST_VTK_FORWARD(name, err, grid_read_vti_mem(out, data, size, name, max_bytes, err));
 }
 
 size_t st_vtkxml_inflate_vtk(void *user, const char *compressor, const unsigned char *in,

@@ -10,17 +10,13 @@
 st_status st_tetio_read_vtu_file(st_tetmesh **out, const char *path, size_t max_bytes,
                                  st_error *err)
 {
-    const st_vtk_plugin *p;
     *out = NULL;
-    st_status s = st_vtk_plugin_get(&p, path, err);
-    return s ? s : p->tet_read_vtu_file(out, path, max_bytes, err);
+    ST_VTK_FORWARD(path, err, tet_read_vtu_file(out, path, max_bytes, err));
 }
 
 st_status st_tetio_read_vtu_mem(st_tetmesh **out, const unsigned char *data, size_t size,
                                 const char *name, size_t max_bytes, st_error *err)
 {
-    const st_vtk_plugin *p;
     *out = NULL;
-    st_status s = st_vtk_plugin_get(&p, name, err);
-    return s ? s : p->tet_read_vtu_mem(out, data, size, name, max_bytes, err);
+    ST_VTK_FORWARD(name, err, tet_read_vtu_mem(out, data, size, name, max_bytes, err));
 }
