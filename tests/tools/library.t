@@ -2,8 +2,9 @@
 # tests/tools/library.t - the shared libraries: libsouptet.so (the C core)
 # and libsouptet-io.so (OpenVDB; VTK through its plugin libsouptet-vtk.so.0,
 # opened on first use). Sonames; the core needs no C++, OpenVDB or VTK;
-# each exports the names its public headers declare and nothing else (the core's few private functions that the io library
-# calls only under SOUPTET_PRIVATE_0); a program on the public headers,
+# each exports the names its public headers declare and nothing else
+# (the core's few private functions that the io library calls only under
+# SOUPTET_PRIVATE_0); a program on the public headers,
 # linked against the core alone, meshes the bunny and cancels a run; and
 # `make install` into a staging directory gives a pkg-config that builds
 # the same program.
