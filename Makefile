@@ -88,12 +88,17 @@ ifeq ($(IO_C),)
 endif
 CORE_C   := $(filter-out $(IO_C),$(LIB_C))
 LIB_CXX  := $(sort $(wildcard src/adapters/*.cpp))
+# The VTK adapters are a library of their own, libsouptet-vtk.so.0, that
+# libsouptet-io opens on first use (src/adapters/gridio_internal.h): with
+# vtkxml.c's checks (also in libsouptet-io.a, for the tests that call them).
+VTK_CXX  := $(addprefix src/adapters/,gridio_vti.cpp tetio_vtu.cpp vtk_capture.cpp tetio_plugin.cpp)
 TOOLS   := $(basename $(notdir $(sort $(wildcard src/tools/*.c))))
 TESTS_C := $(basename $(notdir $(sort $(wildcard tests/test_*.c))))
 
 CORE_OBJ := $(CORE_C:src/%.c=$(BUILD)/obj/%.o)
-IO_OBJ   := $(IO_C:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/obj/%.o)
-LIB_OBJ  := $(CORE_OBJ) $(IO_OBJ)
+IO_OBJ   := $(IO_C:src/%.c=$(BUILD)/obj/%.o) $(patsubst src/%.cpp,$(BUILD)/obj/%.o,$(filter-out $(VTK_CXX),$(LIB_CXX)))
+VTK_OBJ  := $(VTK_CXX:src/%.cpp=$(BUILD)/obj/%.o) $(filter %/vtkxml.o,$(IO_OBJ))
+LIB_OBJ  := $(CORE_OBJ) $(IO_OBJ) $(filter-out $(IO_OBJ),$(VTK_OBJ))
 CLI_OBJ := $(patsubst src/%.c,$(BUILD)/obj/%.o,$(sort $(wildcard src/cli/*.c)))
 LIBA_CORE := $(BUILD)/libsouptet.a
 LIBA_IO   := $(BUILD)/libsouptet-io.a
@@ -101,20 +106,21 @@ LIBA      := $(LIBA_IO) $(LIBA_CORE)
 SOVERSION := 0
 LIBSO_CORE := $(BUILD)/libsouptet.so.$(VERSION)
 LIBSO_IO   := $(BUILD)/libsouptet-io.so.$(VERSION)
+LIBSO_VTK  := $(BUILD)/libsouptet-vtk.so.$(VERSION)
 CORE_LIBS := -lxxhash -ljansson -lz $(OMPLIB) -lm
-IO_LIBS   := -lopenvdb -ltbb -lImath-3_1 \
-        -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
+IO_LIBS   := -lopenvdb -ltbb -lImath-3_1
+VTK_LIBS  := -lvtkIOXML-9.1 -lvtkIOXMLParser-9.1 -lvtkIOCore-9.1 -lvtkCommonExecutionModel-9.1 \
         -lvtkCommonDataModel-9.1 -lvtkCommonMath-9.1 -lvtkCommonCore-9.1 -lvtksys-9.1
 TOOL_BIN := $(TOOLS:%=$(BUILD)/bin/%)
 TEST_BIN := $(TESTS_C:%=$(BUILD)/tests/%)
 
 .PHONY: all tools check test demo demo-sim demo-sim-parts bench setup install uninstall clean fuzz
-all: $(LIBA) $(LIBSO_CORE) $(LIBSO_IO) $(TOOL_BIN) $(TEST_BIN)
+all: $(LIBA) $(LIBSO_CORE) $(LIBSO_IO) $(LIBSO_VTK) $(TOOL_BIN) $(TEST_BIN)
 # Objects stay after a build: make would delete the tools' and tests'
 # objects as intermediates, and the next target would compile them again.
 .SECONDARY:
 # The tools alone (what the demos run): no unit tests, Python or Blender.
-tools: $(TOOL_BIN)
+tools: $(TOOL_BIN) $(LIBSO_VTK)
 
 # The library's objects are position-independent (they go into the shared
 # libraries too); the tools' and tests' are not.
@@ -184,7 +190,22 @@ endif
 # library or link option relinks the libraries, tools and tests of a built
 # tree, which their objects alone would not.
 TOOL_LINK := -Wl,--as-needed
-LINK_NOW := $(LDFLAGS_ALL) | $(SO_LDFLAGS) | $(CORE_LIBS) | $(IO_LIBS) | $(LIBS) | $(TOOL_LINK)
+# The programs export the core's names (st_*) for the VTK plugin to bind
+# to, and find it beside their folder: $(BUILD)/bin -> $(BUILD), or
+# PREFIX/bin -> PREFIX/lib.
+EXE_LINK := -Wl,--dynamic-list=$(BUILD)/exe.dynlist -Wl,-rpath,'$$ORIGIN/..:$$ORIGIN/../lib'
+# Written here as the flags are (a file make cannot forget to make).
+EXE_DYNLIST := { st_*; };
+VTK_MAP := SOUPTET_VTK_0 { global: st_vtk_plugin_entry; local: *; };
+ifneq ($(EXE_DYNLIST),$(file < $(BUILD)/exe.dynlist))
+  $(shell mkdir -p $(BUILD))
+  $(file > $(BUILD)/exe.dynlist,$(EXE_DYNLIST))
+endif
+ifneq ($(VTK_MAP),$(file < $(BUILD)/libsouptet-vtk.map))
+  $(shell mkdir -p $(BUILD))
+  $(file > $(BUILD)/libsouptet-vtk.map,$(VTK_MAP))
+endif
+LINK_NOW := $(LDFLAGS_ALL) | $(SO_LDFLAGS) | $(CORE_LIBS) | $(IO_LIBS) | $(VTK_LIBS) | $(LIBS) | $(TOOL_LINK) | $(EXE_LINK)
 ifneq ($(LINK_NOW),$(file < $(BUILD)/linkflags))
   $(shell mkdir -p $(BUILD))
   $(file > $(BUILD)/linkflags,$(LINK_NOW))
@@ -201,9 +222,16 @@ $(LIBSO_CORE): $(CORE_OBJ) $(BUILD)/libsouptet.map $(BUILD)/linkflags
 $(LIBSO_IO): $(IO_OBJ) $(LIBSO_CORE) $(BUILD)/libsouptet-io.map $(BUILD)/linkflags
 	$(CXX) -shared $(LDFLAGS_ALL) $(SO_LDFLAGS) -Wl,-soname,libsouptet-io.so.$(SOVERSION) \
 	  -Wl,--version-script=$(BUILD)/libsouptet-io.map $(IO_OBJ) -L$(BUILD) -lsouptet \
-	  -Wl,--as-needed $(IO_LIBS) $(CORE_LIBS) -o $@
+	  -Wl,-rpath,'$$ORIGIN' -Wl,--as-needed $(IO_LIBS) $(CORE_LIBS) -o $@
 	ln -sf $(notdir $@) $(BUILD)/libsouptet-io.so.$(SOVERSION)
 	ln -sf libsouptet-io.so.$(SOVERSION) $(BUILD)/libsouptet-io.so
+# The plugin exports its table alone; the core's names it leaves to the
+# program, or to libsouptet.so.0 (NEEDED, found beside it).
+$(LIBSO_VTK): $(VTK_OBJ) $(LIBSO_CORE) $(BUILD)/libsouptet-vtk.map $(BUILD)/linkflags
+	$(CXX) -shared $(LDFLAGS_ALL) $(SO_LDFLAGS) -Wl,-soname,libsouptet-vtk.so.$(SOVERSION) \
+	  -Wl,--version-script=$(BUILD)/libsouptet-vtk.map $(VTK_OBJ) -L$(BUILD) -lsouptet \
+	  -Wl,-rpath,'$$ORIGIN' -Wl,--as-needed $(VTK_LIBS) $(CORE_LIBS) -o $@
+	ln -sf $(notdir $@) $(BUILD)/libsouptet-vtk.so.$(SOVERSION)
 
 # Tools and tests link with the C++ driver: the adapters need libstdc++.
 # A tool keeps only the libraries it calls (--as-needed): one that reads
@@ -211,10 +239,10 @@ $(LIBSO_IO): $(IO_OBJ) $(LIBSO_CORE) $(BUILD)/libsouptet-io.map $(BUILD)/linkfla
 # nor VTK, whose relocations cost a process about 60 ms (issue 41).
 $(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(CLI_OBJ) $(LIBA) $(BUILD)/linkflags
 	@mkdir -p $(dir $@)
-	$(CXX) $(LDFLAGS_ALL) $< $(CLI_OBJ) $(LIBA) $(TOOL_LINK) $(LIBS) -o $@
+	$(CXX) $(LDFLAGS_ALL) $(EXE_LINK) $< $(CLI_OBJ) $(LIBA) $(TOOL_LINK) $(LIBS) -o $@
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LIBA) $(BUILD)/linkflags
 	@mkdir -p $(dir $@)
-	$(CXX) $(LDFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
+	$(CXX) $(LDFLAGS_ALL) $(EXE_LINK) $< $(LIBA) $(LIBS) -o $@
 
 # Peers for make bench (not installed).
 BENCH_BIN := $(BUILD)/bench/vdb_udf $(BUILD)/bench/vdb_dist $(BUILD)/bench/stream26 $(BUILD)/bench/iou \
@@ -233,11 +261,11 @@ $(BUILD)/bench/vdb_dist: bench/vdb_dist.cpp $(LIBA)
 	$(CXX) $(CXXFLAGS_ALL) $< $(LIBA) -Wl,--as-needed $(LIBS) -o $@
 $(BUILD)/bench/%: bench/%.cpp $(LIBA)
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS_ALL) $< $(LIBA) $(LIBS) -o $@
+	$(CXX) $(CXXFLAGS_ALL) $(EXE_LINK) $< $(LIBA) $(LIBS) -o $@
 $(BUILD)/bench/%: bench/%.c $(LIBA)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -c $< -o $@.o
-	$(CXX) $(LDFLAGS_ALL) $@.o $(LIBA) $(LIBS) -o $@
+	$(CXX) $(LDFLAGS_ALL) $(EXE_LINK) $@.o $(LIBA) $(LIBS) -o $@
 
 # libFuzzer harnesses, one per reader (fuzz/fuzz_*.c), built with clang in
 # build-fuzz/ and run by scripts/fuzz for FUZZ_SECONDS each (FUZZ_RUNS=N:
@@ -247,7 +275,7 @@ FUZZ_BIN := $(patsubst fuzz/%.c,$(BUILD)/fuzz/%,$(sort $(wildcard fuzz/fuzz_*.c)
 $(BUILD)/fuzz/%: fuzz/%.c $(LIBA)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -fsanitize=fuzzer -c $< -o $@.o
-	$(CXX) $(LDFLAGS_ALL) -fsanitize=fuzzer $@.o $(LIBA) $(LIBS) -o $@
+	$(CXX) $(LDFLAGS_ALL) $(EXE_LINK) -fsanitize=fuzzer $@.o $(LIBA) $(LIBS) -o $@
 
 ifeq ($(config),fuzz)
 fuzz: $(FUZZ_BIN)
@@ -309,7 +337,8 @@ install: all
 	  $(DESTDIR)$(PREFIX)/share/man/man7
 	install -m 755 $(TOOL_BIN) $(DESTDIR)$(PREFIX)/bin/
 	install -m 644 $(LIBA) $(DESTDIR)$(PREFIX)/lib/
-	install -m 755 $(LIBSO_CORE) $(LIBSO_IO) $(DESTDIR)$(PREFIX)/lib/
+	install -m 755 $(LIBSO_CORE) $(LIBSO_IO) $(LIBSO_VTK) $(DESTDIR)$(PREFIX)/lib/
+	ln -sf libsouptet-vtk.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/libsouptet-vtk.so.$(SOVERSION)
 	for l in libsouptet libsouptet-io; do \
 	  ln -sf $$l.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/$$l.so.$(SOVERSION) && \
 	  ln -sf $$l.so.$(SOVERSION) $(DESTDIR)$(PREFIX)/lib/$$l.so || exit 1; done
@@ -325,7 +354,7 @@ install: all
 uninstall:
 	rm -f $(TOOLS:%=$(DESTDIR)$(PREFIX)/bin/%) $(DESTDIR)$(PREFIX)/lib/libsouptet.a \
 	  $(DESTDIR)$(PREFIX)/lib/libsouptet-io.a $(DESTDIR)$(PREFIX)/lib/libsouptet.so* \
-	  $(DESTDIR)$(PREFIX)/lib/libsouptet-io.so* \
+	  $(DESTDIR)$(PREFIX)/lib/libsouptet-io.so* $(DESTDIR)$(PREFIX)/lib/libsouptet-vtk.so* \
 	  $(DESTDIR)$(PREFIX)/lib/pkgconfig/souptet.pc $(DESTDIR)$(PREFIX)/lib/pkgconfig/souptet-io.pc
 	rm -rf $(DESTDIR)$(PREFIX)/include/souptet
 	rm -f $(TOOLS:%=$(DESTDIR)$(PREFIX)/share/man/man1/%.1) $(DESTDIR)$(PREFIX)/share/man/man7/souptet.7
