@@ -101,6 +101,15 @@ typedef struct watch {
     double last_min;
 } watch;
 
+/* The default parameters with fn called after every iteration. */
+static st_fit_params watched_params(st_fit_iter_fn fn, void *ctx)
+{
+    st_fit_params p = st_fit_params_default();
+    p.on_iter = fn;
+    p.on_iter_ctx = ctx;
+    return p;
+}
+
 static void on_iter(void *ctx, const st_fit_iter *it)
 {
     watch *w = ctx;
@@ -479,10 +488,8 @@ static void test_band_edge(void)
     st_bvh_build(&b, s, &err);
     st_tetmesh *m = ball_mesh(0.5, 1.6);
     band_watch w = {m, b, calloc(m->npoints, sizeof(double))};
-    st_fit_params p = st_fit_params_default();
+    st_fit_params p = watched_params(band_on_iter, &w);
     p.offset_ratio = 0.15;
-    p.on_iter = band_on_iter;
-    p.on_iter_ctx = &w;
     st_fit_stats st;
     st_status rc = st_fit(m, s, b, &p, &st, NULL, &err);
     uint32_t *faces = NULL;
@@ -779,10 +786,8 @@ static void test_stall(void)
     stall_watch w = {m, up, sm.onb, 0.4 * 0.5, calloc(m->npoints, 1), 0, 0, 0, 0, 0};
     size_t within0;
     stall_mark(&w, &within0);   /* what is within on entry counts as reached */
-    st_fit_params p = st_fit_params_default();
+    st_fit_params p = watched_params(stall_iter, &w);
     p.quality = 0;
-    p.on_iter = stall_iter;
-    p.on_iter_ctx = &w;
     st_fit_stats st;
     st_status rc = st_fit(m, up, NULL, &p, &st, NULL, &err);
     TAP_CHECK(rc == ST_OK && w.disagree == 0 && w.iters == st.iters,
