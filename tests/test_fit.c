@@ -12,6 +12,7 @@
  * of every S vertex. */
 #include "souptet/bvh.h"
 #include "souptet/enclose.h"
+#include "souptet/geom.h"
 #include "souptet/isect.h"
 #include "souptet/pred.h"
 #include "souptet/sculpt.h"
@@ -99,6 +100,15 @@ typedef struct watch {
     int checks, broken, fit_iters, quality_rounds;
     double last_min;
 } watch;
+
+/* The default parameters with fn called after every iteration. */
+static st_fit_params watched_params(st_fit_iter_fn fn, void *ctx)
+{
+    st_fit_params p = st_fit_params_default();
+    p.on_iter = fn;
+    p.on_iter_ctx = ctx;
+    return p;
+}
 
 static void on_iter(void *ctx, const st_fit_iter *it)
 {
@@ -478,10 +488,8 @@ static void test_band_edge(void)
     st_bvh_build(&b, s, &err);
     st_tetmesh *m = ball_mesh(0.5, 1.6);
     band_watch w = {m, b, calloc(m->npoints, sizeof(double))};
-    st_fit_params p = st_fit_params_default();
+    st_fit_params p = watched_params(band_on_iter, &w);
     p.offset_ratio = 0.15;
-    p.on_iter = band_on_iter;
-    p.on_iter_ctx = &w;
     st_fit_stats st;
     st_status rc = st_fit(m, s, b, &p, &st, NULL, &err);
     uint32_t *faces = NULL;
@@ -700,6 +708,105 @@ static void test_fill(void)
     st_soup_free(down);
 }
 
+/* The fit's stall rule, as fit.c promises it: a fit that stops with a
+ * boundary vertex still beyond d_offset, having moved something in its
+ * last iteration and before max_iters, has had STALL_ITERS iterations in a
+ * row in which no boundary vertex came within d_offset for the first time.
+ * Kept here as its own copy: fit.c stopping sooner fails this test. */
+#define STALL_ITERS 5
+
+typedef struct stall_watch {
+    const st_tetmesh *m;
+    const st_soup *s;
+    const unsigned char *onb;   /* boundary vertices (the fit phase keeps them) */
+    double d_offset;
+    unsigned char *ever;        /* within d_offset after some fit iteration */
+    int iters, last_new;        /* fit iterations seen; the last that added one */
+    size_t last_within, last_moved, disagree;
+} stall_watch;
+
+/* Every boundary vertex's distance to S by brute force over S's triangles:
+ * marks those within d_offset in w->ever; 1 when one was not marked. */
+static int stall_mark(stall_watch *w, size_t *within)
+{
+    int added = 0;
+    *within = 0;
+    for (size_t v = 0; v < w->m->npoints; v++) {
+        if (!w->onb[v])
+            continue;
+        const double *x = w->m->xyz + 3 * v;
+        double d2 = INFINITY;
+        for (size_t t = 0; t < w->s->ntris; t++) {
+            const uint32_t *c = w->s->tris + 3 * t;
+            d2 = fmin(d2, st_point_triangle_dist2(x, w->s->xyz + 3 * (size_t)c[0],
+                                                  w->s->xyz + 3 * (size_t)c[1],
+                                                  w->s->xyz + 3 * (size_t)c[2], NULL));
+        }
+        if (sqrt(d2) <= w->d_offset) {
+            (*within)++;
+            added |= !w->ever[v];
+            w->ever[v] = 1;
+        }
+    }
+    return added;
+}
+
+/* After each fit iteration: the vertices within d_offset for the first
+ * time, and the count within against the fit's own. */
+static void stall_iter(void *ctx, const st_fit_iter *it)
+{
+    stall_watch *w = ctx;
+    if (strcmp(it->phase, "fit") != 0)
+        return;
+    size_t within;
+    if (stall_mark(w, &within))
+        w->last_new = it->iter;
+    w->iters = it->iter;
+    w->disagree += within != it->within_offset;
+    w->last_within = it->within_offset;
+    w->last_moved = it->moved;
+}
+
+/* The half sphere without its fill: the lower boundary can never come
+ * within d_offset of S, so the fit must end on its stall rule; it may do so
+ * only STALL_ITERS iterations after the last that brought a vertex into the
+ * band for the first time. */
+static void test_stall(void)
+{
+    st_soup *full = st_soup_new(), *up = st_soup_new(), *down = st_soup_new();
+    add_sphere(full, 1.0, 2.0);
+    split_z(full, up, down);
+    st_tetmesh *m = ball_mesh(0.5, 1.6);
+    sm_mesh sm;
+    st_error err;
+    if (sm_mesh_build(&sm, m, &err)) {
+        TAP_CHECK(0, "mesh build: %s", err.msg);
+        return;
+    }
+    stall_watch w = {m, up, sm.onb, 0.4 * 0.5, calloc(m->npoints, 1), 0, 0, 0, 0, 0};
+    size_t within0;
+    stall_mark(&w, &within0);   /* what is within on entry counts as reached */
+    st_fit_params p = watched_params(stall_iter, &w);
+    p.quality = 0;
+    st_fit_stats st;
+    st_status rc = st_fit(m, up, NULL, &p, &st, NULL, &err);
+    TAP_CHECK(rc == ST_OK && w.disagree == 0 && w.iters == st.iters,
+              "%d fit iterations, the count within d_offset as brute force finds it", w.iters);
+    TAP_CHECK(w.last_within < sm.nbv && w.last_moved > 0 && w.iters < p.max_iters,
+              "the fit ended on its stall rule: %zu of %zu within, %zu moved in the last "
+              "iteration", w.last_within, sm.nbv, w.last_moved);
+    TAP_CHECK(w.iters - w.last_new >= STALL_ITERS,
+              "it stopped %d iterations after the last that brought a vertex into the band "
+              "for the first time (iteration %d), not before %d", w.iters - w.last_new,
+              w.last_new, STALL_ITERS);
+    free(w.ever);
+    sm_mesh_free(&sm);
+    st_tetmesh_free(m);
+    st_soup_free(full);
+    st_soup_free(up);
+    st_soup_free(down);
+}
+
 /* Corner k of tet t of m, with point v at y. */
 static const double *corner_at(const st_tetmesh *m, uint32_t t, int k, uint32_t v,
                                const double y[3])
@@ -803,7 +910,7 @@ int main(int argc, char **argv)
     static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads),
                                      TAP_TEST(not_enclosing), TAP_TEST(refusals),
                                      TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
-                                     TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill),
+                                     TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), TAP_TEST(stall),
                                      TAP_TEST(swept), {0}};
     return tap_main(argc, argv, tests);
 }

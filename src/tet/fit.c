@@ -13,8 +13,8 @@
  *                 FIT_HALVINGS times, then skipped; they stop when every
  *                 boundary vertex is within d_offset (or a rescue pass
  *                 tried early, early_rescue, brings them there), nothing
- *                 moves, FIT_STALL_ITERS bring none new into the band, or
- *                 at max_iters;
+ *                 moves, FIT_STALL_ITERS in a row bring no vertex into the
+ *                 band for the first time (fit_reached), or at max_iters;
  *   rescue_pass   the vertices still beyond, held by S near their star,
  *                 try other directions that still bring them closer
  *                 (rescue_vertex), or, for the last few, a neighbour's
@@ -47,10 +47,14 @@
  * few times": 1/16 of a step is already below what one iteration of the
  * paper's scheme moves a vertex near convergence). */
 #define FIT_HALVINGS 4
-/* Iterations without a new boundary vertex reaching the band before the
- * fit gives up on the rest: past this the remaining ones are held by the
- * invariant (thin gaps), and more ODT steps only wear the angles down. */
-#define FIT_STALL_ITERS 10
+/* Iterations in a row that bring no boundary vertex into the band for the
+ * first time (fit_reached) before the fit gives up on the rest: past this
+ * the remaining ones are held by the invariant (thin gaps) or go in and
+ * out of the band as their neighbours' ODT steps swing them, and more
+ * steps only wear the angles down (doc/design/fit.md: the count within
+ * oscillated 222..227 for 18 iterations on the armadillo at 7 cells, and
+ * each new high of the oscillation restarted the old count). */
+#define FIT_STALL_ITERS 5
 /* The early rescue: after FIT_EARLY_RESCUE iterations without a new
  * boundary vertex in the band, or when an iteration leaves at most
  * FIT_EARLY_FEW beyond it, the fit tries the rescue pass: when it brings
@@ -99,6 +103,9 @@ typedef struct fit_run {
     double *dist;         /* per vertex: its distance to S (boundary) */
     dist_summary ds;      /* of dist, as it stands */
     double *save;         /* the early rescue's undo: positions, then dist */
+    unsigned char *reached;   /* per vertex: 1 once a boundary vertex has been
+                                 within d_offset (on entry or after a fit
+                                 iteration) */
     double t0;            /* when st_fit began (sm_now) */
 } fit_run;
 
@@ -186,9 +193,10 @@ static int cmp_rescue(const void *a, const void *b)
  * invariant refused is held by S near its star; a step along another
  * direction that still brings it closer to S often passes (it slides past
  * what holds it). Candidates: the directions within 88 degrees of the way
- * to S's nearest point, at fractions of the way to the band's middle; the
- * closest to S first, the first that keeps the invariant and the star's
- * score floor is taken. 1 when v moved. */
+ * to S's nearest point, at fractions of the way to the band's middle; of
+ * those that keep the star's score floor (tested first: most fail it), the
+ * closest to S first, the first that keeps the invariant is taken. 1 when
+ * v moved. */
 static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
 {
     const sm_mesh *sm = &c->sm;
@@ -213,8 +221,9 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
     t2[1] = n[2] * t1[0] - n[0] * t1[2];
     t2[2] = n[0] * t1[1] - n[1] * t1[0];
     double way = dd - FIT_GOAL_FRACTION * c->d_offset;
+    double floor_score = fmin(RESCUE_FLOOR, sm_star_score(sm, v, x));
     double cd[RESCUE_NCAND][5];
-    size_t nc = 0;
+    size_t nc = 0, ord = 0;
     for (size_t ti = 0; ti < RESCUE_NTILT; ti++) {
         double th = rescue_tilt[ti] * 3.14159265358979323846 / 180.0;
         int naz = ti == 0 ? 1 : RESCUE_AZIMUTHS;
@@ -223,25 +232,30 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
             double dir[3];
             for (int a = 0; a < 3; a++)
                 dir[a] = cos(th) * n[a] + sin(th) * (cos(ph) * t1[a] + sin(ph) * t2[a]);
-            for (size_t fi = 0; fi < RESCUE_NFRAC; fi++, nc++) {
+            for (size_t fi = 0; fi < RESCUE_NFRAC; fi++, ord++) {
                 double st = way * rescue_frac[fi];
                 for (int a = 0; a < 3; a++)
                     cd[nc][1 + a] = x[a] + st * dir[a];
+                /* the score floor first: it is cheaper than the distance,
+                 * and most candidates fail it (a candidate that fails it
+                 * is never taken, so the order of the rest is the same) */
+                if (sm_star_score(sm, v, cd[nc] + 1) < floor_score)
+                    continue;
                 int64_t tri;
                 double d2 = sm_nearest_d2(c, cd[nc] + 1, dd * dd, &tri, NULL);
                 cd[nc][0] = tri >= 0 ? sqrt(d2) : INFINITY;
-                cd[nc][4] = (double)nc;
+                cd[nc][4] = (double)ord;
+                nc++;
             }
         }
     }
     qsort(cd, nc, sizeof cd[0], cmp_rescue);
-    double floor_score = fmin(RESCUE_FLOOR, sm_star_score(sm, v, x));
     sm_star_pts_collect(c, v, sp);
     for (size_t i = 0; i < nc; i++) {
         if (!(cd[i][0] < dd))
             break;
         const double *p = cd[i] + 1;
-        if (sm_star_score(sm, v, p) >= floor_score && sm_move_ok(c, v, p, sp)) {
+        if (sm_move_ok(c, v, p, sp)) {
             memcpy(x, p, 3 * sizeof *x);
             return 1;
         }
@@ -307,30 +321,59 @@ static int rescue_joint(const fit_ctx *c, uint32_t v, star_pts *sp)
     return 0;
 }
 
+/* One round of rescue_vertex over the boundary vertices beyond d_offset,
+ * in index order; a vertex that did not move and whose star has not
+ * changed since is skipped (dy: the dirty set, one step per attempt; it
+ * would fail again). Returns the moves. */
+static size_t rescue_round(fit_ctx *c, double *dist, dirty *dy, star_pts *sp)
+{
+    size_t moved = 0;
+    for (size_t v = 0; v < c->sm.nv; v++) {
+        if (!c->sm.onb[v] || !(dist[v] > c->d_offset))
+            continue;
+        if (dy->moved_at && sm_dirty_unchanged(dy, &c->sm, (uint32_t)v))
+            continue;
+        int k = rescue_vertex(c, (uint32_t)v, sp);
+        if (dy->moved_at) {
+            dy->step++;
+            sm_dirty_mark(dy, (uint32_t)v, k);
+        }
+        if (k) {
+            moved++;
+            dist[v] = sm_dist_to_s(c, c->sm.m->xyz + 3 * v, NULL);
+        }
+    }
+    return moved;
+}
+
 /* Rounds of rescue_vertex over the boundary vertices beyond d_offset, in
  * index order (few vertices, serial: the result does not depend on the
- * thread count). Returns the moves. */
+ * thread count), and with joint the joint rescue when a round moves
+ * nothing. Each round skips the vertices whose rescue failed with nothing
+ * in their star moved since (no memory for the dirty set: none skipped,
+ * the same result). Returns the moves. */
 static size_t rescue_pass(fit_ctx *c, double *dist, int joint)
 {
     size_t moves = 0;
     star_pts sp = STAR_PTS_INIT;
+    dirty dy;
+    if (sm_dirty_init(&dy, c->sm.nv) != ST_OK)
+        sm_dirty_free(&dy);   /* moved_at NULL: no skips */
     for (int round = 0; round < RESCUE_ROUNDS; round++) {
-        size_t moved = 0;
-        for (size_t v = 0; v < c->sm.nv; v++)
-            if (c->sm.onb[v] && dist[v] > c->d_offset && rescue_vertex(c, (uint32_t)v, &sp)) {
-                moved++;
-                dist[v] = sm_dist_to_s(c, c->sm.m->xyz + 3 * v, NULL);
-            }
+        size_t moved = rescue_round(c, dist, &dy, &sp);
         /* when the rescues alone move nothing, the neighbours first */
         for (size_t v = 0; v < c->sm.nv && moved == 0 && joint; v++)
             if (c->sm.onb[v] && dist[v] > c->d_offset && rescue_joint(c, (uint32_t)v, &sp)) {
                 moved++;
                 dist[v] = sm_dist_to_s(c, c->sm.m->xyz + 3 * v, NULL);
             }
+        if (moved && joint && dy.tried_at)   /* which neighbours moved is not */
+            memset(dy.tried_at, 0, c->sm.nv * sizeof *dy.tried_at);   /* kept */
         moves += moved;
         if (moved == 0)
             break;
     }
+    sm_dirty_free(&dy);
     free(sp.list);
     return moves;
 }
@@ -608,7 +651,8 @@ static st_status fit_open(fit_run *r, st_tetmesh *m, const st_soup *s, const st_
     if (rc)
         return rc;
     if (sm_dirty_init(&r->dy, m->npoints) ||
-        !(r->dist = st_malloc_array(m->npoints, sizeof *r->dist)))
+        !(r->dist = st_malloc_array(m->npoints, sizeof *r->dist)) ||
+        !(r->reached = st_calloc_array(m->npoints, 1)))
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory (fit)");
     r->st.h = h;
     r->st.d_offset = r->c.d_offset;
@@ -625,6 +669,7 @@ static st_status fit_open(fit_run *r, st_tetmesh *m, const st_soup *s, const st_
 static void fit_close(fit_run *r)
 {
     free(r->save);
+    free(r->reached);
     free(r->dist);
     sm_dirty_free(&r->dy);
     sm_fit_ctx_close(&r->c);
@@ -685,15 +730,29 @@ static int early_rescue(fit_run *r)
     return 0;
 }
 
+/* Marks the boundary vertices within d_offset as reached; how many were
+ * not before. */
+static size_t fit_reached(fit_run *r)
+{
+    const sm_mesh *sm = &r->c.sm;
+    size_t fresh = 0;
+    for (size_t v = 0; v < sm->nv; v++)
+        if (sm->onb[v] && !r->reached[v] && !(r->dist[v] > r->c.d_offset)) {
+            r->reached[v] = 1;
+            fresh++;
+        }
+    return fresh;
+}
+
 /* The paper's iterations until every boundary vertex is within d_offset
  * (or an early rescue pass brings them there), an iteration moves
- * nothing, FIT_STALL_ITERS bring no new vertex into the band, or
- * max_iters; then a rescue pass. */
+ * nothing, FIT_STALL_ITERS in a row bring no boundary vertex into the
+ * band that had never been in it, or max_iters; then a rescue pass. */
 static st_status fit_iterate(fit_run *r, st_error *err)
 {
     fit_ctx *c = &r->c;
-    size_t best_within = r->ds.within;
     int since_best = 0, failed_trials = 0;
+    fit_reached(r);
     for (int it = 0; it < r->p.max_iters && r->ds.within < c->sm.nbv; it++) {
         if (st_progress_cancelled(c->prog))
             return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
@@ -710,11 +769,10 @@ static st_status fit_iterate(fit_run *r, st_error *err)
         sm_fit_report(&r->p, c, "fit", it + 1, &r->ds, &n, r->t0);
         if (n.moved == 0)
             break;
-        if (r->ds.within > best_within) {
-            best_within = r->ds.within;
+        if (fit_reached(r) > 0) {
             since_best = 0;
         } else if (++since_best >= FIT_STALL_ITERS) {
-            break;   /* the rest are held back: thin gaps or blocked moves */
+            break;   /* the rest are held back, or swing in and out */
         }
         if (failed_trials < FIT_EARLY_TRIALS &&
             (since_best == FIT_EARLY_RESCUE ||

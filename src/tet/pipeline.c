@@ -193,7 +193,7 @@ static void candidate_relay(void *ctx, const char *stage, double fraction)
 /* The fit stops when every boundary vertex is within the offset or after
  * this many iterations that bring no new one (fit.c's FIT_STALL_ITERS;
  * here only for the progress line). */
-#define PROGRESS_FIT_STALL 10
+#define PROGRESS_FIT_STALL 5
 
 /* The fit's iterations: the "iteration" event, and the candidate's
  * progress through the fit and the quality pass. The fit's part: the
