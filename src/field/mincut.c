@@ -291,10 +291,9 @@ static void maxflow(bk *b)
     }
 }
 
-/* The node of voxel w among the sorted voxels vox[lo, hi), or NO_NODE. */
-static uint32_t find_node(const uint32_t *vox, size_t lo, size_t hi, uint32_t w)
+/* The first of the sorted voxels vox[lo, hi) not below w (hi if none). */
+static size_t lower_node(const uint32_t *vox, size_t lo, size_t hi, uint32_t w)
 {
-    const size_t end = hi;
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
         if (vox[mid] < w)
@@ -302,7 +301,7 @@ static uint32_t find_node(const uint32_t *vox, size_t lo, size_t hi, uint32_t w)
         else
             hi = mid;
     }
-    return lo < end && vox[lo] == w ? (uint32_t)lo : NO_NODE;
+    return lo;
 }
 
 /* The capacity of the face between two voxels at unsigned distances a, b. */
@@ -310,6 +309,44 @@ static int32_t face_cap(const st_mincut_params *p, double s, float a, float b)
 {
     double x = (a < b ? a : b) / s;
     return 1 + (int32_t)(p->free_area * (x >= 1.0 ? 1.0 : pow(x, p->power)) + 0.5);
+}
+
+/* The arcs and terminal capacities of nodes [u0, u1) (vox ascending): the
+ * neighbour w = v + off[a] rises with the node, so each direction's node
+ * is found by a cursor that only moves forward (one binary search to
+ * start it), not by a search per arc. */
+static void node_arcs(bk *b, const st_grid *g, const int8_t *label, const uint32_t *vox,
+                      size_t u0, size_t u1, const ptrdiff_t off[6],
+                      const st_mincut_params *p, double s, int fixed)
+{
+    const size_t m = b->n;
+    if (u0 >= u1)
+        return;
+    size_t cur[6];
+    for (unsigned a = 0; a < 6; a++)
+        cur[a] = lower_node(vox, 0, m, (uint32_t)((ptrdiff_t)vox[u0] + off[a]));
+    for (size_t u = u0; u < u1; u++) {
+        const uint32_t v = vox[u];
+        const float dv = fabsf(g->data[v]);
+        int64_t t = (int64_t)llround(label[v] * p->evidence_weight);
+        for (unsigned a = 0; a < 6; a++) {
+            const uint32_t w = (uint32_t)((ptrdiff_t)v + off[a]);
+            size_t c = cur[a];
+            while (c < m && vox[c] < w)
+                c++;
+            cur[a] = c;
+            const uint32_t q = c < m && vox[c] == w ? (uint32_t)c : NO_NODE;
+            const int32_t cap = face_cap(p, s, dv, fabsf(g->data[w]));
+            b->nbr[6 * u + a] = q;
+            b->rc[6 * u + a] = q == NO_NODE ? 0 : cap;
+            if (q == NO_NODE)   /* a decided neighbour: a terminal */
+                t += label[w] >= fixed ? cap : -cap;
+        }
+        if (t > INT32_MAX / 2 || t < -INT32_MAX / 2)
+            t = t > 0 ? INT32_MAX / 2 : -INT32_MAX / 2;
+        b->tr[u] = (int32_t)t;
+        b->dist[u] = 1;
+    }
 }
 
 st_status st_mincut_label(const st_grid *g, int8_t *label,
@@ -371,39 +408,16 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
             if (abs(label[v]) < fixed)
                 vox[c++] = (uint32_t)v;
     }
-    free(first);
     const ptrdiff_t off[6] = {1, -1, (ptrdiff_t)nx, -(ptrdiff_t)nx, (ptrdiff_t)layer,
                               -(ptrdiff_t)layer};
     const double s = p->surface_voxels * g->voxel;
     /* Each node's arcs and terminal capacity (a decided neighbour's arc
-     * goes to its terminal), in parallel; then the trees' roots in order. */
-    #pragma omp parallel for schedule(static)
-    for (size_t u = 0; u < m; u++) {
-        const uint32_t v = vox[u];
-        const float dv = fabsf(g->data[v]);
-        int64_t t = (int64_t)llround(label[v] * p->evidence_weight);
-        for (unsigned a = 0; a < 6; a++) {
-            const uint32_t w = (uint32_t)((ptrdiff_t)v + off[a]);
-            uint32_t q;
-            if (a == 0)
-                q = u + 1 < m && vox[u + 1] == w ? (uint32_t)(u + 1) : NO_NODE;
-            else if (a == 1)
-                q = u > 0 && vox[u - 1] == w ? (uint32_t)(u - 1) : NO_NODE;
-            else if (a & 1u)
-                q = find_node(vox, 0, u, w);
-            else
-                q = find_node(vox, u + 1, m, w);
-            const int32_t cap = face_cap(p, s, dv, fabsf(g->data[w]));
-            b.nbr[6 * u + a] = q;
-            b.rc[6 * u + a] = q == NO_NODE ? 0 : cap;
-            if (q == NO_NODE)   /* a decided neighbour: a terminal */
-                t += label[w] >= fixed ? cap : -cap;
-        }
-        if (t > INT32_MAX / 2 || t < -INT32_MAX / 2)
-            t = t > 0 ? INT32_MAX / 2 : -INT32_MAX / 2;
-        b.tr[u] = (int32_t)t;
-        b.dist[u] = 1;
-    }
+     * goes to its terminal), a z layer at a time in parallel; then the
+     * trees' roots in order. */
+    #pragma omp parallel for schedule(dynamic, 1)
+    for (size_t k = 0; k < nz; k++)
+        node_arcs(&b, g, label, vox, first[k], first[k + 1], off, p, s, fixed);
+    free(first);
     for (size_t u = 0; u < m; u++) {
         if (b.tr[u]) {
             b.tree[u] = (b.tr[u] > 0 ? TREE_S : TREE_T) | F_ACTIVE;

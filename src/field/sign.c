@@ -269,10 +269,10 @@ static inline uint32_t mark_mask(const uint8_t *v, long n)
     return m;
 }
 
-static inline int ctz32(uint32_t m)
+static inline int ctz64(uint64_t m)
 {
 #if defined(__GNUC__)
-    return __builtin_ctz(m);
+    return __builtin_ctzll(m);
 #else
     int b = 0;
     while (!(m & 1u)) {
@@ -281,6 +281,12 @@ static inline int ctz32(uint32_t m)
     }
     return b;
 #endif
+}
+
+/* (m nonzero) */
+static inline int ctz32(uint32_t m)
+{
+    return ctz64(m);
 }
 
 /* Steps a line through coordinate c (of n) can go forward / backward
@@ -1219,11 +1225,60 @@ typedef struct refine_ctx {
  * (sel, indices into b) and the sign flips it found. */
 typedef struct refine_worker {
     refine_buf b;
-    uint32_t *sel;
-    size_t nsel, selcap;
+    uint32_t *sel;      /* in the mask's block */
+    size_t nsel;
     int seloom;
     size_t *flip, nflip, flipcap;
+    /* the tile's candidates near each of its voxel coordinates, per axis
+     * and reach (1..radius voxels): a bit per candidate, mask[((reach -
+     * 1) * 3 + axis) * TILE + coordinate - the tile's first][word]; a
+     * reach's masks made when a voxel of the tile first needs it */
+    uint64_t *mask;
+    size_t words, maskcap;
+    int made[3];
+    long first[3];
 } refine_worker;
+
+/* The masks of reach `have` voxels for w's tile (refine_worker). */
+static void near_masks(const refine_ctx *c, refine_worker *w, int have)
+{
+    const st_grid *g = c->g;
+    const double rr = have * g->voxel;
+    for (int a = 0; a < 3; a++)
+        for (int d = 0; d < TILE; d++) {
+            uint64_t *m = w->mask + (((size_t)(have - 1) * 3 + (size_t)a) * TILE +
+                                     (size_t)d) * w->words;
+            /* the voxel centre's coordinate, as st_grid_center has it */
+            const double x = g->origin[a] + g->voxel * (double)(w->first[a] + d);
+            for (size_t q0 = 0; q0 < w->b.n; q0 += 64) {
+                const size_t q1 = w->b.n - q0 < 64 ? w->b.n : q0 + 64;
+                uint64_t bits = 0;
+                for (size_t q = q0; q < q1; q++) {
+                    const refine_tri *r = &w->b.t[q];
+                    const int in = !(r->hi[a] < x - rr) & !(r->lo[a] > x + rr);
+                    bits |= (uint64_t)in << (q - q0);
+                }
+                m[q0 / 64] = bits;
+            }
+        }
+    w->made[have - 1] = 1;
+}
+
+/* w->sel: the tile's candidates whose boxes meet the box of `have`
+ * voxels around voxel (i, j, k), in their order. */
+static void select_near(const refine_ctx *c, refine_worker *w, long i, long j, long k, int have)
+{
+    if (!w->made[have - 1])
+        near_masks(c, w, have);
+    const size_t W = w->words, base = (size_t)(have - 1) * 3 * TILE;
+    const uint64_t *mx = w->mask + (base + (size_t)(i - w->first[0])) * W;
+    const uint64_t *my = w->mask + (base + TILE + (size_t)(j - w->first[1])) * W;
+    const uint64_t *mz = w->mask + (base + 2 * TILE + (size_t)(k - w->first[2])) * W;
+    w->nsel = 0;
+    for (size_t q = 0; q < W; q++)
+        for (uint64_t m = mx[q] & my[q] & mz[q]; m; m &= m - 1)
+            w->sel[w->nsel++] = (uint32_t)(64 * q + (size_t)ctz64(m));
+}
 
 /* Whether voxel (i, j, k) at pv, of value dv, is inside: its neighbours'
  * answers (the parity of the soup's crossings on the segment to each
@@ -1247,16 +1302,7 @@ static int refine_voxel(const refine_ctx *c, refine_worker *w, long i, long j, l
             continue;
         if (offs[o].cheb > have) {
             have = offs[o].cheb;
-            const double rr = have * g->voxel;
-            w->nsel = 0;
-            for (size_t q = 0; q < w->b.n; q++) {
-                const refine_tri *r = &w->b.t[q];
-                int out = (r->hi[0] < pv[0] - rr) | (r->lo[0] > pv[0] + rr) |
-                          (r->hi[1] < pv[1] - rr) | (r->lo[1] > pv[1] + rr) |
-                          (r->hi[2] < pv[2] - rr) | (r->lo[2] > pv[2] + rr);
-                w->sel[w->nsel] = (uint32_t)q;
-                w->nsel += !out;
-            }
+            select_near(c, w, i, j, k, have);
         }
         double pu[3];
         st_grid_center(g, (size_t)ui, (size_t)uj, (size_t)uk, pu);
@@ -1310,15 +1356,22 @@ static void refine_tile(const refine_ctx *c, refine_worker *w, long t)
     st_bvh_query_box(c->bvh, lo, hi, refine_collect, &w->b);
     if (w->b.oom)
         return;
-    if (w->selcap < w->b.n) {
-        uint32_t *ns = st_realloc_array(w->sel, w->b.n, sizeof *ns);
-        if (!ns) {
+    /* the masks, then sel (b.n indices, two a word) in one block */
+    w->words = (w->b.n + 63) / 64;
+    const size_t nmask = (size_t)c->p->radius * 3 * TILE * w->words;
+    const size_t need = nmask + (w->b.n + 1) / 2;
+    if (w->maskcap < need) {
+        uint64_t *nm = st_realloc_array(w->mask, need, sizeof *nm);
+        if (!nm) {
             w->seloom = 1;
             return;
         }
-        w->sel = ns;
-        w->selcap = w->b.n;
+        w->mask = nm;
+        w->maskcap = need;
     }
+    w->sel = (uint32_t *)(w->mask + nmask);
+    w->made[0] = w->made[1] = w->made[2] = 0;
+    w->first[0] = i0, w->first[1] = j0, w->first[2] = k0;
     for (long k = k0; k < k1; k++)
         for (long j = j0; j < j1; j++)
             for (long i = i0; i < i1; i++) {
@@ -1380,7 +1433,8 @@ st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
      * uses, so the answers are the same; this removes the data race.) */
     #pragma omp parallel reduction(+ : nchanged)
     {
-        refine_worker w = {{NULL, 0, 0, 0, soup}, NULL, 0, 0, 0, NULL, 0, 0};
+        refine_worker w = {{NULL, 0, 0, 0, soup}, NULL, 0, 0, NULL, 0, 0,
+                           NULL, 0, 0, {0, 0, 0}, {0, 0, 0}};
         #pragma omp for schedule(dynamic, 4)
         for (long t = 0; t < ntiles; t++)
             if (!w.b.oom && !w.seloom)
@@ -1397,7 +1451,7 @@ st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
             oom = 1;
         }
         free(w.b.t);
-        free(w.sel);
+        free(w.mask);
     }
     if (oom)
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory in the refinement");

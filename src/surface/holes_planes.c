@@ -478,7 +478,7 @@ typedef struct fanner {
     const double **lp, **ls;
     uint32_t *tri;
     double (*apx)[3];
-    int *flag;
+    int *flag, *best;   /* the edges an apex continues; the best apex's */
     cand *cs;
     fan_out fo;
     double lo[3], hi[3], ext;   /* the original loop's reach box, extent */
@@ -499,8 +499,9 @@ static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
     f->tri = malloc(3 * maxv * sizeof *f->tri);
     f->apx = malloc(MAX_APEX * sizeof *f->apx);
     f->flag = malloc(maxv * sizeof *f->flag);
+    f->best = malloc(maxv * sizeof *f->best);
     f->cs = malloc(MAX_CAND * sizeof *f->cs);
-    if (!f->flag || !f->stk || !f->cur || !f->nxt || !f->lens || !f->rim || !f->pl || !f->lp ||
+    if (!f->flag || !f->best || !f->stk || !f->cur || !f->nxt || !f->lens || !f->rim || !f->pl || !f->lp ||
         !f->ls || !f->tri || !f->apx || !f->cs)
         return oom(err);
     return ST_OK;
@@ -510,7 +511,7 @@ static void fanner_free(fanner *f)
 {
     free(f->stk), free(f->cur), free(f->nxt), free(f->lens), free(f->rim), free(f->pl);
     free(f->lp), free(f->ls), free(f->tri), free(f->apx), free(f->fo.tri), free(f->fo.orig);
-    free(f->flag), free(f->cs);
+    free(f->flag), free(f->best), free(f->cs);
 }
 
 /* The apex for the loop in f->cur (m vertices, centroid o): by the length
@@ -539,15 +540,15 @@ static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
     for (cand *k; (k = least_cand(f->cs, nc)) != NULL && -k->key > best; k->done = 1) {
         fan_flags(k->x, f->cur, f->rim, m, f->flag);
         const double g = fans_uncross(f->guard, k->x, f->cur, m, f->flag);
-        if (g > best) {
+        if (g > best) {   /* its flags kept: not tested again */
             best = g;
             memcpy(ax, k->x, 3 * sizeof *ax);
+            memcpy(f->best, f->flag, m * sizeof *f->best);
         }
     }
     size_t ncont = 0;
     if (best > 0.0) {
-        fan_flags(ax, f->cur, f->rim, m, f->flag);
-        fans_uncross(f->guard, ax, f->cur, m, f->flag);
+        memcpy(f->flag, f->best, m * sizeof *f->flag);
         for (size_t i = 0; i < m; i++)
             ncont += (size_t)f->flag[i];
     }
