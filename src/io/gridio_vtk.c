@@ -6,8 +6,14 @@
  * dlopen finds ST_VTK_PLUGIN through the caller's RUNPATH: the tools',
  * tests' and benches' $ORIGIN/.. (the build tree) and $ORIGIN/../lib
  * (installed), libsouptet-io.so's $ORIGIN; then LD_LIBRARY_PATH and the
- * system's directories.
+ * system's directories. Where a sanitizer's dlopen stands between (ASan
+ * and TSan intercept it, and the loader then reads the runtime's RUNPATH,
+ * not the caller's), the same places are tried by name: the folder of
+ * the object holding this file (dladdr; the program's own path from
+ * /proc/self/exe where it was run by name), its parent, and the
+ * parent's lib.
  */
+#define _GNU_SOURCE /* dladdr */
 #include "souptet/gridio.h"
 #include "souptet/outfile.h"
 #include "../adapters/gridio_internal.h"
@@ -18,19 +24,55 @@
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 static pthread_once_t plugin_once = PTHREAD_ONCE_INIT;
 static const st_vtk_plugin *plugin;
 static char plugin_why[512];
 
+/* ST_VTK_PLUGIN by path, beside the object that holds plugin_open: its
+ * folder, then "..", then "../lib" (the RUNPATHs above); NULL if none. */
+static void *plugin_beside(void)
+{
+    static const char *const rel[] = {"/", "/../", "/../lib/"};
+    Dl_info info;
+    char exe[4096];
+    if (!dladdr((void *)&plugin_beside, &info) || !info.dli_fname)
+        return NULL;
+    const char *obj = info.dli_fname;
+    /* the program itself, run by name through PATH: dladdr gives argv[0] */
+    if (!strchr(obj, '/')) {
+        ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+        if (len <= 0)
+            return NULL;
+        exe[len] = '\0';
+        obj = exe;
+    }
+    const char *slash = strrchr(obj, '/');
+    if (!slash)
+        return NULL;
+    const int dir = (int)(slash - obj);
+    for (size_t i = 0; i < sizeof rel / sizeof rel[0]; i++) {
+        char path[4096];
+        int n = snprintf(path, sizeof path, "%.*s%s%s", dir, obj, rel[i], ST_VTK_PLUGIN);
+        void *h = n > 0 && (size_t)n < sizeof path ? dlopen(path, RTLD_NOW | RTLD_LOCAL) : NULL;
+        if (h)
+            return h;
+    }
+    return NULL;
+}
+
 static void plugin_open(void)
 {
     void *h = dlopen(ST_VTK_PLUGIN, RTLD_NOW | RTLD_LOCAL);
     if (!h) {
+        /* keep the name lookup's reason: it is the one a user can act on */
         const char *e = dlerror();
         snprintf(plugin_why, sizeof plugin_why, "%s", e ? e : "not found");
-        return;
+        h = plugin_beside();
     }
+    if (!h)
+        return;
     const st_vtk_plugin *(*entry)(void);
     /* POSIX's way from dlsym's object pointer to a function pointer. */
     *(void **)&entry = dlsym(h, "st_vtk_plugin_entry");
