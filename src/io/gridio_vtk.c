@@ -8,10 +8,10 @@
  * (installed), libsouptet-io.so's $ORIGIN; then LD_LIBRARY_PATH and the
  * system's directories. Where a sanitizer's dlopen stands between (ASan
  * and TSan intercept it, and the loader then reads the runtime's RUNPATH,
- * not the caller's), the same places are tried by name: the folder of
- * the object holding this file (dladdr; the program's own path from
- * /proc/self/exe where it was run by name), its parent, and the
- * parent's lib.
+ * not the caller's), the same places are tried by path: the folder of
+ * the object holding this file (dladdr, through links as $ORIGIN is;
+ * the program's own path from /proc/self/exe where it was run by name),
+ * its parent, and the parent's lib.
  */
 #define _GNU_SOURCE /* dladdr */
 #include "souptet/gridio.h"
@@ -21,8 +21,10 @@
 #include "../base/fileio.h"
 
 #include <dlfcn.h>
+#include <limits.h>
 #include <pthread.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -36,17 +38,20 @@ static void *plugin_beside(void)
 {
     static const char *const rel[] = {"/", "/../", "/../lib/"};
     Dl_info info;
-    char exe[4096];
+    char exe[PATH_MAX];
     if (!dladdr((void *)&plugin_beside, &info) || !info.dli_fname)
         return NULL;
-    const char *obj = info.dli_fname;
-    /* the program itself, run by name through PATH: dladdr gives argv[0] */
-    if (!strchr(obj, '/')) {
+    /* The object's real path, as $ORIGIN is (through links); for the
+     * program run by name through PATH dladdr gives argv[0], no folder. */
+    const char *obj = exe;
+    if (strchr(info.dli_fname, '/')) {
+        if (!realpath(info.dli_fname, exe))
+            return NULL;
+    } else {
         ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
         if (len <= 0)
             return NULL;
         exe[len] = '\0';
-        obj = exe;
     }
     const char *slash = strrchr(obj, '/');
     if (!slash)
