@@ -632,18 +632,23 @@ static st_status oriented_soup(st_soup *o, uint8_t *rim, size_t *nview, st_sides
     return ST_OK;
 }
 
-/* The triangles of o whose boxes meet a query box, gathered once for a
- * run of voxels along a row (st_bvh_query_box's triangles, in its order):
- * their corners and boxes along x (the BVH's: the least and most of the
- * corners; along y and z the run's box is each voxel's).
- * oom: a growth failed (the run's voxels then query the BVH each). */
+/* The triangles of o whose boxes meet a box, gathered by one query of the
+ * BVH (st_bvh_query_box's triangles, in its order): their boxes along x
+ * and y (the BVH's: the least and most of the corners) and their
+ * corners. The box is a block of voxels' (a few rows of one z slice, a
+ * stretch along x) with each voxel's extent along z, so only x and y are
+ * tested again. sel: the ones a run of voxels along a row reads (indices
+ * into v, in the query's order). oom: a growth failed (the voxels then
+ * query the BVH each). */
 typedef struct gather {
     const st_soup *o;
     size_t n, cap;
-    double *v;          /* GATHERED a triangle: its box along x, its corners */
+    double *v;          /* GATHERED a triangle: its box along x, along y, its corners */
+    uint32_t *sel;      /* cap of them */
+    size_t nsel;
     int oom;
 } gather;
-#define GATHERED 11
+#define GATHERED 13
 
 static int gather_add(void *ctx, uint32_t t)
 {
@@ -651,22 +656,49 @@ static int gather_add(void *ctx, uint32_t t)
     if (g->n == g->cap) {
         const size_t c = g->cap ? 2 * g->cap : 256;
         double *nv = st_realloc_array(g->v, c, GATHERED * sizeof *nv);
-        if (!nv) {
+        uint32_t *ns = nv ? st_realloc_array(g->sel, c, sizeof *ns) : NULL;
+        if (nv)
+            g->v = nv;
+        if (!ns) {
             g->oom = 1;
             return 1;
         }
-        g->v = nv;
+        g->sel = ns;
         g->cap = c;
     }
     const uint32_t *tv = g->o->tris + 3 * (size_t)t;
     double *b = g->v + GATHERED * g->n++;
     for (int c = 0; c < 3; c++)
-        memcpy(b + 2 + 3 * c, g->o->xyz + 3 * (size_t)tv[c], 3 * sizeof *b);
+        memcpy(b + 4 + 3 * c, g->o->xyz + 3 * (size_t)tv[c], 3 * sizeof *b);
     /* finite coordinates (soup.h): the BVH's fmin and fmax */
-    const double lo = b[2] < b[5] ? b[2] : b[5], hi = b[2] > b[5] ? b[2] : b[5];
-    b[0] = b[8] < lo ? b[8] : lo;
-    b[1] = b[8] > hi ? b[8] : hi;
+    for (int k = 0; k < 2; k++) {
+        const double p0 = b[4 + k], p1 = b[7 + k], p2 = b[10 + k];
+        const double lo = p0 < p1 ? p0 : p1, hi = p0 > p1 ? p0 : p1;
+        b[2 * k] = p2 < lo ? p2 : lo;
+        b[2 * k + 1] = p2 > hi ? p2 : hi;
+    }
     return 0;
+}
+
+/* ga: the triangles meeting [lo, hi]. */
+static void gather_box(gather *ga, const st_bvh *bvh, const double lo[3], const double hi[3])
+{
+    ga->n = 0;
+    ga->nsel = 0;
+    ga->oom = 0;
+    st_bvh_query_box(bvh, lo, hi, gather_add, ga);
+}
+
+/* ga->sel: the gathered triangles whose boxes meet [x0, x1] x [y0, y1]. */
+static void gather_select(gather *ga, double x0, double x1, double y0, double y1)
+{
+    size_t m = 0;
+    for (size_t i = 0; i < ga->n; i++) {
+        const double *b = ga->v + GATHERED * i;
+        if (b[0] <= x1 && x0 <= b[1] && b[2] <= y1 && y0 <= b[3])
+            ga->sel[m++] = (uint32_t)i;
+    }
+    ga->nsel = m;
 }
 
 /* The evidence from the triangles of the BVH's soup whose boxes meet
@@ -682,28 +714,28 @@ static int8_t winding_sum(const st_bvh *bvh, const double q[3], const double lo[
     return (int8_t)lround(e);
 }
 
-/* winding_sum's evidence (from the triangles of ga meeting [lo, hi],
- * when ga holds a box around it with its extent along y and z), from
- * the product of mul_angle when rounding is sure: that and add_angle's
- * sum each differ from the true sum by a few units in the last place per
- * term (one argument's rounding; a complex product's), and those on the
- * partial sums, well within DRIFT (m + 4)^2 radians for m terms; else by
- * winding_sum, as it always was. */
+/* winding_sum's evidence (from the triangles of ga's selection meeting
+ * [lo, hi], when that holds every triangle meeting [lo, hi]), from the
+ * product of mul_angle when rounding is sure: that and add_angle's sum
+ * each differ from the true sum by a few units in the last place per term
+ * (one argument's rounding; a complex product's), and those on the
+ * partial sums, well within DRIFT (m + 4)^2 radians for m terms, in any
+ * order of the terms; else by winding_sum, as it always was. */
 #define DRIFT 1e-13
 static int8_t winding_at(const st_bvh *bvh, const gather *ga, const double q[3], const double lo[3],
                          const double hi[3], double scale, double cap)
 {
     wprod w = {bvh->soup, q, 1.0, 0.0, 0, 0};
     int exact = 0;
-    if (ga) {   /* its box has [lo, hi]'s extent along y and z */
+    if (ga) {   /* its selection meets [lo, hi] along y and z */
         wprod acc = w;  /* kept apart from the BVH's callback, in registers */
-        for (size_t i = 0; i < ga->n && !exact; i++) {
-            const double *b = ga->v + GATHERED * i;
+        for (size_t i = 0; i < ga->nsel && !exact; i++) {
+            const double *b = ga->v + GATHERED * (size_t)ga->sel[i];
             if (!(b[0] <= hi[0] && lo[0] <= b[1]))
                 continue;
-            const double u0[3] = {b[2] - q[0], b[3] - q[1], b[4] - q[2]};
-            const double u1[3] = {b[5] - q[0], b[6] - q[1], b[7] - q[2]};
-            const double u2[3] = {b[8] - q[0], b[9] - q[1], b[10] - q[2]};
+            const double u0[3] = {b[4] - q[0], b[5] - q[1], b[6] - q[2]};
+            const double u1[3] = {b[7] - q[0], b[8] - q[1], b[9] - q[2]};
+            const double u2[3] = {b[10] - q[0], b[11] - q[1], b[12] - q[2]};
             exact = prod_term(&acc, u0, u1, u2);
         }
         w = acc;
@@ -723,70 +755,162 @@ static int8_t winding_at(const st_bvh *bvh, const gather *ga, const double q[3],
     return winding_sum(bvh, q, lo, hi, scale, cap);
 }
 
-/* Voxels along a row whose triangles are gathered at once: at most RUN,
- * spanning at most RUN voxels. */
+/* Voxels along a row whose triangles are selected at once: at most RUN,
+ * spanning at most RUN voxels. Rows gathered by one query: BLOCK of a z
+ * slice, over a stretch of at most SPAN voxels along x. */
 #define RUN 8
+#define BLOCK 4
+#define SPAN 24
 
 /* The evidence at the points (x[k], y, z), k < n, x ascending (see
- * sides_internal.h): how 2 with ga gathers the triangles near them all
- * by one query into ga. */
+ * sides_internal.h): how 2 with ga reads the triangles ga gathered (by a
+ * box holding the cube of half-side r around each point, with their
+ * extent along z), selected for them all at once. */
 static void winding_points(int8_t *out, const st_bvh *bvh, gather *ga, const double *x, size_t n,
                            double y, double z, double r, double scale, double cap, int how)
 {
-    if (how == 2 && ga) {
-        const double glo[3] = {x[0] - r, y - r, z - r}, ghi[3] = {x[n - 1] + r, y + r, z + r};
-        ga->n = 0;
-        ga->oom = 0;
-        st_bvh_query_box(bvh, glo, ghi, gather_add, ga);
-    }
+    const gather *use = how == 2 && ga && !ga->oom ? ga : NULL;
+    if (use)
+        gather_select(ga, x[0] - r, x[n - 1] + r, y - r, y + r);
     for (size_t k = 0; k < n; k++) {
         const double q[3] = {x[k], y, z};
         const double lo[3] = {q[0] - r, q[1] - r, q[2] - r};
         const double hi[3] = {q[0] + r, q[1] + r, q[2] + r};
         out[k] = how == 0 ? winding_sum(bvh, q, lo, hi, scale, cap)
-                          : winding_at(bvh, how == 2 && ga && !ga->oom ? ga : NULL, q, lo, hi,
-                                       scale, cap);
+                          : winding_at(bvh, use, q, lo, hi, scale, cap);
     }
 }
 
 void st_sides_winding_points(int8_t *out, const st_bvh *bvh, const double *x, size_t n,
                              double y, double z, double r, double scale, double cap, int how)
 {
-    gather ga = {bvh->soup, 0, 0, NULL, 0};
+    gather ga = {bvh->soup, 0, 0, NULL, NULL, 0, 0};
+    if (n && how == 2) {
+        const double lo[3] = {x[0] - r, y - r, z - r}, hi[3] = {x[n - 1] + r, y + r, z + r};
+        gather_box(&ga, bvh, lo, hi);
+    }
     if (n)
         winding_points(out, bvh, &ga, x, n, y, z, r, scale, cap, how);
     free(ga.v);
+    free(ga.sel);
 }
 
-/* The evidence of the voxels run[0..nr) of row (y, z), by one gathering
- * query around them all; returns nr. */
-static size_t winding_run(int8_t *evidence, const st_grid *g, const st_bvh *bvh, gather *ga,
-                          const size_t *run, size_t nr, size_t y, size_t z, double r,
-                          double scale, double cap)
+/* What the sides' evidence reads: the field's band, the votes that decide
+ * a voxel alone, the oriented soup's BVH, the cube's half-side r, the
+ * scale and the cap of the evidence. */
+typedef struct wctx {
+    const st_grid *g;
+    const uint8_t *votes;
+    int decided;
+    float band;
+    const st_bvh *bvh;
+    double r, scale, cap;
+} wctx;
+
+/* Whether voxel (x, y, z) takes evidence: in the band, undecided. */
+static int takes(const wctx *c, size_t x, size_t y, size_t z)
 {
+    const size_t i = st_grid_index(c->g, x, y, z);
+    const int margin = (int)(c->votes[i] & ST_SIGN_VOTES_COUNT) - 13;
+    return fabsf(c->g->data[i]) < c->band && !(c->decided > 0 && abs(margin) >= c->decided);
+}
+
+/* The evidence of the voxels run[0..nr) of row (y, z), from the
+ * triangles ga gathered around them; returns nr. */
+static size_t winding_run(int8_t *evidence, const wctx *c, gather *ga, const size_t *run, size_t nr,
+                          size_t y, size_t z)
+{
+    const st_grid *g = c->g;
     double x[RUN];
     int8_t e[RUN];
     for (size_t k = 0; k < nr; k++)
         x[k] = g->origin[0] + g->voxel * (double)run[k];
-    winding_points(e, bvh, ga, x, nr, g->origin[1] + g->voxel * (double)y,
-                   g->origin[2] + g->voxel * (double)z, r, scale, cap, 2);
+    winding_points(e, c->bvh, ga, x, nr, g->origin[1] + g->voxel * (double)y,
+                   g->origin[2] + g->voxel * (double)z, c->r, c->scale, c->cap, 2);
     for (size_t k = 0; k < nr; k++)
         evidence[st_grid_index(g, run[k], y, z)] = e[k];
     return nr;
 }
 
+/* The evidence of the voxels that take it in rows y0..y1 (inclusive) of
+ * slice z, x in [x0, x1), x0 and the last x taking it x1l: the triangles
+ * near them gathered by one query, then read by runs (RUN) along each
+ * row; returns how many voxels. */
+static size_t winding_block(int8_t *evidence, const wctx *c, gather *ga, size_t x0, size_t x1,
+                            size_t x1l, size_t y0, size_t y1, size_t z)
+{
+    const st_grid *g = c->g;
+    const double zc = g->origin[2] + g->voxel * (double)z;
+    const double lo[3] = {g->origin[0] + g->voxel * (double)x0 - c->r,
+                          g->origin[1] + g->voxel * (double)y0 - c->r, zc - c->r};
+    const double hi[3] = {g->origin[0] + g->voxel * (double)x1l + c->r,
+                          g->origin[1] + g->voxel * (double)y1 + c->r, zc + c->r};
+    gather_box(ga, c->bvh, lo, hi);
+    size_t count = 0;
+    for (size_t y = y0; y <= y1; y++) {
+        size_t run[RUN], nr = 0;
+        for (size_t x = x0; x <= x1; x++) {
+            const int take = x < x1 && takes(c, x, y, z);
+            if (nr && (x == x1 || (take && (nr == RUN || x - run[0] >= RUN)))) {
+                count += winding_run(evidence, c, ga, run, nr, y, z);
+                nr = 0;
+            }
+            if (take)
+                run[nr++] = x;
+        }
+    }
+    return count;
+}
+
+/* The evidence of the voxels that take it in rows y0..y1 of slice z, by
+ * stretches of at most SPAN voxels along x (winding_block); returns how
+ * many voxels. */
+static size_t winding_rows(int8_t *evidence, const wctx *c, gather *ga, size_t y0, size_t y1,
+                           size_t z)
+{
+    const size_t nx = c->g->nx;
+    size_t count = 0;
+    for (size_t x = 0; x < nx;) {
+        size_t first = SIZE_MAX, last = 0;
+        const size_t end = x + SPAN < nx ? x + SPAN : nx;
+        for (size_t xi = x; xi < end; xi++)
+            for (size_t y = y0; y <= y1; y++)
+                if (takes(c, xi, y, z)) {
+                    if (first == SIZE_MAX)
+                        first = xi;
+                    last = xi;
+                    break;
+                }
+        if (first == SIZE_MAX) {
+            x = end;
+            continue;
+        }
+        /* the stretch from the first voxel taking it */
+        const size_t x1 = first + SPAN < nx ? first + SPAN : nx;
+        for (size_t xi = end; xi < x1; xi++)
+            for (size_t y = y0; y <= y1; y++)
+                if (takes(c, xi, y, z)) {
+                    last = xi;
+                    break;
+                }
+        count += winding_block(evidence, c, ga, first, x1, last, y0, y1, z);
+        x = x1;
+    }
+    return count;
+}
+
 /* 3. The local winding number of the oriented soup (its BVH) near each
  * undecided voxel in the band, as evidence; returns how many voxels. The
- * voxels of a row are taken in runs (RUN), the triangles near a run
- * gathered by one query of the BVH. */
+ * triangles near a block of voxels (BLOCK rows of a slice, SPAN voxels
+ * along x) are gathered by one query of the BVH, and each run of voxels
+ * along a row (RUN) reads those of them near it. */
 static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t *votes,
                                int decided, const st_bvh *bvh, const st_soup *o,
                                const st_sides_params *p)
 {
-    const float band = (float)(p->band_voxels * g->voxel);
-    const double r = p->radius_voxels * g->voxel;
-    const double scale = p->weight / (4.0 * M_PI);
-    const double cap = (double)p->max_evidence;
+    const wctx c = {g, votes, decided, (float)(p->band_voxels * g->voxel), bvh,
+                    p->radius_voxels * g->voxel, p->weight / (4.0 * M_PI),
+                    (double)p->max_evidence};
     size_t count = 0, slices = 0;
     #pragma omp parallel for schedule(dynamic, 1) reduction(+ : count)
     for (size_t z = 0; z < g->nz; z++) {
@@ -794,25 +918,12 @@ static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t
         const size_t done = __atomic_fetch_add(&slices, 1, __ATOMIC_RELAXED);
         if (omp_get_thread_num() == 0)
             st_progress_report(p->progress, "sides", 0.5 * (double)done / (double)g->nz);
-        gather ga = {o, 0, 0, NULL, 0};
-        for (size_t y = 0; y < g->ny; y++) {
-            size_t run[RUN], nr = 0;
-            for (size_t x = 0; x <= g->nx; x++) {
-                int take = 0;
-                if (x < g->nx) {
-                    const size_t i = st_grid_index(g, x, y, z);
-                    const int margin = (int)(votes[i] & ST_SIGN_VOTES_COUNT) - 13;
-                    take = fabsf(g->data[i]) < band && !(decided > 0 && abs(margin) >= decided);
-                }
-                if (nr && (x == g->nx || (take && (nr == RUN || x - run[0] >= RUN)))) {
-                    count += winding_run(evidence, g, bvh, &ga, run, nr, y, z, r, scale, cap);
-                    nr = 0;
-                }
-                if (take)
-                    run[nr++] = x;
-            }
-        }
+        gather ga = {o, 0, 0, NULL, NULL, 0, 0};
+        for (size_t y = 0; y < g->ny; y += BLOCK)
+            count += winding_rows(evidence, &c, &ga, y, y + BLOCK < g->ny ? y + BLOCK - 1 : g->ny - 1,
+                                  z);
         free(ga.v);
+        free(ga.sel);
     }
     return count;
 }
