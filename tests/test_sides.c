@@ -6,6 +6,9 @@
  */
 #include "../src/field/sides_internal.h"
 #include "souptet/bvh.h"
+#include "souptet/grid.h"
+#include "souptet/sides.h"
+#include "souptet/sign.h"
 #include "souptet/soup.h"
 #include "shapes.h"
 #include "tap.h"
@@ -172,7 +175,63 @@ static void test_threshold(void)
     st_soup_free(s);
 }
 
-static const tap_test all_tests[] = {TAP_TEST(closed), TAP_TEST(agree), TAP_TEST(threshold), {0}};
+/* The sides' evidence over a grid (blocks of rows, stretches along x,
+ * runs of voxels): at every voxel that takes it, the sum's at its center;
+ * 0 at the others. The grid is not a multiple of the blocks along x or y;
+ * random values and votes leave voxels out of the band and decided. */
+static void test_grid(void)
+{
+    st_soup *s = bumpy(40, 20, 0.15, 0.6);
+    st_bvh *b = bvh_of(s);
+    st_grid *g = NULL;
+    st_error err;
+    const double origin[3] = {-1.37, -1.29, -1.23};
+    TAP_CHECK(st_grid_new(&g, 53, 27, 25, origin, 0.1, 0.0f, 0, &err) == ST_OK, "grid");
+    const size_t n = g ? st_grid_count(g) : 0;
+    uint8_t *votes = malloc(n ? n : 1);
+    int8_t *e = calloc(n ? n : 1, 1);
+    size_t bad = 0, taken = 0, nonzero = 0;
+    if (g && votes && e && b) {
+        for (size_t i = 0; i < n; i++) {
+            g->data[i] = (float)uniform(0.0, 0.4);
+            votes[i] = (uint8_t)uniform(0.0, 27.0);
+        }
+        const st_sides_params p = st_sides_params_default();
+        const double r = p.radius_voxels * g->voxel, scale = p.weight / (4.0 * M_PI);
+        const size_t count = st_sides_winding_grid(e, g, votes, 10, b, &p);
+        for (size_t z = 0; z < g->nz; z++)
+            for (size_t y = 0; y < g->ny; y++)
+                for (size_t x = 0; x < g->nx; x++) {
+                    const size_t i = st_grid_index(g, x, y, z);
+                    const int margin = (int)(votes[i] & ST_SIGN_VOTES_COUNT) - 13;
+                    const int take = g->data[i] < (float)(p.band_voxels * g->voxel) &&
+                                     abs(margin) < 10;
+                    int8_t want = 0;
+                    if (take) {
+                        const double q[3] = {origin[0] + 0.1 * (double)x,
+                                             origin[1] + 0.1 * (double)y,
+                                             origin[2] + 0.1 * (double)z};
+                        st_sides_winding_points(&want, b, q, 1, q[1], q[2], r, scale,
+                                                (double)p.max_evidence, 0);
+                    }
+                    bad += e[i] != want;
+                    taken += (size_t)take;
+                    nonzero += e[i] != 0;
+                }
+        TAP_CHECK(count == taken, "the voxels that take evidence: %zu of %zu", count, taken);
+    }
+    TAP_CHECK(bad == 0 && taken > n / 4 && taken < n && nonzero > n / 20,
+              "every voxel as the sum at its center (%zu of %zu differ, %zu taken, %zu set)", bad,
+              n, taken, nonzero);
+    free(votes);
+    free(e);
+    st_grid_free(g);
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
+static const tap_test all_tests[] = {TAP_TEST(closed), TAP_TEST(agree), TAP_TEST(threshold),
+                                     TAP_TEST(grid), {0}};
 
 int main(int argc, char **argv)
 {

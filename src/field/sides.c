@@ -928,6 +928,12 @@ static size_t winding_evidence(int8_t *evidence, const st_grid *g, const uint8_t
     return count;
 }
 
+size_t st_sides_winding_grid(int8_t *evidence, const st_grid *g, const uint8_t *votes, int decided,
+                             const st_bvh *bvh, const st_sides_params *p)
+{
+    return winding_evidence(evidence, g, votes, decided, bvh, bvh->soup, p);
+}
+
 typedef struct col_hit {
     double h;       /* dir * the coordinate along the axis, voxel units */
     uint32_t t;     /* the triangle */
