@@ -53,6 +53,62 @@ static void test_checked_sizes(void)
     free(p);
 }
 
+/* VmFlags of the mapping that holds p ("" when /proc/self/smaps cannot
+ * be read). */
+static void vm_flags_of(const void *p, char *flags, size_t n)
+{
+    flags[0] = 0;
+    FILE *f = fopen("/proc/self/smaps", "r");
+    if (!f)
+        return;
+    char line[512];
+    int in = 0;
+    uintptr_t a = (uintptr_t)p;
+    while (fgets(line, sizeof line, f)) {
+        unsigned long lo, hi;
+        if (sscanf(line, "%lx-%lx ", &lo, &hi) == 2)
+            in = a >= lo && a < hi;
+        else if (in && strncmp(line, "VmFlags:", 8) == 0) {
+            snprintf(flags, n, "%s", line + 8);
+            break;
+        }
+    }
+    fclose(f);
+}
+
+/* st_realloc_big: a block grown by doubling from 1 KiB to 64 MiB keeps
+ * its bytes, and its large part is advised to use huge pages ("hg" in the
+ * mapping's VmFlags, where the kernel has transparent huge pages). */
+static void test_realloc_big(void)
+{
+    unsigned char *p = NULL;
+    size_t n = 0, bad = 0;
+    for (size_t cap = 1024; cap <= ((size_t)64 << 20); cap *= 2) {
+        unsigned char *q = st_realloc_big(p, cap);
+        if (!q)
+            break;
+        p = q;
+        for (size_t i = 0; i < n; i++)
+            bad += p[i] != (unsigned char)(i * 7 + i / 4096);
+        for (size_t i = n; i < cap; i++)
+            p[i] = (unsigned char)(i * 7 + i / 4096);
+        n = cap;
+    }
+    TAP_CHECK(n == ((size_t)64 << 20) && bad == 0,
+              "a doubling block keeps its bytes up to 64 MiB (%zu wrong)", bad);
+    char flags[512];
+    vm_flags_of(p + n / 2, flags, sizeof flags);
+    FILE *thp = fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
+    if (thp && flags[0])
+        TAP_CHECK(strstr(flags, " hg") != NULL,
+                  "its middle is advised to use huge pages (VmFlags:%s)", flags);
+    else
+        TAP_NOTE("no transparent huge pages or no /proc/self/smaps: advice not checked");
+    if (thp)
+        fclose(thp);
+    free(p);
+}
+
 static void test_meta(void)
 {
     st_meta m = {0};
@@ -277,7 +333,7 @@ static void test_address_space(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {TAP_TEST(error_format), TAP_TEST(checked_sizes),
+    static const tap_test tests[] = {TAP_TEST(error_format), TAP_TEST(checked_sizes), TAP_TEST(realloc_big),
                                      TAP_TEST(meta), TAP_TEST(grid), TAP_TEST(outfile),
                                      TAP_TEST(outfile_stale), TAP_TEST(address_space), {0}};
     return tap_main(argc, argv, tests);

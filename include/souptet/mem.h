@@ -38,6 +38,14 @@ void *st_realloc_array(void *p, size_t n, size_t size);
 void *st_calloc_big(size_t n);
 /* The same without zeroing. */
 void *st_malloc_big(size_t n);
+/* realloc for an array that grows by doubling into the hundreds of MB (a
+ * reader's vertices): past a few MB the block's whole 2 MiB pages are
+ * advised to be transparent huge pages, so the part still to be touched
+ * is faulted in 2 MiB at a time. p comes from malloc, realloc or
+ * st_realloc_big (glibc grows those large blocks in place or with
+ * mremap; one from st_malloc_big it copies). NULL (p kept) when out of
+ * memory. Release with free(). */
+void *st_realloc_big(void *p, size_t n);
 
 /* The address space this process may still map: the soft RLIMIT_AS
  * (ulimit -v) less what is mapped now (/proc/self/statm); SIZE_MAX when

@@ -82,7 +82,9 @@ static st_status read_fd(int fd, size_t hint, unsigned char **data,
                          size_t *size, const char *name, st_error *err)
 {
     size_t cap = hint ? hint : 65536, n = 0;
-    unsigned char *buf = malloc(cap);
+    /* A large file is read in huge pages (st_malloc_big): its 4 KiB page
+     * faults cost more than the read itself at hundreds of MB. */
+    unsigned char *buf = st_malloc_big(cap);
     if (!buf)
         return st_error_set(err, ST_ENOMEM, name, 0, "out of memory");
     for (;;) {
@@ -90,7 +92,7 @@ static st_status read_fd(int fd, size_t hint, unsigned char **data,
             size_t ncap;
             unsigned char *nb = NULL;
             if (st_size_mul(&ncap, cap, 2) == 0)
-                nb = realloc(buf, ncap);
+                nb = st_realloc_big(buf, ncap);
             if (!nb) {
                 free(buf);
                 return st_error_set(err, ST_ENOMEM, name, 0,

@@ -30,6 +30,23 @@ void *st_malloc_big(size_t n)
     return p;
 }
 
+void *st_realloc_big(void *p, size_t n)
+{
+    unsigned char *q = realloc(p, n ? n : 1);
+    if (!q || n < 4 * HUGE_PAGE)
+        return q;
+#ifdef MADV_HUGEPAGE
+    /* The whole huge pages inside the block (glibc serves blocks this
+     * large with mmap and grows them with mremap, so the advice stays with
+     * the pages when the block moves). Advice only: failure is fine. */
+    uintptr_t a = ((uintptr_t)q + HUGE_PAGE - 1) & ~(uintptr_t)(HUGE_PAGE - 1);
+    uintptr_t e = ((uintptr_t)q + n) & ~(uintptr_t)(HUGE_PAGE - 1);
+    if (e > a)
+        madvise((void *)a, e - a, MADV_HUGEPAGE);
+#endif
+    return q;
+}
+
 void *st_calloc_big(size_t n)
 {
     unsigned char *p = st_malloc_big(n);

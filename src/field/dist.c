@@ -1003,7 +1003,10 @@ static st_status bin_triangles(band_bins *bb, const st_grid *g,
     chunks = chunks < 1 ? 1 : chunks > 8 ? 8 : chunks;
     if (s->ntris < 4096)
         chunks = 1;
-    bb->balls = st_malloc_array(s->ntris, sizeof *bb->balls);
+    /* The balls and the lists are hundreds of MB on a 10M-triangle soup,
+     * touched once in order: huge pages (st_malloc_big; the sizes are
+     * below 2^32 times a few words). */
+    bb->balls = st_malloc_big(s->ntris * sizeof *bb->balls);
     bb->start = st_malloc_array(nb + 1, sizeof(size_t));
     bb->centers = st_malloc_array(bg->n[0] + bg->n[1] + bg->n[2], sizeof(double));
     size_t *cnt = st_calloc_array((size_t)chunks * (nb + 1), sizeof(size_t));
@@ -1051,7 +1054,7 @@ static st_status bin_triangles(band_bins *bb, const st_grid *g,
         }
     }
     bb->start[nb] = at;
-    bb->list = st_malloc_array(at ? at : 1, sizeof(uint32_t));
+    bb->list = at <= SIZE_MAX / sizeof(uint32_t) ? st_malloc_big(at * sizeof(uint32_t)) : NULL;
     if (!bb->list) {
         st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for "
                           "%zu brick candidates", at);

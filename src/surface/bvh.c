@@ -261,6 +261,18 @@ static void build_parallel(build_ctx *c, size_t node, size_t lo, size_t hi,
     #pragma omp taskwait
 }
 
+/* Frees what st_bvh_build holds when memory runs out. */
+static st_status bvh_build_failed(st_bvh *b, build_ctx *c, size_t ntris,
+                                  st_error *err)
+{
+    free(b);
+    free(c->cent);
+    free(c->order);
+    free(c->nodes);
+    return st_error_set(err, ST_ENOMEM, NULL, 0,
+                        "out of memory for a BVH over %zu triangles", ntris);
+}
+
 st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
 {
     *out = NULL;
@@ -278,17 +290,8 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
     c.cent = st_malloc_big(s->ntris * 3 * sizeof(double));
     c.order = st_malloc_big(s->ntris * sizeof(uint32_t));
     c.nodes = st_malloc_big(c.nnodes * sizeof(st_bvh_node));
-    double *tbox = st_malloc_big(s->ntris * 6 * sizeof(double));
-    if (!b || !c.cent || !c.order || !c.nodes || !tbox) {
-        free(b);
-        free(c.cent);
-        free(c.order);
-        free(c.nodes);
-        free(tbox);
-        return st_error_set(err, ST_ENOMEM, NULL, 0,
-                            "out of memory for a BVH over %zu triangles",
-                            s->ntris);
-    }
+    if (!b || !c.cent || !c.order || !c.nodes)
+        return bvh_build_failed(b, &c, s->ntris, err);
     #pragma omp parallel for schedule(static) if (s->ntris >= PARALLEL_MIN)
     for (size_t t = 0; t < s->ntris; t++) {
         c.order[t] = (uint32_t)t;
@@ -306,11 +309,20 @@ st_status st_bvh_build(st_bvh **out, const st_soup *s, st_error *err)
         #pragma omp single
         build_parallel(&c, 0, 0, s->ntris, 1);
     }
+    /* The centroids are freed before the triangles' boxes are taken, so
+     * the two are never both resident: 240 MB less at the peak of a
+     * 10M-triangle soup's build. (Growing the centroids' block into the
+     * boxes' with realloc would keep its touched pages, but glibc copies
+     * a block from posix_memalign into 4 KiB pages: measured slower.) */
+    free(c.cent);
+    c.cent = NULL;
+    double *tbox = st_malloc_big(s->ntris * 6 * sizeof(double));
+    if (!tbox)
+        return bvh_build_failed(b, &c, s->ntris, err);
     #pragma omp parallel for schedule(static) if (s->ntris >= PARALLEL_MIN)
     for (size_t i = 0; i < s->ntris; i++)
         tri_box(s, c.order[i], tbox + 6 * i, tbox + 6 * i + 3);
     node_boxes(c.nodes, c.nnodes, tbox);
-    free(c.cent);
     b->tbox = tbox;
     b->soup = s;
     b->nodes = c.nodes;

@@ -32,7 +32,12 @@ static st_status grow(void **arr, size_t n, size_t elem)
         cap = MIN_CAP;
     else if (st_size_mul(&cap, n, 2) != 0)
         return ST_ENOMEM;
-    void *p = st_realloc_array(*arr, cap, elem);
+    size_t bytes;
+    if (st_size_mul(&bytes, cap, elem) != 0)
+        return ST_ENOMEM;
+    /* Huge pages past a few MB (st_realloc_big): a 10M-triangle soup's
+     * arrays are first touched here. */
+    void *p = st_realloc_big(*arr, bytes);
     if (!p)
         return ST_ENOMEM;
     *arr = p;
