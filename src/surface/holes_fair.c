@@ -67,6 +67,23 @@ static st_status oom(st_error *err)
     return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the faired caps");
 }
 
+/* The capacity for need items past cap: doubled, at least 64. */
+static size_t next_cap(size_t cap, size_t need)
+{
+    const size_t c = cap ? 2 * cap : 64;
+    return c < need ? need : c;
+}
+
+/* p reallocated to c items of size bytes; *ok cleared (and p kept) when
+ * that fails. */
+static void *regrow(void *p, size_t c, size_t size, int *ok)
+{
+    void *q = st_realloc_array(p, c, size);
+    if (!q)
+        *ok = 0;
+    return q ? q : p;
+}
+
 /* ---- 1, 2: the rim's ring and its smoothness ---------------------------- */
 
 typedef struct ring {
@@ -84,35 +101,31 @@ typedef struct ring {
 
 static int push_tri(ring *g, uint32_t t)
 {
+    int ok = 1;
     if (g->nt == g->ct) {
-        size_t c = g->ct ? 2 * g->ct : 64;
-        uint32_t *p = st_realloc_array(g->tris, c, sizeof *p);
-        if (!p)
-            return 0;
-        g->tris = p;
-        g->ct = c;
+        const size_t c = next_cap(g->ct, g->nt + 1);
+        g->tris = regrow(g->tris, c, sizeof *g->tris, &ok);
+        g->ct = ok ? c : g->ct;
     }
-    g->tris[g->nt++] = t;
-    return 1;
+    if (ok)
+        g->tris[g->nt++] = t;
+    return ok;
 }
 
 static int push_nb(ring *g, uint32_t w, const double *p)
 {
+    int ok = 1;
     if (g->nn == g->cn) {
-        size_t c = g->cn ? 2 * g->cn : 64;
-        uint32_t *a = st_realloc_array(g->nb, c, sizeof *a);
-        if (a)
-            g->nb = a;
-        const double **b = st_realloc_array(g->nbp, c, sizeof *b);
-        if (b)
-            g->nbp = b;
-        if (!a || !b)
-            return 0;
-        g->cn = c;
+        const size_t c = next_cap(g->cn, g->nn + 1);
+        g->nb = regrow(g->nb, c, sizeof *g->nb, &ok);
+        g->nbp = regrow(g->nbp, c, sizeof *g->nbp, &ok);
+        g->cn = ok ? c : g->cn;
     }
-    g->nb[g->nn] = w;
-    g->nbp[g->nn++] = p;
-    return 1;
+    if (ok) {
+        g->nb[g->nn] = w;
+        g->nbp[g->nn++] = p;
+    }
+    return ok;
 }
 
 /* A kept triangle at welded point g->w: its other corners join the point's
@@ -279,33 +292,20 @@ static void fmesh_free(fmesh *m)
 
 static int fmesh_grow(fmesh *m, size_t nv, size_t nt)
 {
+    int ok = 1;
     if (nv > m->cv) {
-        size_t c = m->cv ? 2 * m->cv : 64;
-        c = c < nv ? nv : c;
-        double *x = st_realloc_array(m->x, 3 * c, sizeof *x);
-        if (x)
-            m->x = x;
-        double *sg = st_realloc_array(m->sig, c, sizeof *sg);
-        if (sg)
-            m->sig = sg;
-        if (!x || !sg)
-            return 0;
-        m->cv = c;
+        const size_t c = next_cap(m->cv, nv);
+        m->x = regrow(m->x, 3 * c, sizeof *m->x, &ok);
+        m->sig = regrow(m->sig, c, sizeof *m->sig, &ok);
+        m->cv = ok ? c : m->cv;
     }
-    if (nt > m->ct) {
-        size_t c = m->ct ? 2 * m->ct : 64;
-        c = c < nt ? nt : c;
-        uint32_t *v = st_realloc_array(m->v, 3 * c, sizeof *v);
-        if (v)
-            m->v = v;
-        uint32_t *o = st_realloc_array(m->opp, 3 * c, sizeof *o);
-        if (o)
-            m->opp = o;
-        if (!v || !o)
-            return 0;
-        m->ct = c;
+    if (ok && nt > m->ct) {
+        const size_t c = next_cap(m->ct, nt);
+        m->v = regrow(m->v, 3 * c, sizeof *m->v, &ok);
+        m->opp = regrow(m->opp, 3 * c, sizeof *m->opp, &ok);
+        m->ct = ok ? c : m->ct;
     }
-    return 1;
+    return ok;
 }
 
 /* The cap of the loop's points (tri: n - 2 triangles, local indices), its
@@ -349,14 +349,14 @@ static inline size_t prv(size_t h)
     return h - h % 3 + (h + 2) % 3;
 }
 
-/* The angle at p in the triangle (p, a, b). */
-static double angle_at(const double *p, const double *a, const double *b)
+/* The angle opposite the side of length c in a triangle of sides a, b, c
+ * (the law of cosines; 0 for a degenerate one). */
+static double opposite(double a, double b, double c)
 {
-    double u[3], v[3], c[3];
-    st_sub3(u, a, p);
-    st_sub3(v, b, p);
-    st_cross3(c, u, v);
-    return atan2(st_norm3(c), st_dot3(u, v));
+    const double den = 2.0 * a * b;
+    if (!(den > 0.0))
+        return 0.0;
+    return acos(fmax(-1.0, fmin(1.0, (a * a + b * b - c * c) / den)));
 }
 
 /* 1 when the points a and b are joined by an edge of the cap. */
@@ -385,8 +385,9 @@ static int relax(fmesh *m, size_t h)
         return 0;
     const uint32_t a = m->v[h], b = m->v[nxt(h)], c = m->v[prv(h)], d = m->v[prv(g)];
     const double *X = m->x;
-    const double s = angle_at(X + 3 * c, X + 3 * a, X + 3 * b) +
-                     angle_at(X + 3 * d, X + 3 * a, X + 3 * b);
+    const double ab = dist3(X + 3 * a, X + 3 * b);
+    const double s = opposite(dist3(X + 3 * c, X + 3 * a), dist3(X + 3 * c, X + 3 * b), ab) +
+                     opposite(dist3(X + 3 * d, X + 3 * a), dist3(X + 3 * d, X + 3 * b), ab);
     if (!(s > M_PI + 1e-9) || c == d || has_edge(m, c, d))
         return 0;
     const size_t t = h / 3, u = g / 3;
