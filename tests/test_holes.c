@@ -852,10 +852,84 @@ static void test_fans_merged(void)
     }
 }
 
+/* Caps that follow a smooth surface (holes_fair.c): a sphere without its
+ * top (the faces above z = 0.75, a loop of 32 points on the ring at
+ * z = cos(pi/4) = 0.7071) is capped by a dome that continues the sphere's
+ * slope, not by the flat disc of the loop's points; a box without a
+ * corner (its ring bends by pi/2) keeps the cap of its points. */
+static void test_fair(void)
+{
+    st_soup *cut = sphere(0.75), *caps = NULL;
+    st_holes_params hp = st_holes_params_default();
+    st_holes_stats hs;
+    st_error err;
+    hp.planes = 0;
+    int ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err);
+    const double z0 = cos(M_PI / 4);
+    TAP_CHECK(ok && hs.continued && hs.loops == 1 && hs.filled == 1 && caps->nverts > 32 &&
+                  caps->ntris == caps->nverts * 2 - 34,
+              "a sphere without its top: one loop of 32 points, refined into a cap of %zu "
+              "points and %zu triangles (a disc: 2 v - n - 2)", ok ? caps->nverts : 0,
+              ok ? caps->ntris : 0);
+    if (ok) {
+        /* the loop's points are the soup's, bit for bit */
+        size_t same = 0;
+        for (size_t v = 0; v < caps->nverts; v++)
+            for (size_t u = 0; u < cut->nverts; u++)
+                if (!memcmp(caps->xyz + 3 * v, cut->xyz + 3 * u, 3 * sizeof(double))) {
+                    same++;
+                    break;
+                }
+        TAP_CHECK(same == 32, "the cap meets the soup at its 32 loop points exactly (%zu)", same);
+        double top = -INFINITY, rmin = INFINITY, rmax = 0.0;
+        for (size_t v = 0; v < caps->nverts; v++) {
+            const double *x = caps->xyz + 3 * v;
+            top = fmax(top, x[2]);
+            const double r = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+            rmin = fmin(rmin, r);
+            rmax = fmax(rmax, r);
+        }
+        /* the flat cap stays at z0 (its points at radius down to z0); the
+         * dome rises most of the way to the pole and stays near the
+         * sphere */
+        TAP_CHECK(top > z0 + 0.8 * (1.0 - z0) && top < 1.02 && rmin > 0.97 && rmax < 1.02,
+                  "the cap is a dome near the lost top: its highest point %.4f (the pole 1, "
+                  "the loop %.4f), radii %.4f to %.4f", top, z0, rmin, rmax);
+        int pierced = 0;
+        for (size_t t = 0; t < caps->ntris && !pierced; t++)
+            for (size_t u = 0; u < cut->ntris && !pierced; u++) {
+                const uint32_t *a = caps->tris + 3 * t, *b = cut->tris + 3 * u;
+                pierced = st_tri_tri_cross(caps->xyz + 3 * a[0], caps->xyz + 3 * a[1],
+                                           caps->xyz + 3 * a[2], cut->xyz + 3 * b[0],
+                                           cut->xyz + 3 * b[1], cut->xyz + 3 * b[2]);
+            }
+        TAP_CHECK(!pierced, "the dome pierces none of the soup's triangles");
+    }
+    st_soup_free(caps);
+    /* the same soup twice gives the same caps, bit for bit */
+    st_soup *again = NULL;
+    ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err) &&
+         !st_soup_hole_caps(&again, cut, &hp, &hs, &err);
+    TAP_CHECK(ok && caps->nverts == again->nverts && caps->ntris == again->ntris &&
+                  !memcmp(caps->xyz, again->xyz, 3 * caps->nverts * sizeof(double)),
+              "the dome is the same on a second call");
+    st_soup_free(again);
+    st_soup_free(caps);
+    st_soup_free(cut);
+
+    st_soup *box = cornered_box(1);
+    ok = !st_soup_hole_caps(&caps, box, &hp, &hs, &err);
+    TAP_CHECK(ok && hs.filled == 1 && caps->ntris == 22 && caps->nverts == 24,
+              "a box without its corner, planes off: the cap of its 24 loop points, not "
+              "faired (%zu points, %zu triangles)", ok ? caps->nverts : 0, ok ? caps->ntris : 0);
+    st_soup_free(caps);
+    st_soup_free(box);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
                                      TAP_TEST(bend), TAP_TEST(corner), TAP_TEST(corner_pierced),
-                                     TAP_TEST(area_screen), TAP_TEST(fans_merged), {0}};
+                                     TAP_TEST(area_screen), TAP_TEST(fans_merged), TAP_TEST(fair), {0}};
     return tap_main(argc, argv, tests);
 }

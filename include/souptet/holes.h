@@ -8,7 +8,8 @@
  * meet across a hole. How the loops are traced and paired, which are
  * capped, and the caps' shapes: doc/design/holes.md.
  *
- * Units: model units (the caps' vertices are copies of the loops' points;
+ * Units: model units (the caps' vertices are copies of the loops' points,
+ * and inner points of the caps faired over a smooth surface;
  * the parameters are ratios).
  * Ownership: the caller owns *caps (st_soup_free); s, edges and bvh are
  * borrowed for the call only.
@@ -72,7 +73,8 @@ typedef struct st_holes_stats {
 st_holes_params st_holes_params_default(void);
 
 /* *caps gets a new soup of the caps' triangles (possibly none; its
- * vertices are copies of the loops' positions). stats may be NULL.
+ * vertices are copies of the loops' positions, and a faired cap's inner
+ * points: doc/design/holes.md, "Faired caps"). stats may be NULL.
  * ST_EINPUT (bad parameters), ST_ENOMEM, ST_ELIMIT (more than 2^31
  * triangles). */
 st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,

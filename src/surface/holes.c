@@ -1076,6 +1076,16 @@ static st_status cap_loop(capper *c, size_t e0, st_error *err)
         c->st.rebuilt++;
         return ST_OK;
     }
+    /* on an intact soup, a cap of the loop's points faired where the
+     * surface around it is smooth (holes_fair.c) */
+    int faired = 0;
+    const st_holes_rimref ref = {c->s, c->E, c->bvh, l->v};
+    if (c->bend && (rc = st_holes_fair_cap(c->out, &faired, &ref, l->pts, n, l->tri, err)))
+        return rc;
+    if (faired) {
+        c->st.filled++;
+        return ST_OK;
+    }
     const size_t base = c->out->nverts;
     for (size_t i = 0; i < n; i++)
         if ((rc = st_soup_add_vertex(c->out, l->pts[i][0], l->pts[i][1], l->pts[i][2], err)))

@@ -10,6 +10,7 @@
 #include <stdint.h>
 #include <math.h>
 #include "souptet/bvh.h"
+#include "souptet/edges.h"
 #include "souptet/err.h"
 #include "souptet/geom.h"
 #include "souptet/soup.h"
@@ -98,5 +99,27 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
                                const double *const *side, size_t n, double below,
                                st_holes_fill fill, const st_holes_guard *guard, double *bent,
                                st_error *err);
+
+/* What a faired cap reads of the soup around its loop: the soup, its edge
+ * table, its BVH, and the loop's welded points (lv[0..n), one per point of
+ * pts, see holes_fair.c). */
+typedef struct st_holes_rimref {
+    const st_soup *s;
+    const st_soup_edges *E;
+    const st_bvh *bvh;
+    const uint32_t *lv;
+} st_holes_rimref;
+
+/* The cap of the loop pts[0..n) (n >= 3; tri its triangulation, n - 2
+ * triangles of local indices) refined and faired to continue the soup
+ * around it (Liepa 2003; holes_fair.c), where that soup is smooth within
+ * a ring of the loop: appended to out (the loop's points first, as they
+ * are, then the inner points) with *done 1. Where the ring has a sharp or
+ * non-manifold edge, the loop meets a point twice, nothing needs refining,
+ * or the faired cap pierces the soup or itself (exact), out is left as it
+ * was and *done is 0. ST_ENOMEM. */
+st_status st_holes_fair_cap(st_soup *out, int *done, const st_holes_rimref *ref,
+                            const double *const *pts, size_t n, const uint32_t *tri,
+                            st_error *err);
 
 #endif
