@@ -1,4 +1,5 @@
 /* test_sign.c - volume-event voting on hand-made rays and small shapes. */
+#include "souptet/bvh.h"
 #include "souptet/dist.h"
 #include "souptet/sign.h"
 #include "souptet/solid.h"
@@ -660,6 +661,46 @@ static void test_refine(void)
     st_soup_free(cube);
 }
 
+/* The refinement with the soup in two parts, a BVH each (the pipeline's
+ * soup and its hole caps), gives the signs of one BVH over the whole. */
+static void test_refine_parts(void)
+{
+    st_soup *sphere = st_soup_new();
+    add_sphere(sphere, 1.0, 2.0);
+    st_soup *a = st_soup_new(), *b = st_soup_new(), *all = st_soup_new();
+    for (size_t t = 0; t < sphere->ntris; t++) {
+        const uint32_t *tri = sphere->tris + 3 * t;
+        add_tri(t % 3 ? a : b, sphere->xyz + 3 * (size_t)tri[0],
+                sphere->xyz + 3 * (size_t)tri[1], sphere->xyz + 3 * (size_t)tri[2], 0);
+    }
+    st_error err;
+    st_bvh *ba = NULL, *bb = NULL;
+    const int ok = st_soup_append(all, a, &err) == ST_OK && st_soup_append(all, b, &err) == ST_OK &&
+                   st_bvh_build(&ba, a, &err) == ST_OK && st_bvh_build(&bb, b, &err) == ST_OK;
+    st_grid *one = voted_field(all, 20, 0), *two = voted_field(all, 20, 0);
+    const st_sign_refine_params rp = st_sign_refine_params_default();
+    const st_bvh *parts[2] = {ba, bb};
+    size_t c1 = 0, c2 = 0;
+    const st_status r1 = ok && one ? st_sign_refine(one, all, &rp, &c1, &err) : ST_EINTERNAL;
+    const st_status r2 = ok && two ? st_sign_refine_parts(two, all, parts, 2, &rp, &c2, &err)
+                                   : ST_EINTERNAL;
+    TAP_CHECK(r1 == ST_OK && r2 == ST_OK && c1 > 0 && c1 == c2 &&
+                  memcmp(one->data, two->data, st_grid_count(one) * sizeof(float)) == 0,
+              "sphere in two parts (%zu + %zu triangles): the same signs as one BVH "
+              "(%zu and %zu changed)", a->ntris, b->ntris, c1, c2);
+    /* one part alone does not hold the soup's triangles */
+    TAP_CHECK(two && st_sign_refine_parts(two, all, parts, 1, &rp, NULL, &err) == ST_EINPUT,
+              "parts that do not add up to the soup are refused: %s", err.msg);
+    st_grid_free(one);
+    st_grid_free(two);
+    st_bvh_free(ba);
+    st_bvh_free(bb);
+    st_soup_free(a);
+    st_soup_free(b);
+    st_soup_free(all);
+    st_soup_free(sphere);
+}
+
 /* Not a check: the IoU of each variant on the shapes, printed as notes so
  * the default rule's choice can be read off the test log. */
 static void report_variants(void)
@@ -756,6 +797,6 @@ int main(int argc, char **argv)
     }
     static const tap_test tests[] = {TAP_TEST(rays), TAP_TEST(refusals), TAP_TEST(shapes),
                                      TAP_TEST(sweep_matches_lines), TAP_TEST(refine),
-                                     TAP_TEST(zero_distance), {0}};
+                                     TAP_TEST(refine_parts), TAP_TEST(zero_distance), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -161,6 +161,15 @@ st_status st_sign_refine(st_grid *g, const st_soup *soup,
 st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
                              const st_sign_refine_params *p, size_t *changed,
                              st_error *err);
+/* The same with the soup's triangles in parts, one BVH each: soup holds
+ * bvhs[0]->soup's triangles, then bvhs[1]->soup's, ... in order, at the
+ * same vertex positions (st_soup_append), so a soup's BVH is reused when
+ * triangles are added to it (the hole caps). The field is the one
+ * st_sign_refine(g, soup) gives. ST_EINPUT when the parts' triangles do
+ * not add up to soup's. */
+st_status st_sign_refine_parts(st_grid *g, const st_soup *soup, const st_bvh *const *bvhs,
+                               size_t nbvh, const st_sign_refine_params *p, size_t *changed,
+                               st_error *err);
 
 #ifdef __cplusplus
 }

@@ -126,9 +126,11 @@ static st_status symmetric_fill(st_grid *g, const st_soup *s, const st_soup_edge
  * caps as one soup (NULL when there are none). */
 static st_status add_caps(st_grid *g, const st_soup *s, const st_soup_edges *edges,
                           const st_bvh *bvh, const st_pseudo_params *p,
-                          st_pseudo_stats *st, st_soup **with_caps, st_error *err)
+                          st_pseudo_stats *st, st_soup **with_caps, st_soup **caps_out,
+                          st_error *err)
 {
     *with_caps = NULL;
+    *caps_out = NULL;
     st_soup *caps = NULL;
     st_status rc = st_soup_hole_caps_shared(&caps, s, edges, bvh, &p->holes, &st->holes, err);
     if (rc)
@@ -157,8 +159,11 @@ static st_status add_caps(st_grid *g, const st_soup *s, const st_soup_edges *edg
         rc = rc ? rc : st_soup_append(all, caps, err);
         if (rc)
             st_soup_free(all);
-        else
+        else {
             *with_caps = all;
+            *caps_out = caps;
+            caps = NULL;
+        }
     }
     st_soup_free(caps);
     return rc;
@@ -240,7 +245,8 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     st->event_distance = st_sign_event_distance(&p->sign, g);
     st_shells shells;
     memset(&shells, 0, sizeof shells);
-    st_soup *with_caps = NULL;
+    st_soup *with_caps = NULL, *caps = NULL;
+    st_bvh *caps_bvh = NULL;
     /* s's edge table and BVH, built once for the steps that read them */
     st_soup_edges edges;
     int have_edges = 0;
@@ -279,7 +285,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     if (s && p->fill_holes) {
         st_progress_report(progress, "holes", 0.0);
         if ((rc = st_bvh_build(&bvh, s, err)) ||
-            (rc = add_caps(g, s, &edges, bvh, p, st, &with_caps, err)))
+            (rc = add_caps(g, s, &edges, bvh, p, st, &with_caps, &caps, err)))
             goto done;
     }
     STOP_IF_CANCELLED();
@@ -305,7 +311,11 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
         st_progress_report(progress, "refine", 0.0);
         if (!with_caps && bvh && s->ntris)
             rc = st_sign_refine_bvh(g, bvh, &p->refine, &st->refined, err);
-        else
+        else if (with_caps && bvh && !(rc = st_bvh_build(&caps_bvh, caps, err))) {
+            /* s's BVH and one over the caps alone: with_caps is s, then the caps */
+            const st_bvh *parts[2] = {bvh, caps_bvh};
+            rc = st_sign_refine_parts(g, with_caps, parts, 2, &p->refine, &st->refined, err);
+        } else if (!rc)
             rc = st_sign_refine(g, with_caps ? with_caps : s, &p->refine, &st->refined, err);
         if (rc)
             goto done;
@@ -343,6 +353,8 @@ done:
     if (have_edges)
         st_soup_edges_free(&edges);
     st_soup_free(with_caps);
+    st_soup_free(caps);
+    st_bvh_free(caps_bvh);
     st_shells_free(&shells);
     return rc;
 }

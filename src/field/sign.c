@@ -1034,6 +1034,7 @@ typedef struct refine_buf {
     size_t n, cap;
     int oom;
     const st_soup *s;
+    uint32_t base;      /* the queried BVH's first triangle in s */
 } refine_buf;
 
 static int refine_collect(void *ctx, uint32_t tri)
@@ -1050,6 +1051,7 @@ static int refine_collect(void *ctx, uint32_t tri)
         b->cap = cap;
     }
     refine_tri *r = &b->t[b->n++];
+    tri += b->base;
     r->id = tri;
     for (int a = 0; a < 3; a++) {
         r->lo[a] = INFINITY;
@@ -1212,7 +1214,8 @@ enum { TILE = 4 };
 typedef struct refine_ctx {
     const st_grid *g;
     const st_soup *soup;
-    const st_bvh *bvh;
+    const st_bvh *const *bvhs;  /* over soup's triangles, in order */
+    size_t nbvh;
     const st_sign_refine_params *p;
     refine_offset offs[7 * 7 * 7];
     int noffs;
@@ -1353,7 +1356,11 @@ static void refine_tile(const refine_ctx *c, refine_worker *w, long t)
         hi[a] = phi[a] + c->reach;
     }
     w->b.n = 0;
-    st_bvh_query_box(c->bvh, lo, hi, refine_collect, &w->b);
+    w->b.base = 0;
+    for (size_t q = 0; q < c->nbvh && !w->b.oom; q++) {
+        st_bvh_query_box(c->bvhs[q], lo, hi, refine_collect, &w->b);
+        w->b.base += (uint32_t)c->bvhs[q]->soup->ntris;
+    }
     if (w->b.oom)
         return;
     /* the masks, then sel (b.n indices, two a word) in one block */
@@ -1401,9 +1408,21 @@ st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
                              const st_sign_refine_params *p, size_t *changed,
                              st_error *err)
 {
+    return st_sign_refine_parts(g, bvh ? bvh->soup : NULL, &bvh, bvh ? 1 : 0, p, changed, err);
+}
+
+st_status st_sign_refine_parts(st_grid *g, const st_soup *soup, const st_bvh *const *bvhs,
+                               size_t nbvh, const st_sign_refine_params *p, size_t *changed,
+                               st_error *err)
+{
     if (changed)
         *changed = 0;
-    const st_soup *soup = bvh ? bvh->soup : NULL;
+    size_t parts = 0;
+    for (size_t q = 0; q < nbvh; q++)
+        parts += bvhs[q]->soup->ntris;
+    if (soup && parts != soup->ntris)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "the BVHs hold %zu triangles, the soup %zu", parts, soup->ntris);
     if (g->kind != ST_GRID_SIGNED)
         return st_error_set(err, ST_EINPUT, NULL, 0,
                             "refinement needs a signed field");
@@ -1417,7 +1436,8 @@ st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
     refine_ctx c;
     c.g = g;
     c.soup = soup;
-    c.bvh = bvh;
+    c.bvhs = bvhs;
+    c.nbvh = nbvh;
     c.p = p;
     c.noffs = refine_offsets(c.offs, p->radius);
     c.band = (float)(p->band_voxels * g->voxel);
@@ -1433,7 +1453,7 @@ st_status st_sign_refine_bvh(st_grid *g, const st_bvh *bvh,
      * uses, so the answers are the same; this removes the data race.) */
     #pragma omp parallel reduction(+ : nchanged)
     {
-        refine_worker w = {{NULL, 0, 0, 0, soup}, NULL, 0, 0, NULL, 0, 0,
+        refine_worker w = {{NULL, 0, 0, 0, soup, 0}, NULL, 0, 0, NULL, 0, 0,
                            NULL, 0, 0, {0, 0, 0}, {0, 0, 0}};
         #pragma omp for schedule(dynamic, 4)
         for (long t = 0; t < ntiles; t++)
