@@ -606,6 +606,18 @@ typedef struct tally {
     long all, informative, verified, contradicted;
 } tally;
 
+/* accepted()'s shares (below) */
+#define MIN_VERIFIED 0.4
+#define MAX_CONTRA 0.2
+
+/* The contradicted share of what the soup could check (verified or
+ * contradicted); 1 when it could check nothing. */
+static double contradiction(const tally *t)
+{
+    long seen = t->verified + t->contradicted;
+    return seen ? (double)t->contradicted / (double)seen : 1.0;
+}
+
 /* The share of every stride-th sample whose image lands on the soup,
  * among the informative ones: those the map moves by more than the
  * tolerance, not along their own surface (the displacement at least
@@ -617,6 +629,19 @@ typedef struct tally {
 #define MIN_INFORM 0.1
 /* measure_need's blocks, in strided samples */
 #define MEASURE_BLOCK 32
+
+/* Whether accepted()'s contradiction bound is settled with c of the
+ * contradictions counted and at most `rest` samples to come, the
+ * verified count being known's: the share contradicted only grows with
+ * the count (the same rounded division of a larger quotient), so above
+ * MAX_CONTRA with c it stays above, and at most MAX_CONTRA with all the
+ * rest contradicted it stays at most. Either way c gives accepted()'s
+ * answer. */
+static int contra_decided(const tally *known, long c, long rest)
+{
+    const tally lo = {0, 0, known->verified, c}, hi = {0, 0, known->verified, c + rest};
+    return contradiction(&lo) > MAX_CONTRA || contradiction(&hi) <= MAX_CONTRA;
+}
 /* With need > 0, the samples go in blocks of MEASURE_BLOCK, and after
  * each the count stops once even the rest all landing (each informative
  * and verified) would leave the share below need (times 1 - 1e-9, so no
@@ -624,12 +649,12 @@ typedef struct tally {
  * is 0. Callers compare the share with thresholds of at least need, so
  * they decide as on the whole count. The counts at the block ends are
  * sums, the same for any thread count. */
-static tally measure_need(const ctx *C, const st_symmetry *y, double angle,
-                          size_t stride, int full, double need)
+static tally measure_run(const ctx *C, const st_symmetry *y, double angle,
+                         size_t stride, int full, double need, const tally *known)
 {
     const samples *S = C->S;
     const size_t total = (S->n + stride - 1) / stride;
-    const size_t block = need > 0.0 ? MEASURE_BLOCK : (total ? total : 1);
+    const size_t block = need > 0.0 || known ? MEASURE_BLOCK : (total ? total : 1);
     long hits = 0, n = 0, all = 0, contra = 0;
     for (size_t j0 = 0; j0 < total; j0 += block) {
         const size_t j1 = total - j0 > block ? j0 + block : total;
@@ -663,9 +688,19 @@ static tally measure_need(const ctx *C, const st_symmetry *y, double angle,
             tally none = {(long)total, 0, 0, 0};
             return none;
         }
+        if (known && contra_decided(known, contra, (long)(total - j1))) {
+            tally r = {known->all, known->informative, known->verified, contra};
+            return r;
+        }
     }
     tally r = {all, n, hits, full ? contra : 0};
     return r;
+}
+
+static tally measure_need(const ctx *C, const st_symmetry *y, double angle,
+                          size_t stride, int full, double need)
+{
+    return measure_run(C, y, angle, stride, full, need, NULL);
 }
 
 static tally measure(const ctx *C, const st_symmetry *y, double angle,
@@ -674,19 +709,20 @@ static tally measure(const ctx *C, const st_symmetry *y, double angle,
     return measure_need(C, y, angle, stride, full, 0.0);
 }
 
+/* The contradictions of the whole count (stride 1) where its verified
+ * counts are known (t: measure's, stride 1, without them): they matter
+ * only to accepted()'s bound (MAX_CONTRA), so the count stops where
+ * the rest can no longer move the share across it (contra_decided). */
+static tally measure_contra(const ctx *C, const st_symmetry *y, double angle, const tally *t)
+{
+    return measure_run(C, y, angle, 1, 1, 0.0, t);
+}
+
 static double share(const tally *t)
 {
     if ((double)t->informative < MIN_INFORM * (double)t->all)
         return 0.0;
     return (double)t->verified / (double)t->informative;
-}
-
-/* The contradicted share of what the soup could check (verified or
- * contradicted); 1 when it could check nothing. */
-static double contradiction(const tally *t)
-{
-    long seen = t->verified + t->contradicted;
-    return seen ? (double)t->contradicted / (double)seen : 1.0;
 }
 
 /* The share of every stride-th sample's images verified (measure), where
@@ -704,8 +740,6 @@ static double support_need(const ctx *C, const st_symmetry *y, double angle,
  * MIN_VERIFIED of them verified and at most MAX_CONTRA of what the soup
  * could check contradicted. doc/design/symmetry.md has the measurements
  * behind both. */
-#define MIN_VERIFIED 0.4
-#define MAX_CONTRA 0.2
 static int accepted(const tally *t, double min_support)
 {
     double v = share(t);
@@ -1045,7 +1079,7 @@ static void measure_mirrors(const ctx *C, const st_symmetry_params *p, st_symmet
             t = measure_need(C, cand + i, 0.0, 1, 0, fmin(MIN_VERIFIED, p->min_support));
         /* the contradictions matter only between the two shares */
         if (share(&t) >= MIN_VERIFIED && share(&t) < p->min_support)
-            t = measure(C, cand + i, 0.0, 1, 1);
+            t = measure_contra(C, cand + i, 0.0, &t);
         cand[i].support = share(&t);
         ok[i] = accepted(&t, p->min_support);
     }
@@ -1465,7 +1499,7 @@ static int find_helix(const ctx *C, st_symmetry *y, double min_support, int *mea
     for (int i = 0; i < 3; i++) {
         tally t = measure(C, y, turn[i], 1, 0);
         if (share(&t) >= MIN_VERIFIED && share(&t) < min_support)
-            t = measure(C, y, turn[i], 1, 1);
+            t = measure_contra(C, y, turn[i], &t);
         if (!accepted(&t, min_support))
             return 0;
         least = fmin(least, share(&t));

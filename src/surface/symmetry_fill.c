@@ -68,6 +68,8 @@ typedef struct pieces {
     double *reach;       /* per piece: half its box diagonal */
     size_t *vrep;        /* each cap vertex's representative (same position) */
     double lo[3], hi[3]; /* the anchors' box, grown by the largest reach */
+    double *box;         /* per piece: its anchors' box grown by its reach
+                            and a margin (pieces_box), 6 each */
 } pieces;
 
 static const double *g_xyz;   /* qsort's context: set just before the call */
@@ -86,6 +88,7 @@ static void pieces_free(pieces *P)
     free(P->of_tri);
     free(P->reach);
     free(P->vrep);
+    free(P->box);
     memset(P, 0, sizeof *P);
 }
 
@@ -196,17 +199,60 @@ done:
     return rc;
 }
 
-/* The anchors' box, grown by the largest reach (nothing farther is fill). */
-static void pieces_box(pieces *P, const st_soup *anchors)
+/* The margin of a piece's box (PIECE_MARGIN of its reach, and of the
+ * anchors' coordinates): far above the rounding of a distance, so a
+ * point outside the grown box is certainly farther than the reach. */
+#define PIECE_MARGIN 1e-6
+
+/* The anchors' box, grown by the largest reach (nothing farther is
+ * fill), and each piece's, grown by its reach and the margin. */
+static st_status pieces_box(pieces *P, const st_soup *anchors)
 {
-    double most = 0.0;
+    double most = 0.0, big = 0.0;
     for (size_t i = 0; i < P->n; i++)
         most = fmax(most, P->reach[i]);
     st_soup_bounds(anchors, P->lo, P->hi, NULL);
     for (int k = 0; k < 3; k++) {
+        big = fmax(big, fmax(fabs(P->lo[k]), fabs(P->hi[k])));
         P->lo[k] -= most;
         P->hi[k] += most;
     }
+    P->box = st_malloc_array(P->n ? 6 * P->n : 1, sizeof *P->box);
+    if (!P->box)
+        return ST_ENOMEM;
+    for (size_t i = 0; i < 6 * P->n; i++)
+        P->box[i] = i % 6 < 3 ? INFINITY : -INFINITY;
+    for (size_t t = 0; t < anchors->ntris; t++) {
+        double *b = P->box + 6 * P->of_tri[t];
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 3; k++) {
+                const double x = anchors->xyz[3 * (size_t)anchors->tris[3 * t + c] + k];
+                b[k] = fmin(b[k], x);
+                b[3 + k] = fmax(b[3 + k], x);
+            }
+    }
+    for (size_t i = 0; i < P->n; i++) {
+        const double g = P->reach[i] * (1.0 + PIECE_MARGIN) + PIECE_MARGIN * big;
+        for (int k = 0; k < 3; k++) {
+            P->box[6 * i + k] -= g;
+            P->box[6 * i + 3 + k] += g;
+        }
+    }
+    return ST_OK;
+}
+
+/* Whether c lies in the grown box of a piece the map may fill: else
+ * every anchor of such a piece is farther from c than the piece's reach,
+ * and keeps() leaves c's image out whichever anchor is nearest. */
+static int near_ok_piece(const pieces *P, const uint8_t *ok, const double c[3])
+{
+    for (size_t i = 0; i < P->n; i++) {
+        const double *b = P->box + 6 * i;
+        if (ok[i] && c[0] >= b[0] && c[0] <= b[3] && c[1] >= b[1] && c[1] <= b[4] &&
+            c[2] >= b[2] && c[2] <= b[5])
+            return 1;
+    }
+    return 0;
 }
 
 /* ---- the maps ----------------------------------------------------------------- */
@@ -415,6 +461,8 @@ static size_t keeps(const fill_ctx *C, const double q[3][3])
         if (c[k] < C->P->lo[k] || c[k] > C->P->hi[k])
             return SIZE_MAX;
     }
+    if (!near_ok_piece(C->P, C->piece_ok, c))
+        return SIZE_MAX;
     /* the soup wins wherever it is: the tests below (bound >= tol2) */
     const double tol2 = C->tol * C->tol;
     if (st_bvh_within(C->bvh, c, tol2) || (C->fill_bvh && st_bvh_within(C->fill_bvh, c, tol2)))
@@ -1445,7 +1493,8 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
     st->open = P.n - P.ncap;
     if (P.n == 0)
         goto done;
-    pieces_box(&P, anchors);
+    if ((rc = pieces_box(&P, anchors)))
+        goto done;
     if (edges && !(F.rim = rim_bits(s, edges))) {
         rc = ST_ENOMEM;
         goto done;
