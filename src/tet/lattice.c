@@ -203,11 +203,9 @@ void st_lattice_free(st_lattice *L)
     free(L);
 }
 
-/* Face (t, i), the face opposite corner i: its smallest vertex id into
- * *s0, the two others (ascending) as one key. */
-static uint64_t face_key(const st_lattice *L, size_t t, int i, uint32_t *s0)
+/* Face (t, i), the face opposite corner i: its vertex ids ascending. */
+static void face_sorted(const st_lattice *L, size_t t, int i, uint32_t f[3])
 {
-    uint32_t f[3];
     int n = 0;
     for (int c = 0; c < 4; c++)
         if (c != i)
@@ -216,95 +214,82 @@ static uint64_t face_key(const st_lattice *L, size_t t, int i, uint32_t *s0)
     if (f[0] > f[1]) { x = f[0]; f[0] = f[1]; f[1] = x; }
     if (f[1] > f[2]) { x = f[1]; f[1] = f[2]; f[2] = x; }
     if (f[0] > f[1]) { x = f[0]; f[0] = f[1]; f[1] = x; }
-    *s0 = f[0];
-    return (uint64_t)f[1] << 32 | f[2];
 }
 
-/* One bucket's faces slot[0 .. n) with their keys key[0 .. n): sorted by
- * key (insertion: a bucket holds a few dozen), the faces with equal keys
- * are the two sides of one face. */
-static st_status pair_bucket(st_lattice *L, uint64_t *slot, uint64_t *key, size_t n,
-                             st_error *err)
+/* One stable counting-sort pass: the faces in[0 .. nf) by their id
+ * number c (fs[3 f + c]) into out; cnt has nv + 1 slots. */
+static void face_pass(const uint32_t *fs, int c, const uint32_t *in, uint32_t *out, size_t nf,
+                      size_t *cnt, size_t nv)
 {
-    for (size_t a = 1; a < n; a++) {
-        uint64_t k = key[a], sl = slot[a];
-        size_t b = a;
-        for (; b > 0 && key[b - 1] > k; b--) {
-            key[b] = key[b - 1];
-            slot[b] = slot[b - 1];
-        }
-        key[b] = k;
-        slot[b] = sl;
-    }
-    for (size_t a = 0; a + 1 < n; a++) {
-        if (key[a] != key[a + 1])
-            continue;
-        if (a + 2 < n && key[a + 2] == key[a])
-            return st_error_set(err, ST_EINTERNAL, NULL, 0,
-                                "lattice face shared by more than two tets");
-        L->nbr[slot[a]] = (int64_t)(slot[a + 1] / 4);
-        L->nbr[slot[a + 1]] = (int64_t)(slot[a] / 4);
-        a++;
-    }
-    return ST_OK;
+    memset(cnt, 0, (nv + 1) * sizeof *cnt);
+    for (size_t a = 0; a < nf; a++)
+        cnt[fs[3 * (size_t)in[a] + (size_t)c] + 1]++;
+    for (size_t v = 0; v < nv; v++)
+        cnt[v + 1] += cnt[v];
+    for (size_t a = 0; a < nf; a++)
+        out[cnt[fs[3 * (size_t)in[a] + (size_t)c]]++] = in[a];
 }
 
-/* Face adjacency by buckets of the smallest vertex id; star CSR. */
+/* Face adjacency: the faces sorted by their three ids (three counting
+ * passes, the largest id first), a face and the next one with the same ids
+ * are the two sides of one face; star CSR. */
 static st_status build_topology(st_lattice *L, const st_progress *stop, st_error *err)
 {
     size_t nv = L->nverts, nt = L->ntets, nf = 4 * nt;
-    size_t *off = st_calloc_array(nv + 1, sizeof *off);
-    uint64_t *slot = st_malloc_array(nf ? nf : 1, sizeof *slot);
+    if (nf > UINT32_MAX)   /* faces are numbered in 32 bits */
+        return st_error_set(err, ST_ELIMIT, NULL, 0, "lattice of %zu tets is too large", nt);
+    size_t *cnt = st_malloc_array(nv + 1, sizeof *cnt);
+    uint32_t *fs = st_malloc_array(nf ? 3 * nf : 1, sizeof *fs);
+    uint32_t *ord = st_malloc_array(nf ? nf : 1, sizeof *ord);
+    uint32_t *tmp = st_malloc_array(nf ? nf : 1, sizeof *tmp);
     L->nbr = st_malloc_array(nf, sizeof *L->nbr);
     L->star_off = st_calloc_array(nv + 1, sizeof *L->star_off);
     L->star = st_malloc_array(nf, sizeof *L->star);
-    size_t *fill = st_malloc_array(nv + 1, sizeof *fill);
-    uint64_t *key = st_malloc_array(nf ? nf : 1, sizeof *key);
-    uint64_t *fkey = st_malloc_array(nf ? nf : 1, sizeof *fkey);
-    uint32_t *fs0 = st_malloc_array(nf ? nf : 1, sizeof *fs0);
     st_status st = ST_OK;
-    if (!off || !slot || !L->nbr || !L->star_off || !L->star || !fill || !key || !fkey ||
-        !fs0) {
+    if (!cnt || !fs || !ord || !tmp || !L->nbr || !L->star_off || !L->star) {
         st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the lattice's adjacency");
         goto done;
     }
     for (size_t t = 0; t < nt; t++)
         for (int i = 0; i < 4; i++) {
             size_t f = 4 * t + (size_t)i;
-            fkey[f] = face_key(L, t, i, &fs0[f]);
-            off[fs0[f] + 1]++;
+            face_sorted(L, t, i, fs + 3 * f);
+            ord[f] = (uint32_t)f;
             L->star_off[L->tets[f] + 1]++;
         }
-    for (size_t v = 0; v < nv; v++) {
-        off[v + 1] += off[v];
+    for (size_t v = 0; v < nv; v++)
         L->star_off[v + 1] += L->star_off[v];
-    }
-    memcpy(fill, off, (nv + 1) * sizeof *fill);
-    for (size_t f = 0; f < nf; f++) {
-        size_t a = fill[fs0[f]]++;
-        slot[a] = f;
-        key[a] = fkey[f];
-    }
-    memcpy(fill, L->star_off, (nv + 1) * sizeof *fill);
+    memcpy(cnt, L->star_off, (nv + 1) * sizeof *cnt);
     for (size_t t = 0; t < nt; t++)
         for (int i = 0; i < 4; i++)
-            L->star[fill[L->tets[4 * t + (size_t)i]]++] = (uint32_t)t;
+            L->star[cnt[L->tets[4 * t + (size_t)i]]++] = (uint32_t)t;
+    if (st_progress_cancelled(stop)) {
+        st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        goto done;
+    }
+    face_pass(fs, 2, ord, tmp, nf, cnt, nv);
+    face_pass(fs, 1, tmp, ord, nf, cnt, nv);
+    face_pass(fs, 0, ord, tmp, nf, cnt, nv);
     for (size_t f = 0; f < nf; f++)
         L->nbr[f] = -1;
-    for (size_t v = 0; v < nv && st == ST_OK; v++) {
-        if ((v & 4095) == 0 && st_progress_cancelled(stop)) {
-            st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+    for (size_t a = 0; a + 1 < nf; a++) {
+        const uint32_t *x = fs + 3 * (size_t)tmp[a], *y = fs + 3 * (size_t)tmp[a + 1];
+        if (x[0] != y[0] || x[1] != y[1] || x[2] != y[2])
+            continue;
+        if (a + 2 < nf && memcmp(fs + 3 * (size_t)tmp[a + 2], x, 3 * sizeof *x) == 0) {
+            st = st_error_set(err, ST_EINTERNAL, NULL, 0,
+                              "lattice face shared by more than two tets");
             break;
         }
-        st = pair_bucket(L, slot + off[v], key + off[v], off[v + 1] - off[v], err);
+        L->nbr[tmp[a]] = (int64_t)(tmp[a + 1] / 4);
+        L->nbr[tmp[a + 1]] = (int64_t)(tmp[a] / 4);
+        a++;
     }
 done:
-    free(off);
-    free(slot);
-    free(fill);
-    free(key);
-    free(fkey);
-    free(fs0);
+    free(cnt);
+    free(fs);
+    free(ord);
+    free(tmp);
     return st;
 }
 
