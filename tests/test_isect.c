@@ -558,9 +558,20 @@ static double unit_rand(uint64_t *st)
     return (double)(*st >> 11) * (1.0 / 9007199254740992.0);
 }
 
+/* st_tri_box_filter_maybe after st_tri_box_filter_init on a, b, c (the
+ * filter a BVH walk keeps for its query). */
+static int filter_maybe(const double *a, const double *b, const double *c, const double *lo,
+                        const double *hi)
+{
+    st_tri_box_filter f;
+    st_tri_box_filter_init(&f, a, b, c);
+    return st_tri_box_filter_maybe(&f, lo, hi);
+}
+
 static void test_tri_box_maybe(void)
 {
     int missed = 0, n = 0, exact_apart = 0, maybe_apart = 0;
+    int fmissed = 0, filter_apart = 0;
     for (int it = 0; it < 60000; it++) {
         double a[3], b[3], c[3], blo[3], bhi[3];
         rand_pt(a, 3);
@@ -577,6 +588,7 @@ static void test_tri_box_maybe(void)
         int mb = st_tri_box_maybe(a, b, c, blo, bhi);
         n++;
         missed += ex && !mb;
+        fmissed += ex && !filter_maybe(a, b, c, blo, bhi);
     }
     static const double scale[] = {1e-9, 1e-3, 1.0, 1e3, 1e9};
     static const double shift[] = {0.0, 1.0, 1e5};
@@ -607,16 +619,24 @@ static void test_tri_box_maybe(void)
                     lo[1] = hi[1] = v[0][1];
                 int ex = st_tri_box_intersect(v[0], v[1], v[2], lo, hi);
                 int mb = st_tri_box_maybe(v[0], v[1], v[2], lo, hi);
+                int mf = filter_maybe(v[0], v[1], v[2], lo, hi);
                 n++;
                 missed += ex && !mb;
+                fmissed += ex && !mf;
                 exact_apart += !ex;
                 maybe_apart += !mb;
+                filter_apart += !mf;
             }
     TAP_CHECK(missed == 0, "tri-box filter: no meeting pair parted (%d cases, %d missed)",
               n, missed);
     TAP_CHECK(exact_apart > 1000 && maybe_apart * 10 >= exact_apart * 9,
               "tri-box filter: parts %d of the %d pairs the exact test parts", maybe_apart,
               exact_apart);
+    TAP_CHECK(fmissed == 0, "tri-box filter, triangle part once: no meeting pair parted "
+              "(%d cases, %d missed)", n, fmissed);
+    TAP_CHECK(filter_apart * 10 >= exact_apart * 9,
+              "tri-box filter, triangle part once: parts %d of the %d pairs the exact test parts",
+              filter_apart, exact_apart);
 }
 
 /* ---- speed --------------------------------------------------------------------- */

@@ -83,6 +83,27 @@ int st_tri_box_intersect(const double a[3], const double b[3],
 int st_tri_box_maybe(const double a[3], const double b[3], const double c[3],
                      const double lo[3], const double hi[3]);
 
+/* st_tri_box_maybe for one triangle against many boxes (a BVH walk): what
+ * depends on the triangle alone, computed once by st_tri_box_filter_init
+ * (the filter holds no pointer to a, b, c). st_tri_box_filter_maybe is a
+ * filter with the same promise (0 only when the triangle certainly misses
+ * [lo, hi]) and slack (isect.c), several times cheaper per box. */
+typedef struct st_tri_box_filter {
+    double tlo[3], thi[3];   /* the triangle's box */
+    double m;                /* its largest coordinate magnitude */
+    double n[3], nd;         /* the plane: normal, n . a */
+    double an[3];            /* |n| */
+    double ax[9][2];         /* axis k, edge j: (au, aw) */
+    double aabs[9][2];       /* their magnitudes */
+    double pmin[9], pmax[9]; /* the vertices' projections on each axis */
+    int ok;                  /* 0: keep every box (non-finite or out of range) */
+} st_tri_box_filter;
+
+void st_tri_box_filter_init(st_tri_box_filter *f, const double a[3], const double b[3],
+                            const double c[3]);
+int st_tri_box_filter_maybe(const st_tri_box_filter *f, const double lo[3],
+                            const double hi[3]);
+
 /* 1 when p lies in the closed triangle (a b c) of any shape (collinear:
  * its segment; coincident: its point), else 0. (Added by isect.c's
  * author; not part of the original contract.) */

@@ -584,6 +584,98 @@ int st_tri_box_maybe(const double a[3], const double b[3], const double c[3],
     return 1;
 }
 
+/* The same test with the triangle's part computed once, in absolute
+ * coordinates: an axis's projections of the vertices (au V_u + aw V_w)
+ * once per triangle, the box centre's per box, their difference the
+ * gap. Rounding: the axis (au, aw) and the normal are whatever was
+ * computed; any axis separates what it separates, so only the products
+ * and sums below err: a projection and the centre's are off by under
+ * 4 * 2^-53 |a| M each and the difference by one more rounding, under
+ * 10 * 2^-53 * 2 L * M for an edge axis (|a| <= 2 L, the edge between two
+ * vertices within L of the centre per axis), under 50 * 2^-53 * 8 L^2 * M
+ * for the plane (|n| <= 8 L^2); the triangle's vertices off the rounded
+ * normal by under 10 * 2^-53 * 8 L^2 * 2 L. All far below TRI_BOX_SLACK
+ * L (M + L) and TRI_BOX_SLACK L^2 (M + L). L is taken from the
+ * triangle's box (its corners' offsets bound the vertices'), not smaller
+ * than the L above, so the slack is at least as large. */
+void st_tri_box_filter_init(st_tri_box_filter *f, const double a[3], const double b[3],
+                            const double c[3])
+{
+    const double *V[3] = {a, b, c};
+    double m = 0.0, e[3][3];
+    for (int k = 0; k < 3; k++) {
+        f->tlo[k] = MIND(a[k], MIND(b[k], c[k]));
+        f->thi[k] = MAXD(a[k], MAXD(b[k], c[k]));
+        for (int i = 0; i < 3; i++)
+            m = MAXD(m, fabs(V[i][k]));
+        e[0][k] = b[k] - a[k];
+        e[1][k] = c[k] - b[k];
+        e[2][k] = a[k] - c[k];
+    }
+    f->m = m;
+    f->ok = isfinite(m) && m <= 1e60;
+    f->n[0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
+    f->n[1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
+    f->n[2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+    f->nd = f->n[0] * a[0] + f->n[1] * a[1] + f->n[2] * a[2];
+    for (int k = 0; k < 3; k++)
+        f->an[k] = fabs(f->n[k]);
+    for (int k = 0; k < 3; k++) {
+        const int u = (k + 1) % 3, w = (k + 2) % 3;
+        for (int j = 0; j < 3; j++) {
+            const int x = 3 * k + j;
+            const double au = -e[j][w], aw = e[j][u];
+            double p0 = au * a[u] + aw * a[w], p1 = au * b[u] + aw * b[w];
+            double p2 = au * c[u] + aw * c[w];
+            f->ax[x][0] = au;
+            f->ax[x][1] = aw;
+            f->aabs[x][0] = fabs(au);
+            f->aabs[x][1] = fabs(aw);
+            f->pmin[x] = MIND(p0, MIND(p1, p2));
+            f->pmax[x] = MAXD(p0, MAXD(p1, p2));
+        }
+    }
+}
+
+int st_tri_box_filter_maybe(const st_tri_box_filter *f, const double lo[3],
+                            const double hi[3])
+{
+    if (!(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]))
+        return 0;   /* empty box (exact) */
+    if (!f->ok)
+        return 1;
+    /* the triangle inside the box meets it (comparisons: exact) */
+    if (f->tlo[0] >= lo[0] && f->thi[0] <= hi[0] && f->tlo[1] >= lo[1] &&
+        f->thi[1] <= hi[1] && f->tlo[2] >= lo[2] && f->thi[2] <= hi[2])
+        return 1;
+    double ctr[3], e[3], M = f->m, L = 0.0;
+    for (int k = 0; k < 3; k++) {
+        M = MAXD(M, MAXD(fabs(lo[k]), fabs(hi[k])));
+        ctr[k] = 0.5 * (lo[k] + hi[k]);
+        e[k] = 0.5 * (hi[k] - lo[k]);
+        L = MAXD(L, MAXD(e[k], MAXD(fabs(f->tlo[k] - ctr[k]), fabs(f->thi[k] - ctr[k]))));
+    }
+    if (!(M >= 1e-60 && M <= 1e60))
+        return 1;   /* no bound here: keep it, the exact tests decide */
+    L += 1e-15 * M;
+    const double tol2 = TRI_BOX_SLACK * L * (M + L), tol3 = tol2 * L;
+    double d = f->nd - (f->n[0] * ctr[0] + f->n[1] * ctr[1] + f->n[2] * ctr[2]);
+    double r = e[0] * f->an[0] + e[1] * f->an[1] + e[2] * f->an[2];
+    if (fabs(d) > r + tol3)
+        return 0;
+    for (int k = 0; k < 3; k++) {
+        const int u = (k + 1) % 3, w = (k + 2) % 3;
+        for (int j = 0; j < 3; j++) {
+            const int x = 3 * k + j;
+            double cp = f->ax[x][0] * ctr[u] + f->ax[x][1] * ctr[w];
+            double re = e[u] * f->aabs[x][0] + e[w] * f->aabs[x][1];
+            if (f->pmin[x] - cp > re + tol2 || f->pmax[x] - cp < -re - tol2)
+                return 0;
+        }
+    }
+    return 1;
+}
+
 #undef MAXD
 #undef MIND
 

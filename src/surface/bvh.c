@@ -541,18 +541,18 @@ int st_bvh_query_box(const st_bvh *b, const double lo[3], const double hi[3],
  * so no node holding a triangle whose box meets the query triangle is
  * pruned: the visits are a superset of the triangles meeting it. The box
  * test first, since it rejects most nodes for a few comparisons. */
-static int node_meets_tri(const st_bvh_node *n, const double *q[3],
+static int node_meets_tri(const st_bvh_node *n, const st_tri_box_filter *q,
                           const double qlo[3], const double qhi[3])
 {
-    return boxes_meet(n->lo, n->hi, qlo, qhi) &&
-           st_tri_box_maybe(q[0], q[1], q[2], n->lo, n->hi);
+    return boxes_meet(n->lo, n->hi, qlo, qhi) && st_tri_box_filter_maybe(q, n->lo, n->hi);
 }
 
 int st_bvh_query_tri(const st_bvh *b, const double a[3], const double bb[3],
                      const double c[3], int (*visit)(void *ctx, uint32_t tri),
                      void *ctx)
 {
-    const double *q[3] = {a, bb, c};
+    st_tri_box_filter q;
+    st_tri_box_filter_init(&q, a, bb, c);
     double lo[3], hi[3];
     for (int k = 0; k < 3; k++) {
         lo[k] = a[k] < bb[k] ? a[k] : bb[k];
@@ -562,7 +562,7 @@ int st_bvh_query_tri(const st_bvh *b, const double a[3], const double bb[3],
     }
     uint32_t stack[STACK_DEPTH];
     int sp = 0;
-    if (b->nnodes == 0 || !node_meets_tri(&b->nodes[0], q, lo, hi))
+    if (b->nnodes == 0 || !node_meets_tri(&b->nodes[0], &q, lo, hi))
         return 0;
     stack[sp++] = 0;
     while (sp > 0) {
@@ -579,9 +579,9 @@ int st_bvh_query_tri(const st_bvh *b, const double a[3], const double bb[3],
             continue;
         }
         uint32_t l = n->start, r = n->start + 1;
-        if (node_meets_tri(&b->nodes[r], q, lo, hi))
+        if (node_meets_tri(&b->nodes[r], &q, lo, hi))
             stack[sp++] = r;
-        if (node_meets_tri(&b->nodes[l], q, lo, hi))
+        if (node_meets_tri(&b->nodes[l], &q, lo, hi))
             stack[sp++] = l;
     }
     return 0;

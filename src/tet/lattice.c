@@ -203,95 +203,93 @@ void st_lattice_free(st_lattice *L)
     free(L);
 }
 
-/* Face adjacency by buckets of the smallest vertex id; star CSR. */
+/* Face (t, i), the face opposite corner i: its vertex ids ascending. */
+static void face_sorted(const st_lattice *L, size_t t, int i, uint32_t f[3])
+{
+    int n = 0;
+    for (int c = 0; c < 4; c++)
+        if (c != i)
+            f[n++] = L->tets[4 * t + (size_t)c];
+    uint32_t x;
+    if (f[0] > f[1]) { x = f[0]; f[0] = f[1]; f[1] = x; }
+    if (f[1] > f[2]) { x = f[1]; f[1] = f[2]; f[2] = x; }
+    if (f[0] > f[1]) { x = f[0]; f[0] = f[1]; f[1] = x; }
+}
+
+/* One stable counting-sort pass: the faces in[0 .. nf) by their id
+ * number c (fs[3 f + c]) into out; cnt has nv + 1 slots. */
+static void face_pass(const uint32_t *fs, int c, const uint32_t *in, uint32_t *out, size_t nf,
+                      size_t *cnt, size_t nv)
+{
+    memset(cnt, 0, (nv + 1) * sizeof *cnt);
+    for (size_t a = 0; a < nf; a++)
+        cnt[fs[3 * (size_t)in[a] + (size_t)c] + 1]++;
+    for (size_t v = 0; v < nv; v++)
+        cnt[v + 1] += cnt[v];
+    for (size_t a = 0; a < nf; a++)
+        out[cnt[fs[3 * (size_t)in[a] + (size_t)c]]++] = in[a];
+}
+
+/* Face adjacency: the faces sorted by their three ids (three counting
+ * passes, the largest id first), a face and the next one with the same ids
+ * are the two sides of one face; star CSR. */
 static st_status build_topology(st_lattice *L, const st_progress *stop, st_error *err)
 {
     size_t nv = L->nverts, nt = L->ntets, nf = 4 * nt;
-    size_t *off = st_calloc_array(nv + 1, sizeof *off);
-    uint64_t *slot = st_malloc_array(nf, sizeof *slot);
+    if (nf > UINT32_MAX)   /* faces are numbered in 32 bits */
+        return st_error_set(err, ST_ELIMIT, NULL, 0, "lattice of %zu tets is too large", nt);
+    size_t *cnt = st_malloc_array(nv + 1, sizeof *cnt);
+    uint32_t *fs = st_malloc_array(nf ? 3 * nf : 1, sizeof *fs);
+    uint32_t *ord = st_malloc_array(nf ? nf : 1, sizeof *ord);
+    uint32_t *tmp = st_malloc_array(nf ? nf : 1, sizeof *tmp);
     L->nbr = st_malloc_array(nf, sizeof *L->nbr);
     L->star_off = st_calloc_array(nv + 1, sizeof *L->star_off);
     L->star = st_malloc_array(nf, sizeof *L->star);
-    size_t *fill = st_malloc_array(nv + 1, sizeof *fill);
-    uint64_t *key = st_malloc_array(nf ? nf : 1, sizeof *key);
-    if (!off || !slot || !L->nbr || !L->star_off || !L->star || !fill || !key) {
-        free(off);
-        free(slot);
-        free(fill);
-        free(key);
-        return st_error_set(err, ST_ENOMEM, NULL, 0,
-                            "out of memory for the lattice's adjacency");
+    st_status st = ST_OK;
+    if (!cnt || !fs || !ord || !tmp || !L->nbr || !L->star_off || !L->star) {
+        st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the lattice's adjacency");
+        goto done;
     }
-    /* Face (t, i) is the face opposite corner i; sorted ids s0 < s1 < s2. */
-#define FACE_SORTED(t, i, s)                                                \
-    do {                                                                    \
-        uint32_t f_[3];                                                     \
-        int n_ = 0;                                                         \
-        for (int c_ = 0; c_ < 4; c_++)                                      \
-            if (c_ != (i))                                                  \
-                f_[n_++] = L->tets[4 * (t) + (size_t)c_];                   \
-        if (f_[0] > f_[1]) { uint32_t x_ = f_[0]; f_[0] = f_[1]; f_[1] = x_; } \
-        if (f_[1] > f_[2]) { uint32_t x_ = f_[1]; f_[1] = f_[2]; f_[2] = x_; } \
-        if (f_[0] > f_[1]) { uint32_t x_ = f_[0]; f_[0] = f_[1]; f_[1] = x_; } \
-        (s)[0] = f_[0]; (s)[1] = f_[1]; (s)[2] = f_[2];                     \
-    } while (0)
     for (size_t t = 0; t < nt; t++)
         for (int i = 0; i < 4; i++) {
-            uint32_t s[3];
-            FACE_SORTED(t, i, s);
-            off[s[0] + 1]++;
-            L->star_off[L->tets[4 * t + (size_t)i] + 1]++;
+            size_t f = 4 * t + (size_t)i;
+            face_sorted(L, t, i, fs + 3 * f);
+            ord[f] = (uint32_t)f;
+            L->star_off[L->tets[f] + 1]++;
         }
-    for (size_t v = 0; v < nv; v++) {
-        off[v + 1] += off[v];
+    for (size_t v = 0; v < nv; v++)
         L->star_off[v + 1] += L->star_off[v];
-    }
-    memcpy(fill, off, (nv + 1) * sizeof *fill);
-    for (size_t t = 0; t < nt; t++)
-        for (int i = 0; i < 4; i++) {
-            uint32_t s[3];
-            FACE_SORTED(t, i, s);
-            slot[fill[s[0]]++] = 4 * (uint64_t)t + (uint64_t)i;
-        }
-    memcpy(fill, L->star_off, (nv + 1) * sizeof *fill);
+    memcpy(cnt, L->star_off, (nv + 1) * sizeof *cnt);
     for (size_t t = 0; t < nt; t++)
         for (int i = 0; i < 4; i++)
-            L->star[fill[L->tets[4 * t + (size_t)i]]++] = (uint32_t)t;
+            L->star[cnt[L->tets[4 * t + (size_t)i]]++] = (uint32_t)t;
+    if (st_progress_cancelled(stop)) {
+        st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+        goto done;
+    }
+    face_pass(fs, 2, ord, tmp, nf, cnt, nv);
+    face_pass(fs, 1, tmp, ord, nf, cnt, nv);
+    face_pass(fs, 0, ord, tmp, nf, cnt, nv);
     for (size_t f = 0; f < nf; f++)
         L->nbr[f] = -1;
-    /* Each bucket's faces by their two larger ids, (s1, s2) as one key,
-     * computed once: the pairs of a bucket compare keys. */
-    for (size_t a = 0; a < nf; a++) {
-        uint32_t sa[3];
-        FACE_SORTED((size_t)(slot[a] / 4), (int)(slot[a] % 4), sa);
-        key[a] = (uint64_t)sa[1] << 32 | sa[2];
-    }
-    st_status st = ST_OK;
-    for (size_t v = 0; v < nv && st == ST_OK; v++) {
-        if ((v & 4095) == 0 && st_progress_cancelled(stop)) {
-            st = st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+    for (size_t a = 0; a + 1 < nf; a++) {
+        const uint32_t *x = fs + 3 * (size_t)tmp[a], *y = fs + 3 * (size_t)tmp[a + 1];
+        if (x[0] != y[0] || x[1] != y[1] || x[2] != y[2])
+            continue;
+        if (a + 2 < nf && memcmp(fs + 3 * (size_t)tmp[a + 2], x, 3 * sizeof *x) == 0) {
+            st = st_error_set(err, ST_EINTERNAL, NULL, 0,
+                              "lattice face shared by more than two tets");
             break;
         }
-        for (size_t a = off[v]; a < off[v + 1]; a++) {
-            for (size_t b = a + 1; b < off[v + 1]; b++) {
-                if (key[a] != key[b])
-                    continue;
-                if (L->nbr[slot[a]] >= 0 || L->nbr[slot[b]] >= 0) {
-                    st = st_error_set(err, ST_EINTERNAL, NULL, 0,
-                                      "lattice face shared by more than "
-                                      "two tets");
-                    break;
-                }
-                L->nbr[slot[a]] = (int64_t)(slot[b] / 4);
-                L->nbr[slot[b]] = (int64_t)(slot[a] / 4);
-            }
-        }
+        L->nbr[tmp[a]] = (int64_t)(tmp[a + 1] / 4);
+        L->nbr[tmp[a + 1]] = (int64_t)(tmp[a] / 4);
+        a++;
     }
-#undef FACE_SORTED
-    free(off);
-    free(slot);
-    free(fill);
-    free(key);
+done:
+    free(cnt);
+    free(fs);
+    free(ord);
+    free(tmp);
     return st;
 }
 
@@ -746,6 +744,17 @@ static int row_span(const tet_filter *f, const st_grid *g, size_t j, size_t k,
     return *i0 <= *i1;
 }
 
+/* 1 when a brick holding voxels i0..i1 of row (j, k) has an inside voxel. */
+static int row_has_inside(const st_voxel_summary *s, size_t i0, size_t i1, size_t j, size_t k)
+{
+    const unsigned char *fl =
+        s->flags + s->nb[0] * (j / ST_VOXEL_BRICK + s->nb[1] * (k / ST_VOXEL_BRICK));
+    for (size_t bi = i0 / ST_VOXEL_BRICK; bi <= i1 / ST_VOXEL_BRICK; bi++)
+        if (fl[bi] & 1)
+            return 1;
+    return 0;
+}
+
 int st_tet_voxel_count(const st_grid *g, const st_voxel_summary *s,
                        const double p0[3], const double p1[3],
                        const double p2[3], const double p3[3],
@@ -758,8 +767,12 @@ int st_tet_voxel_count(const st_grid *g, const st_voxel_summary *s,
     size_t r0[3], r1[3], q0[3], q1[3];
     int clamped = 0, empty = 0;
     for (int a = 0; a < 3; a++) {
-        double lo = fmin(fmin(p0[a], p1[a]), fmin(p2[a], p3[a]));
-        double hi = fmax(fmax(p0[a], p1[a]), fmax(p2[a], p3[a]));
+        /* comparisons, not fmin / fmax (calls into libm here) */
+        double lo = p0[a] < p1[a] ? p0[a] : p1[a], hi = p0[a] > p1[a] ? p0[a] : p1[a];
+        lo = p2[a] < lo ? p2[a] : lo;
+        lo = p3[a] < lo ? p3[a] : lo;
+        hi = p2[a] > hi ? p2[a] : hi;
+        hi = p3[a] > hi ? p3[a] : hi;
         /* Scan range [floor, ceil] of the box in voxel units: holds every
          * centre in the box despite rounding in the division (the computed
          * quotient is within an ulp of the true one). The summary range has
@@ -804,6 +817,8 @@ int st_tet_voxel_count(const st_grid *g, const st_voxel_summary *s,
         for (size_t j = q0[1]; j <= q1[1]; j++) {
             const float *row = g->data + st_grid_index(g, 0, j, k);
             size_t i0 = q0[0], i1 = q1[0];
+            if (stop_at_inside && s && !row_has_inside(s, i0, i1, j, k))
+                continue;   /* no inside voxel in the row's bricks */
             if (f.ok && !row_span(&f, g, j, k, &i0, &i1))
                 continue;
             if (stop_at_inside) {

@@ -101,6 +101,22 @@ static st_status classify(unsigned char *keep, st_sculpt_stats *stats,
                           const st_soup *s, const st_bvh *bvh,
                           volatile int *cancel, st_error *err);
 
+/* 1 when the box of the tet p[0..3] meets the closed box [lo, hi]
+ * (comparisons only: exact). */
+static int tet_meets_box(const double *const p[4], const double lo[3], const double hi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        double l = p[0][a], h = p[0][a];
+        for (int c = 1; c < 4; c++) {
+            l = p[c][a] < l ? p[c][a] : l;
+            h = p[c][a] > h ? p[c][a] : h;
+        }
+        if (h < lo[a] || l > hi[a])
+            return 0;
+    }
+    return 1;
+}
+
 st_status st_sculpt_classify(unsigned char *keep, st_sculpt_stats *stats,
                              const st_lattice *L, const st_grid *g,
                              const st_soup *s, const st_bvh *bvh,
@@ -133,6 +149,16 @@ static st_status classify(unsigned char *keep, st_sculpt_stats *stats,
         st_bvh_free(own);
         return st;
     }
+    /* The soup's box (the BVH root's, exact): a tet whose box misses it
+     * meets no triangle, and needs no tet query (whose face planes cost
+     * more than the walk it then does). */
+    double root_lo[3] = {INFINITY, INFINITY, INFINITY};
+    double root_hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    if (bvh && bvh->nnodes)
+        for (int a = 0; a < 3; a++) {
+            root_lo[a] = bvh->nodes[0].lo[a];
+            root_hi[a] = bvh->nodes[0].hi[a];
+        }
     size_t nvol = 0, nsurf = 0;
     long long nt = (long long)L->ntets;
 #pragma omp parallel for schedule(dynamic, 256) reduction(+ : nvol, nsurf)
@@ -159,7 +185,7 @@ static st_status classify(unsigned char *keep, st_sculpt_stats *stats,
         if (vol) {
             k = ST_SCULPT_VOLUME;
             nvol++;
-        } else if (bvh) {
+        } else if (bvh && tet_meets_box(p, root_lo, root_hi)) {
             tri_ctx ctx;
             ctx.s = s;
             for (int c = 0; c < 4; c++)
