@@ -637,6 +637,21 @@ static void test_tri_box_maybe(void)
     TAP_CHECK(filter_apart * 10 >= exact_apart * 9,
               "tri-box filter, triangle part once: parts %d of the %d pairs the exact test parts",
               filter_apart, exact_apart);
+    /* a non-finite coordinate keeps the pair (NaN escapes max and min, so
+     * the filter must look), whichever vertex has it; an empty box does not */
+    int kept = 0;
+    for (int i = 0; i < 9; i++)
+        for (int w = 0; w < 2; w++) {
+            double v[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+            const double lo[3] = {5, 5, 5}, hi[3] = {6, 6, 6};
+            v[i / 3][i % 3] = w ? NAN : INFINITY;
+            kept += st_tri_box_maybe(v[0], v[1], v[2], lo, hi);
+            kept += filter_maybe(v[0], v[1], v[2], lo, hi);
+        }
+    const double nlo[3] = {1, 0, 0}, nhi[3] = {0, 1, 1}, tri[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    TAP_CHECK(kept == 36 && !st_tri_box_maybe(tri[0], tri[1], tri[2], nlo, nhi),
+              "tri-box filter: a NaN or infinite coordinate keeps a far box (%d of 36), "
+              "an empty box is parted", kept);
 }
 
 /* ---- speed --------------------------------------------------------------------- */

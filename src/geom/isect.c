@@ -505,8 +505,8 @@ static int tri_box_sat(const double *const V[3], const double lo[3],
  * the box's centre), conservative. M is the largest coordinate magnitude
  * of the triangle and the box, L the largest magnitude after moving the
  * box's centre to the origin (the triangle's offsets and the half
- * extents), plus 1e-15 M. Every factor below is such an offset or a
- * difference of two, at most 4L, and off by at most about 3 ulps of M
+ * extents), plus 1e-15 M. Computed about the centre, every factor is
+ * such an offset or a difference of two, at most 4L, and off by at most about 3 ulps of M
  * (two roundings from the input, one more for a difference). An edge
  * axis's projections and radius are sums of two or three products of two
  * factors: off by under 50 * 2^-53 * L (M + 2L) = 6e-15 L (M + 2L), the
@@ -518,7 +518,9 @@ static int tri_box_sat(const double *const V[3], const double lo[3],
  * the filter can keep a pair the exact test would part, and never parts
  * a pair that meets; far from the origin (M >> L) it still parts what is
  * a few millionths of L apart. Outside M in [1e-60, 1e60] (where the
- * bounds could leave the normal range) it keeps everything. */
+ * bounds could leave the normal range), or with a non-finite coordinate,
+ * it keeps everything. The filter below computes the same axes in
+ * absolute coordinates, the triangle's part once (its own bounds there). */
 #define TRI_BOX_SLACK 1e-11
 
 /* max and min as comparisons: fmax and fmin are calls into libm here
@@ -527,64 +529,7 @@ static int tri_box_sat(const double *const V[3], const double lo[3],
 #define MAXD(x, y) ((x) > (y) ? (x) : (y))
 #define MIND(x, y) ((x) < (y) ? (x) : (y))
 
-int st_tri_box_maybe(const double a[3], const double b[3], const double c[3],
-                     const double lo[3], const double hi[3])
-{
-    double M = 0.0, ctr[3], e[3], v[3][3];
-    const double *V[3] = {a, b, c};
-    for (int k = 0; k < 3; k++) {
-        if (!(lo[k] <= hi[k]))
-            return 0;   /* empty box (exact) */
-        M = MAXD(M, MAXD(fabs(lo[k]), fabs(hi[k])));
-        for (int i = 0; i < 3; i++)
-            M = MAXD(M, fabs(V[i][k]));
-        ctr[k] = 0.5 * (lo[k] + hi[k]);
-        e[k] = 0.5 * (hi[k] - lo[k]);
-    }
-    if (!(M >= 1e-60 && M <= 1e60))
-        return 1;   /* no bound here: keep it, the exact tests decide */
-    double L = 0.0;
-    for (int k = 0; k < 3; k++) {
-        L = MAXD(L, e[k]);
-        for (int i = 0; i < 3; i++) {
-            v[i][k] = V[i][k] - ctr[k];
-            L = MAXD(L, fabs(v[i][k]));
-        }
-    }
-    L += 1e-15 * M;
-    const double tol2 = TRI_BOX_SLACK * L * (M + L), tol3 = tol2 * L;
-    double f[3][3];
-    for (int k = 0; k < 3; k++) {
-        f[0][k] = v[1][k] - v[0][k];
-        f[1][k] = v[2][k] - v[1][k];
-        f[2][k] = v[0][k] - v[2][k];
-    }
-    /* the triangle's plane first: it parts most boxes near a large face */
-    double n[3] = {f[0][1] * f[1][2] - f[0][2] * f[1][1], f[0][2] * f[1][0] - f[0][0] * f[1][2],
-                   f[0][0] * f[1][1] - f[0][1] * f[1][0]};
-    double d = n[0] * v[0][0] + n[1] * v[0][1] + n[2] * v[0][2];
-    double r = e[0] * fabs(n[0]) + e[1] * fabs(n[1]) + e[2] * fabs(n[2]);
-    if (fabs(d) > r + tol3)
-        return 0;
-    /* the nine axes e_k x f_j */
-    for (int k = 0; k < 3; k++) {
-        const int u = (k + 1) % 3, w = (k + 2) % 3;
-        for (int j = 0; j < 3; j++) {
-            /* axis = unit_k x f_j: components (0 at k, -f_w at u, f_u at w) */
-            const double au = -f[j][w], aw = f[j][u];
-            double p0 = au * v[0][u] + aw * v[0][w];
-            double p1 = au * v[1][u] + aw * v[1][w];
-            double p2 = au * v[2][u] + aw * v[2][w];
-            double pmin = MIND(p0, MIND(p1, p2)), pmax = MAXD(p0, MAXD(p1, p2));
-            double re = e[u] * fabs(au) + e[w] * fabs(aw);
-            if (pmin > re + tol2 || pmax < -re - tol2)
-                return 0;
-        }
-    }
-    return 1;
-}
-
-/* The same test with the triangle's part computed once, in absolute
+/* The test, with the triangle's part computed once, in absolute
  * coordinates: an axis's projections of the vertices (au V_u + aw V_w)
  * once per triangle, the box centre's per box, their difference the
  * gap. Rounding: the axis (au, aw) and the normal are whatever was
@@ -613,7 +558,10 @@ void st_tri_box_filter_init(st_tri_box_filter *f, const double a[3], const doubl
         e[2][k] = a[k] - c[k];
     }
     f->m = m;
-    f->ok = isfinite(m) && m <= 1e60;
+    /* NaN is not seen by MAXD: every coordinate is checked */
+    f->ok = m <= 1e60;
+    for (int k = 0; k < 3; k++)
+        f->ok &= isfinite(a[k]) && isfinite(b[k]) && isfinite(c[k]);
     f->n[0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
     f->n[1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
     f->n[2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
@@ -674,6 +622,15 @@ int st_tri_box_filter_maybe(const st_tri_box_filter *f, const double lo[3],
         }
     }
     return 1;
+}
+
+/* One box: the filter's two halves in one call. */
+int st_tri_box_maybe(const double a[3], const double b[3], const double c[3],
+                     const double lo[3], const double hi[3])
+{
+    st_tri_box_filter f;
+    st_tri_box_filter_init(&f, a, b, c);
+    return st_tri_box_filter_maybe(&f, lo, hi);
 }
 
 #undef MAXD
