@@ -393,6 +393,10 @@ out:
 /* Merged fans replace the unmerged ones when they bend along the loop
  * less than MERGE_BETTER times as much (doc/design/holes.md, "MERGE"). */
 #define MERGE_BETTER 0.5
+/* Merged fans are built only where the unmerged ones show a chain: two
+ * apexes within CHAIN times the loop's extent of each other
+ * (doc/design/holes.md, "MERGE"). */
+#define CHAIN 1e-6
 
 /* One vertex of a loop being capped: its point, the third point of the
  * triangle beyond its outgoing edge (the soup's or a fan's), and the
@@ -854,6 +858,17 @@ static st_status fans_run(fanner *f, int merge, const fanner *lead, const double
     return ST_OK;
 }
 
+/* 1 when the fans in f (unmerged) show a chain (MERGE): two of their
+ * apexes within CHAIN times the loop's extent of each other. */
+static int fans_chain(const fanner *f)
+{
+    for (size_t a = 0; a < f->napex; a++)
+        for (size_t b = a + 1; b < f->napex; b++)
+            if (dist3(f->apx[a], f->apx[b]) <= CHAIN * f->ext)
+                return 1;
+    return 0;
+}
+
 st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts,
                                const double *const *side, size_t n, double below,
                                st_holes_fill fill, const st_holes_guard *guard, double *bent,
@@ -864,15 +879,17 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
     fanner fs[3];
     memset(fs, 0, sizeof fs);
     double rbs[3];
-    /* without the apexes merged, and merged each way (MERGE) where that
-     * placed more than one apex (the first is the same in all three):
-     * the merged ones that bend least along the loop where they bend
-     * less than MERGE_BETTER times the unmerged ones, else those */
-    st_status rc = ST_OK;
+    /* without the apexes merged, and, where those show a chain
+     * (fans_chain), merged each way (MERGE; the first apex is the same in
+     * all three): the merged ones that bend least along the loop where
+     * they bend less than MERGE_BETTER times the unmerged ones, else
+     * those */
     size_t v = 0;
-    for (int k = 0; k < 3 && !rc && (k == 0 || fs[0].napex > 1); k++) {
-        rc = fans_run(fs + k, k, k ? fs : NULL, pts, side, n, fill, guard, rbs + k, err);
-        if (!rc && (k == 0 || (rbs[k] < MERGE_BETTER * rbs[0] && rbs[k] < rbs[v])))
+    st_status rc = fans_run(fs, 0, NULL, pts, side, n, fill, guard, rbs, err);
+    const int chain = !rc && fans_chain(fs);
+    for (int k = 1; k < 3 && chain && !rc; k++) {
+        rc = fans_run(fs + k, k, fs, pts, side, n, fill, guard, rbs + k, err);
+        if (!rc && rbs[k] < MERGE_BETTER * rbs[0] && rbs[k] < rbs[v])
             v = (size_t)k;
     }
     const fanner *f = fs + v;
