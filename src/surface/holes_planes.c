@@ -431,15 +431,40 @@ static int fan_flat(const double *a, const double *b, const double *apex, const 
     return bend(t, r) < FAN_FLAT;
 }
 
-/* Which of the loop's edges apex continues (FAN_FLAT): flag[n]. Returns
- * their length. (All of them are fanned: doc/design/holes.md.) */
-static double fan_flags(const double *apex, const fan_v *v, const double *rim, size_t n,
-                        int *flag)
+/* A screen before fan_flat. The apex's height s above edge a -> b's
+ * plane (unit normal r) against its distance |f| from a bounds the angle
+ * t between r and the fan's normal u = e x f (e = b - a, f = apex - a):
+ * u x r = f (e . r) - e (f . r), so sin t >= |s| / |f| - |e . r| / |e|,
+ * less a few roundings of the cross product that fan_flat's u carries.
+ * Where |s| is above (FAN_FAR + |e . r| / |e|) |f|, t is at least about
+ * FAN_FAR (or beyond a right angle), a hundred times FAN_FLAT: fan_flat
+ * would say 0, and the screen says it for a third of the work. slack[i]
+ * is that factor for the loop's edge i (INFINITY, no screen, where e is
+ * zero). */
+#define FAN_FAR 1e-4
+static void fan_slack(double *slack, const fan_v *v, const double *rim, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        double e[3];
+        st_sub3(e, v[i + 1 < n ? i + 1 : 0].p, v[i].p);
+        const double le = st_norm3(e);
+        slack[i] = le > 0.0 ? FAN_FAR + fabs(st_dot3(e, rim + 3 * i)) / le : INFINITY;
+    }
+}
+
+/* Which of the loop's edges apex continues (FAN_FLAT): flag[n], slack[n]
+ * from fan_slack. Returns their length. (All of them are fanned:
+ * doc/design/holes.md.) */
+static double fan_flags(const double *apex, const fan_v *v, const double *rim,
+                        const double *slack, size_t n, int *flag)
 {
     double g = 0.0;
     for (size_t i = 0; i < n; i++) {
-        const double *a = v[i].p, *b = v[(i + 1) % n].p;
-        flag[i] = fan_flat(a, b, apex, rim + 3 * i);
+        const double *a = v[i].p, *b = v[i + 1 < n ? i + 1 : 0].p, *r = rim + 3 * i;
+        double f[3];
+        st_sub3(f, apex, a);
+        const double s = st_dot3(f, r), l = slack[i];
+        flag[i] = !(s * s > l * l * st_dot3(f, f)) && fan_flat(a, b, apex, r);
         if (flag[i])
             g += dist3(a, b);
     }
@@ -498,7 +523,7 @@ typedef struct fanner {
     int merge;          /* apexes merged (MERGE): 0 no, MERGE_SNAP, MERGE_FIXED */
     fan_v *stk, *cur, *nxt;
     size_t *lens;
-    double *rim;
+    double *rim, *slack;
     plane *pl;
     const double **lp, **ls;
     uint32_t *tri;
@@ -526,6 +551,7 @@ static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
     f->nxt = malloc(2 * maxv * sizeof *f->nxt);
     f->lens = malloc(maxv * sizeof *f->lens);
     f->rim = malloc(3 * maxv * sizeof *f->rim);
+    f->slack = malloc(maxv * sizeof *f->slack);
     f->pl = malloc(maxv * sizeof *f->pl);
     f->lp = malloc(maxv * sizeof *f->lp);
     f->ls = malloc(maxv * sizeof *f->ls);
@@ -535,7 +561,7 @@ static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
     f->best = malloc(maxv * sizeof *f->best);
     f->cs = malloc(MAX_CAND * sizeof *f->cs);
     f->flag0 = malloc(maxv * sizeof *f->flag0);
-    if (!f->flag0 || !f->flag || !f->best || !f->stk || !f->cur || !f->nxt || !f->lens || !f->rim || !f->pl || !f->lp ||
+    if (!f->flag0 || !f->flag || !f->best || !f->stk || !f->cur || !f->nxt || !f->lens || !f->rim || !f->slack || !f->pl || !f->lp ||
         !f->ls || !f->tri || !f->apx || !f->cs)
         return oom(err);
     return ST_OK;
@@ -543,7 +569,7 @@ static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
 
 static void fanner_free(fanner *f)
 {
-    free(f->stk), free(f->cur), free(f->nxt), free(f->lens), free(f->rim), free(f->pl);
+    free(f->stk), free(f->cur), free(f->nxt), free(f->lens), free(f->rim), free(f->slack), free(f->pl);
     free(f->lp), free(f->ls), free(f->tri), free(f->apx), free(f->fo.tri), free(f->fo.orig);
     free(f->flag), free(f->best), free(f->cs), free(f->flag0);
 }
@@ -574,6 +600,7 @@ static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
 {
     const size_t np = loop_planes(f->pl, f->rim, (const double *const *)f->lp,
                                   (const double *const *)f->ls, m, f->ext);
+    fan_slack(f->slack, f->cur, f->rim, m);
     size_t nc = 0;
     if (f->nstep < MAX_APEX)
         for (size_t a = 0; a < np; a++)
@@ -584,7 +611,7 @@ static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
                         continue;
                     if (c == b && f->merge == MERGE_SNAP)
                         on_line_apex(f, k->x, a, b);
-                    const double g = fan_flags(k->x, f->cur, f->rim, m, f->flag);
+                    const double g = fan_flags(k->x, f->cur, f->rim, f->slack, m, f->flag);
                     if (!(g > 0.0))
                         continue;
                     k->key = -g, k->tie = (double)nc, k->done = 0;
@@ -592,7 +619,7 @@ static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
                 }
     double best = 0.0;
     for (cand *k; (k = least_cand(f->cs, nc)) != NULL && -k->key > best; k->done = 1) {
-        fan_flags(k->x, f->cur, f->rim, m, f->flag);
+        fan_flags(k->x, f->cur, f->rim, f->slack, m, f->flag);
         const double g = fans_uncross(f->guard, k->x, f->cur, m, f->flag);
         if (g > best) {   /* its flags kept: not tested again */
             best = g;
