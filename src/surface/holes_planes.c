@@ -438,33 +438,42 @@ static int fan_flat(const double *a, const double *b, const double *apex, const 
  * less a few roundings of the cross product that fan_flat's u carries.
  * Where |s| is above (FAN_FAR + |e . r| / |e|) |f|, t is at least about
  * FAN_FAR (or beyond a right angle), a hundred times FAN_FLAT: fan_flat
- * would say 0, and the screen says it for a third of the work. slack[i]
- * is that factor for the loop's edge i (INFINITY, no screen, where e is
- * zero). */
+ * would say 0, and the screen says it for a third of the work. scr[8 i
+ * ..] holds for the loop's edge i its a, r and that factor squared
+ * (INFINITY, no screen, where e is zero). */
 #define FAN_FAR 1e-4
-static void fan_slack(double *slack, const fan_v *v, const double *rim, size_t n)
+static void fan_screen(double *scr, const fan_v *v, const double *rim, size_t n)
 {
     for (size_t i = 0; i < n; i++) {
-        double e[3];
+        double e[3], *q = scr + 8 * i;
         st_sub3(e, v[i + 1 < n ? i + 1 : 0].p, v[i].p);
-        const double le = st_norm3(e);
-        slack[i] = le > 0.0 ? FAN_FAR + fabs(st_dot3(e, rim + 3 * i)) / le : INFINITY;
+        const double le = st_norm3(e), l = FAN_FAR + fabs(st_dot3(e, rim + 3 * i)) / le;
+        memcpy(q, v[i].p, 3 * sizeof *q);
+        memcpy(q + 3, rim + 3 * i, 3 * sizeof *q);
+        q[6] = le > 0.0 ? l * l : INFINITY;
     }
 }
 
-/* Which of the loop's edges apex continues (FAN_FLAT): flag[n], slack[n]
- * from fan_slack. Returns their length. (All of them are fanned:
- * doc/design/holes.md.) */
+/* Which of the loop's edges apex continues (FAN_FLAT): flag[n], scr from
+ * fan_screen, near[n] room for the edges it passes. Returns their
+ * length. (All of them are fanned: doc/design/holes.md.) */
 static double fan_flags(const double *apex, const fan_v *v, const double *rim,
-                        const double *slack, size_t n, int *flag)
+                        const double *scr, size_t n, int *flag, size_t *near)
 {
-    double g = 0.0;
+    size_t k = 0;
     for (size_t i = 0; i < n; i++) {
-        const double *a = v[i].p, *b = v[i + 1 < n ? i + 1 : 0].p, *r = rim + 3 * i;
-        double f[3];
-        st_sub3(f, apex, a);
-        const double s = st_dot3(f, r), l = slack[i];
-        flag[i] = !(s * s > l * l * st_dot3(f, f)) && fan_flat(a, b, apex, r);
+        const double *q = scr + 8 * i;
+        const double f0 = apex[0] - q[0], f1 = apex[1] - q[1], f2 = apex[2] - q[2];
+        const double s = f0 * q[3] + f1 * q[4] + f2 * q[5];
+        flag[i] = 0;
+        near[k] = i;
+        k += !(s * s > q[6] * (f0 * f0 + f1 * f1 + f2 * f2));
+    }
+    double g = 0.0;
+    for (size_t j = 0; j < k; j++) {
+        const size_t i = near[j];
+        const double *a = v[i].p, *b = v[i + 1 < n ? i + 1 : 0].p;
+        flag[i] = fan_flat(a, b, apex, rim + 3 * i);
         if (flag[i])
             g += dist3(a, b);
     }
@@ -523,7 +532,8 @@ typedef struct fanner {
     int merge;          /* apexes merged (MERGE): 0 no, MERGE_SNAP, MERGE_FIXED */
     fan_v *stk, *cur, *nxt;
     size_t *lens;
-    double *rim, *slack;
+    double *rim, *scr;
+    size_t *near;       /* the edges fan_screen passes */
     plane *pl;
     const double **lp, **ls;
     uint32_t *tri;
@@ -551,7 +561,8 @@ static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
     f->nxt = malloc(2 * maxv * sizeof *f->nxt);
     f->lens = malloc(maxv * sizeof *f->lens);
     f->rim = malloc(3 * maxv * sizeof *f->rim);
-    f->slack = malloc(maxv * sizeof *f->slack);
+    f->scr = malloc(8 * maxv * sizeof *f->scr);
+    f->near = malloc(maxv * sizeof *f->near);
     f->pl = malloc(maxv * sizeof *f->pl);
     f->lp = malloc(maxv * sizeof *f->lp);
     f->ls = malloc(maxv * sizeof *f->ls);
@@ -561,15 +572,17 @@ static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
     f->best = malloc(maxv * sizeof *f->best);
     f->cs = malloc(MAX_CAND * sizeof *f->cs);
     f->flag0 = malloc(maxv * sizeof *f->flag0);
-    if (!f->flag0 || !f->flag || !f->best || !f->stk || !f->cur || !f->nxt || !f->lens || !f->rim || !f->slack || !f->pl || !f->lp ||
-        !f->ls || !f->tri || !f->apx || !f->cs)
+    if (!f->flag0 || !f->flag || !f->best || !f->stk || !f->cur || !f->nxt || !f->lens ||
+        !f->rim || !f->scr || !f->near || !f->pl || !f->lp || !f->ls || !f->tri || !f->apx ||
+        !f->cs)
         return oom(err);
     return ST_OK;
 }
 
 static void fanner_free(fanner *f)
 {
-    free(f->stk), free(f->cur), free(f->nxt), free(f->lens), free(f->rim), free(f->slack), free(f->pl);
+    free(f->stk), free(f->cur), free(f->nxt), free(f->lens), free(f->rim), free(f->pl);
+    free(f->scr), free(f->near);
     free(f->lp), free(f->ls), free(f->tri), free(f->apx), free(f->fo.tri), free(f->fo.orig);
     free(f->flag), free(f->best), free(f->cs), free(f->flag0);
 }
@@ -600,7 +613,7 @@ static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
 {
     const size_t np = loop_planes(f->pl, f->rim, (const double *const *)f->lp,
                                   (const double *const *)f->ls, m, f->ext);
-    fan_slack(f->slack, f->cur, f->rim, m);
+    fan_screen(f->scr, f->cur, f->rim, m);
     size_t nc = 0;
     if (f->nstep < MAX_APEX)
         for (size_t a = 0; a < np; a++)
@@ -611,7 +624,7 @@ static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
                         continue;
                     if (c == b && f->merge == MERGE_SNAP)
                         on_line_apex(f, k->x, a, b);
-                    const double g = fan_flags(k->x, f->cur, f->rim, f->slack, m, f->flag);
+                    const double g = fan_flags(k->x, f->cur, f->rim, f->scr, m, f->flag, f->near);
                     if (!(g > 0.0))
                         continue;
                     k->key = -g, k->tie = (double)nc, k->done = 0;
@@ -619,7 +632,7 @@ static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
                 }
     double best = 0.0;
     for (cand *k; (k = least_cand(f->cs, nc)) != NULL && -k->key > best; k->done = 1) {
-        fan_flags(k->x, f->cur, f->rim, f->slack, m, f->flag);
+        fan_flags(k->x, f->cur, f->rim, f->scr, m, f->flag, f->near);
         const double g = fans_uncross(f->guard, k->x, f->cur, m, f->flag);
         if (g > best) {   /* its flags kept: not tested again */
             best = g;
