@@ -412,7 +412,9 @@ typedef struct fan_v {
  * turns from r by more than FAN_SURE times FAN_FLAT (|u x r| against
  * u . r, rounding a few units in the last place of |u|, where the angles
  * compared are a millionth) are told without the normal's scaling and
- * the arc tangent: the answer is bend()'s. */
+ * the arc tangent: the answer is bend()'s. So are those that turn by
+ * less than FAN_FLAT / FAN_SURE (most of those fanned: the apex on the
+ * edge's plane), the other way. */
 #define FAN_SURE 4.0
 static int fan_flat(const double *a, const double *b, const double *apex, const double *r)
 {
@@ -424,8 +426,13 @@ static int fan_flat(const double *a, const double *b, const double *apex, const 
     const double d = st_dot3(u, r), lim = FAN_SURE * FAN_FLAT * d, uu = st_dot3(u, u);
     /* |u| between 1e-100 and 1e100: no product below underflows where it
      * would matter; r is a unit vector or zero (then d is 0: bend() says 4) */
-    if (uu > 1e-200 && uu < 1e200 && (!(d > 0.0) || st_dot3(x, x) > lim * lim))
-        return 0;   /* at least a right angle, or beyond FAN_SURE times FAN_FLAT */
+    if (uu > 1e-200 && uu < 1e200) {
+        const double xx = st_dot3(x, x), in = FAN_FLAT / FAN_SURE * d;
+        if (!(d > 0.0) || xx > lim * lim)
+            return 0;   /* at least a right angle, or beyond FAN_SURE times FAN_FLAT */
+        if (xx < in * in)
+            return 1;   /* within FAN_FLAT / FAN_SURE */
+    }
     double t[3];
     unit_normal(t, a, b, apex);
     return bend(t, r) < FAN_FLAT;
