@@ -38,10 +38,13 @@
  * them by the point; the loop left (split into several where it meets
  * the point more than once) is capped the same way, and one that no
  * point continues along two edges by the caller's triangulation of its
- * own points. The caller keeps the fans or the single cone, whichever
- * continues the soup along the loop better. That last triangulation is
- * not tested for piercing, and the piercing test's cost and the variants
- * not kept are measured in doc/design/holes.md.
+ * own points. That is done three ways: with the apexes as placed, and
+ * with those a chain would place along one line merged into one, two
+ * ways (MERGE); the fans that bend least along the loop are kept. The
+ * caller keeps the fans or the single cone, whichever continues the soup
+ * along the loop better. The fans' triangulations of a loop's own points
+ * are not tested for piercing; that, the piercing test's cost and the
+ * variants not kept are measured in doc/design/holes.md.
  */
 #include "holes_internal.h"
 #include "../base/fpenv.h"
@@ -371,8 +374,29 @@ out:
  * in the plane of the soup's triangle there, on the hole's side: its bend
  * below FAN_FLAT radians. */
 #define FAN_FLAT 1e-6
-/* At most MAX_APEX apexes per loop. */
+/* At most MAX_APEX fans per loop, from as many apexes or fewer (an apex
+ * met again, MERGE, fans once more). */
 #define MAX_APEX 16
+/* Merging apexes (doc/design/holes.md, "MERGE"). The point of the line
+ * where two planes meet is taken nearest the loop's centroid; the loop
+ * left by a fan takes its apex in, its centroid moves, and the next apex
+ * on the same line lands a fraction of the way on: unmerged, a small
+ * loop spends its MAX_APEX apexes on a chain converging along the line,
+ * the last ones a rounding apart. Merged, an apex within MERGE times the
+ * loop's extent of one placed before is that one (the loop left meets it
+ * again and splits there), and the line's point is either one placed
+ * before that lies on both planes (MERGE_SNAP) or the one nearest the
+ * original loop's centroid (MERGE_FIXED). */
+#define MERGE 1e-6
+#define MERGE_SNAP 1
+#define MERGE_FIXED 2
+/* Merged fans replace the unmerged ones when they bend along the loop
+ * less than MERGE_BETTER times as much (doc/design/holes.md, "MERGE"). */
+#define MERGE_BETTER 0.5
+/* Merged fans are built only where the unmerged ones show a chain: two
+ * apexes within CHAIN times the loop's extent of each other
+ * (doc/design/holes.md, "MERGE"). */
+#define CHAIN 1e-6
 
 /* One vertex of a loop being capped: its point, the third point of the
  * triangle beyond its outgoing edge (the soup's or a fan's), and the
@@ -388,7 +412,9 @@ typedef struct fan_v {
  * turns from r by more than FAN_SURE times FAN_FLAT (|u x r| against
  * u . r, rounding a few units in the last place of |u|, where the angles
  * compared are a millionth) are told without the normal's scaling and
- * the arc tangent: the answer is bend()'s. */
+ * the arc tangent: the answer is bend()'s. So are those that turn by
+ * less than FAN_FLAT / FAN_SURE (most of those fanned: the apex on the
+ * edge's plane), the other way. */
 #define FAN_SURE 4.0
 static int fan_flat(const double *a, const double *b, const double *apex, const double *r)
 {
@@ -400,21 +426,60 @@ static int fan_flat(const double *a, const double *b, const double *apex, const 
     const double d = st_dot3(u, r), lim = FAN_SURE * FAN_FLAT * d, uu = st_dot3(u, u);
     /* |u| between 1e-100 and 1e100: no product below underflows where it
      * would matter; r is a unit vector or zero (then d is 0: bend() says 4) */
-    if (uu > 1e-200 && uu < 1e200 && (!(d > 0.0) || st_dot3(x, x) > lim * lim))
-        return 0;   /* at least a right angle, or beyond FAN_SURE times FAN_FLAT */
+    if (uu > 1e-200 && uu < 1e200) {
+        const double xx = st_dot3(x, x), in = FAN_FLAT / FAN_SURE * d;
+        if (!(d > 0.0) || xx > lim * lim)
+            return 0;   /* at least a right angle, or beyond FAN_SURE times FAN_FLAT */
+        if (xx < in * in)
+            return 1;   /* within FAN_FLAT / FAN_SURE */
+    }
     double t[3];
     unit_normal(t, a, b, apex);
     return bend(t, r) < FAN_FLAT;
 }
 
-/* Which of the loop's edges apex continues (FAN_FLAT): flag[n]. Returns
- * their length. (All of them are fanned: doc/design/holes.md.) */
-static double fan_flags(const double *apex, const fan_v *v, const double *rim, size_t n,
-                        int *flag)
+/* A screen before fan_flat. The apex's height s above edge a -> b's
+ * plane (unit normal r) against its distance |f| from a bounds the angle
+ * t between r and the fan's normal u = e x f (e = b - a, f = apex - a):
+ * u x r = f (e . r) - e (f . r), so sin t >= |s| / |f| - |e . r| / |e|,
+ * less a few roundings of the cross product that fan_flat's u carries.
+ * Where |s| is above (FAN_FAR + |e . r| / |e|) |f|, t is at least about
+ * FAN_FAR (or beyond a right angle), a hundred times FAN_FLAT: fan_flat
+ * would say 0, and the screen says it for a third of the work. scr[8 i
+ * ..] holds for the loop's edge i its a, r and that factor squared
+ * (INFINITY, no screen, where e is zero). */
+#define FAN_FAR 1e-4
+static void fan_screen(double *scr, const fan_v *v, const double *rim, size_t n)
 {
-    double g = 0.0;
     for (size_t i = 0; i < n; i++) {
-        const double *a = v[i].p, *b = v[(i + 1) % n].p;
+        double e[3], *q = scr + 8 * i;
+        st_sub3(e, v[i + 1 < n ? i + 1 : 0].p, v[i].p);
+        const double le = st_norm3(e), l = FAN_FAR + fabs(st_dot3(e, rim + 3 * i)) / le;
+        memcpy(q, v[i].p, 3 * sizeof *q);
+        memcpy(q + 3, rim + 3 * i, 3 * sizeof *q);
+        q[6] = le > 0.0 ? l * l : INFINITY;
+    }
+}
+
+/* Which of the loop's edges apex continues (FAN_FLAT): flag[n], scr from
+ * fan_screen, near[n] room for the edges it passes. Returns their
+ * length. (All of them are fanned: doc/design/holes.md.) */
+static double fan_flags(const double *apex, const fan_v *v, const double *rim,
+                        const double *scr, size_t n, int *flag, size_t *near)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++) {
+        const double *q = scr + 8 * i;
+        const double f0 = apex[0] - q[0], f1 = apex[1] - q[1], f2 = apex[2] - q[2];
+        const double s = f0 * q[3] + f1 * q[4] + f2 * q[5];
+        flag[i] = 0;
+        near[k] = i;
+        k += !(s * s > q[6] * (f0 * f0 + f1 * f1 + f2 * f2));
+    }
+    double g = 0.0;
+    for (size_t j = 0; j < k; j++) {
+        const size_t i = near[j];
+        const double *a = v[i].p, *b = v[i + 1 < n ? i + 1 : 0].p;
         flag[i] = fan_flat(a, b, apex, rim + 3 * i);
         if (flag[i])
             g += dist3(a, b);
@@ -470,10 +535,12 @@ static st_status fan_push(fan_out *o, const double *a, const double *b, const do
  * (cur, m vertices; lp, ls its points and sides), its planes and apexes,
  * and the triangles so far (fo). */
 typedef struct fanner {
-    size_t maxv, nloops, napex, top;
+    size_t maxv, nloops, napex, nstep, top;
+    int merge;          /* apexes merged (MERGE): 0 no, MERGE_SNAP, MERGE_FIXED */
     fan_v *stk, *cur, *nxt;
     size_t *lens;
-    double *rim;
+    double *rim, *scr;
+    size_t *near;       /* the edges fan_screen passes */
     plane *pl;
     const double **lp, **ls;
     uint32_t *tri;
@@ -482,7 +549,15 @@ typedef struct fanner {
     cand *cs;
     fan_out fo;
     double lo[3], hi[3], ext;   /* the original loop's reach box, extent */
+    double o0[3];               /* and its centroid */
     const st_holes_guard *guard;
+    /* the original loop's first apex and the edges it continues (its
+     * best_apex, the same however the apexes are merged: none placed
+     * yet, o the centroid), from lead when set */
+    const struct fanner *lead;
+    double ax0[3];
+    int *flag0;
+    size_t ncont0;
 } fanner;
 
 static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
@@ -493,6 +568,8 @@ static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
     f->nxt = malloc(2 * maxv * sizeof *f->nxt);
     f->lens = malloc(maxv * sizeof *f->lens);
     f->rim = malloc(3 * maxv * sizeof *f->rim);
+    f->scr = malloc(8 * maxv * sizeof *f->scr);
+    f->near = malloc(maxv * sizeof *f->near);
     f->pl = malloc(maxv * sizeof *f->pl);
     f->lp = malloc(maxv * sizeof *f->lp);
     f->ls = malloc(maxv * sizeof *f->ls);
@@ -501,8 +578,10 @@ static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
     f->flag = malloc(maxv * sizeof *f->flag);
     f->best = malloc(maxv * sizeof *f->best);
     f->cs = malloc(MAX_CAND * sizeof *f->cs);
-    if (!f->flag || !f->best || !f->stk || !f->cur || !f->nxt || !f->lens || !f->rim || !f->pl || !f->lp ||
-        !f->ls || !f->tri || !f->apx || !f->cs)
+    f->flag0 = malloc(maxv * sizeof *f->flag0);
+    if (!f->flag0 || !f->flag || !f->best || !f->stk || !f->cur || !f->nxt || !f->lens ||
+        !f->rim || !f->scr || !f->near || !f->pl || !f->lp || !f->ls || !f->tri || !f->apx ||
+        !f->cs)
         return oom(err);
     return ST_OK;
 }
@@ -510,8 +589,27 @@ static st_status fanner_alloc(fanner *f, size_t n, st_error *err)
 static void fanner_free(fanner *f)
 {
     free(f->stk), free(f->cur), free(f->nxt), free(f->lens), free(f->rim), free(f->pl);
+    free(f->scr), free(f->near);
     free(f->lp), free(f->ls), free(f->tri), free(f->apx), free(f->fo.tri), free(f->fo.orig);
-    free(f->flag), free(f->best), free(f->cs);
+    free(f->flag), free(f->best), free(f->cs), free(f->flag0);
+}
+
+/* The point of the line where planes a and b meet: an apex placed
+ * before when one lies on both (within MERGE times the extent; the first
+ * such), in x; else x as it was (the point nearest the centroid, which
+ * moves as the loop takes the apexes in and would place a chain of
+ * points converging along the line, doc/design/holes.md "MERGE"). */
+static void on_line_apex(const fanner *f, double *x, size_t a, size_t b)
+{
+    const plane *pa = f->pl + a, *pb = f->pl + b;
+    for (size_t i = 0; i < f->napex; i++) {
+        const double *A = f->apx[i];
+        if (fabs(st_dot3(pa->n, A) - pa->d) <= MERGE * f->ext &&
+            fabs(st_dot3(pb->n, A) - pb->d) <= MERGE * f->ext) {
+            memcpy(x, A, 3 * sizeof *x);
+            return;
+        }
+    }
 }
 
 /* The apex for the loop in f->cur (m vertices, centroid o): by the length
@@ -522,15 +620,18 @@ static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
 {
     const size_t np = loop_planes(f->pl, f->rim, (const double *const *)f->lp,
                                   (const double *const *)f->ls, m, f->ext);
+    fan_screen(f->scr, f->cur, f->rim, m);
     size_t nc = 0;
-    if (f->napex < MAX_APEX)
+    if (f->nstep < MAX_APEX)
         for (size_t a = 0; a < np; a++)
             for (size_t b = a + 1; b < np; b++)
                 for (size_t c = b; c < np; c++) {
                     cand *k = f->cs + nc;
                     if (!candidate(k->x, f->pl, a, b, c, o, f->lo, f->hi))
                         continue;
-                    const double g = fan_flags(k->x, f->cur, f->rim, m, f->flag);
+                    if (c == b && f->merge == MERGE_SNAP)
+                        on_line_apex(f, k->x, a, b);
+                    const double g = fan_flags(k->x, f->cur, f->rim, f->scr, m, f->flag, f->near);
                     if (!(g > 0.0))
                         continue;
                     k->key = -g, k->tie = (double)nc, k->done = 0;
@@ -538,7 +639,7 @@ static size_t best_apex(fanner *f, size_t m, const double *o, double *ax)
                 }
     double best = 0.0;
     for (cand *k; (k = least_cand(f->cs, nc)) != NULL && -k->key > best; k->done = 1) {
-        fan_flags(k->x, f->cur, f->rim, m, f->flag);
+        fan_flags(k->x, f->cur, f->rim, f->scr, m, f->flag, f->near);
         const double g = fans_uncross(f->guard, k->x, f->cur, m, f->flag);
         if (g > best) {   /* its flags kept: not tested again */
             best = g;
@@ -664,6 +765,57 @@ static double fans_bend(const fan_out *fo, const double *const *pts, const doubl
     return rb;
 }
 
+/* The apex ax for the loop in f->cur (m vertices, its edges in f->flag):
+ * one placed before when within MERGE times the extent of it (the
+ * first such; the edges at it, which it would fan flat, no longer
+ * flagged), else a new one. NULL when it no longer continues two edges,
+ * or no apex is left. */
+static const double *place_apex(fanner *f, size_t m, const double *ax)
+{
+    const double *A = NULL;
+    for (size_t a = 0; f->merge && a < f->napex && !A; a++)
+        if (dist3(f->apx[a], ax) <= MERGE * f->ext)
+            A = f->apx[a];
+    if (A) {
+        size_t left = 0;
+        for (size_t i = 0; i < m; i++) {
+            if (f->cur[i].p == A || f->cur[(i + 1) % m].p == A)
+                f->flag[i] = 0;
+            left += (size_t)f->flag[i];
+        }
+        if (left < 2)
+            return NULL;
+    } else {
+        if (f->napex == MAX_APEX)
+            return NULL;
+        memcpy(f->apx[f->napex], ax, sizeof f->apx[f->napex]);
+        A = f->apx[f->napex++];
+    }
+    f->nstep++;
+    return A;
+}
+
+/* best_apex for the loop in f->cur (m vertices, centroid o; the
+ * original loop's with MERGE_FIXED); the original loop's (the first
+ * popped: no step taken) kept in f, or taken from f->lead. */
+static size_t step_apex(fanner *f, size_t m, const double *o, double *ax)
+{
+    const int first = f->nstep == 0 && f->napex == 0;
+    const fanner *l = f->lead;
+    if (first && l) {
+        memcpy(ax, l->ax0, sizeof l->ax0);
+        memcpy(f->flag, l->flag0, m * sizeof *f->flag);
+        return l->ncont0;
+    }
+    const size_t c = best_apex(f, m, f->merge == MERGE_FIXED ? f->o0 : o, ax);
+    if (first) {
+        memcpy(f->ax0, ax, sizeof f->ax0);
+        memcpy(f->flag0, f->flag, m * sizeof *f->flag0);
+        f->ncont0 = c;
+    }
+    return c;
+}
+
 /* Caps the loops on f's stack, from the original loop pts[0..n) down:
  * each by the fans from its best apex, the loop left pushed back, or by
  * fill when no apex continues two of its edges. *whole 0 when the stack
@@ -687,12 +839,15 @@ static st_status fan_loops(fanner *f, int *whole, st_holes_fill fill, st_error *
             f->lp[i] = f->cur[i].p;
             f->ls[i] = f->cur[i].side;
         }
-        if (best_apex(f, m, o, ax) < 2) {
+        if (step_apex(f, m, o, ax) < 2) {
             rc = fill_loop(f, m, fill, err);
             continue;
         }
-        memcpy(f->apx[f->napex], ax, sizeof ax);
-        const double *A = f->apx[f->napex++];
+        const double *A = place_apex(f, m, ax);
+        if (!A) {
+            rc = fill_loop(f, m, fill, err);
+            continue;
+        }
         size_t k, s0;
         rc = fan_apex(f, m, A, &k, &s0, err);
         if (!rc && s0 < m && !push_split(f, k, A)) {
@@ -703,6 +858,64 @@ static st_status fan_loops(fanner *f, int *whole, st_holes_fill fill, st_error *
     return rc;
 }
 
+/* 1 when two of the fans' triangles pierce each other
+ * (st_tri_tri_cross). */
+static int fans_cross(const fan_out *fo)
+{
+    for (size_t t = 0; t < fo->nt; t++)
+        for (size_t u = t + 1; u < fo->nt; u++) {
+            const double *const *a = fo->tri + 3 * t, *const *b = fo->tri + 3 * u;
+            if (st_tri_tri_cross(a[0], a[1], a[2], b[0], b[1], b[2]))
+                return 1;
+        }
+    return 0;
+}
+
+/* The fans of the loop pts[0..n) in f (merge: f->merge; its first apex
+ * from lead when set), their bend
+ * along it in *rb (INFINITY when there are none: no apex, or the stack
+ * overflowed; or, merged, when two of them pierce each other). */
+static st_status fans_run(fanner *f, int merge, const fanner *lead, const double *const *pts,
+                          const double *const *side, size_t n, st_holes_fill fill,
+                          const st_holes_guard *guard, double *rb, st_error *err)
+{
+    *rb = INFINITY;
+    f->guard = guard;
+    f->merge = merge;
+    f->lead = lead;
+    int whole = 0;
+    st_status rc = fanner_alloc(f, n, err);
+    if (rc)
+        return rc;
+    reach_box(f->lo, f->hi, f->o0, &f->ext, pts, n);
+    for (size_t i = 0; i < n; i++) {
+        f->stk[i].p = pts[i];
+        f->stk[i].side = side[i];
+        f->stk[i].orig = (long)i;
+    }
+    f->lens[0] = n;
+    f->top = n;
+    f->nloops = 1;
+    if ((rc = fan_loops(f, &whole, fill, err)) || !whole || f->napex == 0)
+        return rc;
+    /* merged, two lines' apexes can be one point far from where either
+     * chain went: such fans may cross themselves */
+    if (!merge || !fans_cross(&f->fo))
+        *rb = fans_bend(&f->fo, pts, side, n);
+    return ST_OK;
+}
+
+/* 1 when the fans in f (unmerged) show a chain (MERGE): two of their
+ * apexes within CHAIN times the loop's extent of each other. */
+static int fans_chain(const fanner *f)
+{
+    for (size_t a = 0; a < f->napex; a++)
+        for (size_t b = a + 1; b < f->napex; b++)
+            if (dist3(f->apx[a], f->apx[b]) <= CHAIN * f->ext)
+                return 1;
+    return 0;
+}
+
 st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts,
                                const double *const *side, size_t n, double below,
                                st_holes_fill fill, const st_holes_guard *guard, double *bent,
@@ -710,32 +923,30 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
 {
     *done = 0;
     *bent = INFINITY;
-    fanner f;
-    memset(&f, 0, sizeof f);
-    f.guard = guard;
-    int whole = 0;
-    st_status rc = fanner_alloc(&f, n, err);
-    if (rc)
-        goto done;
-    double o0[3];
-    reach_box(f.lo, f.hi, o0, &f.ext, pts, n);
-    for (size_t i = 0; i < n; i++) {
-        f.stk[i].p = pts[i];
-        f.stk[i].side = side[i];
-        f.stk[i].orig = (long)i;
+    fanner fs[3];
+    memset(fs, 0, sizeof fs);
+    double rbs[3];
+    /* without the apexes merged, and, where those show a chain
+     * (fans_chain), merged each way (MERGE; the first apex is the same in
+     * all three): the merged ones that bend least along the loop where
+     * they bend less than MERGE_BETTER times the unmerged ones, else
+     * those */
+    size_t v = 0;
+    st_status rc = fans_run(fs, 0, NULL, pts, side, n, fill, guard, rbs, err);
+    const int chain = !rc && fans_chain(fs);
+    for (int k = 1; k < 3 && chain && !rc; k++) {
+        rc = fans_run(fs + k, k, fs, pts, side, n, fill, guard, rbs + k, err);
+        if (!rc && rbs[k] < MERGE_BETTER * rbs[0] && rbs[k] < rbs[v])
+            v = (size_t)k;
     }
-    f.lens[0] = n;
-    f.top = n;
-    f.nloops = 1;
-    if ((rc = fan_loops(&f, &whole, fill, err)) || !whole)
+    const fanner *f = fs + v;
+    const double rb = rbs[v];
+    if (rc || !(rb < below))
         goto done;
-    const double rb = fans_bend(&f.fo, pts, side, n);
-    if (f.napex == 0 || !(rb < below))
-        goto done;
-    for (size_t t = 0; t < f.fo.nt; t++) {
+    for (size_t t = 0; t < f->fo.nt; t++) {
         const size_t base = out->nverts;
         for (int c = 0; c < 3; c++) {
-            const double *q = f.fo.tri[3 * t + c];
+            const double *q = f->fo.tri[3 * t + c];
             if ((rc = st_soup_add_vertex(out, q[0], q[1], q[2], err)))
                 goto done;
         }
@@ -746,6 +957,7 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
     *done = 1;
     *bent = rb;
 done:
-    fanner_free(&f);
+    for (int k = 0; k < 3; k++)
+        fanner_free(fs + k);
     return rc;
 }
