@@ -693,13 +693,14 @@ static size_t search_greedy(search *S)
  * bombs from i on with an option that may add u; lbl the lcm of the k
  * (exact), or 2^30 with weights rounded down when it is larger (still a
  * lower bound). first[u] and last[u] get the first and last bomb that may
- * add u. */
+ * add u. Past 2^22 weights (16 MB; a cluster_max far above the default's
+ * 64 bombs), no bound and no memo: the plain search. */
 static int bound_prep(search *S, uint32_t *first, uint32_t *last)
 {
     const size_t n = S->n, nl = S->nloc;
     uint32_t *k = st_calloc_array(nl + 1, sizeof *k);
     uint32_t *stamp = st_calloc_array(nl + 1, sizeof *stamp);
-    S->lbw = n * nl <= ((size_t)1 << 24) ? st_malloc_array(n * nl + 1, sizeof *S->lbw) : NULL;
+    S->lbw = n * nl <= ((size_t)1 << 22) ? st_malloc_array(n * nl + 1, sizeof *S->lbw) : NULL;
     if (!k || !stamp || !S->lbw) {
         free(k); free(stamp); free(S->lbw);
         S->lbw = NULL;
