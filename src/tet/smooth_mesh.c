@@ -9,6 +9,7 @@
  * gives the same result as moving them one by one, in any thread order.
  */
 #include "smooth_mesh.h"
+#include "tetqual_pairs.h"
 #include "../base/fpenv.h"
 
 #include "souptet/geom.h"
@@ -21,9 +22,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#ifdef __SSE2__
-#include <emmintrin.h>
-#endif
 
 static int cmp_u32(const void *a, const void *b)
 {
@@ -248,125 +246,6 @@ int sm_star_positive(const sm_mesh *sm, uint32_t v, const double p[3])
 /* Degrees per radian, as tetqual.c has it, so the angles agree. */
 #define SM_RAD2DEG (180.0 / 3.14159265358979323846)
 
-/* fmax for the non-negative operands of sm_norm3 (fabs values, maybe NaN
- * or infinite): returns what fmax returns, without the libm call. */
-static inline double sm_fmax(double a, double b)
-{
-    return (a > b || b != b) ? a : b;
-}
-
-/* st_norm3 (geom.c) inline, operation for operation, so the value is the
- * same bit for bit. */
-static inline double sm_norm3(const double v[3])
-{
-    double m = sm_fmax(fabs(v[0]), sm_fmax(fabs(v[1]), fabs(v[2])));
-    if (!(m > 0.0) || !isfinite(m))
-        return m;
-    double x = v[0] / m, y = v[1] / m, z = v[2] / m;
-    return m * sqrt(x * x + y * y + z * z);
-}
-
-/* The pair (|u x v|, s u . v) of one edge; 0 for a degenerate case. */
-static inline int edge_pair(const double u[3], const double v[3], double s, double *y,
-                            double *x)
-{
-    double w[3];
-    st_cross3(w, u, v);
-    *y = sm_norm3(w);
-    *x = s * st_dot3(u, v);
-    return *y > 0.0 && isfinite(*y) && isfinite(*x);
-}
-
-#ifdef __SSE2__
-/* Two 3-vectors side by side, one per lane (lane 0 the first). */
-typedef struct {
-    __m128d x, y, z;
-} sm_v2;
-
-static inline sm_v2 v2_cross(sm_v2 u, sm_v2 v)
-{
-    /* st_cross3 per lane: the same products and differences, unfused */
-    sm_v2 w;
-    w.x = _mm_sub_pd(_mm_mul_pd(u.y, v.z), _mm_mul_pd(u.z, v.y));
-    w.y = _mm_sub_pd(_mm_mul_pd(u.z, v.x), _mm_mul_pd(u.x, v.z));
-    w.z = _mm_sub_pd(_mm_mul_pd(u.x, v.y), _mm_mul_pd(u.y, v.x));
-    return w;
-}
-
-/* edge_pair for two edges at once, (|u x v|, s u . v) per lane into y and
- * x; the returned mask has both bits set where both lanes pass edge_pair's
- * test. The norm is sm_norm3's, operation for operation, with max for
- * sm_fmax: they differ only where a component of w is NaN, and then
- * either m is NaN (no lane test passes) or a quotient by m is NaN and so
- * is the norm (fails y > 0), as edge_pair fails there. Where m is 0 or
- * infinite, sm_norm3 returns m and edge_pair fails; here 0 / 0 or
- * inf / inf makes the norm NaN and the test fails too. */
-static inline int v2_edge_pairs(sm_v2 u, sm_v2 v, __m128d s, double *y, double *x)
-{
-    const __m128d sign = _mm_set1_pd(-0.0), inf = _mm_set1_pd(INFINITY);
-    sm_v2 w = v2_cross(u, v);
-    __m128d m = _mm_max_pd(_mm_andnot_pd(sign, w.x),
-                           _mm_max_pd(_mm_andnot_pd(sign, w.y), _mm_andnot_pd(sign, w.z)));
-    __m128d qx = _mm_div_pd(w.x, m), qy = _mm_div_pd(w.y, m), qz = _mm_div_pd(w.z, m);
-    __m128d q = _mm_add_pd(_mm_add_pd(_mm_mul_pd(qx, qx), _mm_mul_pd(qy, qy)),
-                           _mm_mul_pd(qz, qz));
-    __m128d ny = _mm_mul_pd(m, _mm_sqrt_pd(q));
-    __m128d dot = _mm_add_pd(_mm_add_pd(_mm_mul_pd(u.x, v.x), _mm_mul_pd(u.y, v.y)),
-                             _mm_mul_pd(u.z, v.z));
-    __m128d nx = _mm_mul_pd(s, dot);
-    _mm_storeu_pd(y, ny);
-    _mm_storeu_pd(x, nx);
-    /* y > 0, y finite, x finite (NaN fails every comparison) */
-    __m128d ok = _mm_and_pd(_mm_and_pd(_mm_cmpgt_pd(ny, _mm_setzero_pd()), _mm_cmplt_pd(ny, inf)),
-                            _mm_cmplt_pd(_mm_andnot_pd(sign, nx), inf));
-    return _mm_movemask_pd(ok);
-}
-
-/* The cross products l x r of component vectors (lane 0, lane 1) of the
- * corner differences: l = (pl0 - ql0, pl1 - ql1), r likewise. */
-#define V2_DIFF(p0, p1, q0, q1, k) \
-    _mm_sub_pd(_mm_set_pd((p1)[k], (p0)[k]), _mm_set_pd((q1)[k], (q0)[k]))
-#define V2_CROSS_OF(lp0, lp1, lq0, lq1, rp0, rp1, rq0, rq1)                                \
-    v2_cross((sm_v2){V2_DIFF(lp0, lp1, lq0, lq1, 0), V2_DIFF(lp0, lp1, lq0, lq1, 1),         \
-                     V2_DIFF(lp0, lp1, lq0, lq1, 2)},                                         \
-             (sm_v2){V2_DIFF(rp0, rp1, rq0, rq1, 0), V2_DIFF(rp0, rp1, rq0, rq1, 1),         \
-                     V2_DIFF(rp0, rp1, rq0, rq1, 2)})
-
-/* tet_extremes' six (y, x) pairs, two edges per SSE2 operation: every lane
- * does tet_extremes' operations on tet_extremes' operands in its order
- * (no fused multiply-add: -ffp-contract=off), so the pairs are the same
- * bit for bit. Returns 0 where tet_extremes does. */
-static inline int tet_pairs_sse2(const double *a, const double *b, const double *c,
-                                 const double *d, double y[6], double x[6])
-{
-    /* (A, B) = d1 x (d2, d3), (C, D) = (d2, c2) x (d3, c0),
-     * (E, F) = (c2, c3) x (c3, c0), (G, H) = b3 x (b0, b1) */
-    const sm_v2 P1 = V2_CROSS_OF(b, b, a, a, c, d, a, a);
-    const sm_v2 P2 = V2_CROSS_OF(c, c, a, b, d, a, a, b);
-    const sm_v2 P3 = V2_CROSS_OF(c, d, b, b, d, a, b, b);
-    const sm_v2 P4 = V2_CROSS_OF(d, d, c, c, a, b, c, c);
-    /* edges 0, 1: u (A, A), v (B, C); 2, 3: (B, D), (C, E); 4, 5: (F, G), (E, H) */
-    sm_v2 U1 = {_mm_unpacklo_pd(P1.x, P1.x), _mm_unpacklo_pd(P1.y, P1.y),
-                _mm_unpacklo_pd(P1.z, P1.z)};
-    sm_v2 V1 = {_mm_shuffle_pd(P1.x, P2.x, 1), _mm_shuffle_pd(P1.y, P2.y, 1),
-                _mm_shuffle_pd(P1.z, P2.z, 1)};
-    sm_v2 U2 = {_mm_unpackhi_pd(P1.x, P2.x), _mm_unpackhi_pd(P1.y, P2.y),
-                _mm_unpackhi_pd(P1.z, P2.z)};
-    sm_v2 V2 = {_mm_unpacklo_pd(P2.x, P3.x), _mm_unpacklo_pd(P2.y, P3.y),
-                _mm_unpacklo_pd(P2.z, P3.z)};
-    sm_v2 U3 = {_mm_shuffle_pd(P3.x, P4.x, 1), _mm_shuffle_pd(P3.y, P4.y, 1),
-                _mm_shuffle_pd(P3.z, P4.z, 1)};
-    sm_v2 V3 = {_mm_shuffle_pd(P3.x, P4.x, 2), _mm_shuffle_pd(P3.y, P4.y, 2),
-                _mm_shuffle_pd(P3.z, P4.z, 2)};
-    int ok = v2_edge_pairs(U1, V1, _mm_set_pd(-1.0, 1.0), y + 0, x + 0);
-    ok &= v2_edge_pairs(U2, V2, _mm_set1_pd(1.0), y + 2, x + 2);
-    ok &= v2_edge_pairs(U3, V3, _mm_set_pd(1.0, -1.0), y + 4, x + 4);
-    return ok == 3;
-}
-#undef V2_CROSS_OF
-#undef V2_DIFF
-#endif
-
 /* The two extreme dihedrals of a tet as (|u x v|, u . v) pairs: the
  * smallest at (*ylo, *xlo), the largest at (*yhi, *xhi). Returns 0 for a
  * degenerate case (see sm_tet_score), which st_tet_dihedral_range must
@@ -375,44 +254,9 @@ static inline int tet_extremes(const double *a, const double *b, const double *c
                                const double *d, double *ylo, double *xlo,
                                double *yhi, double *xhi)
 {
-#ifdef __SSE2__
     double y[6], x[6];
-    if (!tet_pairs_sse2(a, b, c, d, y, x))
+    if (!tq_tet_pairs(a, b, c, d, y, x))
         return 0;
-#else
-    /* sm_tet_score's edge i = (pi, pj), others pk, pl, takes u = e x f,
-     * v = e x g with e = pj - pi, f = pk - pi, g = pl - pi. The edges from
-     * one corner share their differences, and a x b = -(b x a) exactly in
-     * floating point (a1 b2 - a2 b1 = -(a2 b1 - a1 b2)); negating u or v
-     * negates w = u x v and u . v exactly too, so the 18 cross products
-     * come down to 14 with the same |w| and, up to sign, u . v. */
-    double d1[3], d2[3], d3[3], c0[3], c2[3], c3[3], b0[3], b1[3], b3[3];
-    st_sub3(d1, b, a);
-    st_sub3(d2, c, a);
-    st_sub3(d3, d, a);
-    st_sub3(c0, a, b);
-    st_sub3(c2, c, b);
-    st_sub3(c3, d, b);
-    st_sub3(b0, a, c);
-    st_sub3(b1, b, c);
-    st_sub3(b3, d, c);
-    double A[3], B[3], C[3], D[3], E[3], F[3], G[3], H[3];
-    st_cross3(A, d1, d2);   /* edge 0: u = A, v = B */
-    st_cross3(B, d1, d3);   /* edge 1: u = -A, v = C */
-    st_cross3(C, d2, d3);   /* edge 2: u = -B, v = -C */
-    st_cross3(D, c2, c0);   /* edge 3: u = D, v = E */
-    st_cross3(E, c2, c3);   /* edge 4: u = F, v = -E */
-    st_cross3(F, c3, c0);
-    st_cross3(G, b3, b0);   /* edge 5: u = G, v = H */
-    st_cross3(H, b3, b1);
-    /* the sign of u . v: edge 1 has one factor negated, edge 4 one, edge 2
-     * two */
-    double y[6], x[6];
-    if (!edge_pair(A, B, 1.0, y + 0, x + 0) || !edge_pair(A, C, -1.0, y + 1, x + 1) ||
-        !edge_pair(B, C, 1.0, y + 2, x + 2) || !edge_pair(D, E, 1.0, y + 3, x + 3) ||
-        !edge_pair(F, E, -1.0, y + 4, x + 4) || !edge_pair(G, H, 1.0, y + 5, x + 5))
-        return 0;
-#endif
     int imin = 0, imax = 0;   /* smallest angle: largest x / y */
     for (int i = 1; i < 6; i++) {
         if (x[i] * y[imin] > x[imin] * y[i])
