@@ -414,9 +414,43 @@ static void test_score_pairs(void)
               "%d scored 0 or less, %d with equal angles)", tested, degenerate, 24 * ties);
 }
 
+/* sm_mesh_build's neighbour lists: each vertex's edge neighbours in
+ * increasing order without repeats or itself, as a brute force over the
+ * tets finds them (a 5-tet block: lists of 4 to 18 neighbours). */
+static void test_neighbour_lists(void)
+{
+    double lo[3] = {0, 0, 0};
+    st_tetmesh *m = lattice5(3, 1.0, lo, NULL, NULL);
+    sm_mesh sm;
+    st_error err;
+    int ok = sm_mesh_build(&sm, m, &err) == ST_OK, longest = 0;
+    unsigned char *adj = calloc(m->npoints, 1);
+    for (size_t v = 0; v < m->npoints && ok; v++) {
+        memset(adj, 0, m->npoints);
+        for (size_t t = 0; t < m->ntets; t++) {
+            const uint32_t *c = m->tets + 4 * t;
+            if (c[0] == v || c[1] == v || c[2] == v || c[3] == v)
+                for (int k = 0; k < 4; k++)
+                    adj[c[k]] = c[k] != v;
+        }
+        size_t j = sm.vv_off[v];
+        for (uint32_t u = 0; u < m->npoints && ok; u++)
+            if (adj[u])
+                ok = j < sm.vv_off[v + 1] && sm.vv[j++] == u;
+        ok = ok && j == sm.vv_off[v + 1];
+        if ((int)(sm.vv_off[v + 1] - sm.vv_off[v]) > longest)
+            longest = (int)(sm.vv_off[v + 1] - sm.vv_off[v]);
+    }
+    TAP_CHECK(ok && longest >= 12, "the neighbour lists are the tets' edges, sorted, "
+              "without repeats (%zu vertices, the longest %d)", m->npoints, longest);
+    free(adj);
+    sm_mesh_free(&sm);
+    st_tetmesh_free(m);
+}
+
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {TAP_TEST(star_score_is_min), TAP_TEST(score_pairs), TAP_TEST(block),
+    static const tap_test tests[] = {TAP_TEST(star_score_is_min), TAP_TEST(score_pairs), TAP_TEST(neighbour_lists), TAP_TEST(block),
                                      TAP_TEST(ball_many_iters), TAP_TEST(keeps_30),
                                      TAP_TEST(thin_slab), TAP_TEST(threads),
                                      TAP_TEST(refusals), {0}};

@@ -435,11 +435,75 @@ static void test_range_is_dihedrals(void)
               "(%d tets, %d with a 0 angle)", n, flat);
 }
 
+/* Faces by brute force: the neighbour of each tet face is the one other
+ * tet with the same three corners, none (-1) for a boundary face or one
+ * on three or more tets (counted as non-manifold). A vertex with hundreds
+ * of faces where it is the smallest index (the adjacency sorts each
+ * vertex's faces: runs, then merges) and a face on many tets. */
+static void test_adjacency_many(void)
+{
+    st_tetmesh *m = st_tetmesh_new();
+    for (int i = 0; i < 120; i++) {
+        double p[3] = {cos(0.1 * i), sin(0.1 * i), 0.01 * i};
+        add_pt(m, p[0], p[1], p[2]);
+    }
+    /* point 0 in every tet; faces (0 a b) shared along fans, (0 1 2) on
+     * a book of 30 tets, some tets twice over (their four faces are on
+     * two tets each, or more) */
+    for (uint32_t k = 3; k < 33; k++)
+        st_tetmesh_add_tet(m, 0, 1, 2, k, NULL);
+    for (uint32_t k = 3; k < 118; k++)
+        st_tetmesh_add_tet(m, 0, k, k + 1, 119 - (k % 3), NULL);
+    for (uint32_t k = 40; k < 100; k += 7)
+        st_tetmesh_add_tet(m, 0, 119 - (k % 3), k + 1, k, NULL);
+    const size_t nt = m->ntets;
+    int64_t *nbr = NULL;
+    size_t nm = 0;
+    st_status rc = st_tetmesh_neighbors(m, &nbr, &nm, NULL);
+    static const int fc[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+    int ok = rc == ST_OK, shared = 0;
+    size_t want_nm = 0;
+    uint32_t (*key)[3] = malloc(4 * nt * sizeof *key);
+    for (size_t f = 0; f < 4 * nt; f++) {
+        const uint32_t *q = m->tets + 4 * (f / 4);
+        uint32_t v[3] = {q[fc[f % 4][0]], q[fc[f % 4][1]], q[fc[f % 4][2]]};
+        for (int a = 0; a < 3; a++)
+            for (int b = a + 1; b < 3; b++)
+                if (v[b] < v[a]) {
+                    uint32_t t = v[a];
+                    v[a] = v[b];
+                    v[b] = t;
+                }
+        memcpy(key[f], v, sizeof v);
+    }
+    for (size_t f = 0; f < 4 * nt && ok; f++) {
+        size_t same = 0, other = 0, first = f;
+        for (size_t g = 0; g < 4 * nt; g++)
+            if (memcmp(key[f], key[g], sizeof key[f]) == 0) {
+                same++;
+                if (g != f)
+                    other = g;
+                if (g < first)
+                    first = g;
+            }
+        int64_t want = same == 2 ? (int64_t)(other / 4) : -1;
+        ok = nbr[f] == want;
+        shared += same == 2;
+        want_nm += same > 2 && first == f;
+    }
+    TAP_CHECK(ok && nm == want_nm && want_nm > 0 && shared > 50,
+              "many faces on one vertex: neighbours as by brute force (%zu tets, %d shared "
+              "faces, %zu non-manifold)", nt, shared, nm);
+    free(key);
+    free(nbr);
+    st_tetmesh_free(m);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(regular), TAP_TEST(cube_tets),
                                      TAP_TEST(degenerate), TAP_TEST(range_is_dihedrals), TAP_TEST(circumcenter_random),
-                                     TAP_TEST(build), TAP_TEST(compact), TAP_TEST(adjacency),
+                                     TAP_TEST(build), TAP_TEST(compact), TAP_TEST(adjacency), TAP_TEST(adjacency_many),
                                      {0}};
     return tap_main(argc, argv, tests);
 }

@@ -29,15 +29,23 @@ static int cmp_u32(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Sort and deduplicate buf[0..n), dropping `self`; returns the new count. */
-static size_t sort_unique(uint32_t *buf, size_t n, uint32_t self)
+/* Sort buf[0..n) of distinct values: by insertion where short (a
+ * vertex's neighbours, a dozen or two), qsort otherwise. */
+static void sort_distinct(uint32_t *buf, size_t n)
 {
-    qsort(buf, n, sizeof *buf, cmp_u32);
-    size_t k = 0;
-    for (size_t i = 0; i < n; i++)
-        if (buf[i] != self && (k == 0 || buf[k - 1] != buf[i]))
-            buf[k++] = buf[i];
-    return k;
+    if (n > 48) {
+        qsort(buf, n, sizeof *buf, cmp_u32);
+        return;
+    }
+    for (size_t i = 1; i < n; i++) {
+        uint32_t x = buf[i];
+        size_t j = i;
+        while (j > 0 && buf[j - 1] > x) {
+            buf[j] = buf[j - 1];
+            j--;
+        }
+        buf[j] = x;
+    }
 }
 
 void sm_mesh_free(sm_mesh *sm)
@@ -107,16 +115,31 @@ static st_status build_nbrs(size_t nv, const size_t *ioff, const uint32_t *items
         free(nb);
         return ST_ENOMEM;
     }
+    /* seen[u] == v: u is already in v's list (so each list is kept
+     * duplicate-free as it is gathered, and only its distinct entries
+     * are sorted) */
+    uint32_t *seen = st_malloc_array(nv ? nv : 1, sizeof *seen);
+    if (!seen) {
+        free(off);
+        free(nb);
+        return ST_ENOMEM;
+    }
+    memset(seen, 0xff, (nv ? nv : 1) * sizeof *seen);
     size_t w = 0;
     for (size_t v = 0; v < nv; v++) {
         size_t start = w;
         for (size_t j = ioff[v]; j < ioff[v + 1]; j++)
-            for (int c = 0; c < k; c++)
-                nb[w++] = idx[(size_t)k * items[j] + (size_t)c];
-        size_t n = sort_unique(nb + start, w - start, (uint32_t)v);
-        w = start + n;
+            for (int c = 0; c < k; c++) {
+                uint32_t u = idx[(size_t)k * items[j] + (size_t)c];
+                if (u != (uint32_t)v && seen[u] != (uint32_t)v) {
+                    seen[u] = (uint32_t)v;
+                    nb[w++] = u;
+                }
+            }
+        sort_distinct(nb + start, w - start);
         off[v + 1] = w;
     }
+    free(seen);
     *off_out = off;
     *nb_out = nb;
     return ST_OK;
