@@ -2,6 +2,7 @@
  * deterministic for any thread count. Meshes are blocks of 5-tet cubes
  * built here. */
 #include "../src/tet/smooth_mesh.h"
+#include "souptet/geom.h"
 #include "souptet/pred.h"
 #include "souptet/smooth.h"
 #include "souptet/tetmesh.h"
@@ -285,9 +286,171 @@ static void test_star_score_is_min(void)
     st_tetmesh_free(m);
 }
 
+/* The score as the pair formula gives it one edge at a time (tetqual.c's
+ * u = e x f, v = e x g per edge, |u x v| by st_norm3's scaled norm, u . v),
+ * the extreme pairs chosen by x_i y_j against x_j y_i in edge order, and
+ * st_tet_dihedral_range for a degenerate tet: the value sm_tet_score must
+ * give bit for bit however it computes the pairs (two edges per SSE2
+ * operation where there is SSE2). */
+static double norm_ref(const double w[3])
+{
+    double m = fabs(w[0]);
+    double b = fabs(w[1]) > fabs(w[2]) || isnan(fabs(w[2])) ? fabs(w[1]) : fabs(w[2]);
+    m = m > b || isnan(b) ? m : b;
+    if (!(m > 0.0) || !isfinite(m))
+        return m;
+    double x = w[0] / m, y = w[1] / m, z = w[2] / m;
+    return m * sqrt(x * x + y * y + z * z);
+}
+
+static double score_ref(const double *p0, const double *p1, const double *p2, const double *p3)
+{
+    const double *P[4] = {p0, p1, p2, p3};
+    static const int E[6][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2},
+                                {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};
+    double y[6], x[6];
+    int ok = 1;
+    for (int i = 0; i < 6 && ok; i++) {
+        double e[3], f[3], g[3], u[3], v[3], w[3];
+        for (int k = 0; k < 3; k++) {
+            e[k] = P[E[i][1]][k] - P[E[i][0]][k];
+            f[k] = P[E[i][2]][k] - P[E[i][0]][k];
+            g[k] = P[E[i][3]][k] - P[E[i][0]][k];
+        }
+        st_cross3(u, e, f);
+        st_cross3(v, e, g);
+        st_cross3(w, u, v);
+        y[i] = norm_ref(w);
+        x[i] = st_dot3(u, v);
+        ok = y[i] > 0.0 && isfinite(y[i]) && isfinite(x[i]);
+    }
+    double lo, hi;
+    if (!ok) {
+        st_tet_dihedral_range(p0, p1, p2, p3, &lo, &hi);
+    } else {
+        int imin = 0, imax = 0;
+        for (int i = 1; i < 6; i++) {
+            if (x[i] * y[imin] > x[imin] * y[i])
+                imin = i;
+            if (x[i] * y[imax] < x[imax] * y[i])
+                imax = i;
+        }
+        lo = atan2(y[imin], x[imin]) * (180.0 / 3.14159265358979323846);
+        hi = atan2(y[imax], x[imax]) * (180.0 / 3.14159265358979323846);
+    }
+    double s2 = ST_FIT_MAX_WEIGHT * (180.0 - hi);
+    return lo < s2 ? lo : s2;
+}
+
+/* Tets of every kind the passes meet and some they should not: random,
+ * lattice tets with equal angles (ties between edges), slivers, flat,
+ * needles, repeated corners, far from the origin, coordinates near
+ * overflow and underflow, NaN and infinite corners; each also with its
+ * corners in all 24 orders. */
+static void test_score_pairs(void)
+{
+    enum { NT = 400 };
+    int same = 1, tested = 0, degenerate = 0, ties = 0;
+    for (int t = 0; t < NT; t++) {
+        double q[4][3];
+        int kind = t % 10;
+        for (int i = 0; i < 4; i++)
+            for (int a = 0; a < 3; a++)
+                q[i][a] = 2.0 * rnd() - 1.0;
+        if (kind == 1) {          /* a BCC lattice tet: two pairs of equal angles */
+            static const double bcc[4][3] = {{0, 0, 0}, {2, 0, 0}, {1, 1, 1}, {1, 1, -1}};
+            double h = 0.5 + rnd(), o = 100.0 * rnd();
+            for (int i = 0; i < 4; i++)
+                for (int a = 0; a < 3; a++)
+                    q[i][a] = o + h * bcc[i][a];
+            ties++;
+        } else if (kind == 2) {   /* regular: six equal angles */
+            static const double reg[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
+            memcpy(q, reg, sizeof q);
+            ties++;
+        } else if (kind == 3) {   /* sliver */
+            for (int a = 0; a < 3; a++)
+                q[3][a] = 0.3 * q[0][a] + 0.3 * q[1][a] + 0.4 * q[2][a] + 1e-9 * rnd();
+        } else if (kind == 4) {   /* flat: a corner on an edge */
+            for (int a = 0; a < 3; a++)
+                q[3][a] = 2.0 * q[0][a] - q[1][a];
+        } else if (kind == 5) {   /* repeated corner */
+            memcpy(q[3], q[1], sizeof q[3]);
+        } else if (kind == 6) {   /* far from the origin, small */
+            for (int i = 0; i < 4; i++)
+                for (int a = 0; a < 3; a++)
+                    q[i][a] = 1e6 + 1e-4 * q[i][a];
+        } else if (kind == 7) {   /* near overflow (the products are infinite) or underflow */
+            double sc = t % 20 < 10 ? 1e80 : 1e-80;
+            for (int i = 0; i < 4; i++)
+                for (int a = 0; a < 3; a++)
+                    q[i][a] *= sc;
+        } else if (kind == 8) {   /* a NaN or infinite coordinate */
+            q[t % 4][(t / 4) % 3] = t % 20 < 10 ? NAN : -INFINITY;
+        } else if (kind == 9) {   /* needle */
+            for (int a = 0; a < 3; a++)
+                q[1][a] = q[0][a] + 1e-12 * rnd();
+        }
+        static const int perm[24][4] = {
+            {0, 1, 2, 3}, {0, 1, 3, 2}, {0, 2, 1, 3}, {0, 2, 3, 1}, {0, 3, 1, 2}, {0, 3, 2, 1},
+            {1, 0, 2, 3}, {1, 0, 3, 2}, {1, 2, 0, 3}, {1, 2, 3, 0}, {1, 3, 0, 2}, {1, 3, 2, 0},
+            {2, 0, 1, 3}, {2, 0, 3, 1}, {2, 1, 0, 3}, {2, 1, 3, 0}, {2, 3, 0, 1}, {2, 3, 1, 0},
+            {3, 0, 1, 2}, {3, 0, 2, 1}, {3, 1, 0, 2}, {3, 1, 2, 0}, {3, 2, 0, 1}, {3, 2, 1, 0}};
+        for (int k = 0; k < 24; k++) {
+            const double *a = q[perm[k][0]], *b = q[perm[k][1]], *c = q[perm[k][2]],
+                         *d = q[perm[k][3]];
+            double got = sm_tet_score(a, b, c, d), want = score_ref(a, b, c, d);
+            if (memcmp(&got, &want, sizeof got) != 0 && !(isnan(got) && isnan(want))) {
+                if (same)
+                    TAP_NOTE("tet %d order %d: %.17g, the pair formula %.17g", t, k, got, want);
+                same = 0;
+            }
+            degenerate += !(got > 0.0);
+            tested++;
+        }
+    }
+    TAP_CHECK(same && degenerate > tested / 10 && degenerate < tested / 2,
+              "the tet score is the pair formula's bit for bit (%d tets in every corner order, "
+              "%d scored 0 or less, %d with equal angles)", tested, degenerate, 24 * ties);
+}
+
+/* sm_mesh_build's neighbour lists: each vertex's edge neighbours in
+ * increasing order without repeats or itself, as a brute force over the
+ * tets finds them (a 5-tet block: lists of 4 to 18 neighbours). */
+static void test_neighbour_lists(void)
+{
+    double lo[3] = {0, 0, 0};
+    st_tetmesh *m = lattice5(3, 1.0, lo, NULL, NULL);
+    sm_mesh sm;
+    st_error err;
+    int ok = sm_mesh_build(&sm, m, &err) == ST_OK, longest = 0;
+    unsigned char *adj = calloc(m->npoints, 1);
+    for (size_t v = 0; v < m->npoints && ok; v++) {
+        memset(adj, 0, m->npoints);
+        for (size_t t = 0; t < m->ntets; t++) {
+            const uint32_t *c = m->tets + 4 * t;
+            if (c[0] == v || c[1] == v || c[2] == v || c[3] == v)
+                for (int k = 0; k < 4; k++)
+                    adj[c[k]] = c[k] != v;
+        }
+        size_t j = sm.vv_off[v];
+        for (uint32_t u = 0; u < m->npoints && ok; u++)
+            if (adj[u])
+                ok = j < sm.vv_off[v + 1] && sm.vv[j++] == u;
+        ok = ok && j == sm.vv_off[v + 1];
+        if ((int)(sm.vv_off[v + 1] - sm.vv_off[v]) > longest)
+            longest = (int)(sm.vv_off[v + 1] - sm.vv_off[v]);
+    }
+    TAP_CHECK(ok && longest >= 12, "the neighbour lists are the tets' edges, sorted, "
+              "without repeats (%zu vertices, the longest %d)", m->npoints, longest);
+    free(adj);
+    sm_mesh_free(&sm);
+    st_tetmesh_free(m);
+}
+
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {TAP_TEST(star_score_is_min), TAP_TEST(block),
+    static const tap_test tests[] = {TAP_TEST(star_score_is_min), TAP_TEST(score_pairs), TAP_TEST(neighbour_lists), TAP_TEST(block),
                                      TAP_TEST(ball_many_iters), TAP_TEST(keeps_30),
                                      TAP_TEST(thin_slab), TAP_TEST(threads),
                                      TAP_TEST(refusals), {0}};

@@ -385,9 +385,62 @@ static void test_bad(void)
               st_lattice_kind_from_name("cubic", &k) == -1, "lattice names");
 }
 
+/* The summary flags a brick inside-only, outside-only or mixed from every
+ * voxel of it: one inside voxel anywhere in a row (each place in a brick,
+ * the short bricks at the end of a row of 21 too) among outside ones, or
+ * one outside (or NaN) among inside ones, must be seen by
+ * st_tet_voxel_count's stop through the summary, for a small tet around
+ * that voxel's centre. */
+static void test_voxel_summary_each_voxel(void)
+{
+    const double o[3] = {0.25, -1.0, 2.0};
+    st_grid *g = NULL;
+    st_error err;
+    int ok = st_grid_new(&g, 21, 5, 6, o, 0.5, 1.0f, 0, &err) == ST_OK;
+    size_t tried = 0, bad = 0;
+    for (int sign = 0; ok && sign < 3; sign++) {
+        /* sign 0: one inside voxel among outside; 1: one outside among
+         * inside; 2: one NaN among inside */
+        const float bg = sign ? -1.0f : 1.0f, one = sign == 0 ? -1.0f : sign == 1 ? 1.0f : NAN;
+        for (size_t n = 0; n < g->nx * g->ny * g->nz; n++)
+            g->data[n] = bg;
+        for (size_t k = 1; k < g->nz; k += 3)
+            for (size_t j = 0; j < g->ny; j += 2)
+                for (size_t i = 0; i < g->nx; i++) {
+                    const size_t at = st_grid_index(g, i, j, k);
+                    g->data[at] = one;
+                    st_voxel_summary *sum = NULL;
+                    if (st_voxel_summary_build(&sum, g, &err) != ST_OK) {
+                        ok = 0;
+                        break;
+                    }
+                    double c[3], p[4][3];
+                    st_grid_center(g, i, j, k, c);
+                    static const double d[4][3] = {{-0.1, -0.1, -0.1}, {0.35, -0.1, -0.1},
+                                                   {-0.1, 0.35, -0.1}, {-0.1, -0.1, 0.35}};
+                    for (int q = 0; q < 4; q++)
+                        for (int a = 0; a < 3; a++)
+                            p[q][a] = c[a] + d[q][a];
+                    size_t m, M;
+                    int r = st_tet_voxel_count(g, sum, p[0], p[1], p[2], p[3], 1, &m, &M, NULL);
+                    int found = r > 0 || (r == 0 && m > 0);   /* an inside centre in it */
+                    if (sign == 0 ? !found : found)
+                        TAP_NOTE("sign %d voxel %zu %zu %zu: r %d m %zu M %zu", sign, i, j, k, r, m, M);
+                    bad += sign == 0 ? !found : found;
+                    tried++;
+                    st_voxel_summary_free(sum);
+                    g->data[at] = bg;
+                }
+    }
+    TAP_CHECK(ok && bad == 0 && tried == 3 * 21 * 3 * 2,
+              "the summary sees one odd voxel at every place of a brick (%zu grids, %zu wrong)",
+              tried, bad);
+    st_grid_free(g);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(cubic5), TAP_TEST(bcc), TAP_TEST(seeded),
-                                     TAP_TEST(density), TAP_TEST(voxel_count_brute), TAP_TEST(bad), {0}};
+                                     TAP_TEST(density), TAP_TEST(voxel_count_brute), TAP_TEST(voxel_summary_each_voxel), TAP_TEST(bad), {0}};
     return tap_main(argc, argv, tests);
 }

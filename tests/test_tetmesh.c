@@ -345,11 +345,165 @@ static void test_adjacency(void)
     st_tetmesh_free(m);
 }
 
+/* st_tet_dihedral_range takes the atan2 of the edges near the extremes
+ * only: its values must be the smallest and largest of st_tet_dihedrals
+ * bit for bit, on random tets, lattice tets (equal angles), near-flat and
+ * flat ones, needles, tets far from the origin or near overflow and
+ * underflow, and with a NaN or infinite corner; in every corner order. */
+static uint64_t range_rng = 0x9e3779b97f4a7c15ull;
+static double range_rnd(void)   /* xorshift64, uniform in [0, 1) */
+{
+    range_rng ^= range_rng << 13;
+    range_rng ^= range_rng >> 7;
+    range_rng ^= range_rng << 17;
+    return (double)(range_rng >> 11) / 9007199254740992.0;
+}
+
+static void range_tet(double q[4][3], int t)
+{
+    for (int i = 0; i < 4; i++)
+        for (int a = 0; a < 3; a++)
+            q[i][a] = 2.0 * range_rnd() - 1.0;
+    static const double bcc[4][3] = {{0, 0, 0}, {2, 0, 0}, {1, 1, 1}, {1, 1, -1}};
+    switch (t % 9) {
+    case 1:   /* a BCC lattice tet, scaled and moved: equal angles */
+        for (int i = 0; i < 4; i++)
+            for (int a = 0; a < 3; a++)
+                q[i][a] = 37.0 * range_rnd() + (0.5 + range_rnd()) * bcc[i][a];
+        break;
+    case 2:   /* sliver */
+        for (int a = 0; a < 3; a++)
+            q[3][a] = 0.3 * q[0][a] + 0.3 * q[1][a] + 0.4 * q[2][a] + 1e-9 * range_rnd();
+        break;
+    case 3:   /* flat, or a repeated corner */
+        for (int a = 0; a < 3; a++)
+            q[3][a] = t % 2 ? 2.0 * q[0][a] - q[1][a] : q[1][a];
+        break;
+    case 4:   /* needle */
+        for (int a = 0; a < 3; a++)
+            q[1][a] = q[0][a] + 1e-12 * range_rnd();
+        break;
+    case 5:   /* far from the origin */
+        for (int i = 0; i < 4; i++)
+            for (int a = 0; a < 3; a++)
+                q[i][a] = 1e6 + 1e-4 * q[i][a];
+        break;
+    case 6:   /* near overflow or underflow */
+        for (int i = 0; i < 4; i++)
+            for (int a = 0; a < 3; a++)
+                q[i][a] *= t % 2 ? 1e80 : 1e-80;
+        break;
+    case 7:   /* a NaN or infinite coordinate */
+        q[t % 4][t % 3] = t % 2 ? NAN : INFINITY;
+        break;
+    default:
+        break;
+    }
+}
+
+static void test_range_is_dihedrals(void)
+{
+    static const int perm[6][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1},
+                                   {3, 2, 1, 0}, {0, 2, 3, 1}, {1, 3, 2, 0}};
+    int same = 1, n = 0, flat = 0;
+    for (int t = 0; t < 2000; t++) {
+        double q[4][3];
+        range_tet(q, t);
+        for (int k = 0; k < 6; k++) {
+            const double *a = q[perm[k][0]], *b = q[perm[k][1]], *c = q[perm[k][2]],
+                         *d = q[perm[k][3]];
+            double ang[6], lo, hi;
+            st_tet_dihedrals(a, b, c, d, ang);
+            double wlo = ang[0], whi = ang[0];
+            for (int i = 1; i < 6; i++) {
+                wlo = ang[i] < wlo ? ang[i] : wlo;
+                whi = ang[i] > whi ? ang[i] : whi;
+            }
+            st_tet_dihedral_range(a, b, c, d, &lo, &hi);
+            if (memcmp(&lo, &wlo, sizeof lo) != 0 || memcmp(&hi, &whi, sizeof hi) != 0) {
+                if (same)
+                    TAP_NOTE("tet %d order %d: %.17g..%.17g, the angles %.17g..%.17g", t, k,
+                             lo, hi, wlo, whi);
+                same = 0;
+            }
+            flat += wlo == 0.0;
+            n++;
+        }
+    }
+    TAP_CHECK(same && flat > n / 20 && flat < n / 2,
+              "the dihedral range is the smallest and largest dihedral bit for bit "
+              "(%d tets, %d with a 0 angle)", n, flat);
+}
+
+/* Faces by brute force: the neighbour of each tet face is the one other
+ * tet with the same three corners, none (-1) for a boundary face or one
+ * on three or more tets (counted as non-manifold). A vertex with hundreds
+ * of faces where it is the smallest index (the adjacency sorts each
+ * vertex's faces: runs, then merges) and a face on many tets. */
+static void test_adjacency_many(void)
+{
+    st_tetmesh *m = st_tetmesh_new();
+    for (int i = 0; i < 120; i++) {
+        double p[3] = {cos(0.1 * i), sin(0.1 * i), 0.01 * i};
+        add_pt(m, p[0], p[1], p[2]);
+    }
+    /* point 0 in every tet; faces (0 a b) shared along fans, (0 1 2) on
+     * a book of 30 tets, some tets twice over (their four faces are on
+     * two tets each, or more) */
+    for (uint32_t k = 3; k < 33; k++)
+        st_tetmesh_add_tet(m, 0, 1, 2, k, NULL);
+    for (uint32_t k = 3; k < 118; k++)
+        st_tetmesh_add_tet(m, 0, k, k + 1, 119 - (k % 3), NULL);
+    for (uint32_t k = 40; k < 100; k += 7)
+        st_tetmesh_add_tet(m, 0, 119 - (k % 3), k + 1, k, NULL);
+    const size_t nt = m->ntets;
+    int64_t *nbr = NULL;
+    size_t nm = 0;
+    st_status rc = st_tetmesh_neighbors(m, &nbr, &nm, NULL);
+    static const int fc[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+    int ok = rc == ST_OK, shared = 0;
+    size_t want_nm = 0;
+    uint32_t (*key)[3] = malloc(4 * nt * sizeof *key);
+    for (size_t f = 0; f < 4 * nt; f++) {
+        const uint32_t *q = m->tets + 4 * (f / 4);
+        uint32_t v[3] = {q[fc[f % 4][0]], q[fc[f % 4][1]], q[fc[f % 4][2]]};
+        for (int a = 0; a < 3; a++)
+            for (int b = a + 1; b < 3; b++)
+                if (v[b] < v[a]) {
+                    uint32_t t = v[a];
+                    v[a] = v[b];
+                    v[b] = t;
+                }
+        memcpy(key[f], v, sizeof v);
+    }
+    for (size_t f = 0; f < 4 * nt && ok; f++) {
+        size_t same = 0, other = 0, first = f;
+        for (size_t g = 0; g < 4 * nt; g++)
+            if (memcmp(key[f], key[g], sizeof key[f]) == 0) {
+                same++;
+                if (g != f)
+                    other = g;
+                if (g < first)
+                    first = g;
+            }
+        int64_t want = same == 2 ? (int64_t)(other / 4) : -1;
+        ok = nbr[f] == want;
+        shared += same == 2;
+        want_nm += same > 2 && first == f;
+    }
+    TAP_CHECK(ok && nm == want_nm && want_nm > 0 && shared > 50,
+              "many faces on one vertex: neighbours as by brute force (%zu tets, %d shared "
+              "faces, %zu non-manifold)", nt, shared, nm);
+    free(key);
+    free(nbr);
+    st_tetmesh_free(m);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(regular), TAP_TEST(cube_tets),
-                                     TAP_TEST(degenerate), TAP_TEST(circumcenter_random),
-                                     TAP_TEST(build), TAP_TEST(compact), TAP_TEST(adjacency),
+                                     TAP_TEST(degenerate), TAP_TEST(range_is_dihedrals), TAP_TEST(circumcenter_random),
+                                     TAP_TEST(build), TAP_TEST(compact), TAP_TEST(adjacency), TAP_TEST(adjacency_many),
                                      {0}};
     return tap_main(argc, argv, tests);
 }

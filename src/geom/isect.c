@@ -585,6 +585,16 @@ void st_tri_box_filter_init(st_tri_box_filter *f, const double a[3], const doubl
     }
 }
 
+/* 1 when the edge axis x (of axis k: its u, w components cu, cw of the
+ * box's centre and eu, ew of its half extents) separates the box. */
+static inline int axis_apart(const st_tri_box_filter *f, int x, double cu, double cw,
+                             double eu, double ew, double tol2)
+{
+    double cp = f->ax[x][0] * cu + f->ax[x][1] * cw;
+    double re = eu * f->aabs[x][0] + ew * f->aabs[x][1];
+    return f->pmin[x] - cp > re + tol2 || f->pmax[x] - cp < -re - tol2;
+}
+
 int st_tri_box_filter_maybe(const st_tri_box_filter *f, const double lo[3],
                             const double hi[3])
 {
@@ -611,17 +621,17 @@ int st_tri_box_filter_maybe(const st_tri_box_filter *f, const double lo[3],
     double r = e[0] * f->an[0] + e[1] * f->an[1] + e[2] * f->an[2];
     if (fabs(d) > r + tol3)
         return 0;
-    for (int k = 0; k < 3; k++) {
-        const int u = (k + 1) % 3, w = (k + 2) % 3;
-        for (int j = 0; j < 3; j++) {
-            const int x = 3 * k + j;
-            double cp = f->ax[x][0] * ctr[u] + f->ax[x][1] * ctr[w];
-            double re = e[u] * f->aabs[x][0] + e[w] * f->aabs[x][1];
-            if (f->pmin[x] - cp > re + tol2 || f->pmax[x] - cp < -re - tol2)
-                return 0;
-        }
-    }
-    return 1;
+    /* axis k, edge j (x = 3 k + j) with u = k + 1, w = k + 2 (mod 3),
+     * written out: the loop's u and w were computed at run time */
+    return !(axis_apart(f, 0, ctr[1], ctr[2], e[1], e[2], tol2) ||
+             axis_apart(f, 1, ctr[1], ctr[2], e[1], e[2], tol2) ||
+             axis_apart(f, 2, ctr[1], ctr[2], e[1], e[2], tol2) ||
+             axis_apart(f, 3, ctr[2], ctr[0], e[2], e[0], tol2) ||
+             axis_apart(f, 4, ctr[2], ctr[0], e[2], e[0], tol2) ||
+             axis_apart(f, 5, ctr[2], ctr[0], e[2], e[0], tol2) ||
+             axis_apart(f, 6, ctr[0], ctr[1], e[0], e[1], tol2) ||
+             axis_apart(f, 7, ctr[0], ctr[1], e[0], e[1], tol2) ||
+             axis_apart(f, 8, ctr[0], ctr[1], e[0], e[1], tol2));
 }
 
 /* One box: the filter's two halves in one call. */

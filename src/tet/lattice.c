@@ -592,7 +592,17 @@ st_status st_voxel_summary_build(st_voxel_summary **out, const st_grid *g,
                 const float *row = g->data + st_grid_index(g, 0, j, k);
                 unsigned char *fl = s->flags + s->nb[0] *
                                    (j / ST_VOXEL_BRICK + s->nb[1] * (size_t)bk);
-                for (size_t i = 0; i < g->nx; i++)
+                /* a brick's voxels of the row first, then its flag once:
+                 * 1 for a voxel inside (< 0), 2 otherwise (NaN too) */
+                size_t bi = 0;
+#if ST_VOXEL_BRICK == 4
+                for (; 4 * bi + 4 <= g->nx; bi++) {
+                    const float *r4 = row + 4 * bi;
+                    fl[bi] |= (unsigned char)((2u - (r4[0] < 0.0f)) | (2u - (r4[1] < 0.0f)) |
+                                              (2u - (r4[2] < 0.0f)) | (2u - (r4[3] < 0.0f)));
+                }
+#endif
+                for (size_t i = bi * ST_VOXEL_BRICK; i < g->nx; i++)
                     fl[i / ST_VOXEL_BRICK] |= row[i] < 0.0f ? 1 : 2;
             }
     }

@@ -9,6 +9,7 @@
  * gives the same result as moving them one by one, in any thread order.
  */
 #include "smooth_mesh.h"
+#include "tetqual_pairs.h"
 #include "../base/fpenv.h"
 
 #include "souptet/geom.h"
@@ -28,15 +29,23 @@ static int cmp_u32(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Sort and deduplicate buf[0..n), dropping `self`; returns the new count. */
-static size_t sort_unique(uint32_t *buf, size_t n, uint32_t self)
+/* Sort buf[0..n) of distinct values: by insertion where short (a
+ * vertex's neighbours, a dozen or two), qsort otherwise. */
+static void sort_distinct(uint32_t *buf, size_t n)
 {
-    qsort(buf, n, sizeof *buf, cmp_u32);
-    size_t k = 0;
-    for (size_t i = 0; i < n; i++)
-        if (buf[i] != self && (k == 0 || buf[k - 1] != buf[i]))
-            buf[k++] = buf[i];
-    return k;
+    if (n > 48) {
+        qsort(buf, n, sizeof *buf, cmp_u32);
+        return;
+    }
+    for (size_t i = 1; i < n; i++) {
+        uint32_t x = buf[i];
+        size_t j = i;
+        while (j > 0 && buf[j - 1] > x) {
+            buf[j] = buf[j - 1];
+            j--;
+        }
+        buf[j] = x;
+    }
 }
 
 void sm_mesh_free(sm_mesh *sm)
@@ -106,16 +115,31 @@ static st_status build_nbrs(size_t nv, const size_t *ioff, const uint32_t *items
         free(nb);
         return ST_ENOMEM;
     }
+    /* seen[u] == v: u is already in v's list (so each list is kept
+     * duplicate-free as it is gathered, and only its distinct entries
+     * are sorted) */
+    uint32_t *seen = st_malloc_array(nv ? nv : 1, sizeof *seen);
+    if (!seen) {
+        free(off);
+        free(nb);
+        return ST_ENOMEM;
+    }
+    memset(seen, 0xff, (nv ? nv : 1) * sizeof *seen);
     size_t w = 0;
     for (size_t v = 0; v < nv; v++) {
         size_t start = w;
         for (size_t j = ioff[v]; j < ioff[v + 1]; j++)
-            for (int c = 0; c < k; c++)
-                nb[w++] = idx[(size_t)k * items[j] + (size_t)c];
-        size_t n = sort_unique(nb + start, w - start, (uint32_t)v);
-        w = start + n;
+            for (int c = 0; c < k; c++) {
+                uint32_t u = idx[(size_t)k * items[j] + (size_t)c];
+                if (u != (uint32_t)v && seen[u] != (uint32_t)v) {
+                    seen[u] = (uint32_t)v;
+                    nb[w++] = u;
+                }
+            }
+        sort_distinct(nb + start, w - start);
         off[v + 1] = w;
     }
+    free(seen);
     *off_out = off;
     *nb_out = nb;
     return ST_OK;
@@ -245,35 +269,6 @@ int sm_star_positive(const sm_mesh *sm, uint32_t v, const double p[3])
 /* Degrees per radian, as tetqual.c has it, so the angles agree. */
 #define SM_RAD2DEG (180.0 / 3.14159265358979323846)
 
-/* fmax for the non-negative operands of sm_norm3 (fabs values, maybe NaN
- * or infinite): returns what fmax returns, without the libm call. */
-static inline double sm_fmax(double a, double b)
-{
-    return (a > b || b != b) ? a : b;
-}
-
-/* st_norm3 (geom.c) inline, operation for operation, so the value is the
- * same bit for bit. */
-static inline double sm_norm3(const double v[3])
-{
-    double m = sm_fmax(fabs(v[0]), sm_fmax(fabs(v[1]), fabs(v[2])));
-    if (!(m > 0.0) || !isfinite(m))
-        return m;
-    double x = v[0] / m, y = v[1] / m, z = v[2] / m;
-    return m * sqrt(x * x + y * y + z * z);
-}
-
-/* The pair (|u x v|, s u . v) of one edge; 0 for a degenerate case. */
-static inline int edge_pair(const double u[3], const double v[3], double s, double *y,
-                            double *x)
-{
-    double w[3];
-    st_cross3(w, u, v);
-    *y = sm_norm3(w);
-    *x = s * st_dot3(u, v);
-    return *y > 0.0 && isfinite(*y) && isfinite(*x);
-}
-
 /* The two extreme dihedrals of a tet as (|u x v|, u . v) pairs: the
  * smallest at (*ylo, *xlo), the largest at (*yhi, *xhi). Returns 0 for a
  * degenerate case (see sm_tet_score), which st_tet_dihedral_range must
@@ -282,37 +277,8 @@ static inline int tet_extremes(const double *a, const double *b, const double *c
                                const double *d, double *ylo, double *xlo,
                                double *yhi, double *xhi)
 {
-    /* sm_tet_score's edge i = (pi, pj), others pk, pl, takes u = e x f,
-     * v = e x g with e = pj - pi, f = pk - pi, g = pl - pi. The edges from
-     * one corner share their differences, and a x b = -(b x a) exactly in
-     * floating point (a1 b2 - a2 b1 = -(a2 b1 - a1 b2)); negating u or v
-     * negates w = u x v and u . v exactly too, so the 18 cross products
-     * come down to 14 with the same |w| and, up to sign, u . v. */
-    double d1[3], d2[3], d3[3], c0[3], c2[3], c3[3], b0[3], b1[3], b3[3];
-    st_sub3(d1, b, a);
-    st_sub3(d2, c, a);
-    st_sub3(d3, d, a);
-    st_sub3(c0, a, b);
-    st_sub3(c2, c, b);
-    st_sub3(c3, d, b);
-    st_sub3(b0, a, c);
-    st_sub3(b1, b, c);
-    st_sub3(b3, d, c);
-    double A[3], B[3], C[3], D[3], E[3], F[3], G[3], H[3];
-    st_cross3(A, d1, d2);   /* edge 0: u = A, v = B */
-    st_cross3(B, d1, d3);   /* edge 1: u = -A, v = C */
-    st_cross3(C, d2, d3);   /* edge 2: u = -B, v = -C */
-    st_cross3(D, c2, c0);   /* edge 3: u = D, v = E */
-    st_cross3(E, c2, c3);   /* edge 4: u = F, v = -E */
-    st_cross3(F, c3, c0);
-    st_cross3(G, b3, b0);   /* edge 5: u = G, v = H */
-    st_cross3(H, b3, b1);
-    /* the sign of u . v: edge 1 has one factor negated, edge 4 one, edge 2
-     * two */
     double y[6], x[6];
-    if (!edge_pair(A, B, 1.0, y + 0, x + 0) || !edge_pair(A, C, -1.0, y + 1, x + 1) ||
-        !edge_pair(B, C, 1.0, y + 2, x + 2) || !edge_pair(D, E, 1.0, y + 3, x + 3) ||
-        !edge_pair(F, E, -1.0, y + 4, x + 4) || !edge_pair(G, H, 1.0, y + 5, x + 5))
+    if (!tq_tet_pairs(a, b, c, d, y, x))
         return 0;
     int imin = 0, imax = 0;   /* smallest angle: largest x / y */
     for (int i = 1; i < 6; i++) {

@@ -310,16 +310,6 @@ typedef struct face_rec {
     uint64_t id;        /* 4 * tet + corner */
 } face_rec;
 
-static int face_cmp(const void *pa, const void *pb)
-{
-    const face_rec *a = pa, *b = pb;
-    if (a->v1 != b->v1)
-        return a->v1 < b->v1 ? -1 : 1;
-    if (a->v2 != b->v2)
-        return a->v2 < b->v2 ? -1 : 1;
-    return a->id < b->id ? -1 : a->id > b->id;
-}
-
 static void sort3(uint32_t v[3])
 {
     uint32_t t;
@@ -328,22 +318,56 @@ static void sort3(uint32_t v[3])
     if (v[0] > v[1]) { t = v[0]; v[0] = v[1]; v[1] = t; }
 }
 
-/* Sorts small runs by insertion, larger ones with qsort. */
-static void sort_bucket(face_rec *r, size_t n)
+/* The faces' order: by v1, v2, then id (a total order: ids are unique). */
+static int face_less(const face_rec *a, const face_rec *b)
 {
-    if (n > 24) {
-        qsort(r, n, sizeof *r, face_cmp);
-        return;
-    }
+    if (a->v1 != b->v1)
+        return a->v1 < b->v1;
+    if (a->v2 != b->v2)
+        return a->v2 < b->v2;
+    return a->id < b->id;
+}
+
+static void insertion_faces(face_rec *r, size_t n)
+{
     for (size_t i = 1; i < n; i++) {
         face_rec x = r[i];
         size_t j = i;
-        while (j > 0 && face_cmp(&r[j - 1], &x) > 0) {
+        while (j > 0 && face_less(&x, &r[j - 1])) {
             r[j] = r[j - 1];
             j--;
         }
         r[j] = x;
     }
+}
+
+/* Sorts a bucket by face_less (a total order, so any sort gives the same
+ * result): runs of 16 by insertion, then merged
+ * through tmp (n records) with the comparison inlined, where qsort's
+ * indirect calls were most of the fit's adjacency. */
+static void sort_bucket(face_rec *r, face_rec *tmp, size_t n)
+{
+    enum { RUN = 16 };
+    for (size_t i = 0; i < n; i += RUN)
+        insertion_faces(r + i, n - i < RUN ? n - i : RUN);
+    face_rec *src = r, *dst = tmp;
+    for (size_t w = RUN; w < n; w *= 2) {
+        for (size_t lo = 0; lo < n; lo += 2 * w) {
+            size_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
+            size_t i = lo, j = mid, k = lo;
+            while (i < mid && j < hi)
+                dst[k++] = face_less(&src[j], &src[i]) ? src[j++] : src[i++];
+            while (i < mid)
+                dst[k++] = src[i++];
+            while (j < hi)
+                dst[k++] = src[j++];
+        }
+        face_rec *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != r)
+        memcpy(r, src, n * sizeof *r);
 }
 
 /* nbr[4t+i]: neighbour tet, -1 boundary, -2 non-manifold face. */
@@ -397,11 +421,20 @@ static st_status adjacency(const st_tetmesh *m, int64_t **out,
             r->id = 4 * (uint64_t)t + (uint64_t)i;
         }
     free(fill);
-    size_t nm = 0;
+    size_t nm = 0, most = 1;
+    for (size_t b = 0; b < m->npoints; b++)
+        most = start[b + 1] - start[b] > most ? start[b + 1] - start[b] : most;
+    face_rec *tmp = st_malloc_array(most, sizeof *tmp);
+    if (!tmp) {
+        free(nbr);
+        free(rec);
+        free(start);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    }
     for (size_t b = 0; b < m->npoints; b++) {
         face_rec *r = rec + start[b];
         size_t n = start[b + 1] - start[b];
-        sort_bucket(r, n);
+        sort_bucket(r, tmp, n);
         for (size_t i = 0; i < n;) {
             size_t j = i + 1;
             while (j < n && r[j].v1 == r[i].v1 && r[j].v2 == r[i].v2)
@@ -419,6 +452,7 @@ static st_status adjacency(const st_tetmesh *m, int64_t **out,
             i = j;
         }
     }
+    free(tmp);
     free(rec);
     free(start);
     *out = nbr;

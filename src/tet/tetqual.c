@@ -19,6 +19,7 @@
 #include "souptet/tetqual.h"
 #include "../base/fpenv.h"
 #include "souptet/geom.h"
+#include "tetqual_pairs.h"
 
 #include <math.h>
 
@@ -67,18 +68,66 @@ void st_tet_dihedrals(const double p0[3], const double p1[3],
     angles[5] = dihedral(p2, p3, p0, p1);   /* (2 3) */
 }
 
+/* Ratios r = x / y (tetqual_pairs.h) whose atan2 the range skips: an
+ * edge whose ratio is further than TQ_PRUNE_GAP * (1 + |r*|)^2 from the
+ * extreme r* has an angle more than 2e-7 rad from the extreme one, far
+ * beyond the few ulps of atan2 and of the division, so it cannot be the
+ * smallest (largest) angle; past |r*| > TQ_PRUNE_MAX (angles within 1e-6
+ * rad of 0 or 180 degrees) nothing is skipped. smooth_mesh.c's star
+ * scores skip tets by the same rule. */
+#define TQ_PRUNE_GAP 1e-6
+#define TQ_PRUNE_MAX 1e6
+
+/* The range from the six pairs: the angles of the edges whose ratio is
+ * near the extremes, each tetqual's angle bit for bit (dihedral: the same
+ * y, x and atan2), so the minimum and maximum are st_tet_dihedrals'. */
+static void range_of_pairs(const double y[6], const double x[6], double *lo, double *hi)
+{
+    double r[6], rmax = -INFINITY, rmin = INFINITY;
+    for (int i = 0; i < 6; i++) {
+        r[i] = x[i] / y[i];
+        rmax = r[i] > rmax ? r[i] : rmax;
+        rmin = r[i] < rmin ? r[i] : rmin;
+    }
+    double cut_lo = -INFINITY, cut_hi = INFINITY;
+    if (fabs(rmax) <= TQ_PRUNE_MAX)
+        cut_lo = rmax - TQ_PRUNE_GAP * (1.0 + fabs(rmax)) * (1.0 + fabs(rmax));
+    if (fabs(rmin) <= TQ_PRUNE_MAX)
+        cut_hi = rmin + TQ_PRUNE_GAP * (1.0 + fabs(rmin)) * (1.0 + fabs(rmin));
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (int i = 0; i < 6; i++) {
+        const int near_lo = !(r[i] < cut_lo), near_hi = !(r[i] > cut_hi);
+        if (!near_lo && !near_hi)
+            continue;
+        double a = atan2(y[i], x[i]) * RAD2DEG;
+        if (near_lo && a < *lo)
+            *lo = a;
+        if (near_hi && a > *hi)
+            *hi = a;
+    }
+}
+
 void st_tet_dihedral_range(const double p0[3], const double p1[3],
                            const double p2[3], const double p3[3],
                            double *min_deg, double *max_deg)
 {
-    double a[6];
-    st_tet_dihedrals(p0, p1, p2, p3, a);
-    double lo = a[0], hi = a[0];
-    for (int i = 1; i < 6; i++) {
-        if (a[i] < lo)
-            lo = a[i];
-        if (a[i] > hi)
-            hi = a[i];
+    double lo, hi, y[6], x[6];
+    if (tq_tet_pairs(p0, p1, p2, p3, y, x)) {
+        range_of_pairs(y, x, &lo, &hi);
+    } else {
+        /* a degenerate pair: the angles one by one (dihedral's 0 for a
+         * face without area or a value not finite) */
+        double a[6];
+        st_tet_dihedrals(p0, p1, p2, p3, a);
+        lo = a[0];
+        hi = a[0];
+        for (int i = 1; i < 6; i++) {
+            if (a[i] < lo)
+                lo = a[i];
+            if (a[i] > hi)
+                hi = a[i];
+        }
     }
     if (min_deg)
         *min_deg = lo;
