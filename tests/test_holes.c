@@ -781,8 +781,12 @@ static void test_fair(void)
         }
         /* the flat cap stays at z0 (its points at radius down to z0); the
          * dome rises most of the way to the pole and stays near the
-         * sphere */
-        TAP_CHECK(top > z0 + 0.8 * (1.0 - z0) && top < 1.02 && rmin > 0.97 && rmax < 1.02,
+         * sphere. This hole is large (45 degrees) and the sphere's grid
+         * regular: the plate's cotangent Laplacian rises to 0.938 here
+         * (radii from 0.942), the uniform umbrella before it to 0.984
+         * (0.974), but that one falls short on irregular triangulations
+         * such as a scan's (test_fair_irregular, issue 37) */
+        TAP_CHECK(top > z0 + 0.75 * (1.0 - z0) && top < 1.02 && rmin > 0.93 && rmax < 1.02,
                   "the cap is a dome near the lost top: its highest point %.4f (the pole 1, "
                   "the loop %.4f), radii %.4f to %.4f", top, z0, rmin, rmax);
         int pierced = 0;
@@ -924,6 +928,90 @@ static void test_fans_merged(void)
                   "apexes, the closest %.3g apart (extent %.3g), %zu pairs piercing",
                   loops[i].n, ok ? bent : -1.0, loops[i].was, apexes, closest, ext, crossing);
     }
+/* The unit sphere's triangle (a, b, c) split level times at its edges'
+ * midpoints (pushed to the sphere; the same on either side of an edge, bit
+ * for bit), kept where its centroid lies more than cos_keep from axis. */
+static void ico_tri(st_soup *s, const double *a, const double *b, const double *c, int level,
+                    const double *axis, double cos_keep)
+{
+    if (level == 0) {
+        double m[3];
+        for (int q = 0; q < 3; q++)
+            m[q] = (a[q] + b[q] + c[q]) / 3.0;
+        const double d = (m[0] * axis[0] + m[1] * axis[1] + m[2] * axis[2]) /
+                         sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+        if (d < cos_keep)
+            add_tri(s, a, b, c, 0);
+        return;
+    }
+    double ab[3], bc[3], ca[3];
+    const double *e[3][2] = {{a, b}, {b, c}, {c, a}};
+    double *mid[3] = {ab, bc, ca};
+    for (int k = 0; k < 3; k++) {
+        double r = 0.0;
+        for (int q = 0; q < 3; q++)
+            mid[k][q] = e[k][0][q] + e[k][1][q], r += mid[k][q] * mid[k][q];
+        for (int q = 0; q < 3; q++)
+            mid[k][q] /= sqrt(r);
+    }
+    ico_tri(s, a, ab, ca, level - 1, axis, cos_keep);
+    ico_tri(s, b, bc, ab, level - 1, axis, cos_keep);
+    ico_tri(s, c, ca, bc, level - 1, axis, cos_keep);
+    ico_tri(s, ab, bc, ca, level - 1, axis, cos_keep);
+}
+
+/* An icosphere (the icosahedron split 3 times: 1280 triangles of unequal
+ * sizes and valences 5 and 6, as a scan's are irregular) without the
+ * faces within `hole` radians of a tilted axis. */
+static st_soup *icosphere(double hole)
+{
+    const double t = (1.0 + sqrt(5.0)) / 2.0, n = sqrt(1.0 + t * t);
+    static const int f[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11},
+                                 {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                 {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9},
+                                 {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+    const double v[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                             {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                             {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    double u[12][3];
+    for (int i = 0; i < 12; i++)
+        for (int q = 0; q < 3; q++)
+            u[i][q] = v[i][q] / n;
+    const double an = sqrt(0.09 + 0.04 + 1.0), axis[3] = {0.3 / an, 0.2 / an, 1.0 / an};
+    st_soup *s = st_soup_new();
+    for (int k = 0; k < 20; k++)
+        ico_tri(s, u[f[k][0]], u[f[k][1]], u[f[k][2]], 3, axis, cos(hole));
+    return s;
+}
+
+/* Issue 37: the faired cap over a hole in an irregularly sampled sphere
+ * follows the sphere. The plate's Laplacian is the cotangent one (scaled
+ * by the points' areas); with the uniform umbrella the cap fell short of
+ * the sphere by 22% of the lost cap's height (0.0204 of 0.094) here. */
+static void test_fair_irregular(void)
+{
+    const double hole = 25.0 * M_PI / 180.0, sag = 1.0 - cos(hole);
+    st_soup *cut = icosphere(hole), *caps = NULL;
+    st_holes_params hp = st_holes_params_default();
+    st_holes_stats hs;
+    st_error err;
+    hp.planes = 0;
+    const int ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err);
+    double rmin = INFINITY, rmax = 0.0;
+    for (size_t v = 0; ok && v < caps->nverts; v++) {
+        const double *x = caps->xyz + 3 * v;
+        const double r = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        rmin = fmin(rmin, r);
+        rmax = fmax(rmax, r);
+    }
+    TAP_CHECK(ok && hs.loops == 1 && hs.filled == 1 && caps->nverts > 16,
+              "an icosphere without a cap of 25 degrees: one loop, refined (%zu points)",
+              ok ? caps->nverts : 0);
+    TAP_CHECK(ok && 1.0 - rmin < 0.1 * sag && rmax - 1.0 < 0.1 * sag,
+              "its cap is within a tenth of the lost height (%.4f) of the sphere: radii %.4f "
+              "to %.4f", sag, rmin, rmax);
+    st_soup_free(caps);
+    st_soup_free(cut);
 }
 
 int main(int argc, char **argv)
@@ -931,6 +1019,6 @@ int main(int argc, char **argv)
     static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
                                      TAP_TEST(bend), TAP_TEST(corner), TAP_TEST(corner_pierced),
                                      TAP_TEST(area_screen), TAP_TEST(fair),
-                                     TAP_TEST(fans_merged), {0}};
+                                     TAP_TEST(fans_merged), TAP_TEST(fair_irregular), {0}};
     return tap_main(argc, argv, tests);
 }

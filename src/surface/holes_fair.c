@@ -20,10 +20,12 @@
  *      opposite them sum to more than pi); the rim's edges are never
  *      split, so the cap meets the soup exactly at the loop's points;
  *   4. fair: the interior points minimise the sum over the cap's points
- *      (the loop's included) of the squared umbrella Laplacian, the loop
- *      points' umbrellas taken over their soup neighbours and their cap
- *      neighbours together, so the cap continues the slope of the ring
- *      (a thin plate; conjugate gradients on the normal equations, one
+ *      (the loop's included) of the squared cotangent Laplacian times the
+ *      point's area (a third of its triangles'), the loop points' taken
+ *      over their soup triangles and their cap triangles together, so the
+ *      cap continues the slope of the ring (a thin plate, the discrete
+ *      bilaplacian zero at the inner points; the weights from the refined
+ *      flat cap; conjugate gradients on the normal equations, one
  *      coordinate at a time, serial: the same result for any thread
  *      count);
  *   5. check: a faired cap that pierces a kept triangle of the soup, or
@@ -473,7 +475,7 @@ static int refine(fmesh *m)
 
 /* ---- 4: fairing --------------------------------------------------------- */
 
-/* The thin plate's rows: one per cap point, the umbrella Laplacian over
+/* The thin plate's rows: one per cap point, the cotangent Laplacian over
  * the unknowns (the points past the loop's, col = point - n) in CSR, and
  * what the fixed points give (cst, 3 per row). */
 typedef struct plate {
@@ -530,9 +532,94 @@ static int cap_neighbours(const fmesh *m, size_t **ns, uint32_t **nl)
     return 1;
 }
 
-/* The rows of the plate over the refined cap m, the loop points' rows
- * taking their soup neighbours (g) too. 0: out of memory. */
-static int plate_build(plate *P, const fmesh *m, const ring *g, const uint32_t *lv)
+/* Half the cotangent of the angle at c in the triangle (c, a, b): the
+ * weight it gives the edge (a, b) (0 where the triangle is degenerate). */
+static double half_cot(const double *c, const double *a, const double *b)
+{
+    const double u[3] = {a[0] - c[0], a[1] - c[1], a[2] - c[2]};
+    const double v[3] = {b[0] - c[0], b[1] - c[1], b[2] - c[2]};
+    const double x[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                         u[0] * v[1] - u[1] * v[0]};
+    const double sn = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    return sn > 0.0 ? 0.5 * (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) / sn : 0.0;
+}
+
+static double tri_area(const double *a, const double *b, const double *c)
+{
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double x[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                         u[0] * v[1] - u[1] * v[0]};
+    return 0.5 * sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+}
+
+/* Adds w to the weight of v's cap neighbour u (ns, nl: the CSR lists). */
+static void add_nb(const size_t *ns, const uint32_t *nl, double *cw, uint32_t v, uint32_t u,
+                   double w)
+{
+    for (size_t k = ns[v]; k < ns[v + 1]; k++)
+        if (nl[k] == u) {
+            cw[k] += w;
+            return;
+        }
+}
+
+/* The cotangent weights of the cap's edges (cw, beside nl) and each
+ * point's third of its triangles' area, from the cap's triangles. */
+static void cap_cot(const fmesh *m, const size_t *ns, const uint32_t *nl, double *cw,
+                    double *area)
+{
+    for (size_t t = 0; t < m->nt; t++) {
+        const uint32_t *tv = m->v + 3 * t;
+        const double *x[3] = {m->x + 3 * (size_t)tv[0], m->x + 3 * (size_t)tv[1],
+                              m->x + 3 * (size_t)tv[2]};
+        const double a3 = tri_area(x[0], x[1], x[2]) / 3.0;
+        for (int k = 0; k < 3; k++) {
+            const uint32_t p = tv[(k + 1) % 3], q = tv[(k + 2) % 3];
+            const double w = half_cot(x[k], x[(k + 1) % 3], x[(k + 2) % 3]);
+            add_nb(ns, nl, cw, p, q, w);
+            add_nb(ns, nl, cw, q, p, w);
+            area[tv[k]] += a3;
+        }
+    }
+}
+
+/* The same for the soup's side of each loop point: the weights of its
+ * soup neighbours (sw, beside g->nb) and its soup triangles' area, from
+ * the kept triangles at it (the ring's fans). */
+static void ring_cot(const ring *g, size_t n, double *sw, double *area)
+{
+    const st_soup *s = g->ref->s;
+    const st_soup_edges *E = g->ref->E;
+    for (size_t v = 0; v < n; v++)
+        for (size_t i = 0; i < g->nt; i++) {
+            const uint32_t t = g->tris[i];
+            const int c = st_soup_edges_corner(E, s, t, g->ref->lv[v]);
+            if (c < 0)
+                continue;
+            const uint32_t *tv = s->tris + 3 * (size_t)t;
+            const double *x[3] = {s->xyz + 3 * (size_t)tv[c], s->xyz + 3 * (size_t)tv[(c + 1) % 3],
+                                  s->xyz + 3 * (size_t)tv[(c + 2) % 3]};
+            area[v] += tri_area(x[0], x[1], x[2]) / 3.0;
+            for (int j = 1; j <= 2; j++) {
+                /* the edge (v, corner j) and the angle opposite it */
+                const uint32_t u = E->weld[tv[(c + j) % 3]];
+                const double w = half_cot(x[3 - j], x[0], x[j]);
+                for (size_t k = g->nstart[v]; k < g->nstart[v + 1]; k++)
+                    if (g->nb[k] == u) {
+                        sw[k] += w;
+                        break;
+                    }
+            }
+        }
+}
+
+/* The rows of the plate over the refined cap m: each point's cotangent
+ * Laplacian (the loop points' over their soup triangles and their cap
+ * triangles together), scaled by 1 / sqrt of its area, so that the least
+ * squares' optimum is the discrete bilaplacian (C^T A^-1 C u = 0 at the
+ * inner points). 0: out of memory. */
+static int plate_build(plate *P, const fmesh *m, const ring *g)
 {
     size_t *ns = NULL;
     uint32_t *nl = NULL;
@@ -546,43 +633,45 @@ static int plate_build(plate *P, const fmesh *m, const ring *g, const uint32_t *
     P->col = st_malloc_array(ns[m->nv] + m->nv, sizeof *P->col);
     P->val = st_malloc_array(ns[m->nv] + m->nv, sizeof *P->val);
     P->cst = st_calloc_array(3 * m->nv, sizeof *P->cst);
-    int ok = P->start && P->col && P->val && P->cst;
+    double *cw = st_calloc_array(ns[m->nv] + 1, sizeof *cw);
+    double *sw = st_calloc_array(g->nn + 1, sizeof *sw);
+    double *area = st_calloc_array(m->nv, sizeof *area);
+    int ok = P->start && P->col && P->val && P->cst && cw && sw && area;
+    if (ok) {
+        cap_cot(m, ns, nl, cw, area);
+        ring_cot(g, n, sw, area);
+    }
     size_t e = 0;
     for (size_t v = 0; ok && v < m->nv; v++) {
         P->start[v] = e;
-        size_t deg = ns[v + 1] - ns[v];
-        double sum[3] = {0.0, 0.0, 0.0};
-        for (size_t k = ns[v]; k < ns[v + 1]; k++)
+        const double r = area[v] > 0.0 ? 1.0 / sqrt(area[v]) : 0.0;
+        double tw = 0.0, sum[3] = {0.0, 0.0, 0.0};
+        for (size_t k = ns[v]; k < ns[v + 1]; k++) {
+            tw += cw[k];
             if (nl[k] < n)
                 for (int q = 0; q < 3; q++)
-                    sum[q] += m->x[3 * nl[k] + q];
+                    sum[q] += cw[k] * m->x[3 * nl[k] + q];
+            else {
+                P->col[e] = (uint32_t)(nl[k] - n);
+                P->val[e++] = r * cw[k];
+            }
+        }
         if (v < n)
             for (size_t k = g->nstart[v]; k < g->nstart[v + 1]; k++) {
-                int dup = 0;        /* a loop point the cap joins already */
-                for (size_t j = ns[v]; j < ns[v + 1] && !dup; j++)
-                    dup = nl[j] < n && lv[nl[j]] == g->nb[k];
-                if (dup)
-                    continue;
-                deg++;
+                tw += sw[k];
                 for (int q = 0; q < 3; q++)
-                    sum[q] += g->nbp[k][q];
-            }
-        const double w = 1.0 / (double)deg;
-        for (size_t k = ns[v]; k < ns[v + 1]; k++)
-            if (nl[k] >= n) {
-                P->col[e] = (uint32_t)(nl[k] - n);
-                P->val[e++] = w;
+                    sum[q] += sw[k] * g->nbp[k][q];
             }
         if (v >= n) {
             P->col[e] = (uint32_t)(v - n);
-            P->val[e++] = -1.0;
+            P->val[e++] = -r * tw;
         }
         for (int q = 0; q < 3; q++)
-            P->cst[3 * v + q] = w * sum[q] - (v < n ? m->x[3 * v + q] : 0.0);
+            P->cst[3 * v + q] = r * (sum[q] - (v < n ? tw * m->x[3 * v + q] : 0.0));
     }
     if (ok)
         P->start[m->nv] = e;
-    free(ns), free(nl);
+    free(ns), free(nl), free(cw), free(sw), free(area);
     return ok;
 }
 
@@ -647,10 +736,10 @@ static void plate_solve(const plate *P, int q, double *u, double *work)
 
 /* Moves the refined cap's inner points to the thin plate. 0: out of
  * memory. */
-static int fair(fmesh *m, const ring *g, const uint32_t *lv)
+static int fair(fmesh *m, const ring *g)
 {
     plate P;
-    if (!plate_build(&P, m, g, lv)) {
+    if (!plate_build(&P, m, g)) {
         plate_free(&P);
         return 0;
     }
@@ -751,7 +840,7 @@ st_status st_holes_fair_cap(st_soup *out, int *done, const st_holes_rimref *ref,
     }
     if (refined < 0 || m.nv == n)
         goto done;
-    if (!fair(&m, &g, ref->lv)) {
+    if (!fair(&m, &g)) {
         rc = oom(err);
         goto done;
     }
