@@ -2,7 +2,8 @@
  * test_pipeline.c - the whole job in one call (pipeline.h) on a small
  * sphere: the mesh encloses it, the candidates' seeds and the winner's
  * order, the result does not depend on the thread count or on the events
- * being reported, the events come as documented, dry runs and bad
+ * being reported, the events come as documented, the candidates' threads
+ * (a batch's share them; a single one is not nested), dry runs and bad
  * parameters.
  */
 #include "souptet/lattice.h"
