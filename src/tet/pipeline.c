@@ -598,14 +598,20 @@ static void run_batch(candidate_job *jobs, size_t n)
     sigset_t all, old;
     sigfillset(&all);
     int masked = n > 1 && pthread_sigmask(SIG_BLOCK, &all, &old) == 0;
-    for (size_t i = 1; i < n; i++)
+    batch_progress *b = jobs[0].cp.b;
+    for (size_t i = 1; i < n; i++) {
         jobs[i].started = pthread_create(&jobs[i].thread, NULL, job_thread, &jobs[i]) == 0;
+        if (!jobs[i].started)
+            __atomic_sub_fetch(&b->running, 1, __ATOMIC_RELEASE);   /* not yet */
+    }
     if (masked)
         pthread_sigmask(SIG_SETMASK, &old, NULL);
     run_job(&jobs[0]);
     for (size_t i = 1; i < n; i++)
-        if (!jobs[i].started)
+        if (!jobs[i].started) {
+            __atomic_add_fetch(&b->running, 1, __ATOMIC_RELEASE);
             run_job(&jobs[i]);
+        }
     for (size_t i = 1; i < n; i++)
         if (jobs[i].started)
             pthread_join(jobs[i].thread, NULL);
