@@ -9,7 +9,7 @@
  * enclosure and a manifold boundary, never lowers the lowest score and
  * spares the tets that overlapped the pseudo volume; the swept-region
  * test (fit_swept.c, which skips whole bins) answers as a brute-force scan
- * of every S vertex. */
+ * of every S vertex; the quality pass reports each of its rounds. */
 #include "souptet/bvh.h"
 #include "souptet/enclose.h"
 #include "souptet/geom.h"
@@ -237,6 +237,43 @@ static void test_threads(void)
 #else
     TAP_CHECK(1, "1 and 3 threads give bit-identical points # SKIP no OpenMP");
 #endif
+}
+
+/* The quality pass reports each round (stage "quality", rounds done out
+ * of quality_rounds): the pipeline's candidates take threads freed by
+ * the others at these reports (pipeline.c, candidate_threads). */
+typedef struct quality_reports {
+    size_t n, inside, bad;
+} quality_reports;
+
+static void on_report(void *ctx, const char *stage, double fraction)
+{
+    quality_reports *q = ctx;
+    if (strcmp(stage, "quality") != 0)
+        return;
+    q->n++;
+    q->inside += fraction > 0 && fraction < 1;
+    q->bad += !(fraction >= 0 && fraction <= 1);
+}
+
+static void test_quality_reports(void)
+{
+    st_soup *s = st_soup_new();
+    add_sphere(s, 1.0, 2.0);
+    st_tetmesh *m = ball_mesh(0.5, 0.9);
+    st_fit_params p = st_fit_params_default();
+    p.quality_rounds = 10;
+    quality_reports q = {0, 0, 0};
+    const st_progress prog = {on_report, &q, NULL};
+    st_fit_stats st;
+    st_error err;
+    st_status rc = st_fit(m, s, NULL, &p, &st, &prog, &err);
+    TAP_CHECK(rc == ST_OK && st.quality_rounds >= 1 && q.n >= 2 + (size_t)st.quality_rounds &&
+                  q.inside >= 1 && q.bad == 0,
+              "the quality pass reports its rounds: %zu quality reports, %zu inside (0, 1) "
+              "(the last pass ran %d rounds)", q.n, q.inside, st.quality_rounds);
+    st_tetmesh_free(m);
+    st_soup_free(s);
 }
 
 static void test_not_enclosing(void)
@@ -907,7 +944,7 @@ static void test_swept(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads),
+    static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(quality_reports),
                                      TAP_TEST(not_enclosing), TAP_TEST(refusals),
                                      TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
                                      TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), TAP_TEST(stall),

@@ -2,7 +2,8 @@
  * test_pipeline.c - the whole job in one call (pipeline.h) on a small
  * sphere: the mesh encloses it, the candidates' seeds and the winner's
  * order, the result does not depend on the thread count or on the events
- * being reported, the events come as documented, dry runs and bad
+ * being reported, the events come as documented, the candidates' threads
+ * (a batch's share them; a single one is not nested), dry runs and bad
  * parameters.
  */
 #include "souptet/lattice.h"
@@ -282,6 +283,85 @@ static void test_lattice_bound(void)
     st_soup_free(s);
 }
 
+/* What the candidates' events saw of their threads: per "iteration" and
+ * "candidate" event, in order, its candidate and the thread's OpenMP
+ * settings (the event comes from the candidate's thread). */
+typedef struct thread_log {
+    size_t n;
+    struct {
+        size_t k;
+        int done, threads, level;
+    } e[8192];
+} thread_log;
+
+static void on_thread_event(void *ctx, const st_pipeline_event *ev)
+{
+    thread_log *l = ctx;
+    int done = strcmp(ev->what, "candidate") == 0;
+    if (l->n < sizeof l->e / sizeof l->e[0] && (done || strcmp(ev->what, "iteration") == 0)) {
+        l->e[l->n].k = ev->k;
+        l->e[l->n].done = done;
+        l->e[l->n].threads = omp_get_max_threads();
+        l->e[l->n].level = omp_get_level();
+        l->n++;
+    }
+}
+
+/* The candidates' threads (run_candidates): one candidate on 2 threads
+ * has both for its loops, not nested in a region of its own (a nested
+ * region starts new threads each time); two at once have one each, and
+ * once one is done the other takes both, from its next report on; the
+ * mesh is the one thread's. */
+static void test_threads(void)
+{
+    st_soup *s = sphere_soup();
+    st_pipeline_params p = sphere_params();
+    static thread_log l;
+    st_error err;
+    p.on_event = on_thread_event;
+    p.on_event_ctx = &l;
+    p.tries = 1;
+    omp_set_num_threads(2);
+    l.n = 0;
+    st_tetmesh *m = NULL;
+    st_status r = st_pipeline_run(&m, NULL, s, &p, NULL, &err);
+    int ok = r == ST_OK && l.n > 1;
+    for (size_t i = 0; i < l.n; i++)
+        ok &= l.e[i].threads == 2 && l.e[i].level == 0;
+    TAP_CHECK(ok, "one candidate, 2 threads: both for its loops, at level 0 (%zu events; "
+              "the first: %d threads, level %d)", l.n, l.n ? l.e[0].threads : 0,
+              l.n ? l.e[0].level : 0);
+    st_tetmesh_free(m);
+
+    p.tries = 2;
+    omp_set_num_threads(1);
+    st_tetmesh *m1 = NULL;
+    st_status r1 = st_pipeline_run(&m1, NULL, s, &p, NULL, &err);
+    omp_set_num_threads(2);
+    l.n = 0;
+    r = st_pipeline_run(&m, NULL, s, &p, NULL, &err);
+    size_t first_done = l.n, after = 0;
+    int shared = 1, taken = 1;
+    for (size_t i = 0; i < l.n; i++) {
+        if (l.e[i].done && first_done == l.n)
+            first_done = i;
+        else if (i < first_done)
+            shared &= l.e[i].threads == 1 && l.e[i].level == 0;
+        else if (!l.e[i].done && l.e[i - 1].k == l.e[i].k && !l.e[i - 1].done &&
+                 i - 1 > first_done)
+            taken &= l.e[i].threads == 2, after++;
+    }
+    TAP_CHECK(r == ST_OK && r1 == ST_OK && first_done < l.n && first_done > 0 && shared,
+              "two candidates, 2 threads: one each until one is done (%zu events before)",
+              first_done);
+    TAP_CHECK(taken, "then the other takes both (%zu of its events checked)", after);
+    TAP_CHECK(same_mesh(m1, m), "the same mesh as on 1 thread");
+    omp_set_num_threads(1);
+    st_tetmesh_free(m1);
+    st_tetmesh_free(m);
+    st_soup_free(s);
+}
+
 static void test_empty_soup(void)
 {
     st_pipeline_params p = sphere_params();
@@ -299,6 +379,7 @@ int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(candidate_seed), TAP_TEST(candidates),
                                      TAP_TEST(dry_run), TAP_TEST(float32), TAP_TEST(refusals),
-                                     TAP_TEST(lattice_bound), TAP_TEST(empty_soup), {0}};
+                                     TAP_TEST(lattice_bound), TAP_TEST(threads),
+                                     TAP_TEST(empty_soup), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -7,8 +7,9 @@
  * Units: model units (h, offsets, distances); angles in degrees.
  * Ownership: the caller owns *out (st_tetmesh_free) and stats->candidates
  * (free()); the soup is borrowed.
- * Threads: candidates run in parallel; the output depends only on the soup
- * and the parameters (below).
+ * Threads: candidates run in parallel (a batch's on POSIX threads the call
+ * starts and joins, signals blocked in them, besides OpenMP's); the output
+ * depends only on the soup and the parameters (below).
  * Errors: ST_EINPUT (bad parameters, an empty soup), ST_ELIMIT, ST_ENOMEM,
  * ST_ECANCELLED; no mesh on error.
  *
@@ -21,8 +22,10 @@
  * lattice with seed st_pipeline_candidate_seed(seed, k): a random rotation
  * and offset per candidate (seed 0 and k 0: the axis-aligned lattice). The
  * candidates run in batches of ST_PIPELINE_BATCH in index order, the
- * candidates of a batch in parallel (one OpenMP thread each; each
- * candidate's own loops then run on one thread). Once a batch has ended
+ * candidates of a batch at once, each on a thread of its own with its
+ * share of the threads for its own loops (one each on 2 threads); once
+ * one is done, the others take its threads for their loops (from their
+ * next fit iteration or quality round on). Once a batch has ended
  * with a candidate that meets every goal (it encloses, meets the fit's
  * stopping condition, and every tet scores at least the quality pass's
  * goal, min dihedral >= 35 degrees by default, smooth.h, and max <= 133),

@@ -18,6 +18,8 @@
 #include <errno.h>
 #include <math.h>
 #include <omp.h>
+#include <pthread.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -147,9 +149,13 @@ static void emit(const st_pipeline_params *p, st_pipeline_event *ev)
  * batch's report goes out under one lock, one call at a time. */
 typedef struct batch_progress {
     const st_progress *parent;
+    int report;               /* the parent wants reports */
     char stage[96];
     double done[ST_PIPELINE_BATCH];
     size_t n;
+    int threads;              /* the run's threads (run_candidates) */
+    int at_once;              /* the batch's candidates run at once: n, or 1 */
+    int running;              /* of those, the ones still running */
 } batch_progress;
 
 typedef struct candidate_progress {
@@ -157,9 +163,31 @@ typedef struct candidate_progress {
     size_t i;
 } candidate_progress;
 
+/* The threads of candidate cp's own loops (run_candidates): its share of
+ * the run's while others of its batch run (threads / n, the first ones
+ * one more for the remainder), all of them once it runs alone. Set on the
+ * candidate's thread (an OpenMP setting is the calling thread's), at its
+ * start and at each report of its fit and quality pass: a thread whose
+ * candidate ended early goes to the loops of the one still running. No
+ * result depends on it: every loop gives the same for any thread count. */
+static void candidate_threads(candidate_progress *cp)
+{
+    const batch_progress *b = cp->b;
+    const int n = b->at_once, i = n > 1 ? (int)cp->i : 0;
+    int want = b->threads / n + (i < b->threads % n);
+    if (__atomic_load_n(&b->running, __ATOMIC_ACQUIRE) <= 1)
+        want = b->threads;
+    if (want < 1)
+        want = 1;
+    if (omp_get_max_threads() != want)
+        omp_set_num_threads(want);
+}
+
 static void candidate_share(candidate_progress *cp, double share)
 {
     batch_progress *b = cp->b;
+    if (!b->report)
+        return;
     #pragma omp critical(st_pipeline_progress)
     {
         if (share > b->done[cp->i]) {
@@ -186,6 +214,7 @@ static double stage_share(const char *stage, double fraction)
  * iterations (relay_iter) give the fit's part instead. */
 static void candidate_relay(void *ctx, const char *stage, double fraction)
 {
+    candidate_threads(ctx);
     if (strcmp(stage, "fit") != 0)
         candidate_share(ctx, stage_share(stage, fraction));
 }
@@ -264,8 +293,9 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
         return rc;
     c->bombs = ss.bombs;
     c->bombs_left = ss.bombs_left;
-    if (prog && prog->fn == candidate_relay)
-        candidate_share(prog->ctx, 0.1);
+    candidate_progress *cp = prog && prog->fn == candidate_relay ? prog->ctx : NULL;
+    if (cp)
+        candidate_share(cp, 0.1);
     double t1 = now_seconds();
     c->seconds_sculpt = t1 - t0;
     st_pipeline_event ev;
@@ -278,8 +308,7 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
     emit(p, &ev);
 
     st_fit_params fp = st_fit_params_default();
-    iter_relay relay = {p, k, prog && prog->fn == candidate_relay ? prog->ctx : NULL,
-                        fp.quality_rounds, 0, 0, 0};
+    iter_relay relay = {p, k, cp && cp->b->report ? cp : NULL, fp.quality_rounds, 0, 0, 0};
     if (p->on_event || relay.cp) {
         fp.on_iter = relay_iter;
         fp.on_iter_ctx = &relay;
@@ -483,7 +512,7 @@ static int meets_goals(const st_pipeline_candidate *c, const st_pipeline_params 
     return angles_met(c);
 }
 
-/* Candidate k, start to end, its event included. */
+/* Candidate k, start to end (its event: candidate_event). */
 static void run_candidate(st_tetmesh **meshes, st_pipeline_stats *st, size_t k,
                           const st_grid *g, const st_soup *s, const st_bvh *bvh,
                           const st_soup *fill, double h, const st_pipeline_params *p,
@@ -503,68 +532,148 @@ static void run_candidate(st_tetmesh **meshes, st_pipeline_stats *st, size_t k,
         c->points = meshes[k]->npoints;
         dihedral_range(meshes[k], &c->min_dihedral, &c->max_dihedral);
     }
+}
+
+/* Candidate k is done: the "candidate" event. */
+static void candidate_event(const st_pipeline_stats *st, size_t k, double h,
+                            const st_pipeline_params *p)
+{
     st_pipeline_event ev;
     memset(&ev, 0, sizeof ev);
     ev.what = "candidate";
     ev.k = k;
     ev.h = h;
-    ev.tets = c->tets;
-    ev.candidate = c;
+    ev.tets = st->candidates[k].tets;
+    ev.candidate = &st->candidates[k];
     emit(p, &ev);
 }
 
+/* One candidate of a batch on the thread that runs it (run_candidates):
+ * its loops' threads, the candidate, its end. */
+typedef struct candidate_job {
+    st_tetmesh **meshes;
+    st_pipeline_stats *st;
+    size_t k;
+    const st_grid *g;
+    const st_soup *s, *fill;
+    const st_bvh *bvh;
+    double h;
+    const st_pipeline_params *p;
+    const st_progress *prog;   /* the caller's (its cancel flag) */
+    st_progress relay;         /* the candidate's (candidate_relay) */
+    candidate_progress cp;
+    pthread_t thread;
+    int started;               /* on a thread of its own */
+} candidate_job;
+
+/* Its event comes after it has left its threads to the others: what
+ * follows the event in the others' events runs with them (test_pipeline). */
+static void run_job(candidate_job *j)
+{
+    candidate_threads(&j->cp);
+    const int run = !st_progress_cancelled(j->prog);
+    if (run) {
+        run_candidate(j->meshes, j->st, j->k, j->g, j->s, j->bvh, j->fill, j->h, j->p,
+                      &j->relay);
+        candidate_share(&j->cp, 1.0);
+    }
+    __atomic_sub_fetch(&j->cp.b->running, 1, __ATOMIC_RELEASE);
+    if (run)
+        candidate_event(j->st, j->k, j->h, j->p);
+}
+
+static void *job_thread(void *arg)
+{
+    run_job(arg);
+    return NULL;
+}
+
+/* The candidates b0..b1-1 of a batch at once: the first on this thread,
+ * each other on a thread of its own (signals blocked: they stay with the
+ * caller's threads), each with its share of the threads for its own loops
+ * (candidate_threads). A thread that cannot be started leaves its
+ * candidate to this one, after the first. */
+static void run_batch(candidate_job *jobs, size_t n)
+{
+    sigset_t all, old;
+    sigfillset(&all);
+    int masked = n > 1 && pthread_sigmask(SIG_BLOCK, &all, &old) == 0;
+    batch_progress *b = jobs[0].cp.b;
+    for (size_t i = 1; i < n; i++) {
+        jobs[i].started = pthread_create(&jobs[i].thread, NULL, job_thread, &jobs[i]) == 0;
+        if (!jobs[i].started)
+            __atomic_sub_fetch(&b->running, 1, __ATOMIC_RELEASE);   /* not yet */
+    }
+    if (masked)
+        pthread_sigmask(SIG_SETMASK, &old, NULL);
+    run_job(&jobs[0]);
+    for (size_t i = 1; i < n; i++)
+        if (!jobs[i].started) {
+            __atomic_add_fetch(&b->running, 1, __ATOMIC_RELEASE);
+            run_job(&jobs[i]);
+        }
+    for (size_t i = 1; i < n; i++)
+        if (jobs[i].started)
+            pthread_join(jobs[i].thread, NULL);
+}
+
 /* The candidates (see pipeline.h): batches of ST_PIPELINE_BATCH in
- * index order, one thread per candidate when a batch has several; a
- * single candidate keeps all threads for its own loops. Each batch is a
- * stage of the progress line (batch_progress), moved by its candidates'
- * sculpts, fits and quality passes. After each batch, a candidate
- * that meets every goal ends the run: the batches do not depend on the
- * thread count, so neither does which candidates ran. st->ncandidates
- * becomes the number that ran. */
+ * index order, the candidates of a batch at once (run_batch), a single
+ * one on this thread with all threads for its own loops. A batch's
+ * candidates share the threads; once one ends, the others take its
+ * threads for their loops (candidate_threads). Each batch is a stage of
+ * the progress line (batch_progress), moved by its candidates' sculpts,
+ * fits and quality passes. After each batch, a candidate that meets
+ * every goal ends the run: the batches do not depend on the thread
+ * count, so neither does which candidates ran. st->ncandidates becomes
+ * the number that ran. */
 static void run_candidates(st_tetmesh **meshes, st_pipeline_stats *st, const st_grid *g,
                            const st_soup *s, const st_bvh *bvh, const st_soup *fill,
                            double h, const st_pipeline_params *p, const st_progress *prog)
 {
     const size_t K = st->ncandidates;
+    const int threads = omp_get_max_threads();
     size_t ran = 0;
     for (size_t b0 = 0; b0 < K && !st->goal_met; b0 += ST_PIPELINE_BATCH) {
         size_t b1 = b0 + ST_PIPELINE_BATCH < K ? b0 + ST_PIPELINE_BATCH : K;
-        int nthreads = b1 - b0 > 1 ? omp_get_max_threads() : 1;
-        if ((size_t)nthreads > b1 - b0)
-            nthreads = (int)(b1 - b0);
         batch_progress bp;
         memset(&bp, 0, sizeof bp);
         bp.parent = prog;
+        bp.report = prog && prog->fn;
         bp.n = b1 - b0;
+        bp.threads = threads;
+        bp.at_once = threads > 1 ? (int)bp.n : 1;   /* one thread: one at a time */
         if (K == 1)
             snprintf(bp.stage, sizeof bp.stage, "candidate");
         else if (b1 - b0 == 1)
             snprintf(bp.stage, sizeof bp.stage, "candidates %zu of %zu", b1, K);
         else
             snprintf(bp.stage, sizeof bp.stage, "candidates %zu-%zu of %zu", b0 + 1, b1, K);
-        candidate_progress cps[ST_PIPELINE_BATCH];
-        st_progress relays[ST_PIPELINE_BATCH];
+        candidate_job jobs[ST_PIPELINE_BATCH];
+        memset(jobs, 0, sizeof jobs);
         for (size_t i = 0; i < bp.n; i++) {
-            cps[i].b = &bp;
-            cps[i].i = i;
-            relays[i].fn = prog && prog->fn ? candidate_relay : NULL;
-            relays[i].ctx = &cps[i];
-            relays[i].cancel = prog ? prog->cancel : NULL;
+            candidate_job *j = &jobs[i];
+            *j = (candidate_job){.meshes = meshes, .st = st, .k = b0 + i, .g = g, .s = s,
+                                 .fill = fill, .bvh = bvh, .h = h, .p = p, .prog = prog,
+                                 .cp = {&bp, i}};
+            j->relay = (st_progress){candidate_relay, &j->cp, prog ? prog->cancel : NULL};
         }
         st_progress_report(prog, bp.stage, 0.0);
-        #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
-        for (size_t k = b0; k < b1; k++) {
-            if (st_progress_cancelled(prog))
-                continue;
-            run_candidate(meshes, st, k, g, s, bvh, fill, h, p, &relays[k - b0]);
-            if (relays[k - b0].fn)
-                candidate_share(&cps[k - b0], 1.0);
+        if (bp.at_once > 1) {
+            bp.running = bp.at_once;
+            run_batch(jobs, bp.n);
+        } else {
+            for (size_t i = 0; i < bp.n; i++) {
+                bp.running = 1;
+                run_job(&jobs[i]);
+            }
         }
         ran = b1;
         for (size_t k = b0; k < b1 && !p->try_all; k++)
             if (meets_goals(&st->candidates[k], p))
                 st->goal_met = 1;
     }
+    omp_set_num_threads(threads);
     st->ncandidates = ran;
 }
 

@@ -423,6 +423,8 @@ st_status sm_quality_pass(fit_ctx *c, const st_fit_params *p, double *dist,
             qual_colour(c, col, mark, &dy, &moved, &rejected);
         st->quality_rounds = round + 1;
         st->quality_moves += moved;
+        st_progress_report(c->prog, "quality",
+                           (double)(round + 1) / (double)p->quality_rounds);
         if (p->on_iter && c->s) {
             dist_summary ds = sm_boundary_distances(c, dist);
             fit_counts n = {moved, rejected, 0};
