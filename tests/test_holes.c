@@ -928,6 +928,8 @@ static void test_fans_merged(void)
                   "apexes, the closest %.3g apart (extent %.3g), %zu pairs piercing",
                   loops[i].n, ok ? bent : -1.0, loops[i].was, apexes, closest, ext, crossing);
     }
+}
+
 /* The unit sphere's triangle (a, b, c) split level times at its edges'
  * midpoints (pushed to the sphere; the same on either side of an edge, bit
  * for bit), kept where its centroid lies more than cos_keep from axis. */
