@@ -454,10 +454,11 @@ static void fan_screen(double *scr, const fan_v *v, const double *rim, size_t n)
     for (size_t i = 0; i < n; i++) {
         double e[3], *q = scr + 8 * i;
         st_sub3(e, v[i + 1 < n ? i + 1 : 0].p, v[i].p);
-        const double le = st_norm3(e), l = FAN_FAR + fabs(st_dot3(e, rim + 3 * i)) / le;
+        const double le = st_norm3(e);
+        const double l = le > 0.0 ? FAN_FAR + fabs(st_dot3(e, rim + 3 * i)) / le : INFINITY;
         memcpy(q, v[i].p, 3 * sizeof *q);
         memcpy(q + 3, rim + 3 * i, 3 * sizeof *q);
-        q[6] = le > 0.0 ? l * l : INFINITY;
+        q[6] = l * l;
     }
 }
 
