@@ -83,7 +83,7 @@
 #define CYL_SPLIT 1.5
 #define CYL_WIDE 2.0
 /* Splits per triangle, and the cap's triangles, at most. */
-#define CYL_DEPTH 12
+#define CYL_DEPTH 64
 #define CYL_MAX_TRIS 20000u
 
 static st_status oom(st_error *err)
@@ -563,9 +563,10 @@ static void at_weights(const double rt[3][3], const double *w, double *d)
  * loop's developed points) back around the axis into o: each edge but
  * the loop's spanning more than cy->step in angle is split at its
  * developed midpoint (the same midpoint from either side, so the cap
- * stays closed), the loop's points taken as they are. 0: a corner off the
- * cylinder's side of the axis, or too many triangles (o is then not a
- * cap). ST_ENOMEM through *rc. */
+ * stays closed; a triangle with two corners at one point, which covers
+ * nothing, is kept as it is), the loop's points taken as they are. 0: a
+ * corner off the cylinder's side of the axis, too many splits or
+ * triangles (o is then not a cap). ST_ENOMEM through *rc. */
 static int map_back(rcap *o, const cyl *cy, const st_soup *dev, const double *dpts, size_t n,
                     const double *const *pts, st_status *rc, st_error *err)
 {
@@ -622,7 +623,7 @@ static int map_back(rcap *o, const cyl *cy, const st_soup *dev, const double *dp
             memcpy(h[1].w[k], mw, sizeof mw);
             h[0].id[b] = h[1].id[k] = -1;
             h[0].depth = h[1].depth = t0.depth + 1;
-            ok = t0.depth < 64;
+            ok = t0.depth < CYL_DEPTH;
             if (ok && (!push_ctri(&s, &h[1]) || !push_ctri(&s, &h[0])))
                 goto nomem;
         }
