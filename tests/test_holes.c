@@ -311,8 +311,8 @@ static double capped_iou(const st_soup *s, const st_soup *whole, int capped, siz
     double iou = -1, prec, rec;
     uint8_t *truth = NULL;
     st_holes_params hp = area_params();
-    hp.bend = capped == 2;
-    hp.planes = capped == 3;
+    hp.bend = capped == 2 || capped == 4;
+    hp.planes = capped >= 3;
     st_sign_params sp = st_sign_params_default();
     if (st_dist_field(&g, s, &dp, NULL, &err) || st_soup_hole_caps(&caps, s, &hp, NULL, &err))
         goto out;
@@ -1016,11 +1016,121 @@ static void test_fair_irregular(void)
     st_soup_free(cut);
 }
 
+/* A thick ring (a washer: radii 0.5 and 1, height 0.3, NSEG facets
+ * around) as an exact soup on shared points; with cut, its outer rim and
+ * both its faces removed over the first CUT_SEG facets (an arc of a
+ * disc's rim and its faces there, issue 37's largeholes): one loop, along
+ * the bore's facets on both faces and down the rim's ends. */
+#define NSEG 64
+#define CUT_SEG 8
+static st_soup *washer(int cut)
+{
+    st_soup *s = st_soup_new();
+    static const double rad[2] = {0.5, 1.0}, hgt[2] = {0.0, 0.3};
+    for (int j = 0; j < NSEG; j++)      /* point (j, k = radius, h = height) */
+        for (int k = 0; k < 2; k++)
+            for (int h = 0; h < 2; h++) {
+                const double a = 2.0 * M_PI * j / NSEG;
+                st_soup_add_vertex(s, rad[k] * cos(a), rad[k] * sin(a), hgt[h], NULL);
+            }
+#define WV(j, k, h) ((uint32_t)((((j) % NSEG) * 2 + (k)) * 2 + (h)))
+    for (int j = 0; j < NSEG; j++) {
+        const int gone = cut && j < CUT_SEG;
+        /* each quad (a, b, c, d) in order around its outward normal */
+        const uint32_t q[4][4] = {
+            {WV(j, 0, 0), WV(j, 0, 1), WV(j + 1, 0, 1), WV(j + 1, 0, 0)},   /* bore */
+            {WV(j, 1, 0), WV(j + 1, 1, 0), WV(j + 1, 1, 1), WV(j, 1, 1)},   /* rim */
+            {WV(j, 0, 1), WV(j, 1, 1), WV(j + 1, 1, 1), WV(j + 1, 0, 1)},   /* top */
+            {WV(j, 0, 0), WV(j + 1, 0, 0), WV(j + 1, 1, 0), WV(j, 1, 0)}};  /* bottom */
+        for (int f = 0; f < 4; f++) {
+            if (gone && f > 0)
+                continue;
+            st_soup_add_triangle(s, q[f][0], q[f][1], q[f][2], NULL);
+            st_soup_add_triangle(s, q[f][0], q[f][2], q[f][3], NULL);
+        }
+    }
+#undef WV
+    return s;
+}
+
+/* Issue 37: a cap that continues a cylinder across a hole. The washer
+ * without an arc of its rim and faces: the caps of the loop's points (and
+ * the planes' fans) take the chord across the arc; the rim's cylinder,
+ * fitted from the bore's facets along the loop and continued around its
+ * axis, rebuilds the lost rim and the faces where they meet it. */
+static void test_cylinder(void)
+{
+    st_soup *whole = washer(0), *cut = washer(1), *caps = NULL;
+    st_holes_params hp = st_holes_params_default();
+    st_holes_stats hs;
+    st_error err;
+    int ok = !st_soup_hole_caps(&caps, cut, &hp, &hs, &err);
+    TAP_CHECK(ok && hs.continued && hs.loops == 1 && hs.filled == 1,
+              "the washer without an arc of its rim: one loop, capped (%zu loops, %zu capped)",
+              hs.loops, hs.filled);
+    /* the lost faces, as the soup's facets span them: the rim's strip and
+     * the two faces' sectors */
+    const double ch = 2.0 * sin(M_PI / NSEG), ap = cos(M_PI / NSEG);
+    const double lost = CUT_SEG * (0.3 * ch + 2.0 * 0.5 * ch * ap * (1.0 - 0.25));
+    if (ok) {
+        double rmax = 0.0, off = 0.0;
+        unsigned seen = 0;
+        for (size_t v = 0; v < caps->nverts; v++) {
+            const double *x = caps->xyz + 3 * v, r = hypot(x[0], x[1]);
+            rmax = fmax(rmax, r);
+            /* each cap point on the rim's cylinder, a face's plane, or the bore */
+            const double d = fmin(fmin(fabs(r - 1.0), fabs(r - 0.5)),
+                                  fmin(fabs(x[2]), fabs(x[2] - 0.3)));
+            off = fmax(off, d);
+            /* the rim's lost corners: on its circle at the arc's facets'
+             * angles */
+            const double f = atan2(x[1], x[0]) * NSEG / (2.0 * M_PI);
+            if (fabs(r - 1.0) < 1e-9 && f > 0.5 &&
+                f < CUT_SEG - 0.5 && fabs(f - nearbyint(f)) < 1e-9)
+                seen |= 1u << (int)nearbyint(f);
+        }
+        TAP_CHECK(rmax > 1.0 - 1e-9 && rmax < 1.0 + 1e-9 && off < 1e-9,
+                  "the cap reaches the rim's radius (%.6f) and lies on the rim's cylinder, "
+                  "the faces' planes and the bore (off by %.2g at most)", rmax, off);
+        const double a = soup_area(caps);
+        const int every = seen == ((1u << CUT_SEG) - 2u);    /* corners 1 .. CUT_SEG - 1 */
+        TAP_CHECK(fabs(a - lost) < 0.01 * lost && every,
+                  "its area %.4f is the lost faces' %.4f (within 1 %%), with points on the "
+                  "rim's circle at each of its lost facets' angles: %s", a, lost,
+                  every ? "yes" : "no");
+        int pierced = 0;
+        for (size_t t = 0; t < caps->ntris && !pierced; t++)
+            for (size_t u = 0; u < cut->ntris && !pierced; u++) {
+                const uint32_t *x = caps->tris + 3 * t, *y = cut->tris + 3 * u;
+                pierced = st_tri_tri_cross(caps->xyz + 3 * x[0], caps->xyz + 3 * x[1],
+                                           caps->xyz + 3 * x[2], cut->xyz + 3 * y[0],
+                                           cut->xyz + 3 * y[1], cut->xyz + 3 * y[2]);
+            }
+        TAP_CHECK(!pierced, "the cap pierces none of the soup's triangles");
+    }
+    st_soup_free(caps);
+    caps = NULL;
+    /* the whole washer has no holes; a washer cut through (no cylinder's
+     * facets with distinct normals along its loop) is capped as before */
+    ok = !st_soup_hole_caps(&caps, whole, &hp, &hs, &err);
+    TAP_CHECK(ok && hs.boundary_edges == 0 && caps->ntris == 0, "the whole washer: no caps");
+    st_soup_free(caps);
+    size_t nt = 0;
+    const double iou_whole = capped_iou(whole, whole, 1, &nt);
+    const double iou_area = capped_iou(cut, whole, 1, &nt), iou = capped_iou(cut, whole, 4, &nt);
+    TAP_CHECK(iou >= iou_whole - 0.002 && iou_area < iou_whole - 0.01,
+              "the washer without its arc signs as the whole washer: IoU %.4f (the whole %.4f, "
+              "with the least-area cap %.4f)", iou, iou_whole, iou_area);
+    st_soup_free(cut);
+    st_soup_free(whole);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
                                      TAP_TEST(bend), TAP_TEST(corner), TAP_TEST(corner_pierced),
                                      TAP_TEST(area_screen), TAP_TEST(fair),
-                                     TAP_TEST(fans_merged), TAP_TEST(fair_irregular), {0}};
+                                     TAP_TEST(fans_merged), TAP_TEST(fair_irregular),
+                                     TAP_TEST(cylinder), {0}};
     return tap_main(argc, argv, tests);
 }

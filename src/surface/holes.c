@@ -1004,7 +1004,7 @@ static double around_loop(capper *c, size_t e0)
  * cap of the loop's own points in l->tri (a flat hole's cap continues
  * them exactly): the cone from one corner or the fans from several,
  * whichever continues them better. */
-static st_status cap_planes(capper *c, int *rebuilt, st_error *err)
+static st_status cap_planes(capper *c, int *rebuilt, double *bent, st_error *err)
 {
     const loop *l = &c->l;
     const size_t n = l->n;
@@ -1026,6 +1026,7 @@ static st_status cap_planes(capper *c, int *rebuilt, st_error *err)
     if (!rc && (coned || fanned))
         rc = st_soup_append(c->out, fanned && (!coned || fb < cb) ? fans : cone, err);
     *rebuilt = !rc && (coned || fanned);
+    *bent = fanned && (!coned || fb < cb) ? fb : cb;
 done:
     st_soup_free(cone);
     st_soup_free(fans);
@@ -1068,10 +1069,19 @@ static st_status cap_loop(capper *c, size_t e0, st_error *err)
         loop_points(c, 1);
     if (c->bend && (rc = least_bend(&bent, l->pts, l->side, n, l->tri, err)))
         return rc;
-    int rebuilt = 0;
-    if (c->planes && (rc = cap_planes(c, &rebuilt, err)))
+    int rebuilt = 0, cyl = 0;
+    double rb = INFINITY;
+    const size_t vb = c->out->nverts, tb = c->out->ntris;
+    if (c->planes && (rc = cap_planes(c, &rebuilt, &rb, err)))
         return rc;
-    if (rebuilt) {
+    /* where a cylinder runs along the loop, continued across it when that
+     * continues the soup better (holes_cyl.c) */
+    const st_holes_guard guard = {c->bvh, c->E->kept};
+    if (c->planes && (rc = st_holes_cyl_cap(c->out, &cyl, vb, tb, l->pts, l->side, n,
+                                            rebuilt ? rb : rim_bend(l->pts, l->side, n, l->tri),
+                                            c->bend ? least_bend : fill_area, &guard, err)))
+        return rc;
+    if (rebuilt || cyl) {
         c->st.filled++;
         c->st.rebuilt++;
         return ST_OK;

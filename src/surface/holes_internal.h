@@ -100,6 +100,21 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
                                st_holes_fill fill, const st_holes_guard *guard, double *bent,
                                st_error *err);
 
+/* The cap of the loop pts[0..n) (side as above) where the soup's
+ * triangles along it include a cylinder (a fit certified against the
+ * loop's extent; see holes_cyl.c): the cylinder continued across the
+ * hole and rebuilt where it meets the continued planes. out holds the
+ * caps so far, the caller's cap of this loop from vertex vbase and
+ * triangle tbase on; when the cylinder's cap bends along the loop less
+ * than `below` and pierces neither guard's soup, out's triangles before
+ * tbase nor itself, it replaces the caller's (out cut back to vbase,
+ * tbase) with *done 1; else out is left as it was and *done is 0.
+ * ST_ENOMEM, ST_ELIMIT. */
+st_status st_holes_cyl_cap(st_soup *out, int *done, size_t vbase, size_t tbase,
+                           const double *const *pts, const double *const *side, size_t n,
+                           double below, st_holes_fill fill, const st_holes_guard *guard,
+                           st_error *err);
+
 /* What a faired cap reads of the soup around its loop: the soup, its edge
  * table, its BVH, and the loop's welded points (lv[0..n), one per point of
  * pts, see holes_fair.c). */
