@@ -798,63 +798,58 @@ static inline AVX_FN void solid_terms4(const __m256d a[3], const __m256d b[3], c
 }
 
 /* V products of prod_term's at once (lane l: point l's), with their turns
- * and terms. */
+ * and terms (whole numbers, exact as doubles). */
 typedef struct wprod4 {
-    __m256d re, im;
-    long turns[V];
-    size_t terms[V];
+    __m256d re, im, turns, terms;
 } wprod4;
 
-/* prod_term for the lanes of act (bit l: lane l) with their det and den:
- * returns the lanes that must take the sum instead (left as they were). */
-static inline AVX_FN int prod_term4(wprod4 *w, int act, __m256d det, __m256d den)
+/* prod_term for the lanes of act (all ones in a lane it takes) with their
+ * det and den: returns the lanes that must take the sum instead (left as
+ * they were; all ones). */
+static inline AVX_FN __m256d prod_term4(wprod4 *w, __m256d act, __m256d det, __m256d den)
 {
     const __m256d mag = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7FFFFFFFFFFFFFFFLL));
-    const __m256d zero = _mm256_setzero_pd();
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
     /* prod_term's m: |den| > |det| ? |den| : |det| (maxpd's order) */
     const __m256d m = _mm256_max_pd(_mm256_and_pd(den, mag), _mm256_and_pd(det, mag));
     const __m256d bad = _mm256_or_pd(
         _mm256_and_pd(_mm256_cmp_pd(det, zero, _CMP_EQ_OQ), _mm256_cmp_pd(den, zero, _CMP_NGT_UQ)),
         _mm256_or_pd(_mm256_cmp_pd(m, _mm256_set1_pd(0x1p-300), _CMP_NGE_UQ),
                      _mm256_cmp_pd(m, _mm256_set1_pd(0x1p300), _CMP_NLE_UQ)));
-    const int stop = act & _mm256_movemask_pd(bad), upd = act & ~stop;
-    if (!upd)
-        return stop;
+    const __m256d upd = _mm256_andnot_pd(bad, act);
     const __m256d re = S_(M_(w->re, den), M_(w->im, det));
     const __m256d im = A_(M_(w->re, det), M_(w->im, den));
     /* prod_term's turn: the old imaginary part's sign bit equal to det's
-     * and unequal to the new one's */
-    const int so = _mm256_movemask_pd(w->im), sd = _mm256_movemask_pd(det);
-    const int turn = ~(so ^ sd) & (so ^ _mm256_movemask_pd(im)) & upd;
-    for (int l = 0; turn && l < V; l++)
-        if (turn >> l & 1)
-            w->turns[l] += so >> l & 1 ? -1 : 1;
-    const __m256d u = _mm256_castsi256_pd(
-        _mm256_set_epi64x(-(long long)(upd >> 3 & 1), -(long long)(upd >> 2 & 1),
-                          -(long long)(upd >> 1 & 1), -(long long)(upd & 1)));
-    w->re = _mm256_blendv_pd(w->re, re, u);
-    w->im = _mm256_blendv_pd(w->im, im, u);
-    for (int l = 0; l < V; l++)
-        w->terms[l] += (size_t)(upd >> l & 1);
+     * and unequal to the new one's (in the sign bits); up (the old one's
+     * clear) one turn more, else one less */
+    const __m256d sign = _mm256_andnot_pd(mag, _mm256_andnot_pd(_mm256_xor_pd(w->im, det),
+                                                                 _mm256_xor_pd(w->im, im)));
+    /* (masks by and, or: GCC 12 takes blendv lane by lane) */
+    const __m256d turn = _mm256_and_pd(upd, _mm256_cmp_pd(_mm256_or_pd(sign, one), zero, _CMP_LT_OQ));
+    const __m256d step = _mm256_or_pd(_mm256_andnot_pd(mag, w->im), one);
+    w->turns = A_(w->turns, _mm256_and_pd(turn, step));
+    w->re = _mm256_or_pd(_mm256_and_pd(upd, re), _mm256_andnot_pd(upd, w->re));
+    w->im = _mm256_or_pd(_mm256_and_pd(upd, im), _mm256_andnot_pd(upd, w->im));
+    w->terms = A_(w->terms, _mm256_and_pd(upd, one));
     const __m256d r = _mm256_max_pd(_mm256_and_pd(re, mag), _mm256_and_pd(im, mag));
-    const int far = upd & _mm256_movemask_pd(
-                              _mm256_or_pd(_mm256_cmp_pd(r, _mm256_set1_pd(0x1p64), _CMP_NLE_UQ),
-                                           _mm256_cmp_pd(r, _mm256_set1_pd(0x1p-64), _CMP_NGE_UQ)));
+    const int far = _mm256_movemask_pd(_mm256_and_pd(
+        upd, _mm256_or_pd(_mm256_cmp_pd(r, _mm256_set1_pd(0x1p64), _CMP_NLE_UQ),
+                          _mm256_cmp_pd(r, _mm256_set1_pd(0x1p-64), _CMP_NGE_UQ))));
     if (far) {   /* prod_term's rescale, lane by lane */
         double vr[V], vi[V];
         _mm256_storeu_pd(vr, w->re);
         _mm256_storeu_pd(vi, w->im);
         for (int l = 0; l < V; l++)
             if (far >> l & 1) {
-                wprod one = {NULL, NULL, vr[l], vi[l], 0, 0};
-                rescale(&one);
-                vr[l] = one.re;
-                vi[l] = one.im;
+                wprod o = {NULL, NULL, vr[l], vi[l], 0, 0};
+                rescale(&o);
+                vr[l] = o.re;
+                vi[l] = o.im;
             }
         w->re = _mm256_loadu_pd(vr);
         w->im = _mm256_loadu_pd(vi);
     }
-    return stop;
+    return _mm256_and_pd(act, bad);
 }
 
 /* winding_at over ga's selection for the n (2..V) points (x[l], y, z) at
@@ -865,20 +860,26 @@ static inline AVX_FN int prod_term4(wprod4 *w, int act, __m256d det, __m256d den
 static AVX_FN void winding_quad(int8_t *out, const st_bvh *bvh, const gather *ga, const double *x,
                                 size_t n, double y, double z, double r, double scale, double cap)
 {
-    double xs[V];
-    for (size_t l = 0; l < V; l++)
+    double xs[V], ys[V], zs[V];
+    for (size_t l = 0; l < V; l++) {
         xs[l] = x[l < n ? l : n - 1];
-    const __m256d qx = _mm256_loadu_pd(xs), qy = _mm256_set1_pd(y), qz = _mm256_set1_pd(z);
+        ys[l] = y;
+        zs[l] = z;
+    }
+    /* (y and z loaded as vectors: GCC 12 takes what it sees is the same
+     * in every lane one lane at a time, then broadcasts each result) */
+    const __m256d qx = _mm256_loadu_pd(xs), qy = _mm256_loadu_pd(ys), qz = _mm256_loadu_pd(zs);
     const __m256d lox = S_(qx, _mm256_set1_pd(r)), hix = A_(qx, _mm256_set1_pd(r));
-    wprod4 w = {_mm256_set1_pd(1.0), _mm256_setzero_pd(), {0}, {0}};
-    int stop = (0xF << n) & 0xF;
-    for (size_t i = 0; i < ga->nsel && stop != 0xF; i++) {
+    const __m256d zero = _mm256_setzero_pd();
+    wprod4 w = {_mm256_set1_pd(1.0), zero, zero, zero};
+    __m256d stop = _mm256_castsi256_pd(_mm256_set_epi64x(-(long long)(n < 4), -(long long)(n < 3),
+                                                         -(long long)(n < 2), 0));
+    for (size_t i = 0; i < ga->nsel; i++) {
         const double *b = ga->v + GATHERED * (size_t)ga->sel[i];
-        const int meet = _mm256_movemask_pd(
-            _mm256_and_pd(_mm256_cmp_pd(_mm256_set1_pd(b[0]), hix, _CMP_LE_OQ),
-                          _mm256_cmp_pd(lox, _mm256_set1_pd(b[1]), _CMP_LE_OQ)));
-        const int act = meet & ~stop;
-        if (!act)
+        const __m256d act = _mm256_andnot_pd(
+            stop, _mm256_and_pd(_mm256_cmp_pd(_mm256_set1_pd(b[0]), hix, _CMP_LE_OQ),
+                                _mm256_cmp_pd(lox, _mm256_set1_pd(b[1]), _CMP_LE_OQ)));
+        if (!_mm256_movemask_pd(act))
             continue;
         const __m256d u0[3] = {S_(_mm256_set1_pd(b[4]), qx), S_(_mm256_set1_pd(b[5]), qy),
                                S_(_mm256_set1_pd(b[6]), qz)};
@@ -888,17 +889,20 @@ static AVX_FN void winding_quad(int8_t *out, const st_bvh *bvh, const gather *ga
                                S_(_mm256_set1_pd(b[12]), qz)};
         __m256d det, den;
         solid_terms4(u0, u1, u2, &det, &den);
-        stop |= prod_term4(&w, act, det, den);
+        stop = _mm256_or_pd(stop, prod_term4(&w, act, det, den));
     }
-    double vr[V], vi[V];
+    double vr[V], vi[V], vt[V], vn[V];
     _mm256_storeu_pd(vr, w.re);
     _mm256_storeu_pd(vi, w.im);
+    _mm256_storeu_pd(vt, w.turns);
+    _mm256_storeu_pd(vn, w.terms);
+    const int stopped = _mm256_movemask_pd(stop);
     for (size_t l = 0; l < n; l++) {
         const double q[3] = {x[l], y, z};
         const double lo[3] = {q[0] - r, q[1] - r, q[2] - r};
         const double hi[3] = {q[0] + r, q[1] + r, q[2] + r};
-        const wprod one = {bvh->soup, q, vr[l], vi[l], w.turns[l], w.terms[l]};
-        if (stop >> l & 1 || !prod_evidence(&one, scale, cap, &out[l]))
+        const wprod o = {bvh->soup, q, vr[l], vi[l], (long)vt[l], (size_t)vn[l]};
+        if (stopped >> l & 1 || !prod_evidence(&o, scale, cap, &out[l]))
             out[l] = winding_sum(bvh, q, lo, hi, scale, cap);
     }
 }
