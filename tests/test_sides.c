@@ -2,7 +2,8 @@
  * test_sides.c - the sides' local winding number (sides_internal.h): the
  * product of complex numbers with one arc tangent, over each point's own
  * query or over triangles gathered for a row, gives the evidence the sum
- * of arc tangents gives, also where rounding could tell them apart.
+ * of arc tangents gives, also where rounding could tell them apart, and
+ * also for points read together.
  */
 #include "../src/field/sides_internal.h"
 #include "souptet/bvh.h"
@@ -175,6 +176,36 @@ static void test_threshold(void)
     st_soup_free(s);
 }
 
+/* Points read together (how 2 reads up to four points of a row at once
+ * where the processor has AVX): a point on a triangle's centroid (its
+ * term on the negative real axis: it falls back on the sum) among 1 to 4
+ * others of its row, at each place in the row, and boxes that meet a
+ * triangle for some of the points only: the ways agree at every point. */
+static void test_together(void)
+{
+    st_soup *s = bumpy(24, 12, 0.1, 0.7);
+    st_bvh *b = bvh_of(s);
+    size_t bad = 0, nonzero = 0, points = 0;
+    for (size_t t = 0; t < s->ntris; t++) {
+        const uint32_t *v = s->tris + 3 * t;
+        double c[3];
+        for (int k = 0; k < 3; k++)
+            c[k] = (s->xyz[3 * v[0] + k] + s->xyz[3 * v[1] + k] + s->xyz[3 * v[2] + k]) / 3.0;
+        const size_t n = 2 + t % 4, on = (t / 4) % n;
+        double x[8];
+        for (size_t k = 0; k < n; k++)
+            x[k] = c[0] + 0.07 * ((double)k - (double)on);
+        bad += disagree(b, x, n, c[1], c[2], 0.05 + 0.05 * (double)(t % 3), 24.0 / (4.0 * M_PI),
+                        9.0, &nonzero);
+        points += n;
+    }
+    TAP_CHECK(bad == 0 && nonzero > points / 10,
+              "a point on a triangle among others: the ways agree (%zu of %zu differ, %zu set)",
+              bad, points, nonzero);
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
 /* The sides' evidence over a grid (blocks of rows, stretches along x,
  * runs of voxels): at every voxel that takes it, the sum's at its center;
  * 0 at the others. The grid is not a multiple of the blocks along x or y;
@@ -231,7 +262,7 @@ static void test_grid(void)
 }
 
 static const tap_test all_tests[] = {TAP_TEST(closed), TAP_TEST(agree), TAP_TEST(threshold),
-                                     TAP_TEST(grid), {0}};
+                                     TAP_TEST(together), TAP_TEST(grid), {0}};
 
 int main(int argc, char **argv)
 {

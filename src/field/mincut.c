@@ -304,11 +304,22 @@ static size_t lower_node(const uint32_t *vox, size_t lo, size_t hi, uint32_t w)
     return lo;
 }
 
-/* The capacity of the face between two voxels at unsigned distances a, b. */
-static int32_t face_cap(const st_mincut_params *p, double s, float a, float b)
+/* The capacity of a face whose nearer voxel is at unsigned distance a:
+ * the face between voxels at a and b has vox_cap(a < b ? a : b), so each
+ * node's own is taken once (node_caps) for its six faces and its
+ * neighbours'. */
+static int32_t vox_cap(const st_mincut_params *p, double s, float a)
 {
-    double x = (a < b ? a : b) / s;
+    double x = a / s;
     return 1 + (int32_t)(p->free_area * (x >= 1.0 ? 1.0 : pow(x, p->power)) + 0.5);
+}
+
+/* vox_cap of nodes [u0, u1) into cap. */
+static void node_caps(int32_t *cap, const st_grid *g, const uint32_t *vox, size_t u0, size_t u1,
+                      const st_mincut_params *p, double s)
+{
+    for (size_t u = u0; u < u1; u++)
+        cap[u] = vox_cap(p, s, fabsf(g->data[vox[u]]));
 }
 
 /* The arcs and terminal capacities of nodes [u0, u1) (vox ascending): the
@@ -316,7 +327,7 @@ static int32_t face_cap(const st_mincut_params *p, double s, float a, float b)
  * is found by a cursor that only moves forward (one binary search to
  * start it), not by a search per arc. */
 static void node_arcs(bk *b, const st_grid *g, const int8_t *label, const uint32_t *vox,
-                      size_t u0, size_t u1, const ptrdiff_t off[6],
+                      const int32_t *vcap, size_t u0, size_t u1, const ptrdiff_t off[6],
                       const st_mincut_params *p, double s, int fixed)
 {
     const size_t m = b->n;
@@ -336,7 +347,8 @@ static void node_arcs(bk *b, const st_grid *g, const int8_t *label, const uint32
                 c++;
             cur[a] = c;
             const uint32_t q = c < m && vox[c] == w ? (uint32_t)c : NO_NODE;
-            const int32_t cap = face_cap(p, s, dv, fabsf(g->data[w]));
+            const float dw = fabsf(g->data[w]);
+            const int32_t cap = dv < dw ? vcap[u] : q != NO_NODE ? vcap[q] : vox_cap(p, s, dw);
             b->nbr[6 * u + a] = q;
             b->rc[6 * u + a] = q == NO_NODE ? 0 : cap;
             if (q == NO_NODE)   /* a decided neighbour: a terminal */
@@ -414,9 +426,21 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
     /* Each node's arcs and terminal capacity (a decided neighbour's arc
      * goes to its terminal), a z layer at a time in parallel; then the
      * trees' roots in order. */
+    int32_t *vcap = malloc((m ? m : 1) * sizeof *vcap);
+    if (!vcap) {
+        free(first);
+        free(vox);
+        bk_free(&b);
+        return st_error_set(err, ST_ENOMEM, NULL, 0,
+                            "out of memory for the cut (%zu undecided voxels)", m);
+    }
+    #pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < nz; k++)
+        node_caps(vcap, g, vox, first[k], first[k + 1], p, s);
     #pragma omp parallel for schedule(dynamic, 1)
     for (size_t k = 0; k < nz; k++)
-        node_arcs(&b, g, label, vox, first[k], first[k + 1], off, p, s, fixed);
+        node_arcs(&b, g, label, vox, vcap, first[k], first[k + 1], off, p, s, fixed);
+    free(vcap);
     free(first);
     for (size_t u = 0; u < m; u++) {
         if (b.tr[u]) {

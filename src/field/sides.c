@@ -16,6 +16,9 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -722,6 +725,23 @@ static int8_t winding_sum(const st_bvh *bvh, const double q[3], const double lo[
  * partial sums, well within DRIFT (m + 4)^2 radians for m terms, in any
  * order of the terms; else by winding_sum, as it always was. */
 #define DRIFT 1e-13
+
+/* The evidence the product w reads: 1 and *e when its rounding is sure
+ * (DRIFT), else 0. */
+static int prod_evidence(const wprod *w, double scale, double cap, int8_t *e)
+{
+    const double m = (double)w->terms + 4.0;
+    const double sum = 2.0 * (atan2(w->im, w->re) + 2.0 * M_PI * (double)w->turns);
+    const double d = scale * 2.0 * DRIFT * m * m;
+    double e0 = scale * sum - d, e1 = scale * sum + d;
+    e0 = e0 > cap ? cap : e0 < -cap ? -cap : e0;
+    e1 = e1 > cap ? cap : e1 < -cap ? -cap : e1;
+    if (lround(e0) != lround(e1))
+        return 0;
+    *e = (int8_t)lround(e0);
+    return 1;
+}
+
 static int8_t winding_at(const st_bvh *bvh, const gather *ga, const double q[3], const double lo[3],
                          const double hi[3], double scale, double cap)
 {
@@ -742,18 +762,154 @@ static int8_t winding_at(const st_bvh *bvh, const gather *ga, const double q[3],
     } else {
         exact = st_bvh_query_box(bvh, lo, hi, mul_angle, &w);
     }
-    if (!exact) {
-        const double m = (double)w.terms + 4.0;
-        const double sum = 2.0 * (atan2(w.im, w.re) + 2.0 * M_PI * (double)w.turns);
-        const double d = scale * 2.0 * DRIFT * m * m;
-        double e0 = scale * sum - d, e1 = scale * sum + d;
-        e0 = e0 > cap ? cap : e0 < -cap ? -cap : e0;
-        e1 = e1 > cap ? cap : e1 < -cap ? -cap : e1;
-        if (lround(e0) == lround(e1))
-            return (int8_t)lround(e0);
-    }
+    int8_t e;
+    if (!exact && prod_evidence(&w, scale, cap, &e))
+        return e;
     return winding_sum(bvh, q, lo, hi, scale, cap);
 }
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#define SIDES_AVX 1
+#define AVX_FN __attribute__((target("avx")))
+/* V (= 4) points at once: AVX's four lanes of doubles, where the processor
+ * has it (st_sides_winding_points' how 2; the others read one point at a
+ * time). Each lane mirrors the scalar code operation for operation. */
+#define V 4
+#define M_ _mm256_mul_pd
+#define A_ _mm256_add_pd
+#define S_ _mm256_sub_pd
+
+/* solid_terms for V points at once (lane l: the corners less point l), by
+ * the same operations in the same order: each lane's det and den are
+ * solid_terms' bit for bit (no contraction: the Makefile's FP_EXACT). */
+static inline AVX_FN void solid_terms4(const __m256d a[3], const __m256d b[3], const __m256d c[3],
+                                       __m256d *det, __m256d *den)
+{
+    const __m256d la = _mm256_sqrt_pd(A_(A_(M_(a[0], a[0]), M_(a[1], a[1])), M_(a[2], a[2])));
+    const __m256d lb = _mm256_sqrt_pd(A_(A_(M_(b[0], b[0]), M_(b[1], b[1])), M_(b[2], b[2])));
+    const __m256d lc = _mm256_sqrt_pd(A_(A_(M_(c[0], c[0]), M_(c[1], c[1])), M_(c[2], c[2])));
+    *det = A_(S_(M_(a[0], S_(M_(b[1], c[2]), M_(b[2], c[1]))),
+                 M_(a[1], S_(M_(b[0], c[2]), M_(b[2], c[0])))),
+              M_(a[2], S_(M_(b[0], c[1]), M_(b[1], c[0]))));
+    const __m256d ab = A_(A_(M_(a[0], b[0]), M_(a[1], b[1])), M_(a[2], b[2]));
+    const __m256d bc = A_(A_(M_(b[0], c[0]), M_(b[1], c[1])), M_(b[2], c[2]));
+    const __m256d ca = A_(A_(M_(c[0], a[0]), M_(c[1], a[1])), M_(c[2], a[2]));
+    *den = A_(A_(A_(M_(M_(la, lb), lc), M_(ab, lc)), M_(bc, la)), M_(ca, lb));
+}
+
+/* V products of prod_term's at once (lane l: point l's), with their turns
+ * and terms (whole numbers, exact as doubles). */
+typedef struct wprod4 {
+    __m256d re, im, turns, terms;
+} wprod4;
+
+/* prod_term for the lanes of act (all ones in a lane it takes) with their
+ * det and den: returns the lanes that must take the sum instead (left as
+ * they were; all ones). */
+static inline AVX_FN __m256d prod_term4(wprod4 *w, __m256d act, __m256d det, __m256d den)
+{
+    const __m256d mag = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7FFFFFFFFFFFFFFFLL));
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
+    /* prod_term's m: |den| > |det| ? |den| : |det| (maxpd's order) */
+    const __m256d m = _mm256_max_pd(_mm256_and_pd(den, mag), _mm256_and_pd(det, mag));
+    const __m256d bad = _mm256_or_pd(
+        _mm256_and_pd(_mm256_cmp_pd(det, zero, _CMP_EQ_OQ), _mm256_cmp_pd(den, zero, _CMP_NGT_UQ)),
+        _mm256_or_pd(_mm256_cmp_pd(m, _mm256_set1_pd(0x1p-300), _CMP_NGE_UQ),
+                     _mm256_cmp_pd(m, _mm256_set1_pd(0x1p300), _CMP_NLE_UQ)));
+    const __m256d upd = _mm256_andnot_pd(bad, act);
+    const __m256d re = S_(M_(w->re, den), M_(w->im, det));
+    const __m256d im = A_(M_(w->re, det), M_(w->im, den));
+    /* prod_term's turn: the old imaginary part's sign bit equal to det's
+     * and unequal to the new one's (in the sign bits); up (the old one's
+     * clear) one turn more, else one less */
+    const __m256d sign = _mm256_andnot_pd(mag, _mm256_andnot_pd(_mm256_xor_pd(w->im, det),
+                                                                 _mm256_xor_pd(w->im, im)));
+    /* (masks by and, or: GCC 12 takes blendv lane by lane) */
+    const __m256d turn = _mm256_and_pd(upd, _mm256_cmp_pd(_mm256_or_pd(sign, one), zero, _CMP_LT_OQ));
+    const __m256d step = _mm256_or_pd(_mm256_andnot_pd(mag, w->im), one);
+    w->turns = A_(w->turns, _mm256_and_pd(turn, step));
+    w->re = _mm256_or_pd(_mm256_and_pd(upd, re), _mm256_andnot_pd(upd, w->re));
+    w->im = _mm256_or_pd(_mm256_and_pd(upd, im), _mm256_andnot_pd(upd, w->im));
+    w->terms = A_(w->terms, _mm256_and_pd(upd, one));
+    const __m256d r = _mm256_max_pd(_mm256_and_pd(re, mag), _mm256_and_pd(im, mag));
+    const int far = _mm256_movemask_pd(_mm256_and_pd(
+        upd, _mm256_or_pd(_mm256_cmp_pd(r, _mm256_set1_pd(0x1p64), _CMP_NLE_UQ),
+                          _mm256_cmp_pd(r, _mm256_set1_pd(0x1p-64), _CMP_NGE_UQ))));
+    if (far) {   /* prod_term's rescale, lane by lane */
+        double vr[V], vi[V];
+        _mm256_storeu_pd(vr, w->re);
+        _mm256_storeu_pd(vi, w->im);
+        for (int l = 0; l < V; l++)
+            if (far >> l & 1) {
+                wprod o = {NULL, NULL, vr[l], vi[l], 0, 0};
+                rescale(&o);
+                vr[l] = o.re;
+                vi[l] = o.im;
+            }
+        w->re = _mm256_loadu_pd(vr);
+        w->im = _mm256_loadu_pd(vi);
+    }
+    return _mm256_and_pd(act, bad);
+}
+
+/* winding_at over ga's selection for the n (2..V) points (x[l], y, z) at
+ * once: each lane takes the terms winding_at takes for its point, in the
+ * same order, by the same operations, so its product, turns and terms are
+ * winding_at's bit for bit, and so is its evidence (the same fallback on
+ * winding_sum). Lanes from n on copy the last point and take nothing. */
+static AVX_FN void winding_quad(int8_t *out, const st_bvh *bvh, const gather *ga, const double *x,
+                                size_t n, double y, double z, double r, double scale, double cap)
+{
+    double xs[V], ys[V], zs[V];
+    for (size_t l = 0; l < V; l++) {
+        xs[l] = x[l < n ? l : n - 1];
+        ys[l] = y;
+        zs[l] = z;
+    }
+    /* (y and z loaded as vectors: GCC 12 takes what it sees is the same
+     * in every lane one lane at a time, then broadcasts each result) */
+    const __m256d qx = _mm256_loadu_pd(xs), qy = _mm256_loadu_pd(ys), qz = _mm256_loadu_pd(zs);
+    const __m256d lox = S_(qx, _mm256_set1_pd(r)), hix = A_(qx, _mm256_set1_pd(r));
+    const __m256d zero = _mm256_setzero_pd();
+    wprod4 w = {_mm256_set1_pd(1.0), zero, zero, zero};
+    __m256d stop = _mm256_castsi256_pd(_mm256_set_epi64x(-(long long)(n < 4), -(long long)(n < 3),
+                                                         -(long long)(n < 2), 0));
+    for (size_t i = 0; i < ga->nsel; i++) {
+        const double *b = ga->v + GATHERED * (size_t)ga->sel[i];
+        const __m256d act = _mm256_andnot_pd(
+            stop, _mm256_and_pd(_mm256_cmp_pd(_mm256_set1_pd(b[0]), hix, _CMP_LE_OQ),
+                                _mm256_cmp_pd(lox, _mm256_set1_pd(b[1]), _CMP_LE_OQ)));
+        if (!_mm256_movemask_pd(act))
+            continue;
+        const __m256d u0[3] = {S_(_mm256_set1_pd(b[4]), qx), S_(_mm256_set1_pd(b[5]), qy),
+                               S_(_mm256_set1_pd(b[6]), qz)};
+        const __m256d u1[3] = {S_(_mm256_set1_pd(b[7]), qx), S_(_mm256_set1_pd(b[8]), qy),
+                               S_(_mm256_set1_pd(b[9]), qz)};
+        const __m256d u2[3] = {S_(_mm256_set1_pd(b[10]), qx), S_(_mm256_set1_pd(b[11]), qy),
+                               S_(_mm256_set1_pd(b[12]), qz)};
+        __m256d det, den;
+        solid_terms4(u0, u1, u2, &det, &den);
+        stop = _mm256_or_pd(stop, prod_term4(&w, act, det, den));
+    }
+    double vr[V], vi[V], vt[V], vn[V];
+    _mm256_storeu_pd(vr, w.re);
+    _mm256_storeu_pd(vi, w.im);
+    _mm256_storeu_pd(vt, w.turns);
+    _mm256_storeu_pd(vn, w.terms);
+    const int stopped = _mm256_movemask_pd(stop);
+    for (size_t l = 0; l < n; l++) {
+        const double q[3] = {x[l], y, z};
+        const double lo[3] = {q[0] - r, q[1] - r, q[2] - r};
+        const double hi[3] = {q[0] + r, q[1] + r, q[2] + r};
+        const wprod o = {bvh->soup, q, vr[l], vi[l], (long)vt[l], (size_t)vn[l]};
+        if (stopped >> l & 1 || !prod_evidence(&o, scale, cap, &out[l]))
+            out[l] = winding_sum(bvh, q, lo, hi, scale, cap);
+    }
+}
+#undef M_
+#undef A_
+#undef S_
+#endif
 
 /* Voxels along a row whose triangles are selected at once: at most RUN,
  * spanning at most RUN voxels. Rows gathered by one query: BLOCK of a z
@@ -770,9 +926,15 @@ static void winding_points(int8_t *out, const st_bvh *bvh, gather *ga, const dou
                            double y, double z, double r, double scale, double cap, int how)
 {
     const gather *use = how == 2 && ga && !ga->oom ? ga : NULL;
+    size_t k = 0;
     if (use)
         gather_select(ga, x[0] - r, x[n - 1] + r, y - r, y + r);
-    for (size_t k = 0; k < n; k++) {
+#ifdef SIDES_AVX
+    if (use && n >= 2 && __builtin_cpu_supports("avx"))
+        for (; k + 2 <= n; k += V)   /* V points at a time (at least 2) */
+            winding_quad(out + k, bvh, use, x + k, n - k < V ? n - k : V, y, z, r, scale, cap);
+#endif
+    for (; k < n; k++) {
         const double q[3] = {x[k], y, z};
         const double lo[3] = {q[0] - r, q[1] - r, q[2] - r};
         const double hi[3] = {q[0] + r, q[1] + r, q[2] + r};
