@@ -49,37 +49,6 @@
  * cluster larger than cluster_max bombs, or whose search exceeds
  * search_budget nodes, keeps the best choice found (never worse than
  * greedy) and is counted in clusters_greedy.
- *
- * (5) Two prunings keep the search small without changing what it finds.
- * The result of the plain search above is the first leaf, in its order,
- * of the least cost (it replaces the best only by a strictly cheaper one,
- * and prunes only subtrees that cannot be strictly cheaper); so any extra
- * pruning of subtrees that cannot beat the best so far returns the same
- * choice wherever the plain search finished.
- *   The lower bound. Below depth i the bombs i..n-1 are still to choose.
- * Let k(u) be the number of those bombs with an option that may add tet
- * u. Charge each of them, for its cheapest option, 1/k(u) of every
- * uncovered tet u of it: whatever they choose, a tet they add is charged
- * at most k(u) times 1/k(u), so the charges sum to no more than the tets
- * added, and cost + ceil(charges) >= the best prunes. The weights are
- * integers lcm/k(u) (rounded down when the lcm would pass 2^30, which
- * only weakens the bound). Only the bombs that may add a frontier tet
- * (below) can see a covered tet; the others' charges are summed once per
- * depth.
- *   The memo. What the bombs from i on add depends on the choices above i
- * only through which frontier tets - tets that an option above i and an
- * option from i on may add - are covered (the others of their options are
- * all uncovered), and so does the subtree below (the order of options is
- * by those gains). A subtree searched to the end from a state with cost
- * c, best B before and B' after, proves that the bombs from i add at
- * least B' - c from that state (exactly that when B' < B); the state
- * (depth, covered frontier bits) keeps that bound in a hash table, and a
- * later visit of the same state with cost c' prunes when c' + bound >=
- * the best. Clusters are bands along the surface in lattice order, so the
- * frontier stays small and the same states come back often (dynamic
- * programming over the band, in effect). A subtree cut by the budget
- * proves nothing and is not kept; the table stops growing at
- * SEARCH_MEMO_SLOTS entries (the search then only costs more nodes).
  */
 #include "souptet/sculpt.h"
 #include "../base/unionfind.h"
@@ -93,11 +62,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* The search memo's limits (section (5) below): slots (24 bytes each) and
- * key words (8 bytes each). */
-#define SEARCH_MEMO_SLOTS ((size_t)1 << 19)
-#define SEARCH_MEMO_WORDS ((size_t)1 << 21)
 
 st_sculpt_params st_sculpt_params_default(void)
 {
@@ -298,22 +262,6 @@ static size_t add_star(const st_lattice *L, unsigned char *keep, uint32_t v,
 
 /* ---- bomb repair ---- */
 
-/* The memo of explored search states (section (5) above): the state at
- * depth i is which frontier tets (local tets of an option of a bomb above
- * i and of an option of a bomb from i on) are covered; an entry holds a
- * lower bound on what the bombs from i on must add from it. Open
- * addressing; a full table (max_slots at half load, or max_words of keys)
- * takes no more entries, which only costs search nodes. */
-typedef struct memo {
-    size_t nslots, used, max_slots;
-    uint32_t *depth;          /* per slot: depth + 1, 0 when empty */
-    uint32_t *lb;             /* per slot: the suffix's lower bound */
-    uint64_t *hash;           /* per slot */
-    size_t *key;              /* per slot: offset of its words in pool */
-    uint64_t *pool;
-    size_t npool, cap_pool, max_words;
-} memo;
-
 /* One cluster's search state. Option o of bomb i adds the local tets
  * opt_tets[opt_off[4i+o] .. opt_off[4i+o+1]). */
 typedef struct search {
@@ -321,22 +269,11 @@ typedef struct search {
     int *nopt;                /* options per bomb */
     size_t *opt_off;          /* 4n + 1 */
     uint32_t *opt_tets;
-    size_t nloc;              /* local tets */
     uint32_t *cnt;            /* per local tet: chosen options covering it */
     int *sel, *best_sel;
     size_t cost, best_cost;
     size_t nodes, budget;
     int exhausted;
-    uint32_t *lbw;            /* n x nloc: weight of tet u from depth i, */
-    uint64_t lbl;             /*   lbl / (bombs from i that may add u) */
-    uint64_t *lb_rest;        /* n: the bound's sum over the bombs from i */
-    size_t *tb_off;           /*   that meet no frontier tet of depth i; */
-    uint32_t *tb;             /*   the others tb[tb_off[i] .. tb_off[i+1]) */
-    size_t *fr_off;           /* n + 1: the frontier tets of depth i, */
-    uint32_t *fr;             /*   fr[fr_off[i] .. fr_off[i + 1]) */
-    uint64_t *kbuf;           /* per depth: its key, words from kw_off[i] */
-    size_t *kw_off;           /* n + 1 */
-    memo M;
 } search;
 
 static size_t opt_gain(const search *S, size_t i, int o)
@@ -359,155 +296,6 @@ static void opt_apply(search *S, size_t i, int o, int sign)
     }
 }
 
-/* Bomb j's share of the bound of section (5) at depth i: its cheapest
- * option, each uncovered tet u at weight w[u]. */
-static uint64_t bound_share(const search *S, const uint32_t *w, size_t j)
-{
-    uint64_t m = UINT64_MAX;
-    for (int o = 0; o < S->nopt[j] && m; o++) {
-        uint64_t s = 0;
-        size_t a1 = S->opt_off[4 * j + (size_t)o + 1];
-        for (size_t a = S->opt_off[4 * j + (size_t)o]; a < a1; a++) {
-            uint32_t u = S->opt_tets[a];
-            if (S->cnt[u] == 0)
-                s += w[u];
-        }
-        m = s < m ? s : m;
-    }
-    return m;
-}
-
-/* The lower bound of section (5): what the bombs from i on must still add,
- * each charged, for its cheapest option, 1/k of every uncovered tet that k
- * of them may add. The bombs that meet no frontier tet see no covered
- * tet: their shares are summed once, in lb_rest[i]. */
-static size_t lower_bound(const search *S, size_t i)
-{
-    if (!S->tb_off)
-        return 0;
-    const uint32_t *w = S->lbw + i * S->nloc;
-    uint64_t sum = S->lb_rest[i];
-    for (size_t a = S->tb_off[i]; a < S->tb_off[i + 1]; a++)
-        sum += bound_share(S, w, S->tb[a]);
-    return (size_t)((sum + S->lbl - 1) / S->lbl);
-}
-
-/* The key of depth i's state into kbuf; returns its hash. */
-static uint64_t memo_key(search *S, size_t i)
-{
-    uint64_t *k = S->kbuf + S->kw_off[i];
-    size_t nw = S->kw_off[i + 1] - S->kw_off[i];
-    memset(k, 0, nw * sizeof *k);
-    for (size_t a = S->fr_off[i]; a < S->fr_off[i + 1]; a++)
-        if (S->cnt[S->fr[a]])
-            k[(a - S->fr_off[i]) / 64] |= (uint64_t)1 << ((a - S->fr_off[i]) % 64);
-    uint64_t h = 0x9e3779b97f4a7c15ull * (i + 1);
-    for (size_t w = 0; w < nw; w++) {
-        h ^= k[w] + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
-        h *= 0xff51afd7ed558ccdull;
-    }
-    return h ^ (h >> 29);
-}
-
-/* The slot of depth i's key (hash h, in kbuf): its entry, or the empty
- * slot where it would go. */
-static size_t memo_slot(const search *S, size_t i, uint64_t h)
-{
-    const memo *M = &S->M;
-    const uint64_t *k = S->kbuf + S->kw_off[i];
-    size_t nw = S->kw_off[i + 1] - S->kw_off[i];
-    size_t s = (size_t)h & (M->nslots - 1);
-    while (M->depth[s] &&
-           (M->depth[s] != i + 1 || M->hash[s] != h ||
-            memcmp(M->pool + M->key[s], k, nw * sizeof *k)))
-        s = (s + 1) & (M->nslots - 1);
-    return s;
-}
-
-/* Double the table (rehashing its entries); 0 when out of memory. */
-static int memo_grow(memo *M)
-{
-    size_t ns = M->nslots ? 2 * M->nslots : 1024;
-    memo N = *M;
-    N.nslots = ns;
-    N.depth = st_calloc_array(ns, sizeof *N.depth);
-    N.lb = st_malloc_array(ns, sizeof *N.lb);
-    N.hash = st_malloc_array(ns, sizeof *N.hash);
-    N.key = st_malloc_array(ns, sizeof *N.key);
-    if (!N.depth || !N.lb || !N.hash || !N.key) {
-        free(N.depth); free(N.lb); free(N.hash); free(N.key);
-        return 0;
-    }
-    for (size_t s = 0; s < M->nslots; s++) {
-        if (!M->depth[s])
-            continue;
-        size_t t = (size_t)M->hash[s] & (ns - 1);
-        while (N.depth[t])
-            t = (t + 1) & (ns - 1);
-        N.depth[t] = M->depth[s];
-        N.lb[t] = M->lb[s];
-        N.hash[t] = M->hash[s];
-        N.key[t] = M->key[s];
-    }
-    free(M->depth); free(M->lb); free(M->hash); free(M->key);
-    *M = N;
-    return 1;
-}
-
-/* Record that the bombs from i on add at least lb from depth i's state
- * (key in kbuf, hash h); a full table takes nothing. */
-static void memo_store(search *S, size_t i, uint64_t h, size_t lb)
-{
-    memo *M = &S->M;
-    size_t nw = S->kw_off[i + 1] - S->kw_off[i];
-    if (2 * (M->used + 1) > M->nslots &&
-        (M->nslots >= M->max_slots || !memo_grow(M)))
-        return;
-    size_t s = memo_slot(S, i, h);
-    if (!M->depth[s]) {
-        if (M->npool + nw > M->cap_pool) {
-            size_t c = M->cap_pool ? 2 * M->cap_pool : 4096;
-            while (c < M->npool + nw)
-                c *= 2;
-            uint64_t *p = c <= M->max_words ? realloc(M->pool, c * sizeof *p) : NULL;
-            if (!p)
-                return;
-            M->pool = p;
-            M->cap_pool = c;
-        }
-        memcpy(M->pool + M->npool, S->kbuf + S->kw_off[i], nw * sizeof *M->pool);
-        M->key[s] = M->npool;
-        M->npool += nw;
-        M->depth[s] = (uint32_t)(i + 1);
-        M->hash[s] = h;
-        M->lb[s] = 0;
-        M->used++;
-    }
-    if (lb > M->lb[s])
-        M->lb[s] = (uint32_t)(lb > UINT32_MAX ? UINT32_MAX : lb);
-}
-
-/* Bomb i's options from the current state, cheapest first (stable) into
- * order[], their gains into gain[]; returns the first free option (it
- * dominates every other) or -1. */
-static int dfs_order(const search *S, size_t i, size_t gain[4], int order[4])
-{
-    int no = S->nopt[i];
-    for (int o = 0; o < no; o++) {
-        gain[o] = opt_gain(S, i, o);
-        order[o] = o;
-        if (gain[o] == 0)
-            return o;
-    }
-    for (int a = 1; a < no; a++)
-        for (int b = a; b > 0 && gain[order[b]] < gain[order[b - 1]]; b--) {
-            int x = order[b];
-            order[b] = order[b - 1];
-            order[b - 1] = x;
-        }
-    return -1;
-}
-
 static void dfs(search *S, size_t i)
 {
     if (S->cost >= S->best_cost)
@@ -521,37 +309,32 @@ static void dfs(search *S, size_t i)
         S->exhausted = 1;
         return;
     }
-    if (S->cost + lower_bound(S, i) >= S->best_cost)
-        return;
-    uint64_t h = 0;
-    int memo_on = S->M.max_slots && i > 0;
-    if (memo_on) {
-        h = memo_key(S, i);
-        size_t s = S->M.nslots ? memo_slot(S, i, h) : 0;
-        if (S->M.nslots && S->M.depth[s] && S->cost + S->M.lb[s] >= S->best_cost)
-            return;
-    }
     size_t gain[4];
     int order[4], no = S->nopt[i];
-    int o = dfs_order(S, i, gain, order);
-    if (o >= 0) {
-        S->sel[i] = o;
-        dfs(S, i + 1);
-    } else
-        for (int k = 0; k < no && !S->exhausted; k++) {
-            o = order[k];
-            if (S->cost + gain[o] >= S->best_cost)
-                break;   /* sorted: the rest cost no less */
-            opt_apply(S, i, o, +1);
+    for (int o = 0; o < no; o++) {
+        gain[o] = opt_gain(S, i, o);
+        order[o] = o;
+        if (gain[o] == 0) {   /* free: dominates every other option */
             S->sel[i] = o;
             dfs(S, i + 1);
-            opt_apply(S, i, o, -1);
+            return;
         }
-    /* Searched: the suffix's best from here is best_cost - cost when it
-     * improved, else at least that (the children wrote deeper keys only,
-     * so kbuf still holds this depth's). */
-    if (memo_on && !S->exhausted)
-        memo_store(S, i, h, S->best_cost - S->cost);
+    }
+    for (int a = 1; a < no; a++)   /* cheapest first, stable */
+        for (int b = a; b > 0 && gain[order[b]] < gain[order[b - 1]]; b--) {
+            int x = order[b];
+            order[b] = order[b - 1];
+            order[b - 1] = x;
+        }
+    for (int k = 0; k < no && !S->exhausted; k++) {
+        int o = order[k];
+        if (S->cost + gain[o] >= S->best_cost)
+            break;   /* sorted: the rest cost no less */
+        opt_apply(S, i, o, +1);
+        S->sel[i] = o;
+        dfs(S, i + 1);
+        opt_apply(S, i, o, -1);
+    }
 }
 
 /* One repair round's bombs (section (2), (4) above): bomb[b] is the
@@ -659,7 +442,6 @@ static void cluster_options(bomb_round *R, search *S, size_t c0)
         }
     }
     S->opt_off[4 * S->n] = k;
-    S->nloc = nloc;
 }
 
 /* Greedy: each bomb, in order, its cheapest candidate. Leaves the choice
@@ -689,158 +471,6 @@ static size_t search_greedy(search *S)
     return S->best_cost;
 }
 
-/* The bound's weights (section (5)): lbw[i nloc + u] = lbl / k, k the
- * bombs from i on with an option that may add u; lbl the lcm of the k
- * (exact), or 2^30 with weights rounded down when it is larger (still a
- * lower bound). first[u] and last[u] get the first and last bomb that may
- * add u. Past 2^22 weights (16 MB; a cluster_max far above the default's
- * 64 bombs), no bound and no memo: the plain search. */
-static int bound_prep(search *S, uint32_t *first, uint32_t *last)
-{
-    const size_t n = S->n, nl = S->nloc;
-    uint32_t *k = st_calloc_array(nl + 1, sizeof *k);
-    uint32_t *stamp = st_calloc_array(nl + 1, sizeof *stamp);
-    S->lbw = n * nl <= ((size_t)1 << 22) ? st_malloc_array(n * nl + 1, sizeof *S->lbw) : NULL;
-    if (!k || !stamp || !S->lbw) {
-        free(k); free(stamp); free(S->lbw);
-        S->lbw = NULL;
-        return 0;
-    }
-    uint64_t l = 1;
-    for (size_t i = n; i-- > 0;) {
-        for (size_t a = S->opt_off[4 * i]; a < S->opt_off[4 * i + 4]; a++) {
-            uint32_t u = S->opt_tets[a];
-            if (stamp[u] == i + 1)
-                continue;
-            stamp[u] = (uint32_t)(i + 1);
-            if (k[u]++ == 0)
-                last[u] = (uint32_t)i;
-            first[u] = (uint32_t)i;
-            uint64_t a0 = l, b0 = k[u];
-            while (b0) {
-                uint64_t r = a0 % b0;
-                a0 = b0;
-                b0 = r;
-            }
-            if (l <= ((uint64_t)1 << 30))
-                l = l / a0 * k[u];
-        }
-        for (size_t u = 0; u < nl; u++)
-            S->lbw[i * nl + u] = k[u];   /* k for now, weights below */
-    }
-    S->lbl = l <= ((uint64_t)1 << 30) ? l : ((uint64_t)1 << 30);
-    for (size_t a = 0; a < n * nl; a++)
-        S->lbw[a] = S->lbw[a] ? (uint32_t)(S->lbl / S->lbw[a]) : 0;
-    free(k);
-    free(stamp);
-    return 1;
-}
-
-/* The frontier of each depth (section (5)) and the key buffers. */
-static int frontier_prep(search *S, const uint32_t *first, const uint32_t *last)
-{
-    const size_t n = S->n, nl = S->nloc;
-    S->fr_off = st_calloc_array(n + 1, sizeof *S->fr_off);
-    S->kw_off = st_calloc_array(n + 1, sizeof *S->kw_off);
-    if (!S->fr_off || !S->kw_off)
-        return 0;
-    for (size_t u = 0; u < nl; u++)
-        for (size_t i = first[u] + 1; i <= last[u]; i++)
-            S->fr_off[i + 1]++;
-    for (size_t i = 0; i < n; i++) {
-        S->kw_off[i + 1] = S->kw_off[i] + (S->fr_off[i + 1] + 63) / 64;
-        S->fr_off[i + 1] += S->fr_off[i];
-    }
-    S->fr = st_malloc_array(S->fr_off[n] + 1, sizeof *S->fr);
-    S->kbuf = st_malloc_array(S->kw_off[n] + 1, sizeof *S->kbuf);
-    size_t *fill = st_malloc_array(n + 1, sizeof *fill);
-    if (!S->fr || !S->kbuf || !fill) {
-        free(fill);
-        return 0;
-    }
-    memcpy(fill, S->fr_off, (n + 1) * sizeof *fill);
-    for (size_t u = 0; u < nl; u++)
-        for (size_t i = first[u] + 1; i <= last[u]; i++)
-            S->fr[fill[i]++] = (uint32_t)u;
-    free(fill);
-    return 1;
-}
-
-/* Per depth i, the bombs from i on that may add a frontier tet of depth
- * i (tb), and the bound's shares of the others, summed (lb_rest): these
- * see only uncovered tets, whatever the choices above i. */
-static int touch_prep(search *S)
-{
-    const size_t n = S->n;
-    uint32_t *stamp = st_calloc_array(S->nloc + 1, sizeof *stamp);
-    S->lb_rest = st_calloc_array(n + 1, sizeof *S->lb_rest);
-    S->tb = st_malloc_array(n * (n + 1) / 2 + 1, sizeof *S->tb);
-    size_t *off = st_calloc_array(n + 1, sizeof *off);
-    if (!stamp || !S->lb_rest || !S->tb || !off) {
-        free(stamp);
-        free(off);
-        return 0;
-    }
-    size_t k = 0;
-    for (size_t i = 0; i < n; i++) {
-        for (size_t a = S->fr_off[i]; a < S->fr_off[i + 1]; a++)
-            stamp[S->fr[a]] = (uint32_t)(i + 1);
-        for (size_t j = i; j < n; j++) {
-            int meets = 0;
-            for (size_t a = S->opt_off[4 * j]; a < S->opt_off[4 * j + 4] && !meets; a++)
-                meets = stamp[S->opt_tets[a]] == i + 1;
-            if (meets)
-                S->tb[k++] = (uint32_t)j;
-            else   /* nothing is covered in its options yet: cnt all 0 */
-                S->lb_rest[i] += bound_share(S, S->lbw + i * S->nloc, j);
-        }
-        off[i + 1] = k;
-    }
-    free(stamp);
-    S->tb_off = off;
-    return 1;
-}
-
-/* The bound and the memo for the search; 0 when out of memory (then the
- * search runs without them, as it may). */
-static int search_prep(search *S)
-{
-    uint32_t *first = st_malloc_array(S->nloc + 1, sizeof *first);
-    uint32_t *last = st_malloc_array(S->nloc + 1, sizeof *last);
-    int ok = first && last && bound_prep(S, first, last) &&
-             frontier_prep(S, first, last) && touch_prep(S);
-    free(first);
-    free(last);
-    if (ok) {
-        S->M.max_slots = SEARCH_MEMO_SLOTS;
-        S->M.max_words = SEARCH_MEMO_WORDS;
-    }
-    return ok;
-}
-
-static void search_free(search *S)
-{
-    free(S->nopt);
-    free(S->opt_off);
-    free(S->opt_tets);
-    free(S->cnt);
-    free(S->sel);
-    free(S->best_sel);
-    free(S->lbw);
-    free(S->lb_rest);
-    free(S->tb_off);
-    free(S->tb);
-    free(S->fr_off);
-    free(S->fr);
-    free(S->kbuf);
-    free(S->kw_off);
-    free(S->M.depth);
-    free(S->M.lb);
-    free(S->M.hash);
-    free(S->M.key);
-    free(S->M.pool);
-}
-
 /* The branch and bound from the greedy choice, for a cluster of at most
  * cluster_max bombs that all have a candidate: 1 when it searched every
  * choice within the budget (best_sel is then the cheapest), else 0
@@ -861,7 +491,6 @@ static int search_exact(search *S, const st_sculpt_params *p)
     for (size_t q = 0; q < n; q++)
         any_empty |= S->nopt[q] == 0;
     if (greedy_sel && !any_empty) {
-        search_prep(S);
         dfs(S, 0);
         searched = !S->exhausted;
         if (S->best_cost > greedy_cost) {   /* nothing better */
@@ -917,7 +546,12 @@ static st_status solve_cluster(bomb_round *R, size_t c0, size_t n,
         }
     }
 done:
-    search_free(&S);
+    free(S.nopt);
+    free(S.opt_off);
+    free(S.opt_tets);
+    free(S.cnt);
+    free(S.sel);
+    free(S.best_sel);
     return st;
 }
 
