@@ -405,10 +405,12 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
     b.dist = malloc((m + 1) * sizeof *b.dist);
     b.active = malloc((m + 1) * sizeof *b.active);
     b.orphan = malloc((m + 1) * sizeof *b.orphan);
+    int32_t *vcap = malloc((m ? m : 1) * sizeof *vcap);   /* each node's face capacity */
     if (!vox || !b.nbr || !b.rc || !b.tr || !b.tree || !b.parent || !b.ts || !b.dist ||
-        !b.active || !b.orphan) {
+        !b.active || !b.orphan || !vcap) {
         free(first);
         free(vox);
+        free(vcap);
         bk_free(&b);
         return st_error_set(err, ST_ENOMEM, NULL, 0,
                             "out of memory for the cut (%zu undecided voxels)", m);
@@ -423,17 +425,9 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
     const ptrdiff_t off[6] = {1, -1, (ptrdiff_t)nx, -(ptrdiff_t)nx, (ptrdiff_t)layer,
                               -(ptrdiff_t)layer};
     const double s = p->surface_voxels * g->voxel;
-    /* Each node's arcs and terminal capacity (a decided neighbour's arc
-     * goes to its terminal), a z layer at a time in parallel; then the
-     * trees' roots in order. */
-    int32_t *vcap = malloc((m ? m : 1) * sizeof *vcap);
-    if (!vcap) {
-        free(first);
-        free(vox);
-        bk_free(&b);
-        return st_error_set(err, ST_ENOMEM, NULL, 0,
-                            "out of memory for the cut (%zu undecided voxels)", m);
-    }
+    /* Each node's face capacity, then its arcs and terminal capacity (a
+     * decided neighbour's arc goes to its terminal), a z layer at a time
+     * in parallel; then the trees' roots in order. */
     #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < nz; k++)
         node_caps(vcap, g, vox, first[k], first[k + 1], p, s);
