@@ -40,10 +40,12 @@ if mode == 'eta':
     sys.exit(0 if eta > 0 else 1)
 EOF
 
-# One batch of two candidates at 20 cells, one thread: about 3 s in the
-# candidates' line (at 12 cells each batch's line took about a second, and
-# its ETA, shown past a second, came and went with the machine's load).
-SOUPTET_PROGRESS=1 soupmesh --cells 20 --tries 2 --try-all --threads 1 -o m.vtu "$BUNNY" 2>p.err
+# One batch of two candidates at 28 cells, one thread: about 3 s in the
+# candidates' line on a quiet machine (at 20 cells it took 3 s once and,
+# as the candidates got faster, under a second, too short for the ETA;
+# at 12 cells each batch's line took about a second, and its ETA, shown
+# past a second, came and went with the machine's load).
+SOUPTET_PROGRESS=1 soupmesh --cells 28 --tries 2 --try-all --threads 1 -o m.vtu "$BUNNY" 2>p.err
 ok $? "soupmesh with SOUPTET_PROGRESS=1 on a non-terminal"
 "$PYVTK" lines.py p.err monotone
 ok $? "every stage's percentage only goes up, its clock never jumps more than 2 s"
@@ -61,7 +63,9 @@ SOUPTET_PROGRESS=1 soupmesh -q --cells 4 -o q.vtu "$BUNNY" 2>q.err && ! [ -s q.e
 ok $? "... and none with -q even when forced"
 
 # Every stage moves (issue 40, item 2): on a holed soup whose run takes a
-# few seconds, with two batches of candidates, the stages come in order,
+# few seconds (22 cells: each batch about a second on a quiet machine;
+# at 12 and 16 cells a batch took under half a second and drew only
+# 3-4 percentages), with two batches of candidates, the stages come in order,
 # each batch of candidates shows distinct percentages as its candidates
 # sculpt, fit and pass for quality (before,
 # nothing moved between the distance band's 100% and the first
@@ -109,7 +113,7 @@ if any(len(pcts[w]) < 3 for w in want[2:]):
 sys.exit(0 if max(gaps or [0]) <= 2.5 else 1)
 EOF
 holed_bunny >holed.obj
-(SOUPTET_PROGRESS=1 soupmesh --cells 12 --tries 4 --try-all -o h.vtu holed.obj 2>&1 >/dev/null;
+(SOUPTET_PROGRESS=1 soupmesh --cells 22 --tries 4 --try-all -o h.vtu holed.obj 2>&1 >/dev/null;
  echo "exit $?" >&2) 2>h.rc | "$PYVTK" stamp.py h.rec
 grep -q '^exit 0$' h.rc
 ok $? "soupmesh on a holed soup, 4 candidates in 2 batches"
