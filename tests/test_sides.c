@@ -261,8 +261,77 @@ static void test_grid(void)
     st_soup_free(s);
 }
 
+/* The same soup and rows scaled by s (coordinates, boxes): the terms
+ * are taken times a power of two near 1 / r^3 (sides.c term_unit), so
+ * the product seldom needs a rescale. Scaled by a power of two the
+ * evidence is the unscaled one, by all three ways (every operation
+ * scales exactly); scaled far (terms underflowing, overflowing) the ways
+ * agree. Boxes of half-side down to 2^-700 around points on the
+ * triangles (terms near 1, a unit past the range of doubles unless it
+ * is bounded): the ways agree. */
+static void test_scales(void)
+{
+    const double by[5] = {0x1p-40, 0x1p+37, 0x1p-700, 1e-200, 3e120};
+    st_soup *s0 = bumpy(40, 20, 0.15, 0.6);
+    st_bvh *b0 = bvh_of(s0);
+    for (int f = 0; f < 5; f++) {
+        st_soup *s = bumpy(40, 20, 0.15, 0.6);
+        for (size_t i = 0; i < 3 * s->nverts; i++)
+            s->xyz[i] *= by[f];
+        st_bvh *b = bvh_of(s);
+        size_t bad = 0, moved = 0, nonzero = 0, points = 0;
+        for (int i = 0; i < 400 && b && b0; i++) {
+            const size_t n = 1 + (size_t)uniform(0.0, 8.0);
+            const double r = uniform(0.02, 0.8), step = uniform(0.01, 0.2);
+            double x[16], xs[16];
+            x[0] = uniform(-1.4, 1.4);
+            for (size_t k = 1; k < n; k++)
+                x[k] = x[k - 1] + step * (double)(1 + (k % 2));
+            for (size_t k = 0; k < n; k++)
+                xs[k] = x[k] * by[f];
+            const double y = uniform(-1.3, 1.3), z = uniform(-1.3, 1.3);
+            const double scale = 24.0 / (4.0 * M_PI);
+            bad += disagree(b, xs, n, y * by[f], z * by[f], r * by[f], scale, 9.0, &nonzero);
+            if (f < 2) {
+                int8_t e0[16], e[16];
+                st_sides_winding_points(e0, b0, x, n, y, z, r, scale, 9.0, 0);
+                for (int how = 0; how < 3; how++) {
+                    st_sides_winding_points(e, b, xs, n, y * by[f], z * by[f], r * by[f], scale,
+                                            9.0, how);
+                    for (size_t k = 0; k < n; k++)
+                        moved += e[k] != e0[k];
+                }
+            }
+            points += n;
+        }
+        TAP_CHECK(bad == 0 && moved == 0 && (f > 1 || nonzero > points / 10),
+                  "scaled by %g: the ways agree (%zu of %zu points differ, %zu moved, %zu set)",
+                  by[f], bad, points, moved, nonzero);
+        st_bvh_free(b);
+        st_soup_free(s);
+    }
+    for (int f = 0; f < 3; f++) {
+        const double r = f == 0 ? 0x1p-100 : f == 1 ? 0x1p-400 : 0x1p-700;
+        size_t bad = 0, nonzero = 0;
+        for (size_t t = 0; t < s0->ntris && b0; t++) {
+            const uint32_t *v = s0->tris + 3 * t;
+            double c[3];
+            for (int k = 0; k < 3; k++)
+                c[k] = (s0->xyz[3 * v[0] + k] + s0->xyz[3 * v[1] + k] + s0->xyz[3 * v[2] + k]) /
+                       3.0;
+            const double x[2] = {c[0], c[0] + 2.0 * r};
+            bad += disagree(b0, x, 2, c[1], c[2], r, 24.0 / (4.0 * M_PI), 9.0, &nonzero);
+        }
+        TAP_CHECK(bad == 0 && nonzero > s0->ntris / 2,
+                  "boxes of half-side %g on the triangles: the ways agree (%zu of %zu differ, "
+                  "%zu set)", r, bad, 2 * s0->ntris, nonzero);
+    }
+    st_bvh_free(b0);
+    st_soup_free(s0);
+}
+
 static const tap_test all_tests[] = {TAP_TEST(closed), TAP_TEST(agree), TAP_TEST(threshold),
-                                     TAP_TEST(together), TAP_TEST(grid), {0}};
+                                     TAP_TEST(together), TAP_TEST(grid), TAP_TEST(scales), {0}};
 
 int main(int argc, char **argv)
 {
