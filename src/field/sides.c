@@ -126,10 +126,13 @@ typedef struct wprod {
 /* The power of two each term is taken times, for a cube of half-side r:
  * 1 / r^3 to within a factor 2^3 (a term is about the cube of the point's
  * distance from the triangle). Exact: times a power of two, every
- * operation of solid_terms and of the product gives the same bits but
- * for the exponent (no term reaching it is under 2^-300 or over 2^300),
- * so the product's argument and its turns are those of the unscaled
- * terms; only the rescales (rescale) become rare where r is far from 1
+ * operation of the product gives the same bits but for the exponent (a
+ * term reaching it is within [2^-300, 2^300], the unit within 2^-600 and
+ * 2^600; only a term's part under 2^-422, an angle under 2^-120 of it,
+ * can fall under the doubles' range and then moves the product by less
+ * than its rounding, well inside DRIFT), so the product's argument and
+ * its turns are those of the unscaled terms and the evidence is the same;
+ * only the rescales (rescale) become rare where r is far from 1
  * (dragon_res3 at 7 cells: 1.1 M of 2.7 M quads' terms rescaled). */
 static double term_unit(double r)
 {
