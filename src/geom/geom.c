@@ -13,9 +13,17 @@
 
 #include <math.h>
 
+/* fmax(a, b) for a, b that are not -0 (lengths and fabs values): the
+ * other one when one is NaN, NaN when both are, else the larger. Inline,
+ * where fmax is a call into libm unless NaN is compiled away (fpenv.h). */
+static inline double max_len(double a, double b)
+{
+    return a > b || b != b ? a : b;
+}
+
 double st_norm3(const double v[3])
 {
-    double m = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
+    double m = max_len(fabs(v[0]), max_len(fabs(v[1]), fabs(v[2])));
     if (!(m > 0.0) || !isfinite(m))
         return m;
     double x = v[0] / m, y = v[1] / m, z = v[2] / m;
@@ -45,6 +53,40 @@ double st_point_segment_dist2(const double p[3], const double a[3],
     return st_dot3(d, d);
 }
 
+/* The degeneracy test of st_point_triangle_dist2 (geom.h): whether
+ * !(|n| > ST_DEGENERATE_AREA_RATIO * emax * emax), |n| and emax (the
+ * longest edge) by st_norm3; sets *nl = st_norm3(n) when it says no.
+ *
+ * Screen: where the longest edge squared (ee, a dot product) is in
+ * [2^-400, 2^400], nothing below overflows and ee * ee and the threshold
+ * t = R^2 ee^2 are normal doubles, so the dot products and st_norm3 are
+ * each within 10 rounding units (2e-15) of the exact lengths of the same
+ * rounded vectors n and e[i] (subnormal squares in n . n add at most
+ * 2^-1074 each, far below 1e-6 t >= 2^-873). The squared test n . n
+ * against t then agrees with the norms' test wherever the two sides
+ * differ by more than 1e-6 (relative): it decides those, and only the
+ * band between (and NaN, infinity, extreme scales) takes the three edge
+ * norms, the same answer in both cases, bit for bit. */
+static int tri_degenerate(const double e[3][3], const double n[3], double *nl)
+{
+    double ee = st_dot3(e[0], e[0]), e1 = st_dot3(e[1], e[1]), e2 = st_dot3(e[2], e[2]);
+    ee = e1 > ee ? e1 : ee;
+    ee = e2 > ee ? e2 : ee;
+    if (ee >= 0x1p-400 && ee <= 0x1p400) {   /* false for NaN */
+        const double t = ST_DEGENERATE_AREA_RATIO * ST_DEGENERATE_AREA_RATIO * ee * ee;
+        const double nn = st_dot3(n, n);
+        if (nn < t * (1.0 - 1e-6))
+            return 1;
+        if (nn > t * (1.0 + 1e-6)) {
+            *nl = st_norm3(n);
+            return 0;
+        }
+    }
+    double emax = max_len(st_norm3(e[0]), max_len(st_norm3(e[1]), st_norm3(e[2])));
+    *nl = st_norm3(n);
+    return !(*nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
+}
+
 double st_point_triangle_dist2(const double p[3], const double a[3],
                                const double b[3], const double c[3],
                                double closest[3])
@@ -55,9 +97,8 @@ double st_point_triangle_dist2(const double p[3], const double a[3],
     st_sub3(e[1], c, b);
     st_sub3(e[2], a, c);
     st_cross3(n, e[0], e[1]);
-    double emax = fmax(st_norm3(e[0]), fmax(st_norm3(e[1]), st_norm3(e[2])));
-    double nl = st_norm3(n);
-    int degenerate = !(nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
+    double nl = 0.0;
+    int degenerate = tri_degenerate(e, n, &nl);
     if (!degenerate)
         for (int k = 0; k < 3; k++)
             n[k] /= nl;                 /* unit normal: no under/overflow */
