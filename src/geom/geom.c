@@ -87,11 +87,38 @@ static int tri_degenerate(const double e[3][3], const double n[3], double *nl)
     return !(*nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
 }
 
+/* Whether p lies outside the edge e from v: behind the in-plane normal
+ * n x e, which points into the triangle (n its unit normal). */
+static inline int edge_outside(const double n[3], const double e[3], const double p[3],
+                               const double v[3])
+{
+    double m[3], vp[3];
+    st_cross3(m, n, e);
+    st_sub3(vp, p, v);
+    return st_dot3(vp, m) < 0.0;
+}
+
+/* The distance from p to the segment [u, w] into *best, and its closest
+ * point into closest (when not NULL), if it is below *best. */
+static inline void nearer_edge(const double p[3], const double u[3], const double w[3],
+                               double *best, double closest[3])
+{
+    double q[3];
+    const double d2 = st_point_segment_dist2(p, u, w, q);
+    if (d2 < *best) {
+        *best = d2;
+        if (closest) {
+            closest[0] = q[0];
+            closest[1] = q[1];
+            closest[2] = q[2];
+        }
+    }
+}
+
 double st_point_triangle_dist2(const double p[3], const double a[3],
                                const double b[3], const double c[3],
                                double closest[3])
 {
-    const double *v[3] = {a, b, c};
     double e[3][3], n[3];
     st_sub3(e[0], b, a);
     st_sub3(e[1], c, b);
@@ -99,21 +126,18 @@ double st_point_triangle_dist2(const double p[3], const double a[3],
     st_cross3(n, e[0], e[1]);
     double nl = 0.0;
     int degenerate = tri_degenerate(e, n, &nl);
-    if (!degenerate)
-        for (int k = 0; k < 3; k++)
-            n[k] /= nl;                 /* unit normal: no under/overflow */
+    if (!degenerate) {   /* unit normal: no under/overflow */
+        n[0] /= nl;
+        n[1] /= nl;
+        n[2] /= nl;
+    }
 
     int outside[3] = {1, 1, 1};
     if (!degenerate) {
-        int inside = 1;
-        for (int i = 0; i < 3; i++) {
-            double m[3], vp[3];
-            st_cross3(m, n, e[i]);      /* in-plane, points into the triangle */
-            st_sub3(vp, p, v[i]);
-            outside[i] = st_dot3(vp, m) < 0.0;
-            inside &= !outside[i];
-        }
-        if (inside) {
+        outside[0] = edge_outside(n, e[0], p, a);
+        outside[1] = edge_outside(n, e[1], p, b);
+        outside[2] = edge_outside(n, e[2], p, c);
+        if (!(outside[0] | outside[1] | outside[2])) {
             double ap[3];
             st_sub3(ap, p, a);
             double s = st_dot3(ap, n);
@@ -125,19 +149,12 @@ double st_point_triangle_dist2(const double p[3], const double a[3],
             return s * s;
         }
     }
-    double best = INFINITY, q[3];
-    for (int i = 0; i < 3; i++) {
-        if (!outside[i])
-            continue;
-        double d2 = st_point_segment_dist2(p, v[i], v[(i + 1) % 3], q);
-        if (d2 < best) {
-            best = d2;
-            if (closest) {
-                closest[0] = q[0];
-                closest[1] = q[1];
-                closest[2] = q[2];
-            }
-        }
-    }
+    double best = INFINITY;   /* the edges in order ab, bc, ca; the first of equals */
+    if (outside[0])
+        nearer_edge(p, a, b, &best, closest);
+    if (outside[1])
+        nearer_edge(p, b, c, &best, closest);
+    if (outside[2])
+        nearer_edge(p, c, a, &best, closest);
     return best;
 }
