@@ -336,6 +336,166 @@ static void test_bvh_nearest_exact(void)
     st_soup_free(s);
 }
 
+/* The nearest walk as it was before its box distances went two lanes at
+ * a time and before the leaf triangles' box test: depth first, the nearer
+ * child first (the farther pushed first), a node skipped when its box
+ * distance is no longer below the best, every leaf triangle measured. The
+ * first triangle visited at the least distance wins: the tie rule
+ * st_bvh_nearest must keep, bit for bit. */
+static double ref_box_dist2(const st_bvh_node *n, const double p[3])
+{
+    double d2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        const double below = n->lo[a] - p[a], above = p[a] - n->hi[a];
+        const double d = (below > 0.0 ? below : 0.0) + (above > 0.0 ? above : 0.0);
+        d2 += d * d;
+    }
+    return d2;
+}
+
+static double ref_nearest(const st_bvh *b, const double p[3], double max_d2, int64_t *tri,
+                          double closest[3])
+{
+    const st_soup *s = b->soup;
+    double best = max_d2, sd2[128];
+    uint32_t stack[128];
+    int sp = 0;
+    *tri = -1;
+    if (ref_box_dist2(&b->nodes[0], p) < best) {
+        sd2[sp] = ref_box_dist2(&b->nodes[0], p);
+        stack[sp++] = 0;
+    }
+    while (sp > 0) {
+        sp--;
+        if (sd2[sp] >= best)
+            continue;
+        const st_bvh_node *n = &b->nodes[stack[sp]];
+        for (uint32_t i = 0; i < n->count; i++) {
+            uint32_t t = b->order[n->start + i];
+            const uint32_t *v = s->tris + 3 * (size_t)t;
+            double q[3];
+            double d2 = st_point_triangle_dist2(p, s->xyz + 3 * (size_t)v[0],
+                                                s->xyz + 3 * (size_t)v[1],
+                                                s->xyz + 3 * (size_t)v[2], q);
+            if (d2 < best) {
+                best = d2;
+                *tri = t;
+                memcpy(closest, q, sizeof q);
+            }
+        }
+        if (n->count)
+            continue;
+        uint32_t l = n->start, r = n->start + 1;
+        double dl = ref_box_dist2(&b->nodes[l], p), dr = ref_box_dist2(&b->nodes[r], p);
+        if (dl > dr) {
+            uint32_t t = l;
+            l = r;
+            r = t;
+            double d = dl;
+            dl = dr;
+            dr = d;
+        }
+        if (dr < best) {
+            sd2[sp] = dr;
+            stack[sp++] = r;
+        }
+        if (dl < best) {
+            sd2[sp] = dl;
+            stack[sp++] = l;
+        }
+    }
+    return best;
+}
+
+/* Ties and degenerate triangles: a grid of squares, each split in two
+ * (shared edges and vertices: points equidistant from several triangles),
+ * every third triangle also twice more (exact duplicates), collinear,
+ * repeated-vertex and one-point triangles, slivers and random ones.
+ * Points on the grid's vertices and edges, just off them, far away (up to
+ * 1e6 times the soup's size) and along the axes through vertices (equal
+ * box distances of sibling nodes), with bounds from none to nothing:
+ * st_bvh_nearest gives the reference walk's distance, triangle and
+ * closest point bit for bit, and the distance is the brute force least
+ * one, bit for bit. */
+static void test_bvh_nearest_ties(void)
+{
+    st_soup *s = st_soup_new();
+    const int G = 24;
+    for (int j = 0; j <= G; j++)
+        for (int i = 0; i <= G; i++)
+            st_soup_add_vertex(s, i / (double)G, j / (double)G, 0.5, NULL);
+    for (int j = 0; j < G; j++)
+        for (int i = 0; i < G; i++) {
+            uint32_t a = (uint32_t)(j * (G + 1) + i), b = a + 1, c = a + (uint32_t)G + 1,
+                     d = c + 1;
+            for (int r = 0; r < ((i + j) % 3 == 0 ? 3 : 1); r++) {
+                st_soup_add_triangle(s, a, b, d, NULL);
+                st_soup_add_triangle(s, a, d, c, NULL);
+            }
+        }
+    for (int k = 0; k < 60; k++) {
+        double c[3] = {urand(), urand(), urand()};
+        add_random_triangle(s, c, k % 4 == 0 ? 0.5 : 0.05, k % 3 == 0);
+        if (k % 5 == 0) {   /* a repeated vertex, and a point */
+            uint32_t v = (uint32_t)(s->nverts - 1);
+            st_soup_add_triangle(s, v, v - 1, v - 1, NULL);
+            st_soup_add_triangle(s, v, v, v, NULL);
+        }
+    }
+    st_bvh *b;
+    st_error err;
+    TAP_CHECK(st_bvh_build(&b, s, &err) == ST_OK, "bvh build (ties)");
+    static const double bounds[] = {INFINITY, 1e-2, 1e-6, 0.0};
+    size_t bad = 0, bad_ref = 0, queries = 0, ties = 0;
+    for (int i = 0; i < 2500; i++) {
+        double p[3];
+        const int kind = i % 5;
+        const double gx = (double)(i % (G + 1)) / G, gy = (double)((i / 7) % (G + 1)) / G;
+        if (kind == 0) {   /* a grid vertex, at a height */
+            p[0] = gx, p[1] = gy, p[2] = 0.5 + (i % 2 ? 0.0 : 0.1 * urand());
+        } else if (kind == 1) {   /* a grid edge's midpoint, a little off it */
+            p[0] = gx + 0.5 / G, p[1] = gy, p[2] = 0.5 + 1e-9 * (urand() - 0.5);
+        } else if (kind == 2) {   /* far away */
+            const double far = pow(10.0, 1 + (i % 6));
+            p[0] = far * (urand() - 0.5), p[1] = far * (urand() - 0.5), p[2] = far * (urand() - 0.5);
+        } else if (kind == 3) {   /* along an axis through a vertex */
+            p[0] = gx, p[1] = gy, p[2] = (i % 2 ? -1.0 : 2.0) * urand();
+        } else {
+            p[0] = urand() * 1.6 - 0.3, p[1] = urand() * 1.6 - 0.3, p[2] = urand() * 1.6 - 0.3;
+        }
+        for (size_t j = 0; j < sizeof bounds / sizeof *bounds; j++, queries++) {
+            double q[3] = {0, 0, 0}, rq[3] = {0, 0, 0}, want = bounds[j];
+            int64_t tri, rtri;
+            size_t at_min = 0;
+            for (size_t t = 0; t < s->ntris; t++) {
+                const uint32_t *u = s->tris + 3 * t;
+                double d2 = st_point_triangle_dist2(p, s->xyz + 3 * (size_t)u[0],
+                                                    s->xyz + 3 * (size_t)u[1],
+                                                    s->xyz + 3 * (size_t)u[2], NULL);
+                if (d2 < want) {
+                    want = d2;
+                    at_min = 1;
+                } else if (d2 == want)
+                    at_min++;
+            }
+            ties += at_min > 1;
+            double got = st_bvh_nearest(b, p, bounds[j], &tri, q);
+            double ref = ref_nearest(b, p, bounds[j], &rtri, rq);
+            bad += memcmp(&got, &want, sizeof got) != 0;
+            bad_ref += memcmp(&got, &ref, sizeof got) != 0 || tri != rtri ||
+                       memcmp(q, rq, sizeof q) != 0;
+        }
+    }
+    TAP_CHECK(bad == 0, "bvh nearest with ties: the brute force least distance bit for bit "
+              "(%zu of %zu differ)", bad, queries);
+    TAP_CHECK(bad_ref == 0 && ties > queries / 10,
+              "bvh nearest with ties: the reference walk's triangle and closest point, the "
+              "first visited at the least distance (%zu of %zu differ; %zu with ties)",
+              bad_ref, queries, ties);
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
 /* A BVH over enough triangles to be built by parallel tasks has the
  * serial build's layout: inner nodes numbered depth first, the right
  * child's subtree before the left's, leaves of at most ST_BVH_LEAF slots
@@ -647,7 +807,8 @@ int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(layout), TAP_TEST(band_exact_on_random_soup),
                                      TAP_TEST(large_oblique_triangle), TAP_TEST(bvh_nearest),
-                                     TAP_TEST(bvh_nearest_exact), TAP_TEST(bvh_parallel_layout),
+                                     TAP_TEST(bvh_nearest_exact), TAP_TEST(bvh_nearest_ties),
+                                     TAP_TEST(bvh_parallel_layout),
                                      TAP_TEST(threads_identical), TAP_TEST(fine_soup_exact),
                                      TAP_TEST(real_model), TAP_TEST(blocks_equal_dense), {0}};
     return tap_main(argc, argv, tests);

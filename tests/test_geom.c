@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* The right triangle (0,0,0) (1,0,0) (0,1,0): known answers in each of its
  * seven Voronoi regions, at height z = 2. */
@@ -130,9 +131,134 @@ static void test_segment(void)
     TAP_NEAR(st_point_segment_dist2(p1, a, a, NULL), 2.0, 0, "zero-length segment");
 }
 
+/* The degeneracy test as it was decided before the squared-length screen
+ * (geom.c's tri_degenerate): the three edge norms and the normal's, all by
+ * st_norm3, the threshold ST_DEGENERATE_AREA_RATIO * emax^2; then the same
+ * distance as st_point_triangle_dist2 (face, or the edges p lies outside
+ * of). The reference the screened routine must match bit for bit. */
+static double ref_tri_dist2(const double p[3], const double a[3], const double b[3],
+                            const double c[3], double closest[3])
+{
+    const double *v[3] = {a, b, c};
+    double e[3][3], n[3];
+    st_sub3(e[0], b, a);
+    st_sub3(e[1], c, b);
+    st_sub3(e[2], a, c);
+    st_cross3(n, e[0], e[1]);
+    double emax = fmax(st_norm3(e[0]), fmax(st_norm3(e[1]), st_norm3(e[2])));
+    double nl = st_norm3(n);
+    int degenerate = !(nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
+    int outside[3] = {1, 1, 1}, inside = !degenerate;
+    if (!degenerate) {
+        for (int k = 0; k < 3; k++)
+            n[k] /= nl;
+        for (int i = 0; i < 3; i++) {
+            double m[3], vp[3];
+            st_cross3(m, n, e[i]);
+            st_sub3(vp, p, v[i]);
+            outside[i] = st_dot3(vp, m) < 0.0;
+            inside &= !outside[i];
+        }
+    }
+    if (inside) {
+        double ap[3];
+        st_sub3(ap, p, a);
+        double s = st_dot3(ap, n);
+        for (int k = 0; k < 3; k++)
+            closest[k] = p[k] - s * n[k];
+        return s * s;
+    }
+    double best = INFINITY, q[3];
+    for (int i = 0; i < 3; i++)
+        if (outside[i]) {
+            double d2 = st_point_segment_dist2(p, v[i], v[(i + 1) % 3], q);
+            if (d2 < best) {
+                best = d2;
+                for (int k = 0; k < 3; k++)
+                    closest[k] = q[k];
+            }
+        }
+    return best;
+}
+
+/* Triangles right at the degeneracy threshold (height within 1e-5
+ * relative of ST_DEGENERATE_AREA_RATIO times the base: both sides of it,
+ * in and beyond the screen's undecided band), slivers, collinear and
+ * repeated vertices, random ones, at scales from 1e-200 to 1e200 (and
+ * with infinite and NaN coordinates): st_point_triangle_dist2 gives the
+ * reference's distance and closest point, bit for bit. */
+static void test_screen_bit_identical(void)
+{
+    unsigned seed = 4242;
+    static const double scales[] = {1e-200, 1e-120, 1e-30, 1e-3, 1.0, 7.0, 1e30, 1e120, 1e200};
+    size_t bad = 0, cases = 0, degenerate = 0, flat = 0;
+    for (size_t si = 0; si < sizeof scales / sizeof *scales; si++) {
+        const double sc = scales[si];
+        for (int t = 0; t < 4000; t++) {
+            double v[3][3], p[3];
+            for (int k = 0; k < 3; k++)
+                for (int a = 0; a < 3; a++)
+                    v[k][a] = sc * (urand(&seed) * 2 - 1);
+            const int kind = t % 5;
+            if (kind <= 1) {   /* near the threshold: base L along u, height h along w */
+                double L = sc * (0.5 + urand(&seed)), rel = (urand(&seed) * 2 - 1) * 1e-5;
+                if (kind == 1)
+                    rel *= 1e-3;   /* inside the +-1e-6 band */
+                double h = ST_DEGENERATE_AREA_RATIO * L * (1.0 + rel);
+                double mid = 0.2 + 0.6 * urand(&seed);
+                for (int a = 0; a < 3; a++) {
+                    v[1][a] = v[0][a] + (a == t % 3 ? L : 0.0);
+                    v[2][a] = v[0][a] + (a == t % 3 ? mid * L : 0.0) + (a == (t + 1) % 3 ? h : 0.0);
+                }
+            } else if (kind == 2) {   /* collinear, or a repeated vertex */
+                for (int a = 0; a < 3; a++)
+                    v[2][a] = t % 2 ? v[1][a] : v[0][a] + 0.5 * (v[1][a] - v[0][a]);
+            }
+            for (int a = 0; a < 3; a++)   /* around the triangle and across it */
+                p[a] = (v[0][a] + v[1][a] + v[2][a]) / 3.0 + sc * (urand(&seed) * 2 - 1) *
+                                                                   (t % 3 ? 1e-6 : 1.0);
+            double q[3] = {0, 0, 0}, rq[3] = {0, 0, 0};
+            double d2 = st_point_triangle_dist2(p, v[0], v[1], v[2], q);
+            double r2 = ref_tri_dist2(p, v[0], v[1], v[2], rq);
+            cases++;
+            bad += memcmp(&d2, &r2, sizeof d2) != 0 || memcmp(q, rq, sizeof q) != 0;
+            double e[3][3], n[3];
+            st_sub3(e[0], v[1], v[0]);
+            st_sub3(e[1], v[2], v[1]);
+            st_sub3(e[2], v[0], v[2]);
+            st_cross3(n, e[0], e[1]);
+            double emax = fmax(st_norm3(e[0]), fmax(st_norm3(e[1]), st_norm3(e[2])));
+            int dg = !(st_norm3(n) > ST_DEGENERATE_AREA_RATIO * emax * emax);
+            degenerate += dg;
+            flat += kind <= 1 && !dg;
+        }
+    }
+    const double big = 1e300, inf = INFINITY, nan = NAN;
+    const double odd[][3][3] = {
+        {{-big, 0, 0}, {big, 0, 0}, {0, big, 0}},   /* edges overflow */
+        {{0, 0, 0}, {inf, 0, 0}, {0, 1, 0}},
+        {{0, 0, 0}, {1, nan, 0}, {0, 1, 0}},
+        {{0, 0, 0}, {4.9e-324, 0, 0}, {0, 4.9e-324, 0}},   /* subnormal */
+    };
+    for (size_t i = 0; i < sizeof odd / sizeof *odd; i++) {
+        const double p[3] = {0.25, 0.25, 1.0};
+        double q[3] = {0, 0, 0}, rq[3] = {0, 0, 0};
+        double d2 = st_point_triangle_dist2(p, odd[i][0], odd[i][1], odd[i][2], q);
+        double r2 = ref_tri_dist2(p, odd[i][0], odd[i][1], odd[i][2], rq);
+        cases++;
+        bad += memcmp(&d2, &r2, sizeof d2) != 0 || memcmp(q, rq, sizeof q) != 0;
+    }
+    TAP_CHECK(bad == 0, "screened degeneracy test: bit for bit the four-norm reference "
+              "(%zu of %zu differ)", bad, cases);
+    TAP_CHECK(degenerate > cases / 5 && flat > cases / 20,
+              "the cases cover both sides of the threshold (%zu degenerate, %zu flat but not)",
+              degenerate, flat);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(voronoi_regions), TAP_TEST(degenerate_triangles),
-                                     TAP_TEST(segment), TAP_TEST(random_against_sampling), {0}};
+                                     TAP_TEST(segment), TAP_TEST(random_against_sampling),
+                                     TAP_TEST(screen_bit_identical), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -13,9 +13,17 @@
 
 #include <math.h>
 
+/* fmax(a, b) for a, b that are not -0 (lengths and fabs values): the
+ * other one when one is NaN, NaN when both are, else the larger. Inline,
+ * where fmax is a call into libm unless NaN is compiled away (fpenv.h). */
+static inline double max_len(double a, double b)
+{
+    return a > b || b != b ? a : b;
+}
+
 double st_norm3(const double v[3])
 {
-    double m = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
+    double m = max_len(fabs(v[0]), max_len(fabs(v[1]), fabs(v[2])));
     if (!(m > 0.0) || !isfinite(m))
         return m;
     double x = v[0] / m, y = v[1] / m, z = v[2] / m;
@@ -45,34 +53,91 @@ double st_point_segment_dist2(const double p[3], const double a[3],
     return st_dot3(d, d);
 }
 
+/* The degeneracy test of st_point_triangle_dist2 (geom.h): whether
+ * !(|n| > ST_DEGENERATE_AREA_RATIO * emax * emax), |n| and emax (the
+ * longest edge) by st_norm3; sets *nl = st_norm3(n) when it says no.
+ *
+ * Screen: where the longest edge squared (ee, a dot product) is in
+ * [2^-400, 2^400], nothing below overflows and ee * ee and the threshold
+ * t = R^2 ee^2 are normal doubles, so the dot products and st_norm3 are
+ * each within 10 rounding units (2e-15) of the exact lengths of the same
+ * rounded vectors n and e[i] (subnormal squares in n . n add at most
+ * 2^-1074 each, far below 1e-6 t >= 2^-873). The squared test n . n
+ * against t then agrees with the norms' test wherever the two sides
+ * differ by more than 1e-6 (relative): it decides those, and only the
+ * band between (and NaN, infinity, extreme scales) takes the three edge
+ * norms, the same answer in both cases, bit for bit. */
+static int tri_degenerate(const double e[3][3], const double n[3], double *nl)
+{
+    double ee = st_dot3(e[0], e[0]), e1 = st_dot3(e[1], e[1]), e2 = st_dot3(e[2], e[2]);
+    ee = e1 > ee ? e1 : ee;
+    ee = e2 > ee ? e2 : ee;
+    if (ee >= 0x1p-400 && ee <= 0x1p400) {   /* false for NaN */
+        const double t = ST_DEGENERATE_AREA_RATIO * ST_DEGENERATE_AREA_RATIO * ee * ee;
+        const double nn = st_dot3(n, n);
+        if (nn < t * (1.0 - 1e-6))
+            return 1;
+        if (nn > t * (1.0 + 1e-6)) {
+            *nl = st_norm3(n);
+            return 0;
+        }
+    }
+    double emax = max_len(st_norm3(e[0]), max_len(st_norm3(e[1]), st_norm3(e[2])));
+    *nl = st_norm3(n);
+    return !(*nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
+}
+
+/* Whether p lies outside the edge e from v: behind the in-plane normal
+ * n x e, which points into the triangle (n its unit normal). */
+static inline int edge_outside(const double n[3], const double e[3], const double p[3],
+                               const double v[3])
+{
+    double m[3], vp[3];
+    st_cross3(m, n, e);
+    st_sub3(vp, p, v);
+    return st_dot3(vp, m) < 0.0;
+}
+
+/* The distance from p to the segment [u, w] into *best, and its closest
+ * point into closest (when not NULL), if it is below *best. */
+static inline void nearer_edge(const double p[3], const double u[3], const double w[3],
+                               double *best, double closest[3])
+{
+    double q[3];
+    const double d2 = st_point_segment_dist2(p, u, w, q);
+    if (d2 < *best) {
+        *best = d2;
+        if (closest) {
+            closest[0] = q[0];
+            closest[1] = q[1];
+            closest[2] = q[2];
+        }
+    }
+}
+
 double st_point_triangle_dist2(const double p[3], const double a[3],
                                const double b[3], const double c[3],
                                double closest[3])
 {
-    const double *v[3] = {a, b, c};
     double e[3][3], n[3];
     st_sub3(e[0], b, a);
     st_sub3(e[1], c, b);
     st_sub3(e[2], a, c);
     st_cross3(n, e[0], e[1]);
-    double emax = fmax(st_norm3(e[0]), fmax(st_norm3(e[1]), st_norm3(e[2])));
-    double nl = st_norm3(n);
-    int degenerate = !(nl > ST_DEGENERATE_AREA_RATIO * emax * emax);
-    if (!degenerate)
-        for (int k = 0; k < 3; k++)
-            n[k] /= nl;                 /* unit normal: no under/overflow */
+    double nl = 0.0;
+    int degenerate = tri_degenerate(e, n, &nl);
+    if (!degenerate) {   /* unit normal: no under/overflow */
+        n[0] /= nl;
+        n[1] /= nl;
+        n[2] /= nl;
+    }
 
     int outside[3] = {1, 1, 1};
     if (!degenerate) {
-        int inside = 1;
-        for (int i = 0; i < 3; i++) {
-            double m[3], vp[3];
-            st_cross3(m, n, e[i]);      /* in-plane, points into the triangle */
-            st_sub3(vp, p, v[i]);
-            outside[i] = st_dot3(vp, m) < 0.0;
-            inside &= !outside[i];
-        }
-        if (inside) {
+        outside[0] = edge_outside(n, e[0], p, a);
+        outside[1] = edge_outside(n, e[1], p, b);
+        outside[2] = edge_outside(n, e[2], p, c);
+        if (!(outside[0] | outside[1] | outside[2])) {
             double ap[3];
             st_sub3(ap, p, a);
             double s = st_dot3(ap, n);
@@ -84,19 +149,12 @@ double st_point_triangle_dist2(const double p[3], const double a[3],
             return s * s;
         }
     }
-    double best = INFINITY, q[3];
-    for (int i = 0; i < 3; i++) {
-        if (!outside[i])
-            continue;
-        double d2 = st_point_segment_dist2(p, v[i], v[(i + 1) % 3], q);
-        if (d2 < best) {
-            best = d2;
-            if (closest) {
-                closest[0] = q[0];
-                closest[1] = q[1];
-                closest[2] = q[2];
-            }
-        }
-    }
+    double best = INFINITY;   /* the edges in order ab, bc, ca; the first of equals */
+    if (outside[0])
+        nearer_edge(p, a, b, &best, closest);
+    if (outside[1])
+        nearer_edge(p, b, c, &best, closest);
+    if (outside[2])
+        nearer_edge(p, c, a, &best, closest);
     return best;
 }
