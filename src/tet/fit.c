@@ -180,6 +180,10 @@ static const double rescue_frac[] = {1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125, 0.0
 /* A rescue move may not bring its star's score below this (degrees), or
  * below what it was if lower; the quality pass raises it after. */
 #define RESCUE_FLOOR 25.0
+/* rescue_vertex's lower bound on a candidate's distance to S is dd - st
+ * less this (units of h): far more than the rounding of the step and of
+ * the distances, so the bound holds; a larger value only tests more. */
+#define RESCUE_LB_SLACK 1e-6
 
 static int cmp_rescue(const void *a, const void *b)
 {
@@ -241,26 +245,39 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
                  * is never taken, so the order of the rest is the same) */
                 if (sm_star_score(sm, v, cd[nc] + 1) < floor_score)
                     continue;
-                int64_t tri;
-                double d2 = sm_nearest_d2(c, cd[nc] + 1, dd * dd, &tri, NULL);
-                cd[nc][0] = tri >= 0 ? sqrt(d2) : INFINITY;
+                cd[nc][0] = dd - st - RESCUE_LB_SLACK * c->h;
                 cd[nc][4] = (double)ord;
                 nc++;
             }
         }
     }
+    /* The candidate taken is the first by (distance to S, order) of those
+     * closer than dd that keep the invariant. Searched by a lower bound on
+     * the distance (the step is st long, so the distance is at least dd -
+     * st; the slack covers the rounding): in the bound's order, a
+     * candidate is tested (invariant, then distance: a distance costs
+     * more) while its bound is no more than the best distance found, so
+     * a rescue that fails computes no distance. */
     qsort(cd, nc, sizeof cd[0], cmp_rescue);
     sm_star_pts_collect(c, v, sp);
-    for (size_t i = 0; i < nc; i++) {
-        if (!(cd[i][0] < dd))
-            break;
-        const double *p = cd[i] + 1;
-        if (sm_move_ok(c, v, p, sp)) {
-            memcpy(x, p, 3 * sizeof *x);
-            return 1;
+    double best = dd, best_ord = INFINITY;
+    size_t bi = SIZE_MAX;
+    for (size_t i = 0; i < nc && !(cd[i][0] > best); i++) {
+        if (!sm_move_ok(c, v, cd[i] + 1, sp))
+            continue;
+        int64_t tri;
+        double d2 = sm_nearest_d2(c, cd[i] + 1, dd * dd, &tri, NULL);
+        double d = tri >= 0 ? sqrt(d2) : INFINITY;
+        if (d < dd && (d < best || (d == best && cd[i][4] < best_ord))) {
+            best = d;
+            best_ord = cd[i][4];
+            bi = i;
         }
     }
-    return 0;
+    if (bi == SIZE_MAX)
+        return 0;
+    memcpy(x, cd[bi] + 1, 3 * sizeof *x);
+    return 1;
 }
 
 /* The joint rescue runs while at most this many boundary vertices are
