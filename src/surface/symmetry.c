@@ -560,15 +560,22 @@ static int lands_tri(const ctx *C, const double q[3], const double nq[3],
            fabs(st_dot3(nq, C->tn + 3 * (size_t)*tri)) >= MATCH_COS;
 }
 
-static int lands(const ctx *C, const double q[3], const double nq[3],
-                 double reach, double closest[3])
+static int lands_at(const ctx *C, const double q[3], const double nq[3],
+                    double reach, double closest[3], int64_t *tri)
+{
+    double d2 = nearest(C, q, reach, tri, closest);
+    (void)d2;
+    if (*tri < 0)
+        return 0;
+    return fabs(st_dot3(nq, C->tn + 3 * (size_t)*tri)) >= MATCH_COS;
+}
+
+
+static int lands_pt(const ctx *C, const double q[3], const double nq[3],
+                    double reach, double closest[3])
 {
     int64_t tri;
-    double d2 = nearest(C, q, reach, &tri, closest);
-    (void)d2;
-    if (tri < 0)
-        return 0;
-    return fabs(st_dot3(nq, C->tn + 3 * (size_t)tri)) >= MATCH_COS;
+    return lands_at(C, q, nq, reach, closest, &tri);
 }
 
 /* Whether point c of triangle t lies on one of its boundary edges: the
@@ -776,9 +783,9 @@ static st_symmetry mirror_of(const double n[3], double off)
     return y;
 }
 
-/* ICP rounds: match each sample's image to the nearest point of the soup,
- * re-estimate the plane from the pairs. */
-static void refine_mirror(const ctx *C, st_symmetry *y, int coarse_rounds)
+/* ICP rounds, point to point: match each sample's image to the nearest
+ * point of the soup, re-estimate the plane from the pairs' midpoints. */
+static void refine_mirror_mid(const ctx *C, st_symmetry *y, int coarse_rounds)
 {
     const samples *S = C->S;
     double *mid = st_malloc_array(3 * (S->n / REFINE_STRIDE + 1), sizeof *mid);
@@ -800,7 +807,7 @@ static void refine_mirror(const ctx *C, st_symmetry *y, int coarse_rounds)
                 fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
                 continue; /* on the plane, or sliding along it */
             st_symmetry_apply(y, 0.0, S->nrm + 3 * k, 0, nq);
-            if (!lands(C, q, nq, (coarse ? REFINE_WIDE : REFINE_REACH) * C->tol, c))
+            if (!lands_pt(C, q, nq, (coarse ? REFINE_WIDE : REFINE_REACH) * C->tol, c))
                 continue;
             for (int x = 0; x < 3; x++) {
                 mid[3 * m + x] = 0.5 * (p[x] + c[x]);
@@ -852,6 +859,158 @@ static void refine_mirror(const ctx *C, st_symmetry *y, int coarse_rounds)
         }
     }
     free(mid);
+}
+
+/* The normal equations of one point-to-plane round (refine_mirror): the
+ * plane's normal turned by x[0] u + x[1] v and its offset moved by x[2]
+ * L, in coordinates centred at the samples' centroid and divided by L. */
+typedef struct plane_step {
+    double a[3][3], b[3];
+    double n[3], u[3], v[3], off, L;
+    const double *c0;
+    size_t m;
+} plane_step;
+
+static void step_start(plane_step *F, const st_symmetry *y, const double c0[3], double L)
+{
+    memset(F, 0, sizeof *F);
+    memcpy(F->n, y->dir, sizeof F->n);
+    int k = 0; /* the axis least along n */
+    for (int x = 1; x < 3; x++)
+        if (fabs(F->n[x]) < fabs(F->n[k]))
+            k = x;
+    double e[3] = {0, 0, 0};
+    e[k] = 1.0;
+    st_cross3(F->u, F->n, e);
+    normalize(F->u);
+    st_cross3(F->v, F->n, F->u);
+    F->c0 = c0;
+    F->L = L;
+    F->off = (st_dot3(y->dir, y->point) - st_dot3(F->n, c0)) / L;
+}
+
+/* The pair: sample p, its image's nearest point c on a triangle of unit
+ * normal m. The residual is the image's distance from c's tangent plane
+ * (m . (q - c)); the row its derivative by the three unknowns. */
+static void step_add(plane_step *F, const double p[3], const double q[3],
+                     const double c[3], const double m[3])
+{
+    double pl[3], d[3];
+    for (int x = 0; x < 3; x++) {
+        pl[x] = (p[x] - F->c0[x]) / F->L;
+        d[x] = (q[x] - c[x]) / F->L;
+    }
+    const double sd = st_dot3(F->n, pl) - F->off, mn = st_dot3(m, F->n);
+    const double row[3] = {-2.0 * (mn * st_dot3(F->u, pl) + sd * st_dot3(m, F->u)),
+                           -2.0 * (mn * st_dot3(F->v, pl) + sd * st_dot3(m, F->v)),
+                           2.0 * mn};
+    const double r = st_dot3(m, d);
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++)
+            F->a[i][j] += row[i] * row[j];
+        F->b[i] -= row[i] * r;
+    }
+    F->m++;
+}
+
+/* The least-squares step (Cholesky, a relative 1e-9 of the trace added to
+ * the diagonal so an unconstrained direction stays still) into *y.
+ * 0 when the system has no solution. */
+static int step_solve(const plane_step *F, st_symmetry *y)
+{
+    double a[3][3], x[3];
+    const double tr = F->a[0][0] + F->a[1][1] + F->a[2][2];
+    if (!(tr > 0.0))
+        return 0;
+    memcpy(a, F->a, sizeof a);
+    for (int i = 0; i < 3; i++)
+        a[i][i] += 1e-9 * tr;
+    for (int j = 0; j < 3; j++) { /* a = l l^T, l in the lower half */
+        for (int k = 0; k < j; k++)
+            a[j][j] -= a[j][k] * a[j][k];
+        if (!(a[j][j] > 0.0))
+            return 0;
+        a[j][j] = sqrt(a[j][j]);
+        for (int i = j + 1; i < 3; i++) {
+            for (int k = 0; k < j; k++)
+                a[i][j] -= a[i][k] * a[j][k];
+            a[i][j] /= a[j][j];
+        }
+    }
+    for (int i = 0; i < 3; i++) {
+        x[i] = F->b[i];
+        for (int k = 0; k < i; k++)
+            x[i] -= a[i][k] * x[k];
+        x[i] /= a[i][i];
+    }
+    for (int i = 2; i >= 0; i--) {
+        for (int k = i + 1; k < 3; k++)
+            x[i] -= a[k][i] * x[k];
+        x[i] /= a[i][i];
+    }
+    double n[3];
+    for (int k = 0; k < 3; k++)
+        n[k] = F->n[k] + x[0] * F->u[k] + x[1] * F->v[k];
+    normalize(n);
+    double off = (F->off + x[2]) * F->L + st_dot3(n, F->c0);
+    if (!isfinite(off) || !isfinite(n[0] + n[1] + n[2]))
+        return 0;
+    canon_plane(n, &off);
+    *y = mirror_of(n, off);
+    return 1;
+}
+
+/* ICP rounds, point to plane (Chen & Medioni 1992, for the mirror's three
+ * degrees of freedom): match each sample's image to the nearest point of
+ * the soup, then move the plane so the images lie on the matched points'
+ * tangent planes (a Gauss-Newton step). Point to point (the pairs'
+ * midpoints fitted by a plane) settles slowly where the images' error runs
+ * along the surface: on the clean couplingdown it stopped 0.9 degrees off
+ * the true plane (support 0.832 against 1.000), and a start 5.3 degrees off
+ * moved only to 4.7. */
+static void refine_mirror_plane(const ctx *C, st_symmetry *y, int coarse_rounds)
+{
+    const samples *S = C->S;
+    const double L = sqrt(S->area) > C->tol ? sqrt(S->area) : C->tol;
+    for (int round = 0; round < coarse_rounds + REFINE_ROUNDS; round++) {
+        const int coarse = round < coarse_rounds;
+        plane_step F;
+        step_start(&F, y, S->c, L);
+        /* sequential: the sums are in sample order, independent of
+         * threads */
+        for (size_t k = 0; k < S->n; k += coarse ? REFINE_COARSE_STRIDE : REFINE_STRIDE) {
+            double q[3], nq[3], c[3], d[3];
+            const double *p = S->p + 3 * k;
+            st_symmetry_apply(y, 0.0, p, 1, q);
+            st_sub3(d, q, p);
+            double l = st_norm3(d);
+            if (!(l > C->tol) ||
+                fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
+                continue; /* on the plane, or sliding along it */
+            st_symmetry_apply(y, 0.0, S->nrm + 3 * k, 0, nq);
+            int64_t t;
+            if (!lands_at(C, q, nq, (coarse ? REFINE_WIDE : REFINE_REACH) * C->tol, c, &t))
+                continue;
+            step_add(&F, p, q, c, C->tn + 3 * (size_t)t);
+        }
+        st_symmetry z = *y;
+        /* (a wide round that fails leaves the plane to the close ones) */
+        if (F.m < 16 / REFINE_STRIDE + 4 || !step_solve(&F, &z) ||
+            fabs(st_dot3(z.dir, y->dir)) < 0.9) {
+            if (!coarse)
+                break; /* too few pairs, or the fit turned away: keep the plane */
+            round = coarse_rounds - 1;
+            continue;
+        }
+        double moved = fabs(st_dot3(z.dir, z.point) - st_dot3(y->point, y->dir)) / C->tol,
+               turned = 1.0 - fabs(st_dot3(z.dir, y->dir));
+        *y = z;
+        if (moved < REFINE_STILL && turned < REFINE_STILL * REFINE_STILL) {
+            if (!coarse)
+                break; /* settled */
+            round = coarse_rounds - 1; /* settled at the wide reach */
+        }
+    }
 }
 
 static int same_plane(const st_symmetry *a, const st_symmetry *b, double tol)
@@ -1061,21 +1220,31 @@ static void vote_mirrors(const ctx *C, st_symmetry *out, size_t max, size_t peak
 }
 
 /* Candidates [from, to) refined (after `coarse` wide rounds), their
- * supports set, ok[i] whether accepted. Each candidate on its own: the
- * same result for any thread count. */
+ * supports set, ok[i] whether accepted, screened[i] whether they passed
+ * the screen. With `plane`, only those that passed it, refined again
+ * point to plane (refine_mirror_plane) from where they are. Each
+ * candidate on its own: the same result for any thread count. */
 static void measure_mirrors(const ctx *C, const st_symmetry_params *p, st_symmetry *cand,
-                            int *ok, size_t from, size_t to, int coarse)
+                            int *ok, int *screened, size_t from, size_t to, int coarse,
+                            int plane)
 {
 #pragma omp parallel for schedule(dynamic, 1)
     for (long i = (long)from; i < (long)to; i++) {
-        refine_mirror(C, cand + i, coarse);
+        ok[i] = 0;
+        if (plane && !screened[i])
+            continue;
+        if (plane)
+            refine_mirror_plane(C, cand + i, 0);
+        else
+            refine_mirror_mid(C, cand + i, coarse);
         /* a plane that fails on every SCREEN-th sample by far is not
          * measured on all: only accepted planes' supports are read */
         /* (below the needs, measure_need may stop early: a share that
          * low is refused either way, and only accepted ones are read) */
         tally t = measure_need(C, cand + i, 0.0, SCREEN, 0,
                                fmin(SCREEN_SHARE * MIN_VERIFIED, p->min_support));
-        if (share(&t) >= SCREEN_SHARE * MIN_VERIFIED)
+        screened[i] = share(&t) >= SCREEN_SHARE * MIN_VERIFIED;
+        if (screened[i])
             t = measure_need(C, cand + i, 0.0, 1, 0, fmin(MIN_VERIFIED, p->min_support));
         /* the contradictions matter only between the two shares */
         if (share(&t) >= MIN_VERIFIED && share(&t) < p->min_support)
@@ -1672,15 +1841,21 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
     nc += npeak;
     st_symmetry mirrors[3 + VOTE_CANDIDATES + VOTE_PEAKS];
     size_t nm = 0;
-    int ok[3 + VOTE_CANDIDATES + VOTE_PEAKS];
-    measure_mirrors(&C, p, cand, ok, 0, first_peak, 0);
+    int ok[3 + VOTE_CANDIDATES + VOTE_PEAKS], screened[3 + VOTE_CANDIDATES + VOTE_PEAKS];
+    measure_mirrors(&C, p, cand, ok, screened, 0, first_peak, 0, 0);
     collect_mirrors(cand, ok, 0, first_peak, p->tolerance, mirrors, &nm);
     /* the peaks: a second look where the sharpest cells give no plane */
     if (nm == 0 && nc > first_peak) {
-        measure_mirrors(&C, p, cand, ok, first_peak, nc, REFINE_COARSE);
+        measure_mirrors(&C, p, cand, ok, screened, first_peak, nc, REFINE_COARSE, 0);
         collect_mirrors(cand, ok, first_peak, nc, p->tolerance, mirrors, &nm);
     } else {
         nc = first_peak;
+    }
+    /* a third where still none holds: the screened candidates refined
+     * point to plane (doc/design/symmetry.md, "Point to plane") */
+    if (nm == 0) {
+        measure_mirrors(&C, p, cand, ok, screened, 0, nc, 0, 1);
+        collect_mirrors(cand, ok, 0, nc, p->tolerance, mirrors, &nm);
     }
     out->candidates += nc;
     for (size_t i = 0; i < nm; i++)
