@@ -570,14 +570,6 @@ static int lands_at(const ctx *C, const double q[3], const double nq[3],
     return fabs(st_dot3(nq, C->tn + 3 * (size_t)*tri)) >= MATCH_COS;
 }
 
-
-static int lands_pt(const ctx *C, const double q[3], const double nq[3],
-                    double reach, double closest[3])
-{
-    int64_t tri;
-    return lands_at(C, q, nq, reach, closest, &tri);
-}
-
 /* Whether point c of triangle t lies on one of its boundary edges: the
  * soup ends there, so what lies beyond it is unknown, not absent. */
 static int on_rim(const ctx *C, int64_t t, const double c[3])
@@ -783,6 +775,25 @@ static st_symmetry mirror_of(const double n[3], double off)
     return y;
 }
 
+/* A refinement's match of sample k under mirror y: its image q, and the
+ * nearest point c (triangle *t) of the soup where the image lands within
+ * the round's reach with a matching normal. 0 where the sample lies on the
+ * plane or slides along it (no evidence for the plane), or does not land. */
+static int image_lands(const ctx *C, const st_symmetry *y, size_t k, int coarse,
+                       double q[3], double c[3], int64_t *t)
+{
+    const samples *S = C->S;
+    const double *p = S->p + 3 * k;
+    double nq[3], d[3];
+    st_symmetry_apply(y, 0.0, p, 1, q);
+    st_sub3(d, q, p);
+    double l = st_norm3(d);
+    if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
+        return 0;
+    st_symmetry_apply(y, 0.0, S->nrm + 3 * k, 0, nq);
+    return lands_at(C, q, nq, (coarse ? REFINE_WIDE : REFINE_REACH) * C->tol, c, t);
+}
+
 /* ICP rounds, point to point: match each sample's image to the nearest
  * point of the soup, re-estimate the plane from the pairs' midpoints. */
 static void refine_mirror_mid(const ctx *C, st_symmetry *y, int coarse_rounds)
@@ -798,16 +809,10 @@ static void refine_mirror_mid(const ctx *C, st_symmetry *y, int coarse_rounds)
         /* sequential: the sums are in sample order, independent of
          * threads */
         for (size_t k = 0; k < S->n; k += coarse ? REFINE_COARSE_STRIDE : REFINE_STRIDE) {
-            double q[3], nq[3], c[3], d[3];
+            double q[3], c[3];
             const double *p = S->p + 3 * k;
-            st_symmetry_apply(y, 0.0, p, 1, q);
-            st_sub3(d, q, p);
-            double l = st_norm3(d);
-            if (!(l > C->tol) ||
-                fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
-                continue; /* on the plane, or sliding along it */
-            st_symmetry_apply(y, 0.0, S->nrm + 3 * k, 0, nq);
-            if (!lands_pt(C, q, nq, (coarse ? REFINE_WIDE : REFINE_REACH) * C->tol, c))
+            int64_t t;
+            if (!image_lands(C, y, k, coarse, q, c, &t))
                 continue;
             for (int x = 0; x < 3; x++) {
                 mid[3 * m + x] = 0.5 * (p[x] + c[x]);
@@ -979,17 +984,10 @@ static void refine_mirror_plane(const ctx *C, st_symmetry *y, int coarse_rounds)
         /* sequential: the sums are in sample order, independent of
          * threads */
         for (size_t k = 0; k < S->n; k += coarse ? REFINE_COARSE_STRIDE : REFINE_STRIDE) {
-            double q[3], nq[3], c[3], d[3];
+            double q[3], c[3];
             const double *p = S->p + 3 * k;
-            st_symmetry_apply(y, 0.0, p, 1, q);
-            st_sub3(d, q, p);
-            double l = st_norm3(d);
-            if (!(l > C->tol) ||
-                fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
-                continue; /* on the plane, or sliding along it */
-            st_symmetry_apply(y, 0.0, S->nrm + 3 * k, 0, nq);
             int64_t t;
-            if (!lands_at(C, q, nq, (coarse ? REFINE_WIDE : REFINE_REACH) * C->tol, c, &t))
+            if (!image_lands(C, y, k, coarse, q, c, &t))
                 continue;
             step_add(&F, p, q, c, C->tn + 3 * (size_t)t);
         }
