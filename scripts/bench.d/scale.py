@@ -20,14 +20,18 @@ folder.
 SOUPTET_BENCH_SCALE_MODELS picks the corpus models of the first table,
 SOUPTET_BENCH_SCALE_PEER the OpenVDB repeats (0: none).
 
-Every row is `soupmesh --tries 1` under /usr/bin/time (wall clock, peak
-RSS), with soupmesh -v's stage times (distance, signs, candidates), the tets
+Every row is `soupmesh --tries 1` under /usr/bin/time (wall clock, CPU
+seconds user + sys, peak RSS), with soupmesh -v's stage times (distance, signs, candidates), the tets
 and whether the mesh encloses the input. The dragon's row also runs
 OpenVDB's meshToUnsignedDistanceField at 256^3 (bench/vdb_dist: the whole
 process, reading the soup and writing the .vdb, as soupdist -r 256 beside
 it does), soupdist and `soupmesh -q` --tries 1 and --tries 4, alternating,
 median of 3 (issue 23's targets; -q because -v adds work a user's run does
 not do: the input -> boundary distance and per-iteration statistics).
+
+On a shared machine the wall clock is mostly the other jobs: the CPU
+seconds (the soupdist / OpenVDB ratio by CPU too) and the load average at
+the stage's start and end are in the tables for that.
 """
 import math
 import os
@@ -109,15 +113,15 @@ def write_copies(src, k, out):
 
 
 def mesh_row(bench, build, path, cells, out):
-    r = bench.run(["/usr/bin/time", "-f", "WALL %e RSS %M",
+    r = bench.run(["/usr/bin/time", "-f", "WALL %e CPU %U %S RSS %M",
                    os.path.join(build, "bin", "soupmesh"), "-v", "--tries", "1",
                    "--cells", str(cells), "--threads", str(bench.THREADS), "-o", out, path])
     if r.returncode not in (0, 3):
         raise RuntimeError("soupmesh failed on %s: %s" % (path, r.stderr[-2000:]))
     e = r.stderr
-    m = re.search(r"WALL ([0-9.]+) RSS (\d+)", e)
-    row = {"seconds": float(m.group(1)), "rss_mib": int(m.group(2)) / 1024.0,
-           "encloses": r.returncode == 0}
+    m = re.search(r"WALL ([0-9.]+) CPU ([0-9.]+) ([0-9.]+) RSS (\d+)", e)
+    row = {"seconds": float(m.group(1)), "cpu_s": float(m.group(2)) + float(m.group(3)),
+           "rss_mib": int(m.group(4)) / 1024.0, "encloses": r.returncode == 0}
     m = re.search(r"(\d+) vertices, (\d+) triangles", e)
     row["triangles"] = int(m.group(2))
     m = re.search(r"distance ([0-9.]+) s, signs ([0-9.]+) s(?: \([^)]*\))?, \d+ candidates? ([0-9.]+) s", e)
@@ -158,11 +162,13 @@ def quiet_run(bench, build, path, tries, out):
 
 
 def whole_run(bench, cmd):
-    """Wall seconds of a whole process (start, reading and writing count)."""
-    r = bench.run(["/usr/bin/time", "-f", "WALL %e"] + cmd)
+    """(wall seconds, CPU seconds user + sys) of a whole process (start,
+    reading and writing count)."""
+    r = bench.run(["/usr/bin/time", "-f", "WALL %e CPU %U %S"] + cmd)
     if r.returncode != 0:
         raise RuntimeError("%s failed: %s" % (cmd[0], r.stderr[-2000:]))
-    return float(re.findall(r"WALL ([0-9.]+)", r.stderr)[-1])
+    m = re.findall(r"WALL ([0-9.]+) CPU ([0-9.]+) ([0-9.]+)", r.stderr)[-1]
+    return float(m[0]), float(m[1]) + float(m[2])
 
 
 def peer_ratios(bench, build, model, tmp):
@@ -186,13 +192,26 @@ def peer_ratios(bench, build, model, tmp):
         rss.append(m)
         s4.append(quiet_run(bench, build, model, 4, out)[0])
     med = lambda v: sorted(v)[len(v) // 2]
+    sd_cpu, vd_cpu = med([x[1] for x in sd]), med([x[1] for x in vd])
+    sd, vd = [x[0] for x in sd], [x[0] for x in vd]
     return {"soupdist_s": med(sd), "openvdb_s": med(vd), "soupmesh_s": med(sm),
+            "soupdist_cpu_s": sd_cpu, "openvdb_cpu_s": vd_cpu,
+            "soupdist_cpu_ratio": sd_cpu / vd_cpu,
             "soupmesh_tries4_s": med(s4), "soupmesh_rss_mib": max(rss),
             "soupdist_ratio": med(sd) / med(vd), "soupmesh_ratio": med(sm) / med(vd),
             "tries4_ratio": med(s4) / med(sm)}
 
 
+def load_average():
+    """The 1, 5 and 15 minute load averages, as text."""
+    try:
+        return "%.2f %.2f %.2f" % os.getloadavg()
+    except OSError:
+        return "unknown"
+
+
 def stage(build, bench):
+    load_start = load_average()
     tmp = os.path.join(bench.RESULTS, "tmp")
     os.makedirs(tmp, exist_ok=True)
     tri_rows, cell_rows = [], []
@@ -221,17 +240,20 @@ def stage(build, bench):
         row["model"], row["cells"] = CELLS_MODEL, c
         cell_rows.append(row)
     peer = peer_ratios(bench, build, dragon, tmp) if dragon else None
+    load_end = load_average()
 
     md = ["# soupmesh cost growth (issue 23)", "",
-          "`soupmesh --tries 1 --threads %d`, wall clock and peak RSS (/usr/bin/time)." % bench.THREADS,
+          "`soupmesh --tries 1 --threads %d`, wall clock, CPU seconds (user + sys) and peak "
+          "RSS (/usr/bin/time). Load average (1, 5, 15 min) at the start %s, at the end %s "
+          "(%d cores)." % (bench.THREADS, load_start, load_end, os.cpu_count() or 0),
           "", "## Against the triangle count (--cells 10)", "",
-          "| model | triangles | voxels | tets | min..max dihedral | encloses | distance s | signs s | candidates s | total s | peak MiB |",
-          "|---|---:|---:|---:|---|---|---:|---:|---:|---:|---:|"]
+          "| model | triangles | voxels | tets | min..max dihedral | encloses | distance s | signs s | candidates s | total s | CPU s | peak MiB |",
+          "|---|---:|---:|---:|---|---|---:|---:|---:|---:|---:|---:|"]
     for r in tri_rows:
-        md.append("| %s | %d | %d | %d | %.1f..%.1f | %s | %.2f | %.2f | %.2f | %.2f | %.0f |" % (
+        md.append("| %s | %d | %d | %d | %.1f..%.1f | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f |" % (
             r["model"], r["triangles"], r["voxels"], r.get("tets", 0), r.get("min_dihedral", 0),
             r.get("max_dihedral", 0), "yes" if r["encloses"] else "NO", r.get("distance_s", 0),
-            r.get("signs_s", 0), r.get("candidates_s", 0), r["seconds"], r["rss_mib"]))
+            r.get("signs_s", 0), r.get("candidates_s", 0), r["seconds"], r["cpu_s"], r["rss_mib"]))
     xs = [r["triangles"] for r in tri_rows]
     md += ["", "Fitted exponent (cost ~ triangles^e): time %.2f, peak memory %.2f, "
            "distance %.2f, signs %.2f, candidates %.2f." % (
@@ -241,13 +263,13 @@ def stage(build, bench):
                fit_exponent(xs, [r.get("signs_s", 0) for r in tri_rows]),
                fit_exponent(xs, [r.get("candidates_s", 0) for r in tri_rows])),
            "", "## Against --cells (%s)" % CELLS_MODEL, "",
-           "| cells | voxels | tets | min..max dihedral | encloses | distance s | signs s | candidates s | total s | peak MiB |",
-           "|---:|---:|---:|---|---|---:|---:|---:|---:|---:|"]
+           "| cells | voxels | tets | min..max dihedral | encloses | distance s | signs s | candidates s | total s | CPU s | peak MiB |",
+           "|---:|---:|---:|---|---|---:|---:|---:|---:|---:|---:|"]
     for r in cell_rows:
-        md.append("| %d | %d | %d | %.1f..%.1f | %s | %.2f | %.2f | %.2f | %.2f | %.0f |" % (
+        md.append("| %d | %d | %d | %.1f..%.1f | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f |" % (
             r["cells"], r["voxels"], r.get("tets", 0), r.get("min_dihedral", 0),
             r.get("max_dihedral", 0), "yes" if r["encloses"] else "NO", r.get("distance_s", 0),
-            r.get("signs_s", 0), r.get("candidates_s", 0), r["seconds"], r["rss_mib"]))
+            r.get("signs_s", 0), r.get("candidates_s", 0), r["seconds"], r["cpu_s"], r["rss_mib"]))
     cs = [r["cells"] for r in cell_rows]
     md += ["", "Fitted exponent (cost ~ cells^e): time %.2f, peak memory %.2f; "
            "time against tets %.2f, against voxels %.2f." % (
@@ -259,9 +281,10 @@ def stage(build, bench):
         md += ["", "## Beside OpenVDB (the dragon, alternating, median of %d)" % PEER_REPEAT, "",
                "Whole processes. soupdist -r %d: %.2f s; OpenVDB meshToUnsignedDistanceField at %d^3 "
                "(bench/vdb_dist, reading and writing as soupdist): %.2f s "
-               "(ratio %.2f, target <= 0.5); soupmesh -q --tries 1: %.2f s (ratio %.2f, target <= 1.5), "
+               "(ratio %.2f, target <= 0.5; by CPU seconds %.2f / %.2f: %.2f); soupmesh -q --tries 1: %.2f s (ratio %.2f, target <= 1.5), "
                "peak %.0f MiB (target <= 400); --tries 4: %.2f s (%.2f x --tries 1, target <= 2)." % (
                    PEER_RES, peer["soupdist_s"], PEER_RES, peer["openvdb_s"], peer["soupdist_ratio"],
+                   peer["soupdist_cpu_s"], peer["openvdb_cpu_s"], peer["soupdist_cpu_ratio"],
                    peer["soupmesh_s"], peer["soupmesh_ratio"], peer["soupmesh_rss_mib"],
                    peer["soupmesh_tries4_s"], peer["tries4_ratio"])]
     rows = {"triangles": tri_rows, "cells": cell_rows, "openvdb": peer}
