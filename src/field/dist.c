@@ -758,6 +758,8 @@ static void walk_band(const st_grid *g, const brick_out *o, const st_soup *s,
     const double B2 = B * B;
     double px[BAND_NV], py[BAND_NV], pz[BAND_NV], off[BAND_NV], cur[BAND_NV],
            curd[BAND_NV];
+    /* The voxels' centers again, one point each: what band_try reads. */
+    double pt[BAND_NV][3];
     size_t idx[BAND_NV];
     unsigned nv = 0;
     for (size_t k = v->lo[2]; k < v->hi[2]; k++)
@@ -768,6 +770,7 @@ static void walk_band(const st_grid *g, const brick_out *o, const st_soup *s,
                                      g->origin[2] + g->voxel * (double)k};
                 double d[3];
                 st_sub3(d, p, v->c);
+                memcpy(pt[nv], p, sizeof p);
                 px[nv] = p[0];
                 py[nv] = p[1];
                 pz[nv] = p[2];
@@ -797,8 +800,7 @@ static void walk_band(const st_grid *g, const brick_out *o, const st_soup *s,
         do {
             const unsigned e = (unsigned)__builtin_ctz(pass);
             pass &= pass - 1;
-            const double p[3] = {px[e], py[e], pz[e]};
-            band_try(t, p, &cur[e], &curd[e]);
+            band_try(t, pt[e], &cur[e], &curd[e]);
         } while (pass);
     }
     sc->nsetup = nsetup;
