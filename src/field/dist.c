@@ -16,6 +16,10 @@
  * pruning changes the work, never the answer. A full field also keeps
  * each voxel's nearest triangle, the first of any ties in a fixed order,
  * so its bricks walk their candidates whole, sorted by (bound, index).
+ * A band field's bricks are walked by the 8^3 blocks that hold them, and
+ * a block's bricks share their triangles' setups (a triangle reaches about
+ * a dozen bricks; per block, three to five setups instead), each made the
+ * first time a group's voxel passes the triangle's ball test.
  *
  * Stored by blocks (st_dist_field_blocks). The same bricks, walked by
  * the 8^3 blocks that hold them (a brick lies in one block): a block gets
