@@ -16,6 +16,10 @@
  * pruning changes the work, never the answer. A full field also keeps
  * each voxel's nearest triangle, the first of any ties in a fixed order,
  * so its bricks walk their candidates whole, sorted by (bound, index).
+ * A band field's bricks are walked by the 8^3 blocks that hold them, and
+ * a block's bricks share their triangles' setups (a triangle reaches about
+ * a dozen bricks; per block, three to five setups instead), each made the
+ * first time a group's voxel passes the triangle's ball test.
  *
  * Stored by blocks (st_dist_field_blocks). The same bricks, walked by
  * the 8^3 blocks that hold them (a brick lies in one block): a block gets
@@ -644,12 +648,10 @@ static void walk_box(const st_grid *g, const brick_out *o, const st_soup *s,
     sc->nsetup = nsetup;
 }
 
-/* One band voxel's candidate: set up (once per brick) and measured, its
- * plane first. Keeps the smaller squared distance in *cur, its root in
- * *curd. */
-static inline void band_try(const st_soup *s, brick_scratch *sc,
-                            uint32_t *nsetup, uint32_t c, const double p[3],
-                            double *cur, double *curd)
+/* Candidate c's setup: made once per brick (or, shared, once per block)
+ * and cached in the scratch. */
+static inline const tri_setup *band_setup(const st_soup *s, brick_scratch *sc,
+                                          uint32_t *nsetup, uint32_t c)
 {
     if (sc->slot[c] == UINT32_MAX) {
         const uint32_t at = (*nsetup)++;
@@ -662,7 +664,14 @@ static inline void band_try(const st_soup *s, brick_scratch *sc,
             sc->spos[at] = e;
         }
     }
-    const tri_setup *t = &sc->setups[sc->slot[c]];
+    return &sc->setups[sc->slot[c]];
+}
+
+/* One band voxel's candidate t, measured, its plane first. Keeps the
+ * smaller squared distance in *cur, its root in *curd. */
+static inline void band_try(const tri_setup *t, const double p[3],
+                            double *cur, double *curd)
+{
     double pd = 0.0;
     if (!t->degenerate) {
         double v0p[3];
@@ -753,6 +762,8 @@ static void walk_band(const st_grid *g, const brick_out *o, const st_soup *s,
     const double B2 = B * B;
     double px[BAND_NV], py[BAND_NV], pz[BAND_NV], off[BAND_NV], cur[BAND_NV],
            curd[BAND_NV];
+    /* The voxels' centers again, one point each: what band_try reads. */
+    double pt[BAND_NV][3];
     size_t idx[BAND_NV];
     unsigned nv = 0;
     for (size_t k = v->lo[2]; k < v->hi[2]; k++)
@@ -763,6 +774,7 @@ static void walk_band(const st_grid *g, const brick_out *o, const st_soup *s,
                                      g->origin[2] + g->voxel * (double)k};
                 double d[3];
                 st_sub3(d, p, v->c);
+                memcpy(pt[nv], p, sizeof p);
                 px[nv] = p[0];
                 py[nv] = p[1];
                 pz[nv] = p[2];
@@ -785,12 +797,15 @@ static void walk_band(const st_grid *g, const brick_out *o, const st_soup *s,
         band_masks(px, py, pz, off, curd, w, q, &live, &pass);
         if (!live)
             break;              /* no later one is closer to any voxel */
-        while (pass) {
+        if (!pass)
+            continue;
+        /* Set up once for the group's voxels it may reach. */
+        const tri_setup *t = band_setup(s, sc, &nsetup, w->at[q]);
+        do {
             const unsigned e = (unsigned)__builtin_ctz(pass);
             pass &= pass - 1;
-            const double p[3] = {px[e], py[e], pz[e]};
-            band_try(s, sc, &nsetup, w->at[q], p, &cur[e], &curd[e]);
-        }
+            band_try(t, pt[e], &cur[e], &curd[e]);
+        } while (pass);
     }
     sc->nsetup = nsetup;
     const float Bf = (float)B;
@@ -1085,6 +1100,42 @@ done:
 #define BRICKS_PER_BLOCK (ST_GRID_BLOCK / BRICK)
 _Static_assert(ST_GRID_BLOCK % BRICK == 0, "a brick must lie in one block");
 
+/* The bricks of block b (block coordinates b[3]), their values written
+ * through o, sharing their candidates' setups (see brick_scratch): each
+ * triangle is set up once for the block, not once per brick. The values
+ * are the same either way (a setup is a function of the triangle alone).
+ * -1: out of memory. */
+static int block_bricks(const st_grid *g, const brick_out *o, const st_soup *s,
+                        const band_bins *bb, const size_t b[3], double B,
+                        brick_scratch *sc)
+{
+    const brick_grid *bg = &bb->bg;
+    size_t bricks[BRICKS_PER_BLOCK * BRICKS_PER_BLOCK * BRICKS_PER_BLOCK];
+    size_t nbricks = 0, total = 0;
+    for (size_t z = 0; z < BRICKS_PER_BLOCK; z++)
+        for (size_t y = 0; y < BRICKS_PER_BLOCK; y++)
+            for (size_t x = 0; x < BRICKS_PER_BLOCK; x++) {
+                const size_t c[3] = {b[0] * BRICKS_PER_BLOCK + x,
+                                     b[1] * BRICKS_PER_BLOCK + y,
+                                     b[2] * BRICKS_PER_BLOCK + z};
+                if (c[0] >= bg->n[0] || c[1] >= bg->n[1] || c[2] >= bg->n[2])
+                    continue;
+                const size_t brick = c[0] + bg->n[0] * (c[1] + bg->n[1] * c[2]);
+                bricks[nbricks++] = brick;
+                total += bin_count(bb, brick);
+            }
+    sc->shared = 1;
+    sc->nsetup = 0;
+    if (total > UINT32_MAX || scratch_setups(sc, total))
+        return -1;
+    int bad = 0;
+    for (size_t i = 0; i < nbricks && !bad; i++)
+        if (!(bad = scratch_reserve(sc, bin_count(bb, bricks[i]))))
+            process_brick(g, o, s, bb, bricks[i], B, sc);
+    setups_clear(sc);
+    return bad ? -1 : 0;
+}
+
 /* One block of a field stored by blocks: its bricks' values into its
  * slot; then, if every voxel holds the band, no slot. A block whose
  * bricks have no candidates has none to begin with. -1: out of memory. */
@@ -1110,33 +1161,7 @@ static int process_block(st_grid_blocks *bk, const st_soup *s,
         o.lo[2] + ST_GRID_BLOCK > n[2])
         for (size_t q = 0; q < E; q++)
             o.val[q] = Bf;
-    /* The block's bricks, and room for the setups of all their
-     * candidates: the bricks share them (see brick_scratch). */
-    const brick_grid *bg = &bb->bg;
-    size_t bricks[BRICKS_PER_BLOCK * BRICKS_PER_BLOCK * BRICKS_PER_BLOCK];
-    size_t nbricks = 0, total = 0;
-    for (size_t z = 0; z < BRICKS_PER_BLOCK; z++)
-        for (size_t y = 0; y < BRICKS_PER_BLOCK; y++)
-            for (size_t x = 0; x < BRICKS_PER_BLOCK; x++) {
-                const size_t c[3] = {b[0] * BRICKS_PER_BLOCK + x,
-                                     b[1] * BRICKS_PER_BLOCK + y,
-                                     b[2] * BRICKS_PER_BLOCK + z};
-                if (c[0] >= bg->n[0] || c[1] >= bg->n[1] || c[2] >= bg->n[2])
-                    continue;
-                const size_t brick = c[0] + bg->n[0] * (c[1] + bg->n[1] * c[2]);
-                bricks[nbricks++] = brick;
-                total += bin_count(bb, brick);
-            }
-    sc->shared = 1;
-    sc->nsetup = 0;
-    if (total > UINT32_MAX || scratch_setups(sc, total))
-        return -1;
-    int bad = 0;
-    for (size_t i = 0; i < nbricks && !bad; i++)
-        if (!(bad = scratch_reserve(sc, bin_count(bb, bricks[i]))))
-            process_brick(g, &o, s, bb, bricks[i], B, sc);
-    setups_clear(sc);
-    if (bad)
+    if (block_bricks(g, &o, s, bb, b, B, sc))
         return -1;
     size_t q = 0;
     while (q < E && o.val[q] == Bf)
@@ -1177,7 +1202,15 @@ static st_status band_bricks(const st_grid *g, int32_t *near,
                              const band_bins *bb, double B,
                              const st_progress *progress, st_error *err)
 {
-    const size_t nunits = bk ? bk->nb[0] * bk->nb[1] * bk->nb[2] : bb->nb;
+    /* A dense band field is walked by the blocks of bricks too (the
+     * setups shared within each); a full field brick by brick, each
+     * brick's candidates sorted whole. */
+    const size_t nbl[3] = {(bb->bg.n[0] + BRICKS_PER_BLOCK - 1) / BRICKS_PER_BLOCK,
+                           (bb->bg.n[1] + BRICKS_PER_BLOCK - 1) / BRICKS_PER_BLOCK,
+                           (bb->bg.n[2] + BRICKS_PER_BLOCK - 1) / BRICKS_PER_BLOCK};
+    const int by_block = bk || !near;
+    const size_t nunits = bk ? bk->nb[0] * bk->nb[1] * bk->nb[2]
+                          : by_block ? nbl[0] * nbl[1] * nbl[2] : bb->nb;
     const brick_out dense = {g->data, near, {1, g->nx, g->nx * g->ny}, {0, 0, 0}};
     int oom = 0;
     size_t done = 0;
@@ -1188,14 +1221,18 @@ static st_status band_bricks(const st_grid *g, int32_t *near,
     {
         brick_scratch sc;
         memset(&sc, 0, sizeof sc);
-        #pragma omp for schedule(dynamic, bk ? 4 : 16)
+        #pragma omp for schedule(dynamic, by_block ? 4 : 16)
         for (size_t u = 0; u < nunits; u++) {
             if (st_progress_cancelled(progress))
                 continue;
             int bad;
             if (bk)
                 bad = process_block(bk, s, bb, u, B, &sc);
-            else if (!(bad = scratch_reserve(&sc, bin_count(bb, u)) ||
+            else if (by_block) {
+                const size_t b[3] = {u % nbl[0], (u / nbl[0]) % nbl[1],
+                                     u / (nbl[0] * nbl[1])};
+                bad = block_bricks(g, &dense, s, bb, b, B, &sc);
+            } else if (!(bad = scratch_reserve(&sc, bin_count(bb, u)) ||
                              scratch_setups(&sc, bin_count(bb, u))))
                 process_brick(g, &dense, s, bb, u, B, &sc);
             if (bad) {
