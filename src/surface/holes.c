@@ -316,9 +316,11 @@ static st_status fill_area(double *area, const double *const *pts, const double 
 
 /* The bend along the loop of the cap tri[3 (n - 2)] (local indices, as
  * least_bend's): the sum over the loop's edges of length times the
- * dihedral between the cap's triangle on it and the soup's. */
+ * dihedral between the cap's triangle on it and the soup's, or, where the
+ * edge runs along a crease (crease: st_holes_creases, or NULL), the
+ * other face's plane there (st_holes_crease_bend). */
 static double rim_bend(const double *const *pts, const double *const *side, size_t n,
-                       const uint32_t *tri)
+                       const uint32_t *tri, const double *crease)
 {
     double b = 0.0;
     for (size_t t = 0; t + 2 < n; t++) {
@@ -332,7 +334,7 @@ static double rim_bend(const double *const *pts, const double *const *side, size
             /* the loop edge from i to i + 1 mod n */
             const size_t i = (a + 1) % n == z ? a : z;
             unit_normal(nr, pts[i], side[i], pts[(i + 1) % n]);
-            b += dist3(pts[a], pts[z]) * bend(nt, nr);
+            b += dist3(pts[a], pts[z]) * st_holes_crease_bend(nt, nr, crease ? crease + 6 * i : NULL);
         }
     }
     return b;
@@ -884,6 +886,7 @@ typedef struct loop {
     uint32_t *v, *e;            /* nb + 1 each */
     const double **pts, **side; /* max_loop + 1 each */
     uint32_t *tri;              /* 3 (max_loop + 1) */
+    double *crease;             /* 6 (max_loop + 1): st_holes_creases */
 } loop;
 
 static st_status loop_alloc(loop *l, size_t nb, size_t max_loop, st_error *err)
@@ -893,12 +896,13 @@ static st_status loop_alloc(loop *l, size_t nb, size_t max_loop, st_error *err)
     l->pts = st_malloc_array(max_loop + 1, sizeof *l->pts);
     l->side = st_malloc_array(max_loop + 1, sizeof *l->side);
     l->tri = st_malloc_array(3 * (max_loop + 1), sizeof *l->tri);
-    return l->v && l->e && l->pts && l->side && l->tri ? ST_OK : oom(err);
+    l->crease = st_malloc_array(6 * (max_loop + 1), sizeof *l->crease);
+    return l->v && l->e && l->pts && l->side && l->tri && l->crease ? ST_OK : oom(err);
 }
 
 static void loop_free(loop *l)
 {
-    free(l->v), free(l->e), free(l->pts), free(l->side), free(l->tri);
+    free(l->v), free(l->e), free(l->pts), free(l->side), free(l->tri), free(l->crease);
 }
 
 /* Walks the loop from boundary edge e0 (not used yet) by the partners,
@@ -1008,7 +1012,7 @@ static st_status cap_planes(capper *c, int *rebuilt, double *bent, st_error *err
 {
     const loop *l = &c->l;
     const size_t n = l->n;
-    const double below = CONE_BETTER * rim_bend(l->pts, l->side, n, l->tri);
+    const double below = CONE_BETTER * rim_bend(l->pts, l->side, n, l->tri, l->crease);
     int coned = 0, fanned = 0;
     double cb, fb = INFINITY;
     st_soup *cone = st_soup_new(), *fans = st_soup_new();
@@ -1018,7 +1022,7 @@ static st_status cap_planes(capper *c, int *rebuilt, double *bent, st_error *err
         rc = oom(err);
         goto done;
     }
-    const st_holes_guard guard = {c->bvh, c->E->kept};
+    const st_holes_guard guard = {c->bvh, c->E->kept, l->crease};
     rc = st_holes_planes_cap(cone, &coned, l->pts, l->side, n, below, &guard, &cb, err);
     if (!rc)
         rc = st_holes_planes_fans(fans, &fanned, l->pts, l->side, n, below,
@@ -1067,6 +1071,8 @@ static st_status cap_loop(capper *c, size_t e0, st_error *err)
     }
     if (c->bend || c->planes)
         loop_points(c, 1);
+    if (c->planes)
+        st_holes_creases(l->crease, l->pts, l->side, n);
     if (c->bend && (rc = least_bend(&bent, l->pts, l->side, n, l->tri, err)))
         return rc;
     int rebuilt = 0, cyl = 0;
@@ -1076,9 +1082,10 @@ static st_status cap_loop(capper *c, size_t e0, st_error *err)
         return rc;
     /* where a cylinder runs along the loop, continued across it when that
      * continues the soup better (holes_cyl.c) */
-    const st_holes_guard guard = {c->bvh, c->E->kept};
+    const st_holes_guard guard = {c->bvh, c->E->kept, l->crease};
     if (c->planes && (rc = st_holes_cyl_cap(c->out, &cyl, vb, tb, l->pts, l->side, n,
-                                            rebuilt ? rb : rim_bend(l->pts, l->side, n, l->tri),
+                                            rebuilt ? rb : rim_bend(l->pts, l->side, n, l->tri,
+                                                                    l->crease),
                                             c->bend ? least_bend : fill_area, &guard, err)))
         return rc;
     if (rebuilt || cyl) {

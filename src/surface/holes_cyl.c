@@ -637,10 +637,11 @@ nomem:
 }
 
 /* The cap's bend along the loop (length times dihedral over the loop's
- * edges, against the soup's triangles there); INFINITY unless each loop
+ * edges, against the soup's triangles there, or the planes of the
+ * creases the loop runs along: st_holes_crease_bend); INFINITY unless each loop
  * edge is the edge of exactly one of its triangles. cnt[n] scratch. */
 static double cap_rim_bend(const rcap *o, const double *const *pts, const double *const *side,
-                           size_t n, unsigned *cnt)
+                           size_t n, const double *crease, unsigned *cnt)
 {
     double b = 0.0;
     memset(cnt, 0, n * sizeof *cnt);
@@ -656,7 +657,8 @@ static double cap_rim_bend(const rcap *o, const double *const *pts, const double
             const size_t i = (size_t)(a + 1) % n == (size_t)z ? (size_t)a : (size_t)z;
             cnt[i]++;
             unit_normal(nr, pts[i], side[i], pts[(i + 1) % n]);
-            b += dist3(pts[i], pts[(i + 1) % n]) * bend(nt, nr);
+            b += dist3(pts[i], pts[(i + 1) % n]) *
+                 st_holes_crease_bend(nt, nr, crease ? crease + 6 * i : NULL);
         }
     }
     for (size_t i = 0; i < n; i++)
@@ -795,7 +797,7 @@ static st_status pick_cap(rcap *o, double *best, const cyl *cy, st_soup *const *
     for (int k = 0; k < 2 && !rc; k++) {
         if (!dev[k] || !map_back(&r, cy, dev[k], dpts, n, pts, &rc, err))
             continue;
-        const double b = cap_rim_bend(&r, pts, side, n, cnt);
+        const double b = cap_rim_bend(&r, pts, side, n, g ? g->crease : NULL, cnt);
         if (!(b < *best) || cap_crosses(&r, g, out, tbase, &rc, err))
             continue;
         *best = b;

@@ -68,7 +68,41 @@ int st_holes_area_above(const double *const *pts, size_t n, double lim);
 typedef struct st_holes_guard {
     const st_bvh *bvh;
     const uint8_t *kept;
+    const double *crease;   /* NULL, or st_holes_creases' planes per loop
+                             * edge: the caps' bend along the loop is then
+                             * st_holes_crease_bend's */
 } st_holes_guard;
+
+/* The creases the loop pts[0..n) runs along: for each loop edge i, the
+ * unit normals (crease[6 i], crease[6 i + 3]; zero where none) of up to
+ * two planes of the soup's other triangles along the loop (pts[j],
+ * side[j], pts[j + 1]) that hold both of its ends exactly (st_orient3d)
+ * and not its own triangle's third point: the edge lies on the line where
+ * its triangle's face meets another face of the part, and the face lost
+ * across it may be that one (holes.c; doc/design/holes.md, "Creases"). */
+void st_holes_creases(double *crease, const double *const *pts, const double *const *side,
+                      size_t n);
+
+/* The bend along a loop edge of a cap triangle of unit normal nt, against
+ * the soup's triangle there (unit normal nr, as bend()) or, where the
+ * edge runs along a crease (cr: its two normals from st_holes_creases, or
+ * NULL), against the other face's plane there (the angle between the two
+ * planes, 0 where the cap lies in it): the least. */
+static inline double st_holes_crease_bend(const double *nt, const double *nr, const double *cr)
+{
+    double b = bend(nt, nr);
+    if (!cr || st_dot3(nt, nt) == 0.0)
+        return b;
+    for (int k = 0; k < 2; k++) {
+        const double *a = cr + 3 * k;
+        if (st_dot3(a, a) == 0.0)
+            continue;
+        double c[3];
+        st_cross3(c, nt, a);
+        b = fmin(b, atan2(st_norm3(c), fabs(st_dot3(nt, a))));
+    }
+    return b;
+}
 
 /* The cap of the loop pts[0..n) (n >= 3) from a corner rebuilt from the
  * planes of the soup's triangles along it (side[i]: the third point of

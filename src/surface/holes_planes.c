@@ -42,7 +42,12 @@
  * with those a chain would place along one line merged into one, two
  * ways (MERGE); the fans that bend least along the loop are kept. The
  * caller keeps the fans or the single cone, whichever continues the soup
- * along the loop better. The fans' triangulations of a loop's own points
+ * along the loop better. Where a loop edge runs along a crease (the
+ * soup's triangle there is one face, and both its ends lie on the plane
+ * of another face along the loop: a tunnel's mouth whose face around it
+ * was lost), a cap that continues that other face bends nowhere there
+ * (st_holes_creases, st_holes_crease_bend; doc/design/holes.md,
+ * "Creases"). The fans' triangulations of a loop's own points
  * are not tested for piercing; that, the piercing test's cost and the
  * variants not kept are measured in doc/design/holes.md.
  */
@@ -50,6 +55,7 @@
 #include "../base/fpenv.h"
 #include "souptet/geom.h"
 #include "souptet/isect.h"
+#include "souptet/pred.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -88,6 +94,47 @@ typedef struct plane {
     double len;         /* the length of the loop edges on it */
 } plane;
 
+/* 1 when a loop edge runs along a crease (its two normals from
+ * st_holes_creases, cr[6]): its bend may then be 0. */
+static int on_crease(const double *cr)
+{
+    return st_dot3(cr, cr) != 0.0;
+}
+
+/* 1 when d lies on the plane through t[0], t[1], t[2] (exact). */
+static int on_plane(const double *const *t, const double *d)
+{
+    return st_orient3d(t[0], t[1], t[2], d) == 0.0;
+}
+
+void st_holes_creases(double *crease, const double *const *pts, const double *const *side,
+                      size_t n)
+{
+    memset(crease, 0, 6 * n * sizeof *crease);
+    for (size_t i = 0; i < n; i++) {
+        const double *p = pts[i], *q = pts[(i + 1) % n];
+        const double *held[2][3];
+        int got = 0;
+        for (size_t j = 0; j < n && got < 2; j++) {
+            const double *t[3] = {pts[j], side[j], pts[(j + 1) % n]};
+            double nn[3];
+            unit_normal(nn, t[0], t[1], t[2]);
+            if (j == i || st_dot3(nn, nn) == 0.0 || !on_plane(t, p) || !on_plane(t, q) ||
+                on_plane(t, side[i]))
+                continue;
+            int same = 0;
+            for (int k = 0; k < got && !same; k++)
+                same = on_plane(held[k], t[0]) && on_plane(held[k], t[1]) &&
+                       on_plane(held[k], t[2]);
+            if (same)
+                continue;
+            memcpy(crease + 6 * i + 3 * got, nn, sizeof nn);
+            memcpy(held[got], t, sizeof t);
+            got++;
+        }
+    }
+}
+
 /* 1 when the cone from apex bends surely no less than below along the
  * loop (cone_bend would say 0), from a lower bound of each term taken
  * without the arc tangent and the scaled norms: the sine of the angle
@@ -97,7 +144,7 @@ typedef struct plane {
  * and sums): the margins, a relative 1e-10 and 1e-12 times the loop's
  * length in radians, are far beyond those. 0 when unsure. */
 static int cone_above(const double *apex, const double *const *pts, const double *rim, size_t n,
-                      double below)
+                      const double *crease, double below)
 {
     double lb = 0.0, len = 0.0;
     for (size_t i = 0; i < n; i++) {
@@ -112,7 +159,7 @@ static int cone_above(const double *apex, const double *const *pts, const double
             return 0;
         const double l = sqrt(ee);
         len += l;
-        if (uu > 1e-200 && uu < 1e200)
+        if (uu > 1e-200 && uu < 1e200 && !(crease && on_crease(crease + 6 * i)))
             lb += l * (d > 0.0 ? sqrt(st_dot3(x, x) / uu) : 0.5 * M_PI);
         if (lb * (1.0 - 1e-10) - 1e-12 * len >= below)
             return 1;
@@ -129,13 +176,15 @@ static int cone_above(const double *apex, const double *const *pts, const double
  * the same order, could only grow (a NaN stays one and fails the test
  * too). */
 static int cone_bend(const double *apex, const double *const *pts, const double *rim, size_t n,
-                     double below, double *tn, double *total, double *rimb)
+                     const double *crease, double below, double *tn, double *total,
+                     double *rimb)
 {
     double b = 0.0;
     for (size_t i = 0; i < n; i++) {
         const double *p = pts[i], *q = pts[(i + 1) % n];
         unit_normal(tn + 3 * i, p, q, apex);
-        b += dist3(p, q) * bend(tn + 3 * i, rim + 3 * i);
+        b += dist3(p, q) * st_holes_crease_bend(tn + 3 * i, rim + 3 * i,
+                                                crease ? crease + 6 * i : NULL);
         if (!(b < below))
             return 0;
     }
@@ -324,6 +373,7 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
     double lo[3], hi[3], o[3], ext;
     reach_box(lo, hi, o, &ext, pts, n);
     const size_t m = loop_planes(pl, rim, pts, side, n, ext);
+    const double *crease = guard ? guard->crease : NULL;
     /* the cones that bend less than below, the least bent first (ties
      * by the bend of their spokes too): the first whose triangles pierce
      * none of the soup */
@@ -334,8 +384,8 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
                 cand *k = cs + nc;
                 double rb, cb;
                 if (!candidate(k->x, pl, a, b, c, o, lo, hi) ||
-                    cone_above(k->x, pts, rim, n, below) ||
-                    !cone_bend(k->x, pts, rim, n, below, tn, &cb, &rb))
+                    cone_above(k->x, pts, rim, n, crease, below) ||
+                    !cone_bend(k->x, pts, rim, n, crease, below, tn, &cb, &rb))
                     continue;
                 k->key = rb, k->tie = cb, k->a = a, k->b = b, k->c = c, k->done = 0;
                 nc++;
@@ -746,9 +796,11 @@ static int push_split(fanner *f, size_t k, const double *A)
     return 1;
 }
 
-/* The caps' bend along the original loop pts[0..n). */
+/* The caps' bend along the original loop pts[0..n) (crease: the loop's
+ * creases, st_holes_crease_bend; NULL: against the soup's triangles
+ * only). */
 static double fans_bend(const fan_out *fo, const double *const *pts, const double *const *side,
-                        size_t n)
+                        size_t n, const double *crease)
 {
     double rb = 0.0;
     for (size_t t = 0; t < fo->nt; t++) {
@@ -760,7 +812,8 @@ static double fans_bend(const fan_out *fo, const double *const *pts, const doubl
             if (i < 0)
                 continue;
             unit_normal(nr, pts[i], side[i], pts[((size_t)i + 1) % n]);
-            rb += dist3(pts[i], pts[((size_t)i + 1) % n]) * bend(nt, nr);
+            rb += dist3(pts[i], pts[((size_t)i + 1) % n]) *
+                  st_holes_crease_bend(nt, nr, crease ? crease + 6 * i : NULL);
         }
     }
     return rb;
@@ -878,9 +931,9 @@ static int fans_cross(const fan_out *fo)
  * overflowed; or, merged, when two of them pierce each other). */
 static st_status fans_run(fanner *f, int merge, const fanner *lead, const double *const *pts,
                           const double *const *side, size_t n, st_holes_fill fill,
-                          const st_holes_guard *guard, double *rb, st_error *err)
+                          const st_holes_guard *guard, double *rb, double *rbc, st_error *err)
 {
-    *rb = INFINITY;
+    *rb = *rbc = INFINITY;
     f->guard = guard;
     f->merge = merge;
     f->lead = lead;
@@ -901,8 +954,10 @@ static st_status fans_run(fanner *f, int merge, const fanner *lead, const double
         return rc;
     /* merged, two lines' apexes can be one point far from where either
      * chain went: such fans may cross themselves */
-    if (!merge || !fans_cross(&f->fo))
-        *rb = fans_bend(&f->fo, pts, side, n);
+    if (!merge || !fans_cross(&f->fo)) {
+        *rb = fans_bend(&f->fo, pts, side, n, NULL);
+        *rbc = guard && guard->crease ? fans_bend(&f->fo, pts, side, n, guard->crease) : *rb;
+    }
     return ST_OK;
 }
 
@@ -926,22 +981,25 @@ st_status st_holes_planes_fans(st_soup *out, int *done, const double *const *pts
     *bent = INFINITY;
     fanner fs[3];
     memset(fs, 0, sizeof fs);
-    double rbs[3];
+    double rbs[3], rbc[3];
     /* without the apexes merged, and, where those show a chain
      * (fans_chain), merged each way (MERGE; the first apex is the same in
      * all three): the merged ones that bend least along the loop where
      * they bend less than MERGE_BETTER times the unmerged ones, else
-     * those */
+     * those. That choice by their bend against the soup's triangles
+     * alone: along creases every one may bend nowhere, and a rounding
+     * would pick merged fans that fold (doc/design/holes.md, "Creases");
+     * the caller's bound by the bend with the creases (rbc) */
     size_t v = 0;
-    st_status rc = fans_run(fs, 0, NULL, pts, side, n, fill, guard, rbs, err);
+    st_status rc = fans_run(fs, 0, NULL, pts, side, n, fill, guard, rbs, rbc, err);
     const int chain = !rc && fans_chain(fs);
     for (int k = 1; k < 3 && chain && !rc; k++) {
-        rc = fans_run(fs + k, k, fs, pts, side, n, fill, guard, rbs + k, err);
+        rc = fans_run(fs + k, k, fs, pts, side, n, fill, guard, rbs + k, rbc + k, err);
         if (!rc && rbs[k] < MERGE_BETTER * rbs[0] && rbs[k] < rbs[v])
             v = (size_t)k;
     }
     const fanner *f = fs + v;
-    const double rb = rbs[v];
+    const double rb = rbc[v];
     if (rc || !(rb < below))
         goto done;
     for (size_t t = 0; t < f->fo.nt; t++) {
