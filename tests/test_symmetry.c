@@ -14,7 +14,9 @@
  * samples is accepted (late_support). The near grid (large slanted
  * triangles): the same set as the same part with its triangles split
  * fine enough that no grid is built (slanted). A disc-like part with a
- * quarter lost from one side: its plane where it is (lost_side). */
+ * quarter lost from one side: its plane where it is (lost_side). The
+ * bracket with a third lost (accepted on the contradiction rule, whose
+ * rims are made when first needed) the same on 1 and 2 threads. */
 #include "souptet/bvh.h"
 #include "souptet/soup.h"
 #include "souptet/symmetry.h"
@@ -289,6 +291,19 @@ static void test_lost_third(void)
     TAP_CHECK(my && at < 0.5 * tol, "bracket with a third lost: the plane y = 0 "
               "(%.4f off, normal y %.5f, support %.3f)", at, my ? my->dir[1] : 0.0,
               my ? my->support : 0.0);
+#ifdef _OPENMP
+    /* its plane is accepted on the contradiction rule: the rims are made
+     * when the first count needs them, in measure_mirrors' threads */
+    int nt = omp_get_max_threads();
+    st_symmetry_set set1, set2;
+    omp_set_num_threads(1);
+    detect(&set1, s, tol);
+    omp_set_num_threads(2);
+    detect(&set2, s, tol);
+    omp_set_num_threads(nt);
+    TAP_CHECK(memcmp(&set1, &set2, sizeof set1) == 0 && memcmp(&set, &set1, sizeof set) == 0,
+              "bracket with a third lost: the same bytes on 1, 2 and %d threads", nt);
+#endif
     st_soup_free(s);
 }
 
