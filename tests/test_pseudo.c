@@ -917,6 +917,39 @@ static void test_fill(void)
             TAP_CHECK(ok && (double)faces >= 0.6 * n * n && (double)faces <= n * n + 1,
                       "and covers most of it: %zu squares of about %.0f", faces, n * n);
         }
+        /* the same squares as the nearest search gives (the fill asks only
+         * whether a triangle is within a voxel: st_bvh_within), in grid
+         * order: each square's first corner is its center less half a
+         * voxel along both other axes */
+        size_t ref = 0, same = 0;
+        for (size_t k = 0; ok && k < g->nz; k++)
+            for (size_t j = 0; j < g->ny; j++)
+                for (size_t i = 0; i < g->nx; i++)
+                    for (int a = 0; a < 3; a++) {
+                        size_t o[3] = {i, j, k};
+                        const size_t nn[3] = {g->nx, g->ny, g->nz};
+                        if (o[a] + 1 >= nn[a])
+                            continue;
+                        o[a]++;
+                        if ((g->data[st_grid_index(g, i, j, k)] < 0.0f) ==
+                            (g->data[st_grid_index(g, o[0], o[1], o[2])] < 0.0f))
+                            continue;
+                        double c[3];
+                        int64_t tri;
+                        st_grid_center(g, i, j, k, c);
+                        c[a] += 0.5 * g->voxel;
+                        (void)st_bvh_nearest(bvh, c, g->voxel * g->voxel, &tri, NULL);
+                        if (tri >= 0)
+                            continue;
+                        const double *q = ref < faces ? f->xyz + 12 * ref : NULL;
+                        c[(a + 1) % 3] -= 0.5 * g->voxel;
+                        c[(a + 2) % 3] -= 0.5 * g->voxel;
+                        same += q && q[0] == c[0] && q[1] == c[1] && q[2] == c[2];
+                        ref++;
+                    }
+        TAP_CHECK(ok && ref == faces && same == faces,
+                  "%s box: the squares of the nearest search (%zu of %zu, %zu in place)",
+                  closed ? "closed" : "open", ref, faces, same);
         /* how much of the boundary is a guess: the top's share of a cube's
          * boundary faces, about 1/6 (less the rim within a voxel of the
          * walls), as far from the soup as its middle from the walls' top

@@ -71,9 +71,9 @@ st_status st_pseudo_fill(st_soup **out, const st_grid *g, const st_bvh *bvh,
                     double c[3];
                     st_grid_center(g, i, j, k, c);
                     c[a] += 0.5 * v;
-                    int64_t tri;
-                    (void)st_bvh_nearest(bvh, c, reach2, &tri, NULL);
-                    if (tri >= 0)
+                    /* the first triangle within reach will do: st_bvh_within
+                     * finds one exactly when the nearest search does */
+                    if (st_bvh_within(bvh, c, reach2))
                         continue;   /* the soup passes between them */
                     st_status rc = add_square(f, c, a, 0.5 * v, err);
                     if (rc) {
@@ -145,9 +145,7 @@ st_status st_pseudo_guess_symmetric(st_pseudo_guess *out, const st_grid *g,
         const uint32_t *t = fill->tris + 6 * (size_t)q;
         const double *a = fill->xyz + 3 * (size_t)t[0], *c = fill->xyz + 3 * (size_t)t[2];
         const double m[3] = {0.5 * (a[0] + c[0]), 0.5 * (a[1] + c[1]), 0.5 * (a[2] + c[2])};
-        int64_t tri;
-        (void)st_bvh_nearest(b, m, reach2, &tri, NULL);
-        near += tri >= 0;
+        near += (size_t)st_bvh_within(b, m, reach2);
     }
     st_bvh_free(b);
     out->symmetric_faces = near;

@@ -373,14 +373,12 @@ static const double *point_of(const st_grid *g, const long q0[3], const int s[3]
     return pt;
 }
 
-/* Whether point q is within sqrt(d2) of the seen soup (seen NULL: yes). */
+/* Whether point q is within sqrt(d2) of the seen soup (seen NULL: yes):
+ * the first triangle within it will do (st_bvh_within finds one exactly
+ * when the nearest search does). */
 static int near_seen(const st_bvh *seen, const double q[3], double d2)
 {
-    int64_t tri = -1;
-    if (!seen)
-        return 1;
-    st_bvh_nearest(seen, q, d2, &tri, NULL);
-    return tri >= 0;
+    return !seen || st_bvh_within(seen, q, d2);
 }
 
 st_status st_sides_mirror(st_grid *g, const st_soup *soup, size_t seen_triangles,

@@ -224,6 +224,69 @@ int st_holes_area_above(const double *const *pts, size_t n, double lim)
     return vector_area_above(pts, n, lim) || least_area_above(pts, n, lim);
 }
 
+/* least_bend's program: its tables (n x n) and the soup's triangle on
+ * the closing edge. */
+typedef struct bend_dp {
+    size_t n;
+    const double *const *pts;
+    double *ang, *w, *nrm, *el, last[3];
+    uint16_t *best;
+} bend_dp;
+
+/* *a plus l times bend(t, r) (bend() exactly: the arc tangent of the
+ * same two values) into *a, and 1; or 0, *a as it was, when the sum is
+ * surely above lim: told before the arc tangent from a lower bound of
+ * the bend, the sine of the angle (|t x r| of unit vectors, less a
+ * relative 1e-6, far beyond the rounding of the norms and of atan2),
+ * or 1.5 where the angle is at least a right angle, the sum's rounding
+ * monotone in the bend. */
+static int bend_add(double *a, double l, const double *t, const double *r, double lim)
+{
+    if (st_dot3(t, t) == 0.0 || st_dot3(r, r) == 0.0) {
+        *a += l * 4.0;
+        return 1;
+    }
+    double c[3];
+    st_cross3(c, t, r);
+    const double y = st_norm3(c), x = st_dot3(t, r);
+    if (*a + l * (x > 0.0 ? y * (1.0 - 1e-6) : 1.5) > lim)
+        return 0;
+    *a += l * atan2(y, x);
+    return 1;
+}
+
+/* The sub-polygon (i, j) of least_bend through apex k: its bend, area and
+ * triangle's normal taken into (*ba, *bw, bn, *mk) when they are below
+ * them, (bend, area) compared in that order, ties by the lower k. The
+ * bends added are never negative (nor their sums' rounding): an apex whose
+ * two sides alone, or with one of its bends, bend more than the best is
+ * not taken, nor measured further. */
+static void bend_apex(const bend_dp *d, size_t i, size_t k, size_t j, double *ba, double *bw,
+                      double *bn, size_t *mk)
+{
+    const size_t n = d->n;
+    const double *const *pts = d->pts;
+    double a = d->ang[i * n + k] + d->ang[k * n + j];
+    if (a > *ba)
+        return;
+    double t[3];
+    unit_normal(t, pts[i], pts[k], pts[j]);
+    if (!bend_add(&a, d->el[i * n + k], t, d->nrm + 3 * (i * n + k), *ba) ||
+        !bend_add(&a, d->el[k * n + j], t, d->nrm + 3 * (k * n + j), *ba))
+        return;
+    if (j - i == n - 1)     /* the closing edge, passed n-1 -> 0 */
+        a += d->el[n - 1] * bend(t, d->last);
+    if (!(a <= *ba))        /* the area only breaks ties */
+        return;
+    const double c = d->w[i * n + k] + d->w[k * n + j] + tri_area(pts[i], pts[k], pts[j]);
+    if (a < *ba || (a == *ba && (c < *bw || (c == *bw && k < *mk)))) {
+        *ba = a;
+        *bw = c;
+        *mk = k;
+        memcpy(bn, t, sizeof t);
+    }
+}
+
 /* The triangulation of the polygon pts[0..n) (n >= 3) on its own vertices
  * that bends least: the sum over its edges of length times bend (bend()),
  * the discrete total mean curvature, is least; ties by area. The edges
@@ -240,69 +303,55 @@ int st_holes_area_above(const double *const *pts, size_t n, double lim)
  * one (ruled between two rims of the loop) only by its facets' small
  * angles; the least-area cap cuts straight across a curved face and,
  * where the loop runs over several faces of a part, folds through its
- * solid. Fills tri[3 (n - 2)] and *area with the cap's area (an
- * st_holes_fill, holes_internal.h). ST_ENOMEM. */
-static st_status least_bend(double *area, const double *const *pts, const double *const *side,
-                            size_t n, uint32_t *tri, st_error *err)
+ * solid. Each sub-polygon tries first the apex that (i, j - 1) took
+ * (usually the best or near it: the apexes after it are then mostly
+ * passed over unmeasured), then the others in order; the least (bend,
+ * area, apex) is the same in any order (ties keep the first k). Fills
+ * tri[3 (n - 2)] and *area with the cap's area (an st_holes_fill,
+ * holes_internal.h). ST_ENOMEM. */
+st_status st_holes_least_bend(double *area, const double *const *pts, const double *const *side,
+                              size_t n, uint32_t *tri, st_error *err)
 {
-    double *ang = malloc(n * n * sizeof *ang), *w = malloc(n * n * sizeof *w);
-    double *nrm = malloc(3 * n * n * sizeof *nrm), *el = malloc(n * n * sizeof *el);
-    uint16_t *best = malloc(n * n * sizeof *best);
+    bend_dp d = {n, pts, malloc(n * n * sizeof *d.ang), malloc(n * n * sizeof *d.w),
+                 malloc(3 * n * n * sizeof *d.nrm), malloc(n * n * sizeof *d.el), {0, 0, 0},
+                 malloc(n * n * sizeof *d.best)};
     size_t *stack = malloc(2 * n * sizeof *stack);
     st_status rc = ST_OK;
-    if (!ang || !w || !nrm || !el || !best || !stack) {
+    if (!d.ang || !d.w || !d.nrm || !d.el || !d.best || !stack) {
         rc = oom(err);
         goto done;
     }
     for (size_t i = 0; i < n; i++)     /* el[i n + k], i < k: dist3(pts[i], pts[k]) */
         for (size_t k = i + 1; k < n; k++)
-            el[i * n + k] = dist3(pts[i], pts[k]);
+            d.el[i * n + k] = dist3(pts[i], pts[k]);
     /* (i, i + 1): the soup's triangle across the edge, passed i -> c -> i+1;
      * (i, j) above: the triangle (i, k, j) of its best triangulation */
     for (size_t i = 0; i + 1 < n; i++) {
-        ang[i * n + i + 1] = 0.0;
-        w[i * n + i + 1] = 0.0;
-        unit_normal(nrm + 3 * (i * n + i + 1), pts[i], side[i], pts[i + 1]);
+        d.ang[i * n + i + 1] = 0.0;
+        d.w[i * n + i + 1] = 0.0;
+        unit_normal(d.nrm + 3 * (i * n + i + 1), pts[i], side[i], pts[i + 1]);
     }
-    double last[3];     /* the soup's triangle on the closing edge, 0 -> n-1 -> c */
-    unit_normal(last, pts[0], pts[n - 1], side[n - 1]);
+    /* the soup's triangle on the closing edge, 0 -> n-1 -> c */
+    unit_normal(d.last, pts[0], pts[n - 1], side[n - 1]);
     for (size_t len = 2; len < n; len++)
         for (size_t i = 0; i + len < n; i++) {
             const size_t j = i + len;
             double ba = INFINITY, bw = INFINITY, bn[3] = {0, 0, 0};     /* bend, area, normal */
-            size_t mk = i + 1;
-            for (size_t k = i + 1; k < j; k++) {
-                /* the bends added are never negative (nor their sum's
-                 * rounding): an apex whose two sides alone bend more than
-                 * the best is not taken */
-                double a = ang[i * n + k] + ang[k * n + j];
-                if (a > ba)
-                    continue;
-                double t[3];
-                unit_normal(t, pts[i], pts[k], pts[j]);
-                a += el[i * n + k] * bend(t, nrm + 3 * (i * n + k));
-                a += el[k * n + j] * bend(t, nrm + 3 * (k * n + j));
-                if (j - i == n - 1)     /* the closing edge, passed n-1 -> 0 */
-                    a += el[n - 1] * bend(t, last);
-                if (!(a <= ba))         /* the area only breaks ties */
-                    continue;
-                const double c = w[i * n + k] + w[k * n + j] + tri_area(pts[i], pts[k], pts[j]);
-                if (a < ba || (a == ba && c < bw)) {    /* ties keep the first k */
-                    ba = a;
-                    bw = c;
-                    mk = k;
-                    memcpy(bn, t, sizeof t);
-                }
-            }
-            ang[i * n + j] = ba;
-            w[i * n + j] = bw;
-            best[i * n + j] = (uint16_t)mk;
-            memcpy(nrm + 3 * (i * n + j), bn, sizeof bn);
+            size_t mk = j;
+            const size_t k0 = len > 2 ? d.best[i * n + j - 1] : i + 1;
+            bend_apex(&d, i, k0, j, &ba, &bw, bn, &mk);
+            for (size_t k = i + 1; k < j; k++)
+                if (k != k0)
+                    bend_apex(&d, i, k, j, &ba, &bw, bn, &mk);
+            d.ang[i * n + j] = ba;
+            d.w[i * n + j] = bw;
+            d.best[i * n + j] = (uint16_t)(mk < j ? mk : i + 1);
+            memcpy(d.nrm + 3 * (i * n + j), bn, sizeof bn);
         }
-    *area = w[n - 1];
-    emit_triangles(best, n, stack, tri);
+    *area = d.w[n - 1];
+    emit_triangles(d.best, n, stack, tri);
 done:
-    free(ang), free(w), free(nrm), free(el), free(best), free(stack);
+    free(d.ang), free(d.w), free(d.nrm), free(d.el), free(d.best), free(stack);
     return rc;
 }
 
@@ -1026,7 +1075,7 @@ static st_status cap_planes(capper *c, int *rebuilt, double *bent, st_error *err
     rc = st_holes_planes_cap(cone, &coned, l->pts, l->side, n, below, &guard, &cb, err);
     if (!rc)
         rc = st_holes_planes_fans(fans, &fanned, l->pts, l->side, n, below,
-                                  c->bend ? least_bend : fill_area, &guard, &fb, err);
+                                  c->bend ? st_holes_least_bend : fill_area, &guard, &fb, err);
     if (!rc && (coned || fanned))
         rc = st_soup_append(c->out, fanned && (!coned || fb < cb) ? fans : cone, err);
     *rebuilt = !rc && (coned || fanned);
@@ -1073,7 +1122,7 @@ static st_status cap_loop(capper *c, size_t e0, st_error *err)
         loop_points(c, 1);
     if (c->planes)
         st_holes_creases(l->crease, l->pts, l->side, n);
-    if (c->bend && (rc = least_bend(&bent, l->pts, l->side, n, l->tri, err)))
+    if (c->bend && (rc = st_holes_least_bend(&bent, l->pts, l->side, n, l->tri, err)))
         return rc;
     int rebuilt = 0, cyl = 0;
     double rb = INFINITY;
@@ -1086,7 +1135,7 @@ static st_status cap_loop(capper *c, size_t e0, st_error *err)
     if (c->planes && (rc = st_holes_cyl_cap(c->out, &cyl, vb, tb, l->pts, l->side, n,
                                             rebuilt ? rb : rim_bend(l->pts, l->side, n, l->tri,
                                                                     l->crease),
-                                            c->bend ? least_bend : fill_area, &guard, err)))
+                                            c->bend ? st_holes_least_bend : fill_area, &guard, err)))
         return rc;
     if (rebuilt || cyl) {
         c->st.filled++;

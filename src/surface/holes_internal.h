@@ -56,6 +56,15 @@ static inline double bend(const double *a, const double *b)
 st_status st_holes_least_area(double *area, const double *const *pts, size_t n, uint32_t *tri,
                               st_error *err);
 
+/* The triangulation of the loop pts[0..n) (n >= 3) on its own points
+ * that bends least along its edges and the soup's triangles beside the
+ * loop (side[i]: the third point of the one on edge pts[i] -> pts[i + 1
+ * mod n]), ties by area, then by the first apex (holes.c): fills
+ * tri[3 (n - 2)] with local indices and *area with its area (an
+ * st_holes_fill). ST_ENOMEM. */
+st_status st_holes_least_bend(double *area, const double *const *pts, const double *const *side,
+                              size_t n, uint32_t *tri, st_error *err);
+
 /* 1 when st_holes_least_area's area of the loop pts[0..n) is surely above
  * lim, told without it where it can be (its vector area, or the same
  * program rounded otherwise, with a margin; holes.c); 0 when unsure.
