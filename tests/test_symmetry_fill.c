@@ -6,7 +6,8 @@
  * threads); a 70-degree hole across a mirror plane whose copy is whole
  * (its cap dropped, the fill closes it) and whose copy is itself holed
  * (the fill leaves the hole partly open but lies behind the cap: the cap
- * is dropped, the partial fill kept). */
+ * is dropped, the partial fill kept); an 80-degree hole across the plane,
+ * whose cap is split where the mirror sends the hole onto itself. */
 #include "souptet/bvh.h"
 #include "souptet/edges.h"
 #include "souptet/holes.h"
@@ -302,6 +303,58 @@ static void test_mirror_turn(void)
     st_soup_free(s);
 }
 
+/* The angle of the centroid of f's triangle t, in [0, 360). */
+static double tri_angle(const st_soup *f, size_t t)
+{
+    double c[2] = {0, 0};
+    for (int k = 0; k < 3; k++)
+        for (int a = 0; a < 2; a++)
+            c[a] += f->xyz[3 * f->tris[3 * t + k] + a] / 3.0;
+    const double a = atan2(c[1], c[0]) * 180.0 / M_PI;
+    return a < 0 ? a + 360.0 : a;
+}
+
+/* An 80-degree hole [60, 140] across the mirror x = 0 (angle a to
+ * 180 - a): the mirror sends [60, 120] onto itself (the copy of what is
+ * lost there is lost too) and [120, 140] onto [40, 60], which the soup
+ * has. The fill runs along too little of the rim to close the hole, so
+ * on 73c174e the cap stayed whole and no fill was kept ([120, 140] as
+ * the cap's guess). The cap is split: the fill kept over [120, 140], the
+ * cap kept over the part the mirror sends onto itself alone. */
+static void test_straddles(void)
+{
+    const double hole[2] = {60.0, 140.0};
+    int missing;
+    st_soup *s = cylinder(hole, 1, &missing);
+    for (size_t t = 0; t < s->ntris; t++) {   /* a bore: the solid outside */
+        const uint32_t v = s->tris[3 * t + 1];
+        s->tris[3 * t + 1] = s->tris[3 * t + 2];
+        s->tris[3 * t + 2] = v;
+    }
+    const st_symmetry_set set = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8, 0.0}}, 1, 1};
+    run r;
+    TAP_CHECK(fill_of(&r, s, &set) == 0, "a hole across the plane: the fill runs");
+    TAP_CHECK(r.st.caps == 1 && r.st.open == 0, "one capped hole (%zu)", r.st.caps);
+    const double spoken = side_covered(r.fill, s, 1.0, 122.0, 138.0),
+                 self = side_covered(r.fill, s, 1.0, 65.0, 115.0);
+    TAP_CHECK(spoken == 1.0, "the fill covers the part the mirror speaks for (%.4f of [122, "
+              "138]; area %.4f)", spoken, r.st.area);
+    TAP_CHECK(self == 0.0, "and nothing of the part it sends onto itself (%.4f of [65, 115])",
+              self);
+    TAP_CHECK(on_side_in(r.fill, 1.0, 120.0, 140.0), "every fill vertex on the side, in "
+              "[120, 140]");
+    int in_self = 1;
+    for (size_t t = 0; t < r.kept->ntris; t++)
+        in_self &= in_range(tri_angle(r.kept, t), 55.0, 125.0);
+    TAP_CHECK(r.kept->ntris > 0 && r.kept->ntris < r.caps->ntris && in_self,
+              "the cap kept over the self-mapped part alone (%zu of %zu cap triangles)",
+              r.kept->ntris, r.caps->ntris);
+    TAP_CHECK(r.st.caps_split == 1 && r.st.caps_covered == 1, "the cap is split (%zu split, "
+              "%zu covered)", r.st.caps_split, r.st.caps_covered);
+    run_free(&r);
+    st_soup_free(s);
+}
+
 static void test_no_symmetry(void)
 {
     const double hole[2] = {0.0, 40.0};
@@ -324,7 +377,7 @@ int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(open_hole), TAP_TEST(rim_in_hole),
                                      TAP_TEST(copy_whole),
-                                     TAP_TEST(copy_holed), TAP_TEST(mirror_turn),
+                                     TAP_TEST(copy_holed), TAP_TEST(mirror_turn), TAP_TEST(straddles),
                                      TAP_TEST(no_symmetry), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -123,6 +123,9 @@ typedef struct st_symmetry_fill_stats {
                              itself holed): no fill there */
     size_t caps_agree;    /* caps the fill closes but does not depart from
                              (within tol of the cap): kept, no fill */
+    size_t caps_split;    /* of caps_covered, split: the fill kept where the
+                             map speaks for the lost surface, the cap kept
+                             where it sends the hole onto itself */
 } st_symmetry_fill_stats;
 
 /* Where soup s has holes, the images of s's triangles under the
@@ -148,7 +151,11 @@ typedef struct st_symmetry_fill_stats {
  * or centroid farther than tol plus the map's error): else the cap stays,
  * without fill. Where a set of mirrors alone leaves a hole unclosed, a
  * third round tries the turns two mirrors make (about the line where
- * their planes meet, by twice their angle) for it. *kept_caps gets the caps minus the pieces the fill closes. Mirror
+ * their planes meet, by twice their angle) for it. A cap still left that
+ * a mirror's fill covers in part, where the hole straddles the plane, is
+ * split: the cap kept where the mirror sends the hole onto itself, the
+ * mirror's fill over the rest (when the two run along 3/4 of the rim).
+ * *kept_caps gets the caps minus the pieces the fill closes. Mirror
  * images are re-oriented so the fill keeps s's orientation. Deterministic for any thread count. bvh: st_bvh_build(s).
  * Both outputs are the caller's (st_soup_free); empty soups when set has
  * nothing. ST_EINPUT for a tol that is not positive and finite;

@@ -862,10 +862,10 @@ int tool_report_symmetries(tool_ctx *t, const st_soup *soup, const st_bvh *bvh,
     if (set->candidates > 0) {
         tool_say(t, 2, "symmetries: %zu accepted (support >= %.2f, or a mirror seldom "
                  "contradicted) within %.6g (%zu candidates measured); fill: %zu triangles from %zu maps, %zu of %zu caps dropped as "
-                 "covered, %zu kept (the fill agrees with them), %zu of %zu holes too large "
+                 "covered (%zu split), %zu kept (the fill agrees with them), %zu of %zu holes too large "
                  "to cap filled, %zu left as they were (the copy itself holed), %.3f s",
                  set->n, sp.min_support, tolerance, set->candidates, fill->triangles,
-                 fill->maps, fill->caps_covered, fill->caps, fill->caps_agree,
+                 fill->maps, fill->caps_covered, fill->caps, fill->caps_split, fill->caps_agree,
                  fill->open_filled, fill->open, fill->unclosed, seconds);
     } else {
         st_error err;

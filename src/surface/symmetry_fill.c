@@ -26,7 +26,11 @@
  * across it would cut the solid the fill bounds; where the two agree the
  * cap stays and the fill is left out. A cap whose fill does not close it
  * is dropped all the same where the fill lies behind it (contradicted:
- * the cap encloses space the copy shows empty).
+ * the cap encloses space the copy shows empty). A cap still left that a
+ * mirror's fill covers in part is split where the hole straddles the
+ * plane (split_caps): the cap kept where the mirror sends the hole onto
+ * itself (the copy of what is lost there is lost too), the fill over the
+ * rest.
  *
  * Every decision is a distance compared with a tolerance of a voxel: the
  * fill is evidence for the signs (pseudo.c lowers it into the field as it
@@ -446,6 +450,7 @@ typedef struct fill_ctx {
     double tol;
     double reach2;             /* above the largest piece_ok reach squared
                                   (0: the anchors' whole box) */
+    const st_soup *caps;       /* the caps (the anchors' first triangles) */
 } fill_ctx;
 
 /* The piece image q fills, or SIZE_MAX. It must be off the soup (farther
@@ -496,6 +501,8 @@ typedef struct rims {
     double *mid;      /* 3n */
     double *len;      /* n */
     size_t *piece;    /* n */
+    size_t *tri;      /* n: a cap triangle the edge bounds (SIZE_MAX: an
+                         open rim's) */
 } rims;
 
 static void rims_free(rims *R)
@@ -504,6 +511,7 @@ static void rims_free(rims *R)
     free(R->mid);
     free(R->len);
     free(R->piece);
+    free(R->tri);
     memset(R, 0, sizeof *R);
 }
 
@@ -526,6 +534,7 @@ static st_status rims_grow(rims *R, size_t more)
     R->mid = grown(R->mid, 3 * cap, sizeof *R->mid, &fail);
     R->len = grown(R->len, cap, sizeof *R->len, &fail);
     R->piece = grown(R->piece, cap, sizeof *R->piece, &fail);
+    R->tri = grown(R->tri, cap, sizeof *R->tri, &fail);
     if (fail)
         return ST_ENOMEM;
     R->cap = cap;
@@ -545,7 +554,8 @@ static void ends_of(double e[6], const double p[3], const double q[3])
     memcpy(e + 3, swap ? p : q, 3 * sizeof *e);
 }
 
-static st_status rims_add(rims *R, const double p[3], const double q[3], size_t piece)
+static st_status rims_add(rims *R, const double p[3], const double q[3], size_t piece,
+                          size_t tri)
 {
     if (rims_grow(R, 1))
         return ST_ENOMEM;
@@ -554,6 +564,7 @@ static st_status rims_add(rims *R, const double p[3], const double q[3], size_t 
     for (int k = 0; k < 3; k++)
         R->mid[3 * R->n + k] = 0.5 * (p[k] + q[k]);
     R->len[R->n] = st_norm3(d);
+    R->tri[R->n] = tri;
     R->piece[R->n++] = piece;
     return ST_OK;
 }
@@ -573,7 +584,7 @@ static st_status rims_make(rims *R, const st_soup *caps, const pieces *P)
         if (j == i + 1 && e[i].a != e[i].b) {
             const uint32_t *c = caps->tris + 3 * e[i].tri;
             rc = rims_add(R, caps->xyz + 3 * c[e[i].ia], caps->xyz + 3 * c[e[i].ib],
-                          P->of_tri[e[i].tri]);
+                          P->of_tri[e[i].tri], e[i].tri);
         }
         i = j;
     }
@@ -668,7 +679,7 @@ static st_status open_rims(pieces *P, rims *R, st_soup *anchors, const st_soup *
         uf_join(uf, wa, wb);
         deg[wa]++;
         deg[wb]++;
-        rc = rims_add(R, p, q, wa);   /* piece: its welded end, for now */
+        rc = rims_add(R, p, q, wa, SIZE_MAX);   /* piece: its welded end, for now */
     }
     /* a loop: two open edges at every vertex; the edges the holes left
      * open where loops touch (a vertex of other degree) stay as they are */
@@ -682,6 +693,7 @@ static st_status open_rims(pieces *P, rims *R, st_soup *anchors, const st_soup *
         memmove(R->ends + 6 * kept, R->ends + 6 * r, 6 * sizeof *R->ends);
         memmove(R->mid + 3 * kept, R->mid + 3 * r, 3 * sizeof *R->mid);
         R->len[kept] = R->len[r];
+        R->tri[kept] = R->tri[r];
         R->piece[kept++] = R->piece[r];
     }
     R->n = kept;
@@ -1018,10 +1030,11 @@ static st_status open_length(double *open, size_t npieces, const fill_set *F,
     return ST_OK;
 }
 
-/* kept: the caps' triangles outside the covered pieces, their vertices
- * shared as in caps. */
+/* kept: the caps' triangles outside the covered pieces, and those of a
+ * split cap it keeps (cap_keep: 0 elsewhere), their vertices shared as in
+ * caps. */
 static st_status keep_uncovered(st_soup *kept, const st_soup *caps, const pieces *P,
-                                const uint8_t *covered, st_error *err)
+                                const uint8_t *covered, const uint8_t *cap_keep, st_error *err)
 {
     size_t *to = st_malloc_array(caps->nverts ? caps->nverts : 1, sizeof *to);
     if (!to)
@@ -1030,7 +1043,7 @@ static st_status keep_uncovered(st_soup *kept, const st_soup *caps, const pieces
     for (size_t v = 0; v < caps->nverts; v++)
         to[v] = SIZE_MAX;
     for (size_t t = 0; t < caps->ntris && !rc; t++) {
-        if (covered[P->of_tri[t]])
+        if (covered[P->of_tri[t]] && !(cap_keep && cap_keep[t]))
             continue;
         uint32_t w[3];
         for (int k = 0; k < 3 && !rc; k++) {
@@ -1051,15 +1064,17 @@ static st_status keep_uncovered(st_soup *kept, const st_soup *caps, const pieces
 /* The fill goes all or nothing with its piece: *fill gets the triangles of
  * the covered pieces (where a cap stays, a partial fill beside it would
  * cut the solid the cap closes; where a rim stays open, a partial fill
- * would be a wall the votes cannot read). */
+ * would be a wall the votes cannot read); of a split cap's, those it keeps
+ * (fill_keep: the part the cap is dropped from). */
 static st_status fill_of_covered(st_soup **fill, const fill_set *F, const uint8_t *covered,
-                                 st_symmetry_fill_stats *st, st_error *err)
+                                 const uint8_t *fill_keep, st_symmetry_fill_stats *st,
+                                 st_error *err)
 {
     st_soup *in = F->soup, *out = st_soup_new();
     if (!out)
         return ST_ENOMEM;
     for (size_t t = 0; t < in->ntris; t++) {
-        if (!covered[F->piece[t]])
+        if (!covered[F->piece[t]] || (fill_keep && !fill_keep[t]))
             continue;
         double q[3][3];
         for (int k = 0; k < 3; k++)
@@ -1272,7 +1287,8 @@ static void departs(uint8_t *depart, size_t npieces, const fill_set *F,
 }
 
 /* What became of a piece. */
-enum { PIECE_LEFT, PIECE_CLOSED, PIECE_UNCLOSED, PIECE_AGREES, PIECE_CONTRADICTED };
+enum { PIECE_LEFT, PIECE_CLOSED, PIECE_UNCLOSED, PIECE_AGREES, PIECE_CONTRADICTED,
+       PIECE_SPLIT };
 
 /* state[i] (for the pieces where todo[i]; NULL: all): PIECE_CLOSED when
  * piece i's fill closes it: the fill runs along its rim (at least
@@ -1406,6 +1422,173 @@ static st_status contradicted(uint8_t *state, const pieces *P, const fill_set *F
     return ST_OK;
 }
 
+/* ---- split: a cap a mirror covers in part ------------------------------------ */
+
+typedef struct kept_fill_ctx {
+    const fill_set *F;
+    const uint8_t *fill_keep;
+    size_t piece;
+    const double *x;
+    double reach2;
+} kept_fill_ctx;
+
+/* A kept fill triangle of the piece within reach of x: 1. */
+static int near_kept_fill(void *ctx, uint32_t t)
+{
+    const kept_fill_ctx *K = ctx;
+    if (K->F->piece[t] != K->piece || !K->fill_keep[t])
+        return 0;
+    const double *v = K->F->soup->xyz;
+    const uint32_t *c = K->F->soup->tris + 3 * (size_t)t;
+    return st_point_triangle_dist2(K->x, v + 3 * c[0], v + 3 * c[1], v + 3 * c[2], NULL) <=
+           K->reach2;
+}
+
+/* What mirror m says of point x of cap piece i: x's image lies nearer
+ * the soup than the holes' anchors (SPOKEN: the copy of what is lost
+ * there survives), or in this same hole (SELF: the hole straddles the
+ * plane, the copy of what is lost there is lost too: only the cap can
+ * say), or in another hole (OTHER: the copy itself holed). */
+enum { SPOKEN, SELF, OTHER };
+
+static int spoken_for(const fill_ctx *C, const map *m, size_t i, const double x[3])
+{
+    double q[3];
+    int64_t tri;
+    st_symmetry_apply(m->y, m->angle, x, 1, q);
+    const double ds = st_bvh_nearest(C->bvh, q, INFINITY, &tri, NULL);
+    if (tri < 0)
+        return OTHER;
+    const double da = st_bvh_nearest(C->anchors_bvh, q, ds, &tri, NULL);
+    return tri < 0 || da > ds ? SPOKEN : C->P->of_tri[tri] == i ? SELF : OTHER;
+}
+
+/* by[i]: for each cap piece the rounds leave in place (PIECE_LEFT or
+ * PIECE_UNCLOSED) with fill, the mirror that gave it the most fill
+ * triangles (ties: the lower map); SIZE_MAX where none did. */
+static st_status split_mirror(size_t *by, const uint8_t *state, const pieces *P,
+                              const fill_set *F, const map *maps, size_t nmaps)
+{
+    size_t *count = calloc(P->ncap * nmaps, sizeof *count);
+    if (!count)
+        return ST_ENOMEM;
+    for (size_t t = 0; t < F->soup->ntris; t++) {
+        const size_t i = F->piece[t];
+        if (i < P->ncap && (state[i] == PIECE_LEFT || state[i] == PIECE_UNCLOSED) &&
+            maps[F->map[t]].y->kind == ST_SYMMETRY_MIRROR)
+            count[i * nmaps + F->map[t]]++;
+    }
+    for (size_t i = 0; i < P->ncap; i++) {
+        by[i] = SIZE_MAX;
+        for (size_t m = 0; m < nmaps; m++)
+            if (count[i * nmaps + m] && (by[i] == SIZE_MAX || count[i * nmaps + m] >
+                                                                 count[i * nmaps + by[i]]))
+                by[i] = m;
+    }
+    free(count);
+    return ST_OK;
+}
+
+/* The caps the rounds leave in place while a mirror fills them in part
+ * (split_mirror): the mirror speaks for one part of the lost surface and
+ * not for the rest, where it sends the hole onto itself (spoken_for). The
+ * cap is split there: its triangles the mirror speaks for are dropped
+ * (cap_keep[t] SPOKEN, 0) and its fill kept over them (a fill triangle of
+ * that mirror whose nearest cap triangle is dropped: fill_keep), the rest
+ * of the cap kept. The piece is split (PIECE_SPLIT) when a triangle is
+ * dropped, the self-mapped part (SELF) straddles the plane (corners
+ * farther than tol on both sides), at most 1 - RIM_COVERED of the cap's
+ * area maps into other holes (OTHER: the copy itself holed, as on a soup
+ * with half its faces deleted), and the kept cap's rim edges and the
+ * ones within RIM_REACH tol of the kept fill are RIM_COVERED of the rim's
+ * length (the two close the hole together); else nothing changes.
+ * cap_keep: one per cap triangle, 1 where a split cap is kept, else 0;
+ * fill_keep: one per fill triangle, 1 outside the split pieces. len, by:
+ * 5 and 1 per cap piece, scratch. */
+static void split_caps(uint8_t *state, uint8_t *cap_keep, uint8_t *fill_keep, double *len,
+                       const size_t *by, const fill_ctx *C, const rims *R, const fill_set *F,
+                       const st_bvh *fill_bvh, const map *maps)
+{
+    const pieces *P = C->P;
+    const st_soup *caps = C->caps, *f = F->soup;
+    const long long nc = (long long)caps->ntris;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (long long t = 0; t < nc; t++) {
+        const size_t i = P->of_tri[t];
+        double x[3] = {0, 0, 0};
+        for (int k = 0; k < 3 && by[i] != SIZE_MAX; k++)
+            for (int a = 0; a < 3; a++)
+                x[a] += caps->xyz[3 * (size_t)caps->tris[3 * t + k] + a] / 3.0;
+        cap_keep[t] = by[i] == SIZE_MAX ? OTHER : (uint8_t)spoken_for(C, maps + by[i], i, x);
+    }
+    /* per piece: rim, along, the cap's area and its part mapped into
+     * other holes, and the self-mapped part's sides of the plane (bit 1:
+     * before, 2: behind; bit 4: a triangle dropped) */
+    memset(len, 0, 5 * P->ncap * sizeof *len);
+    for (size_t t = 0; t < caps->ntris; t++) {
+        const size_t i = P->of_tri[t];
+        if (by[i] == SIZE_MAX)
+            continue;
+        double q[3][3];
+        for (int k = 0; k < 3; k++)
+            memcpy(q[k], caps->xyz + 3 * (size_t)caps->tris[3 * t + k], sizeof q[k]);
+        len[5 * i + 2] += tri_area(q);
+        len[5 * i + 3] += cap_keep[t] == OTHER ? tri_area(q) : 0.0;
+        if (cap_keep[t] == SPOKEN)
+            len[5 * i + 4] = (double)((int)len[5 * i + 4] | 4);
+        if (cap_keep[t] != SELF)
+            continue;
+        const st_symmetry *y = maps[by[i]].y;
+        int side = (int)len[5 * i + 4];
+        for (int k = 0; k < 3; k++) {
+            const double *v = caps->xyz + 3 * (size_t)caps->tris[3 * t + k];
+            const double d[3] = {v[0] - y->point[0], v[1] - y->point[1], v[2] - y->point[2]};
+            const double h = st_dot3(d, y->dir);
+            side |= h > C->tol ? 1 : h < -C->tol ? 2 : 0;
+        }
+        len[5 * i + 4] = side;
+    }
+    for (size_t t = 0; t < f->ntris; t++) {
+        const size_t i = F->piece[t];
+        if (i >= P->ncap || by[i] == SIZE_MAX)
+            continue;
+        double c[3] = {0, 0, 0};
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++)
+                c[a] += f->xyz[3 * f->tris[3 * t + k] + a] / 3.0;
+        int64_t tri;
+        st_bvh_nearest(C->anchors_bvh, c, INFINITY, &tri, NULL);
+        fill_keep[t] = F->map[t] == by[i] && tri >= 0 && (size_t)tri < caps->ntris &&
+                       P->of_tri[tri] == i && !cap_keep[tri];
+    }
+    const double reach = RIM_REACH * C->tol;
+    for (size_t r = 0; r < R->n; r++) {
+        const size_t i = R->piece[r];
+        if (i >= P->ncap || by[i] == SIZE_MAX)
+            continue;
+        len[5 * i] += R->len[r];
+        int along = cap_keep[R->tri[r]];
+        if (!along) {
+            const double *m = R->mid + 3 * r;
+            kept_fill_ctx K = {F, fill_keep, i, m, reach * reach};
+            const double lo[3] = {m[0] - reach, m[1] - reach, m[2] - reach};
+            const double hi[3] = {m[0] + reach, m[1] + reach, m[2] + reach};
+            along = st_bvh_query_box(fill_bvh, lo, hi, near_kept_fill, &K);
+        }
+        len[5 * i + 1] += along ? R->len[r] : 0.0;
+    }
+    for (size_t i = 0; i < P->ncap; i++) {
+        const double *l = len + 5 * i;
+        if (by[i] != SIZE_MAX && l[4] == 7.0 && l[3] <= (1.0 - RIM_COVERED) * l[2] &&
+            l[1] >= RIM_COVERED * l[0])
+            state[i] = PIECE_SPLIT;
+    }
+    for (size_t t = 0; t < caps->ntris; t++)
+        cap_keep[t] = cap_keep[t] && state[P->of_tri[t]] == PIECE_SPLIT;
+    for (size_t t = 0; t < f->ntris; t++)
+        fill_keep[t] = fill_keep[t] || F->piece[t] >= P->ncap || state[F->piece[t]] != PIECE_SPLIT;
+}
+
 /* The fill in two rounds: the maps that put a piece's whole rim back on
  * the soup; then, for the holes they left open or uncapped (no fill, or
  * one that does not close), also the maps that put back what the soup can
@@ -1414,7 +1597,8 @@ static st_status contradicted(uint8_t *state, const pieces *P, const fill_set *F
  * rest; then turn_round with the mirrors' turns (maps[nset, nmaps)); then
  * the caps the fill contradicts (contradicted). covered[i]: piece i's cap
  * dropped and its fill kept. */
-static st_status fill_rounds(uint8_t *covered, fill_set *F, st_bvh **fill_bvh, const fill_ctx *C,
+static st_status fill_rounds(uint8_t *covered, uint8_t **cap_keep, uint8_t **fill_keep,
+                             fill_set *F, st_bvh **fill_bvh, const fill_ctx *C,
                              const rims *R, const map *maps, size_t nset, size_t nmaps,
                              size_t *keep, uint8_t *ok, double *share, double *map_err,
                              st_symmetry_fill_stats *st, st_error *err)
@@ -1435,8 +1619,23 @@ static st_status fill_rounds(uint8_t *covered, fill_set *F, st_bvh **fill_bvh, c
     rc = rc ? rc : turn_round(state, open, F, fill_bvh, C, R, maps, nset, nmaps, keep, ok, share,
                               map_err, err);
     rc = rc ? rc : contradicted(state, P, F, C->anchors_bvh, C->tol);
+    if (!rc && !(*cap_keep = st_malloc_array(C->caps->ntris ? C->caps->ntris : 1, 1)))
+        rc = ST_ENOMEM;
+    if (!rc && !(*fill_keep = st_malloc_array(F->soup->ntris ? F->soup->ntris : 1, 1)))
+        rc = ST_ENOMEM;
+    double *len = rc ? NULL : st_malloc_array(P->ncap ? 5 * P->ncap : 1, sizeof *len);
+    size_t *by = rc ? NULL : st_malloc_array(P->ncap ? P->ncap : 1, sizeof *by);
+    if (!rc && (!len || !by))
+        rc = ST_ENOMEM;
+    rc = rc ? rc : split_mirror(by, state, P, F, maps, nmaps);
+    if (!rc)
+        split_caps(state, *cap_keep, *fill_keep, len, by, C, R, F, *fill_bvh, maps);
+    free(len);
+    free(by);
     for (size_t i = 0; i < P->n && !rc; i++) {
-        covered[i] = state[i] == PIECE_CLOSED || state[i] == PIECE_CONTRADICTED;
+        covered[i] = state[i] == PIECE_CLOSED || state[i] == PIECE_CONTRADICTED ||
+                     state[i] == PIECE_SPLIT;
+        st->caps_split += state[i] == PIECE_SPLIT;
         st->unclosed += state[i] == PIECE_UNCLOSED;
         st->caps_agree += state[i] == PIECE_AGREES;
         if (i < P->ncap)
@@ -1468,7 +1667,7 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
     fill_set F = {.soup = st_soup_new(), .maps = maps};
     st_bvh *anchors_bvh = NULL, *fill_bvh = NULL, *bounds_bvh = NULL;
     size_t *keep = NULL;
-    uint8_t *covered = NULL, *ok = NULL;
+    uint8_t *covered = NULL, *ok = NULL, *cap_keep = NULL, *fill_keep = NULL;
     double *share = NULL, *map_err = NULL;
     pieces P;
     rims R;
@@ -1517,12 +1716,12 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
     const size_t nmaps = mirror_turns(turns, maps, nset, sizeof maps / sizeof *maps, set, P.lo,
                                       P.hi, tol, s, bvh, bounds_bvh);
     st->maps = nmaps;
-    const fill_ctx C = {s, bvh, anchors_bvh, NULL, bounds_bvh, &P, NULL, tol, 0.0};
-    if ((rc = fill_rounds(covered, &F, &fill_bvh, &C, &R, maps, nset, nmaps, keep, ok, share,
-                          map_err, st, err)) ||
-        (rc = keep_uncovered(kept, cp, &P, covered, err)))
+    const fill_ctx C = {s, bvh, anchors_bvh, NULL, bounds_bvh, &P, NULL, tol, 0.0, cp};
+    if ((rc = fill_rounds(covered, &cap_keep, &fill_keep, &F, &fill_bvh, &C, &R, maps, nset,
+                          nmaps, keep, ok, share, map_err, st, err)) ||
+        (rc = keep_uncovered(kept, cp, &P, covered, cap_keep, err)))
         goto done;
-    rc = fill_of_covered(&fill, &F, covered, st, err);
+    rc = fill_of_covered(&fill, &F, covered, fill_keep, st, err);
 done:
     if (rc == ST_ENOMEM)
         st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the symmetric fill");
@@ -1544,6 +1743,8 @@ done:
     free(keep);
     free(covered);
     free(ok);
+    free(cap_keep);
+    free(fill_keep);
     if (!rc && !fill && !(fill = st_soup_new()))
         rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the symmetric fill");
     if (rc) {
