@@ -362,6 +362,37 @@ static void test_threads(void)
     st_soup_free(s);
 }
 
+/* The field's default resolution (pipeline.c field_voxels, soupmesh -r):
+ * 16 voxels per lattice cell up to 128, 8 per cell beyond. A dry run at
+ * each cell count makes the field of the explicit -r the rule gives. */
+static void test_field_rule(void)
+{
+    static const size_t cells[] = {4, 7, 10, 20}, voxels[] = {64, 112, 128, 160};
+    st_soup *s = sphere_soup();
+    for (size_t i = 0; i < sizeof cells / sizeof *cells; i++) {
+        size_t dims[2][3] = {{0}};
+        int ok = 1;
+        for (int k = 0; k < 2; k++) {
+            st_pipeline_params p = sphere_params();
+            st_tetmesh *m = NULL;
+            st_pipeline_stats st;
+            st_error err;
+            p.cells = cells[i];
+            p.field_cells = k ? voxels[i] : 0;
+            p.tries = 1;
+            p.try_all = 0;
+            p.dry_run = 1;
+            ok &= st_pipeline_run(&m, &st, s, &p, NULL, &err) == ST_OK;
+            memcpy(dims[k], st.field_dims, sizeof dims[k]);
+            free(st.candidates);
+        }
+        TAP_CHECK(ok && memcmp(dims[0], dims[1], sizeof dims[0]) == 0,
+                  "%zu cells: the default field is -r %zu's (%zux%zux%zu, %zux%zux%zu)", cells[i],
+                  voxels[i], dims[0][0], dims[0][1], dims[0][2], dims[1][0], dims[1][1], dims[1][2]);
+    }
+    st_soup_free(s);
+}
+
 static void test_empty_soup(void)
 {
     st_pipeline_params p = sphere_params();
@@ -380,6 +411,6 @@ int main(int argc, char **argv)
     static const tap_test tests[] = {TAP_TEST(candidate_seed), TAP_TEST(candidates),
                                      TAP_TEST(dry_run), TAP_TEST(float32), TAP_TEST(refusals),
                                      TAP_TEST(lattice_bound), TAP_TEST(threads),
-                                     TAP_TEST(empty_soup), {0}};
+                                     TAP_TEST(field_rule), TAP_TEST(empty_soup), {0}};
     return tap_main(argc, argv, tests);
 }
