@@ -49,6 +49,25 @@
  * cluster larger than cluster_max bombs, or whose search exceeds
  * search_budget nodes, keeps the best choice found (never worse than
  * greedy) and is counted in clusters_greedy.
+ *
+ * (5) The memo makes the search of (4) cheaper without changing what it
+ * does, node for node, budget included. Below depth i the search depends
+ * on the choices above i only through (a) which tets of the options of
+ * bombs i.. are covered, and only for the "frontier" tets that options of
+ * bombs above i can cover (the others are uncovered), and (b) the slack
+ * best_cost - cost: every test below (gain 0, the order by gain, cost +
+ * gain >= best_cost) reads the covered bits and costs relative to the
+ * entry. So while best_cost stays, the subtree entered with the same
+ * (depth, covered frontier, slack) visits the same number of nodes and
+ * finds the same leaves. A subtree that ran to its end (not cut by the
+ * budget) without a cheaper leaf is stored with its node count; a later
+ * entry with the same key adds that count to the nodes instead of
+ * searching (no cheaper leaf can come of it), or, when the count would
+ * exceed the budget, ends the search as the budget would have inside it.
+ * The choice, clusters_exact and the node count (search_nodes) are those
+ * of the search without memo; search_expanded counts the nodes searched.
+ * A memo is made once a cluster's search has run MEMO_START nodes, and
+ * stores nothing once full (MEMO_MAX_SLOTS, MEMO_MAX_WORDS).
  */
 #include "souptet/sculpt.h"
 #include "../base/unionfind.h"
@@ -75,6 +94,7 @@ st_sculpt_params st_sculpt_params_default(void)
     p.repair_manifold = 1;
     p.cluster_max = 64;
     p.search_budget = (size_t)1 << 20;
+    p.search_memo = 1;
     p.cancel = NULL;
     return p;
 }
@@ -262,6 +282,26 @@ static size_t add_star(const st_lattice *L, unsigned char *keep, uint32_t v,
 
 /* ---- bomb repair ---- */
 
+/* The memo of section (5): subtrees searched to their end without finding
+ * a cheaper leaf, keyed by (depth, slack, covered frontier tets), with the
+ * number of nodes they counted. Slot k is empty when hash[k] == 0; its key
+ * is pool[off[k] ..) (one word depth << 32 | slack, then the frontier's
+ * covered bits). cov holds a bit per local tet, set while it is covered
+ * (opt_apply keeps it); depth i's frontier is the set bits of mask[moff[i]
+ * .. moff[i + 1]), laid over cov's words from word wlo[i] (no memo at
+ * depth i when it is more than MEMO_MAX_WORDS_KEY words). */
+typedef struct memo {
+    uint64_t *cov, *mask;
+    size_t *moff, *wlo;
+    uint64_t *hash;
+    uint32_t *off, *nodes;
+    size_t cap, used;
+    uint64_t *pool;
+    size_t pool_len, pool_cap;
+    uint64_t *key;            /* scratch: the key at hand */
+    size_t hits, stored;
+} memo;
+
 /* One cluster's search state. Option o of bomb i adds the local tets
  * opt_tets[opt_off[4i+o] .. opt_off[4i+o+1]). */
 typedef struct search {
@@ -272,8 +312,11 @@ typedef struct search {
     uint32_t *cnt;            /* per local tet: chosen options covering it */
     int *sel, *best_sel;
     size_t cost, best_cost;
-    size_t nodes, budget;
+    size_t nodes, budget;     /* nodes counted (memo hits count theirs) */
+    size_t expanded;          /* nodes actually expanded */
     int exhausted;
+    int memo_on;              /* 1: make a memo once MEMO_START nodes ran */
+    memo *M;                  /* NULL: no memo (yet) */
 } search;
 
 static size_t opt_gain(const search *S, size_t i, int o)
@@ -289,26 +332,238 @@ static void opt_apply(search *S, size_t i, int o, int sign)
     for (size_t a = S->opt_off[4 * i + (size_t)o]; a < S->opt_off[4 * i + (size_t)o + 1]; a++) {
         uint32_t u = S->opt_tets[a];
         if (sign > 0) {
-            if (S->cnt[u]++ == 0)
+            if (S->cnt[u]++ == 0) {
                 S->cost++;
-        } else if (--S->cnt[u] == 0)
+                if (S->M)
+                    S->M->cov[u / 64] |= (uint64_t)1 << (u % 64);
+            }
+        } else if (--S->cnt[u] == 0) {
             S->cost--;
+            if (S->M)
+                S->M->cov[u / 64] &= ~((uint64_t)1 << (u % 64));
+        }
     }
 }
 
-static void dfs(search *S, size_t i)
+/* ---- the memo of section (5) ---- */
+
+#define MEMO_START ((size_t)1 << 15)   /* nodes before a memo is made */
+#define MEMO_MIN_NODES 2            /* smaller subtrees: not stored */
+#define MEMO_MAX_WORDS_KEY 16      /* wider frontiers: no memo there */
+#define MEMO_MAX_SLOTS ((size_t)1 << 19)
+#define MEMO_MAX_WORDS ((size_t)1 << 21)
+
+static size_t memo_words(const memo *M, size_t i)
 {
-    if (S->cost >= S->best_cost)
-        return;
-    if (i == S->n) {
-        S->best_cost = S->cost;
-        memcpy(S->best_sel, S->sel, S->n * sizeof *S->sel);
-        return;
+    return 1 + M->moff[i + 1] - M->moff[i];
+}
+
+/* The key of depth i with this slack into M->key; 0 when i has no memo. */
+static int memo_key(search *S, size_t i, size_t slack)
+{
+    memo *M = S->M;
+    size_t w = M->moff[i + 1] - M->moff[i];
+    if (w > MEMO_MAX_WORDS_KEY || slack > UINT32_MAX)
+        return 0;
+    const uint64_t *mask = M->mask + M->moff[i], *cov = M->cov + M->wlo[i];
+    uint64_t *key = M->key;
+    key[0] = (uint64_t)i << 32 | (uint64_t)slack;
+    for (size_t k = 0; k < w; k++)
+        key[1 + k] = cov[k] & mask[k];
+    return 1;
+}
+
+static uint64_t memo_hash(const uint64_t *key, size_t w)
+{
+    uint64_t h = 0x9e3779b97f4a7c15u;
+    for (size_t k = 0; k < w; k++) {
+        h = (h ^ key[k]) * 0xff51afd7ed558ccdu;
+        h ^= h >> 32;
     }
+    return h | 1;
+}
+
+/* Probe for M->key (depth i): 1 and its slot in *k, or 0 and the empty
+ * slot where it would go. */
+static int memo_find(const memo *M, size_t i, size_t *k)
+{
+    size_t w = memo_words(M, i), mask = M->cap - 1;
+    uint64_t h = memo_hash(M->key, w);
+    size_t s = (size_t)h & mask;
+    for (; M->hash[s]; s = (s + 1) & mask)
+        if (M->hash[s] == h &&
+            memcmp(M->pool + M->off[s], M->key, w * sizeof *M->key) == 0) {
+            *k = s;
+            return 1;
+        }
+    *k = s;
+    return 0;
+}
+
+/* Double the table; 0 when it cannot (cap reached, no memory). */
+static int memo_grow(memo *M)
+{
+    size_t cap = 2 * M->cap;
+    if (cap > MEMO_MAX_SLOTS)
+        return 0;
+    uint64_t *hash = st_calloc_array(cap, sizeof *hash);
+    uint32_t *off = st_malloc_array(cap, sizeof *off);
+    uint32_t *nodes = st_malloc_array(cap, sizeof *nodes);
+    if (!hash || !off || !nodes) {
+        free(hash);
+        free(off);
+        free(nodes);
+        return 0;
+    }
+    for (size_t s = 0; s < M->cap; s++) {
+        if (!M->hash[s])
+            continue;
+        size_t t = (size_t)M->hash[s] & (cap - 1);
+        while (hash[t])
+            t = (t + 1) & (cap - 1);
+        hash[t] = M->hash[s];
+        off[t] = M->off[s];
+        nodes[t] = M->nodes[s];
+    }
+    free(M->hash);
+    free(M->off);
+    free(M->nodes);
+    M->hash = hash;
+    M->off = off;
+    M->nodes = nodes;
+    M->cap = cap;
+    return 1;
+}
+
+/* Store the subtree of depth i (whose key dfs() recomputes into M->key:
+ * the state is back to the subtree's entry) with its node count; a full
+ * memo stores nothing. */
+static void memo_store(search *S, size_t i, size_t slack, size_t nodes)
+{
+    memo *M = S->M;
+    size_t w = memo_words(M, i), k;
+    if (!memo_key(S, i, slack) || memo_find(M, i, &k))
+        return;
+    if (2 * (M->used + 1) > M->cap) {
+        if (!memo_grow(M))
+            return;
+        memo_find(M, i, &k);
+    }
+    if (M->pool_len + w > M->pool_cap) {
+        size_t c = 2 * M->pool_cap;
+        while (c < M->pool_len + w)
+            c *= 2;
+        if (c > MEMO_MAX_WORDS)
+            return;
+        uint64_t *pool = st_realloc_array(M->pool, c, sizeof *pool);
+        if (!pool)
+            return;
+        M->pool = pool;
+        M->pool_cap = c;
+    }
+    memcpy(M->pool + M->pool_len, M->key, w * sizeof *M->key);
+    M->hash[k] = memo_hash(M->key, w);
+    M->off[k] = (uint32_t)M->pool_len;
+    M->nodes[k] = (uint32_t)nodes;
+    M->pool_len += w;
+    M->used++;
+    M->stored++;
+}
+
+static void memo_free(memo *M)
+{
+    if (!M)
+        return;
+    free(M->cov);
+    free(M->mask);
+    free(M->moff);
+    free(M->wlo);
+    free(M->hash);
+    free(M->off);
+    free(M->nodes);
+    free(M->pool);
+    free(M->key);
+    free(M);
+}
+
+/* The frontiers: local tet u is in the frontier of every depth i with
+ * first(u) < i <= last(u), first and last the bombs whose options hold u;
+ * depth i's mask spans the words of its lowest to its highest such u. cov
+ * is filled from cnt (the memo starts in the middle of a search). NULL when
+ * memory is short. */
+static memo *memo_new(const search *S)
+{
+    const size_t n = S->n, ntot = S->opt_off[4 * n];
+    memo *M = st_calloc_array(1, sizeof *M);
+    size_t *first = st_malloc_array(ntot + 1, sizeof *first);
+    size_t *last = st_malloc_array(ntot + 1, sizeof *last);
+    size_t *hi = st_calloc_array(n + 1, sizeof *hi);
+    if (!M || !first || !last || !hi || !(M->moff = st_calloc_array(n + 1, sizeof *M->moff)) ||
+        !(M->wlo = st_malloc_array(n + 1, sizeof *M->wlo)))
+        goto fail;
+    size_t nloc = 0;
+    for (size_t q = 0; q < n; q++)
+        for (size_t a = S->opt_off[4 * q]; a < S->opt_off[4 * q + 4]; a++) {
+            uint32_t u = S->opt_tets[a];
+            for (; nloc <= u; nloc++)
+                first[nloc] = SIZE_MAX;
+            if (first[u] == SIZE_MAX)
+                first[u] = q;
+            last[u] = q;
+        }
+    for (size_t i = 0; i <= n; i++)
+        M->wlo[i] = SIZE_MAX;
+    for (size_t u = 0; u < nloc; u++)   /* the words of depth i: wlo .. hi */
+        for (size_t i = first[u] + 1; i <= last[u]; i++) {
+            if (M->wlo[i] == SIZE_MAX)
+                M->wlo[i] = u / 64;
+            hi[i] = u / 64 + 1;
+        }
+    for (size_t i = 0; i < n; i++) {
+        if (M->wlo[i] == SIZE_MAX)
+            M->wlo[i] = hi[i] = 0;
+        M->moff[i + 1] = M->moff[i] + hi[i] - M->wlo[i];
+    }
+    size_t maxw = 1 + MEMO_MAX_WORDS_KEY;
+    M->cap = 1024;
+    M->pool_cap = 4096;
+    M->cov = st_calloc_array(nloc / 64 + 1, sizeof *M->cov);
+    M->mask = st_calloc_array(M->moff[n] + 1, sizeof *M->mask);
+    M->hash = st_calloc_array(M->cap, sizeof *M->hash);
+    M->off = st_malloc_array(M->cap, sizeof *M->off);
+    M->nodes = st_malloc_array(M->cap, sizeof *M->nodes);
+    M->pool = st_malloc_array(M->pool_cap, sizeof *M->pool);
+    M->key = st_malloc_array(maxw, sizeof *M->key);
+    if (!M->cov || !M->mask || !M->hash || !M->off || !M->nodes || !M->pool || !M->key)
+        goto fail;
+    for (size_t u = 0; u < nloc; u++) {
+        for (size_t i = first[u] + 1; i <= last[u]; i++)
+            M->mask[M->moff[i] + u / 64 - M->wlo[i]] |= (uint64_t)1 << (u % 64);
+        if (S->cnt[u])
+            M->cov[u / 64] |= (uint64_t)1 << (u % 64);
+    }
+    free(first);
+    free(last);
+    free(hi);
+    return M;
+fail:
+    free(first);
+    free(last);
+    free(hi);
+    memo_free(M);
+    return NULL;
+}
+
+static void dfs(search *S, size_t i);
+
+/* One node of section (4)'s search below the checks of dfs(). */
+static void dfs_expand(search *S, size_t i)
+{
     if (++S->nodes > S->budget) {
         S->exhausted = 1;
         return;
     }
+    S->expanded++;
     size_t gain[4];
     int order[4], no = S->nopt[i];
     for (int o = 0; o < no; o++) {
@@ -335,6 +590,37 @@ static void dfs(search *S, size_t i)
         dfs(S, i + 1);
         opt_apply(S, i, o, -1);
     }
+}
+
+static void dfs(search *S, size_t i)
+{
+    if (S->cost >= S->best_cost)
+        return;
+    if (i == S->n) {
+        S->best_cost = S->cost;
+        memcpy(S->best_sel, S->sel, S->n * sizeof *S->sel);
+        return;
+    }
+    if (S->memo_on && !S->M && S->nodes >= MEMO_START) {
+        S->M = memo_new(S);   /* a search this long: worth a memo */
+        S->memo_on = S->M != NULL;
+    }
+    size_t slack = S->best_cost - S->cost, k = 0, n0 = S->nodes;
+    int keyed = S->M && memo_key(S, i, slack);
+    if (keyed && memo_find(S->M, i, &k)) {   /* replay: count, find nothing */
+        S->M->hits++;
+        if (S->nodes + S->M->nodes[k] > S->budget) {
+            S->nodes = S->budget + 1;
+            S->exhausted = 1;
+        } else
+            S->nodes += S->M->nodes[k];
+        return;
+    }
+    size_t best0 = S->best_cost;
+    dfs_expand(S, i);
+    if (keyed && !S->exhausted && S->best_cost == best0 &&
+        S->nodes - n0 >= MEMO_MIN_NODES && S->nodes - n0 <= UINT32_MAX)
+        memo_store(S, i, slack, S->nodes - n0);
 }
 
 /* One repair round's bombs (section (2), (4) above): bomb[b] is the
@@ -491,8 +777,11 @@ static int search_exact(search *S, const st_sculpt_params *p)
     for (size_t q = 0; q < n; q++)
         any_empty |= S->nopt[q] == 0;
     if (greedy_sel && !any_empty) {
+        S->memo_on = p->search_memo;
         dfs(S, 0);
         searched = !S->exhausted;
+        memo_free(S->M);
+        S->M = NULL;
         if (S->best_cost > greedy_cost) {   /* nothing better */
             S->best_cost = greedy_cost;
             memcpy(S->best_sel, greedy_sel, n * sizeof *greedy_sel);
@@ -534,6 +823,8 @@ static st_status solve_cluster(bomb_round *R, size_t c0, size_t n,
         ss->clusters_exact++;
     else
         ss->clusters_greedy++;
+    ss->search_nodes += S.nodes;
+    ss->search_expanded += S.expanded;
     /* Apply the choice. */
     for (size_t q = 0; q < n; q++) {
         if (S.nopt[q] == 0)
@@ -610,6 +901,7 @@ st_status st_sculpt_repair_bombs(unsigned char *keep, st_sculpt_stats *stats,
     ss->clusters = ss->clusters_exact = ss->clusters_greedy = 0;
     ss->largest_cluster = ss->snowflakes = ss->bomb_tets = 0;
     ss->greedy_tets = 0;
+    ss->search_nodes = ss->search_expanded = 0;
     ss->repair_rounds = 0;
     size_t nt = L->ntets;
     int64_t *claim = st_malloc_array(nt, sizeof *claim);
