@@ -432,9 +432,64 @@ static void test_search_optimal(void)
     st_lattice_free(L);
 }
 
+/* A band of bombs (tets within 0.2 of a patch of sphere) in one cluster:
+ * the memo must give the choice, the node count and the exactness of the
+ * search without it, at budgets that cut the search and at one that lets
+ * it finish, while expanding fewer nodes. */
+static void test_search_memo(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {16, 16, 16};
+    st_lattice_params lp = st_lattice_params_default();
+    lp.kind = ST_LATTICE_BCC;
+    lp.h = 1;
+    lp.pad = 0;
+    st_lattice *L = NULL;
+    st_error err;
+    if (st_lattice_build(&L, lo, hi, &lp, &err)) {
+        TAP_CHECK(0, "lattice for the memo test");
+        return;
+    }
+    unsigned char *keep = calloc(L->ntets, 1), *a = malloc(L->ntets),
+                  *b = malloc(L->ntets);
+    const double R = 9;
+    for (size_t t = 0; t < L->ntets; t++) {
+        double c[3];
+        centroid(L, t, c);
+        double x = c[0] - 8, y = c[1] - 8, z = c[2] - 8 + R - 2;
+        double r = sqrt(x * x + y * y + z * z);
+        if (fabs(r - R) < 0.2 && z > R - 2.5 && fabs(x) < 2 && fabs(y) < 2)
+            keep[t] = ST_SCULPT_VOLUME;
+    }
+    st_sculpt_params p = st_sculpt_params_default();
+    const int budgets[] = {16, 17, 18, 20, 24};   /* log2 */
+    for (int k = 0; k < 5; k++) {
+        st_sculpt_stats sa, sb;
+        p.search_budget = (size_t)1 << budgets[k];
+        p.search_memo = 0;
+        memcpy(a, keep, L->ntets);
+        int ok = st_sculpt_repair_bombs(a, &sa, L, &p, &err) == ST_OK;
+        p.search_memo = 1;
+        memcpy(b, keep, L->ntets);
+        ok = ok && st_sculpt_repair_bombs(b, &sb, L, &p, &err) == ST_OK;
+        TAP_CHECK(ok && sa.bombs == 36 && sa.clusters == 1 &&
+                  memcmp(a, b, L->ntets) == 0 && sa.bomb_tets == sb.bomb_tets &&
+                  sa.clusters_exact == sb.clusters_exact &&
+                  sa.search_nodes == sb.search_nodes &&
+                  sb.search_expanded < sa.search_expanded,
+                  "budget 2^%d: the memo gives the same repair (%zu tets, exact "
+                  "%zu) and count (%zu nodes), %zu expanded", budgets[k],
+                  sb.bomb_tets, sb.clusters_exact, sb.search_nodes, sb.search_expanded);
+    }
+    free(keep);
+    free(a);
+    free(b);
+    st_lattice_free(L);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(enclosure), TAP_TEST(known_repairs),
-                                     TAP_TEST(search_optimal), {0}};
+                                     TAP_TEST(search_optimal), TAP_TEST(search_memo),
+                                     {0}};
     return tap_main(argc, argv, tests);
 }

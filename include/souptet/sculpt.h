@@ -81,6 +81,9 @@ typedef struct st_sculpt_params {
     int repair_manifold;      /* 1: add snowflakes at pinched vertices */
     size_t cluster_max;       /* bombs per cluster searched at all (64) */
     size_t search_budget;     /* search nodes per cluster (1 << 20) */
+    int search_memo;          /* 1: replay searched subtrees from a memo
+                                 (the same choice and node count as
+                                 without, fewer nodes expanded; default) */
     volatile int *cancel;     /* NULL, or a caller's flag (progress.h):
                                  once nonzero, st_sculpt stops between
                                  its steps and within the classification,
@@ -106,6 +109,9 @@ typedef struct st_sculpt_stats {
     size_t bomb_tets;         /* tets added for bombs */
     size_t greedy_tets;       /* what the greedy choice (each bomb in turn,
                                  its cheapest snowflake) would have added */
+    size_t search_nodes;      /* search nodes counted against the budgets
+                                 (the same with and without the memo) */
+    size_t search_expanded;   /*   of which expanded (the rest replayed) */
     size_t repair_rounds;     /* rounds of bomb repair (1 when it works) */
     size_t bombs_left;        /* bombs after repair (0 unless repair is off
                                  or a bomb had no complete snowflake) */

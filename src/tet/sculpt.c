@@ -49,6 +49,36 @@
  * cluster larger than cluster_max bombs, or whose search exceeds
  * search_budget nodes, keeps the best choice found (never worse than
  * greedy) and is counted in clusters_greedy.
+ *
+ * (5) The memo makes the search of (4) cheaper without changing what it
+ * does, node for node, budget included. Below depth i the search depends
+ * on the choices above i only through (a) which tets of the options of
+ * bombs i.. are covered, and only for the "frontier" tets that options of
+ * bombs above i can cover (the others are uncovered), and (b) the slack
+ * best_cost - cost: every test below (gain 0, the order by gain, cost +
+ * gain >= best_cost) reads the covered bits and costs relative to the
+ * entry. So while best_cost stays, the subtree entered with the same
+ * (depth, covered frontier, slack) visits the same number of nodes and
+ * finds the same leaves. A subtree that ran to its end (not cut by the
+ * budget) without a cheaper leaf is stored with its node count; a later
+ * entry with the same key adds that count to the nodes instead of
+ * searching (no cheaper leaf can come of it), or, when the count would
+ * exceed the budget, ends the search as the budget would have inside it.
+ * The choice, clusters_exact and the node count (search_nodes) are those
+ * of the search without memo; search_expanded counts the nodes searched.
+ * This holds for any subset of the entries: a key not found is searched,
+ * which is what the search without memo does. So the memo may forget:
+ * it is made once a cluster's search has run MEMO_START nodes, small (4
+ * KB) and grown by doubling up to MEMO_MAX_SLOTS slots and MEMO_MAX_POOL
+ * key words, emptied when full; it stores subtrees of MEMO_MIN_NODES
+ * nodes or more, probes only at depths with an entry, and is dropped for
+ * the rest of the search when over a window of MEMO_WINDOW nodes its
+ * hits replayed fewer nodes than it made probes and stores (the plain
+ * search costs some 30 ns a node: a memo that rarely hits costs more in
+ * cache misses than it saves).
+ *
+ * (6) The covered tets are a bitset (cov), each option a list of (word,
+ * bits) pairs: a gain is a few popcounts instead of a count per tet.
  */
 #include "souptet/sculpt.h"
 #include "../base/unionfind.h"
@@ -62,7 +92,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
 st_sculpt_params st_sculpt_params_default(void)
 {
     st_sculpt_params p;
@@ -75,6 +104,7 @@ st_sculpt_params st_sculpt_params_default(void)
     p.repair_manifold = 1;
     p.cluster_max = 64;
     p.search_budget = (size_t)1 << 20;
+    p.search_memo = 1;
     p.cancel = NULL;
     return p;
 }
@@ -263,52 +293,324 @@ static size_t add_star(const st_lattice *L, unsigned char *keep, uint32_t v,
 /* ---- bomb repair ---- */
 
 /* One cluster's search state. Option o of bomb i adds the local tets
- * opt_tets[opt_off[4i+o] .. opt_off[4i+o+1]). */
+ * opt_tets[opt_off[4i+o] .. opt_off[4i+o+1]); the search reads them as
+ * pairs (word, bits) over cov, a bit per local tet set while a chosen
+ * option covers it: pair_w[a], pair_m[a] for a in pair_off[4i+o] ..
+ * pair_off[4i+o+1], one pair per word, and pair_new[a] the bits the
+ * option newly covered when it was applied (its undo). */
 typedef struct search {
     size_t n;                 /* bombs */
     int *nopt;                /* options per bomb */
     size_t *opt_off;          /* 4n + 1 */
     uint32_t *opt_tets;
-    uint32_t *cnt;            /* per local tet: chosen options covering it */
+    size_t nloc;              /* local tets */
+    size_t *pair_off;         /* 4n + 1 */
+    uint32_t *pair_w;
+    uint64_t *pair_m, *pair_new;
+    uint64_t *cov;            /* nloc / 64 + 1 words */
     int *sel, *best_sel;
-    size_t cost, best_cost;
-    size_t nodes, budget;
+    size_t cost, best_cost;   /* cost: the covered bits */
+    size_t nodes, budget;     /* nodes counted (memo hits count theirs) */
+    size_t expanded;          /* nodes actually expanded */
     int exhausted;
+    int memo_on;              /* 1: make a memo once MEMO_START nodes ran */
+    struct memo *M;           /* NULL: no memo (yet) */
 } search;
 
+static size_t popcount64(uint64_t x)
+{
+    x = x - ((x >> 1) & 0x5555555555555555u);
+    x = (x & 0x3333333333333333u) + ((x >> 2) & 0x3333333333333333u);
+    x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0fu;
+    return (size_t)((x * 0x0101010101010101u) >> 56);
+}
+
+/* The tets option o of bomb i would add to the choice: its uncovered. */
 static size_t opt_gain(const search *S, size_t i, int o)
 {
-    size_t g = 0;
-    for (size_t a = S->opt_off[4 * i + (size_t)o]; a < S->opt_off[4 * i + (size_t)o + 1]; a++)
-        g += S->cnt[S->opt_tets[a]] == 0;
+    size_t g = 0, k = 4 * i + (size_t)o;
+    for (size_t a = S->pair_off[k]; a < S->pair_off[k + 1]; a++)
+        g += popcount64(S->pair_m[a] & ~S->cov[S->pair_w[a]]);
     return g;
 }
 
-static void opt_apply(search *S, size_t i, int o, int sign)
+/* Choose option o of bomb i: cover its tets (cost grows by its gain). */
+static void opt_apply(search *S, size_t i, int o)
 {
-    for (size_t a = S->opt_off[4 * i + (size_t)o]; a < S->opt_off[4 * i + (size_t)o + 1]; a++) {
-        uint32_t u = S->opt_tets[a];
-        if (sign > 0) {
-            if (S->cnt[u]++ == 0)
-                S->cost++;
-        } else if (--S->cnt[u] == 0)
-            S->cost--;
+    size_t k = 4 * i + (size_t)o;
+    for (size_t a = S->pair_off[k]; a < S->pair_off[k + 1]; a++) {
+        uint64_t *c = S->cov + S->pair_w[a], nw = S->pair_m[a] & ~*c;
+        S->pair_new[a] = nw;
+        *c |= nw;
+        S->cost += popcount64(nw);
     }
 }
 
-static void dfs(search *S, size_t i)
+/* Undo opt_apply(S, i, o): the undos come in the reverse order of the
+ * applies, or all of them at once. */
+static void opt_undo(search *S, size_t i, int o)
 {
-    if (S->cost >= S->best_cost)
+    size_t k = 4 * i + (size_t)o;
+    for (size_t a = S->pair_off[k]; a < S->pair_off[k + 1]; a++) {
+        S->cov[S->pair_w[a]] &= ~S->pair_new[a];
+        S->cost -= popcount64(S->pair_new[a]);
+    }
+}
+
+/* ---- the memo of section (5) ---- */
+
+#define MEMO_START ((size_t)1 << 15)   /* nodes before a memo is made */
+#define MEMO_MIN_NODES 4               /* smaller subtrees: not stored */
+#define MEMO_MAX_KEY 16                /* wider frontiers (words): no memo */
+#define MEMO_SLOTS0 ((size_t)1 << 9)   /* slots at first (4 KB) */
+#define MEMO_MAX_SLOTS ((size_t)1 << 17)
+#define MEMO_POOL0 ((size_t)1 << 9)    /* pool words at first (4 KB) */
+#define MEMO_MAX_POOL ((size_t)1 << 18)
+#define MEMO_WINDOW ((size_t)1 << 15)  /* expanded nodes between checks */
+
+/* The memo of section (5): subtrees searched to their end without a
+ * cheaper leaf, keyed by (depth, slack, covered frontier tets), with the
+ * nodes they counted. An entry is pool[e] = its nodes, then its key: one
+ * word depth << 32 | slack, then the words of depth i's frontier, the
+ * bits of mask[moff[i] .. moff[i + 1]) laid over cov from word wlo[i].
+ * slot[s] is 0 (empty) or (the key's hash's high half | 1) << 32 | e: a
+ * probe compares that first, the key in full on a match. count[i] is the
+ * entries of depth i (no probe at a depth without). */
+typedef struct memo {
+    uint64_t *mask;
+    size_t *moff, *wlo;
+    uint32_t *count;
+    uint64_t *slot;
+    size_t cap, used;
+    uint64_t *pool;
+    size_t pool_len, pool_cap;
+    uint64_t key[1 + MEMO_MAX_KEY];   /* the key at hand */
+    size_t hits, stored, flushes;
+    size_t probes, saved;     /* probes made, nodes the hits replayed */
+    size_t win[4];            /* expanded, probes, stored, saved at the
+                                 start of the window (section (5)) */
+} memo;
+
+/* The key of depth i with this slack into M->key: its words, or 0 when
+ * depth i has no memo (its frontier is too wide). */
+static size_t memo_key(const search *S, size_t i, size_t slack)
+{
+    memo *M = S->M;
+    size_t w = M->moff[i + 1] - M->moff[i];
+    if (w > MEMO_MAX_KEY || slack > UINT32_MAX)
+        return 0;
+    const uint64_t *mask = M->mask + M->moff[i], *cov = S->cov + M->wlo[i];
+    M->key[0] = (uint64_t)i << 32 | (uint64_t)slack;
+    for (size_t k = 0; k < w; k++)
+        M->key[1 + k] = cov[k] & mask[k];
+    return 1 + w;
+}
+
+static uint64_t memo_hash(const uint64_t *key, size_t w)
+{
+    uint64_t h = 0x9e3779b97f4a7c15u;
+    for (size_t k = 0; k < w; k++) {
+        h = (h ^ key[k]) * 0xff51afd7ed558ccdu;
+        h ^= h >> 32;
+    }
+    return h;
+}
+
+static uint64_t memo_tag(uint64_t h)
+{
+    return (h >> 32 | 1) << 32;
+}
+
+/* The entry of M->key (w words, hash h): its pool offset + 1, or 0. */
+static size_t memo_find(const memo *M, size_t w, uint64_t h)
+{
+    const size_t m = M->cap - 1;
+    const uint64_t tag = memo_tag(h);
+    for (size_t s = (size_t)h & m; M->slot[s]; s = (s + 1) & m) {
+        if ((M->slot[s] & ~(uint64_t)UINT32_MAX) != tag)
+            continue;
+        const uint64_t *key = M->pool + (uint32_t)M->slot[s] + 1;
+        size_t k = 0;
+        while (k < w && key[k] == M->key[k])
+            k++;
+        if (k == w)
+            return (size_t)(uint32_t)M->slot[s] + 1;
+    }
+    return 0;
+}
+
+static void memo_insert(memo *M, uint64_t h, size_t e)
+{
+    const size_t m = M->cap - 1;
+    size_t s = (size_t)h & m;
+    while (M->slot[s])
+        s = (s + 1) & m;
+    M->slot[s] = memo_tag(h) | (uint64_t)e;
+}
+
+/* Double the slots (rehashing from the pool's keys); 0 when it cannot. */
+static int memo_grow(memo *M)
+{
+    size_t cap = 2 * M->cap;
+    uint64_t *slot = cap <= MEMO_MAX_SLOTS ? st_calloc_array(cap, sizeof *slot) : NULL;
+    if (!slot)
+        return 0;
+    uint64_t *old = M->slot;
+    size_t ocap = M->cap;
+    M->slot = slot;
+    M->cap = cap;
+    for (size_t s = 0; s < ocap; s++)
+        if (old[s]) {
+            size_t e = (uint32_t)old[s];
+            size_t i = (size_t)(M->pool[e + 1] >> 32);
+            memo_insert(M, memo_hash(M->pool + e + 1, 1 + M->moff[i + 1] - M->moff[i]), e);
+        }
+    free(old);
+    return 1;
+}
+
+/* Room for an entry of w key words: grow the slots or the pool within
+ * their caps, else empty the memo. */
+static void memo_room(memo *M, size_t w, size_t n)
+{
+    if (2 * (M->used + 1) > M->cap && !memo_grow(M))
+        goto flush;
+    if (M->pool_len + 1 + w > M->pool_cap) {
+        size_t c = 2 * M->pool_cap;
+        uint64_t *pool = c <= MEMO_MAX_POOL ? st_realloc_array(M->pool, c, sizeof *pool) : NULL;
+        if (!pool)
+            goto flush;
+        M->pool = pool;
+        M->pool_cap = c;
+    }
+    return;
+flush:
+    memset(M->slot, 0, M->cap * sizeof *M->slot);
+    memset(M->count, 0, (n + 1) * sizeof *M->count);
+    M->used = M->pool_len = 0;
+    M->flushes++;
+}
+
+/* Store the subtree of depth i, back at its entry state, with its node
+ * count (its key is not in the memo: it was probed at the entry, or
+ * depth i had no entry then, and the subtree stores deeper keys only). */
+static void memo_store(search *S, size_t i, size_t slack, size_t nodes)
+{
+    memo *M = S->M;
+    size_t w = memo_key(S, i, slack);
+    if (!w)
         return;
-    if (i == S->n) {
-        S->best_cost = S->cost;
-        memcpy(S->best_sel, S->sel, S->n * sizeof *S->sel);
+    memo_room(M, w, S->n);
+    size_t e = M->pool_len;
+    M->pool[e] = nodes;
+    memcpy(M->pool + e + 1, M->key, w * sizeof *M->key);
+    memo_insert(M, memo_hash(M->key, w), e);
+    M->pool_len += 1 + w;
+    M->used++;
+    M->count[i]++;
+    M->stored++;
+}
+
+static void memo_free(memo *M)
+{
+    if (!M)
+        return;
+    free(M->mask);
+    free(M->moff);
+    free(M->wlo);
+    free(M->count);
+    free(M->slot);
+    free(M->pool);
+    free(M);
+}
+
+/* The frontiers: local tet u is in the frontier of every depth i with
+ * first(u) < i <= last(u), first and last the bombs whose options hold u;
+ * depth i's mask spans the words of its lowest to its highest such u.
+ * NULL when memory is short. */
+static memo *memo_new(const search *S)
+{
+    const size_t n = S->n, nloc = S->nloc;
+    memo *M = st_calloc_array(1, sizeof *M);
+    size_t *first = st_malloc_array(nloc + 1, sizeof *first);
+    size_t *last = st_malloc_array(nloc + 1, sizeof *last);
+    size_t *hi = st_calloc_array(n + 1, sizeof *hi);
+    if (!M || !first || !last || !hi || !(M->moff = st_calloc_array(n + 2, sizeof *M->moff)) ||
+        !(M->wlo = st_malloc_array(n + 1, sizeof *M->wlo)))
+        goto fail;
+    for (size_t u = 0; u < nloc; u++)
+        first[u] = SIZE_MAX;
+    for (size_t q = 0; q < n; q++)
+        for (size_t a = S->opt_off[4 * q]; a < S->opt_off[4 * q + 4]; a++) {
+            uint32_t u = S->opt_tets[a];
+            if (first[u] == SIZE_MAX)
+                first[u] = q;
+            last[u] = q;
+        }
+    for (size_t i = 0; i <= n; i++)
+        M->wlo[i] = SIZE_MAX;
+    for (size_t u = 0; u < nloc; u++)   /* the words of depth i: wlo .. hi */
+        for (size_t i = first[u] + 1; i <= last[u]; i++) {
+            if (M->wlo[i] == SIZE_MAX)
+                M->wlo[i] = u / 64;
+            hi[i] = u / 64 + 1;
+        }
+    for (size_t i = 0; i <= n; i++) {
+        if (M->wlo[i] == SIZE_MAX)
+            M->wlo[i] = hi[i] = 0;
+        M->moff[i + 1] = M->moff[i] + hi[i] - M->wlo[i];
+    }
+    M->cap = MEMO_SLOTS0;
+    M->pool_cap = MEMO_POOL0;
+    M->mask = st_calloc_array(M->moff[n + 1] + 1, sizeof *M->mask);
+    M->count = st_calloc_array(n + 1, sizeof *M->count);
+    M->slot = st_calloc_array(M->cap, sizeof *M->slot);
+    M->pool = st_malloc_array(M->pool_cap, sizeof *M->pool);
+    if (!M->mask || !M->count || !M->slot || !M->pool)
+        goto fail;
+    for (size_t u = 0; u < nloc; u++)
+        for (size_t i = first[u] + 1; i <= last[u]; i++)
+            M->mask[M->moff[i] + u / 64 - M->wlo[i]] |= (uint64_t)1 << (u % 64);
+    free(first);
+    free(last);
+    free(hi);
+    return M;
+fail:
+    free(first);
+    free(last);
+    free(hi);
+    memo_free(M);
+    return NULL;
+}
+
+static void dfs(search *S, size_t i);
+
+/* Every MEMO_WINDOW nodes expanded: a memo whose hits in the window
+ * replayed fewer nodes than it made probes and stores costs more than it
+ * saves, and is dropped for the rest of the cluster's search. */
+static void memo_check(search *S)
+{
+    memo *M = S->M;
+    if (M->saved - M->win[3] < (M->probes - M->win[1]) + (M->stored - M->win[2])) {
+        memo_free(M);
+        S->M = NULL;
+        S->memo_on = 0;
         return;
     }
+    M->win[0] = S->expanded;
+    M->win[1] = M->probes;
+    M->win[2] = M->stored;
+    M->win[3] = M->saved;
+}
+
+/* One node of section (4)'s search below the checks of dfs(). */
+static void dfs_expand(search *S, size_t i)
+{
     if (++S->nodes > S->budget) {
         S->exhausted = 1;
         return;
     }
+    S->expanded++;
     size_t gain[4];
     int order[4], no = S->nopt[i];
     for (int o = 0; o < no; o++) {
@@ -330,11 +632,49 @@ static void dfs(search *S, size_t i)
         int o = order[k];
         if (S->cost + gain[o] >= S->best_cost)
             break;   /* sorted: the rest cost no less */
-        opt_apply(S, i, o, +1);
+        opt_apply(S, i, o);
         S->sel[i] = o;
         dfs(S, i + 1);
-        opt_apply(S, i, o, -1);
+        opt_undo(S, i, o);
     }
+}
+
+static void dfs(search *S, size_t i)
+{
+    if (S->cost >= S->best_cost)
+        return;
+    if (i == S->n) {
+        S->best_cost = S->cost;
+        memcpy(S->best_sel, S->sel, S->n * sizeof *S->sel);
+        return;
+    }
+    if (S->memo_on && !S->M && S->nodes >= MEMO_START) {
+        S->M = memo_new(S);   /* a search this long: worth a memo */
+        S->memo_on = S->M != NULL;
+        if (S->M)
+            S->M->win[0] = S->expanded;
+    }
+    if (S->M && S->expanded - S->M->win[0] >= MEMO_WINDOW)
+        memo_check(S);
+    memo *M = S->M;
+    size_t slack = S->best_cost - S->cost, n0 = S->nodes, best0 = S->best_cost;
+    if (M && M->count[i]) {
+        size_t w = memo_key(S, i, slack), e;
+        M->probes++;
+        if (w && (e = memo_find(M, w, memo_hash(M->key, w))) != 0) {
+            M->hits++;   /* replay: count its nodes, it finds nothing */
+            M->saved += M->pool[e - 1];
+            if (S->nodes + M->pool[e - 1] > S->budget) {
+                S->nodes = S->budget + 1;
+                S->exhausted = 1;
+            } else
+                S->nodes += M->pool[e - 1];
+            return;
+        }
+    }
+    dfs_expand(S, i);
+    if (S->M && !S->exhausted && S->best_cost == best0 && S->nodes - n0 >= MEMO_MIN_NODES)
+        memo_store(S, i, slack, S->nodes - n0);
 }
 
 /* One repair round's bombs (section (2), (4) above): bomb[b] is the
@@ -442,6 +782,24 @@ static void cluster_options(bomb_round *R, search *S, size_t c0)
         }
     }
     S->opt_off[4 * S->n] = k;
+    S->nloc = nloc;
+    /* The pairs: an option's tets grouped by word of cov. */
+    size_t np = 0;
+    for (size_t j = 0; j < 4 * S->n; j++) {
+        S->pair_off[j] = np;
+        for (size_t a = S->opt_off[j]; a < S->opt_off[j + 1]; a++) {
+            uint32_t u = S->opt_tets[a];
+            size_t x = S->pair_off[j];
+            while (x < np && S->pair_w[x] != u / 64)
+                x++;
+            if (x == np) {
+                S->pair_w[np] = u / 64;
+                S->pair_m[np++] = 0;
+            }
+            S->pair_m[x] |= (uint64_t)1 << (u % 64);
+        }
+    }
+    S->pair_off[4 * S->n] = np;
 }
 
 /* Greedy: each bomb, in order, its cheapest candidate. Leaves the choice
@@ -461,13 +819,13 @@ static size_t search_greedy(search *S)
         }
         S->sel[q] = bo < 0 ? 0 : bo;
         if (bo >= 0)
-            opt_apply(S, q, bo, +1);
+            opt_apply(S, q, bo);
     }
     S->best_cost = S->cost;
     memcpy(S->best_sel, S->sel, n * sizeof *S->sel);
-    for (size_t q = 0; q < n; q++)
+    for (size_t q = n; q-- > 0;)
         if (S->nopt[q] > 0)
-            opt_apply(S, q, S->sel[q], -1);
+            opt_undo(S, q, S->sel[q]);
     return S->best_cost;
 }
 
@@ -491,8 +849,11 @@ static int search_exact(search *S, const st_sculpt_params *p)
     for (size_t q = 0; q < n; q++)
         any_empty |= S->nopt[q] == 0;
     if (greedy_sel && !any_empty) {
+        S->memo_on = p->search_memo;
         dfs(S, 0);
         searched = !S->exhausted;
+        memo_free(S->M);
+        S->M = NULL;
         if (S->best_cost > greedy_cost) {   /* nothing better */
             S->best_cost = greedy_cost;
             memcpy(S->best_sel, greedy_sel, n * sizeof *greedy_sel);
@@ -521,10 +882,15 @@ static st_status solve_cluster(bomb_round *R, size_t c0, size_t n,
             total += L->star_off[v + 1] - L->star_off[v];
         }
     S.opt_tets = st_malloc_array(total + 1, sizeof *S.opt_tets);
-    S.cnt = st_calloc_array(total + 1, sizeof *S.cnt);
+    S.pair_off = st_calloc_array(4 * n + 1, sizeof *S.pair_off);
+    S.pair_w = st_malloc_array(total + 1, sizeof *S.pair_w);
+    S.pair_m = st_malloc_array(total + 1, sizeof *S.pair_m);
+    S.pair_new = st_malloc_array(total + 1, sizeof *S.pair_new);
+    S.cov = st_calloc_array(total / 64 + 1, sizeof *S.cov);
     S.sel = st_calloc_array(n, sizeof *S.sel);
     S.best_sel = st_calloc_array(n, sizeof *S.best_sel);
-    if (!S.nopt || !S.opt_off || !S.opt_tets || !S.cnt || !S.sel || !S.best_sel) {
+    if (!S.nopt || !S.opt_off || !S.opt_tets || !S.pair_off || !S.pair_w || !S.pair_m ||
+        !S.pair_new || !S.cov || !S.sel || !S.best_sel) {
         st = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
         goto done;
     }
@@ -534,6 +900,8 @@ static st_status solve_cluster(bomb_round *R, size_t c0, size_t n,
         ss->clusters_exact++;
     else
         ss->clusters_greedy++;
+    ss->search_nodes += S.nodes;
+    ss->search_expanded += S.expanded;
     /* Apply the choice. */
     for (size_t q = 0; q < n; q++) {
         if (S.nopt[q] == 0)
@@ -549,7 +917,11 @@ done:
     free(S.nopt);
     free(S.opt_off);
     free(S.opt_tets);
-    free(S.cnt);
+    free(S.pair_off);
+    free(S.pair_w);
+    free(S.pair_m);
+    free(S.pair_new);
+    free(S.cov);
     free(S.sel);
     free(S.best_sel);
     return st;
@@ -610,6 +982,7 @@ st_status st_sculpt_repair_bombs(unsigned char *keep, st_sculpt_stats *stats,
     ss->clusters = ss->clusters_exact = ss->clusters_greedy = 0;
     ss->largest_cluster = ss->snowflakes = ss->bomb_tets = 0;
     ss->greedy_tets = 0;
+    ss->search_nodes = ss->search_expanded = 0;
     ss->repair_rounds = 0;
     size_t nt = L->ntets;
     int64_t *claim = st_malloc_array(nt, sizeof *claim);
