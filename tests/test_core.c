@@ -109,6 +109,53 @@ static void test_realloc_big(void)
     free(p);
 }
 
+/* The array allocators: from 1 MiB on a block is whole 2 MiB pages
+ * advised to be transparent huge pages ("hg"), a calloc'd one is zero
+ * even where a freed dirty block is reused, and realloc keeps the bytes
+ * across both sides of that size. */
+static void test_array_huge(void)
+{
+    const size_t n = (size_t)3 << 20;
+    unsigned char *d = st_malloc_array(n, 1);
+    TAP_CHECK(d != NULL, "a 3 MiB array");
+    if (!d)
+        return;
+    memset(d, 0xab, n);
+    char flags[512];
+    vm_flags_of(d + n / 2, flags, sizeof flags);
+    FILE *thp = fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
+    if (thp && flags[0])
+        TAP_CHECK(strstr(flags, " hg") != NULL,
+                  "a 3 MiB array is advised to use huge pages (VmFlags:%s)", flags);
+    else
+        TAP_NOTE("no transparent huge pages or no /proc/self/smaps: advice not checked");
+    if (thp)
+        fclose(thp);
+    free(d);
+    size_t nonzero = 0;
+    uint32_t *z = st_calloc_array(n / 4, 4);
+    for (size_t i = 0; z && i < n / 4; i++)
+        nonzero += z[i] != 0;
+    TAP_CHECK(z && nonzero == 0, "a 3 MiB calloc'd array is zero (%zu words not)", nonzero);
+    free(z);
+    size_t bad = 0, have = 0;
+    unsigned char *p = NULL;
+    for (size_t cap = (size_t)1 << 19; cap <= ((size_t)16 << 20); cap *= 2) {
+        unsigned char *q = st_realloc_array(p, cap, 1);
+        if (!q)
+            break;
+        p = q;
+        for (size_t i = 0; i < have; i++)
+            bad += p[i] != (unsigned char)(i * 13 + i / 4096);
+        for (size_t i = have; i < cap; i++)
+            p[i] = (unsigned char)(i * 13 + i / 4096);
+        have = cap;
+    }
+    TAP_CHECK(have == ((size_t)16 << 20) && bad == 0,
+              "an array grown 512 KiB -> 16 MiB keeps its bytes (%zu wrong)", bad);
+    free(p);
+}
+
 static void test_meta(void)
 {
     st_meta m = {0};
@@ -333,7 +380,7 @@ static void test_address_space(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {TAP_TEST(error_format), TAP_TEST(checked_sizes), TAP_TEST(realloc_big),
+    static const tap_test tests[] = {TAP_TEST(error_format), TAP_TEST(checked_sizes), TAP_TEST(realloc_big), TAP_TEST(array_huge),
                                      TAP_TEST(meta), TAP_TEST(grid), TAP_TEST(outfile),
                                      TAP_TEST(outfile_stale), TAP_TEST(address_space), {0}};
     return tap_main(argc, argv, tests);

@@ -14,9 +14,12 @@
  * first touched in 4 KiB pages 0.94 s, in 2 MiB pages 0.02 s. */
 #define HUGE_PAGE ((size_t)2 << 20)
 
+/* From this size on, blocks are whole huge pages (see mem.h). */
+#define HUGE_FROM (HUGE_PAGE / 2)
+
 void *st_malloc_big(size_t n)
 {
-    if (n < 4 * HUGE_PAGE)
+    if (n < HUGE_FROM)
         return malloc(n ? n : 1);
     size_t rounded = (n + HUGE_PAGE - 1) / HUGE_PAGE * HUGE_PAGE;
     if (rounded < n)
@@ -49,6 +52,8 @@ void *st_realloc_big(void *p, size_t n)
 
 void *st_calloc_big(size_t n)
 {
+    if (n < HUGE_FROM)
+        return calloc(n ? n : 1, 1);
     unsigned char *p = st_malloc_big(n);
     if (!p)
         return NULL;
@@ -80,7 +85,7 @@ void *st_malloc_array(size_t n, size_t size)
     size_t bytes;
     if (st_size_mul(&bytes, n, size) != 0)
         return NULL;
-    return malloc(bytes ? bytes : 1);
+    return st_malloc_big(bytes);
 }
 
 void *st_calloc_array(size_t n, size_t size)
@@ -88,7 +93,7 @@ void *st_calloc_array(size_t n, size_t size)
     size_t bytes;
     if (st_size_mul(&bytes, n, size) != 0)
         return NULL;
-    return calloc(n ? n : 1, size ? size : 1);
+    return st_calloc_big(bytes);
 }
 
 void *st_realloc_array(void *p, size_t n, size_t size)

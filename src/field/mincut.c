@@ -428,7 +428,7 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
      * count, then their prefix sums: the same node order for any number
      * of threads). */
     const size_t layer = nx * ny;
-    size_t *first = malloc((nz + 1) * sizeof *first);
+    size_t *first = st_malloc_array(nz + 1, sizeof *first);
     if (!first)
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the cut");
     #pragma omp parallel for schedule(static)
@@ -448,17 +448,17 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
     const size_t m = first[nz];
     bk b = {0};
     b.n = m;
-    uint32_t *vox = malloc((m ? m : 1) * sizeof *vox);
-    b.nbr = malloc((6 * m + 1) * sizeof *b.nbr);
-    b.rc = malloc((6 * m + 1) * sizeof *b.rc);
-    b.tr = malloc((m + 1) * sizeof *b.tr);
-    b.tree = malloc(m + 1);
-    b.parent = malloc(m + 1);
-    b.ts = calloc(m + 1, sizeof *b.ts);
-    b.dist = malloc((m + 1) * sizeof *b.dist);
-    b.active = malloc((m + 1) * sizeof *b.active);
-    b.orphan = malloc((m + 1) * sizeof *b.orphan);
-    int32_t *vcap = malloc((m ? m : 1) * sizeof *vcap);   /* each node's face capacity */
+    uint32_t *vox = st_malloc_array(m ? m : 1, sizeof *vox);
+    b.nbr = st_malloc_array(6 * m + 1, sizeof *b.nbr);
+    b.rc = st_malloc_array(6 * m + 1, sizeof *b.rc);
+    b.tr = st_malloc_array(m + 1, sizeof *b.tr);
+    b.tree = st_malloc_array(m + 1, 1);
+    b.parent = st_malloc_array(m + 1, 1);
+    b.ts = st_calloc_array(m + 1, sizeof *b.ts);
+    b.dist = st_malloc_array(m + 1, sizeof *b.dist);
+    b.active = st_malloc_array(m + 1, sizeof *b.active);
+    b.orphan = st_malloc_array(m + 1, sizeof *b.orphan);
+    int32_t *vcap = st_malloc_array(m ? m : 1, sizeof *vcap);   /* each node's face capacity */
     if (!vox || !b.nbr || !b.rc || !b.tr || !b.tree || !b.parent || !b.ts || !b.dist ||
         !b.active || !b.orphan || !vcap) {
         free(first);
