@@ -14,6 +14,7 @@
 #include "tap.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -999,6 +1000,61 @@ static void test_fill(void)
     }
 }
 
+/* The guess's depth (st_pseudo_guess_measure) is the largest distance from
+ * a fill square's center to the soup: the same number, bit for bit, as a
+ * nearest search from every square's center, at 1 and 2 threads. On a
+ * one-sided wavy ball (a fill below the horizon, its squares at many
+ * depths) and an open box (a flat cap, deepest in its middle). */
+static double guess_depth_every_square(const st_soup *f, const st_bvh *bvh)
+{
+    double depth2 = 0.0;
+    for (size_t q = 0; q < f->ntris / 2; q++) {
+        const uint32_t *t = f->tris + 6 * q;
+        const double *a = f->xyz + 3 * (size_t)t[0], *c = f->xyz + 3 * (size_t)t[2];
+        const double m[3] = {0.5 * (a[0] + c[0]), 0.5 * (a[1] + c[1]), 0.5 * (a[2] + c[2])};
+        int64_t tri;
+        const double d2 = st_bvh_nearest(bvh, m, INFINITY, &tri, NULL);
+        depth2 = d2 > depth2 ? d2 : depth2;
+    }
+    return sqrt(depth2);
+}
+
+static void test_guess_depth(void)
+{
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    for (int shape = 0; shape < 2; shape++) {
+        st_soup *s = st_soup_new(), *f = NULL;
+        if (shape == 0)
+            add_wavy_ball(s, 0.3, 1);
+        else
+            add_box_faces(s, lo, hi, 2, top_face, 0);
+        const st_pseudo_params pp = st_pseudo_params_default();
+        st_dist_params dp = st_dist_params_default();
+        dp.cells = 48;
+        st_grid *g = NULL;
+        st_bvh *bvh = NULL;
+        st_error err;
+        const int ok = !st_pseudo_volume_bvh(&g, s, &dp, &pp, NULL, NULL, &bvh, &err) &&
+                       !st_pseudo_fill(&f, g, bvh, NULL, &err) && f->ntris > 0;
+        const double ref = ok ? guess_depth_every_square(f, bvh) : -1.0;
+        for (int threads = 1; threads <= 2; threads++) {
+            st_pseudo_guess gs = {0, 0, -1.0, 0};
+            omp_set_num_threads(threads);
+            if (ok)
+                st_pseudo_guess_measure(&gs, g, f, bvh);
+            TAP_CHECK(ok && gs.depth == ref && ref > 0.0,
+                      "%s, %d thread(s): the guess's depth %.17g is the farthest square's "
+                      "%.17g (%zu squares)", shape ? "open box" : "one-sided ball", threads,
+                      gs.depth, ref, ok ? f->ntris / 2 : 0);
+        }
+        omp_set_num_threads(2);
+        st_soup_free(f);
+        st_bvh_free(bvh);
+        st_grid_free(g);
+        st_soup_free(s);
+    }
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(entry_point), TAP_TEST(large_holes),
@@ -1006,6 +1062,6 @@ int main(int argc, char **argv)
                                      TAP_TEST(onesided_caps), TAP_TEST(columns),
                                      TAP_TEST(columns_caps), TAP_TEST(sides_orientation),
                                      TAP_TEST(shared_tables), TAP_TEST(shells_shortcut),
-                                     TAP_TEST(fill), {0}};
+                                     TAP_TEST(fill), TAP_TEST(guess_depth), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -109,7 +109,11 @@ void st_pseudo_guess_measure(st_pseudo_guess *out, const st_grid *g, const st_so
             }
     }
     /* a square's two triangles are (b, b+1, b+2) and (b, b+2, b+3)
-     * (add_square): b and b+2 are opposite corners */
+     * (add_square): b and b+2 are opposite corners. The depth is the
+     * largest of the squares' distances: a square with a triangle closer
+     * than the largest so far (st_bvh_within, which stops at the first
+     * one) cannot raise it, so only the others are measured (nearest). The
+     * maximum is the same in any order, so for any number of threads. */
     const long long nsq = fill && bvh ? (long long)(fill->ntris / 2) : 0;
     double depth2 = 0.0;
     #pragma omp parallel for schedule(dynamic, 256) reduction(max : depth2)
@@ -117,6 +121,8 @@ void st_pseudo_guess_measure(st_pseudo_guess *out, const st_grid *g, const st_so
         const uint32_t *t = fill->tris + 6 * (size_t)q;
         const double *a = fill->xyz + 3 * (size_t)t[0], *c = fill->xyz + 3 * (size_t)t[2];
         const double m[3] = {0.5 * (a[0] + c[0]), 0.5 * (a[1] + c[1]), 0.5 * (a[2] + c[2])};
+        if (depth2 > 0.0 && st_bvh_within(bvh, m, depth2))
+            continue;
         int64_t tri;
         const double d2 = st_bvh_nearest(bvh, m, INFINITY, &tri, NULL);
         depth2 = d2 > depth2 ? d2 : depth2;
