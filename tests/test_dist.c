@@ -803,6 +803,45 @@ static void test_real_model(void)
     st_soup_free(s);
 }
 
+/* st_dist_field_far: st_dist_field's layout, band and metadata, every
+ * voxel at the value st_dist_field gives a voxel beyond the band (the
+ * field's largest); a full band is refused. */
+static void test_far_field(void)
+{
+    st_soup *s = random_soup(60);
+    st_dist_params p = st_dist_params_default();
+    p.cells = 24;
+    st_grid *d = NULL, *f = NULL;
+    st_error err;
+    const int ok = !st_dist_field(&d, s, &p, NULL, &err) && !st_dist_field_far(&f, s, &p, &err);
+    int same = ok && f->nx == d->nx && f->ny == d->ny && f->nz == d->nz &&
+               f->voxel == d->voxel && f->band == d->band && f->kind == d->kind &&
+               !memcmp(f->origin, d->origin, sizeof f->origin);
+    const char *keys[] = {"triangles", "vertices", "band_voxels"};
+    for (int k = 0; same && k < 3; k++)
+        same = st_meta_get(&f->meta, keys[k]) && st_meta_get(&d->meta, keys[k]) &&
+               !strcmp(st_meta_get(&f->meta, keys[k]), st_meta_get(&d->meta, keys[k]));
+    TAP_CHECK(same, "the far field has the distance field's layout, band and metadata");
+    float dmax = 0.0f;
+    size_t far = 0, n = ok ? st_grid_count(d) : 0, at_far = 0;
+    for (size_t i = 0; i < n; i++) {
+        dmax = d->data[i] > dmax ? d->data[i] : dmax;
+        far += f->data[i] == (float)f->band;
+    }
+    for (size_t i = 0; i < n; i++)
+        at_far += d->data[i] == dmax;
+    TAP_CHECK(ok && n > 0 && far == n && dmax == (float)f->band && at_far > 0 && at_far < n,
+              "every voxel holds the band's far value %g, the distance field's largest "
+              "(%zu of %zu voxels there)", ok ? f->band : 0.0, at_far, n);
+    st_grid_free(f);
+    f = NULL;
+    p.band = INFINITY;
+    TAP_CHECK(st_dist_field_far(&f, s, &p, &err) == ST_EINPUT && !f,
+              "a full band is refused: %s", err.msg);
+    st_grid_free(d);
+    st_soup_free(s);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(layout), TAP_TEST(band_exact_on_random_soup),
@@ -810,6 +849,7 @@ int main(int argc, char **argv)
                                      TAP_TEST(bvh_nearest_exact), TAP_TEST(bvh_nearest_ties),
                                      TAP_TEST(bvh_parallel_layout),
                                      TAP_TEST(threads_identical), TAP_TEST(fine_soup_exact),
-                                     TAP_TEST(real_model), TAP_TEST(blocks_equal_dense), {0}};
+                                     TAP_TEST(real_model), TAP_TEST(blocks_equal_dense),
+                                     TAP_TEST(far_field), {0}};
     return tap_main(argc, argv, tests);
 }

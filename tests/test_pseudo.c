@@ -1055,6 +1055,72 @@ static void test_guess_depth(void)
     }
 }
 
+/* signs_only (pseudo.h): on a closed ball and on two interpenetrating
+ * closed boxes the shortcut runs without distances: the same layout and
+ * the same sign voxel for voxel as with the distances, every value the
+ * band's far value, and the metadata says so; with one open triangle
+ * beside the ball, or a full band, the distances are computed: the same
+ * bytes as without signs_only. */
+static void test_signs_only(void)
+{
+    for (int shape = 0; shape < 4; shape++) {
+        st_soup *s = st_soup_new(), *b = st_soup_new();
+        const double lo1[3] = {0.01, 0.02, 0.03}, hi1[3] = {2.01, 2.02, 2.03};
+        const double lo2[3] = {1.3, 1.31, 1.32}, hi2[3] = {3.3, 3.31, 3.32};
+        st_error err;
+        if (shape == 1) {
+            add_box_oriented(s, lo1, hi1);
+            add_box_oriented(b, lo2, hi2);
+            st_soup_append(s, b, &err);
+        } else
+            add_closed_ball(s);
+        if (shape == 2)
+            add_tri(s, (double[3]){0.1, 0.1, 0.1}, (double[3]){0.5, 0.1, 0.2},
+                    (double[3]){0.1, 0.6, 0.3}, 0);
+        st_dist_params dp = st_dist_params_default();
+        dp.cells = 40;
+        if (shape == 3)
+            dp.band = INFINITY;
+        st_pseudo_params pp = st_pseudo_params_default();
+        pp.symmetry = 0;   /* the ball's many symmetries: slow, and beside the point */
+        st_grid *with = NULL, *without = NULL;
+        st_pseudo_stats sw, so;
+        int ok = !st_pseudo_volume(&with, s, &dp, &pp, &sw, NULL, &err);
+        pp.signs_only = 1;
+        ok = ok && !st_pseudo_volume(&without, s, &dp, &pp, &so, NULL, &err);
+        const size_t n = ok ? st_grid_count(with) : 0;
+        size_t sign = 0, far = 0;
+        for (size_t i = 0; i < n; i++) {
+            sign += (with->data[i] < 0.0f) != (without->data[i] < 0.0f);
+            far += fabsf(without->data[i]) == (float)without->band;
+        }
+        const int layout = ok && with->nx == without->nx && with->ny == without->ny &&
+                           with->nz == without->nz && with->voxel == without->voxel &&
+                           with->band == without->band && with->kind == without->kind &&
+                           !memcmp(with->origin, without->origin, sizeof with->origin);
+        static const char *const names[] = {"a closed ball", "two interpenetrating boxes",
+                                            "the ball and an open triangle",
+                                            "the ball on a full band"};
+        if (shape < 2)
+            TAP_CHECK(layout && sign == 0 && far == n && so.shells_only &&
+                          so.inside == sw.inside && so.inside > 0 &&
+                          st_meta_get(&without->meta, "distances") &&
+                          !st_meta_get(&with->meta, "distances"),
+                      "%s, signs only: no distance, the same %zu signs (%zu differ), every "
+                      "value the far one (%zu of %zu)", names[shape], so.inside, sign, far, n);
+        else
+            TAP_CHECK(layout && !memcmp(with->data, without->data, n * sizeof *with->data) &&
+                          so.shells_only == (shape == 3) &&
+                          !st_meta_get(&without->meta, "distances"),
+                      "%s, signs only: the distances are computed, the same bytes",
+                      names[shape]);
+        st_grid_free(with);
+        st_grid_free(without);
+        st_soup_free(s);
+        st_soup_free(b);
+    }
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(entry_point), TAP_TEST(large_holes),
@@ -1062,6 +1128,7 @@ int main(int argc, char **argv)
                                      TAP_TEST(onesided_caps), TAP_TEST(columns),
                                      TAP_TEST(columns_caps), TAP_TEST(sides_orientation),
                                      TAP_TEST(shared_tables), TAP_TEST(shells_shortcut),
-                                     TAP_TEST(fill), TAP_TEST(guess_depth), {0}};
+                                     TAP_TEST(fill), TAP_TEST(guess_depth),
+                                     TAP_TEST(signs_only), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -91,6 +91,16 @@ st_status st_dist_field_blocks(st_grid_blocks **out, const st_soup *s,
                                const st_dist_params *p,
                                const st_progress *progress, st_error *err);
 
+/* The field st_dist_field would make for s and p (the same layout, band
+ * and metadata) with every voxel at the band's far value, the value
+ * st_dist_field gives a voxel no triangle comes within the band of: no
+ * distance is computed. For a caller that reads only signs it decides
+ * without distances (the closed shells' solid: pseudo.h, signs_only).
+ * p's band must be finite (ST_EINPUT otherwise); errors as
+ * st_dist_layout's, ST_ENOMEM. */
+st_status st_dist_field_far(st_grid **out, const st_soup *s,
+                            const st_dist_params *p, st_error *err);
+
 /* Lower g's values to the distance to s's triangles where that is below
  * `reach` (model units): the field of the union of g's soup and s, as far
  * as reach (hole caps added to a field from a file). Exact point-triangle

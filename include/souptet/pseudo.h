@@ -83,6 +83,14 @@ typedef struct st_pseudo_params {
     double cap_reach;               /* voxels (3; the field's band if less) */
     int shells_shortcut;            /* the shells alone when they are the
                                        whole soup (1; 0: every step runs) */
+    int signs_only;                 /* st_pseudo_volume(_bvh): the caller
+                                       reads only the field's signs, so
+                                       where the shortcut runs no distance
+                                       is computed: every voxel holds the
+                                       band's far value (st_dist_field_far)
+                                       with the shells' sign, the same
+                                       signs, and the metadata says
+                                       "distances" (0: distances always) */
     int symmetry;                   /* step 2: the soup's symmetries
                                        (symmetry.h) fill the holes, capped
                                        or too large to cap, their images

@@ -91,6 +91,10 @@ st_status st_sign_field(st_grid *g, const st_sign_params *p,
  * rays in range): ST_OK, or the ST_EINPUT st_sign_field would give. */
 st_status st_sign_check_field(const st_grid *g, const st_sign_params *p, st_error *err);
 
+/* The parameters' part of those checks alone (k and rays in range), for a
+ * field made to be signed without a vote (pseudo.h, signs_only). */
+st_status st_sign_check_params(const st_sign_params *p, st_error *err);
+
 /* st_sign_field with more evidence for the cut (p->cut only): extra[i]
  * (NULL: none) is added to voxel i's evidence from the votes (a margin of
  * U - 13 votes; see mincut.h for its weight), for what the votes cannot

@@ -1467,6 +1467,38 @@ st_status st_dist_field(st_grid **out, const st_soup *s,
     return ST_OK;
 }
 
+st_status st_dist_field_far(st_grid **out, const st_soup *s,
+                            const st_dist_params *p, st_error *err)
+{
+    *out = NULL;
+    dist_plan pl;
+    st_status st = dist_setup(&pl, s, p, err);
+    if (st)
+        return st;
+    if (pl.full)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "a field of far values needs a finite band");
+    const double B = pl.band_vox * pl.h;
+    st_grid *g;
+    st = st_grid_new_unset(&g, pl.dims[0], pl.dims[1], pl.dims[2], pl.origin,
+                           pl.h, p->max_bytes, err);
+    if (st)
+        return st;
+    g->kind = ST_GRID_DISTANCE;
+    g->band = B;
+    const float Bf = (float)B;
+    const long long n = (long long)st_grid_count(g);
+    #pragma omp parallel for schedule(static)
+    for (long long i = 0; i < n; i++)
+        g->data[i] = Bf;
+    if ((st = dist_meta(&g->meta, s, 0, pl.band_vox, err))) {
+        st_grid_free(g);
+        return st;
+    }
+    *out = g;
+    return ST_OK;
+}
+
 st_status st_dist_field_blocks(st_grid_blocks **out, const st_soup *s,
                                const st_dist_params *p,
                                const st_progress *progress, st_error *err)

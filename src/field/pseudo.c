@@ -39,6 +39,7 @@ st_pseudo_params st_pseudo_params_default(void)
     p.sides = 1;
     p.sides_params = st_sides_params_default();
     p.shells_shortcut = 1;
+    p.signs_only = 0;
     p.symmetry = 1;
     return p;
 }
@@ -47,10 +48,12 @@ st_pseudo_params st_pseudo_params_default(void)
  * so step 5 would overwrite every sign; g gets the shells' solid alone,
  * each voxel st_grid_signed_value(its distance, inside the solid). */
 static st_status shells_only(st_grid *g, const st_shells *shells, const st_pseudo_params *p,
-                             st_pseudo_stats *st, st_error *err)
+                             int far, st_pseudo_stats *st, st_error *err)
 {
     st->failed_step = "vote";   /* the field's checks: the field is to blame */
-    st_status rc = st_sign_check_field(g, &p->sign, err);
+    /* a field of far values (signs_only) is made here, and constant: only
+     * the parameters are checked */
+    st_status rc = far ? st_sign_check_params(&p->sign, err) : st_sign_check_field(g, &p->sign, err);
     if (rc)
         return rc;
     st->failed_step = "shells";
@@ -62,7 +65,57 @@ static st_status shells_only(st_grid *g, const st_shells *shells, const st_pseud
                            "closed shells: every triangle is in one, the signs are their "
                            "solid (no caps, vote or refinement)"))
         rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
+    if (!rc && far && st_meta_set(&g->meta, "distances",
+                                  "none: every voxel holds the band's far value, signed "
+                                  "(signs_only)"))
+        rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory");
     return rc;
+}
+
+/* Step 1's tables: s's edges (when a step reads them) and its closed
+ * shells; built by the sign step, or before the field by
+ * st_pseudo_volume_bvh when the distances may be skipped (signs_only). */
+typedef struct sign_prep {
+    st_soup_edges edges;
+    int have_edges;
+    st_shells shells;
+    int shortcut;       /* every triangle in a closed shell (shells_shortcut) */
+    int far;            /* the field holds far values (st_dist_field_far) */
+    double seconds;     /* building them */
+} sign_prep;
+
+static void prep_free(sign_prep *pr)
+{
+    if (pr->have_edges)
+        st_soup_edges_free(&pr->edges);
+    pr->have_edges = 0;
+    st_shells_free(&pr->shells);
+}
+
+/* pr from zero; on failure *failed names the step and the caller frees
+ * pr (prep_free). */
+static st_status prep_build(sign_prep *pr, const st_soup *s, const st_pseudo_params *p,
+                            const st_progress *progress, const char **failed, st_error *err)
+{
+    memset(pr, 0, sizeof *pr);
+    const double t0 = now_seconds();
+    st_status rc;
+    if (s && (p->closed_shells || p->fill_holes || (p->sides && p->sign.cut))) {
+        *failed = p->closed_shells ? "shells" : p->fill_holes ? "holes" : "vote";
+        if ((rc = st_soup_edges_build(&pr->edges, s, err)))
+            return rc;
+        pr->have_edges = 1;
+    }
+    if (s && p->closed_shells) {
+        *failed = "shells";
+        st_progress_report(progress, "shells", 0.0);
+        if ((rc = st_soup_closed_shells_edges(&pr->shells, s, &pr->edges, err)))
+            return rc;
+        pr->shortcut = p->shells_shortcut && pr->shells.count > 0 &&
+                       pr->shells.open_triangles == 0;
+    }
+    pr->seconds = now_seconds() - t0;
+    return ST_OK;
 }
 
 /* Step 2's symmetry (pseudo.h): the soup's symmetries at a voxel's
@@ -228,10 +281,15 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
         }                                                                      \
     } while (0)
 
-st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+/* st_pseudo_sign_bvh, with step 1's tables given (and freed here) or
+ * built here (given NULL). */
+static st_status pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p,
                              st_pseudo_stats *stats, const st_progress *progress,
-                             st_bvh **bvh_out, st_error *err)
+                             st_bvh **bvh_out, sign_prep *given, st_error *err)
 {
+    sign_prep own, *pr = given ? given : &own;
+    if (!given)
+        memset(&own, 0, sizeof own);
     if (bvh_out)
         *bvh_out = NULL;
     if (p && p->symmetric_fill)
@@ -239,44 +297,33 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     st_pseudo_stats local;
     st_pseudo_stats *st = stats ? stats : &local;
     memset(st, 0, sizeof *st);
-    if (!g || !p)
+    if (!g || !p) {
+        prep_free(pr);
         return st_error_set(err, ST_EINTERNAL, NULL, 0, "st_pseudo_sign: bad arguments");
+    }
     st->surface = s != NULL;
     st->event_distance = st_sign_event_distance(&p->sign, g);
-    st_shells shells;
-    memset(&shells, 0, sizeof shells);
     st_soup *with_caps = NULL, *caps = NULL;
     st_bvh *caps_bvh = NULL;
-    /* s's edge table and BVH, built once for the steps that read them */
-    st_soup_edges edges;
-    int have_edges = 0;
+    /* s's BVH, built once for the steps that read it (the edge table is
+     * step 1's, pr's) */
     st_bvh *bvh = NULL;
     st_status rc = ST_OK;
-    double t0 = now_seconds();
+    double t0 = now_seconds() - (given ? given->seconds : 0.0);
     STOP_IF_CANCELLED();
-    if (s && (p->closed_shells || p->fill_holes || (p->sides && p->sign.cut))) {
-        st->failed_step = p->closed_shells ? "shells" : p->fill_holes ? "holes" : "vote";
-        if ((rc = st_soup_edges_build(&edges, s, err)))
+    if (!given && (rc = prep_build(&own, s, p, progress, &st->failed_step, err)))
+        goto done;
+    st->shells = pr->shells.count;
+    st->shell_open_triangles = pr->shells.open_triangles;
+    if (pr->shortcut) {
+        if (pr->have_edges)
+            st_soup_edges_free(&pr->edges);
+        pr->have_edges = 0;
+        st->shells_only = 1;
+        if ((rc = shells_only(g, &pr->shells, p, pr->far, st, err)))
             goto done;
-        have_edges = 1;
-    }
-    if (s && p->closed_shells) {
-        st->failed_step = "shells";
-        st_progress_report(progress, "shells", 0.0);
-        rc = st_soup_closed_shells_edges(&shells, s, &edges, err);
-        if (rc)
-            goto done;
-        st->shells = shells.count;
-        st->shell_open_triangles = shells.open_triangles;
-        if (p->shells_shortcut && shells.count > 0 && shells.open_triangles == 0) {
-            st_soup_edges_free(&edges);
-            have_edges = 0;
-            st->shells_only = 1;
-            if ((rc = shells_only(g, &shells, p, st, err)))
-                goto done;
-            st->seconds_shells = now_seconds() - t0;
-            goto count_inside;
-        }
+        st->seconds_shells = now_seconds() - t0;
+        goto count_inside;
     }
     STOP_IF_CANCELLED();
     double t1 = now_seconds();
@@ -285,7 +332,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     if (s && p->fill_holes) {
         st_progress_report(progress, "holes", 0.0);
         if ((rc = st_bvh_build(&bvh, s, err)) ||
-            (rc = add_caps(g, s, &edges, bvh, p, st, &with_caps, &caps, err)))
+            (rc = add_caps(g, s, &pr->edges, bvh, p, st, &with_caps, &caps, err)))
             goto done;
     }
     STOP_IF_CANCELLED();
@@ -294,14 +341,14 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     st->failed_step = "vote";
     if (s && p->sides && p->sign.cut) {
         /* the caps are new triangles: their soup gets its own edges */
-        if ((rc = vote_with_sides(g, with_caps ? with_caps : s, with_caps ? NULL : &edges, p, st,
+        if ((rc = vote_with_sides(g, with_caps ? with_caps : s, with_caps ? NULL : &pr->edges, p, st,
                                   progress, err)))
             goto done;
     } else if ((rc = st_sign_field(g, &p->sign, progress, err)))
         goto done;
-    if (have_edges) {
-        st_soup_edges_free(&edges);
-        have_edges = 0;
+    if (pr->have_edges) {
+        st_soup_edges_free(&pr->edges);
+        pr->have_edges = 0;
     }
     STOP_IF_CANCELLED();
     double t3 = now_seconds();
@@ -325,7 +372,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     double t4 = now_seconds();
     st->seconds_refine = t4 - t3;
     st->failed_step = "shells";
-    if (s && p->closed_shells && (rc = st_shells_sign(g, &shells, &st->shell_changed, err)))
+    if (s && p->closed_shells && (rc = st_shells_sign(g, &pr->shells, &st->shell_changed, err)))
         goto done;
     st->seconds_shells += now_seconds() - t4;
 count_inside:;
@@ -350,13 +397,18 @@ done:
         *p->symmetric_fill = NULL;
     }
     st_bvh_free(bvh);
-    if (have_edges)
-        st_soup_edges_free(&edges);
     st_soup_free(with_caps);
     st_soup_free(caps);
     st_bvh_free(caps_bvh);
-    st_shells_free(&shells);
+    prep_free(pr);
     return rc;
+}
+
+st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+                             st_pseudo_stats *stats, const st_progress *progress,
+                             st_bvh **bvh_out, st_error *err)
+{
+    return pseudo_sign(g, s, p, stats, progress, bvh_out, NULL, err);
 }
 
 st_status st_pseudo_volume(st_grid **out, const st_soup *s, const st_dist_params *dp,
@@ -377,8 +429,30 @@ st_status st_pseudo_volume_bvh(st_grid **out, const st_soup *s, const st_dist_pa
     if (!out || !s || !dp || !p)
         return st_error_set(err, ST_EINTERNAL, NULL, 0, "st_pseudo_volume: bad arguments");
     st_grid *g = NULL;
-    st_status rc = st_dist_field(&g, s, dp, progress, err);
-    rc = rc ? rc : st_pseudo_sign_bvh(g, s, p, stats, progress, bvh_out, err);
+    st_status rc;
+    if (p->signs_only && s && p->closed_shells) {
+        /* step 1 first: where the shells decide every sign, the field
+         * needs no distance */
+        sign_prep pr;
+        const char *failed = NULL;
+        if ((rc = prep_build(&pr, s, p, progress, &failed, err))) {
+            prep_free(&pr);
+            if (stats) {
+                memset(stats, 0, sizeof *stats);
+                stats->failed_step = failed;
+            }
+            return rc;
+        }
+        pr.far = pr.shortcut && isfinite(dp->band);
+        rc = pr.far ? st_dist_field_far(&g, s, dp, err) : st_dist_field(&g, s, dp, progress, err);
+        if (rc)
+            prep_free(&pr);
+        else
+            rc = pseudo_sign(g, s, p, stats, progress, bvh_out, &pr, err);
+    } else {
+        rc = st_dist_field(&g, s, dp, progress, err);
+        rc = rc ? rc : st_pseudo_sign_bvh(g, s, p, stats, progress, bvh_out, err);
+    }
     if (rc) {
         st_grid_free(g);
         return rc;

@@ -837,6 +837,17 @@ unsigned st_sign_line(const float *d, size_t n, float t,
     return events;
 }
 
+st_status st_sign_check_params(const st_sign_params *p, st_error *err)
+{
+    if (!(p->k > 0.0 && p->k <= 1.0))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "k must be in (0, 1], not %g", p->k);
+    if (p->rays != 13 && p->rays != 26)
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "rays must be 13 or 26, not %d", p->rays);
+    return ST_OK;
+}
+
 st_status st_sign_check_field(const st_grid *g, const st_sign_params *p, st_error *err)
 {
     if (g->kind == ST_GRID_SIGNED)
@@ -846,12 +857,9 @@ st_status st_sign_check_field(const st_grid *g, const st_sign_params *p, st_erro
     if (g->kind != ST_GRID_DISTANCE && g->kind != ST_GRID_UNKNOWN)
         return st_error_set(err, ST_EINPUT, NULL, 0,
                             "not a distance field");
-    if (!(p->k > 0.0 && p->k <= 1.0))
-        return st_error_set(err, ST_EINPUT, NULL, 0,
-                            "k must be in (0, 1], not %g", p->k);
-    if (p->rays != 13 && p->rays != 26)
-        return st_error_set(err, ST_EINPUT, NULL, 0,
-                            "rays must be 13 or 26, not %d", p->rays);
+    st_status ps = st_sign_check_params(p, err);
+    if (ps)
+        return ps;
     const size_t n = st_grid_count(g);
     /* One branch-free pass (vectorised, 32-bit counts per block): not
      * finite, negative, and different from the first value (a constant

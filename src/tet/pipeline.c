@@ -923,6 +923,9 @@ st_status st_pipeline_run(st_tetmesh **out, st_pipeline_stats *stats,
     st_soup *fill = NULL, *sym = NULL, *enc = NULL;
     st_bvh *enc_bvh = NULL;
     pp.symmetric_fill = &sym;   /* the guess's symmetric part (make_fill) */
+    /* The sculpting, the fill and the parts read only the field's signs;
+     * the density filter's clean-up reads its depths too (thin parts). */
+    pp.signs_only = p->density_rho <= 0;
     rc = make_field(&g, &bvh, st, s, &dp, &pp, p, t_start, prog, err);
     pp.symmetric_fill = NULL;
     if (rc)
