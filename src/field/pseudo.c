@@ -228,9 +228,76 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
         }                                                                      \
     } while (0)
 
+/* The first steps of the signs, which do not read the field: s's edge
+ * table (for the shells, the caps and the sides' vote) and its closed
+ * shells. With the shortcut (every triangle in a closed shell) the edges
+ * are freed at once: nothing after reads them. */
+typedef struct sign_prep {
+    st_soup_edges edges;
+    int have_edges;
+    st_shells shells;
+    int shortcut;
+    double seconds;
+    const char *failed_step;    /* on failure */
+} sign_prep;
+
+static st_status prep_shells(sign_prep *pr, const st_soup *s, const st_pseudo_params *p,
+                             const st_progress *progress, st_error *err)
+{
+    memset(pr, 0, sizeof *pr);
+    const double t0 = now_seconds();
+    st_status rc = ST_OK;
+    if (s && (p->closed_shells || p->fill_holes || (p->sides && p->sign.cut))) {
+        pr->failed_step = p->closed_shells ? "shells" : p->fill_holes ? "holes" : "vote";
+        if ((rc = st_soup_edges_build(&pr->edges, s, err)))
+            return rc;
+        pr->have_edges = 1;
+    }
+    if (s && p->closed_shells) {
+        pr->failed_step = "shells";
+        st_progress_report(progress, "shells", 0.0);
+        if ((rc = st_soup_closed_shells_edges(&pr->shells, s, &pr->edges, err)))
+            return rc;
+        if (p->shells_shortcut && pr->shells.count > 0 && pr->shells.open_triangles == 0) {
+            st_soup_edges_free(&pr->edges);
+            pr->have_edges = 0;
+            pr->shortcut = 1;
+        }
+    }
+    pr->failed_step = NULL;
+    pr->seconds = now_seconds() - t0;
+    return ST_OK;
+}
+
+static void prep_free(sign_prep *pr)
+{
+    if (pr->have_edges)
+        st_soup_edges_free(&pr->edges);
+    pr->have_edges = 0;
+    st_shells_free(&pr->shells);
+}
+
+/* st_pseudo_sign_bvh with s's BVH already built (given, may be NULL: its
+ * time given_seconds, counted as the BVH's): the steps use it instead of
+ * building one, and it is the one handed out (freed on failure, or when
+ * bvh_out is NULL). pre: the first steps made already (prep_shells), or
+ * NULL to make them here; this call frees them either way. */
+static st_status pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+                             st_pseudo_stats *stats, const st_progress *progress,
+                             st_bvh **bvh_out, st_bvh *given, double given_seconds,
+                             sign_prep *pre, st_error *err);
+
 st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_params *p,
                              st_pseudo_stats *stats, const st_progress *progress,
                              st_bvh **bvh_out, st_error *err)
+{
+    return pseudo_sign(g, s, p, stats, progress, bvh_out, NULL, 0.0, NULL, err);
+}
+
+static st_status pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p,
+                             st_pseudo_stats *stats, const st_progress *progress,
+                             st_bvh **bvh_out, st_bvh *given, double given_seconds,
+                             sign_prep *pre, st_error *err)
 {
     if (bvh_out)
         *bvh_out = NULL;
@@ -239,44 +306,41 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     st_pseudo_stats local;
     st_pseudo_stats *st = stats ? stats : &local;
     memset(st, 0, sizeof *st);
-    if (!g || !p)
+    if (!g || !p) {
+        st_bvh_free(given);
+        if (pre)
+            prep_free(pre);
         return st_error_set(err, ST_EINTERNAL, NULL, 0, "st_pseudo_sign: bad arguments");
+    }
     st->surface = s != NULL;
     st->event_distance = st_sign_event_distance(&p->sign, g);
-    st_shells shells;
-    memset(&shells, 0, sizeof shells);
     st_soup *with_caps = NULL, *caps = NULL;
     st_bvh *caps_bvh = NULL;
-    /* s's edge table and BVH, built once for the steps that read them */
-    st_soup_edges edges;
-    int have_edges = 0;
-    st_bvh *bvh = NULL;
+    /* s's edge table, closed shells and BVH, made once for the steps
+     * that read them */
+    sign_prep own;
+    sign_prep *pr = pre ? pre : &own;
+    st_bvh *bvh = given;
+    st->seconds_bvh = given_seconds;
     st_status rc = ST_OK;
     double t0 = now_seconds();
-    STOP_IF_CANCELLED();
-    if (s && (p->closed_shells || p->fill_holes || (p->sides && p->sign.cut))) {
-        st->failed_step = p->closed_shells ? "shells" : p->fill_holes ? "holes" : "vote";
-        if ((rc = st_soup_edges_build(&edges, s, err)))
+    if (!pre) {
+        memset(&own, 0, sizeof own);
+        STOP_IF_CANCELLED();
+        if ((rc = prep_shells(&own, s, p, progress, err))) {
+            st->failed_step = own.failed_step;
             goto done;
-        have_edges = 1;
-    }
-    if (s && p->closed_shells) {
-        st->failed_step = "shells";
-        st_progress_report(progress, "shells", 0.0);
-        rc = st_soup_closed_shells_edges(&shells, s, &edges, err);
-        if (rc)
-            goto done;
-        st->shells = shells.count;
-        st->shell_open_triangles = shells.open_triangles;
-        if (p->shells_shortcut && shells.count > 0 && shells.open_triangles == 0) {
-            st_soup_edges_free(&edges);
-            have_edges = 0;
-            st->shells_only = 1;
-            if ((rc = shells_only(g, &shells, p, st, err)))
-                goto done;
-            st->seconds_shells = now_seconds() - t0;
-            goto count_inside;
         }
+    }
+    t0 -= pr->seconds * (pre != NULL);    /* made before: its time counts */
+    st->shells = pr->shells.count;
+    st->shell_open_triangles = pr->shells.open_triangles;
+    if (pr->shortcut) {
+        st->shells_only = 1;
+        if ((rc = shells_only(g, &pr->shells, p, st, err)))
+            goto done;
+        st->seconds_shells = now_seconds() - t0;
+        goto count_inside;
     }
     STOP_IF_CANCELLED();
     double t1 = now_seconds();
@@ -284,8 +348,8 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     st->failed_step = "holes";
     if (s && p->fill_holes) {
         st_progress_report(progress, "holes", 0.0);
-        if ((rc = st_bvh_build(&bvh, s, err)) ||
-            (rc = add_caps(g, s, &edges, bvh, p, st, &with_caps, &caps, err)))
+        if ((!bvh && (rc = st_bvh_build(&bvh, s, err))) ||
+            (rc = add_caps(g, s, &pr->edges, bvh, p, st, &with_caps, &caps, err)))
             goto done;
     }
     STOP_IF_CANCELLED();
@@ -294,14 +358,14 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     st->failed_step = "vote";
     if (s && p->sides && p->sign.cut) {
         /* the caps are new triangles: their soup gets its own edges */
-        if ((rc = vote_with_sides(g, with_caps ? with_caps : s, with_caps ? NULL : &edges, p, st,
-                                  progress, err)))
+        if ((rc = vote_with_sides(g, with_caps ? with_caps : s, with_caps ? NULL : &pr->edges, p,
+                                  st, progress, err)))
             goto done;
     } else if ((rc = st_sign_field(g, &p->sign, progress, err)))
         goto done;
-    if (have_edges) {
-        st_soup_edges_free(&edges);
-        have_edges = 0;
+    if (pr->have_edges) {
+        st_soup_edges_free(&pr->edges);
+        pr->have_edges = 0;
     }
     STOP_IF_CANCELLED();
     double t3 = now_seconds();
@@ -325,7 +389,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
     double t4 = now_seconds();
     st->seconds_refine = t4 - t3;
     st->failed_step = "shells";
-    if (s && p->closed_shells && (rc = st_shells_sign(g, &shells, &st->shell_changed, err)))
+    if (s && p->closed_shells && (rc = st_shells_sign(g, &pr->shells, &st->shell_changed, err)))
         goto done;
     st->seconds_shells += now_seconds() - t4;
 count_inside:;
@@ -340,7 +404,7 @@ count_inside:;
         st_progress_report(progress, "bvh", 0.0);
         if (!bvh && (rc = st_bvh_build(&bvh, s, err)))
             goto done;
-        st->seconds_bvh = now_seconds() - tb;
+        st->seconds_bvh += now_seconds() - tb;
         *bvh_out = bvh;
         bvh = NULL;
     }
@@ -350,12 +414,10 @@ done:
         *p->symmetric_fill = NULL;
     }
     st_bvh_free(bvh);
-    if (have_edges)
-        st_soup_edges_free(&edges);
+    prep_free(pr);
     st_soup_free(with_caps);
     st_soup_free(caps);
     st_bvh_free(caps_bvh);
-    st_shells_free(&shells);
     return rc;
 }
 
@@ -377,8 +439,34 @@ st_status st_pseudo_volume_bvh(st_grid **out, const st_soup *s, const st_dist_pa
     if (!out || !s || !dp || !p)
         return st_error_set(err, ST_EINTERNAL, NULL, 0, "st_pseudo_volume: bad arguments");
     st_grid *g = NULL;
-    st_status rc = st_dist_field(&g, s, dp, progress, err);
-    rc = rc ? rc : st_pseudo_sign_bvh(g, s, p, stats, progress, bvh_out, err);
+    /* A dense soup's band comes from the BVH the caller gets anyway
+     * (st_dist_wants_bvh): built first, its time counted as the BVH's. */
+    st_bvh *bvh = NULL;
+    double bvh_seconds = 0.0;
+    st_status rc = ST_OK;
+    sign_prep pre, *prep = NULL;
+    if (bvh_out && st_dist_wants_bvh(s, dp)) {
+        /* The signs' first steps before the BVH: a closed soup's edge
+         * table (gone after them) and its BVH are never held at once,
+         * as they are not when the BVH comes at the end. */
+        prep = &pre;
+        if ((rc = prep_shells(&pre, s, p, progress, err)) && stats) {
+            memset(stats, 0, sizeof *stats);
+            stats->failed_step = pre.failed_step;
+        }
+        const double tb = now_seconds();
+        rc = rc ? rc : st_bvh_build(&bvh, s, err);
+        bvh_seconds = now_seconds() - tb;
+    }
+    rc = rc ? rc : st_dist_field_bvh(&g, s, dp, bvh, progress, err);
+    if (rc) {
+        if (prep)
+            prep_free(prep);
+        st_bvh_free(bvh);
+        st_grid_free(g);
+        return rc;
+    }
+    rc = pseudo_sign(g, s, p, stats, progress, bvh_out, bvh, bvh_seconds, prep, err);
     if (rc) {
         st_grid_free(g);
         return rc;
