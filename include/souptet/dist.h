@@ -36,6 +36,7 @@
 #define SOUPTET_DIST_H
 
 #include <stddef.h>
+#include "souptet/bvh.h"
 #include "souptet/err.h"
 #include "souptet/grid.h"
 #include "souptet/progress.h"
@@ -81,6 +82,33 @@ st_status st_dist_layout(const st_soup *s, const st_dist_params *p,
 st_status st_dist_field(st_grid **out, const st_soup *s,
                         const st_dist_params *p, const st_progress *progress,
                         st_error *err);
+
+/* A soup with at least this many triangles per voxel of its grid is
+ * dense: its band is found faster by a BVH's nearest-triangle walks, one
+ * per voxel (st_dist_field_bvh), than by binning every triangle into the
+ * bricks its band reaches (a 10M-triangle soup on a 138x18x18 grid has
+ * 234 per voxel, and about 150 M (brick, triangle) pairs). */
+#define ST_DIST_BVH_TRIS_PER_VOXEL 16.0
+
+/* 1 when st_dist_field_bvh would walk a BVH for soup s under p: a finite
+ * band and at least ST_DIST_BVH_TRIS_PER_VOXEL triangles per voxel of the
+ * grid st_dist_layout gives (0 when the layout fails: st_dist_field says
+ * why). A caller that builds s's BVH anyway (st_pseudo_volume_bvh) builds
+ * it first when this says so. */
+int st_dist_wants_bvh(const st_soup *s, const st_dist_params *p);
+
+/* st_dist_field, with bvh over s (st_bvh_build; may be NULL). With a BVH
+ * and a finite band, each voxel's value is a minimum over the triangles a
+ * depth-first walk of the BVH cannot rule out (nearer child first, boxes
+ * against the best distance so far, with the same slack as the bricks'
+ * ball tests), each measured as the brick pass measures it: the same
+ * field as st_dist_field's (tests/test_dist_bvh.c compares them bit for
+ * bit), without the bins. A full field (band INFINITY) or a NULL bvh
+ * goes st_dist_field's way. Same errors; identical for any number of
+ * threads. */
+st_status st_dist_field_bvh(st_grid **out, const st_soup *s,
+                            const st_dist_params *p, const st_bvh *bvh,
+                            const st_progress *progress, st_error *err);
 
 /* The same field with a finite band, stored by blocks (grid.h): only the
  * blocks within reach of the band are computed and stored, so a far

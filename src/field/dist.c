@@ -1284,6 +1284,124 @@ static st_status band_pass(st_grid *g, int32_t *near, st_grid_blocks *bk,
     return ST_OK;
 }
 
+/* The band by a BVH (st_dist_field_bvh): one nearest-triangle walk per
+ * voxel. Depth first, the nearer child first; a node or a leaf's
+ * triangle is skipped when its box is farther than the best distance so
+ * far times (1 + 1e-9) plus 1e-12 voxel, the slack of the bricks' ball
+ * tests (a box is the exact min/max of its triangles' coordinates, so
+ * it is never farther than a triangle in it); the others are measured by
+ * band_try, as a brick measures them. So a voxel's value is, as there,
+ * the minimum over every triangle within B, in another order. */
+#define DIST_BVH_STACK 128
+
+static inline double lohi_d2(const double lo[3], const double hi[3], const double p[3])
+{
+    double d2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        const double below = lo[a] - p[a], above = p[a] - hi[a];
+        const double d = (below > 0.0 ? below : 0.0) + (above > 0.0 ? above : 0.0);
+        d2 += d * d;
+    }
+    return d2;
+}
+
+/* The band value of the voxel at p: B, or its distance to s below B. */
+static float bvh_voxel(const st_bvh *bvh, const st_soup *s, const double p[3],
+                       double B, double slack)
+{
+    const double B2 = B * B;
+    double cur = B2, curd = B;
+    double lim = curd * (1.0 + 1e-9) + slack, lim2 = lim * lim;
+    uint32_t stack[DIST_BVH_STACK];
+    double sd2[DIST_BVH_STACK];
+    int sp = 0;
+    const st_bvh_node *nodes = bvh->nodes;
+    const double d0 = lohi_d2(nodes[0].lo, nodes[0].hi, p);
+    if (d0 <= lim2) {
+        stack[0] = 0;
+        sd2[sp++] = d0;
+    }
+    tri_setup t;
+    while (sp > 0) {
+        sp--;
+        if (sd2[sp] > lim2)
+            continue;               /* the best shrank since it was pushed */
+        const st_bvh_node *n = &nodes[stack[sp]];
+        if (n->count) {
+            for (uint32_t i = 0; i < n->count; i++) {
+                const double *tb = bvh->tbox + 6 * (size_t)(n->start + i);
+                if (lohi_d2(tb, tb + 3, p) > lim2)
+                    continue;
+                setup_triangle(&t, s, bvh->order[n->start + i]);
+                const double before = cur;
+                band_try(&t, p, &cur, &curd);
+                if (cur < before) {
+                    lim = curd * (1.0 + 1e-9) + slack;
+                    lim2 = lim * lim;
+                }
+            }
+            continue;
+        }
+        uint32_t l = n->start, r = n->start + 1;
+        double dl = lohi_d2(nodes[l].lo, nodes[l].hi, p);
+        double dr = lohi_d2(nodes[r].lo, nodes[r].hi, p);
+        if (dl > dr) {              /* the nearer one on top */
+            const uint32_t x = l;
+            l = r;
+            r = x;
+            const double d = dl;
+            dl = dr;
+            dr = d;
+        }
+        /* A tree of at most 2^32 triangles, median splits: far shallower
+         * than the stack (each level leaves at most one node behind). */
+        if (dr <= lim2 && sp < DIST_BVH_STACK) {
+            stack[sp] = r;
+            sd2[sp++] = dr;
+        }
+        if (dl <= lim2 && sp < DIST_BVH_STACK) {
+            stack[sp] = l;
+            sd2[sp++] = dl;
+        }
+    }
+    return cur >= B2 ? (float)B : (float)curd;
+}
+
+/* Every voxel of the dense band field g by bvh_voxel, rows in parallel
+ * (each voxel's walk is its own: the same for any thread count). */
+static st_status band_pass_bvh(st_grid *g, const st_soup *s, const st_bvh *bvh,
+                               double B, const st_progress *progress, st_error *err)
+{
+    const size_t nx = g->nx, rows = g->ny * g->nz;
+    const double slack = 1e-12 * g->voxel;
+    size_t done = 0;
+    const int stopped = st_progress_cancelled(progress);
+    #pragma omp parallel for schedule(dynamic, 4) if (!stopped)
+    for (size_t r = 0; r < rows; r++) {
+        if (st_progress_cancelled(progress))
+            continue;
+        const size_t j = r % g->ny, k = r / g->ny;
+        double p[3] = {0.0, g->origin[1] + g->voxel * (double)j,
+                       g->origin[2] + g->voxel * (double)k};
+        float *row = g->data + nx * r;
+        for (size_t i = 0; i < nx; i++) {
+            p[0] = g->origin[0] + g->voxel * (double)i;
+            row[i] = bvh_voxel(bvh, s, p, B, slack);
+        }
+        size_t now;
+        #pragma omp atomic capture
+        now = ++done;
+#ifdef _OPENMP
+        if (omp_get_thread_num() == 0 && (now & 255) == 0)
+#endif
+            st_progress_report(progress, "distance band", (double)now / (double)rows);
+    }
+    if (st_progress_cancelled(progress))
+        return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
+    st_progress_report(progress, "distance band", 1.0);
+    return ST_OK;
+}
+
 /* Distance from p to triangle t of s, squared. */
 static double soup_tri_dist2(const st_soup *s, int32_t t, const double p[3])
 {
@@ -1428,9 +1546,25 @@ static st_status dist_meta(st_meta *m, const st_soup *s, int full,
     return ST_OK;
 }
 
+int st_dist_wants_bvh(const st_soup *s, const st_dist_params *p)
+{
+    dist_plan pl;
+    if (!s || !p || s->ntris == 0 || dist_setup(&pl, s, p, NULL) || pl.full)
+        return 0;
+    const double voxels = (double)pl.dims[0] * (double)pl.dims[1] * (double)pl.dims[2];
+    return (double)s->ntris >= ST_DIST_BVH_TRIS_PER_VOXEL * voxels;
+}
+
 st_status st_dist_field(st_grid **out, const st_soup *s,
                         const st_dist_params *p, const st_progress *progress,
                         st_error *err)
+{
+    return st_dist_field_bvh(out, s, p, NULL, progress, err);
+}
+
+st_status st_dist_field_bvh(st_grid **out, const st_soup *s,
+                            const st_dist_params *p, const st_bvh *bvh,
+                            const st_progress *progress, st_error *err)
 {
     *out = NULL;
     dist_plan pl;
@@ -1452,7 +1586,10 @@ st_status st_dist_field(st_grid **out, const st_soup *s,
         return st_error_set(err, ST_ENOMEM, NULL, 0,
                             "out of memory for the nearest-triangle map");
     }
-    st = band_pass(g, near, NULL, s, B, progress, err);
+    if (bvh && !full)
+        st = band_pass_bvh(g, s, bvh, B, progress, err);
+    else
+        st = band_pass(g, near, NULL, s, B, progress, err);
     if (!st && full)
         st = full_pass(g, near, s, B, progress, err);
     free(near);

@@ -72,9 +72,10 @@ static st_status shells_only(st_grid *g, const st_shells *shells, const st_pseud
     return rc;
 }
 
-/* Step 1's tables: s's edges (when a step reads them) and its closed
- * shells; built by the sign step, or before the field by
- * st_pseudo_volume_bvh when the distances may be skipped (signs_only). */
+/* Step 1's tables: s's edges (when a step reads them; none after the
+ * shortcut) and its closed shells; built by the sign step, or before the
+ * field by st_pseudo_volume_bvh when the distances may be skipped
+ * (signs_only) or come from the BVH (a dense soup). */
 typedef struct sign_prep {
     st_soup_edges edges;
     int have_edges;
@@ -113,6 +114,11 @@ static st_status prep_build(sign_prep *pr, const st_soup *s, const st_pseudo_par
             return rc;
         pr->shortcut = p->shells_shortcut && pr->shells.count > 0 &&
                        pr->shells.open_triangles == 0;
+        if (pr->shortcut) {
+            /* nothing after reads them: gone before a BVH is built */
+            st_soup_edges_free(&pr->edges);
+            pr->have_edges = 0;
+        }
     }
     pr->seconds = now_seconds() - t0;
     return ST_OK;
@@ -282,10 +288,14 @@ st_status st_pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p
     } while (0)
 
 /* st_pseudo_sign_bvh, with step 1's tables given (and freed here) or
- * built here (given NULL). */
+ * built here (given NULL), and s's BVH already built (bvh_given, may be
+ * NULL; bvh_seconds its time, counted as the BVH's): the steps use it
+ * instead of building one, and it is the one handed out (freed on
+ * failure, or when bvh_out is NULL). */
 static st_status pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_params *p,
                              st_pseudo_stats *stats, const st_progress *progress,
-                             st_bvh **bvh_out, sign_prep *given, st_error *err)
+                             st_bvh **bvh_out, sign_prep *given, st_bvh *bvh_given,
+                             double bvh_seconds, st_error *err)
 {
     sign_prep own, *pr = given ? given : &own;
     if (!given)
@@ -299,6 +309,7 @@ static st_status pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_param
     memset(st, 0, sizeof *st);
     if (!g || !p) {
         prep_free(pr);
+        st_bvh_free(bvh_given);
         return st_error_set(err, ST_EINTERNAL, NULL, 0, "st_pseudo_sign: bad arguments");
     }
     st->surface = s != NULL;
@@ -307,7 +318,8 @@ static st_status pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_param
     st_bvh *caps_bvh = NULL;
     /* s's BVH, built once for the steps that read it (the edge table is
      * step 1's, pr's) */
-    st_bvh *bvh = NULL;
+    st_bvh *bvh = bvh_given;
+    st->seconds_bvh = bvh_seconds;
     st_status rc = ST_OK;
     double t0 = now_seconds() - (given ? given->seconds : 0.0);
     STOP_IF_CANCELLED();
@@ -316,9 +328,6 @@ static st_status pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_param
     st->shells = pr->shells.count;
     st->shell_open_triangles = pr->shells.open_triangles;
     if (pr->shortcut) {
-        if (pr->have_edges)
-            st_soup_edges_free(&pr->edges);
-        pr->have_edges = 0;
         st->shells_only = 1;
         if ((rc = shells_only(g, &pr->shells, p, pr->far, st, err)))
             goto done;
@@ -331,7 +340,7 @@ static st_status pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_param
     st->failed_step = "holes";
     if (s && p->fill_holes) {
         st_progress_report(progress, "holes", 0.0);
-        if ((rc = st_bvh_build(&bvh, s, err)) ||
+        if ((!bvh && (rc = st_bvh_build(&bvh, s, err))) ||
             (rc = add_caps(g, s, &pr->edges, bvh, p, st, &with_caps, &caps, err)))
             goto done;
     }
@@ -387,7 +396,7 @@ count_inside:;
         st_progress_report(progress, "bvh", 0.0);
         if (!bvh && (rc = st_bvh_build(&bvh, s, err)))
             goto done;
-        st->seconds_bvh = now_seconds() - tb;
+        st->seconds_bvh += now_seconds() - tb;
         *bvh_out = bvh;
         bvh = NULL;
     }
@@ -408,7 +417,7 @@ st_status st_pseudo_sign_bvh(st_grid *g, const st_soup *s, const st_pseudo_param
                              st_pseudo_stats *stats, const st_progress *progress,
                              st_bvh **bvh_out, st_error *err)
 {
-    return pseudo_sign(g, s, p, stats, progress, bvh_out, NULL, err);
+    return pseudo_sign(g, s, p, stats, progress, bvh_out, NULL, NULL, 0.0, err);
 }
 
 st_status st_pseudo_volume(st_grid **out, const st_soup *s, const st_dist_params *dp,
@@ -429,29 +438,41 @@ st_status st_pseudo_volume_bvh(st_grid **out, const st_soup *s, const st_dist_pa
     if (!out || !s || !dp || !p)
         return st_error_set(err, ST_EINTERNAL, NULL, 0, "st_pseudo_volume: bad arguments");
     st_grid *g = NULL;
-    st_status rc;
-    if (p->signs_only && s && p->closed_shells) {
-        /* step 1 first: where the shells decide every sign, the field
-         * needs no distance */
-        sign_prep pr;
-        const char *failed = NULL;
-        if ((rc = prep_build(&pr, s, p, progress, &failed, err))) {
-            prep_free(&pr);
-            if (stats) {
-                memset(stats, 0, sizeof *stats);
-                stats->failed_step = failed;
-            }
-            return rc;
-        }
-        pr.far = pr.shortcut && isfinite(dp->band);
-        rc = pr.far ? st_dist_field_far(&g, s, dp, err) : st_dist_field(&g, s, dp, progress, err);
-        if (rc)
-            prep_free(&pr);
-        else
-            rc = pseudo_sign(g, s, p, stats, progress, bvh_out, &pr, err);
-    } else {
+    st_status rc = ST_OK;
+    const int far_may = p->signs_only && p->closed_shells && isfinite(dp->band);
+    const int dense = bvh_out && st_dist_wants_bvh(s, dp);
+    if (!far_may && !dense) {
         rc = st_dist_field(&g, s, dp, progress, err);
         rc = rc ? rc : st_pseudo_sign_bvh(g, s, p, stats, progress, bvh_out, err);
+    } else {
+        /* Step 1 first: where the shells decide every sign and only signs
+         * are read, the field needs no distance (st_dist_field_far); a
+         * dense soup's band comes from the BVH the caller gets anyway
+         * (st_dist_wants_bvh), built after step 1 so that a closed soup's
+         * edge table (gone after it) and its BVH are never held at once. */
+        sign_prep pr;
+        const char *failed = NULL;
+        st_bvh *bvh = NULL;
+        double bvh_seconds = 0.0;
+        if ((rc = prep_build(&pr, s, p, progress, &failed, err)) && stats) {
+            memset(stats, 0, sizeof *stats);
+            stats->failed_step = failed;
+        }
+        pr.far = far_may && pr.shortcut;
+        if (!rc && pr.far) {
+            rc = st_dist_field_far(&g, s, dp, err);
+        } else if (!rc) {
+            const double tb = now_seconds();
+            if (dense)
+                rc = st_bvh_build(&bvh, s, err);
+            bvh_seconds = now_seconds() - tb;
+            rc = rc ? rc : st_dist_field_bvh(&g, s, dp, bvh, progress, err);
+        }
+        if (rc) {
+            prep_free(&pr);
+            st_bvh_free(bvh);
+        } else
+            rc = pseudo_sign(g, s, p, stats, progress, bvh_out, &pr, bvh, bvh_seconds, err);
     }
     if (rc) {
         st_grid_free(g);
