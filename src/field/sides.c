@@ -955,8 +955,8 @@ static AVX_FN void winding_quad(int8_t *out, const st_bvh *bvh, const gather *ga
 /* Voxels along a row whose triangles are selected at once: at most RUN,
  * spanning at most RUN voxels. Rows gathered by one query: BLOCK of a z
  * slice, over a stretch of at most SPAN voxels along x. */
-#define RUN 8
-#define BLOCK 4
+#define RUN 12
+#define BLOCK 8
 #define SPAN 24
 
 /* The evidence at the points (x[k], y, z), k < n, x ascending (see
