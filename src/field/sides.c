@@ -675,33 +675,50 @@ typedef struct gather {
 } gather;
 #define GATHERED 13
 
+/* ga's arrays grown to twice their size (256 at first); 1 (and ga->oom)
+ * when memory runs out. Apart from gather_add, which then needs no
+ * registers saved. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static int gather_grow(gather *g)
+{
+    const size_t c = g->cap ? 2 * g->cap : 256;
+    double *nv = st_realloc_array(g->v, c, GATHERED * sizeof *nv);
+    uint32_t *ns = nv ? st_realloc_array(g->sel, c, sizeof *ns) : NULL;
+    if (nv)
+        g->v = nv;
+    if (!ns) {
+        g->oom = 1;
+        return 1;
+    }
+    g->sel = ns;
+    g->cap = c;
+    return 0;
+}
+
 static int gather_add(void *ctx, uint32_t t)
 {
     gather *g = ctx;
-    if (g->n == g->cap) {
-        const size_t c = g->cap ? 2 * g->cap : 256;
-        double *nv = st_realloc_array(g->v, c, GATHERED * sizeof *nv);
-        uint32_t *ns = nv ? st_realloc_array(g->sel, c, sizeof *ns) : NULL;
-        if (nv)
-            g->v = nv;
-        if (!ns) {
-            g->oom = 1;
-            return 1;
-        }
-        g->sel = ns;
-        g->cap = c;
-    }
+    if (g->n == g->cap && gather_grow(g))
+        return 1;
     const uint32_t *tv = g->o->tris + 3 * (size_t)t;
+    const double *A = g->o->xyz + 3 * (size_t)tv[0], *B = g->o->xyz + 3 * (size_t)tv[1],
+                 *C = g->o->xyz + 3 * (size_t)tv[2];
+    /* the corners read once, the box taken from them */
+    const double ax = A[0], ay = A[1], az = A[2], bx = B[0], by = B[1], bz = B[2];
+    const double cx = C[0], cy = C[1], cz = C[2];
     double *b = g->v + GATHERED * g->n++;
-    for (int c = 0; c < 3; c++)
-        memcpy(b + 4 + 3 * c, g->o->xyz + 3 * (size_t)tv[c], 3 * sizeof *b);
     /* finite coordinates (soup.h): the BVH's fmin and fmax */
-    for (int k = 0; k < 2; k++) {
-        const double p0 = b[4 + k], p1 = b[7 + k], p2 = b[10 + k];
-        const double lo = p0 < p1 ? p0 : p1, hi = p0 > p1 ? p0 : p1;
-        b[2 * k] = p2 < lo ? p2 : lo;
-        b[2 * k + 1] = p2 > hi ? p2 : hi;
-    }
+    const double xlo = ax < bx ? ax : bx, xhi = ax > bx ? ax : bx;
+    const double ylo = ay < by ? ay : by, yhi = ay > by ? ay : by;
+    b[0] = cx < xlo ? cx : xlo;
+    b[1] = cx > xhi ? cx : xhi;
+    b[2] = cy < ylo ? cy : ylo;
+    b[3] = cy > yhi ? cy : yhi;
+    b[4] = ax, b[5] = ay, b[6] = az;
+    b[7] = bx, b[8] = by, b[9] = bz;
+    b[10] = cx, b[11] = cy, b[12] = cz;
     return 0;
 }
 
@@ -938,8 +955,8 @@ static AVX_FN void winding_quad(int8_t *out, const st_bvh *bvh, const gather *ga
 /* Voxels along a row whose triangles are selected at once: at most RUN,
  * spanning at most RUN voxels. Rows gathered by one query: BLOCK of a z
  * slice, over a stretch of at most SPAN voxels along x. */
-#define RUN 8
-#define BLOCK 4
+#define RUN 12
+#define BLOCK 8
 #define SPAN 24
 
 /* The evidence at the points (x[k], y, z), k < n, x ascending (see
