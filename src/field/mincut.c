@@ -15,7 +15,7 @@
  * border); a decided neighbour is a terminal, its arc's capacity added to
  * the node's terminal capacity. The nodes are kept in storage order with
  * their six neighbours' node numbers (NO_NODE for a decided one), so the
- * graph costs about 70 bytes per undecided voxel and nothing per decided
+ * graph costs about 74 bytes per undecided voxel and nothing per decided
  * one. Arcs are (node, direction): directions 0..5 are +x, -x, +y, -y, +z,
  * -z, so a ^ 1 is the opposite direction and the arc (v, a)'s sister is
  * (nbr(v, a), a ^ 1).
@@ -52,6 +52,7 @@ typedef struct bk {
     int32_t *tr;          /* terminal residual: > 0 from S, < 0 to T */
     uint8_t *tree;        /* TREE_S / TREE_T / free, F_ACTIVE */
     uint8_t *parent;      /* direction to the parent, or P_* */
+    uint32_t *up;         /* the parent node (when parent[v] is a direction) */
     uint32_t *ts, *dist;  /* the distance-to-root heuristic's marks */
     uint32_t *active;     /* FIFO ring of n + 1 */
     size_t ah, at;
@@ -114,7 +115,7 @@ static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
     uint32_t x;
     for (x = s; b->parent[x] != P_TERMINAL;) {
         unsigned pa = b->parent[x];
-        uint32_t y = nb(b, x, pa);
+        uint32_t y = b->up[x];
         int32_t c = b->rc[6 * (size_t)y + (pa ^ 1u)];
         if (c < m)
             m = c;
@@ -127,7 +128,7 @@ static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
         int32_t c = b->rc[6 * (size_t)x + pa];
         if (c < m)
             m = c;
-        x = nb(b, x, pa);
+        x = b->up[x];
     }
     if (-b->tr[x] < m)
         m = -b->tr[x];
@@ -136,7 +137,7 @@ static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
     b->rc[6 * (size_t)t + (a ^ 1u)] += m;
     for (x = s; b->parent[x] != P_TERMINAL;) {
         unsigned pa = b->parent[x];
-        uint32_t y = nb(b, x, pa);
+        uint32_t y = b->up[x];
         b->rc[6 * (size_t)x + pa] += m;
         if ((b->rc[6 * (size_t)y + (pa ^ 1u)] -= m) == 0)
             set_orphan(b, x);
@@ -146,7 +147,7 @@ static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
         set_orphan(b, x);
     for (x = t; b->parent[x] != P_TERMINAL;) {
         unsigned pa = b->parent[x];
-        uint32_t y = nb(b, x, pa);
+        uint32_t y = b->up[x];
         b->rc[6 * (size_t)y + (pa ^ 1u)] += m;
         if ((b->rc[6 * (size_t)x + pa] -= m) == 0)
             set_orphan(b, x);
@@ -191,7 +192,7 @@ static void adopt(bk *b, uint32_t v)
                 d = INF_D;
                 break;
             }
-            k = nb(b, k, pk);
+            k = b->up[k];
         }
         if (d == INF_D)
             continue;
@@ -199,13 +200,14 @@ static void adopt(bk *b, uint32_t v)
             d_min = d;
             a_min = a;
         }
-        for (k = j; b->ts[k] != b->time; k = nb(b, k, b->parent[k])) {
+        for (k = j; b->ts[k] != b->time; k = b->up[k]) {
             b->ts[k] = b->time;
             b->dist[k] = d--;
         }
     }
     if (a_min != P_NONE) {
         b->parent[v] = (uint8_t)a_min;
+        b->up[v] = nb(b, v, a_min);
         b->ts[v] = b->time;
         b->dist[v] = d_min + 1;
         return;
@@ -231,6 +233,7 @@ static void bk_free(bk *b)
     free(b->tr);
     free(b->tree);
     free(b->parent);
+    free(b->up);
     free(b->ts);
     free(b->dist);
     free(b->active);
@@ -261,6 +264,7 @@ static void maxflow(bk *b)
             if (!Y) {
                 b->tree[q] |= (uint8_t)X;
                 b->parent[q] = (uint8_t)(a ^ 1u);
+                b->up[q] = cur;
                 b->ts[q] = b->ts[cur];
                 b->dist[q] = b->dist[cur] + 1;
                 set_active(b, q);
@@ -277,6 +281,7 @@ static void maxflow(bk *b)
                 break;
             } else if (b->ts[q] <= b->ts[cur] && b->dist[q] > b->dist[cur]) {
                 b->parent[q] = (uint8_t)(a ^ 1u);
+                b->up[q] = cur;
                 b->ts[q] = b->ts[cur];
                 b->dist[q] = b->dist[cur] + 1;
             }
@@ -454,12 +459,13 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
     b.tr = st_malloc_array(m + 1, sizeof *b.tr);
     b.tree = st_malloc_array(m + 1, 1);
     b.parent = st_malloc_array(m + 1, 1);
+    b.up = st_malloc_array(m + 1, sizeof *b.up);
     b.ts = st_calloc_array(m + 1, sizeof *b.ts);
     b.dist = st_malloc_array(m + 1, sizeof *b.dist);
     b.active = st_malloc_array(m + 1, sizeof *b.active);
     b.orphan = st_malloc_array(m + 1, sizeof *b.orphan);
     int32_t *vcap = st_malloc_array(m ? m : 1, sizeof *vcap);   /* each node's face capacity */
-    if (!vox || !b.nbr || !b.rc || !b.tr || !b.tree || !b.parent || !b.ts || !b.dist ||
+    if (!vox || !b.nbr || !b.rc || !b.tr || !b.tree || !b.parent || !b.up || !b.ts || !b.dist ||
         !b.active || !b.orphan || !vcap) {
         free(first);
         free(vox);
