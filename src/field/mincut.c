@@ -381,10 +381,15 @@ static void node_caps(int32_t *cap, const st_grid *g, const uint32_t *vox, size_
         cap[u] = vox_cap(p, s, fabsf(g->data[vox[u]]));
 }
 
-/* The arcs and terminal capacities of nodes [u0, u1) (vox ascending): the
- * neighbour w = v + off[a] rises with the node, so each direction's node
- * is found by a cursor that only moves forward (one binary search to
- * start it), not by a search per arc. */
+/* The arcs and terminal capacities of nodes [u0, u1) (vox ascending). A
+ * neighbour w = v + off[a] is a node when its evidence is undecided (the
+ * label says so, no search); the arc between two nodes is written by the
+ * lower one, both ways (the same face, the same capacity), so each face
+ * is done once and each arc slot written by one thread: the higher node's
+ * slot in direction a ^ 1 is left to it. The lower node finds the higher
+ * one's number as v + 1's is u + 1 (storage order), and v + nx's and v +
+ * nx ny's by cursors that only move forward (one binary search to start
+ * each), since w rises with the node. */
 static void node_arcs(bk *b, const st_grid *g, const int8_t *label, const uint32_t *vox,
                       const int32_t *vcap, size_t u0, size_t u1, const ptrdiff_t off[6],
                       const st_mincut_params *p, double s, int fixed, const int64_t *ecap)
@@ -392,26 +397,38 @@ static void node_arcs(bk *b, const st_grid *g, const int8_t *label, const uint32
     const size_t m = b->n;
     if (u0 >= u1)
         return;
-    size_t cur[6];
-    for (unsigned a = 0; a < 6; a++)
-        cur[a] = lower_node(vox, 0, m, (uint32_t)((ptrdiff_t)vox[u0] + off[a]));
+    size_t cur[6] = {0};
+    for (unsigned a = 2; a < 6; a += 2)
+        cur[a] = lower_node(vox, u0, m, (uint32_t)((ptrdiff_t)vox[u0] + off[a]));
     for (size_t u = u0; u < u1; u++) {
         const uint32_t v = vox[u];
         const float dv = fabsf(g->data[v]);
         int64_t t = ecap[label[v] + 128];
         for (unsigned a = 0; a < 6; a++) {
             const uint32_t w = (uint32_t)((ptrdiff_t)v + off[a]);
-            size_t c = cur[a];
-            while (c < m && vox[c] < w)
-                c++;
-            cur[a] = c;
-            const uint32_t q = c < m && vox[c] == w ? (uint32_t)c : NO_NODE;
+            const int lw = label[w];
             const float dw = fabsf(g->data[w]);
-            const int32_t cap = dv < dw ? vcap[u] : q != NO_NODE ? vcap[q] : vox_cap(p, s, dw);
-            b->nbr[6 * u + a] = q;
-            b->rc[6 * u + a] = q == NO_NODE ? 0 : cap;
-            if (q == NO_NODE)   /* a decided neighbour: a terminal */
-                t += label[w] >= fixed ? cap : -cap;
+            if (lw > -fixed && lw < fixed) {    /* a node */
+                if (a & 1u)
+                    continue;                   /* the lower node's to write */
+                size_t q = u + 1;
+                if (a) {
+                    for (q = cur[a]; vox[q] < w; q++)
+                        ;
+                    cur[a] = q;
+                }
+                const int32_t cap = dv < dw ? vcap[u] : vcap[q];
+                b->nbr[6 * u + a] = (uint32_t)q;
+                b->rc[6 * u + a] = cap;
+                b->nbr[6 * q + (a ^ 1u)] = (uint32_t)u;
+                b->rc[6 * q + (a ^ 1u)] = cap;
+                continue;
+            }
+            /* a decided neighbour: a terminal */
+            const int32_t cap = dv < dw ? vcap[u] : vox_cap(p, s, dw);
+            b->nbr[6 * u + a] = NO_NODE;
+            b->rc[6 * u + a] = 0;
+            t += lw >= fixed ? cap : -cap;
         }
         if (t > INT32_MAX / 2 || t < -INT32_MAX / 2)
             t = t > 0 ? INT32_MAX / 2 : -INT32_MAX / 2;
