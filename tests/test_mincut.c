@@ -9,6 +9,7 @@
 #include "tap.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -270,6 +271,168 @@ static void test_reference(void)
               inside, outside);
 }
 
+/* The voxels where st_mincut_label's labels differ from the reference's
+ * on grid g with evidence ev (ev is kept); 1 + n when the cut fails. */
+static size_t differ_from_reference(const st_grid *g, const int8_t *ev, const st_mincut_params *p)
+{
+    const size_t n = st_grid_count(g);
+    int8_t *lab = malloc(n);
+    uint8_t *in = malloc(n);
+    st_error err;
+    size_t differ = 1 + n;
+    memcpy(lab, ev, n);
+    if (st_mincut_label(g, lab, p, NULL, &err) == ST_OK) {
+        reference_cut(g, ev, p, in);
+        differ = 0;
+        for (size_t v = 0; v < n; v++)
+            differ += lab[v] != (int8_t)in[v];
+    }
+    free(lab);
+    free(in);
+    return differ;
+}
+
+/* Grids made to be hard for the solver's shortcuts, each against the
+ * reference: a serpentine corridor of free space walled by cheap faces
+ * (long augmenting paths, deep trees, orphans re-adopted along it), a
+ * checkerboard of opposite evidence (roots of both trees side by side
+ * everywhere), exact ties (a voxel whose evidence equals the cost of
+ * cutting it out: the least inside leaves it out), no evidence at all,
+ * evidence one way everywhere, grids one voxel thick between their
+ * borders, and random parameters (the decided threshold from 1 to 127,
+ * the faces' cost and power). */
+static void fill_case(st_grid *g, int8_t *ev, int kind, unsigned *seed)
+{
+    const size_t nx = g->nx, ny = g->ny, nz = g->nz;
+    for (size_t k = 0; k < nz; k++)
+        for (size_t j = 0; j < ny; j++)
+            for (size_t i = 0; i < nx; i++) {
+                const size_t v = st_grid_index(g, i, j, k);
+                float d = 2.0f;
+                int e = 0;
+                if (kind == 0) {        /* serpentine: rows j odd are walls with one gap */
+                    const int wall = j % 2 == 1 && i != ((j / 2) % 2 ? 1 : nx - 2);
+                    d = wall ? 0.05f * (float)(rnd(seed) % 8) : 2.0f;
+                    e = j == 1 && i == 1 ? 9 : j == ny - 2 ? -3 : 0;
+                    if (k == nz / 2 && j % 2 == 0 && i == nx / 2)
+                        e = (int)(rnd(seed) % 19) - 9;
+                } else if (kind == 1) { /* checkerboard */
+                    e = (i + j + k) % 2 ? 4 : -4;
+                    d = 0.25f * (float)(rnd(seed) % 9);
+                } else if (kind == 2) { /* ties: cap 100 a free face, 100 a vote */
+                    e = i == nx / 2 && j == ny / 2 && k == nz / 2 ? 6 : 0;
+                    if (i == 2 && j == 2 && k == 2)
+                        e = 7;
+                } else if (kind == 3) { /* nothing */
+                    d = 0.3f * (float)(rnd(seed) % 5);
+                } else if (kind == 4) { /* inside evidence everywhere */
+                    e = 1 + (int)(rnd(seed) % 9);
+                    d = 0.1f * (float)(rnd(seed) % 4);  /* cheap faces: a small flow */
+                } else {                /* random evidence and distances */
+                    e = (int)(rnd(seed) % 255) - 127;
+                    if (rnd(seed) % 3)
+                        e /= 16;
+                    d = 0.2f * (float)(rnd(seed) % 12);
+                }
+                g->data[v] = d;
+                ev[v] = (int8_t)e;
+            }
+}
+
+static void test_adversarial(void)
+{
+    unsigned seed = 31337u;
+    size_t differ = 0, cases = 0;
+    static const size_t dims[][3] = {{15, 13, 5}, {9, 8, 7}, {9, 9, 9}, {8, 7, 6}, {10, 9, 8},
+                                     {3, 9, 8}, {9, 3, 8}, {9, 8, 3}, {2, 2, 2}, {1, 5, 5},
+                                     {4, 4, 4}, {12, 5, 4}};
+    for (int kind = 0; kind < 6; kind++)
+        for (size_t t = 0; t < sizeof dims / sizeof dims[0]; t++) {
+            st_grid *g;
+            st_error err;
+            const double org[3] = {0, 0, 0};
+            if (st_grid_new(&g, dims[t][0], dims[t][1], dims[t][2], org, 1.0, 0.0f, 0, &err)) {
+                differ++;
+                continue;
+            }
+            if (kind == 1 && st_grid_count(g) > 400) {
+                st_grid_free(g);        /* the reference augments a unit at a time */
+                continue;
+            }
+            int8_t *ev = malloc(st_grid_count(g));
+            st_mincut_params p = st_mincut_params_default();
+            if (kind == 2)
+                p.free_area = 99.0;     /* a free face costs 100, six of them a vote of 6 */
+            if (kind == 5) {
+                p.fixed_evidence = 1 + (int)(rnd(&seed) % 127);
+                p.free_area = 1.0 + rnd(&seed) % 3000;
+                p.power = 1.0 + rnd(&seed) % 3;
+                p.evidence_weight = 1.0 + rnd(&seed) % 300;
+            }
+            fill_case(g, ev, kind, &seed);
+            differ += differ_from_reference(g, ev, &p);
+            cases++;
+            free(ev);
+            st_grid_free(g);
+        }
+    TAP_CHECK(differ == 0, "adversarial grids: the cut's labels are the reference's (%zu voxels differ in %zu grids)",
+              differ, cases);
+    /* The tie: the voxel of evidence 6 (its cut costs exactly its
+     * evidence) is outside, the one of 7 inside. */
+    st_grid *g;
+    st_error err;
+    const double org[3] = {0, 0, 0};
+    if (st_grid_new(&g, 9, 9, 9, org, 1.0, 0.0f, 0, &err) == ST_OK) {
+        const size_t n = st_grid_count(g);
+        int8_t *ev = malloc(n);
+        fill_case(g, ev, 2, &seed);
+        st_mincut_params p = st_mincut_params_default();
+        p.free_area = 99.0;
+        int ok = st_mincut_label(g, ev, &p, NULL, &err) == ST_OK;
+        TAP_CHECK(ok && ev[st_grid_index(g, 4, 4, 4)] == 0 && ev[st_grid_index(g, 2, 2, 2)] == 1,
+                  "an exact tie goes outside (the least inside), one more vote inside");
+        free(ev);
+        st_grid_free(g);
+    }
+}
+
+/* Larger random grids (about 60 K voxels, too big for the reference's
+ * pace): the labels and the cut's cost are the same on 1 and 3 threads. */
+static void test_threads(void)
+{
+    unsigned seed = 4711u;
+    size_t differ = 0, flows_differ = 0;
+    for (int trial = 0; trial < 3; trial++) {
+        st_grid *g;
+        st_error err;
+        const double org[3] = {0, 0, 0};
+        if (st_grid_new(&g, 41 + (size_t)trial, 38, 37, org, 1.0, 0.0f, 0, &err)) {
+            differ++;
+            continue;
+        }
+        const size_t n = st_grid_count(g);
+        int8_t *ev = malloc(n), *l1 = malloc(n), *l3 = malloc(n);
+        fill_case(g, ev, trial == 1 ? 0 : 5, &seed);
+        st_mincut_params p = st_mincut_params_default();
+        double f1 = -1, f3 = -2;
+        memcpy(l1, ev, n);
+        memcpy(l3, ev, n);
+        omp_set_num_threads(1);
+        int ok = st_mincut_label(g, l1, &p, &f1, &err) == ST_OK;
+        omp_set_num_threads(3);
+        ok &= st_mincut_label(g, l3, &p, &f3, &err) == ST_OK;
+        differ += ok ? 0 : 1;
+        for (size_t v = 0; v < n; v++)
+            differ += l1[v] != l3[v];
+        flows_differ += f1 != f3;
+        free(ev); free(l1); free(l3);
+        st_grid_free(g);
+    }
+    TAP_CHECK(differ == 0 && flows_differ == 0,
+              "1 and 3 threads: the same labels (%zu differ) and cut cost (%zu differ)", differ,
+              flows_differ);
+}
+
 /* The distance from q to a jar: the box [-1,1]^3 whose top face (z = 1)
  * has a square mouth |x|, |y| < 0.5 cut out of it. */
 static double jar_distance(const double q[3])
@@ -413,7 +576,7 @@ static void test_enclosed(void)
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(brute_force), TAP_TEST(cup), TAP_TEST(enclosed),
-                                     TAP_TEST(reference),
-                                     {0}};
+                                     TAP_TEST(reference), TAP_TEST(adversarial),
+                                     TAP_TEST(threads), {0}};
     return tap_main(argc, argv, tests);
 }

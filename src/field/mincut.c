@@ -15,7 +15,7 @@
  * border); a decided neighbour is a terminal, its arc's capacity added to
  * the node's terminal capacity. The nodes are kept in storage order with
  * their six neighbours' node numbers (NO_NODE for a decided one), so the
- * graph costs about 70 bytes per undecided voxel and nothing per decided
+ * graph costs about 74 bytes per undecided voxel and nothing per decided
  * one. Arcs are (node, direction): directions 0..5 are +x, -x, +y, -y, +z,
  * -z, so a ^ 1 is the opposite direction and the arc (v, a)'s sister is
  * (nbr(v, a), a ^ 1).
@@ -32,6 +32,7 @@
 #include <limits.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #define TREE_S 0x01u
 #define TREE_T 0x02u
@@ -52,6 +53,7 @@ typedef struct bk {
     int32_t *tr;          /* terminal residual: > 0 from S, < 0 to T */
     uint8_t *tree;        /* TREE_S / TREE_T / free, F_ACTIVE */
     uint8_t *parent;      /* direction to the parent, or P_* */
+    uint32_t *up;         /* the parent node (when parent[v] is a direction) */
     uint32_t *ts, *dist;  /* the distance-to-root heuristic's marks */
     uint32_t *active;     /* FIFO ring of n + 1 */
     size_t ah, at;
@@ -114,7 +116,7 @@ static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
     uint32_t x;
     for (x = s; b->parent[x] != P_TERMINAL;) {
         unsigned pa = b->parent[x];
-        uint32_t y = nb(b, x, pa);
+        uint32_t y = b->up[x];
         int32_t c = b->rc[6 * (size_t)y + (pa ^ 1u)];
         if (c < m)
             m = c;
@@ -127,7 +129,7 @@ static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
         int32_t c = b->rc[6 * (size_t)x + pa];
         if (c < m)
             m = c;
-        x = nb(b, x, pa);
+        x = b->up[x];
     }
     if (-b->tr[x] < m)
         m = -b->tr[x];
@@ -136,7 +138,7 @@ static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
     b->rc[6 * (size_t)t + (a ^ 1u)] += m;
     for (x = s; b->parent[x] != P_TERMINAL;) {
         unsigned pa = b->parent[x];
-        uint32_t y = nb(b, x, pa);
+        uint32_t y = b->up[x];
         b->rc[6 * (size_t)x + pa] += m;
         if ((b->rc[6 * (size_t)y + (pa ^ 1u)] -= m) == 0)
             set_orphan(b, x);
@@ -146,7 +148,7 @@ static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
         set_orphan(b, x);
     for (x = t; b->parent[x] != P_TERMINAL;) {
         unsigned pa = b->parent[x];
-        uint32_t y = nb(b, x, pa);
+        uint32_t y = b->up[x];
         b->rc[6 * (size_t)y + (pa ^ 1u)] += m;
         if ((b->rc[6 * (size_t)x + pa] -= m) == 0)
             set_orphan(b, x);
@@ -191,7 +193,7 @@ static void adopt(bk *b, uint32_t v)
                 d = INF_D;
                 break;
             }
-            k = nb(b, k, pk);
+            k = b->up[k];
         }
         if (d == INF_D)
             continue;
@@ -199,13 +201,14 @@ static void adopt(bk *b, uint32_t v)
             d_min = d;
             a_min = a;
         }
-        for (k = j; b->ts[k] != b->time; k = nb(b, k, b->parent[k])) {
+        for (k = j; b->ts[k] != b->time; k = b->up[k]) {
             b->ts[k] = b->time;
             b->dist[k] = d--;
         }
     }
     if (a_min != P_NONE) {
         b->parent[v] = (uint8_t)a_min;
+        b->up[v] = nb(b, v, a_min);
         b->ts[v] = b->time;
         b->dist[v] = d_min + 1;
         return;
@@ -231,6 +234,7 @@ static void bk_free(bk *b)
     free(b->tr);
     free(b->tree);
     free(b->parent);
+    free(b->up);
     free(b->ts);
     free(b->dist);
     free(b->active);
@@ -261,6 +265,7 @@ static void maxflow(bk *b)
             if (!Y) {
                 b->tree[q] |= (uint8_t)X;
                 b->parent[q] = (uint8_t)(a ^ 1u);
+                b->up[q] = cur;
                 b->ts[q] = b->ts[cur];
                 b->dist[q] = b->dist[cur] + 1;
                 set_active(b, q);
@@ -277,6 +282,7 @@ static void maxflow(bk *b)
                 break;
             } else if (b->ts[q] <= b->ts[cur] && b->dist[q] > b->dist[cur]) {
                 b->parent[q] = (uint8_t)(a ^ 1u);
+                b->up[q] = cur;
                 b->ts[q] = b->ts[cur];
                 b->dist[q] = b->dist[cur] + 1;
             }
@@ -375,10 +381,15 @@ static void node_caps(int32_t *cap, const st_grid *g, const uint32_t *vox, size_
         cap[u] = vox_cap(p, s, fabsf(g->data[vox[u]]));
 }
 
-/* The arcs and terminal capacities of nodes [u0, u1) (vox ascending): the
- * neighbour w = v + off[a] rises with the node, so each direction's node
- * is found by a cursor that only moves forward (one binary search to
- * start it), not by a search per arc. */
+/* The arcs and terminal capacities of nodes [u0, u1) (vox ascending). A
+ * neighbour w = v + off[a] is a node when its evidence is undecided (the
+ * label says so, no search); the arc between two nodes is written by the
+ * lower one, both ways (the same face, the same capacity), so each face
+ * is done once and each arc slot written by one thread: the higher node's
+ * slot in direction a ^ 1 is left to it. The lower node finds the higher
+ * one's number as v + 1's is u + 1 (storage order), and v + nx's and v +
+ * nx ny's by cursors that only move forward (one binary search to start
+ * each), since w rises with the node. */
 static void node_arcs(bk *b, const st_grid *g, const int8_t *label, const uint32_t *vox,
                       const int32_t *vcap, size_t u0, size_t u1, const ptrdiff_t off[6],
                       const st_mincut_params *p, double s, int fixed, const int64_t *ecap)
@@ -386,32 +397,63 @@ static void node_arcs(bk *b, const st_grid *g, const int8_t *label, const uint32
     const size_t m = b->n;
     if (u0 >= u1)
         return;
-    size_t cur[6];
-    for (unsigned a = 0; a < 6; a++)
-        cur[a] = lower_node(vox, 0, m, (uint32_t)((ptrdiff_t)vox[u0] + off[a]));
+    size_t cur[6] = {0};
+    for (unsigned a = 2; a < 6; a += 2)
+        cur[a] = lower_node(vox, u0, m, (uint32_t)((ptrdiff_t)vox[u0] + off[a]));
     for (size_t u = u0; u < u1; u++) {
         const uint32_t v = vox[u];
         const float dv = fabsf(g->data[v]);
         int64_t t = ecap[label[v] + 128];
         for (unsigned a = 0; a < 6; a++) {
             const uint32_t w = (uint32_t)((ptrdiff_t)v + off[a]);
-            size_t c = cur[a];
-            while (c < m && vox[c] < w)
-                c++;
-            cur[a] = c;
-            const uint32_t q = c < m && vox[c] == w ? (uint32_t)c : NO_NODE;
+            const int lw = label[w];
             const float dw = fabsf(g->data[w]);
-            const int32_t cap = dv < dw ? vcap[u] : q != NO_NODE ? vcap[q] : vox_cap(p, s, dw);
-            b->nbr[6 * u + a] = q;
-            b->rc[6 * u + a] = q == NO_NODE ? 0 : cap;
-            if (q == NO_NODE)   /* a decided neighbour: a terminal */
-                t += label[w] >= fixed ? cap : -cap;
+            if (lw > -fixed && lw < fixed) {    /* a node */
+                if (a & 1u)
+                    continue;                   /* the lower node's to write */
+                size_t q = u + 1;
+                if (a) {
+                    for (q = cur[a]; vox[q] < w; q++)
+                        ;
+                    cur[a] = q;
+                }
+                const int32_t cap = dv < dw ? vcap[u] : vcap[q];
+                b->nbr[6 * u + a] = (uint32_t)q;
+                b->rc[6 * u + a] = cap;
+                b->nbr[6 * q + (a ^ 1u)] = (uint32_t)u;
+                b->rc[6 * q + (a ^ 1u)] = cap;
+                continue;
+            }
+            /* a decided neighbour: a terminal */
+            const int32_t cap = dv < dw ? vcap[u] : vox_cap(p, s, dw);
+            b->nbr[6 * u + a] = NO_NODE;
+            b->rc[6 * u + a] = 0;
+            t += lw >= fixed ? cap : -cap;
         }
         if (t > INT32_MAX / 2 || t < -INT32_MAX / 2)
             t = t > 0 ? INT32_MAX / 2 : -INT32_MAX / 2;
         b->tr[u] = (int32_t)t;
         b->dist[u] = 1;
     }
+}
+
+/* The border of a z layer (all of it if `outer`) set outside, then the
+ * count of its undecided voxels (|evidence| < fixed), the rows' insides
+ * counted without a test per voxel for the border. */
+static size_t mark_layer(int8_t *lab, size_t nx, size_t ny, int outer, int fixed)
+{
+    size_t cnt = 0;
+    for (size_t j = 0; j < ny; j++) {
+        int8_t *row = lab + j * nx;
+        if (outer || j == 0 || j == ny - 1) {
+            memset(row, -127, nx);
+            continue;
+        }
+        row[0] = row[nx - 1] = -127;
+        for (size_t i = 1; i + 1 < nx; i++)
+            cnt += row[i] > -fixed && row[i] < fixed;
+    }
+    return cnt;
 }
 
 st_status st_mincut_label(const st_grid *g, int8_t *label,
@@ -432,16 +474,8 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
     if (!first)
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the cut");
     #pragma omp parallel for schedule(static)
-    for (size_t k = 0; k < nz; k++) {
-        size_t cnt = 0;
-        for (size_t j = 0, v = k * layer; j < ny; j++)
-            for (size_t i = 0; i < nx; i++, v++) {
-                if (i == 0 || j == 0 || k == 0 || i == nx - 1 || j == ny - 1 || k == nz - 1)
-                    label[v] = -127;
-                cnt += abs(label[v]) < fixed;
-            }
-        first[k + 1] = cnt;
-    }
+    for (size_t k = 0; k < nz; k++)
+        first[k + 1] = mark_layer(label + k * layer, nx, ny, k == 0 || k == nz - 1, fixed);
     first[0] = 0;
     for (size_t k = 0; k < nz; k++)
         first[k + 1] += first[k];
@@ -454,12 +488,13 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
     b.tr = st_malloc_array(m + 1, sizeof *b.tr);
     b.tree = st_malloc_array(m + 1, 1);
     b.parent = st_malloc_array(m + 1, 1);
+    b.up = st_malloc_array(m + 1, sizeof *b.up);
     b.ts = st_calloc_array(m + 1, sizeof *b.ts);
     b.dist = st_malloc_array(m + 1, sizeof *b.dist);
     b.active = st_malloc_array(m + 1, sizeof *b.active);
     b.orphan = st_malloc_array(m + 1, sizeof *b.orphan);
     int32_t *vcap = st_malloc_array(m ? m : 1, sizeof *vcap);   /* each node's face capacity */
-    if (!vox || !b.nbr || !b.rc || !b.tr || !b.tree || !b.parent || !b.ts || !b.dist ||
+    if (!vox || !b.nbr || !b.rc || !b.tr || !b.tree || !b.parent || !b.up || !b.ts || !b.dist ||
         !b.active || !b.orphan || !vcap) {
         free(first);
         free(vox);
