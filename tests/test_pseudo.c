@@ -14,6 +14,9 @@
 #include "tap.h"
 
 #include <math.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 #include <stdlib.h>
 #include <string.h>
 
@@ -999,6 +1002,82 @@ static void test_fill(void)
     }
 }
 
+/* The guess's depth (st_pseudo_guess_measure) is the largest distance
+ * from a fill square's center to the soup, to the bit, as measured square
+ * by square with the unbounded nearest search (kept here: the measure
+ * passes over the centers that cannot raise it), on 1 and 3 threads:
+ * random soups of 1 to 400 triangles, thousands of squares in and around
+ * them (some on them: depth 0 there). */
+static void test_guess_depth(void)
+{
+    uint64_t r = 0x853c49e6748fea9bull;
+    size_t differ = 0, cases = 0, positive = 0;
+    st_error err;
+    for (int it = 0; it < 60; it++) {
+        st_soup *s = st_soup_new(), *f = st_soup_new();
+        const size_t nt = 1 + (size_t)(it * 37 % 400), nsq = 200 + (size_t)(it * 53 % 2000);
+        double u[9];
+        for (size_t t = 0; t < nt; t++) {
+            for (int k = 0; k < 9; k++) {
+                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+                u[k] = (double)(r >> 11) / 9007199254740992.0;
+            }
+            const double sc = it % 3 ? 0.1 : 1.0;  /* small triangles or large ones */
+            add_tri(s, u, (double[3]){u[0] + sc * (u[3] - 0.5), u[1] + sc * (u[4] - 0.5), u[2]},
+                    (double[3]){u[0], u[1] + sc * (u[7] - 0.5), u[2] + sc * (u[8] - 0.5)}, 0);
+        }
+        for (size_t q = 0; q < nsq; q++) {     /* squares as st_pseudo_fill makes them */
+            for (int k = 0; k < 3; k++) {
+                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+                u[k] = 1.6 * (double)(r >> 11) / 9007199254740992.0 - 0.3;
+            }
+            if (q % 97 == 0)
+                memcpy(u, s->xyz, 3 * sizeof *u);   /* on the soup */
+            const size_t b = f->nverts;
+            for (int c = 0; c < 4; c++)
+                st_soup_add_vertex(f, u[0] + 0.01 * (c == 1 || c == 2), u[1] + 0.01 * (c >= 2),
+                                   u[2], &err);
+            st_soup_add_triangle(f, (uint32_t)b, (uint32_t)b + 1, (uint32_t)b + 2, &err);
+            st_soup_add_triangle(f, (uint32_t)b, (uint32_t)b + 2, (uint32_t)b + 3, &err);
+        }
+        st_bvh *bvh = NULL;
+        st_grid *g = NULL;
+        if (st_bvh_build(&bvh, s, &err) || st_grid_new(&g, 4, 4, 4, (double[3]){0, 0, 0}, 0.25,
+                                                        1.0f, 0, &err)) {
+            st_bvh_free(bvh), st_grid_free(g), st_soup_free(s), st_soup_free(f);
+            continue;
+        }
+        g->data[5] = -1.0f;
+        double ref = 0.0;
+        for (size_t q = 0; q < f->ntris / 2; q++) {
+            const uint32_t *t = f->tris + 6 * q;
+            const double *a = f->xyz + 3 * (size_t)t[0], *c = f->xyz + 3 * (size_t)t[2];
+            const double m[3] = {0.5 * (a[0] + c[0]), 0.5 * (a[1] + c[1]), 0.5 * (a[2] + c[2])};
+            int64_t tri;
+            const double d2 = st_bvh_nearest(bvh, m, INFINITY, &tri, NULL);
+            ref = d2 > ref ? d2 : ref;
+        }
+        ref = sqrt(ref);
+        for (int threads = 1; threads <= 3; threads += 2) {
+#ifdef _OPENMP
+            omp_set_num_threads(threads);
+#endif
+            st_pseudo_guess gs = {0, 0, -1.0, 0};
+            st_pseudo_guess_measure(&gs, g, f, bvh);
+            differ += !(gs.depth == ref) || gs.fill_faces != f->ntris / 2;
+            cases++;
+        }
+        positive += ref > 0.0;
+        st_bvh_free(bvh), st_grid_free(g), st_soup_free(s), st_soup_free(f);
+    }
+#ifdef _OPENMP
+    omp_set_num_threads(omp_get_num_procs());
+#endif
+    TAP_CHECK(cases == 120 && differ == 0 && positive == 60,
+              "guess depth the nearest search's, square by square (%zu of %zu differ)", differ,
+              cases);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(entry_point), TAP_TEST(large_holes),
@@ -1006,6 +1085,6 @@ int main(int argc, char **argv)
                                      TAP_TEST(onesided_caps), TAP_TEST(columns),
                                      TAP_TEST(columns_caps), TAP_TEST(sides_orientation),
                                      TAP_TEST(shared_tables), TAP_TEST(shells_shortcut),
-                                     TAP_TEST(fill), {0}};
+                                     TAP_TEST(fill), TAP_TEST(guess_depth), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -110,6 +110,12 @@ void st_pseudo_guess_measure(st_pseudo_guess *out, const st_grid *g, const st_so
     }
     /* a square's two triangles are (b, b+1, b+2) and (b, b+2, b+3)
      * (add_square): b and b+2 are opposite corners */
+    /* the depth: the largest of the squares' centers' distances to the
+     * soup. A center with a triangle closer than the largest so far (in
+     * its thread) cannot raise it, and st_bvh_within tells that at the
+     * first such triangle (where the nearest search would look on); the
+     * others are measured as before. The largest is the same whatever
+     * the threads took. */
     const long long nsq = fill && bvh ? (long long)(fill->ntris / 2) : 0;
     double depth2 = 0.0;
     #pragma omp parallel for schedule(dynamic, 256) reduction(max : depth2)
@@ -117,6 +123,8 @@ void st_pseudo_guess_measure(st_pseudo_guess *out, const st_grid *g, const st_so
         const uint32_t *t = fill->tris + 6 * (size_t)q;
         const double *a = fill->xyz + 3 * (size_t)t[0], *c = fill->xyz + 3 * (size_t)t[2];
         const double m[3] = {0.5 * (a[0] + c[0]), 0.5 * (a[1] + c[1]), 0.5 * (a[2] + c[2])};
+        if (depth2 > 0.0 && st_bvh_within(bvh, m, depth2))
+            continue;
         int64_t tri;
         const double d2 = st_bvh_nearest(bvh, m, INFINITY, &tri, NULL);
         depth2 = d2 > depth2 ? d2 : depth2;
