@@ -829,6 +829,80 @@ static void test_screen_same(void)
               differ, loops);
 }
 
+/* The fans' screen (st_holes_fan_near) passes the edges the one it
+ * replaced passed, each edge's test as it was (kept here: its a, r and
+ * factor in a row of 8), in order, on loops of 1 to 90 edges (odd and
+ * even: two at a time, the last alone) and apexes near one edge's plane
+ * (some on it, some at a zero-length edge: factor INFINITY, one a NaN)
+ * whose factor is where its test turns, give or take two units in the
+ * last place: the rounding of each sum decides there. */
+static void test_fan_near(void)
+{
+    uint64_t r = 0xbb67ae8584caa73bull;
+    size_t differ = 0, passed = 0, tried = 0;
+    static double rows[90][8], scr[7 * 90];
+    size_t got[90], want[90];
+    for (int it = 0; it < 3000; it++) {
+        const size_t n = 1 + (size_t)(it % 90);
+        double u[8];
+        for (size_t i = 0; i < n; i++) {
+            for (int k = 0; k < 8; k++) {
+                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+                u[k] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
+            }
+            double *q = rows[i];
+            const double l = sqrt(u[3] * u[3] + u[4] * u[4] + u[5] * u[5]);
+            const double fac = 1e-4 + 1e-9 * fabs(u[6]);
+            for (int k = 0; k < 3; k++)
+                q[k] = 10.0 * u[k], q[3 + k] = u[3 + k] / l;
+            q[6] = i % 17 == 5 ? INFINITY : fac * fac;
+        }
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < 7; c++)
+                scr[(size_t)c * n + i] = rows[i][c];
+        /* the apex: from edge t's a, along a unit vector across its r
+         * tilted by the factor's root, scaled, nudged */
+        const size_t t = (size_t)it % n;
+        const double *q = rows[t];
+        double v[3] = {q[4], -q[3], 0.0};
+        double vl = sqrt(v[0] * v[0] + v[1] * v[1]);
+        if (!(vl > 0.0))
+            v[0] = 1.0, vl = 1.0;
+        const double sn = it % 7 == 0 ? 0.0 : sqrt(isinf(q[6]) ? 1e-8 : q[6]), d = 1.0 + u[7];
+        double apex[3];
+        for (int k = 0; k < 3; k++) {
+            apex[k] = q[k] + d * (v[k] / vl * sqrt(1.0 - sn * sn) + q[3 + k] * sn);
+            if (it % 3 < 2)
+                apex[k] = nextafter(apex[k], it % 3 ? INFINITY : -INFINITY);
+        }
+        if (it == 2999)
+            apex[1] = NAN;
+        if (!isinf(q[6])) {     /* edge t's factor where its test turns, give or take */
+            const double f0 = apex[0] - q[0], f1 = apex[1] - q[1], f2 = apex[2] - q[2];
+            const double s = f0 * q[3] + f1 * q[4] + f2 * q[5];
+            double l2 = s * s / (f0 * f0 + f1 * f1 + f2 * f2);
+            for (int k = it % 5; k < 2; k++)
+                l2 = nextafter(l2, it % 2 ? INFINITY : 0.0);
+            rows[t][6] = scr[6 * n + t] = l2;
+        }
+        size_t nw = 0;
+        for (size_t i = 0; i < n; i++) {
+            const double *p = rows[i];
+            const double f0 = apex[0] - p[0], f1 = apex[1] - p[1], f2 = apex[2] - p[2];
+            const double s = f0 * p[3] + f1 * p[4] + f2 * p[5];
+            want[nw] = i;
+            nw += !(s * s > p[6] * (f0 * f0 + f1 * f1 + f2 * f2));
+        }
+        const size_t ng = st_holes_fan_near(got, scr, n, apex);
+        differ += ng != nw || memcmp(got, want, nw * sizeof *got) != 0;
+        passed += nw;
+        tried += n;
+    }
+    TAP_CHECK(differ == 0 && passed > 2000 && passed < tried,
+              "fan screen the same edges as edge by edge (%zu of 3000 loops differ, %zu of %zu "
+              "edges passed)", differ, passed, tried);
+}
+
 /* least_bend as it was before it tried each sub-polygon's likely apex
  * first and bounded the bends before their arc tangents (kept here to
  * hold the faster one to the same caps): every apex in order, ties by
@@ -1466,7 +1540,8 @@ int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
                                      TAP_TEST(bend), TAP_TEST(corner), TAP_TEST(corner_pierced),
-                                     TAP_TEST(area_screen), TAP_TEST(screen_same), TAP_TEST(bend_same), TAP_TEST(fair),
+                                     TAP_TEST(area_screen), TAP_TEST(screen_same), TAP_TEST(fan_near),
+                                     TAP_TEST(bend_same), TAP_TEST(fair),
                                      TAP_TEST(fans_merged), TAP_TEST(fair_irregular),
                                      TAP_TEST(cylinder), TAP_TEST(crease), {0}};
     return tap_main(argc, argv, tests);

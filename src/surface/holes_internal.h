@@ -71,6 +71,14 @@ st_status st_holes_least_bend(double *area, const double *const *pts, const doub
  * Never 1 where that area is at most lim. */
 int st_holes_area_above(const double *const *pts, size_t n, double lim);
 
+/* The screen before the fans' flatness test (holes_planes.c): the loop's
+ * edges i (of n) whose fan to apex may continue the soup's plane across
+ * them, |s| <= sqrt(l2) |f| with f = apex - a and s = f . r, decided as
+ * !(s s > l2 (f . f)) with the dot products summed x, y, z: in near[]
+ * (room for n), in order; returns how many. scr holds a column of each:
+ * a's x, y, z, r's x, y, z, l2 (scr[c n + i]). */
+size_t st_holes_fan_near(size_t *near, const double *scr, size_t n, const double *apex);
+
 /* The surviving soup a rebuilt corner's triangles may not pierce
  * (st_tri_tri_cross; touching it is no crossing): its BVH and which of
  * its triangles count (edges.h's kept). NULL or bvh NULL: no test. */

@@ -61,6 +61,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -495,21 +498,59 @@ static int fan_flat(const double *a, const double *b, const double *apex, const 
  * less a few roundings of the cross product that fan_flat's u carries.
  * Where |s| is above (FAN_FAR + |e . r| / |e|) |f|, t is at least about
  * FAN_FAR (or beyond a right angle), a hundred times FAN_FLAT: fan_flat
- * would say 0, and the screen says it for a third of the work. scr[8 i
- * ..] holds for the loop's edge i its a, r and that factor squared
+ * would say 0, and the screen says it for a third of the work. scr holds
+ * for the loop's edge i, a column of each: scr[i], scr[n + i], scr[2 n +
+ * i] its a, scr[3 n + i ..] its r and scr[6 n + i] that factor squared
  * (INFINITY, no screen, where e is zero). */
 #define FAN_FAR 1e-4
 static void fan_screen(double *scr, const fan_v *v, const double *rim, size_t n)
 {
     for (size_t i = 0; i < n; i++) {
-        double e[3], *q = scr + 8 * i;
+        double e[3];
         st_sub3(e, v[i + 1 < n ? i + 1 : 0].p, v[i].p);
         const double le = st_norm3(e);
         const double l = le > 0.0 ? FAN_FAR + fabs(st_dot3(e, rim + 3 * i)) / le : INFINITY;
-        memcpy(q, v[i].p, 3 * sizeof *q);
-        memcpy(q + 3, rim + 3 * i, 3 * sizeof *q);
-        q[6] = l * l;
+        for (int c = 0; c < 3; c++) {
+            scr[(size_t)c * n + i] = v[i].p[c];
+            scr[(size_t)(3 + c) * n + i] = rim[3 * i + c];
+        }
+        scr[6 * n + i] = l * l;
     }
+}
+
+size_t st_holes_fan_near(size_t *near, const double *scr, size_t n, const double *apex)
+{
+    const double *a0 = scr, *a1 = scr + n, *a2 = scr + 2 * n;
+    const double *r0 = scr + 3 * n, *r1 = scr + 4 * n, *r2 = scr + 5 * n, *ll = scr + 6 * n;
+    size_t k = 0, i = 0;
+#ifdef __SSE2__
+    const __m128d x0 = _mm_set1_pd(apex[0]), x1 = _mm_set1_pd(apex[1]), x2 = _mm_set1_pd(apex[2]);
+    for (; i + 1 < n; i += 2) {
+        const __m128d f0 = _mm_sub_pd(x0, _mm_loadu_pd(a0 + i));
+        const __m128d f1 = _mm_sub_pd(x1, _mm_loadu_pd(a1 + i));
+        const __m128d f2 = _mm_sub_pd(x2, _mm_loadu_pd(a2 + i));
+        const __m128d sv = _mm_add_pd(_mm_add_pd(_mm_mul_pd(f0, _mm_loadu_pd(r0 + i)),
+                                                 _mm_mul_pd(f1, _mm_loadu_pd(r1 + i))),
+                                      _mm_mul_pd(f2, _mm_loadu_pd(r2 + i)));
+        const __m128d ff = _mm_add_pd(_mm_add_pd(_mm_mul_pd(f0, f0), _mm_mul_pd(f1, f1)),
+                                      _mm_mul_pd(f2, f2));
+        const int pass = _mm_movemask_pd(
+            _mm_cmpngt_pd(_mm_mul_pd(sv, sv), _mm_mul_pd(_mm_loadu_pd(ll + i), ff)));
+        if (pass) {     /* most pass neither */
+            if (pass & 1)
+                near[k++] = i;
+            if (pass & 2)
+                near[k++] = i + 1;
+        }
+    }
+#endif
+    for (; i < n; i++) {
+        const double f0 = apex[0] - a0[i], f1 = apex[1] - a1[i], f2 = apex[2] - a2[i];
+        const double sv = f0 * r0[i] + f1 * r1[i] + f2 * r2[i];
+        near[k] = i;
+        k += !(sv * sv > ll[i] * (f0 * f0 + f1 * f1 + f2 * f2));
+    }
+    return k;
 }
 
 /* Which of the loop's edges apex continues (FAN_FLAT): flag[n], scr from
@@ -518,15 +559,8 @@ static void fan_screen(double *scr, const fan_v *v, const double *rim, size_t n)
 static double fan_flags(const double *apex, const fan_v *v, const double *rim,
                         const double *scr, size_t n, int *flag, size_t *near)
 {
-    size_t k = 0;
-    for (size_t i = 0; i < n; i++) {
-        const double *q = scr + 8 * i;
-        const double f0 = apex[0] - q[0], f1 = apex[1] - q[1], f2 = apex[2] - q[2];
-        const double s = f0 * q[3] + f1 * q[4] + f2 * q[5];
-        flag[i] = 0;
-        near[k] = i;
-        k += !(s * s > q[6] * (f0 * f0 + f1 * f1 + f2 * f2));
-    }
+    memset(flag, 0, n * sizeof *flag);
+    const size_t k = st_holes_fan_near(near, scr, n, apex);
     double g = 0.0;
     for (size_t j = 0; j < k; j++) {
         const size_t i = near[j];
