@@ -1002,6 +1002,74 @@ static void test_fill(void)
     }
 }
 
+/* The fill (st_pseudo_fill) is the one the voxel-by-voxel scan gave
+ * (kept here: every voxel, each axis's neighbour through st_grid_index),
+ * square for square and in order, to the bit: random signs on grids of 1
+ * to 9 voxels a side (sign changes on every side of the grid, in the last
+ * row and column too), a few triangles explaining some faces. */
+static void test_fill_scan(void)
+{
+    uint64_t r = 0x510e527fade682d1ull;
+    size_t differ = 0, squares = 0, grids = 0;
+    st_error err;
+    for (int it = 0; it < 200; it++) {
+        const size_t n[3] = {1 + (size_t)(it % 9), 1 + (size_t)(it / 9 % 9), 1 + (size_t)(it * 7 % 9)};
+        st_grid *g = NULL;
+        st_soup *s = st_soup_new(), *f = NULL;
+        st_bvh *bvh = NULL;
+        add_tri(s, (double[3]){0.1, 0.2, 0.3}, (double[3]){0.9, 0.2, 0.5},
+                (double[3]){0.3, 0.8, 0.6 + 0.01 * it}, 0);
+        if (st_grid_new(&g, n[0], n[1], n[2], (double[3]){0, 0, 0}, 0.11, 1.0f, 0, &err) ||
+            st_bvh_build(&bvh, s, &err)) {
+            st_grid_free(g), st_bvh_free(bvh), st_soup_free(s);
+            continue;
+        }
+        g->kind = ST_GRID_SIGNED;
+        for (size_t q = 0; q < st_grid_count(g); q++) {
+            r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+            g->data[q] = (r >> 40) % 3 == 0 ? -1.0f : 1.0f;
+        }
+        if (st_pseudo_fill(&f, g, bvh, NULL, &err)) {
+            st_grid_free(g), st_bvh_free(bvh), st_soup_free(s);
+            continue;
+        }
+        grids++;
+        size_t at = 0, bad = 0;
+        for (size_t k = 0; k < n[2]; k++)
+            for (size_t j = 0; j < n[1]; j++)
+                for (size_t i = 0; i < n[0]; i++)
+                    for (int a = 0; a < 3; a++) {
+                        size_t o[3] = {i, j, k};
+                        if (o[a] + 1 >= n[a])
+                            continue;
+                        o[a]++;
+                        if ((g->data[st_grid_index(g, i, j, k)] < 0.0f) ==
+                            (g->data[st_grid_index(g, o[0], o[1], o[2])] < 0.0f))
+                            continue;
+                        double c[3];
+                        st_grid_center(g, i, j, k, c);
+                        c[a] += 0.5 * g->voxel;
+                        if (st_bvh_within(bvh, c, g->voxel * g->voxel))
+                            continue;
+                        const int u = (a + 1) % 3, w = (a + 2) % 3;
+                        for (int q = 0; q < 4; q++) {
+                            double p[3] = {c[0], c[1], c[2]};
+                            p[u] += (q == 1 || q == 2) ? 0.5 * g->voxel : -0.5 * g->voxel;
+                            p[w] += q >= 2 ? 0.5 * g->voxel : -0.5 * g->voxel;
+                            bad += at + 4 > f->nverts || memcmp(p, f->xyz + 3 * (at + (size_t)q),
+                                                                sizeof p) != 0;
+                        }
+                        at += 4;
+                    }
+        differ += bad || at != f->nverts || f->ntris != at / 2;
+        squares += at / 4;
+        st_grid_free(g), st_bvh_free(bvh), st_soup_free(s), st_soup_free(f);
+    }
+    TAP_CHECK(grids == 200 && differ == 0 && squares > 1000,
+              "fill the voxel-by-voxel scan's, square for square (%zu of %zu grids differ, %zu "
+              "squares)", differ, grids, squares);
+}
+
 /* The guess's depth (st_pseudo_guess_measure) is the largest distance
  * from a fill square's center to the soup, to the bit, as measured square
  * by square with the unbounded nearest search (kept here: the measure
@@ -1085,6 +1153,7 @@ int main(int argc, char **argv)
                                      TAP_TEST(onesided_caps), TAP_TEST(columns),
                                      TAP_TEST(columns_caps), TAP_TEST(sides_orientation),
                                      TAP_TEST(shared_tables), TAP_TEST(shells_shortcut),
-                                     TAP_TEST(fill), TAP_TEST(guess_depth), {0}};
+                                     TAP_TEST(fill), TAP_TEST(fill_scan), TAP_TEST(guess_depth),
+                                     {0}};
     return tap_main(argc, argv, tests);
 }
