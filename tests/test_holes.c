@@ -922,7 +922,8 @@ static int ref_cone_above(const double *apex, const double *const *pts, const do
             return 0;
         const double l = sqrt(ee);
         len += l;
-        if (uu > 1e-200 && uu < 1e200 && !(crease && st_dot3(crease + 6 * i, crease + 6 * i) != 0.0))
+        const int along = crease && st_dot3(crease + 6 * i, crease + 6 * i) != 0.0;
+        if (uu > 1e-200 && uu < 1e200 && !along)
             lb += l * (d > 0.0 ? sqrt(st_dot3(x, x) / uu) : 0.5 * M_PI);
         if (lb * (1.0 - 1e-10) - 1e-12 * len >= below)
             return 1;
@@ -942,8 +943,8 @@ static void test_cone_same(void)
     size_t differ = 0, yes = 0, cases = 0;
     static double xyz[70][3], rim[3 * 70], crease[6 * 70];
     const double *pts[70];
-    double *p = NULL, *rr = NULL, *mask = NULL;
-    p = malloc(3 * 71 * sizeof *p), rr = malloc(3 * 70 * sizeof *rr), mask = malloc(70 * sizeof *mask);
+    double *p = malloc(3 * 71 * sizeof *p), *rr = malloc(3 * 70 * sizeof *rr);
+    double *mask = malloc(70 * sizeof *mask);
     st_holes_cone_rim cr = {p, rr, mask};
     for (int it = 0; it < 2000; it++) {
         const size_t n = 1 + (size_t)(it % 70);
@@ -981,7 +982,8 @@ static void test_cone_same(void)
                 const double l = sqrt(st_dot3(e, e)), w = st_dot3(uu, uu);
                 len += l;
                 if (w > 1e-200 && w < 1e200 && !(cz && i % 5 == 2))
-                    lb += l * (st_dot3(uu, rim + 3 * i) > 0.0 ? sqrt(st_dot3(x, x) / w) : 0.5 * M_PI);
+                    lb += l * (st_dot3(uu, rim + 3 * i) > 0.0 ? sqrt(st_dot3(x, x) / w)
+                                                              : 0.5 * M_PI);
             }
             const double v = m ? lb * (1.0 - 1e-10) - 1e-12 * len : big;
             const double belows[3] = {v, nextafter(v, INFINITY), nextafter(v, -INFINITY)};
@@ -1636,7 +1638,8 @@ int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
                                      TAP_TEST(bend), TAP_TEST(corner), TAP_TEST(corner_pierced),
-                                     TAP_TEST(area_screen), TAP_TEST(screen_same), TAP_TEST(fan_near),
+                                     TAP_TEST(area_screen), TAP_TEST(screen_same),
+                                     TAP_TEST(fan_near),
                                      TAP_TEST(cone_same),
                                      TAP_TEST(bend_same), TAP_TEST(fair),
                                      TAP_TEST(fans_merged), TAP_TEST(fair_irregular),

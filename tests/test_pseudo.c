@@ -1013,7 +1013,8 @@ static void test_fill_scan(void)
     size_t differ = 0, squares = 0, grids = 0;
     st_error err;
     for (int it = 0; it < 200; it++) {
-        const size_t n[3] = {1 + (size_t)(it % 9), 1 + (size_t)(it / 9 % 9), 1 + (size_t)(it * 7 % 9)};
+        const size_t n[3] = {1 + (size_t)(it % 9), 1 + (size_t)(it / 9 % 9),
+                             1 + (size_t)(it * 7 % 9)};
         st_grid *g = NULL;
         st_soup *s = st_soup_new(), *f = NULL;
         st_bvh *bvh = NULL;

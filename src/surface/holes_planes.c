@@ -215,8 +215,8 @@ int st_holes_cone_above(const double *apex, const st_holes_cone_rim *cr, size_t 
         const __m128d l = _mm_sqrt_pd(ee), pos = _mm_cmpgt_pd(d, zero);
         const __m128d sn = _mm_sqrt_pd(_mm_div_pd(xx, uu));
         /* the term where it counts, else 0 (lb + 0 is lb: lb is never -0) */
-        const __m128d counts = _mm_and_pd(_mm_and_pd(_mm_cmpgt_pd(uu, tiny), _mm_cmplt_pd(uu, huge)),
-                                          _mm_loadu_pd(cr->mask + i));
+        const __m128d uu_in = _mm_and_pd(_mm_cmpgt_pd(uu, tiny), _mm_cmplt_pd(uu, huge));
+        const __m128d counts = _mm_and_pd(uu_in, _mm_loadu_pd(cr->mask + i));
         const __m128d t = _mm_and_pd(
             counts, _mm_mul_pd(l, _mm_or_pd(_mm_and_pd(pos, sn), _mm_andnot_pd(pos, right))));
         if (_mm_movemask_pd(_mm_and_pd(_mm_cmpgt_pd(ee, tiny), _mm_cmplt_pd(ee, huge))) != 3)
@@ -240,6 +240,7 @@ int st_holes_cone_above(const double *apex, const st_holes_cone_rim *cr, size_t 
         st_cross3(x, u, r);
         const double ee = st_dot3(e, e), uu = st_dot3(u, u), d = st_dot3(u, r);
         const double l = sqrt(ee);
+        /* the mask's bits all set read as a NaN: unequal to 0 */
         const int counts = uu > 1e-200 && uu < 1e200 && cr->mask[i] != 0.0;
         const int res = cone_term(&lb, &len, ee, l,
                                   counts ? l * (d > 0.0 ? sqrt(st_dot3(x, x) / uu) : 0.5 * M_PI)
