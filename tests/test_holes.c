@@ -742,6 +742,265 @@ static void test_area_screen(void)
     TAP_CHECK(sure == loops, "screen above 0.999 of it (%zu of %zu)", sure, loops);
 }
 
+/* The screen's dynamic program as it was before it took two apexes at a
+ * time (kept here to hold the faster one to the same sum): each apex in
+ * order, passed over where its two sides alone reach the best so far;
+ * the sum it compares with the limit. */
+static double ref_screen_sum(const double *const *pts, size_t n)
+{
+    double *w = malloc(n * n * sizeof *w);
+    for (size_t i = 0; i + 1 < n; i++)
+        w[i * n + i + 1] = 0.0;
+    for (size_t len = 2; len < n; len++)
+        for (size_t i = 0; i + len < n; i++) {
+            const size_t j = i + len;
+            const double *pi = pts[i], *pj = pts[j];
+            double m = INFINITY, f[3];
+            st_sub3(f, pj, pi);
+            for (size_t k = i + 1; k < j; k++) {
+                const double s = w[i * n + k] + w[k * n + j];
+                if (!(s < m))
+                    continue;
+                double e[3], c[3];
+                st_sub3(e, pts[k], pi);
+                st_cross3(c, e, f);
+                const double t = s + 0.5 * sqrt(st_dot3(c, c));
+                m = t < m ? t : m;
+            }
+            w[i * n + j] = m;
+        }
+    const double cap = w[n - 1];
+    free(w);
+    return cap * (1.0 - 1e-10);     /* SURE_MARGIN, holes.c */
+}
+
+/* The screen says what it said before, to the last bit of its sum: above
+ * the limit just below the old sum (or the vector area already said so),
+ * not above the sum itself, on loops of 3 to 250 points, odd and even
+ * (two apexes at a time, the last alone): flat regular ones (every
+ * triangulation's area the same up to rounding), integer points over the
+ * faces of a box (exact ties), wavy, random, and ones with repeated and
+ * collinear points (triangles of area 0). */
+static void test_screen_same(void)
+{
+    uint64_t r = 0x6a09e667f3bcc909ull;
+    size_t differ = 0, loops = 0;
+    static double xyz[250][3];
+    const double *pts[250];
+    for (int it = 0; it < 400; it++) {
+        const size_t n = it % 40 == 39 ? 250 - (size_t)(it / 40) : 3 + (size_t)(it * 7 % 70);
+        const int kind = it % 5;    /* flat, box faces, wavy, random, repeated points */
+        for (size_t i = 0; i < n; i++) {
+            double u[3];
+            for (int k = 0; k < 3; k++) {
+                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+                u[k] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
+            }
+            const double a = 2.0 * M_PI * (double)i / (double)n;
+            double *p = xyz[i];
+            if (kind == 1) {
+                const double q = floor(12.0 * (double)i / (double)n);
+                const size_t face = (size_t)q / 4, st = (size_t)q % 4;
+                p[0] = face == 0 ? 4.0 : (double)st;
+                p[1] = face == 1 ? 4.0 : face == 0 ? (double)st : 4.0 - (double)st;
+                p[2] = face == 2 ? 4.0 : (double)(face == 1) * (double)st;
+            } else if (kind == 4) {
+                const size_t m = i / 3 * 3;
+                const double b = 2.0 * M_PI * (double)m / (double)n;
+                p[0] = 2.0 * cos(b) + (double)(i - m) * (it % 2 ? 0.0 : 0.25);
+                p[1] = 2.0 * sin(b);
+                p[2] = 0.5 * u[2];
+            } else {
+                p[0] = kind == 3 ? u[0] : 30.0 * cos(a) + 3.0 * (kind == 2) * u[0];
+                p[1] = kind == 3 ? u[1] : 20.0 * sin(a) + 3.0 * (kind == 2) * u[1];
+                p[2] = kind == 0 ? 7.0 : kind == 2 ? 4.0 * sin(5 * a) : u[2];
+            }
+            pts[i] = xyz[i];
+        }
+        const double sum = ref_screen_sum(pts, n);
+        /* above just below the sum (the vector area may say so first),
+         * not at it or above */
+        differ += !st_holes_area_above(pts, n, nextafter(sum, -INFINITY));
+        differ += st_holes_area_above(pts, n, sum) || st_holes_area_above(pts, n, sum * 1.5);
+        loops++;
+    }
+    TAP_CHECK(loops == 400 && differ == 0,
+              "screen the same to the bit as the one apex at a time (%zu of %zu differ)",
+              differ, loops);
+}
+
+/* The fans' screen (st_holes_fan_near) passes the edges the one it
+ * replaced passed, each edge's test as it was (kept here: its a, r and
+ * factor in a row of 8), in order, on loops of 1 to 90 edges (odd and
+ * even: two at a time, the last alone) and apexes near one edge's plane
+ * (some on it, some at a zero-length edge: factor INFINITY, one a NaN)
+ * whose factor is where its test turns, give or take two units in the
+ * last place: the rounding of each sum decides there. */
+static void test_fan_near(void)
+{
+    uint64_t r = 0xbb67ae8584caa73bull;
+    size_t differ = 0, passed = 0, tried = 0;
+    static double rows[90][8], scr[7 * 90];
+    size_t got[90], want[90];
+    for (int it = 0; it < 3000; it++) {
+        const size_t n = 1 + (size_t)(it % 90);
+        double u[8];
+        for (size_t i = 0; i < n; i++) {
+            for (int k = 0; k < 8; k++) {
+                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+                u[k] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
+            }
+            double *q = rows[i];
+            const double l = sqrt(u[3] * u[3] + u[4] * u[4] + u[5] * u[5]);
+            const double fac = 1e-4 + 1e-9 * fabs(u[6]);
+            for (int k = 0; k < 3; k++)
+                q[k] = 10.0 * u[k], q[3 + k] = u[3 + k] / l;
+            q[6] = i % 17 == 5 ? INFINITY : fac * fac;
+        }
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < 7; c++)
+                scr[(size_t)c * n + i] = rows[i][c];
+        /* the apex: from edge t's a, along a unit vector across its r
+         * tilted by the factor's root, scaled, nudged */
+        const size_t t = (size_t)it % n;
+        const double *q = rows[t];
+        double v[3] = {q[4], -q[3], 0.0};
+        double vl = sqrt(v[0] * v[0] + v[1] * v[1]);
+        if (!(vl > 0.0))
+            v[0] = 1.0, vl = 1.0;
+        const double sn = it % 7 == 0 ? 0.0 : sqrt(isinf(q[6]) ? 1e-8 : q[6]), d = 1.0 + u[7];
+        double apex[3];
+        for (int k = 0; k < 3; k++) {
+            apex[k] = q[k] + d * (v[k] / vl * sqrt(1.0 - sn * sn) + q[3 + k] * sn);
+            if (it % 3 < 2)
+                apex[k] = nextafter(apex[k], it % 3 ? INFINITY : -INFINITY);
+        }
+        if (it == 2999)
+            apex[1] = NAN;
+        if (!isinf(q[6])) {     /* edge t's factor where its test turns, give or take */
+            const double f0 = apex[0] - q[0], f1 = apex[1] - q[1], f2 = apex[2] - q[2];
+            const double s = f0 * q[3] + f1 * q[4] + f2 * q[5];
+            double l2 = s * s / (f0 * f0 + f1 * f1 + f2 * f2);
+            for (int k = it % 5; k < 2; k++)
+                l2 = nextafter(l2, it % 2 ? INFINITY : 0.0);
+            rows[t][6] = scr[6 * n + t] = l2;
+        }
+        size_t nw = 0;
+        for (size_t i = 0; i < n; i++) {
+            const double *p = rows[i];
+            const double f0 = apex[0] - p[0], f1 = apex[1] - p[1], f2 = apex[2] - p[2];
+            const double s = f0 * p[3] + f1 * p[4] + f2 * p[5];
+            want[nw] = i;
+            nw += !(s * s > p[6] * (f0 * f0 + f1 * f1 + f2 * f2));
+        }
+        const size_t ng = st_holes_fan_near(got, scr, n, apex);
+        differ += ng != nw || memcmp(got, want, nw * sizeof *got) != 0;
+        passed += nw;
+        tried += n;
+    }
+    TAP_CHECK(differ == 0 && passed > 2000 && passed < tried,
+              "fan screen the same edges as edge by edge (%zu of 3000 loops differ, %zu of %zu "
+              "edges passed)", differ, passed, tried);
+}
+
+/* The cones' screen as it was before it took two edges at a time (kept
+ * here to hold the faster one to the same answers): edge by edge, each
+ * term and sum in order. */
+static int ref_cone_above(const double *apex, const double *const *pts, const double *rim,
+                          size_t n, const double *crease, double below)
+{
+    double lb = 0.0, len = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const double *p = pts[i], *q = pts[(i + 1) % n], *r = rim + 3 * i;
+        double e[3], f[3], u[3], x[3];
+        st_sub3(e, q, p);
+        st_sub3(f, apex, p);
+        st_cross3(u, e, f);
+        st_cross3(x, u, r);
+        const double ee = st_dot3(e, e), uu = st_dot3(u, u), d = st_dot3(u, r);
+        if (!(ee > 1e-200 && ee < 1e200))
+            return 0;
+        const double l = sqrt(ee);
+        len += l;
+        const int along = crease && st_dot3(crease + 6 * i, crease + 6 * i) != 0.0;
+        if (uu > 1e-200 && uu < 1e200 && !along)
+            lb += l * (d > 0.0 ? sqrt(st_dot3(x, x) / uu) : 0.5 * M_PI);
+        if (lb * (1.0 - 1e-10) - 1e-12 * len >= below)
+            return 1;
+    }
+    return 0;
+}
+
+/* The cones' screen (st_holes_cone_above) says what it said edge by edge,
+ * on loops of 1 to 70 edges (odd and even) with random normals, some
+ * edges along creases, some of length 0 (unsure there), apexes on an
+ * edge's line (no term), and below at each sum the old one reached, give
+ * or take a unit in the last place (the rounding of each term and sum
+ * decides there). */
+static void test_cone_same(void)
+{
+    uint64_t r = 0x3c6ef372fe94f82bull;
+    size_t differ = 0, yes = 0, cases = 0;
+    static double xyz[70][3], rim[3 * 70], crease[6 * 70];
+    const double *pts[70];
+    double *p = malloc(3 * 71 * sizeof *p), *rr = malloc(3 * 70 * sizeof *rr);
+    double *mask = malloc(70 * sizeof *mask);
+    st_holes_cone_rim cr = {p, rr, mask};
+    for (int it = 0; it < 2000; it++) {
+        const size_t n = 1 + (size_t)(it % 70);
+        double u[6];
+        for (size_t i = 0; i < n; i++) {
+            for (int k = 0; k < 6; k++) {
+                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+                u[k] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
+            }
+            const double a = 2.0 * M_PI * (double)i / (double)n;
+            xyz[i][0] = 3.0 * cos(a) + u[0], xyz[i][1] = 3.0 * sin(a) + u[1], xyz[i][2] = u[2];
+            if (it % 11 == 3 && i == n / 2 && i > 0)
+                memcpy(xyz[i], xyz[i - 1], sizeof xyz[i]);     /* an edge of length 0 */
+            const double l = sqrt(u[3] * u[3] + u[4] * u[4] + u[5] * u[5]);
+            for (int k = 0; k < 3; k++)
+                rim[3 * i + k] = u[3 + k] / l, crease[6 * i + k] = i % 5 == 2 ? 1.0 : 0.0;
+            pts[i] = xyz[i];
+        }
+        double apex[3] = {u[0], u[1], 2.0 * u[2] + (it % 2 ? 1.0 : -1.0)};
+        if (it % 13 == 0)       /* on the line of edge 0 */
+            for (int k = 0; k < 3; k++)
+                apex[k] = 2.0 * xyz[n > 1 ? 1 : 0][k] - xyz[0][k];
+        const double *cz = it % 3 ? crease : NULL;
+        st_holes_cone_rim_fill(&cr, pts, rim, cz, n);
+        /* the sums the old screen reaches: each one's below, and next to it */
+        const double big = ref_cone_above(apex, pts, rim, n, cz, -INFINITY) ? 1e300 : 0.0;
+        for (size_t m = 0; m <= n; m++) {
+            double lb = 0.0, len = 0.0;
+            for (size_t i = 0; i < m; i++) {
+                double e[3], f[3], uu[3], x[3];
+                st_sub3(e, pts[(i + 1) % n], pts[i]);
+                st_sub3(f, apex, pts[i]);
+                st_cross3(uu, e, f);
+                st_cross3(x, uu, rim + 3 * i);
+                const double l = sqrt(st_dot3(e, e)), w = st_dot3(uu, uu);
+                len += l;
+                if (w > 1e-200 && w < 1e200 && !(cz && i % 5 == 2))
+                    lb += l * (st_dot3(uu, rim + 3 * i) > 0.0 ? sqrt(st_dot3(x, x) / w)
+                                                              : 0.5 * M_PI);
+            }
+            const double v = m ? lb * (1.0 - 1e-10) - 1e-12 * len : big;
+            const double belows[3] = {v, nextafter(v, INFINITY), nextafter(v, -INFINITY)};
+            for (int b = 0; b < 3; b++) {
+                const int want = ref_cone_above(apex, pts, rim, n, cz, belows[b]);
+                differ += st_holes_cone_above(apex, &cr, n, belows[b]) != want;
+                yes += (size_t)want;
+                cases++;
+            }
+        }
+    }
+    free(p), free(rr), free(mask);
+    TAP_CHECK(differ == 0 && yes > cases / 4 && yes < cases,
+              "cone screen the same as edge by edge (%zu of %zu differ, %zu above)", differ, cases,
+              yes);
+}
+
 /* least_bend as it was before it tried each sub-polygon's likely apex
  * first and bounded the bends before their arc tangents (kept here to
  * hold the faster one to the same caps): every apex in order, ties by
@@ -1379,7 +1638,10 @@ int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
                                      TAP_TEST(bend), TAP_TEST(corner), TAP_TEST(corner_pierced),
-                                     TAP_TEST(area_screen), TAP_TEST(bend_same), TAP_TEST(fair),
+                                     TAP_TEST(area_screen), TAP_TEST(screen_same),
+                                     TAP_TEST(fan_near),
+                                     TAP_TEST(cone_same),
+                                     TAP_TEST(bend_same), TAP_TEST(fair),
                                      TAP_TEST(fans_merged), TAP_TEST(fair_irregular),
                                      TAP_TEST(cylinder), TAP_TEST(crease), {0}};
     return tap_main(argc, argv, tests);

@@ -14,7 +14,9 @@
 #include "tap.h"
 
 #include <math.h>
+#ifdef _OPENMP
 #include <omp.h>
+#endif
 #include <stdlib.h>
 #include <string.h>
 
@@ -1000,59 +1002,149 @@ static void test_fill(void)
     }
 }
 
-/* The guess's depth (st_pseudo_guess_measure) is the largest distance from
- * a fill square's center to the soup: the same number, bit for bit, as a
- * nearest search from every square's center, at 1 and 2 threads. On a
- * one-sided wavy ball (a fill below the horizon, its squares at many
- * depths) and an open box (a flat cap, deepest in its middle). */
-static double guess_depth_every_square(const st_soup *f, const st_bvh *bvh)
+/* The fill (st_pseudo_fill) is the one the voxel-by-voxel scan gave
+ * (kept here: every voxel, each axis's neighbour through st_grid_index),
+ * square for square and in order, to the bit: random signs on grids of 1
+ * to 9 voxels a side (sign changes on every side of the grid, in the last
+ * row and column too), a few triangles explaining some faces. */
+static void test_fill_scan(void)
 {
-    double depth2 = 0.0;
-    for (size_t q = 0; q < f->ntris / 2; q++) {
-        const uint32_t *t = f->tris + 6 * q;
-        const double *a = f->xyz + 3 * (size_t)t[0], *c = f->xyz + 3 * (size_t)t[2];
-        const double m[3] = {0.5 * (a[0] + c[0]), 0.5 * (a[1] + c[1]), 0.5 * (a[2] + c[2])};
-        int64_t tri;
-        const double d2 = st_bvh_nearest(bvh, m, INFINITY, &tri, NULL);
-        depth2 = d2 > depth2 ? d2 : depth2;
+    uint64_t r = 0x510e527fade682d1ull;
+    size_t differ = 0, squares = 0, grids = 0;
+    st_error err;
+    for (int it = 0; it < 200; it++) {
+        const size_t n[3] = {1 + (size_t)(it % 9), 1 + (size_t)(it / 9 % 9),
+                             1 + (size_t)(it * 7 % 9)};
+        st_grid *g = NULL;
+        st_soup *s = st_soup_new(), *f = NULL;
+        st_bvh *bvh = NULL;
+        add_tri(s, (double[3]){0.1, 0.2, 0.3}, (double[3]){0.9, 0.2, 0.5},
+                (double[3]){0.3, 0.8, 0.6 + 0.01 * it}, 0);
+        if (st_grid_new(&g, n[0], n[1], n[2], (double[3]){0, 0, 0}, 0.11, 1.0f, 0, &err) ||
+            st_bvh_build(&bvh, s, &err)) {
+            st_grid_free(g), st_bvh_free(bvh), st_soup_free(s);
+            continue;
+        }
+        g->kind = ST_GRID_SIGNED;
+        for (size_t q = 0; q < st_grid_count(g); q++) {
+            r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+            g->data[q] = (r >> 40) % 3 == 0 ? -1.0f : 1.0f;
+        }
+        if (st_pseudo_fill(&f, g, bvh, NULL, &err)) {
+            st_grid_free(g), st_bvh_free(bvh), st_soup_free(s);
+            continue;
+        }
+        grids++;
+        size_t at = 0, bad = 0;
+        for (size_t k = 0; k < n[2]; k++)
+            for (size_t j = 0; j < n[1]; j++)
+                for (size_t i = 0; i < n[0]; i++)
+                    for (int a = 0; a < 3; a++) {
+                        size_t o[3] = {i, j, k};
+                        if (o[a] + 1 >= n[a])
+                            continue;
+                        o[a]++;
+                        if ((g->data[st_grid_index(g, i, j, k)] < 0.0f) ==
+                            (g->data[st_grid_index(g, o[0], o[1], o[2])] < 0.0f))
+                            continue;
+                        double c[3];
+                        st_grid_center(g, i, j, k, c);
+                        c[a] += 0.5 * g->voxel;
+                        if (st_bvh_within(bvh, c, g->voxel * g->voxel))
+                            continue;
+                        const int u = (a + 1) % 3, w = (a + 2) % 3;
+                        for (int q = 0; q < 4; q++) {
+                            double p[3] = {c[0], c[1], c[2]};
+                            p[u] += (q == 1 || q == 2) ? 0.5 * g->voxel : -0.5 * g->voxel;
+                            p[w] += q >= 2 ? 0.5 * g->voxel : -0.5 * g->voxel;
+                            bad += at + 4 > f->nverts || memcmp(p, f->xyz + 3 * (at + (size_t)q),
+                                                                sizeof p) != 0;
+                        }
+                        at += 4;
+                    }
+        differ += bad || at != f->nverts || f->ntris != at / 2;
+        squares += at / 4;
+        st_grid_free(g), st_bvh_free(bvh), st_soup_free(s), st_soup_free(f);
     }
-    return sqrt(depth2);
+    TAP_CHECK(grids == 200 && differ == 0 && squares > 1000,
+              "fill the voxel-by-voxel scan's, square for square (%zu of %zu grids differ, %zu "
+              "squares)", differ, grids, squares);
 }
 
+/* The guess's depth (st_pseudo_guess_measure) is the largest distance
+ * from a fill square's center to the soup, to the bit, as measured square
+ * by square with the unbounded nearest search (kept here: the measure
+ * passes over the centers that cannot raise it), on 1 and 3 threads:
+ * random soups of 1 to 400 triangles, thousands of squares in and around
+ * them (some on them: depth 0 there). */
 static void test_guess_depth(void)
 {
-    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-    for (int shape = 0; shape < 2; shape++) {
-        st_soup *s = st_soup_new(), *f = NULL;
-        if (shape == 0)
-            add_wavy_ball(s, 0.3, 1);
-        else
-            add_box_faces(s, lo, hi, 2, top_face, 0);
-        const st_pseudo_params pp = st_pseudo_params_default();
-        st_dist_params dp = st_dist_params_default();
-        dp.cells = 48;
-        st_grid *g = NULL;
-        st_bvh *bvh = NULL;
-        st_error err;
-        const int ok = !st_pseudo_volume_bvh(&g, s, &dp, &pp, NULL, NULL, &bvh, &err) &&
-                       !st_pseudo_fill(&f, g, bvh, NULL, &err) && f->ntris > 0;
-        const double ref = ok ? guess_depth_every_square(f, bvh) : -1.0;
-        for (int threads = 1; threads <= 2; threads++) {
-            st_pseudo_guess gs = {0, 0, -1.0, 0};
-            omp_set_num_threads(threads);
-            if (ok)
-                st_pseudo_guess_measure(&gs, g, f, bvh);
-            TAP_CHECK(ok && gs.depth == ref && ref > 0.0,
-                      "%s, %d thread(s): the guess's depth %.17g is the farthest square's "
-                      "%.17g (%zu squares)", shape ? "open box" : "one-sided ball", threads,
-                      gs.depth, ref, ok ? f->ntris / 2 : 0);
+    uint64_t r = 0x853c49e6748fea9bull;
+    size_t differ = 0, cases = 0, positive = 0;
+    st_error err;
+    for (int it = 0; it < 60; it++) {
+        st_soup *s = st_soup_new(), *f = st_soup_new();
+        const size_t nt = 1 + (size_t)(it * 37 % 400), nsq = 200 + (size_t)(it * 53 % 2000);
+        double u[9];
+        for (size_t t = 0; t < nt; t++) {
+            for (int k = 0; k < 9; k++) {
+                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+                u[k] = (double)(r >> 11) / 9007199254740992.0;
+            }
+            const double sc = it % 3 ? 0.1 : 1.0;  /* small triangles or large ones */
+            add_tri(s, u, (double[3]){u[0] + sc * (u[3] - 0.5), u[1] + sc * (u[4] - 0.5), u[2]},
+                    (double[3]){u[0], u[1] + sc * (u[7] - 0.5), u[2] + sc * (u[8] - 0.5)}, 0);
         }
-        omp_set_num_threads(2);
-        st_soup_free(f);
-        st_bvh_free(bvh);
-        st_grid_free(g);
-        st_soup_free(s);
+        for (size_t q = 0; q < nsq; q++) {     /* squares as st_pseudo_fill makes them */
+            for (int k = 0; k < 3; k++) {
+                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
+                u[k] = 1.6 * (double)(r >> 11) / 9007199254740992.0 - 0.3;
+            }
+            if (q % 97 == 0)
+                memcpy(u, s->xyz, 3 * sizeof *u);   /* on the soup */
+            const size_t b = f->nverts;
+            for (int c = 0; c < 4; c++)
+                st_soup_add_vertex(f, u[0] + 0.01 * (c == 1 || c == 2), u[1] + 0.01 * (c >= 2),
+                                   u[2], &err);
+            st_soup_add_triangle(f, (uint32_t)b, (uint32_t)b + 1, (uint32_t)b + 2, &err);
+            st_soup_add_triangle(f, (uint32_t)b, (uint32_t)b + 2, (uint32_t)b + 3, &err);
+        }
+        st_bvh *bvh = NULL;
+        st_grid *g = NULL;
+        if (st_bvh_build(&bvh, s, &err) || st_grid_new(&g, 4, 4, 4, (double[3]){0, 0, 0}, 0.25,
+                                                        1.0f, 0, &err)) {
+            st_bvh_free(bvh), st_grid_free(g), st_soup_free(s), st_soup_free(f);
+            continue;
+        }
+        g->data[5] = -1.0f;
+        double ref = 0.0;
+        for (size_t q = 0; q < f->ntris / 2; q++) {
+            const uint32_t *t = f->tris + 6 * q;
+            const double *a = f->xyz + 3 * (size_t)t[0], *c = f->xyz + 3 * (size_t)t[2];
+            const double m[3] = {0.5 * (a[0] + c[0]), 0.5 * (a[1] + c[1]), 0.5 * (a[2] + c[2])};
+            int64_t tri;
+            const double d2 = st_bvh_nearest(bvh, m, INFINITY, &tri, NULL);
+            ref = d2 > ref ? d2 : ref;
+        }
+        ref = sqrt(ref);
+        for (int threads = 1; threads <= 3; threads += 2) {
+#ifdef _OPENMP
+            omp_set_num_threads(threads);
+#endif
+            st_pseudo_guess gs = {0, 0, -1.0, 0};
+            st_pseudo_guess_measure(&gs, g, f, bvh);
+            differ += !(gs.depth == ref) || gs.fill_faces != f->ntris / 2;
+            cases++;
+        }
+        positive += ref > 0.0;
+        st_bvh_free(bvh), st_grid_free(g), st_soup_free(s), st_soup_free(f);
     }
+#ifdef _OPENMP
+    omp_set_num_threads(omp_get_num_procs());
+#endif
+    TAP_CHECK(cases == 120 && differ == 0 && positive == 60,
+              "guess depth the nearest search's, square by square (%zu of %zu differ)", differ,
+              cases);
 }
 
 /* signs_only (pseudo.h): on a closed ball and on two interpenetrating
@@ -1128,7 +1220,7 @@ int main(int argc, char **argv)
                                      TAP_TEST(onesided_caps), TAP_TEST(columns),
                                      TAP_TEST(columns_caps), TAP_TEST(sides_orientation),
                                      TAP_TEST(shared_tables), TAP_TEST(shells_shortcut),
-                                     TAP_TEST(fill), TAP_TEST(guess_depth),
+                                     TAP_TEST(fill), TAP_TEST(fill_scan), TAP_TEST(guess_depth),
                                      TAP_TEST(signs_only), {0}};
     return tap_main(argc, argv, tests);
 }

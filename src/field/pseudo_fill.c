@@ -54,19 +54,26 @@ st_status st_pseudo_fill(st_soup **out, const st_grid *g, const st_bvh *bvh,
     if (!f)
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory (fill)");
     const double v = g->voxel, reach2 = v * v;
-    const size_t n[3] = {g->nx, g->ny, g->nz};
+    const size_t nx = g->nx, ny = g->ny, nz = g->nz;
     size_t count = 0;
-    for (size_t k = 0; k < n[2]; k++)
-        for (size_t j = 0; j < n[1]; j++)
-            for (size_t i = 0; i < n[0]; i++) {
-                size_t ijk[3] = {i, j, k};
-                int in = g->data[st_grid_index(g, i, j, k)] < 0.0f;
+    /* row by row: a voxel's sign and its three neighbours' above it (x,
+     * y, z: the faces in that order, as before), most voxels passed over
+     * at once (no neighbour differs) */
+    for (size_t k = 0; k < nz; k++)
+        for (size_t j = 0; j < ny; j++) {
+            const float *row = g->data + nx * (j + ny * k);
+            /* beyond the grid: the voxel's own row, which never differs */
+            const float *up[3] = {row + 1, j + 1 < ny ? row + nx : row,
+                                  k + 1 < nz ? row + nx * ny : row};
+            for (size_t i = 0; i < nx; i++) {
+                const int in = row[i] < 0.0f;
+                const int dx = i + 1 < nx && (up[0][i] < 0.0f) != in;
+                const int dy = (up[1][i] < 0.0f) != in, dz = (up[2][i] < 0.0f) != in;
+                if (!(dx | dy | dz))
+                    continue;
+                const int differs[3] = {dx, dy, dz};
                 for (int a = 0; a < 3; a++) {
-                    if (ijk[a] + 1 >= n[a])
-                        continue;
-                    size_t o[3] = {i, j, k};
-                    o[a]++;
-                    if ((g->data[st_grid_index(g, o[0], o[1], o[2])] < 0.0f) == in)
+                    if (!differs[a])
                         continue;
                     double c[3];
                     st_grid_center(g, i, j, k, c);
@@ -83,6 +90,7 @@ st_status st_pseudo_fill(st_soup **out, const st_grid *g, const st_bvh *bvh,
                     count++;
                 }
             }
+        }
     if (faces)
         *faces = count;
     *out = f;
@@ -109,11 +117,13 @@ void st_pseudo_guess_measure(st_pseudo_guess *out, const st_grid *g, const st_so
             }
     }
     /* a square's two triangles are (b, b+1, b+2) and (b, b+2, b+3)
-     * (add_square): b and b+2 are opposite corners. The depth is the
-     * largest of the squares' distances: a square with a triangle closer
-     * than the largest so far (st_bvh_within, which stops at the first
-     * one) cannot raise it, so only the others are measured (nearest). The
-     * maximum is the same in any order, so for any number of threads. */
+     * (add_square): b and b+2 are opposite corners */
+    /* the depth: the largest of the squares' centers' distances to the
+     * soup. A center with a triangle closer than the largest so far (in
+     * its thread) cannot raise it, and st_bvh_within tells that at the
+     * first such triangle (where the nearest search would look on); the
+     * others are measured as before. The largest is the same whatever
+     * the threads took. */
     const long long nsq = fill && bvh ? (long long)(fill->ntris / 2) : 0;
     double depth2 = 0.0;
     #pragma omp parallel for schedule(dynamic, 256) reduction(max : depth2)

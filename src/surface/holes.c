@@ -31,6 +31,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #define NONE UINT32_MAX
 /* A cone from a rebuilt corner replaces the cap of the loop's own points
@@ -181,42 +184,86 @@ static int vector_area_above(const double *const *pts, size_t n, double lim)
     return area * (1.0 - SURE_MARGIN) > lim;
 }
 
+/* The least over the apexes k in (i, j) of w[i n + k] + w[k n + j] plus
+ * the area of (pts[i], pts[k], pts[j]) by a plain square root: with the
+ * loop's coordinates in xs, ys, zs and the table also transposed (wt[j n
+ * + k] = w[k n + j]). Two apexes at a time with SSE2: each lane's
+ * operations are the scalar ones, in the same order (no fused
+ * multiply-add), so every sum is the same to the bit, and the least of
+ * them is the same in any order (none is NaN where it is taken). */
+static double area_row(const double *xs, const double *ys, const double *zs, const double *w,
+                       const double *wt, size_t n, size_t i, size_t j)
+{
+    const double p0 = xs[i], p1 = ys[i], p2 = zs[i];
+    const double f0 = xs[j] - p0, f1 = ys[j] - p1, f2 = zs[j] - p2;
+    const double *wi = w + i * n, *wj = wt + j * n;
+    double m = INFINITY;
+    size_t k = i + 1;
+#ifdef __SSE2__
+    const __m128d vp0 = _mm_set1_pd(p0), vp1 = _mm_set1_pd(p1), vp2 = _mm_set1_pd(p2);
+    const __m128d vf0 = _mm_set1_pd(f0), vf1 = _mm_set1_pd(f1), vf2 = _mm_set1_pd(f2);
+    const __m128d half = _mm_set1_pd(0.5);
+    __m128d vm = _mm_set1_pd(INFINITY);
+    for (; k + 1 < j; k += 2) {
+        const __m128d s = _mm_add_pd(_mm_loadu_pd(wi + k), _mm_loadu_pd(wj + k));
+        const __m128d e0 = _mm_sub_pd(_mm_loadu_pd(xs + k), vp0);
+        const __m128d e1 = _mm_sub_pd(_mm_loadu_pd(ys + k), vp1);
+        const __m128d e2 = _mm_sub_pd(_mm_loadu_pd(zs + k), vp2);
+        const __m128d c0 = _mm_sub_pd(_mm_mul_pd(e1, vf2), _mm_mul_pd(e2, vf1));
+        const __m128d c1 = _mm_sub_pd(_mm_mul_pd(e2, vf0), _mm_mul_pd(e0, vf2));
+        const __m128d c2 = _mm_sub_pd(_mm_mul_pd(e0, vf1), _mm_mul_pd(e1, vf0));
+        const __m128d dd = _mm_add_pd(_mm_add_pd(_mm_mul_pd(c0, c0), _mm_mul_pd(c1, c1)),
+                                      _mm_mul_pd(c2, c2));
+        const __m128d t = _mm_add_pd(s, _mm_mul_pd(half, _mm_sqrt_pd(dd)));
+        const __m128d lt = _mm_cmplt_pd(t, vm);
+        vm = _mm_or_pd(_mm_and_pd(lt, t), _mm_andnot_pd(lt, vm));
+    }
+    double lanes[2];
+    _mm_storeu_pd(lanes, vm);
+    m = lanes[1] < lanes[0] ? lanes[1] : lanes[0];
+#endif
+    for (; k < j; k++) {
+        const double s = wi[k] + wj[k];
+        if (!(s < m))
+            continue;
+        const double e0 = xs[k] - p0, e1 = ys[k] - p1, e2 = zs[k] - p2;
+        const double c0 = e1 * f2 - e2 * f1, c1 = e2 * f0 - e0 * f2, c2 = e0 * f1 - e1 * f0;
+        const double t = s + 0.5 * sqrt(c0 * c0 + c1 * c1 + c2 * c2);
+        m = t < m ? t : m;
+    }
+    return m;
+}
+
 /* 1 when least_area's area of the loop pts[0..n) is surely above lim:
  * least_area's dynamic program on a plain square root for each triangle's
  * length (least_area's scaled one and this differ by a few units in the
  * last place per triangle, and both programs give the least over all
  * triangulations of their rounded sums, the additions being monotone),
- * with no triangulation kept, and an apex skipped once its two sides
- * alone reach the best so far (the areas are never negative). 0 when
- * out of memory (least_area then runs, and says so). */
+ * with no triangulation kept (area_row). 0 when out of memory
+ * (least_area then runs, and says so). */
 static int least_area_above(const double *const *pts, size_t n, double lim)
 {
-    double *w = malloc(n * n * sizeof *w);
-    if (!w)
-        return 0;
-    for (size_t i = 0; i + 1 < n; i++)
-        w[i * n + i + 1] = 0.0;
-    for (size_t len = 2; len < n; len++)
-        for (size_t i = 0; i + len < n; i++) {
-            const size_t j = i + len;
-            const double *pi = pts[i], *pj = pts[j];
-            double m = INFINITY, f[3];
-            st_sub3(f, pj, pi);
-            for (size_t k = i + 1; k < j; k++) {
-                const double s = w[i * n + k] + w[k * n + j];
-                if (!(s < m))
-                    continue;
-                double e[3], c[3];
-                st_sub3(e, pts[k], pi);
-                st_cross3(c, e, f);
-                const double t = s + 0.5 * sqrt(st_dot3(c, c));
-                m = t < m ? t : m;
-            }
-            w[i * n + j] = m;
+    double *w = st_malloc_array(n * n, sizeof *w), *wt = st_malloc_array(n * n, sizeof *wt);
+    double *xyz = st_malloc_array(3 * n, sizeof *xyz);
+    int above = 0;
+    if (w && wt && xyz) {
+        double *xs = xyz, *ys = xyz + n, *zs = xyz + 2 * n;
+        for (size_t i = 0; i < n; i++) {
+            xs[i] = pts[i][0], ys[i] = pts[i][1], zs[i] = pts[i][2];
+            if (i + 1 < n)
+                w[i * n + i + 1] = wt[(i + 1) * n + i] = 0.0;
         }
-    const double cap = w[n - 1];
+        for (size_t len = 2; len < n; len++)
+            for (size_t i = 0; i + len < n; i++) {
+                const size_t j = i + len;
+                w[i * n + j] = wt[j * n + i] = area_row(xs, ys, zs, w, wt, n, i, j);
+            }
+        above = w[n - 1] * (1.0 - SURE_MARGIN) > lim;
+    }
     free(w);
-    return cap * (1.0 - SURE_MARGIN) > lim;
+    free(wt);
+    free(xyz);
+    return above;
 }
 
 int st_holes_area_above(const double *const *pts, size_t n, double lim)

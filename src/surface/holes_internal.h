@@ -71,6 +71,33 @@ st_status st_holes_least_bend(double *area, const double *const *pts, const doub
  * Never 1 where that area is at most lim. */
 int st_holes_area_above(const double *const *pts, size_t n, double lim);
 
+/* A loop as the cones' screen reads it (holes_planes.c): its points
+ * p[c (n + 1) + i] (coordinate c, the first point again at i = n), its
+ * edges' unit normals r[c n + i] (rim, as loop_planes gives them) and
+ * whether each edge counts (mask[i]: all bits set where it is not along a
+ * crease, else 0.0), filled by
+ * st_holes_cone_rim_fill from pts[0..n), rim[3 n] and crease (NULL:
+ * none). */
+typedef struct st_holes_cone_rim {
+    double *p, *r, *mask;
+} st_holes_cone_rim;
+void st_holes_cone_rim_fill(st_holes_cone_rim *cr, const double *const *pts, const double *rim,
+                            const double *crease, size_t n);
+/* 1 when the cone from apex over the loop in cr (n edges) surely bends
+ * no less than below along it: the sum over its edges, in order, of the
+ * edge's length times the sine of the angle between the soup's normal and
+ * the cone's (a right angle where they face apart), less a margin, reaches
+ * below before an edge of a length out of [1e-100, 1e100]. 0 when unsure. */
+int st_holes_cone_above(const double *apex, const st_holes_cone_rim *cr, size_t n, double below);
+
+/* The screen before the fans' flatness test (holes_planes.c): the loop's
+ * edges i (of n) whose fan to apex may continue the soup's plane across
+ * them, |s| <= sqrt(l2) |f| with f = apex - a and s = f . r, decided as
+ * !(s s > l2 (f . f)) with the dot products summed x, y, z: in near[]
+ * (room for n), in order; returns how many. scr holds a column of each:
+ * a's x, y, z, r's x, y, z, l2 (scr[c n + i]). */
+size_t st_holes_fan_near(size_t *near, const double *scr, size_t n, const double *apex);
+
 /* The surviving soup a rebuilt corner's triangles may not pierce
  * (st_tri_tri_cross; touching it is no crossing): its BVH and which of
  * its triangles count (edges.h's kept). NULL or bvh NULL: no test. */

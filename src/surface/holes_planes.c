@@ -61,6 +61,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -135,6 +138,35 @@ void st_holes_creases(double *crease, const double *const *pts, const double *co
     }
 }
 
+void st_holes_cone_rim_fill(st_holes_cone_rim *cr, const double *const *pts, const double *rim,
+                            const double *crease, size_t n)
+{
+    for (size_t i = 0; i <= n; i++)
+        for (int c = 0; c < 3; c++)
+            cr->p[(size_t)c * (n + 1) + i] = pts[i < n ? i : 0][c];
+    for (size_t i = 0; i < n; i++) {
+        for (int c = 0; c < 3; c++)
+            cr->r[(size_t)c * n + i] = rim[3 * i + c];
+        /* all bits set where the edge counts (an SSE2 mask), else 0 */
+        const uint64_t all = crease && on_crease(crease + 6 * i) ? 0 : UINT64_MAX;
+        memcpy(cr->mask + i, &all, sizeof all);
+    }
+}
+
+/* One edge's part of st_holes_cone_above into *lb and *len (the sums so
+ * far): -1 when its length is out of range (unsure), 1 when the sums
+ * reach below, else 0. */
+static int cone_term(double *lb, double *len, double ee, double l, double term, int counts,
+                     double below)
+{
+    if (!(ee > 1e-200 && ee < 1e200))
+        return -1;
+    *len += l;
+    if (counts)
+        *lb += term;
+    return *lb * (1.0 - 1e-10) - 1e-12 * *len >= below;
+}
+
 /* 1 when the cone from apex bends surely no less than below along the
  * loop (cone_bend would say 0), from a lower bound of each term taken
  * without the arc tangent and the scaled norms: the sine of the angle
@@ -142,27 +174,80 @@ void st_holes_creases(double *crease, const double *const *pts, const double *co
  * where u . r > 0; a right angle where not) is at most the angle, which
  * bend() rounds to within a few units in the last place (as the lengths
  * and sums): the margins, a relative 1e-10 and 1e-12 times the loop's
- * length in radians, are far beyond those. 0 when unsure. */
-static int cone_above(const double *apex, const double *const *pts, const double *rim, size_t n,
-                      const double *crease, double below)
+ * length in radians, are far beyond those. 0 when unsure. The terms two
+ * edges at a time (SSE2: each lane the scalar operations in the same
+ * order), summed one by one in order as before (cone_term; there
+ * the terms that do not count add 0). */
+int st_holes_cone_above(const double *apex, const st_holes_cone_rim *cr, size_t n, double below)
 {
+    const double *px = cr->p, *py = cr->p + n + 1, *pz = cr->p + 2 * (n + 1);
+    const double *rx = cr->r, *ry = cr->r + n, *rz = cr->r + 2 * n;
     double lb = 0.0, len = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        const double *p = pts[i], *q = pts[(i + 1) % n], *r = rim + 3 * i;
-        double e[3], f[3], u[3], x[3];
-        st_sub3(e, q, p);
-        st_sub3(f, apex, p);
+    size_t i = 0;
+#ifdef __SSE2__
+    const __m128d ax = _mm_set1_pd(apex[0]), ay = _mm_set1_pd(apex[1]), az = _mm_set1_pd(apex[2]);
+    const __m128d tiny = _mm_set1_pd(1e-200), huge = _mm_set1_pd(1e200);
+    const __m128d right = _mm_set1_pd(0.5 * M_PI), zero = _mm_setzero_pd();
+    _Static_assert(sizeof(double) == sizeof(uint64_t), "a mask per double");
+    for (; i + 1 < n; i += 2) {
+        const __m128d p0 = _mm_loadu_pd(px + i), p1 = _mm_loadu_pd(py + i);
+        const __m128d p2 = _mm_loadu_pd(pz + i);
+        const __m128d e0 = _mm_sub_pd(_mm_loadu_pd(px + i + 1), p0);
+        const __m128d e1 = _mm_sub_pd(_mm_loadu_pd(py + i + 1), p1);
+        const __m128d e2 = _mm_sub_pd(_mm_loadu_pd(pz + i + 1), p2);
+        const __m128d f0 = _mm_sub_pd(ax, p0), f1 = _mm_sub_pd(ay, p1), f2 = _mm_sub_pd(az, p2);
+        const __m128d u0 = _mm_sub_pd(_mm_mul_pd(e1, f2), _mm_mul_pd(e2, f1));
+        const __m128d u1 = _mm_sub_pd(_mm_mul_pd(e2, f0), _mm_mul_pd(e0, f2));
+        const __m128d u2 = _mm_sub_pd(_mm_mul_pd(e0, f1), _mm_mul_pd(e1, f0));
+        const __m128d r0 = _mm_loadu_pd(rx + i), r1 = _mm_loadu_pd(ry + i);
+        const __m128d r2 = _mm_loadu_pd(rz + i);
+        const __m128d x0 = _mm_sub_pd(_mm_mul_pd(u1, r2), _mm_mul_pd(u2, r1));
+        const __m128d x1 = _mm_sub_pd(_mm_mul_pd(u2, r0), _mm_mul_pd(u0, r2));
+        const __m128d x2 = _mm_sub_pd(_mm_mul_pd(u0, r1), _mm_mul_pd(u1, r0));
+        const __m128d ee = _mm_add_pd(_mm_add_pd(_mm_mul_pd(e0, e0), _mm_mul_pd(e1, e1)),
+                                      _mm_mul_pd(e2, e2));
+        const __m128d uu = _mm_add_pd(_mm_add_pd(_mm_mul_pd(u0, u0), _mm_mul_pd(u1, u1)),
+                                      _mm_mul_pd(u2, u2));
+        const __m128d d = _mm_add_pd(_mm_add_pd(_mm_mul_pd(u0, r0), _mm_mul_pd(u1, r1)),
+                                     _mm_mul_pd(u2, r2));
+        const __m128d xx = _mm_add_pd(_mm_add_pd(_mm_mul_pd(x0, x0), _mm_mul_pd(x1, x1)),
+                                      _mm_mul_pd(x2, x2));
+        const __m128d l = _mm_sqrt_pd(ee), pos = _mm_cmpgt_pd(d, zero);
+        const __m128d sn = _mm_sqrt_pd(_mm_div_pd(xx, uu));
+        /* the term where it counts, else 0 (lb + 0 is lb: lb is never -0) */
+        const __m128d uu_in = _mm_and_pd(_mm_cmpgt_pd(uu, tiny), _mm_cmplt_pd(uu, huge));
+        const __m128d counts = _mm_and_pd(uu_in, _mm_loadu_pd(cr->mask + i));
+        const __m128d t = _mm_and_pd(
+            counts, _mm_mul_pd(l, _mm_or_pd(_mm_and_pd(pos, sn), _mm_andnot_pd(pos, right))));
+        if (_mm_movemask_pd(_mm_and_pd(_mm_cmpgt_pd(ee, tiny), _mm_cmplt_pd(ee, huge))) != 3)
+            break;      /* an edge out of range: the scalar loop says where */
+        len += _mm_cvtsd_f64(l);
+        lb += _mm_cvtsd_f64(t);
+        if (lb * (1.0 - 1e-10) - 1e-12 * len >= below)
+            return 1;
+        len += _mm_cvtsd_f64(_mm_unpackhi_pd(l, l));
+        lb += _mm_cvtsd_f64(_mm_unpackhi_pd(t, t));
+        if (lb * (1.0 - 1e-10) - 1e-12 * len >= below)
+            return 1;
+    }
+#endif
+    for (; i < n; i++) {
+        const double e[3] = {px[i + 1] - px[i], py[i + 1] - py[i], pz[i + 1] - pz[i]};
+        const double f[3] = {apex[0] - px[i], apex[1] - py[i], apex[2] - pz[i]};
+        const double r[3] = {rx[i], ry[i], rz[i]};
+        double u[3], x[3];
         st_cross3(u, e, f);
         st_cross3(x, u, r);
         const double ee = st_dot3(e, e), uu = st_dot3(u, u), d = st_dot3(u, r);
-        if (!(ee > 1e-200 && ee < 1e200))
-            return 0;
         const double l = sqrt(ee);
-        len += l;
-        if (uu > 1e-200 && uu < 1e200 && !(crease && on_crease(crease + 6 * i)))
-            lb += l * (d > 0.0 ? sqrt(st_dot3(x, x) / uu) : 0.5 * M_PI);
-        if (lb * (1.0 - 1e-10) - 1e-12 * len >= below)
-            return 1;
+        /* the mask's bits all set read as a NaN: unequal to 0 */
+        const int counts = uu > 1e-200 && uu < 1e200 && cr->mask[i] != 0.0;
+        const int res = cone_term(&lb, &len, ee, l,
+                                  counts ? l * (d > 0.0 ? sqrt(st_dot3(x, x) / uu) : 0.5 * M_PI)
+                                         : 0.0,
+                                  counts, below);
+        if (res)
+            return res > 0;
     }
     return 0;
 }
@@ -365,8 +450,10 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
     double *rim = malloc(3 * n * sizeof *rim), *tn = malloc(3 * n * sizeof *tn);
     plane *pl = malloc(n * sizeof *pl);
     cand *cs = malloc(MAX_CAND * sizeof *cs);
+    st_holes_cone_rim cr = {malloc(3 * (n + 1) * sizeof *cr.p), malloc(3 * n * sizeof *cr.r),
+                            malloc(n * sizeof *cr.mask)};
     st_status rc = ST_OK;
-    if (!rim || !tn || !pl || !cs) {
+    if (!rim || !tn || !pl || !cs || !cr.p || !cr.r || !cr.mask) {
         rc = oom(err);
         goto out;
     }
@@ -374,6 +461,7 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
     reach_box(lo, hi, o, &ext, pts, n);
     const size_t m = loop_planes(pl, rim, pts, side, n, ext);
     const double *crease = guard ? guard->crease : NULL;
+    st_holes_cone_rim_fill(&cr, pts, rim, crease, n);
     /* the cones that bend less than below, the least bent first (ties
      * by the bend of their spokes too): the first whose triangles pierce
      * none of the soup */
@@ -384,7 +472,7 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
                 cand *k = cs + nc;
                 double rb, cb;
                 if (!candidate(k->x, pl, a, b, c, o, lo, hi) ||
-                    cone_above(k->x, pts, rim, n, crease, below) ||
+                    st_holes_cone_above(k->x, &cr, n, below) ||
                     !cone_bend(k->x, pts, rim, n, crease, below, tn, &cb, &rb))
                     continue;
                 k->key = rb, k->tie = cb, k->a = a, k->b = b, k->c = c, k->done = 0;
@@ -414,7 +502,7 @@ st_status st_holes_planes_cap(st_soup *out, int *done, const double *const *pts,
     *done = 1;
     *bent = best;
 out:
-    free(rim), free(tn), free(pl), free(cs);
+    free(rim), free(tn), free(pl), free(cs), free(cr.p), free(cr.r), free(cr.mask);
     return rc;
 }
 
@@ -495,21 +583,59 @@ static int fan_flat(const double *a, const double *b, const double *apex, const 
  * less a few roundings of the cross product that fan_flat's u carries.
  * Where |s| is above (FAN_FAR + |e . r| / |e|) |f|, t is at least about
  * FAN_FAR (or beyond a right angle), a hundred times FAN_FLAT: fan_flat
- * would say 0, and the screen says it for a third of the work. scr[8 i
- * ..] holds for the loop's edge i its a, r and that factor squared
+ * would say 0, and the screen says it for a third of the work. scr holds
+ * for the loop's edge i, a column of each: scr[i], scr[n + i], scr[2 n +
+ * i] its a, scr[3 n + i ..] its r and scr[6 n + i] that factor squared
  * (INFINITY, no screen, where e is zero). */
 #define FAN_FAR 1e-4
 static void fan_screen(double *scr, const fan_v *v, const double *rim, size_t n)
 {
     for (size_t i = 0; i < n; i++) {
-        double e[3], *q = scr + 8 * i;
+        double e[3];
         st_sub3(e, v[i + 1 < n ? i + 1 : 0].p, v[i].p);
         const double le = st_norm3(e);
         const double l = le > 0.0 ? FAN_FAR + fabs(st_dot3(e, rim + 3 * i)) / le : INFINITY;
-        memcpy(q, v[i].p, 3 * sizeof *q);
-        memcpy(q + 3, rim + 3 * i, 3 * sizeof *q);
-        q[6] = l * l;
+        for (int c = 0; c < 3; c++) {
+            scr[(size_t)c * n + i] = v[i].p[c];
+            scr[(size_t)(3 + c) * n + i] = rim[3 * i + c];
+        }
+        scr[6 * n + i] = l * l;
     }
+}
+
+size_t st_holes_fan_near(size_t *near, const double *scr, size_t n, const double *apex)
+{
+    const double *a0 = scr, *a1 = scr + n, *a2 = scr + 2 * n;
+    const double *r0 = scr + 3 * n, *r1 = scr + 4 * n, *r2 = scr + 5 * n, *ll = scr + 6 * n;
+    size_t k = 0, i = 0;
+#ifdef __SSE2__
+    const __m128d x0 = _mm_set1_pd(apex[0]), x1 = _mm_set1_pd(apex[1]), x2 = _mm_set1_pd(apex[2]);
+    for (; i + 1 < n; i += 2) {
+        const __m128d f0 = _mm_sub_pd(x0, _mm_loadu_pd(a0 + i));
+        const __m128d f1 = _mm_sub_pd(x1, _mm_loadu_pd(a1 + i));
+        const __m128d f2 = _mm_sub_pd(x2, _mm_loadu_pd(a2 + i));
+        const __m128d sv = _mm_add_pd(_mm_add_pd(_mm_mul_pd(f0, _mm_loadu_pd(r0 + i)),
+                                                 _mm_mul_pd(f1, _mm_loadu_pd(r1 + i))),
+                                      _mm_mul_pd(f2, _mm_loadu_pd(r2 + i)));
+        const __m128d ff = _mm_add_pd(_mm_add_pd(_mm_mul_pd(f0, f0), _mm_mul_pd(f1, f1)),
+                                      _mm_mul_pd(f2, f2));
+        const int pass = _mm_movemask_pd(
+            _mm_cmpngt_pd(_mm_mul_pd(sv, sv), _mm_mul_pd(_mm_loadu_pd(ll + i), ff)));
+        if (pass) {     /* most pass neither */
+            if (pass & 1)
+                near[k++] = i;
+            if (pass & 2)
+                near[k++] = i + 1;
+        }
+    }
+#endif
+    for (; i < n; i++) {
+        const double f0 = apex[0] - a0[i], f1 = apex[1] - a1[i], f2 = apex[2] - a2[i];
+        const double sv = f0 * r0[i] + f1 * r1[i] + f2 * r2[i];
+        near[k] = i;
+        k += !(sv * sv > ll[i] * (f0 * f0 + f1 * f1 + f2 * f2));
+    }
+    return k;
 }
 
 /* Which of the loop's edges apex continues (FAN_FLAT): flag[n], scr from
@@ -518,15 +644,8 @@ static void fan_screen(double *scr, const fan_v *v, const double *rim, size_t n)
 static double fan_flags(const double *apex, const fan_v *v, const double *rim,
                         const double *scr, size_t n, int *flag, size_t *near)
 {
-    size_t k = 0;
-    for (size_t i = 0; i < n; i++) {
-        const double *q = scr + 8 * i;
-        const double f0 = apex[0] - q[0], f1 = apex[1] - q[1], f2 = apex[2] - q[2];
-        const double s = f0 * q[3] + f1 * q[4] + f2 * q[5];
-        flag[i] = 0;
-        near[k] = i;
-        k += !(s * s > q[6] * (f0 * f0 + f1 * f1 + f2 * f2));
-    }
+    memset(flag, 0, n * sizeof *flag);
+    const size_t k = st_holes_fan_near(near, scr, n, apex);
     double g = 0.0;
     for (size_t j = 0; j < k; j++) {
         const size_t i = near[j];
