@@ -120,6 +120,38 @@ static st_status fit_quality(fit_run *r, st_error *err)
 
 /* ---- fit iterations --------------------------------------------------- */
 
+/* The index (from vt_off[v]) of the lowest-scoring tet of v's star as it
+ * is, the first to try in star_keeps_floor. */
+static size_t star_worst(const sm_mesh *sm, uint32_t v)
+{
+    size_t worst = SIZE_MAX;
+    double lowest = INFINITY;
+    for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j++) {
+        const uint32_t *k = sm->m->tets + 4 * (size_t)sm->vt[j];
+        double sc = sm_tet_score(sm->m->xyz + 3 * (size_t)k[0], sm->m->xyz + 3 * (size_t)k[1],
+                                 sm->m->xyz + 3 * (size_t)k[2], sm->m->xyz + 3 * (size_t)k[3]);
+        if (sc < lowest) {
+            lowest = sc;
+            worst = j - sm->vt_off[v];
+        }
+    }
+    return worst;
+}
+
+/* 1 when the star of v with v at p scores at least floor_score
+ * (sm_star_score(sm, v, p) >= floor_score), cut short for the rescues,
+ * whose candidates mostly fall below it: the star's score is asked only
+ * whether it is above the largest double below the floor
+ * (sm_star_score_above: its exact score when above that, else a value at
+ * most that), tet `first` first, so a position below the floor ends at
+ * its first tet there instead of scoring the whole star. */
+static int star_keeps_floor(const sm_mesh *sm, uint32_t v, const double p[3], size_t first,
+                            double floor_score)
+{
+    double below = nextafter(floor_score, -INFINITY);
+    return sm_star_score_above(sm, v, p, first, below) > below;
+}
+
 /* One fit move of v (the step tau toward its ODT target, and toward the
  * band when beyond it), halved while the invariant refuses it. 1 when v
  * moved; *n counts. */
@@ -226,6 +258,7 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
     t2[2] = n[0] * t1[1] - n[1] * t1[0];
     double way = dd - FIT_GOAL_FRACTION * c->d_offset;
     double floor_score = fmin(RESCUE_FLOOR, sm_star_score(sm, v, x));
+    const size_t worst = star_worst(sm, v);
     double cd[RESCUE_NCAND][5];
     size_t nc = 0, ord = 0;
     for (size_t ti = 0; ti < RESCUE_NTILT; ti++) {
@@ -243,7 +276,7 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
                 /* the score floor first: it is cheaper than the distance,
                  * and most candidates fail it (a candidate that fails it
                  * is never taken, so the order of the rest is the same) */
-                if (sm_star_score(sm, v, cd[nc] + 1) < floor_score)
+                if (!star_keeps_floor(sm, v, cd[nc] + 1, worst, floor_score))
                     continue;
                 cd[nc][0] = dd - st - RESCUE_LB_SLACK * c->h;
                 cd[nc][4] = (double)ord;
@@ -308,6 +341,7 @@ static int rescue_joint(const fit_ctx *c, uint32_t v, star_pts *sp)
         double *xu = xyz + 3 * (size_t)u;
         const double save[3] = {xu[0], xu[1], xu[2]};
         const double floor_score = fmin(RESCUE_FLOOR, sm_star_score(sm, u, save));
+        const size_t worst = star_worst(sm, u);
         int collected = 0;
         for (size_t si = 0; si < JOINT_NSTEP; si++)
             for (int dz = -1; dz <= 1; dz++)
@@ -320,7 +354,7 @@ static int rescue_joint(const fit_ctx *c, uint32_t v, star_pts *sp)
                         const double p[3] = {save[0] + l * dx, save[1] + l * dy,
                                              save[2] + l * dz};
                         if (!(sm_dist_to_s(c, p, NULL) <= c->d_offset) ||
-                            sm_star_score(sm, u, p) < floor_score)
+                            !star_keeps_floor(sm, u, p, worst, floor_score))
                             continue;
                         if (!collected) {
                             sm_star_pts_collect(c, u, sp);

@@ -81,7 +81,16 @@ static int box_rejected(const st_plane_filter *pl, const double lo[3], const dou
 {
     if (pl->side == 0)
         return 0;
-    for (int c = 0; c < 8; c++) {
+    /* The corner furthest toward r's side first (bit k: hi along k where
+     * the plane's normal leans that way): where any corner is kept, that
+     * one is the likeliest, and most bins end after one test. The answer
+     * is the same whichever order (all eight must be rejected). */
+    int first = 0;
+    for (int k = 0; k < 3; k++)
+        if ((double)pl->side * pl->n[k] > 0.0)
+            first |= 1 << k;
+    for (int i = 0; i < 8; i++) {
+        const int c = i ^ first;
         const double q[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
         if (!st_plane_filter_rejects(pl, q))
             return 0;
@@ -89,21 +98,25 @@ static int box_rejected(const st_plane_filter *pl, const double lo[3], const dou
     return 1;
 }
 
-/* The extent of bin i along axis a holding every point the grid puts
- * there, cut to lo..hi: the bin widened by m = 1e-10 of the grid's
- * coordinates (sm_pgrid_coord's rounding is a few units of 2^-53 of them),
- * the end bins open (clamped coordinates). 0 when m is not small beside a
- * bin (then nothing is skipped). */
-static int bin_extent(const pgrid *g, size_t i, int a, double lo, double hi, double out[2])
+/* The margin of the bins' extents along axis a: m = 1e-10 of the grid's
+ * coordinates (sm_pgrid_coord's rounding is a few units of 2^-53 of them).
+ * NaN when m is not small beside a bin (then nothing is skipped). */
+static double bin_margin(const pgrid *g, int a)
 {
     double m = 1e-10 * (fabs(g->lo[a]) + (double)g->n[a] * g->cell);
-    if (!(m < 0.01 * g->cell))
-        return 0;
+    return m < 0.01 * g->cell ? m : NAN;
+}
+
+/* The extent of bin i along axis a holding every point the grid puts
+ * there, cut to lo..hi: the bin widened by the margin m (bin_margin), the
+ * end bins open (clamped coordinates). */
+static void bin_extent(const pgrid *g, size_t i, int a, double m, double lo, double hi,
+                       double out[2])
+{
     double b0 = i == 0 ? -INFINITY : g->lo[a] + (double)i * g->cell - m;
     double b1 = i + 1 >= g->n[a] ? INFINITY : g->lo[a] + (double)(i + 1) * g->cell + m;
     out[0] = fmax(b0, lo);
     out[1] = fmin(b1, hi);
-    return 1;
 }
 
 /* The faces (bits) that may hold a point of the bin box blo..bhi; 0 when
@@ -172,17 +185,23 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
         a1[a] = sm_pgrid_coord(g, hi[a], a);
     }
     const uint64_t all = ((uint64_t)1 << nf) - 1;   /* nf <= SWEPT_MAX_FACES < 64 */
+    /* the margins once per call, each axis's extent once per row */
+    const double m[3] = {bin_margin(g, 0), bin_margin(g, 1), bin_margin(g, 2)};
+    const int whole_bins = !isnan(m[0]) && !isnan(m[1]) && !isnan(m[2]);
     double ez[2], ey[2], ex[2];
-    for (size_t iz = a0[2]; iz <= a1[2]; iz++)
-        for (size_t iy = a0[1]; iy <= a1[1]; iy++)
+    for (size_t iz = a0[2]; iz <= a1[2]; iz++) {
+        if (whole_bins)
+            bin_extent(g, iz, 2, m[2], lo[2], hi[2], ez);
+        for (size_t iy = a0[1]; iy <= a1[1]; iy++) {
+            if (whole_bins)
+                bin_extent(g, iy, 1, m[1], lo[1], hi[1], ey);
             for (size_t ix = a0[0]; ix <= a1[0]; ix++) {
                 size_t b = ix + g->n[0] * (iy + g->n[1] * iz);
                 if (g->off[b] == g->off[b + 1])
                     continue;
                 uint64_t keep = all;
-                if (bin_extent(g, ix, 0, lo[0], hi[0], ex) &&
-                    bin_extent(g, iy, 1, lo[1], hi[1], ey) &&
-                    bin_extent(g, iz, 2, lo[2], hi[2], ez)) {
+                if (whole_bins) {
+                    bin_extent(g, ix, 0, m[0], lo[0], hi[0], ex);
                     const double blo[3] = {ex[0], ey[0], ez[0]}, bhi[3] = {ex[1], ey[1], ez[1]};
                     keep = bin_faces(nf, (const double(*)[6])box, in, out, blo, bhi);
                 }
@@ -209,5 +228,7 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
                     }
                 }
             }
+        }
+    }
     return 1;
 }

@@ -285,10 +285,34 @@ static int near_enough(const fit_ctx *c, const qual_move *q, const double p[3], 
     return q->dx + sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) <= dmax - slack;
 }
 
+/* Score the candidates: cand[i][0] is candidate i's score when exact[i],
+ * else an upper bound on it (a tet's score at or below the cut it was
+ * scored against; sm_star_score_above). Each is cut at the best exact
+ * score so far (thr at least): one at or below that cannot come first,
+ * and most end after a tet or two instead of scoring the whole star. */
+static void qual_score(const sm_mesh *sm, qual_move *q, double thr, unsigned char *exact)
+{
+    double best = thr;
+    for (int i = 0; i < q->nc; i++) {
+        double x = sm_star_score_above(sm, q->v, q->cand[i] + 1, q->worst, best);
+        q->cand[i][0] = x;
+        q->cand[i][4] = i;
+        exact[i] = x > best || best == thr;   /* at or below thr: never tried */
+        if (x > best)
+            best = x;
+    }
+}
+
 /* The candidates by score, best first; the first that raises the star's
  * lowest score by QUAL_MIN_GAIN, keeps a boundary vertex within
  * max(d_offset, its distance) of S and keeps the invariant is taken.
- * 1 when v moved; *rejected counts the invariant's refusals. */
+ * The order is found lazily (qual_score): sorted by the scores and
+ * bounds, a bound that reaches the front is scored exactly (cut at thr)
+ * and moved back to its place; a score at the front is then at least
+ * every bound behind it (and ahead of equal ones by order), so the
+ * candidates are tried in the order of the exact scores, as a full sort
+ * of them would give. 1 when v moved; *rejected counts the invariant's
+ * refusals. */
 static int qual_take(const fit_ctx *c, qual_move *q, star_pts *sp, size_t *rejected)
 {
     const sm_mesh *sm = &c->sm;
@@ -299,19 +323,29 @@ static int qual_take(const fit_ctx *c, qual_move *q, star_pts *sp, size_t *rejec
      * any score there sorts it after those that are: the worst tet as it
      * is, scored first, turns most of them away after one tet */
     const double thr = q->s0 + QUAL_MIN_GAIN;
-    for (int i = 0; i < q->nc; i++) {
-        q->cand[i][0] = sm_star_score_above(sm, v, q->cand[i] + 1, q->worst, thr);
-        q->cand[i][4] = i;
-    }
+    unsigned char exact[QUAL_NCAND];
+    qual_score(sm, q, thr, exact);
     qsort(q->cand, (size_t)q->nc, sizeof q->cand[0], cmp_cand);
-    if (!(q->cand[0][0] > q->s0 + QUAL_MIN_GAIN))
+    if (!(q->cand[0][0] > thr))
         return 0;
     sm_star_pts_collect(c, v, sp);
     double dmax = fmax(c->d_offset, q->dx);
-    for (int i = 0; i < q->nc; i++) {
-        if (!(q->cand[i][0] > q->s0 + QUAL_MIN_GAIN))
+    for (int i = 0; i < q->nc;) {
+        if (!(q->cand[i][0] > thr))
             break;
-        const double *p = q->cand[i] + 1;
+        const int o = (int)q->cand[i][4];
+        if (!exact[o]) {
+            q->cand[i][0] = sm_star_score_above(sm, v, q->cand[i] + 1, q->worst, thr);
+            exact[o] = 1;
+            for (int j = i; j + 1 < q->nc && cmp_cand(q->cand[j], q->cand[j + 1]) > 0; j++) {
+                double t[5];
+                memcpy(t, q->cand[j], sizeof t);
+                memcpy(q->cand[j], q->cand[j + 1], sizeof t);
+                memcpy(q->cand[j + 1], t, sizeof t);
+            }
+            continue;
+        }
+        const double *p = q->cand[i++] + 1;
         if (sm->onb[v] && c->s && !near_enough(c, q, p, dmax)) {
             int64_t tri;
             double d2 = sm_nearest_d2(c, p, dmax * dmax, &tri, NULL);
