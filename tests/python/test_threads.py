@@ -19,7 +19,14 @@ def test_other_threads_run_during_mesh(bunny):
     out = {}
 
     def work():
-        out["m"] = souptet.mesh(*bunny, cells=6, tries=1, threads=1)
+        # meshes until half a second has passed: long enough to tell, however
+        # fast one mesh is (a run holding the GIL would let the loop below
+        # tick once or twice per mesh, a few times a second)
+        t_work = time.monotonic()
+        while True:
+            out["m"] = souptet.mesh(*bunny, cells=14, tries=1, threads=1)
+            if not out["m"].encloses or time.monotonic() - t_work > 0.5:
+                break
         done.set()
     t = threading.Thread(target=work)
     t.start()
