@@ -36,6 +36,20 @@ static inline void st_cross3(double out[3], const double a[3], const double b[3]
     out[2] = z;
 }
 
+/* The squared distance from p to the box [lo, hi]: per axis the larger of
+ * lo - p, p - hi and 0 (at most one is positive, so the sum is exact and
+ * the same as choosing the positive one), without branches. */
+static inline double st_box_dist2(const double lo[3], const double hi[3], const double p[3])
+{
+    double d2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        const double below = lo[a] - p[a], above = p[a] - hi[a];
+        const double d = (below > 0.0 ? below : 0.0) + (above > 0.0 ? above : 0.0);
+        d2 += d * d;
+    }
+    return d2;
+}
+
 /* Euclidean length, scaled so that tiny or huge components neither
  * underflow nor overflow when squared. */
 double st_norm3(const double v[3]);

@@ -1294,17 +1294,6 @@ static st_status band_pass(st_grid *g, int32_t *near, st_grid_blocks *bk,
  * the minimum over every triangle within B, in another order. */
 #define DIST_BVH_STACK 128
 
-static inline double lohi_d2(const double lo[3], const double hi[3], const double p[3])
-{
-    double d2 = 0.0;
-    for (int a = 0; a < 3; a++) {
-        const double below = lo[a] - p[a], above = p[a] - hi[a];
-        const double d = (below > 0.0 ? below : 0.0) + (above > 0.0 ? above : 0.0);
-        d2 += d * d;
-    }
-    return d2;
-}
-
 /* The band value of the voxel at p: B, or its distance to s below B. */
 static float bvh_voxel(const st_bvh *bvh, const st_soup *s, const double p[3],
                        double B, double slack)
@@ -1316,7 +1305,7 @@ static float bvh_voxel(const st_bvh *bvh, const st_soup *s, const double p[3],
     double sd2[DIST_BVH_STACK];
     int sp = 0;
     const st_bvh_node *nodes = bvh->nodes;
-    const double d0 = lohi_d2(nodes[0].lo, nodes[0].hi, p);
+    const double d0 = st_box_dist2(nodes[0].lo, nodes[0].hi, p);
     if (d0 <= lim2) {
         stack[0] = 0;
         sd2[sp++] = d0;
@@ -1330,7 +1319,7 @@ static float bvh_voxel(const st_bvh *bvh, const st_soup *s, const double p[3],
         if (n->count) {
             for (uint32_t i = 0; i < n->count; i++) {
                 const double *tb = bvh->tbox + 6 * (size_t)(n->start + i);
-                if (lohi_d2(tb, tb + 3, p) > lim2)
+                if (st_box_dist2(tb, tb + 3, p) > lim2)
                     continue;
                 setup_triangle(&t, s, bvh->order[n->start + i]);
                 const double before = cur;
@@ -1343,8 +1332,8 @@ static float bvh_voxel(const st_bvh *bvh, const st_soup *s, const double p[3],
             continue;
         }
         uint32_t l = n->start, r = n->start + 1;
-        double dl = lohi_d2(nodes[l].lo, nodes[l].hi, p);
-        double dr = lohi_d2(nodes[r].lo, nodes[r].hi, p);
+        double dl = st_box_dist2(nodes[l].lo, nodes[l].hi, p);
+        double dr = st_box_dist2(nodes[r].lo, nodes[r].hi, p);
         if (dl > dr) {              /* the nearer one on top */
             const uint32_t x = l;
             l = r;

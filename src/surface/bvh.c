@@ -345,23 +345,10 @@ void st_bvh_free(st_bvh *b)
     free(b);
 }
 
-/* The squared distance from p to the box [lo, hi]: per axis the larger of
- * lo - p, p - hi and 0 (at most one is positive, so the sum is exact and
- * the same as choosing the positive one), without branches. */
-static double lohi_dist2(const double lo[3], const double hi[3], const double p[3])
-{
-    double d2 = 0.0;
-    for (int a = 0; a < 3; a++) {
-        const double below = lo[a] - p[a], above = p[a] - hi[a];
-        const double d = (below > 0.0 ? below : 0.0) + (above > 0.0 ? above : 0.0);
-        d2 += d * d;
-    }
-    return d2;
-}
 
 static double box_dist2(const st_bvh_node *n, const double p[3])
 {
-    return lohi_dist2(n->lo, n->hi, p);
+    return st_box_dist2(n->lo, n->hi, p);
 }
 
 /* box_dist2 of two nodes at once, bit for bit: with SSE2 (every x86-64)
@@ -411,7 +398,7 @@ static int tri_beyond(const double *tb, const double p[3], double reach, double 
     side = tb[4] - tb[1] > side ? tb[4] - tb[1] : side;
     side = tb[5] - tb[2] > side ? tb[5] - tb[2] : side;
     const double lim = (reach + TRI_SKIP_SIDE * side + TRI_SKIP_ABS * m) * (1.0 + TRI_SKIP_REL);
-    return lohi_dist2(tb, tb + 3, p) > lim * lim;
+    return st_box_dist2(tb, tb + 3, p) > lim * lim;
 }
 
 /* The largest coordinate magnitude of the soup (its root box's). */
