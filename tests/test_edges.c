@@ -6,6 +6,8 @@
 #include "souptet/edges.h"
 #include "souptet/weld.h"
 #include "shapes.h"
+#define SPLITMIX_SEED 55
+#include "splitmix.h"
 #include "tap.h"
 
 #include <stdint.h>
@@ -258,9 +260,132 @@ static void test_many_vertices(void)
     st_soup_free(s);
 }
 
+/* The table by its definition (edges.h), the slow way: every triangle's
+ * sorted welded corners compared with every earlier one's through one
+ * qsort by (corners, triangle), and the half-edges through one qsort by
+ * (key, triangle). */
+typedef struct ref_key {
+    uint32_t k[3], t;
+} ref_key;
+
+static int ref_key_cmp(const void *x, const void *y)
+{
+    const ref_key *p = x, *q = y;
+    for (int j = 0; j < 3; j++)
+        if (p->k[j] != q->k[j])
+            return p->k[j] < q->k[j] ? -1 : 1;
+    return p->t < q->t ? -1 : p->t > q->t;
+}
+
+static int ref_half_cmp(const void *x, const void *y)
+{
+    const st_half_edge *p = x, *q = y;
+    if (p->key != q->key)
+        return p->key < q->key ? -1 : 1;
+    return p->t < q->t ? -1 : p->t > q->t;
+}
+
+/* 1 when e is the table the definition gives for s with flags. */
+static int matches_reference(const st_soup_edges *e, const st_soup *s, unsigned flags)
+{
+    const size_t nt = s->ntris;
+    ref_key *k = calloc(nt + 1, sizeof *k);
+    uint8_t *kept = calloc(nt + 1, 1);
+    st_half_edge *he = calloc(3 * nt + 1, sizeof *he);
+    if (!k || !kept || !he)
+        abort();
+    size_t dups = 0, degenerate = 0, nh = 0;
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t c[3];
+        for (int j = 0; j < 3; j++)
+            c[j] = e->weld[s->tris[3 * t + (size_t)j]];
+        for (int i = 0; i < 3; i++)
+            for (int j = i + 1; j < 3; j++)
+                if (c[j] < c[i]) {
+                    const uint32_t x = c[i];
+                    c[i] = c[j];
+                    c[j] = x;
+                }
+        memcpy(k[t].k, c, sizeof c);
+        k[t].t = (uint32_t)t;
+        degenerate += c[0] == c[1] || c[1] == c[2];
+    }
+    qsort(k, nt, sizeof *k, ref_key_cmp);
+    for (size_t i = 0; i < nt; i++) {
+        const int dup = i > 0 && memcmp(k[i].k, k[i - 1].k, sizeof k[i].k) == 0;
+        dups += (size_t)dup;
+        kept[k[i].t] = (uint8_t)(k[i].k[0] != k[i].k[1] && k[i].k[1] != k[i].k[2] && !dup);
+        if (k[i].k[0] == k[i].k[1] || k[i].k[1] == k[i].k[2] ||
+            (!kept[k[i].t] && !(flags & ST_EDGES_DUPLICATES)))
+            continue;
+        const uint64_t a = k[i].k[0], b = k[i].k[1], c = k[i].k[2];
+        const uint64_t keys[3] = {a << 32 | b, b << 32 | c, a << 32 | c};
+        for (int j = 0; j < 3; j++) {
+            he[nh].key = keys[j];
+            he[nh++].t = k[i].t;
+        }
+    }
+    qsort(he, nh, sizeof *he, ref_half_cmp);
+    int same = e->nhalf == nh && e->duplicates == dups && e->degenerate == degenerate;
+    for (size_t t = 0; t < nt && same; t++)
+        same = e->kept[t] == kept[t];
+    for (size_t h = 0; h < nh && same; h++)
+        same = e->he[h].key == he[h].key && e->he[h].t == he[h].t;
+    free(k);
+    free(kept);
+    free(he);
+    return same;
+}
+
+/* Random soups over few points: fans of hundreds of triangles around one
+ * vertex (the buckets sorted by qsort), duplicates in any corner order,
+ * degenerate triangles, triangles repeated far apart; each table is the
+ * definition's, half-edge for half-edge. Pins the counting sorts (edges.c)
+ * to the order of the radix sorts they replaced. */
+static void test_reference(void)
+{
+    int all = 1;
+    size_t tables = 0;
+    for (int round = 0; round < 12; round++) {
+        st_soup *s = new_soup();
+        const int npts = round < 4 ? 6 : round < 8 ? 40 : 400;
+        for (int v = 0; v < npts; v++)
+            vert(s, (double)rng_int(3), (double)rng_int(3), (double)(v / 8));
+        for (int t = 0; t < 3000; t++) {
+            uint32_t c[3];
+            for (int j = 0; j < 3; j++)
+                c[j] = (uint32_t)(rng_next() % (uint64_t)npts);
+            if (t % 3 == 0)
+                c[0] = 0;                       /* a fan around point 0 */
+            if (t > 10 && t % 7 == 0) {         /* an earlier triangle, rotated or turned */
+                const uint32_t *o = s->tris + 3 * (rng_next() % (uint64_t)s->ntris);
+                const int r = (int)(rng_next() % 3), turn = (int)(rng_next() % 2);
+                for (int j = 0; j < 3; j++)
+                    c[j] = o[turn ? (r + 3 - j) % 3 : (r + j) % 3];
+            }
+            st_soup_add_triangle(s, c[0], c[1], c[2], NULL);
+        }
+        for (unsigned flags = 0; flags <= ST_EDGES_DUPLICATES; flags += ST_EDGES_DUPLICATES) {
+            st_soup_edges e;
+            st_error err;
+            if (st_soup_edges_build_opts(&e, s, flags, &err) != ST_OK) {
+                all = 0;
+                continue;
+            }
+            all &= matches_reference(&e, s, flags) && e.duplicates > 0 && e.degenerate > 0;
+            tables++;
+            st_soup_edges_free(&e);
+        }
+        st_soup_free(s);
+    }
+    TAP_CHECK(all && tables == 24, "reference: %zu random tables with fans, duplicates and "
+              "degenerate triangles are the definition's", tables);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(weld), TAP_TEST(closed_box), TAP_TEST(damage),
-                                     TAP_TEST(order), TAP_TEST(many_vertices), {0}};
+                                     TAP_TEST(order), TAP_TEST(many_vertices),
+                                     TAP_TEST(reference), {0}};
     return tap_main(argc, argv, tests);
 }

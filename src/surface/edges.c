@@ -1,62 +1,41 @@
 /*
  * edges.c - edges and pieces of a soup on welded vertices (see edges.h).
  *
- *   1. weld the vertices exactly; sort the triangles by their sorted
- *      welded corners (ties by index): a run of equal corners is one
- *      triangle and its duplicates; keep the first of each run that is
- *      not degenerate;
- *   2. sort the kept triangles' half-edges (with ST_EDGES_DUPLICATES,
- *      every non-degenerate triangle's) by their unordered welded ends
- *      (ties by triangle: the order is total);
+ *   1. weld the vertices exactly; sort each triangle's welded corners
+ *      (a <= b <= c); bucket the triangles by a (a counting sort, in
+ *      triangle order) and, within each bucket, find the triangles whose
+ *      (b, c) an earlier one has: the duplicates; keep every triangle that
+ *      is neither degenerate nor a duplicate;
+ *   2. bucket the kept triangles' half-edges (with ST_EDGES_DUPLICATES,
+ *      every non-degenerate triangle's) by their lower welded end (a
+ *      counting sort, in triangle order), then sort each bucket by the
+ *      higher end, stably: the order by unordered ends, ties by triangle
+ *      (total);
  *   3. join the triangles of every edge (unionfind.h: toward the smaller
  *      index, so every root is its piece's smallest triangle).
+ *
+ * The counting sorts place each element once, with no scratch copy of the
+ * half-edges: on a 10M-triangle soup the radix sorts they replace (three
+ * and five 16-bit passes, a 480 MB scratch array) took most of the table's
+ * time and fresh memory (doc/design/edges.md).
  */
 #include "souptet/edges.h"
 #include "souptet/mem.h"
 #include "souptet/weld.h"
-#include "../base/radix.h"
 #include "../base/unionfind.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct tri_key {
-    uint32_t k[3];      /* sorted welded corners */
-    uint32_t t;
-} tri_key;
+/* Buckets up to this long are searched or sorted in place by insertion
+ * (a vertex's bucket holds about six half-edges on a mesh); longer ones
+ * (fans) by qsort, on keys that are unique within a bucket, so the order
+ * is the same either way. */
+#define SMALL_BUCKET 32
 
-/* Digit `pass` of the key (k[0], k[1], k[2]) packed into 3 * bits bits
- * (every corner is below 2^bits), k[2] in the lowest: the key's order in
- * as few 16-bit passes as the packed width needs (4 rather than 6 on the
- * dragon). The keys are made in triangle order, so the stable passes
- * leave ties by t. */
-static uint32_t tri_digit(const void *x, int pass, unsigned bits)
-{
-    const tri_key *k = x;
-    const unsigned lo = 16u * (unsigned)pass;
-    uint64_t d = 0;
-    for (unsigned j = 0; j < 3; j++) {
-        const unsigned start = j * bits;
-        const uint64_t field = k->k[2 - j];
-        if (start >= lo + 16 || start + bits <= lo)
-            continue;
-        d |= start >= lo ? field << (start - lo) : field >> (lo - start);
-    }
-    return (uint32_t)d & 0xffffu;
-}
-
-/* The key's ends packed into 2 * bits bits (both ends are below
- * 2^bits): the same order as the key's, in fewer passes. The half-edges
- * are made in triangle order, so the stable passes leave ties by t. */
-static uint32_t half_digit(const void *x, int pass, unsigned bits)
-{
-    const st_half_edge *h = x;
-    const uint64_t packed = (h->key >> 32) << bits | (h->key & 0xffffffffu);
-    return (uint32_t)(packed >> (16 * pass)) & 0xffffu;
-}
-
-ST_RADIX_SORT_DEFINE(sort_tri_keys, sizeof(tri_key), tri_digit)
-ST_RADIX_SORT_DEFINE(sort_half_edges, sizeof(st_half_edge), half_digit)
+/* Arrays of buckets this long are swept in parallel (each bucket is
+ * independent: the result does not depend on the threads). */
+#define PARALLEL_MIN 65536
 
 void st_soup_edges_free(st_soup_edges *e)
 {
@@ -90,6 +69,170 @@ int st_soup_edges_corner(const st_soup_edges *e, const st_soup *s, uint32_t t, u
     return -1;
 }
 
+/* Counts per bucket (bucket i's in cnt[i + 1], cnt[0] 0) into starts:
+ * cnt[i] becomes the first slot of bucket i (the prefix sums). */
+static void bucket_starts(size_t *cnt, size_t nb)
+{
+    for (size_t i = 1; i <= nb; i++)
+        cnt[i] += cnt[i - 1];
+}
+
+/* (b, c, t) triples of one bucket, for qsort: by b, c, then t. */
+static int triple_cmp(const void *x, const void *y)
+{
+    const uint32_t *p = x, *q = y;
+    for (int k = 0; k < 3; k++)
+        if (p[k] != q[k])
+            return p[k] < q[k] ? -1 : 1;
+    return 0;
+}
+
+/* Step 1 within the bucket ids[0..m) (triangles in increasing order, all
+ * with the same smallest corner; srt their sorted corners): dup[i] = 1
+ * when an earlier triangle of the bucket has the same two other corners.
+ * Returns the duplicates, or SIZE_MAX when out of memory. */
+static size_t bucket_duplicates(const uint32_t *ids, size_t m, const uint32_t *srt,
+                                uint8_t *dup)
+{
+    size_t n = 0;
+    if (m <= SMALL_BUCKET) {
+        for (size_t i = 0; i < m; i++) {
+            const uint32_t *k = srt + 3 * (size_t)ids[i];
+            dup[i] = 0;
+            for (size_t j = 0; j < i && !dup[i]; j++) {
+                const uint32_t *q = srt + 3 * (size_t)ids[j];
+                dup[i] = k[1] == q[1] && k[2] == q[2];
+            }
+            n += dup[i];
+        }
+        return n;
+    }
+    uint32_t *tr = malloc(m * 3 * sizeof *tr);
+    if (!tr)
+        return SIZE_MAX;
+    for (size_t i = 0; i < m; i++) {
+        tr[3 * i] = srt[3 * (size_t)ids[i] + 1];
+        tr[3 * i + 1] = srt[3 * (size_t)ids[i] + 2];
+        tr[3 * i + 2] = (uint32_t)i;   /* ids ascend: the index orders as t */
+    }
+    qsort(tr, m, 3 * sizeof *tr, triple_cmp);
+    for (size_t i = 0; i < m; i++) {
+        const int d = i > 0 && tr[3 * i] == tr[3 * i - 3] && tr[3 * i + 1] == tr[3 * i - 2];
+        dup[tr[3 * i + 2]] = (uint8_t)d;
+        n += (size_t)d;
+    }
+    free(tr);
+    return n;
+}
+
+static int half_cmp(const void *x, const void *y)
+{
+    const st_half_edge *p = x, *q = y;
+    if (p->key != q->key)
+        return p->key < q->key ? -1 : 1;
+    return p->t < q->t ? -1 : p->t > q->t;
+}
+
+/* Step 2 within one bucket: by key, stably (the bucket is in triangle
+ * order, and a triangle has one half-edge per key, so (key, t) is unique
+ * and qsort's order is the stable one). */
+static void sort_bucket(st_half_edge *h, size_t m)
+{
+    if (m > SMALL_BUCKET) {
+        qsort(h, m, sizeof *h, half_cmp);
+        return;
+    }
+    for (size_t i = 1; i < m; i++) {
+        const st_half_edge x = h[i];
+        size_t j = i;
+        for (; j > 0 && h[j - 1].key > x.key; j--)
+            h[j] = h[j - 1];
+        h[j] = x;
+    }
+}
+
+/* Step 1: e->kept, e->degenerate, e->duplicates from the sorted corners
+ * srt; cnt holds nweld + 1 zeroed counters. ST_ENOMEM. */
+static st_status mark_kept(st_soup_edges *e, const uint32_t *srt, size_t nt, size_t *cnt)
+{
+    const size_t nw = e->nweld;
+    uint32_t *ids = st_malloc_big((nt + 1) * sizeof *ids);
+    uint8_t *dup = st_malloc_big(nt + 1);
+    if (!ids || !dup) {
+        free(ids);
+        free(dup);
+        return ST_ENOMEM;
+    }
+    for (size_t t = 0; t < nt; t++) {
+        cnt[srt[3 * t] + 1]++;
+        e->degenerate += srt[3 * t] == srt[3 * t + 1] || srt[3 * t + 1] == srt[3 * t + 2];
+    }
+    bucket_starts(cnt, nw);
+    for (size_t t = 0; t < nt; t++)
+        ids[cnt[srt[3 * t]]++] = (uint32_t)t;   /* cnt[a] ends at bucket a + 1's start */
+    size_t dups = 0, failed = 0;
+    const long long lnw = (long long)nw;
+    #pragma omp parallel for schedule(static) reduction(+ : dups, failed) if (nw >= PARALLEL_MIN)
+    for (long long a = 0; a < lnw; a++) {
+        const size_t lo = a ? cnt[a - 1] : 0, hi = cnt[a];
+        const size_t n = bucket_duplicates(ids + lo, hi - lo, srt, dup + lo);
+        if (n == SIZE_MAX)
+            failed++;
+        else
+            dups += n;
+    }
+    for (size_t i = 0; i < nt && !failed; i++) {
+        const uint32_t t = ids[i], *k = srt + 3 * (size_t)t;
+        e->kept[t] = (uint8_t)(k[0] != k[1] && k[1] != k[2] && !dup[i]);
+    }
+    free(ids);
+    free(dup);
+    e->duplicates = dups;
+    return failed ? ST_ENOMEM : ST_OK;
+}
+
+/* Step 2: e->he, e->nhalf from the sorted corners srt of the triangles
+ * that give half-edges; cnt holds nweld + 1 counters. ST_ENOMEM. */
+static st_status sort_half_edges(st_soup_edges *e, const uint32_t *srt, size_t nt,
+                                 unsigned flags, size_t *cnt)
+{
+    const size_t nw = e->nweld;
+    memset(cnt, 0, (nw + 1) * sizeof *cnt);
+    size_t nh = 0;
+    for (size_t t = 0; t < nt; t++) {
+        const uint32_t *k = srt + 3 * t;
+        if (k[0] == k[1] || k[1] == k[2] || (!e->kept[t] && !(flags & ST_EDGES_DUPLICATES)))
+            continue;
+        cnt[k[0] + 1] += 2;   /* (a, b) and (a, c) */
+        cnt[k[1] + 1]++;      /* (b, c) */
+        nh += 3;
+    }
+    bucket_starts(cnt, nw);
+    for (size_t t = 0; t < nt; t++) {
+        const uint32_t *k = srt + 3 * t;
+        if (k[0] == k[1] || k[1] == k[2] || (!e->kept[t] && !(flags & ST_EDGES_DUPLICATES)))
+            continue;
+        const uint64_t a = k[0], b = k[1], c = k[2];
+        st_half_edge *h = &e->he[cnt[a]++];
+        h->key = a << 32 | b;
+        h->t = (uint32_t)t;
+        h = &e->he[cnt[b]++];
+        h->key = b << 32 | c;
+        h->t = (uint32_t)t;
+        h = &e->he[cnt[a]++];
+        h->key = a << 32 | c;
+        h->t = (uint32_t)t;
+    }
+    const long long lnw = (long long)nw;
+    #pragma omp parallel for schedule(static) if (nw >= PARALLEL_MIN)
+    for (long long a = 0; a < lnw; a++) {
+        const size_t lo = a ? cnt[a - 1] : 0;
+        sort_bucket(e->he + lo, cnt[a] - lo);
+    }
+    e->nhalf = nh;
+    return ST_OK;
+}
+
 st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned flags,
                                    st_error *err)
 {
@@ -99,89 +242,48 @@ st_status st_soup_edges_build_opts(st_soup_edges *e, const st_soup *s, unsigned 
                             "%zu triangles: the soup's edges are read for at most 2^31",
                             s->ntris);
     const size_t nt = s->ntris;
-    /* arrays over every triangle or vertex, sorted and read at random:
-     * huge pages past a few MB (st_malloc_big; nt < 2^31 and the vertex
-     * count below 2^32 keep the products in range) */
-    tri_key *keys = st_malloc_big((nt + 1) * sizeof *keys);
+    /* arrays over every triangle or vertex, read at random: huge pages
+     * past a few MB (st_malloc_big; nt < 2^31 and the vertex count below
+     * 2^32 keep the products in range) */
     e->weld = st_malloc_big((s->nverts + 1) * sizeof *e->weld);
+    uint32_t *srt = st_malloc_big((3 * nt + 1) * sizeof *srt);
+    if (!e->weld || !srt || st_weld_vertices(e->weld, &e->nweld, s, err)) {
+        free(srt);
+        st_soup_edges_free(e);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
+    }
     e->kept = st_calloc_big(nt + 1);
-    e->he = st_malloc_big((3 * nt + 1) * sizeof *e->he);
-    e->piece = st_malloc_big((nt + 1) * sizeof *e->piece);
-    size_t *uf = st_malloc_big((nt + 1) * sizeof *uf);
-    /* the radix sorts' scratch: the half-edges */
-    st_half_edge *tmp = st_malloc_big((3 * nt + 1) * sizeof *tmp);
-    if (!keys || !e->weld || st_weld_vertices(e->weld, &e->nweld, s, err) ||
-        !e->kept || !e->he || !e->piece || !uf || !tmp) {
-        free(keys);
-        free(uf);
-        free(tmp);
-        st_soup_edges_free(e);
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
+    size_t *cnt = st_calloc_big((e->nweld + 2) * sizeof *cnt);
+    st_status rc = !e->kept || !cnt ? ST_ENOMEM : ST_OK;
+    for (size_t t = 0; t < nt && !rc; t++) {
+        uint32_t a = e->weld[s->tris[3 * t]], b = e->weld[s->tris[3 * t + 1]],
+                 c = e->weld[s->tris[3 * t + 2]], x;
+        if (a > b) { x = a; a = b; b = x; }
+        if (b > c) { x = b; b = c; c = x; }
+        if (a > b) { x = a; a = b; b = x; }
+        srt[3 * t] = a;
+        srt[3 * t + 1] = b;
+        srt[3 * t + 2] = c;
     }
-
     /* 1. welded, non-degenerate, first of its duplicates */
-    size_t nk = 0;
-    for (size_t t = 0; t < nt; t++) {
-        uint32_t a = e->weld[s->tris[3 * t]], b = e->weld[s->tris[3 * t + 1]],
-                 c = e->weld[s->tris[3 * t + 2]], x;
-        e->degenerate += a == b || b == c || a == c;
-        if (a > b) { x = a; a = b; b = x; }
-        if (b > c) { x = b; b = c; c = x; }
-        if (a > b) { x = a; a = b; b = x; }
-        keys[nk].k[0] = a;
-        keys[nk].k[1] = b;
-        keys[nk].k[2] = c;
-        keys[nk].t = (uint32_t)t;
-        nk++;
-    }
-    _Static_assert(sizeof(tri_key) <= sizeof(st_half_edge), "the scratch holds the keys");
-    unsigned bits = 0;   /* every welded index is below 2^bits */
-    while (bits < 32 && (e->nweld - 1) >> bits)
-        bits++;
-    if (sort_tri_keys(keys, tmp, nk, (int)((3 * bits + 15) / 16), bits)) {
-        free(keys);
-        free(uf);
-        free(tmp);
-        st_soup_edges_free(e);
-        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
-    }
-
+    rc = rc ? rc : mark_kept(e, srt, nt, cnt);
     /* 2. half-edges of the kept triangles (with ST_EDGES_DUPLICATES, of
-     * every non-degenerate one), made in triangle order */
-    for (size_t i = 0; i < nk; i++) {
-        const uint32_t *k = keys[i].k, t = keys[i].t;
-        const int dup = i > 0 && memcmp(k, keys[i - 1].k, sizeof keys[i].k) == 0;
-        e->duplicates += dup;
-        e->kept[t] = (uint8_t)(k[0] != k[1] && k[1] != k[2] && !dup);
-    }
-    free(keys);
-    size_t nh = 0;
-    for (size_t t = 0; t < nt; t++) {
-        uint32_t a = e->weld[s->tris[3 * t]], b = e->weld[s->tris[3 * t + 1]],
-                 c = e->weld[s->tris[3 * t + 2]], x;
-        if (a > b) { x = a; a = b; b = x; }
-        if (b > c) { x = b; b = c; c = x; }
-        if (a > b) { x = a; a = b; b = x; }
-        if (a == b || b == c || (!e->kept[t] && !(flags & ST_EDGES_DUPLICATES)))
-            continue;
-        const uint64_t ends[3] = {(uint64_t)a << 32 | b, (uint64_t)b << 32 | c,
-                                  (uint64_t)a << 32 | c};
-        for (int j = 0; j < 3; j++) {
-            e->he[nh].key = ends[j];
-            e->he[nh].t = (uint32_t)t;
-            nh++;
-        }
-    }
-    const int sorted = sort_half_edges(e->he, tmp, nh, (int)((2 * bits + 15) / 16), bits);
-    free(tmp);
-    if (sorted) {
+     * every non-degenerate one) */
+    if (!rc && !(e->he = st_malloc_big((3 * nt + 1) * sizeof *e->he)))
+        rc = ST_ENOMEM;
+    rc = rc ? rc : sort_half_edges(e, srt, nt, flags, cnt);
+    free(srt);
+    free(cnt);
+    size_t *uf = rc ? NULL : st_malloc_big((nt + 1) * sizeof *uf);
+    e->piece = rc ? NULL : st_malloc_big((nt + 1) * sizeof *e->piece);
+    if (rc || !uf || !e->piece) {
         free(uf);
         st_soup_edges_free(e);
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's edges");
     }
-    e->nhalf = nh;
 
     /* 3. pieces */
+    const size_t nh = e->nhalf;
     for (size_t t = 0; t < nt; t++)
         uf[t] = t;
     for (size_t i = 0, j; i < nh; i = j)
