@@ -198,9 +198,7 @@ static void test_order(void)
     st_soup_free(r);
 }
 
-/* More than 2^16 welded vertices (the half-edges' sort then packs two
- * 17-bit ends into three 16-bit digits, the triangles' three into four),
- * the triangles scrambled and some
+/* More than 2^16 welded vertices, the triangles scrambled and some
  * duplicated: the half-edges still run by key, ties by triangle, and a
  * grid's edges come out as counted by hand. */
 static void test_many_vertices(void)
@@ -238,8 +236,7 @@ static void test_many_vertices(void)
         TAP_CHECK(sorted && ends, "many vertices (flags %u): by key, ties by triangle", flags);
         const size_t copies = (nt + 96) / 97, boundary = 4 * (N - 1);
         const size_t all = 3 * quads + 2 * (N - 1);    /* the grid's edges */
-        int first_kept = 1;   /* the triangles' sort (3 corners of 17 bits packed
-                                 into four 16-bit digits) keeps ties by triangle */
+        int first_kept = 1;   /* the first of each set of copies is kept */
         for (size_t t = 0; t < s->ntris; t++)
             first_kept &= e.kept[t] == (t < nt);
         TAP_CHECK(first_kept, "many vertices (flags %u): each original kept, each later "
