@@ -189,7 +189,12 @@ static void test_wants_bvh(void)
     TAP_CHECK(st_dist_wants_bvh(fine, &p), "48 K triangles on 14^3 voxels: dense, the BVH's way");
     TAP_CHECK(!st_dist_wants_bvh(coarse, &p), "240 triangles on 14^3 voxels: the bricks' way");
     p.cells = 5;
-    TAP_CHECK(!st_dist_wants_bvh(fine, &p), "48 K triangles on 15^3 voxels: 14.2 a voxel, the bricks' way");
+    TAP_CHECK(st_dist_wants_bvh(fine, &p), "48 K triangles on 15^3 voxels: 14.3 a voxel, the BVH's way");
+    /* The threshold, one triangle a voxel (dist.h: measured) */
+    p.cells = 26;
+    TAP_CHECK(st_dist_wants_bvh(fine, &p), "48 K triangles on 36^3 voxels: 1.03 a voxel, the BVH's way");
+    p.cells = 27;
+    TAP_CHECK(!st_dist_wants_bvh(fine, &p), "48 K triangles on 37^3 voxels: 0.95 a voxel, the bricks' way");
     p.cells = 128;
     TAP_CHECK(!st_dist_wants_bvh(fine, &p), "48 K triangles on 138^3 voxels: the bricks' way");
     p.cells = 4;

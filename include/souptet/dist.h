@@ -86,9 +86,12 @@ st_status st_dist_field(st_grid **out, const st_soup *s,
 /* A soup with at least this many triangles per voxel of its grid is
  * dense: its band is found faster by a BVH's nearest-triangle walks, one
  * per voxel (st_dist_field_bvh), than by binning every triangle into the
- * bricks its band reaches (a 10M-triangle soup on a 138x18x18 grid has
- * 234 per voxel, and about 150 M (brick, triangle) pairs). */
-#define ST_DIST_BVH_TRIS_PER_VOXEL 16.0
+ * bricks its band reaches. Measured (instructions, default band, the BVH
+ * already built; doc/design/dist.md): the two cost the same between 0.3
+ * (armadillo) and 0.7 (cheese, large CAD triangles) triangles per voxel;
+ * at 1 the walks take 0.35-0.67 of the bricks' instructions on the
+ * seven soups measured, at 10 a tenth. */
+#define ST_DIST_BVH_TRIS_PER_VOXEL 1.0
 
 /* 1 when st_dist_field_bvh would walk a BVH for soup s under p: a finite
  * band and at least ST_DIST_BVH_TRIS_PER_VOXEL triangles per voxel of the

@@ -1195,6 +1195,23 @@ static st_status block_slots(st_grid_blocks *bk, const band_bins *bb,
     return ST_OK;
 }
 
+/* One more of the band's `total` units done: count it in *done (shared by
+ * the threads) and report the fraction from thread 0 every mask + 1 units
+ * (mask + 1 a power of two). */
+static void band_progress(const st_progress *progress, size_t *done, size_t total,
+                          size_t mask)
+{
+    size_t now;
+    #pragma omp atomic capture
+    now = ++*done;
+#ifdef _OPENMP
+    if (omp_get_thread_num() != 0)
+        return;
+#endif
+    if ((now & mask) == 0)
+        st_progress_report(progress, "distance band", (double)now / (double)total);
+}
+
 /* The band's exact distances for every brick of g (dense: through near as
  * well, if given), or of every block of bk (then g is bk's head). */
 static st_status band_bricks(const st_grid *g, int32_t *near,
@@ -1240,14 +1257,7 @@ static st_status band_bricks(const st_grid *g, int32_t *near,
                 oom = 1;
                 continue;
             }
-            size_t now;
-            #pragma omp atomic capture
-            now = ++done;
-#ifdef _OPENMP
-            if (omp_get_thread_num() == 0 && (now & 1023) == 0)
-#endif
-                st_progress_report(progress, "distance band",
-                                   (double)now / (double)nunits);
+            band_progress(progress, &done, nunits, 1023);
         }
         scratch_free(&sc);
     }
@@ -1377,13 +1387,7 @@ static st_status band_pass_bvh(st_grid *g, const st_soup *s, const st_bvh *bvh,
             p[0] = g->origin[0] + g->voxel * (double)i;
             row[i] = bvh_voxel(bvh, s, p, B, slack);
         }
-        size_t now;
-        #pragma omp atomic capture
-        now = ++done;
-#ifdef _OPENMP
-        if (omp_get_thread_num() == 0 && (now & 255) == 0)
-#endif
-            st_progress_report(progress, "distance band", (double)now / (double)rows);
+        band_progress(progress, &done, rows, 255);
     }
     if (st_progress_cancelled(progress))
         return st_error_set(err, ST_ECANCELLED, NULL, 0, "cancelled");
