@@ -224,7 +224,7 @@ static void test_star_score_is_min(void)
     /* windows of the tet list as stars: single tets (each kind alone),
      * a few, exactly a block, past a block, all */
     static const int lens[] = {1, 1, 2, 3, 4, 5, 9, 64, 65, 130, NT};
-    int same = 1, tested = 0, finite_lo = 0, above_ok = 1, above_below = 0;
+    int same = 1, tested = 0, finite_lo = 0, above_ok = 1, above_below = 0, above_first = 1;
     for (size_t k = 0; k < sizeof lens / sizeof lens[0]; k++) {
         for (int trial = 0; trial < NTRIAL; trial++) {
             int len = lens[k], start = (int)(rnd() * (NT - len + 1));
@@ -255,6 +255,22 @@ static void test_star_score_is_min(void)
                 if (want > thr[i] ? memcmp(&a, &want, sizeof a) != 0
                                   : !(a <= thr[i] && a >= want))
                     above_ok = 0;
+                /* at or below: the score of the first tet there, tet
+                 * `first` first, then the others in order (what the
+                 * quality pass sorts its bounds by) */
+                if (!(want > thr[i])) {
+                    double w = INFINITY;
+                    for (int r = -1; r < len && !(w <= thr[i]); r++) {
+                        int t = r < 0 ? start + (int)first : start + r;
+                        if ((r < 0 && (int)first >= len) || (r >= 0 && r == (int)first))
+                            continue;
+                        const uint32_t *tc = m->tets + 4 * (size_t)t;
+                        w = sm_tet_score(p, m->xyz + 3 * (size_t)tc[1],
+                                         m->xyz + 3 * (size_t)tc[2], m->xyz + 3 * (size_t)tc[3]);
+                    }
+                    if (memcmp(&a, &w, sizeof a) != 0)
+                        above_first = 0;
+                }
                 above_below += !(want > thr[i]);
             }
             tested++;
@@ -266,6 +282,8 @@ static void test_star_score_is_min(void)
               "the star score above a threshold is the score, or at most the threshold "
               "and at least the score (%d of %d thresholds at or above the score)",
               above_below, 6 * tested);
+    TAP_CHECK(above_first, "at or below the threshold, the star score above it is the score of "
+              "the first tet there (the given one first), bit for bit");
     TAP_CHECK(same && finite_lo > tested / 8,
               "the star score is the minimum of the tet scores, bit for bit (%d stars, %d "
               "with a non-zero score)", tested, finite_lo);

@@ -865,6 +865,36 @@ static int brute_in_star(const sm_mesh *sm, uint32_t v, const double y[3], const
     return in;
 }
 
+/* The S vertex sm_swept_kept's scan names when v's move to p loses one:
+ * in bin order (z, then y, then x, as the scan visits them; each bin's
+ * points in their order), the first that lies in some closed tet
+ * (x, p, a, b) of a boundary face (v, a, b) and leaves the star. Every
+ * face is tested at every point, as the scan did before it visited only
+ * the faces a bin keeps; UINT32_MAX when none leaves. */
+static uint32_t first_swept_leaving(const sm_mesh *sm, const pgrid *g, uint32_t v,
+                                    const double p[3])
+{
+    const double *x = sm->m->xyz + 3 * (size_t)v;
+    const size_t nb = g->n[0] * g->n[1] * g->n[2];
+    for (size_t b = 0; b < nb; b++)
+        for (size_t j = g->off[b]; j < g->off[b + 1]; j++) {
+            const double *q = g->bpts + 3 * j;
+            int swept = 0;
+            for (size_t f = sm->vf_off[v]; f < sm->vf_off[v + 1] && !swept; f++) {
+                const uint32_t *k = sm->bf + 3 * (size_t)sm->vf[f];
+                const double *ab[2];
+                int n = 0;
+                for (int i = 0; i < 3; i++)
+                    if (k[i] != v)
+                        ab[n++] = sm->m->xyz + 3 * (size_t)k[i];
+                swept = st_point_in_tet(q, x, p, ab[0], ab[1]) != ST_OUTSIDE;
+            }
+            if (swept && brute_in_star(sm, v, x, q) && !brute_in_star(sm, v, p, q))
+                return g->idx[j];
+        }
+    return UINT32_MAX;
+}
+
 /* sm_swept_kept against every S vertex: a dense cloud of tiny triangles
  * in the shell the boundary stars cover (many points per bin, so whole
  * bins are skipped and kept), moves of every size from a hair to a third
@@ -898,7 +928,7 @@ static void test_swept(void)
     st_error err;
     TAP_CHECK(sm_mesh_build(&sm, m, &err) == ST_OK && sm_pgrid_build(&g, s, h / 4.0) == ST_OK,
               "mesh incidence and point grid");
-    size_t tried = 0, kept = 0, left = 0, wrong = 0, bad_failed = 0;
+    size_t tried = 0, kept = 0, left = 0, wrong = 0, bad_failed = 0, other_failed = 0;
     static const double scale[] = {1e-6, 1e-3, 0.02, 0.1, 0.35};
     for (uint32_t v = 0; v < sm.nv; v++) {
         const double *x = m->xyz + 3 * (size_t)v;
@@ -927,6 +957,7 @@ static void test_swept(void)
             if (r == 0) {
                 const double *q = failed < g.npts ? g.pts + 3 * (size_t)failed : NULL;
                 bad_failed += !q || !brute_in_star(&sm, v, x, q) || brute_in_star(&sm, v, p, q);
+                other_failed += failed != first_swept_leaving(&sm, &g, v, p);
             }
         }
     }
@@ -936,6 +967,9 @@ static void test_swept(void)
     TAP_CHECK(wrong == 0, "the swept test answers as the brute force every time (%zu differ)",
               wrong);
     TAP_CHECK(bad_failed == 0, "every failed point named is one that leaves (%zu not)", bad_failed);
+    TAP_CHECK(other_failed == 0,
+              "the point named is the per-point scan's: the first swept point that leaves, in "
+              "bin order, every face tested (%zu differ)", other_failed);
     sm_pgrid_free(&g);
     sm_mesh_free(&sm);
     st_tetmesh_free(m);

@@ -230,8 +230,8 @@ static int cmp_rescue(const void *a, const void *b)
  * direction that still brings it closer to S often passes (it slides past
  * what holds it). Candidates: the directions within 88 degrees of the way
  * to S's nearest point, at fractions of the way to the band's middle; of
- * those that keep the star's score floor (tested first: most fail it), the
- * closest to S first, the first that keeps the invariant is taken. 1 when
+ * those that keep the star's score floor and the invariant, the closest to
+ * S is taken (the first by order among equals). 1 when
  * v moved. */
 static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
 {
@@ -273,11 +273,6 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
                 double st = way * rescue_frac[fi];
                 for (int a = 0; a < 3; a++)
                     cd[nc][1 + a] = x[a] + st * dir[a];
-                /* the score floor first: it is cheaper than the distance,
-                 * and most candidates fail it (a candidate that fails it
-                 * is never taken, so the order of the rest is the same) */
-                if (!star_keeps_floor(sm, v, cd[nc] + 1, worst, floor_score))
-                    continue;
                 cd[nc][0] = dd - st - RESCUE_LB_SLACK * c->h;
                 cd[nc][4] = (double)ord;
                 nc++;
@@ -285,18 +280,25 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
         }
     }
     /* The candidate taken is the first by (distance to S, order) of those
-     * closer than dd that keep the invariant. Searched by a lower bound on
-     * the distance (the step is st long, so the distance is at least dd -
-     * st; the slack covers the rounding): in the bound's order, a
-     * candidate is tested (invariant, then distance: a distance costs
-     * more) while its bound is no more than the best distance found, so
-     * a rescue that fails computes no distance. */
+     * closer than dd that keep the star's score floor and the invariant.
+     * Searched by a lower bound on the distance (the step is st long, so
+     * the distance is at least dd - st; the slack covers the rounding): in
+     * the bound's order, a candidate is tested (the score floor, then the
+     * invariant, then the distance: cheapest first, and most candidates
+     * fail the floor) while its bound is no more than the best distance
+     * found, so a rescue that fails computes no distance, and one that
+     * finds a close candidate early tests neither the floor nor the
+     * invariant of the candidates whose bound is past it. A candidate that
+     * fails the floor changes nothing of the search, so the candidates
+     * tested past it, and the one taken, are those of filtering by the
+     * floor before the sort (as until batch 55). */
     qsort(cd, nc, sizeof cd[0], cmp_rescue);
     sm_star_pts_collect(c, v, sp);
     double best = dd, best_ord = INFINITY;
     size_t bi = SIZE_MAX;
     for (size_t i = 0; i < nc && !(cd[i][0] > best); i++) {
-        if (!sm_move_ok(c, v, cd[i] + 1, sp))
+        if (!star_keeps_floor(sm, v, cd[i] + 1, worst, floor_score) ||
+            !sm_move_ok(c, v, cd[i] + 1, sp))
             continue;
         int64_t tri;
         double d2 = sm_nearest_d2(c, cd[i] + 1, dd * dd, &tri, NULL);

@@ -140,6 +140,21 @@ static uint64_t bin_faces(size_t nf, const double (*box)[6], const st_plane_filt
     return keep;
 }
 
+/* The index of the lowest set bit of m (m not 0). */
+static inline int lowest_bit(uint64_t m)
+{
+#if defined(__GNUC__)
+    return __builtin_ctzll(m);
+#else
+    int b = 0;
+    while (!(m & 1u)) {
+        m >>= 1;
+        b++;
+    }
+    return b;
+#endif
+}
+
 int sm_swept_applies(const sm_mesh *sm, uint32_t v)
 {
     return sm->vf_off[v + 1] - sm->vf_off[v] <= SWEPT_MAX_FACES;
@@ -211,9 +226,9 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
                         q[2] < lo[2] || q[2] > hi[2])
                         continue;
                     int swept = 0;
-                    for (size_t i = 0; i < nf && !swept; i++) {
-                        if (!(keep >> i & 1))
-                            continue;
+                    /* the faces the bin keeps, in index order */
+                    for (uint64_t kb = keep; kb && !swept; kb &= kb - 1) {
+                        const size_t i = (size_t)lowest_bit(kb);
                         const double *bx = box[i];
                         if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] || q[0] > bx[3] ||
                             q[1] > bx[4] || q[2] > bx[5])

@@ -347,14 +347,18 @@ typedef struct score_cut {
     int *below;
 } score_cut;
 
+/* The block's minimum over the tets j0 <= j < j1 of v's star but `skip`
+ * (an index into vt; SIZE_MAX: none), with v at p. */
 static double star_block_score(const sm_mesh *sm, uint32_t v, const double p[3],
-                               size_t j0, size_t j1, const score_cut *cut)
+                               size_t j0, size_t j1, size_t skip, const score_cut *cut)
 {
     double ylo[SM_STAR_BLOCK], xlo[SM_STAR_BLOCK], yhi[SM_STAR_BLOCK], xhi[SM_STAR_BLOCK];
     double rlo[SM_STAR_BLOCK], rhi[SM_STAR_BLOCK];
     double s = INFINITY, rlo_max = -INFINITY, rhi_min = INFINITY;
     size_t n = 0;
     for (size_t j = j0; j < j1; j++) {
+        if (j == skip)
+            continue;
         const double *q[4];
         star_corners(sm, sm->vt[j], v, p, q);
         if (!tet_extremes(q[0], q[1], q[2], q[3], ylo + n, xlo + n, yhi + n, xhi + n)) {
@@ -415,7 +419,7 @@ double sm_star_score(const sm_mesh *sm, uint32_t v, const double p[3])
     double s = INFINITY;
     for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j += SM_STAR_BLOCK) {
         size_t j1 = j + SM_STAR_BLOCK < sm->vt_off[v + 1] ? j + SM_STAR_BLOCK : sm->vt_off[v + 1];
-        double x = star_block_score(sm, v, p, j, j1, NULL);
+        double x = star_block_score(sm, v, p, j, j1, SIZE_MAX, NULL);
         if (x < s)
             s = x;
     }
@@ -426,12 +430,19 @@ double sm_star_score_above(const sm_mesh *sm, uint32_t v, const double p[3], siz
                            double thr)
 {
     size_t n = sm->vt_off[v + 1] - sm->vt_off[v];
+    /* Tet `first` is not scored again below: its score (sm_tet_score's,
+     * bit for bit the value the blocks take for it) joins the minimum
+     * as s0, and being above thr it never ends a block early, so the
+     * result is the same with it in the blocks or out. */
+    double s0 = INFINITY;
+    size_t skip = SIZE_MAX;
     if (first < n) {
         const double *q[4];
         star_corners(sm, sm->vt[sm->vt_off[v] + first], v, p, q);
-        double s = sm_tet_score(q[0], q[1], q[2], q[3]);
-        if (s <= thr)
-            return s;   /* a tet of the star's minimum: at most thr too */
+        s0 = sm_tet_score(q[0], q[1], q[2], q[3]);
+        if (s0 <= thr)
+            return s0;   /* a tet of the star's minimum: at most thr too */
+        skip = sm->vt_off[v] + first;
     }
     /* The ratios r = x / y at the angles where a tet's score is thr: its
      * min dihedral is at most thr where r >= cot(thr), its max at least
@@ -447,10 +458,10 @@ double sm_star_score_above(const sm_mesh *sm, uint32_t v, const double p[3], siz
         cut.lo = ca - 1e-6 * (1.0 + fabs(ca));
         cut.hi = cb + 1e-6 * (1.0 + fabs(cb));
     }
-    double s = INFINITY;
+    double s = s0;
     for (size_t j = sm->vt_off[v]; j < sm->vt_off[v + 1]; j += SM_STAR_BLOCK) {
         size_t j1 = j + SM_STAR_BLOCK < sm->vt_off[v + 1] ? j + SM_STAR_BLOCK : sm->vt_off[v + 1];
-        double x = star_block_score(sm, v, p, j, j1, &cut);
+        double x = star_block_score(sm, v, p, j, j1, skip, &cut);
         if (below)
             return x;
         if (x < s)
