@@ -745,6 +745,77 @@ static void test_fill(void)
     st_soup_free(down);
 }
 
+/* The shared set-up (st_fit_shared_new): fits given it, twice from one
+ * set-up and at once (the pipeline's candidates), move every vertex
+ * exactly as fits that built their own (the fill's BVH, the point grid);
+ * a set-up made for another surface, fill or cell width is refused. */
+static int same_mesh(const st_tetmesh *a, const st_tetmesh *b)
+{
+    return a->npoints == b->npoints && a->ntets == b->ntets &&
+           memcmp(a->xyz, b->xyz, 3 * a->npoints * sizeof *a->xyz) == 0 &&
+           memcmp(a->tets, b->tets, 4 * a->ntets * sizeof *a->tets) == 0;
+}
+
+static void test_shared(void)
+{
+    st_soup *full = st_soup_new(), *up = st_soup_new(), *down = st_soup_new();
+    add_sphere(full, 1.0, 2.0);
+    split_z(full, up, down);
+    const double h = 0.5;
+    st_fit_shared *sh = NULL;
+    st_error err;
+    TAP_CHECK(st_fit_shared_new(&sh, up, down, h, &err) == ST_OK && sh, "the set-up is made");
+    st_tetmesh *m[3];
+    st_fit_stats st[3];
+    st_status rc[3];
+    for (int k = 0; k < 3; k++)
+        m[k] = ball_mesh(h, 1.6);
+    #pragma omp parallel for num_threads(2) schedule(static, 1)
+    for (int k = 0; k < 3; k++) {
+        st_fit_params p = st_fit_params_default();
+        p.cell_width = h;
+        p.fill = down;
+        p.shared = k ? sh : NULL;
+        st_error e;
+        rc[k] = st_fit(m[k], up, NULL, &p, &st[k], NULL, &e);
+    }
+    for (int k = 1; k < 3; k++)
+        TAP_CHECK(rc[0] == ST_OK && rc[k] == ST_OK && same_mesh(m[0], m[k]) &&
+                      st[0].moves == st[k].moves && st[0].iters == st[k].iters &&
+                      st[0].max_distance == st[k].max_distance &&
+                      st[0].min_dihedral_after == st[k].min_dihedral_after,
+                  "fit %d with the shared set-up: the same mesh as with its own "
+                  "(%zu moves, max distance %.6f, angles %.3f..%.3f)",
+                  k, st[k].moves, st[k].max_distance, st[k].min_dihedral_after,
+                  st[k].max_dihedral_after);
+    struct {
+        const st_soup *s, *fill;
+        double h;
+        const char *what;
+    } bad[3] = {{full, down, h, "another surface"}, {up, NULL, h, "another fill"},
+                {up, down, 0.25, "another cell width"}};
+    for (int k = 0; k < 3; k++) {
+        st_tetmesh *b = ball_mesh(h, 1.6);
+        st_fit_params p = st_fit_params_default();
+        p.cell_width = bad[k].h;
+        p.fill = bad[k].fill;
+        p.shared = sh;
+        TAP_CHECK(st_fit(b, bad[k].s, NULL, &p, NULL, NULL, &err) == ST_EINPUT,
+                  "a set-up made for %s is refused", bad[k].what);
+        st_tetmesh_free(b);
+    }
+    st_fit_shared *none = sh;
+    TAP_CHECK(st_fit_shared_new(&none, up, down, 0.0, &err) == ST_EINPUT && !none,
+              "no set-up without a cell width");
+    for (int k = 0; k < 3; k++)
+        st_tetmesh_free(m[k]);
+    st_fit_shared_free(sh);
+    st_fit_shared_free(NULL);
+    st_soup_free(full);
+    st_soup_free(up);
+    st_soup_free(down);
+}
+
 /* The fit's stall rule, as fit.c promises it: a fit that stops with a
  * boundary vertex still beyond d_offset, having moved something in its
  * last iteration and before max_iters, has had STALL_ITERS iterations in a
@@ -981,7 +1052,8 @@ int main(int argc, char **argv)
     static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(quality_reports),
                                      TAP_TEST(not_enclosing), TAP_TEST(refusals),
                                      TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
-                                     TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), TAP_TEST(stall),
+                                     TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), TAP_TEST(shared),
+                                     TAP_TEST(stall),
                                      TAP_TEST(swept), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -25,7 +25,9 @@
  * candidates of a batch at once, each on a thread of its own with its
  * share of the threads for its own loops (one each on 2 threads); once
  * one is done, the others take its threads for their loops (from their
- * next fit iteration or quality round on). Once a batch has ended
+ * next fit iteration or quality round on). They share the fits' set-up
+ * that depends on the soup, the fill and h alone (st_fit_shared: the
+ * fill's BVH, the point grid), built once. Once a batch has ended
  * with a candidate that meets every goal (it encloses, meets the fit's
  * stopping condition, and every tet scores at least the quality pass's
  * goal, min dihedral >= 35 degrees by default, smooth.h, and max <= 133),

@@ -120,6 +120,9 @@ typedef struct st_fit_iter {
 
 typedef void (*st_fit_iter_fn)(void *ctx, const st_fit_iter *it);
 
+/* A fit's shared set-up (st_fit_shared_new). */
+typedef struct st_fit_shared st_fit_shared;
+
 typedef struct st_fit_params {
     double offset_ratio;   /* d_offset = offset_ratio * h (default 0.4) */
     double cell_width;     /* h; 0: the mesh's meta "h" (default 0) */
@@ -142,6 +145,14 @@ typedef struct st_fit_params {
                               pseudo volume's fill, st_pseudo_fill). The
                               mesh still encloses S alone. NULL: none
                               (default NULL) */
+    const st_fit_shared *shared;
+                           /* what st_fit would otherwise build from S, the
+                              fill and h alone (st_fit_shared_new), made
+                              once for several fits of meshes to the same
+                              S (the pipeline's candidates); it must have
+                              been made from this s, fill and cell width
+                              (ST_EINPUT otherwise). NULL: st_fit builds
+                              its own (default NULL) */
     int count_before;      /* 1: count the enclosure on entry into the
                               stats' *_before (an exact pass over S, as
                               long as the one after); 0: skip it, the
@@ -182,6 +193,17 @@ typedef struct st_fit_stats {
 } st_fit_stats;
 
 st_fit_params st_fit_params_default(void);
+
+/* The part of a fit's set-up that depends only on the surface s, the fill
+ * (st_fit_params.fill, may be NULL) and the cell width h > 0: the fill's
+ * BVH and the grid of S's vertices. Built once, it serves any number of
+ * st_fit calls with these s, fill and h, at once too (read-only); a fit
+ * given it runs exactly as one that built its own. s and fill are
+ * borrowed and must outlive it. ST_OK, ST_EINPUT (no triangles, bad h) or
+ * ST_ENOMEM; *out NULL on failure. st_fit_shared_free is safe on NULL. */
+st_status st_fit_shared_new(st_fit_shared **out, const st_soup *s, const st_soup *fill,
+                            double h, st_error *err);
+void st_fit_shared_free(st_fit_shared *sh);
 
 /* Fit m in place to the surface s. bvh is a BVH over s (NULL: st_fit
  * builds one). The mesh need not enclose s on entry: what holds on entry

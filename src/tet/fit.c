@@ -686,6 +686,11 @@ static st_status fit_check(const st_tetmesh *m, const st_soup *s, const st_fit_p
         return st_error_set(err, ST_EINPUT, NULL, 0,
                             "no cell width: the mesh has no meta \"h\" (give the "
                             "lattice cell width)");
+    const st_fit_shared *sh = p->shared;
+    if (sh && (sh->s != s || sh->fill != p->fill || sh->h != *h))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "the fit's shared set-up was made for another surface, "
+                            "fill or cell width");
     size_t bad = sm_count_nonpositive(m);
     if (bad)
         return st_error_set(err, ST_EINPUT, NULL, 0,
@@ -699,8 +704,8 @@ static st_status fit_check(const st_tetmesh *m, const st_soup *s, const st_fit_p
 static st_status fit_open(fit_run *r, st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
                           double h, const st_progress *prog, st_error *err)
 {
-    st_status rc = sm_fit_ctx_open(&r->c, m, s, bvh, r->p.fill, h, r->p.offset_ratio * h,
-                                   prog, err);
+    st_status rc = sm_fit_ctx_open(&r->c, m, s, bvh, r->p.fill, r->p.shared, h,
+                                   r->p.offset_ratio * h, prog, err);
     if (rc)
         return rc;
     if (sm_dirty_init(&r->dy, m->npoints) ||

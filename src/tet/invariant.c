@@ -202,7 +202,7 @@ static st_status svertices_in_star(const fit_ctx *c, uint32_t v, star_pt **list,
                                    size_t *n, size_t *cap)
 {
     const sm_mesh *sm = &c->sm;
-    const pgrid *g = &c->pg;
+    const pgrid *g = c->pg;
     *n = 0;
     if (g->npts == 0)
         return ST_OK;
@@ -298,7 +298,7 @@ static int svertices_kept(const fit_ctx *c, uint32_t v, const double p[3],
                           uint32_t *failed)
 {
     for (size_t i = 0; i < n; i++)
-        if (in_pos_star(&c->sm, v, p, c->pg.pts + 3 * (size_t)list[i].pt,
+        if (in_pos_star(&c->sm, v, p, c->pg->pts + 3 * (size_t)list[i].pt,
                         (ptrdiff_t)list[i].tet, was_positive) < 0) {
             *failed = list[i].pt;
             return 0;
@@ -430,7 +430,7 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
      * others do, and the star's points need not be gathered. */
     uint32_t b = c->blocker ? c->blocker[v] : UINT32_MAX;
     if (b != UINT32_MAX && c->s && (c->sm.onb[v] || c->full_check)) {
-        const double *q = c->pg.pts + 3 * (size_t)b;
+        const double *q = c->pg->pts + 3 * (size_t)b;
         const double *x = c->sm.m->xyz + 3 * (size_t)v;
         if (in_star(&c->sm, v, p, q, -1) < 0 && in_star(&c->sm, v, x, q, -1) >= 0)
             return 0;
@@ -440,7 +440,7 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
     if (!sp->have)
         star_pts_fill(c, sp, 1);
     uint32_t failed;
-    int kept = sp->swept ? sm_swept_kept(&c->sm, &c->pg, v, p, &failed) : -1;
+    int kept = sp->swept ? sm_swept_kept(&c->sm, c->pg, v, p, &failed) : -1;
     if (kept < 0 && sp->swept)
         star_pts_fill(c, sp, 0);
     if (!sp->ok)
@@ -553,8 +553,8 @@ void sm_fit_report(const st_fit_params *p, const fit_ctx *c, const char *phase,
 /* ---- the context ---------------------------------------------------- */
 
 st_status sm_fit_ctx_open(fit_ctx *c, st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
-                          const st_soup *fill, double h, double d_offset,
-                          const st_progress *prog, st_error *err)
+                          const st_soup *fill, const st_fit_shared *sh, double h,
+                          double d_offset, const st_progress *prog, st_error *err)
 {
     memset(c, 0, sizeof *c);
     c->s = s;
@@ -567,7 +567,9 @@ st_status sm_fit_ctx_open(fit_ctx *c, st_tetmesh *m, const st_soup *s, const st_
     if (!bvh && (rc = st_bvh_build(&c->own_bvh, s, err)))
         goto done;
     c->bvh = bvh ? bvh : c->own_bvh;
-    if (fill && fill->ntris > 0) {
+    if (sh) {
+        c->fbvh = sh->fbvh;
+    } else if (fill && fill->ntris > 0) {
         if ((rc = st_bvh_build(&c->own_fbvh, fill, err)))
             goto done;
         c->fbvh = c->own_fbvh;
@@ -579,7 +581,8 @@ st_status sm_fit_ctx_open(fit_ctx *c, st_tetmesh *m, const st_soup *s, const st_
     /* the point grid's bins a quarter of the cell at most (finer on dense
      * soups: pgrid.c): the swept test and the
      * star scans visit whole bins (doc/design/fit.md, Cost) */
-    if (sm_pgrid_build(&c->pg, s, h / 4.0) ||
+    c->pg = sh ? &sh->pg : &c->own_pg;
+    if ((!sh && sm_pgrid_build(&c->own_pg, s, h / 4.0)) ||
         !(c->blocker = st_malloc_array(m->npoints, sizeof *c->blocker)) ||
         !(c->tblocker = st_malloc_array(m->npoints, sizeof *c->tblocker)) ||
         !(c->dpos = st_malloc_array(m->npoints, 3 * sizeof *c->dpos))) {
@@ -601,9 +604,47 @@ void sm_fit_ctx_close(fit_ctx *c)
     free(c->blocker);
     free(c->tblocker);
     free(c->dpos);
-    sm_pgrid_free(&c->pg);
+    sm_pgrid_free(&c->own_pg);
     sm_mesh_free(&c->sm);
     st_bvh_free(c->own_bvh);
     st_bvh_free(c->own_fbvh);
     memset(c, 0, sizeof *c);
+}
+
+/* ---- the shared set-up (smooth.h) ---------------------------------- */
+
+st_status st_fit_shared_new(st_fit_shared **out, const st_soup *s, const st_soup *fill,
+                            double h, st_error *err)
+{
+    *out = NULL;
+    if (!s || s->ntris == 0 || !(h > 0.0) || !isfinite(h))
+        return st_error_set(err, ST_EINPUT, NULL, 0,
+                            "the fit's set-up needs a surface with triangles and h > 0");
+    st_fit_shared *sh = calloc(1, sizeof *sh);
+    if (!sh)
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory (fit)");
+    sh->s = s;
+    sh->fill = fill;
+    sh->h = h;
+    st_status rc = ST_OK;
+    /* as sm_fit_ctx_open builds them */
+    if (fill && fill->ntris > 0 && (rc = st_bvh_build(&sh->fbvh, fill, err))) {
+        st_fit_shared_free(sh);
+        return rc;
+    }
+    if (sm_pgrid_build(&sh->pg, s, h / 4.0)) {
+        st_fit_shared_free(sh);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory (fit)");
+    }
+    *out = sh;
+    return ST_OK;
+}
+
+void st_fit_shared_free(st_fit_shared *sh)
+{
+    if (!sh)
+        return;
+    st_bvh_free(sh->fbvh);
+    sm_pgrid_free(&sh->pg);
+    free(sh);
 }

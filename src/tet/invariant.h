@@ -44,7 +44,8 @@ typedef struct fit_ctx {
     const st_bvh *bvh;
     const st_bvh *fbvh;  /* the fill's (st_fit_params.fill), or NULL:
                             distances are to S or it (sm_nearest_d2) */
-    pgrid pg;
+    const pgrid *pg;     /* S's vertices in bins: own_pg, or the shared
+                            set-up's (st_fit_shared) */
     double *dpos;        /* per vertex: where its distance in dist[] was
                             taken (3 each; NaN: not yet) */
     uint32_t *blocker;   /* per vertex: the S vertex that last stopped its
@@ -60,17 +61,28 @@ typedef struct fit_ctx {
     const st_progress *prog;   /* its cancel flag stops the fit between
                                   iterations and rounds (may be NULL) */
     st_bvh *own_bvh, *own_fbvh;   /* the BVHs sm_fit_ctx_open built */
+    pgrid own_pg;                 /* the point grid it built */
 } fit_ctx;
+
+/* st_fit_shared (smooth.h): what sm_fit_ctx_open builds from S, the fill
+ * and h alone, and what it was built from (st_fit checks them). */
+struct st_fit_shared {
+    const st_soup *s, *fill;
+    double h;
+    st_bvh *fbvh;        /* the fill's, or NULL (no fill or no triangles) */
+    pgrid pg;            /* S's vertices in bins of h / 4 */
+};
 
 /* The invariant of fitting m (positively oriented, with tets) to s (with
  * triangles) in c: m's incidence, s's BVH (bvh, or built when NULL), the
  * fill's (none when fill is NULL or empty), full_check (m has a face of
  * three tets or more), the point grid (bins of h / 4), the blockers and
- * distance positions (none yet). ST_OK, or the failure (err set); either
- * way sm_fit_ctx_close frees c. */
+ * distance positions (none yet). sh (may be NULL; made from s, fill and h)
+ * gives the fill's BVH and the point grid instead of building them. ST_OK,
+ * or the failure (err set); either way sm_fit_ctx_close frees c. */
 st_status sm_fit_ctx_open(fit_ctx *c, st_tetmesh *m, const st_soup *s, const st_bvh *bvh,
-                          const st_soup *fill, double h, double d_offset,
-                          const st_progress *prog, st_error *err);
+                          const st_soup *fill, const st_fit_shared *sh, double h,
+                          double d_offset, const st_progress *prog, st_error *err);
 void sm_fit_ctx_close(fit_ctx *c);
 
 /* Which vertices can be skipped: a vertex move is a deterministic function

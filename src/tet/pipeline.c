@@ -276,6 +276,7 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
                                       st_pipeline_candidate *c, size_t k,
                                       const st_grid *g, const st_soup *s,
                                       const st_bvh *bvh, const st_soup *fill,
+                                      const st_fit_shared *shared,
                                       double h, const st_pipeline_params *p,
                                       const st_progress *prog, st_error *err)
 {
@@ -317,6 +318,7 @@ static st_status run_sculpt_candidate(st_tetmesh **out,
     fp.cell_width = h;
     fp.quality = p->quality;
     fp.fill = fill;
+    fp.shared = shared;
     fp.count_before = 0;   /* only the count after is reported */
     if (p->fit_max_iters > 0)
         fp.max_iters = p->fit_max_iters;
@@ -515,15 +517,15 @@ static int meets_goals(const st_pipeline_candidate *c, const st_pipeline_params 
 /* Candidate k, start to end (its event: candidate_event). */
 static void run_candidate(st_tetmesh **meshes, st_pipeline_stats *st, size_t k,
                           const st_grid *g, const st_soup *s, const st_bvh *bvh,
-                          const st_soup *fill, double h, const st_pipeline_params *p,
-                          const st_progress *prog)
+                          const st_soup *fill, const st_fit_shared *shared, double h,
+                          const st_pipeline_params *p, const st_progress *prog)
 {
     st_pipeline_candidate *c = &st->candidates[k];
     st_error e;
     st_error_clear(&e);
     st_status r = p->density_rho > 0
         ? run_density_candidate(&meshes[k], c, g, s, bvh, h, p, &e)
-        : run_sculpt_candidate(&meshes[k], c, k, g, s, bvh, fill, h, p, prog, &e);
+        : run_sculpt_candidate(&meshes[k], c, k, g, s, bvh, fill, shared, h, p, prog, &e);
     if (r) {
         c->failed = 1;
         st_error_format(&e, c->message, sizeof c->message);
@@ -557,6 +559,7 @@ typedef struct candidate_job {
     const st_grid *g;
     const st_soup *s, *fill;
     const st_bvh *bvh;
+    const st_fit_shared *shared;
     double h;
     const st_pipeline_params *p;
     const st_progress *prog;   /* the caller's (its cancel flag) */
@@ -573,8 +576,8 @@ static void run_job(candidate_job *j)
     candidate_threads(&j->cp);
     const int run = !st_progress_cancelled(j->prog);
     if (run) {
-        run_candidate(j->meshes, j->st, j->k, j->g, j->s, j->bvh, j->fill, j->h, j->p,
-                      &j->relay);
+        run_candidate(j->meshes, j->st, j->k, j->g, j->s, j->bvh, j->fill, j->shared, j->h,
+                      j->p, &j->relay);
         candidate_share(&j->cp, 1.0);
     }
     __atomic_sub_fetch(&j->cp.b->running, 1, __ATOMIC_RELEASE);
@@ -631,6 +634,16 @@ static void run_candidates(st_tetmesh **meshes, st_pipeline_stats *st, const st_
                            const st_soup *s, const st_bvh *bvh, const st_soup *fill,
                            double h, const st_pipeline_params *p, const st_progress *prog)
 {
+    /* the fits' set-up that depends on s, the fill and h alone, built once
+     * for all candidates (st_fit_shared_new: each fit runs as it would with
+     * its own); none when it cannot be built, and each fit builds its own */
+    st_fit_shared *shared = NULL;
+    if (p->density_rho <= 0) {
+        st_error e;
+        st_error_clear(&e);
+        if (st_fit_shared_new(&shared, s, fill, h, &e))
+            shared = NULL;
+    }
     const size_t K = st->ncandidates;
     const int threads = omp_get_max_threads();
     size_t ran = 0;
@@ -654,7 +667,8 @@ static void run_candidates(st_tetmesh **meshes, st_pipeline_stats *st, const st_
         for (size_t i = 0; i < bp.n; i++) {
             candidate_job *j = &jobs[i];
             *j = (candidate_job){.meshes = meshes, .st = st, .k = b0 + i, .g = g, .s = s,
-                                 .fill = fill, .bvh = bvh, .h = h, .p = p, .prog = prog,
+                                 .fill = fill, .bvh = bvh, .shared = shared, .h = h,
+                                 .p = p, .prog = prog,
                                  .cp = {&bp, i}};
             j->relay = (st_progress){candidate_relay, &j->cp, prog ? prog->cancel : NULL};
         }
@@ -675,6 +689,7 @@ static void run_candidates(st_tetmesh **meshes, st_pipeline_stats *st, const st_
     }
     omp_set_num_threads(threads);
     st->ncandidates = ran;
+    st_fit_shared_free(shared);
 }
 
 /* The fill (pseudo.h): the pseudo volume's boundary where the soup has

@@ -482,6 +482,7 @@ static st_status quality_on(sm_mesh *sm, double h, int rounds, double goal, int 
     fit_ctx c;
     memset(&c, 0, sizeof c);
     c.sm = *sm;   /* borrowed: not freed here */
+    c.pg = &c.own_pg;   /* empty: no surface */
     c.h = h;
     c.fair_boundary = boundary;
     st_fit_params p;
