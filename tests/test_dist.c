@@ -496,6 +496,97 @@ static void test_bvh_nearest_ties(void)
     st_soup_free(s);
 }
 
+/* st_bvh_within_hint answers as st_bvh_within, bit for bit, whatever the
+ * hints: on a grid of squares in the plane z = 0.5 (shared edges and
+ * vertices: triangles that touch; every third square twice more, exact
+ * duplicates), with slivers, collinear and one-point triangles, at
+ * points exactly a bound above the plane (the distance, and the box
+ * distance, equal to the bound: not within), on it, a little off it and
+ * anywhere, with each point's hints from the query before (a run at
+ * nearby points, as the fill passes them), from every slot in turn, and
+ * none or out of range. A 1 names a slot whose triangle is within; a 0
+ * names none. */
+static void test_bvh_within_hint(void)
+{
+    st_soup *s = st_soup_new();
+    const int G = 16;
+    for (int j = 0; j <= G; j++)
+        for (int i = 0; i <= G; i++)
+            st_soup_add_vertex(s, i / (double)G, j / (double)G, 0.5, NULL);
+    for (int j = 0; j < G; j++)
+        for (int i = 0; i < G; i++) {
+            uint32_t a = (uint32_t)(j * (G + 1) + i), b = a + 1, c = a + (uint32_t)G + 1,
+                     d = c + 1;
+            for (int r = 0; r < ((i + j) % 3 == 0 ? 3 : 1); r++) {
+                st_soup_add_triangle(s, a, b, d, NULL);
+                st_soup_add_triangle(s, a, d, c, NULL);
+            }
+        }
+    for (int k = 0; k < 40; k++) {
+        double c[3] = {urand(), urand(), urand()};
+        add_random_triangle(s, c, k % 4 == 0 ? 0.3 : 0.03, k % 3 == 0);
+        if (k % 5 == 0) {
+            uint32_t v = (uint32_t)(s->nverts - 1);
+            st_soup_add_triangle(s, v, v, v, NULL);
+        }
+    }
+    st_bvh *b;
+    st_error err;
+    TAP_CHECK(st_bvh_build(&b, s, &err) == ST_OK, "bvh build (hints)");
+    /* bounds exactly representable squares: a point that high above the
+     * plane is at exactly the bound */
+    static const double h[] = {0.25, 0.0625, 1.0 / 64, 1.0 / 1024, 0.0};
+    const uint32_t nt = (uint32_t)s->ntris;
+    uint32_t run = ST_BVH_NO_HINT;
+    size_t bad = 0, bad_found = 0, queries = 0, at_bound = 0, hit = 0, yes = 0;
+    for (int i = 0; i < 4000; i++) {
+        double p[3];
+        const int kind = i % 4;
+        const double x = (double)(i % (2 * G + 1)) / (2 * G), y = (double)((i / 5) % (G + 1)) / G;
+        const double hh = h[(i / 4) % 5];
+        p[0] = x, p[1] = y;
+        p[2] = kind == 0 ? 0.5 + hh : kind == 1 ? 0.5 - hh
+             : kind == 2 ? 0.5 + hh * (1.0 + 1e-12 * (urand() - 0.5)) : urand() * 1.4 - 0.2;
+        if (kind == 3)
+            p[0] = urand() * 1.4 - 0.2, p[1] = urand() * 1.4 - 0.2;
+        for (size_t j = 0; j < sizeof h / sizeof *h; j++) {
+            const double bound = h[j] * h[j];
+            const int want = st_bvh_within(b, p, bound);
+            at_bound += kind < 2 && h[j] == hh && !want;
+            /* the run's hint, one slot after another, none, out of range */
+            const uint32_t tries[4] = {run, (uint32_t)(i * 7 + (int)j) % nt, ST_BVH_NO_HINT,
+                                       nt + (uint32_t)j};
+            for (int t = 0; t < 4; t++, queries++) {
+                uint32_t found = 12345;
+                const int got = st_bvh_within_hint(b, p, bound, tries + t, t == 3 ? 1 : 2,
+                                                   &found);
+                bad += got != want;
+                if (got) {
+                    const uint32_t *v = found < nt ? s->tris + 3 * (size_t)b->order[found] : NULL;
+                    bad_found += !v || !(st_point_triangle_dist2(p, s->xyz + 3 * (size_t)v[0],
+                                                                 s->xyz + 3 * (size_t)v[1],
+                                                                 s->xyz + 3 * (size_t)v[2],
+                                                                 NULL) < bound);
+                    hit += found == tries[0] || (t != 3 && found == tries[1]);
+                } else
+                    bad_found += found != ST_BVH_NO_HINT;
+                if (t == 0 && found != ST_BVH_NO_HINT)
+                    run = found;
+                yes += got;
+            }
+        }
+    }
+    TAP_CHECK(bad == 0 && queries > 0, "bvh within hint: st_bvh_within's answer whatever the hints "
+              "(%zu of %zu differ)", bad, queries);
+    TAP_CHECK(bad_found == 0, "bvh within hint: the slot found is within, none when 0 (%zu bad)",
+              bad_found);
+    TAP_CHECK(at_bound > 100 && hit > queries / 16 && yes > queries / 4 && yes < queries,
+              "bvh within hint: points at exactly the bound (%zu), hints taken (%zu), found %zu of "
+              "%zu", at_bound, hit, yes, queries);
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
 /* A BVH over enough triangles to be built by parallel tasks has the
  * serial build's layout: inner nodes numbered depth first, the right
  * child's subtree before the left's, leaves of at most ST_BVH_LEAF slots
@@ -847,6 +938,7 @@ int main(int argc, char **argv)
     static const tap_test tests[] = {TAP_TEST(layout), TAP_TEST(band_exact_on_random_soup),
                                      TAP_TEST(large_oblique_triangle), TAP_TEST(bvh_nearest),
                                      TAP_TEST(bvh_nearest_exact), TAP_TEST(bvh_nearest_ties),
+                                     TAP_TEST(bvh_within_hint),
                                      TAP_TEST(bvh_parallel_layout),
                                      TAP_TEST(threads_identical), TAP_TEST(fine_soup_exact),
                                      TAP_TEST(real_model), TAP_TEST(blocks_equal_dense),

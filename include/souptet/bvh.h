@@ -58,6 +58,20 @@ double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
  * such triangle (much faster where the soup is dense). Thread-safe. */
 int st_bvh_within(const st_bvh *b, const double p[3], double max_d2);
 
+/* st_bvh_within's answer, bit for bit, first trying the triangles
+ * hints[0..nhints) name (slots of order[]; ST_BVH_NO_HINT, or any value
+ * at least the soup's triangle count: none): when one is closer than
+ * sqrt(max_d2) and the walk could not skip it, the walk would find a
+ * triangle too (bvh.c, slot_within), and none is run. *found gets the
+ * slot of the triangle that answered (the hint's, or the one the walk
+ * found; ST_BVH_NO_HINT when none is within reach). A run of queries at
+ * nearby points (a grid's faces, a mesh's triangles in order) passing
+ * the last answers on skips most walks. Thread-safe: the hints are the
+ * caller's. */
+#define ST_BVH_NO_HINT UINT32_MAX
+int st_bvh_within_hint(const st_bvh *b, const double p[3], double max_d2,
+                       const uint32_t *hints, size_t nhints, uint32_t *found);
+
 /* Call visit(ctx, tri) for every triangle whose bounding box meets the
  * closed box [lo, hi] (a superset of the triangles that meet the box: the
  * caller decides exactly). Stops at the first nonzero return of visit and

@@ -22,6 +22,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 
 static st_status add_square(st_soup *f, const double c[3], int axis, double half,
                             st_error *err)
@@ -56,6 +57,15 @@ st_status st_pseudo_fill(st_soup **out, const st_grid *g, const st_bvh *bvh,
     const double v = g->voxel, reach2 = v * v;
     const size_t nx = g->nx, ny = g->ny, nz = g->nz;
     size_t count = 0;
+    /* hints: the soup triangle found last at each column (the rows
+     * before: the boundary passes near it), and the last found */
+    uint32_t *col = malloc((nx + 1) * sizeof *col);
+    if (!col) {
+        st_soup_free(f);
+        return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory (fill)");
+    }
+    for (size_t i = 0; i <= nx; i++)
+        col[i] = ST_BVH_NO_HINT;
     /* row by row: a voxel's sign and its three neighbours' above it (x,
      * y, z: the faces in that order, as before), most voxels passed over
      * at once (no neighbour differs) */
@@ -79,11 +89,19 @@ st_status st_pseudo_fill(st_soup **out, const st_grid *g, const st_bvh *bvh,
                     st_grid_center(g, i, j, k, c);
                     c[a] += 0.5 * v;
                     /* the first triangle within reach will do: st_bvh_within
-                     * finds one exactly when the nearest search does */
-                    if (st_bvh_within(bvh, c, reach2))
+                     * finds one exactly when the nearest search does; the
+                     * one found for the face before, when it is within
+                     * reach here too, says the same (st_bvh_within_hint) */
+                    const uint32_t hints[2] = {col[i], col[nx]};
+                    uint32_t found;
+                    const int near = st_bvh_within_hint(bvh, c, reach2, hints, 2, &found);
+                    if (found != ST_BVH_NO_HINT)
+                        col[i] = col[nx] = found;
+                    if (near)
                         continue;   /* the soup passes between them */
                     st_status rc = add_square(f, c, a, 0.5 * v, err);
                     if (rc) {
+                        free(col);
                         st_soup_free(f);
                         return rc;
                     }
@@ -91,6 +109,7 @@ st_status st_pseudo_fill(st_soup **out, const st_grid *g, const st_bvh *bvh,
                 }
             }
         }
+    free(col);
     if (faces)
         *faces = count;
     *out = f;

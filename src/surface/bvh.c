@@ -419,7 +419,7 @@ static double magnitude(const st_bvh *b)
  * walk to it is the nearest search's while best is still max_d2, so it
  * finds a triangle exactly when that search does. */
 static double nearest_walk(const st_bvh *b, const double p[3], double max_d2, int any,
-                           int64_t *tri, double closest[3])
+                           int64_t *tri, double closest[3], uint32_t *slot)
 {
     const st_soup *s = b->soup;
     double best = max_d2;
@@ -457,6 +457,8 @@ static double nearest_walk(const st_bvh *b, const double p[3], double max_d2, in
                         memcpy(closest, q, sizeof q);
                     if (any) {
                         *tri = best_tri;
+                        if (slot)
+                            *slot = n->start + i;
                         return best;
                     }
                 }
@@ -487,13 +489,49 @@ static double nearest_walk(const st_bvh *b, const double p[3], double max_d2, in
 double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
                       int64_t *tri, double closest[3])
 {
-    return nearest_walk(b, p, max_d2, 0, tri, closest);
+    return nearest_walk(b, p, max_d2, 0, tri, closest, NULL);
 }
 
 int st_bvh_within(const st_bvh *b, const double p[3], double max_d2)
 {
     int64_t tri;
-    (void)nearest_walk(b, p, max_d2, 1, &tri, NULL);
+    (void)nearest_walk(b, p, max_d2, 1, &tri, NULL, NULL);
+    return tri >= 0;
+}
+
+/* The triangle in slot i answers st_bvh_within's walk for p and max_d2
+ * when its box is nearer than max_d2, the leaf scan would not skip it
+ * (tri_beyond, as the walk calls it) and its distance is below max_d2.
+ * The walk then reaches its leaf unless it stops before: every node
+ * above holds the triangle's box, and the computed box distance of a
+ * larger box is never the greater (each rounded subtraction, maximum
+ * with zero, square and sum is monotone in its operands), so each of
+ * them is pushed and popped while nothing is found (best is still
+ * max_d2); in the leaf the triangle is found, or one before it. Either
+ * way st_bvh_within says 1: exactly the walk's answer, with no margin. */
+static int slot_within(const st_bvh *b, uint32_t i, const double p[3], double max_d2)
+{
+    const double *tb = b->tbox + 6 * (size_t)i;
+    if (!(st_box_dist2(tb, tb + 3, p) < max_d2) ||
+        tri_beyond(tb, p, sqrt(max_d2), magnitude(b)))
+        return 0;
+    const st_soup *s = b->soup;
+    const uint32_t *v = s->tris + 3 * (size_t)b->order[i];
+    return st_point_triangle_dist2(p, s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
+                                   s->xyz + 3 * (size_t)v[2], NULL) < max_d2;
+}
+
+int st_bvh_within_hint(const st_bvh *b, const double p[3], double max_d2,
+                       const uint32_t *hints, size_t nhints, uint32_t *found)
+{
+    for (size_t h = 0; h < nhints; h++)
+        if (hints[h] < b->soup->ntris && slot_within(b, hints[h], p, max_d2)) {
+            *found = hints[h];
+            return 1;
+        }
+    int64_t tri;
+    *found = ST_BVH_NO_HINT;
+    (void)nearest_walk(b, p, max_d2, 1, &tri, NULL, found);
     return tri >= 0;
 }
 

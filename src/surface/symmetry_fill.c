@@ -453,12 +453,23 @@ typedef struct fill_ctx {
     const st_soup *caps;       /* the caps (the anchors' first triangles) */
 } fill_ctx;
 
+/* st_bvh_within(b, c, d2), trying *hint first; *hint becomes the
+ * triangle that answered (kept when none did). */
+static int within(const st_bvh *b, const double c[3], double d2, uint32_t *hint)
+{
+    uint32_t found;
+    const int r = st_bvh_within_hint(b, c, d2, hint, 1, &found);
+    if (found != ST_BVH_NO_HINT)
+        *hint = found;
+    return r;
+}
+
 /* The piece image q fills, or SIZE_MAX. It must be off the soup (farther
  * than tol: the soup wins wherever it is) and in a hole: within its
  * piece's reach and, for a cap, nearer the cap than the soup; for an open
  * rim (which is on the soup), with the rim the soup's nearest part, to
  * within tol, so an image beside a wall the rim is not on adds nothing. */
-static size_t keeps(const fill_ctx *C, const double q[3][3])
+static size_t keeps(const fill_ctx *C, const double q[3][3], uint32_t hint[3])
 {
     double c[3];
     for (int k = 0; k < 3; k++) {
@@ -470,7 +481,10 @@ static size_t keeps(const fill_ctx *C, const double q[3][3])
         return SIZE_MAX;
     /* the soup wins wherever it is: the tests below (bound >= tol2) */
     const double tol2 = C->tol * C->tol;
-    if (st_bvh_within(C->bvh, c, tol2) || (C->fill_bvh && st_bvh_within(C->fill_bvh, c, tol2)))
+    /* hint: the triangles these tests found last (the soup's, the fill's,
+     * the soup's against bound), tried first (st_bvh_within_hint: the
+     * same answers) */
+    if (within(C->bvh, c, tol2, hint) || (C->fill_bvh && within(C->fill_bvh, c, tol2, hint + 1)))
         return SIZE_MAX;
     int64_t tri;
     const double most = C->P->hi[0] - C->P->lo[0] + C->P->hi[1] - C->P->lo[1] +
@@ -487,7 +501,7 @@ static size_t keeps(const fill_ctx *C, const double q[3][3])
         return SIZE_MAX;
     const double near = sqrt(d2) - C->tol;
     const double bound = i < C->P->ncap ? fmax(tol2, d2) : near > C->tol ? near * near : tol2;
-    return st_bvh_within(C->bvh, c, bound) ? SIZE_MAX : i;
+    return within(C->bvh, c, bound, hint + 2) ? SIZE_MAX : i;
 }
 
 /* ---- the rims ------------------------------------------------------------------ */
@@ -1235,12 +1249,18 @@ static st_status map_all(fill_set *F, st_bvh **fill_bvh, const fill_ctx *C0, con
         for (long long v = 0; v < nv; v++)
             st_symmetry_apply(maps[mi].y, maps[mi].angle, s->xyz + 3 * v, 1, vimg + 3 * v);
         size_t any = 0;
-#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : any)
-        for (long long t = 0; t < nt; t++) {
-            double q[3][3];
-            image_from(s, (size_t)t, maps + mi, vimg, q);
-            keep[t] = helix && !held[t] ? SIZE_MAX : keeps(&C, q);
-            any += keep[t] != SIZE_MAX;
+        /* the images of triangles in order lie near one another: each
+         * thread's tests pass on what they found (keeps' hint) */
+#pragma omp parallel reduction(+ : any)
+        {
+            uint32_t hint[3] = {ST_BVH_NO_HINT, ST_BVH_NO_HINT, ST_BVH_NO_HINT};
+#pragma omp for schedule(dynamic, 1024)
+            for (long long t = 0; t < nt; t++) {
+                double q[3][3];
+                image_from(s, (size_t)t, maps + mi, vimg, q);
+                keep[t] = helix && !held[t] ? SIZE_MAX : keeps(&C, q, hint);
+                any += keep[t] != SIZE_MAX;
+            }
         }
         if (!any)
             continue;
