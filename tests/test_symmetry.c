@@ -16,7 +16,8 @@
  * fine enough that no grid is built (slanted). A disc-like part with a
  * quarter lost from one side: its plane where it is (lost_side). The
  * bracket with a third lost (accepted on the contradiction rule, whose
- * rims are made when first needed) the same on 1 and 2 threads. */
+ * rims are made when first needed) the same on 1 and 2 threads. A ball,
+ * whose set fills with mirrors: no axis measured (full_of_mirrors). */
 #include "souptet/bvh.h"
 #include "souptet/soup.h"
 #include "souptet/symmetry.h"
@@ -607,12 +608,34 @@ static void test_slanted(void)
     st_soup_free(t);
 }
 
+/* A ball with a small hole at its top: every plane through its centre is
+ * a mirror, and the set fills with ST_SYMMETRY_MAX of them, so no axis
+ * can enter it (keep() replaces only one of its own kind): the axes are
+ * not measured. The candidates measured are then the mirrors' alone: the
+ * 3 principal planes and at most 16 vote cells (the peaks run only where
+ * none of them is accepted); on f6ab7ab the axes were measured as well
+ * (and counted), and dropped. */
+static void test_full_of_mirrors(void)
+{
+    st_soup *s = st_soup_new();
+    add_sphere(s, 1.0, 0.9);
+    st_symmetry_set set;
+    TAP_CHECK(detect(&set, s, 0.03) == 0, "full of mirrors: detection runs");
+    TAP_CHECK(set.n == ST_SYMMETRY_MAX && count_kind(&set, ST_SYMMETRY_MIRROR) == set.n,
+              "a ball: %zu symmetries, %zu of them mirrors", set.n,
+              count_kind(&set, ST_SYMMETRY_MIRROR));
+    TAP_CHECK(set.candidates <= 3 + 16, "no axis measured: %zu candidates, the mirrors' alone",
+              set.candidates);
+    st_soup_free(s);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(bracket), TAP_TEST(hex_bar), TAP_TEST(none),
                                      TAP_TEST(asymmetric), TAP_TEST(nearly), TAP_TEST(tiny),
                                      TAP_TEST(planar), TAP_TEST(helix),
                                      TAP_TEST(not_helix), TAP_TEST(lost_third), TAP_TEST(lost_side),
-                                     TAP_TEST(late_support), TAP_TEST(slanted), {0}};
+                                     TAP_TEST(late_support), TAP_TEST(slanted),
+                                     TAP_TEST(full_of_mirrors), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -111,7 +111,8 @@ typedef struct st_symmetry_fill_stats {
     size_t maps;          /* maps tried: a mirror is one, a rotation of
                              order n is n - 1, a continuous one or a helix
                              FILL_ANGLES - 1; with mirrors alone, also the
-                             turn two mirrors make, each way */
+                             turn two mirrors make, each way, where a
+                             hole is left unclosed (the third round) */
     size_t triangles;     /* fill triangles kept */
     double area;          /* their area, model units squared */
     size_t caps;          /* cap pieces (connected) given */

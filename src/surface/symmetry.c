@@ -1784,6 +1784,19 @@ static void keep(st_symmetry_set *out, const st_symmetry *y, double tol)
         out->items[w] = *y;
 }
 
+/* Whether keep(out, y, ..) can change out for a y of this kind: the set
+ * has room, or holds one of that kind (which y may replace). A set full
+ * of other kinds (a ball's 16 mirrors) keeps none. */
+static int room_for(const st_symmetry_set *out, st_symmetry_kind kind)
+{
+    if (out->n < ST_SYMMETRY_MAX)
+        return 1;
+    for (size_t i = 0; i < out->n; i++)
+        if (out->items[i].kind == kind)
+            return 1;
+    return 0;
+}
+
 /* A continuous rotation and a helix about one line (within REFINE_REACH
  * tolerances: the helix' axis is refined, the rotation's is not) are two
  * readings of one turned part: the one with the lower support goes. */
@@ -1918,13 +1931,20 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
             dup = same_line(axes + j, axes + i, p->tolerance);
         if (dup)
             continue;
+        /* a set full of other kinds takes no axis (keep): not measured */
+        const int helix = room_for(out, ST_SYMMETRY_HELIX),
+                  turn = room_for(out, ST_SYMMETRY_ROTATION);
+        if (!helix && !turn)
+            continue;
         double sup = 0.0;
         out->candidates++;
         st_symmetry hx = axes[i];
-        int measured;
-        if (find_helix(&C, &hx, p->min_support, &measured))
+        int measured = 0;
+        if (helix && find_helix(&C, &hx, p->min_support, &measured))
             keep(out, &hx, p->tolerance);
         out->candidates += (size_t)measured;
+        if (!turn)
+            continue;
         int order = axis_order(&C, axes + i, p->max_order, p->min_support,
                                &sup);
         if (order < 0)

@@ -1609,19 +1609,29 @@ static void split_caps(uint8_t *state, uint8_t *cap_keep, uint8_t *fill_keep, do
         fill_keep[t] = fill_keep[t] || F->piece[t] >= P->ncap || state[F->piece[t]] != PIECE_SPLIT;
 }
 
+/* What mirror_turns needs besides the fill's context: room for the
+ * rotations, the set, and the room for maps. */
+typedef struct turn_src {
+    st_symmetry *rot;
+    const st_symmetry_set *set;
+    size_t max;
+} turn_src;
+
 /* The fill in two rounds: the maps that put a piece's whole rim back on
  * the soup; then, for the holes they left open or uncapped (no fill, or
  * one that does not close), also the maps that put back what the soup can
  * check of the rim: a rim whose preimage falls in the copy's own holes
  * (the damage removed the faces that would verify it) is judged on the
- * rest; then turn_round with the mirrors' turns (maps[nset, nmaps)); then
- * the caps the fill contradicts (contradicted). covered[i]: piece i's cap
- * dropped and its fill kept. */
+ * rest; then turn_round with the mirrors' turns (T: made here, into
+ * maps[nset, *nmaps), only where a piece is left unclosed: elsewhere no
+ * round reads them, and on a round part with many mirrors they cost more
+ * than the fill); then the caps the fill contradicts (contradicted).
+ * covered[i]: piece i's cap dropped and its fill kept. */
 static st_status fill_rounds(uint8_t *covered, uint8_t **cap_keep, uint8_t **fill_keep,
                              fill_set *F, st_bvh **fill_bvh, const fill_ctx *C,
-                             const rims *R, const map *maps, size_t nset, size_t nmaps,
-                             size_t *keep, uint8_t *ok, double *share, double *map_err,
-                             st_symmetry_fill_stats *st, st_error *err)
+                             const rims *R, map *maps, size_t nset, size_t *nmaps,
+                             const turn_src *T, size_t *keep, uint8_t *ok, double *share,
+                             double *map_err, st_symmetry_fill_stats *st, st_error *err)
 {
     const pieces *P = C->P;
     uint8_t *state = calloc(P->n, 1), *open = st_malloc_array(P->n, 1);
@@ -1636,7 +1646,14 @@ static st_status fill_rounds(uint8_t *covered, uint8_t **cap_keep, uint8_t **fil
         rc = map_all(F, fill_bvh, C, R, maps, 0, nset, open, NULL, keep, ok, share, map_err, err);
         rc = rc ? rc : decide(state, open, P, R, F, C->bvh, *fill_bvh, C->anchors_bvh, C->tol);
     }
-    rc = rc ? rc : turn_round(state, open, F, fill_bvh, C, R, maps, nset, nmaps, keep, ok, share,
+    size_t unclosed = 0;
+    for (size_t i = 0; i < P->n && !rc; i++)
+        unclosed += state[i] == PIECE_UNCLOSED;
+    *nmaps = nset;
+    if (!rc && unclosed)
+        *nmaps = mirror_turns(T->rot, maps, nset, T->max, T->set, P->lo, P->hi, C->tol, C->s,
+                              C->bvh, C->bounds);
+    rc = rc ? rc : turn_round(state, open, F, fill_bvh, C, R, maps, nset, *nmaps, keep, ok, share,
                               map_err, err);
     rc = rc ? rc : contradicted(state, P, F, C->anchors_bvh, C->tol);
     if (!rc && !(*cap_keep = st_malloc_array(C->caps->ntris ? C->caps->ntris : 1, 1)))
@@ -1647,7 +1664,7 @@ static st_status fill_rounds(uint8_t *covered, uint8_t **cap_keep, uint8_t **fil
     size_t *by = rc ? NULL : st_malloc_array(P->ncap ? P->ncap : 1, sizeof *by);
     if (!rc && (!len || !by))
         rc = ST_ENOMEM;
-    rc = rc ? rc : split_mirror(by, state, P, F, maps, nmaps);
+    rc = rc ? rc : split_mirror(by, state, P, F, maps, *nmaps);
     if (!rc)
         split_caps(state, *cap_keep, *fill_keep, len, by, C, R, F, *fill_bvh, maps);
     free(len);
@@ -1733,12 +1750,13 @@ st_status st_symmetry_fill(st_soup **fill_out, st_soup **kept_out, const st_soup
                   (bounds->ntris && (rc = st_bvh_build(&bounds_bvh, bounds, err)))))
         goto done;
     const size_t nset = maps_of(set, maps, sizeof maps / sizeof *maps);
-    const size_t nmaps = mirror_turns(turns, maps, nset, sizeof maps / sizeof *maps, set, P.lo,
-                                      P.hi, tol, s, bvh, bounds_bvh);
-    st->maps = nmaps;
+    size_t nmaps = nset;
+    const turn_src T = {turns, set, sizeof maps / sizeof *maps};
     const fill_ctx C = {s, bvh, anchors_bvh, NULL, bounds_bvh, &P, NULL, tol, 0.0, cp};
-    if ((rc = fill_rounds(covered, &cap_keep, &fill_keep, &F, &fill_bvh, &C, &R, maps, nset,
-                          nmaps, keep, ok, share, map_err, st, err)) ||
+    rc = fill_rounds(covered, &cap_keep, &fill_keep, &F, &fill_bvh, &C, &R, maps, nset, &nmaps,
+                     &T, keep, ok, share, map_err, st, err);
+    st->maps = nmaps;
+    if (rc ||
         (rc = keep_uncovered(kept, cp, &P, covered, cap_keep, err)))
         goto done;
     rc = fill_of_covered(&fill, &F, covered, fill_keep, st, err);
