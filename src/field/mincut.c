@@ -24,6 +24,8 @@
  * which every maximum flow shares (the least inside of the cheapest
  * labellings): the flow's paths and their order are free to change
  * (plant_roots pushes the one-arc paths before the trees grow).
+ *
+ * Measurements of the solver's work: doc/design/mincut.md.
  */
 #include "souptet/mincut.h"
 #include "../base/fpenv.h"
