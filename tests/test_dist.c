@@ -407,6 +407,25 @@ static double ref_nearest(const st_bvh *b, const double p[3], double max_d2, int
     return best;
 }
 
+/* A G x G grid of squares over the unit square in z = 0.5, two triangles each, every
+ * third square (by i + j) three times over: touching and duplicated
+ * triangles, for the walks' ties. */
+static void add_tied_sheet(st_soup *s, int G)
+{
+    for (int j = 0; j <= G; j++)
+        for (int i = 0; i <= G; i++)
+            st_soup_add_vertex(s, i / (double)G, j / (double)G, 0.5, NULL);
+    for (int j = 0; j < G; j++)
+        for (int i = 0; i < G; i++) {
+            uint32_t a = (uint32_t)(j * (G + 1) + i), b = a + 1, c = a + (uint32_t)G + 1,
+                     d = c + 1;
+            for (int r = 0; r < ((i + j) % 3 == 0 ? 3 : 1); r++) {
+                st_soup_add_triangle(s, a, b, d, NULL);
+                st_soup_add_triangle(s, a, d, c, NULL);
+            }
+        }
+}
+
 /* Ties and degenerate triangles: a grid of squares, each split in two
  * (shared edges and vertices: points equidistant from several triangles),
  * every third triangle also twice more (exact duplicates), collinear,
@@ -421,18 +440,7 @@ static void test_bvh_nearest_ties(void)
 {
     st_soup *s = st_soup_new();
     const int G = 24;
-    for (int j = 0; j <= G; j++)
-        for (int i = 0; i <= G; i++)
-            st_soup_add_vertex(s, i / (double)G, j / (double)G, 0.5, NULL);
-    for (int j = 0; j < G; j++)
-        for (int i = 0; i < G; i++) {
-            uint32_t a = (uint32_t)(j * (G + 1) + i), b = a + 1, c = a + (uint32_t)G + 1,
-                     d = c + 1;
-            for (int r = 0; r < ((i + j) % 3 == 0 ? 3 : 1); r++) {
-                st_soup_add_triangle(s, a, b, d, NULL);
-                st_soup_add_triangle(s, a, d, c, NULL);
-            }
-        }
+    add_tied_sheet(s, G);
     for (int k = 0; k < 60; k++) {
         double c[3] = {urand(), urand(), urand()};
         add_random_triangle(s, c, k % 4 == 0 ? 0.5 : 0.05, k % 3 == 0);
@@ -510,18 +518,7 @@ static void test_bvh_within_hint(void)
 {
     st_soup *s = st_soup_new();
     const int G = 16;
-    for (int j = 0; j <= G; j++)
-        for (int i = 0; i <= G; i++)
-            st_soup_add_vertex(s, i / (double)G, j / (double)G, 0.5, NULL);
-    for (int j = 0; j < G; j++)
-        for (int i = 0; i < G; i++) {
-            uint32_t a = (uint32_t)(j * (G + 1) + i), b = a + 1, c = a + (uint32_t)G + 1,
-                     d = c + 1;
-            for (int r = 0; r < ((i + j) % 3 == 0 ? 3 : 1); r++) {
-                st_soup_add_triangle(s, a, b, d, NULL);
-                st_soup_add_triangle(s, a, d, c, NULL);
-            }
-        }
+    add_tied_sheet(s, G);
     for (int k = 0; k < 40; k++) {
         double c[3] = {urand(), urand(), urand()};
         add_random_triangle(s, c, k % 4 == 0 ? 0.3 : 0.03, k % 3 == 0);

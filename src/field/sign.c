@@ -36,6 +36,7 @@
 #include "souptet/isect.h"
 #include "souptet/pred.h"
 #include "souptet/mincut.h"
+#include "../base/bits.h"
 
 #include <float.h>
 #include <limits.h>
@@ -269,24 +270,10 @@ static inline uint32_t mark_mask(const uint8_t *v, long n)
     return m;
 }
 
-static inline int ctz64(uint64_t m)
-{
-#if defined(__GNUC__)
-    return __builtin_ctzll(m);
-#else
-    int b = 0;
-    while (!(m & 1u)) {
-        m >>= 1;
-        b++;
-    }
-    return b;
-#endif
-}
-
 /* (m nonzero) */
 static inline int ctz32(uint32_t m)
 {
-    return ctz64(m);
+    return st_lowest_bit(m);
 }
 
 /* Steps a line through coordinate c (of n) can go forward / backward
@@ -1288,7 +1275,7 @@ static void select_near(const refine_ctx *c, refine_worker *w, long i, long j, l
     w->nsel = 0;
     for (size_t q = 0; q < W; q++)
         for (uint64_t m = mx[q] & my[q] & mz[q]; m; m &= m - 1)
-            w->sel[w->nsel++] = (uint32_t)(64 * q + (size_t)ctz64(m));
+            w->sel[w->nsel++] = (uint32_t)(64 * q + (size_t)st_lowest_bit(m));
 }
 
 /* Whether voxel (i, j, k) at pv, of value dv, is inside: its neighbours'

@@ -51,6 +51,7 @@
 
 #include "souptet/isect.h"
 #include "souptet/pred.h"
+#include "../base/bits.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -140,21 +141,6 @@ static uint64_t bin_faces(size_t nf, const double (*box)[6], const st_plane_filt
     return keep;
 }
 
-/* The index of the lowest set bit of m (m not 0). */
-static inline int lowest_bit(uint64_t m)
-{
-#if defined(__GNUC__)
-    return __builtin_ctzll(m);
-#else
-    int b = 0;
-    while (!(m & 1u)) {
-        m >>= 1;
-        b++;
-    }
-    return b;
-#endif
-}
-
 int sm_swept_applies(const sm_mesh *sm, uint32_t v)
 {
     return sm->vf_off[v + 1] - sm->vf_off[v] <= SWEPT_MAX_FACES;
@@ -228,7 +214,7 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
                     int swept = 0;
                     /* the faces the bin keeps, in index order */
                     for (uint64_t kb = keep; kb && !swept; kb &= kb - 1) {
-                        const size_t i = (size_t)lowest_bit(kb);
+                        const size_t i = (size_t)st_lowest_bit(kb);
                         const double *bx = box[i];
                         if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] || q[0] > bx[3] ||
                             q[1] > bx[4] || q[2] > bx[5])
