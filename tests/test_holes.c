@@ -701,6 +701,51 @@ static void test_corner_pierced(void)
     st_soup_free(cut);
 }
 
+/* k numbers in [-0.5, 0.5) from the xorshift state *r, the random
+ * loops' draws. */
+static void draw_centred(uint64_t *r, double *u, int k)
+{
+    for (int j = 0; j < k; j++) {
+        *r ^= *r << 13, *r ^= *r >> 7, *r ^= *r << 17;
+        u[j] = (double)(*r >> 11) / 9007199254740992.0 - 0.5;
+    }
+}
+
+/* The flat, wavy and random loops' size: an ellipse of radii rx, ry in
+ * z = flat_z (kind 0), with noise * u added and z = wave * sin(lobes a)
+ * (kind 2). */
+typedef struct loop_shape {
+    double rx, ry, noise, flat_z, wave, lobes;
+} loop_shape;
+
+/* Point i of n of a random loop of the given kind (it % 5 in the tests):
+ * 0 flat and regular (every triangulation's area the same up to
+ * rounding), 1 integer points over the x = 4, y = 4 and z = 4 faces of a
+ * box (exact ties), 2 wavy, 3 random (u), 4 runs of three repeated
+ * (odd it) or collinear points around a circle of radius 2. */
+static void loop_point(double p[3], const loop_shape *sh, int kind, size_t i, size_t n, int it,
+                       const double u[3])
+{
+    const double a = 2.0 * M_PI * (double)i / (double)n;
+    if (kind == 1) {
+        const double q = floor(12.0 * (double)i / (double)n);
+        const size_t face = (size_t)q / 4, st = (size_t)q % 4;
+        p[0] = face == 0 ? 4.0 : (double)st;
+        p[1] = face == 1 ? 4.0 : face == 0 ? (double)st : 4.0 - (double)st;
+        p[2] = face == 2 ? 4.0 : (double)(face == 1) * (double)st;
+    } else if (kind == 4) {
+        const size_t m = i / 3 * 3;
+        const double b = 2.0 * M_PI * (double)m / (double)n;
+        p[0] = 2.0 * cos(b) + (double)(i - m) * (it % 2 ? 0.0 : 0.25);
+        p[1] = 2.0 * sin(b);
+        p[2] = 0.5 * u[2];
+    } else {
+        p[0] = kind == 3 ? u[0] : sh->rx * cos(a) + sh->noise * (kind == 2) * u[0];
+        p[1] = kind == 3 ? u[1] : sh->ry * sin(a) + sh->noise * (kind == 2) * u[1];
+        p[2] = kind == 0 ? sh->flat_z : kind == 2 ? sh->wave * sin(sh->lobes * a) : u[2];
+    }
+}
+
 /* The screen that spares least_area on loops surely too large: never
  * above where least_area's area is not (random loops, planar convex ones
  * among them, where the vector area is the least area and only rounding
@@ -717,10 +762,7 @@ static void test_area_screen(void)
         const int kind = it % 3;    /* 0 planar convex, 1 wavy, 2 random */
         for (size_t i = 0; i < n; i++) {
             double u[3];
-            for (int k = 0; k < 3; k++) {
-                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
-                u[k] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
-            }
+            draw_centred(&r, u, 3);
             const double a = 2.0 * M_PI * (double)i / (double)n;
             xyz[i][0] = kind == 2 ? u[0] : 3.0 * cos(a) + 0.3 * (kind == 1) * u[0];
             xyz[i][1] = kind == 2 ? u[1] : 2.0 * sin(a) + 0.3 * (kind == 1) * u[1];
@@ -783,6 +825,7 @@ static double ref_screen_sum(const double *const *pts, size_t n)
  * collinear points (triangles of area 0). */
 static void test_screen_same(void)
 {
+    const loop_shape wide = {30.0, 20.0, 3.0, 7.0, 4.0, 5.0};
     uint64_t r = 0x6a09e667f3bcc909ull;
     size_t differ = 0, loops = 0;
     static double xyz[250][3];
@@ -792,29 +835,8 @@ static void test_screen_same(void)
         const int kind = it % 5;    /* flat, box faces, wavy, random, repeated points */
         for (size_t i = 0; i < n; i++) {
             double u[3];
-            for (int k = 0; k < 3; k++) {
-                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
-                u[k] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
-            }
-            const double a = 2.0 * M_PI * (double)i / (double)n;
-            double *p = xyz[i];
-            if (kind == 1) {
-                const double q = floor(12.0 * (double)i / (double)n);
-                const size_t face = (size_t)q / 4, st = (size_t)q % 4;
-                p[0] = face == 0 ? 4.0 : (double)st;
-                p[1] = face == 1 ? 4.0 : face == 0 ? (double)st : 4.0 - (double)st;
-                p[2] = face == 2 ? 4.0 : (double)(face == 1) * (double)st;
-            } else if (kind == 4) {
-                const size_t m = i / 3 * 3;
-                const double b = 2.0 * M_PI * (double)m / (double)n;
-                p[0] = 2.0 * cos(b) + (double)(i - m) * (it % 2 ? 0.0 : 0.25);
-                p[1] = 2.0 * sin(b);
-                p[2] = 0.5 * u[2];
-            } else {
-                p[0] = kind == 3 ? u[0] : 30.0 * cos(a) + 3.0 * (kind == 2) * u[0];
-                p[1] = kind == 3 ? u[1] : 20.0 * sin(a) + 3.0 * (kind == 2) * u[1];
-                p[2] = kind == 0 ? 7.0 : kind == 2 ? 4.0 * sin(5 * a) : u[2];
-            }
+            draw_centred(&r, u, 3);
+            loop_point(xyz[i], &wide, kind, i, n, it, u);
             pts[i] = xyz[i];
         }
         const double sum = ref_screen_sum(pts, n);
@@ -846,10 +868,7 @@ static void test_fan_near(void)
         const size_t n = 1 + (size_t)(it % 90);
         double u[8];
         for (size_t i = 0; i < n; i++) {
-            for (int k = 0; k < 8; k++) {
-                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
-                u[k] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
-            }
+            draw_centred(&r, u, 8);
             double *q = rows[i];
             const double l = sqrt(u[3] * u[3] + u[4] * u[4] + u[5] * u[5]);
             const double fac = 1e-4 + 1e-9 * fabs(u[6]);
@@ -950,10 +969,7 @@ static void test_cone_same(void)
         const size_t n = 1 + (size_t)(it % 70);
         double u[6];
         for (size_t i = 0; i < n; i++) {
-            for (int k = 0; k < 6; k++) {
-                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
-                u[k] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
-            }
+            draw_centred(&r, u, 6);
             const double a = 2.0 * M_PI * (double)i / (double)n;
             xyz[i][0] = 3.0 * cos(a) + u[0], xyz[i][1] = 3.0 * sin(a) + u[1], xyz[i][2] = u[2];
             if (it % 11 == 3 && i == n / 2 && i > 0)
@@ -1080,6 +1096,7 @@ static void ref_least_bend(double *area, const double *const *pts, const double 
  * triangles bend 4). */
 static void test_bend_same(void)
 {
+    const loop_shape small = {3.0, 3.0, 0.3, 1.0, 1.0, 3.0};
     uint64_t r = 0x2545f4914f6cdd1dull;
     size_t differ = 0, loops = 0;
     double xyz[64][3], sd[64][3];
@@ -1090,29 +1107,8 @@ static void test_bend_same(void)
         const int kind = it % 5;    /* flat, box faces, wavy, random, repeated points */
         for (size_t i = 0; i < n; i++) {
             double u[3];
-            for (int k = 0; k < 3; k++) {
-                r ^= r << 13, r ^= r >> 7, r ^= r << 17;
-                u[k] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
-            }
-            const double a = 2.0 * M_PI * (double)i / (double)n;
-            double *p = xyz[i];
-            if (kind == 1) {    /* around a box corner: x = 4, y = 4 or z = 4 faces */
-                const double q = floor(12.0 * (double)i / (double)n);
-                const size_t face = (size_t)q / 4, st = (size_t)q % 4;
-                p[0] = face == 0 ? 4.0 : (double)st;
-                p[1] = face == 1 ? 4.0 : face == 0 ? (double)st : 4.0 - (double)st;
-                p[2] = face == 2 ? 4.0 : 0.0 + (double)(face == 1) * (double)st;
-            } else if (kind == 4) {
-                const size_t m = i / 3 * 3;     /* runs of three: repeated or collinear */
-                const double b = 2.0 * M_PI * (double)m / (double)n;
-                p[0] = 2.0 * cos(b) + (double)(i - m) * (it % 2 ? 0.0 : 0.25);
-                p[1] = 2.0 * sin(b);
-                p[2] = 0.5 * u[2];
-            } else {
-                p[0] = kind == 3 ? u[0] : 3.0 * cos(a) + 0.3 * (kind == 2) * u[0];
-                p[1] = kind == 3 ? u[1] : 3.0 * sin(a) + 0.3 * (kind == 2) * u[1];
-                p[2] = kind == 0 ? 1.0 : kind == 2 ? sin(3 * a) : u[2];
-            }
+            draw_centred(&r, u, 3);
+            loop_point(xyz[i], &small, kind, i, n, it, u);
             pts[i] = xyz[i];
         }
         for (size_t i = 0; i < n; i++) {    /* beside each edge, out of the loop */
