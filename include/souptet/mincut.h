@@ -1,6 +1,7 @@
 /*
- * mincut.h - inside/outside of a voxel grid by a minimum cut (Boykov and
- * Kolmogorov's augmenting-path max-flow, 2004, on the grid's 6-neighbour
+ * mincut.h - inside/outside of a voxel grid by a minimum cut (an
+ * augmenting-path max-flow, incremental breadth-first search: Goldberg,
+ * Hed, Kaplan, Tarjan and Werneck, 2011, on the grid's 6-neighbour
  * graph).
  *
  * Units: voxels; capacities are integers.

@@ -1,15 +1,22 @@
 /*
- * mincut.c - a minimum cut on a voxel grid (see mincut.h): Boykov and
- * Kolmogorov's max-flow ("An experimental comparison of min-cut/max-flow
- * algorithms for energy minimization in vision", PAMI 2004), written here
- * for the implicit 6-neighbour graph of a grid, integer capacities.
+ * mincut.c - a minimum cut on a voxel grid (see mincut.h): the incremental
+ * breadth-first search max-flow (IBFS) of Goldberg, Hed, Kaplan, Tarjan
+ * and Werneck ("Maximum flows by incremental breadth-first search", ESA
+ * 2011), written here for the implicit 6-neighbour graph of a grid,
+ * integer capacities.
  *
  * Two search trees grow from the terminals (S, the inside: voxels with
  * inside evidence; T, the outside: voxels with outside evidence and the
- * grid's border) along arcs with residual capacity; where they touch, the
- * path is augmented, the arcs it saturates cut nodes off their tree
- * (orphans), and the orphans look for a new parent in their own tree or
- * become free. When neither tree can grow, the S tree is the inside.
+ * grid's border) along arcs with residual capacity, as in Boykov and
+ * Kolmogorov's method, but a level at a time, alternately: every node
+ * carries its level in its tree (roots 1) and a tree arc always goes one
+ * level down. Where the trees touch, the path is augmented; the arcs it
+ * saturates cut nodes off their tree (orphans), and an orphan takes a
+ * neighbour one level above it as its parent, found in one look at its six
+ * arcs (no walk to the root), or else moves down below its highest
+ * reaching neighbour, its children orphans in turn, or leaves the tree if
+ * that is beyond the level being grown. When S cannot grow, S is the
+ * inside.
  *
  * Only the undecided voxels are nodes (|evidence| below p->fixed, off the
  * border); a decided neighbour is a terminal, its arc's capacity added to
@@ -25,7 +32,8 @@
  * labellings): the flow's paths and their order are free to change
  * (plant_roots pushes the one-arc paths before the trees grow).
  *
- * Measurements of the solver's work: doc/design/mincut.md.
+ * Measurements of the solver's work (and of Boykov and Kolmogorov's
+ * trees, which it replaced): doc/design/mincut.md.
  */
 #include "souptet/mincut.h"
 #include "../base/fpenv.h"
@@ -39,31 +47,39 @@
 #define TREE_S 0x01u
 #define TREE_T 0x02u
 #define TREES (TREE_S | TREE_T)
-#define F_ACTIVE 0x08u
+#define F_QS 0x10u              /* in S's ring */
+#define F_QT 0x20u              /* in T's ring */
 
 #define P_TERMINAL 6u
 #define P_ORPHAN 7u
 #define P_NONE 8u
 
 #define NO_NODE UINT32_MAX
-#define INF_D UINT32_MAX
 
-typedef struct bk {
+/* A tree's nodes to scan: a FIFO ring of n + 1 (each node in it at most
+ * once, by its flag); those at level D are the ones not yet scanned, and
+ * every node of the tree below D has been. */
+typedef struct level_ring {
+    uint32_t *q;
+    size_t h, t;
+    uint32_t D;
+    uint8_t flag;
+} level_ring;
+
+typedef struct ibfs {
     size_t n;             /* nodes */
     uint32_t *nbr;        /* nbr[6 v + a]: the neighbouring node, or NO_NODE */
     int32_t *rc;          /* residual capacity of arc (v, a): rc[6 v + a] */
     int32_t *tr;          /* terminal residual: > 0 from S, < 0 to T */
-    uint8_t *tree;        /* TREE_S / TREE_T / free, F_ACTIVE */
+    uint8_t *tree;        /* TREE_S / TREE_T / free, F_QS, F_QT */
     uint8_t *parent;      /* direction to the parent, or P_* */
     uint32_t *up;         /* the parent node (when parent[v] is a direction) */
-    uint32_t *ts, *dist;  /* the distance-to-root heuristic's marks */
-    uint32_t *active;     /* FIFO ring of n + 1 */
-    size_t ah, at;
+    uint32_t *lev;        /* the node's level in its tree (roots 1) */
+    level_ring S, T;
     uint32_t *orphan;     /* FIFO ring of n + 1 */
     size_t oh, ot;
-    uint32_t time;
     int64_t flow;
-} bk;
+} ibfs;
 
 st_mincut_params st_mincut_params_default(void)
 {
@@ -78,41 +94,38 @@ st_mincut_params st_mincut_params_default(void)
     return p;
 }
 
-static void set_active(bk *b, uint32_t v)
-{
-    if (b->tree[v] & F_ACTIVE)
-        return;
-    b->tree[v] |= F_ACTIVE;
-    b->active[b->at] = v;
-    b->at = b->at == b->n ? 0 : b->at + 1;
-}
-
-static uint32_t next_active(bk *b)
-{
-    while (b->ah != b->at) {
-        uint32_t v = b->active[b->ah];
-        b->ah = b->ah == b->n ? 0 : b->ah + 1;
-        if (b->tree[v] & TREES)
-            return v;           /* stays flagged while it is the current node */
-        b->tree[v] &= (uint8_t)~F_ACTIVE;
-    }
-    return NO_NODE;
-}
-
-static void set_orphan(bk *b, uint32_t v)
+static void set_orphan(ibfs *b, uint32_t v)
 {
     b->parent[v] = P_ORPHAN;
     b->orphan[b->ot] = v;
     b->ot = b->ot == b->n ? 0 : b->ot + 1;
 }
 
-static inline uint32_t nb(const bk *b, uint32_t v, unsigned a)
+/* v to the tail of ring L unless it is in it already. */
+static void ring_push(ibfs *b, level_ring *L, uint32_t v)
+{
+    if (b->tree[v] & L->flag)
+        return;
+    b->tree[v] |= L->flag;
+    L->q[L->t] = v;
+    L->t = L->t == b->n ? 0 : L->t + 1;
+}
+
+static uint32_t ring_pop(ibfs *b, level_ring *L)
+{
+    uint32_t v = L->q[L->h];
+    L->h = L->h == b->n ? 0 : L->h + 1;
+    b->tree[v] &= (uint8_t)~L->flag;
+    return v;
+}
+
+static inline uint32_t nb(const ibfs *b, uint32_t v, unsigned a)
 {
     return b->nbr[6 * (size_t)v + a];
 }
 
 /* Push the bottleneck along S root .. s -> t .. T root (arc (s, a)). */
-static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
+static void augment(ibfs *b, uint32_t s, uint32_t t, unsigned a)
 {
     int32_t m = b->rc[6 * (size_t)s + a];
     uint32_t x;
@@ -163,73 +176,126 @@ static void augment(bk *b, uint32_t s, uint32_t t, unsigned a)
 
 /* Residual capacity that lets v (in tree X) hang below its neighbour
  * j = v + off[a]: j -> v for S, v -> j for T. */
-static inline int32_t tree_cap(const bk *b, unsigned X, uint32_t v, uint32_t j, unsigned a)
+static inline int32_t tree_cap(const ibfs *b, unsigned X, uint32_t v, uint32_t j, unsigned a)
 {
     return X == TREE_S ? b->rc[6 * (size_t)j + (a ^ 1u)] : b->rc[6 * (size_t)v + a];
 }
 
-static void adopt(bk *b, uint32_t v)
+/* A new parent for the orphan v: a neighbour of its tree one level above
+ * it that reaches it (for T: that it reaches), kept at its level; else the
+ * least-level such neighbour, v one level below it and its children
+ * orphans (their levels no longer fit), and v pending if that is the
+ * tree's pending level; beyond it, or with no such neighbour, v leaves the
+ * tree. The levels fall strictly towards the roots, so no parent is ever
+ * a descendant; every tree node that reaches v from below the pending
+ * level was scanned, so had v a neighbour there it would have been
+ * found, and v leaving is seen by the pending nodes that reach it. */
+static void adopt(ibfs *b, uint32_t v)
 {
     const unsigned X = b->tree[v] & TREES;
-    uint32_t d_min = INF_D;
-    unsigned a_min = P_NONE;
+    level_ring *L = X == TREE_S ? &b->S : &b->T;
+    const uint32_t lv = b->lev[v];
+    uint32_t lmin = UINT32_MAX;
+    unsigned amin = P_NONE;
     for (unsigned a = 0; a < 6; a++) {
         uint32_t j = nb(b, v, a);
         if (j == NO_NODE || (b->tree[j] & TREES) != X || tree_cap(b, X, v, j, a) <= 0)
             continue;
-        /* Is j's origin a terminal, and how far? */
-        uint32_t d = 0, k = j;
-        for (;;) {
-            if (b->ts[k] == b->time) {
-                d += b->dist[k];
-                break;
-            }
-            unsigned pk = b->parent[k];
-            d++;
-            if (pk == P_TERMINAL) {
-                b->ts[k] = b->time;
-                b->dist[k] = 1;
-                break;
-            }
-            if (pk == P_ORPHAN) {
-                d = INF_D;
-                break;
-            }
-            k = b->up[k];
+        if (b->lev[j] + 1 == lv) {
+            b->parent[v] = (uint8_t)a;
+            b->up[v] = j;
+            return;
         }
-        if (d == INF_D)
-            continue;
-        if (d < d_min) {
-            d_min = d;
-            a_min = a;
+        if (b->lev[j] < lmin) {
+            lmin = b->lev[j];
+            amin = a;
         }
-        for (k = j; b->ts[k] != b->time; k = b->up[k]) {
-            b->ts[k] = b->time;
-            b->dist[k] = d--;
-        }
-    }
-    if (a_min != P_NONE) {
-        b->parent[v] = (uint8_t)a_min;
-        b->up[v] = nb(b, v, a_min);
-        b->ts[v] = b->time;
-        b->dist[v] = d_min + 1;
-        return;
     }
     for (unsigned a = 0; a < 6; a++) {
         uint32_t j = nb(b, v, a);
-        if (j == NO_NODE || (b->tree[j] & TREES) != X)
-            continue;
-        if (tree_cap(b, X, v, j, a) > 0)
-            set_active(b, j);
-        unsigned pj = b->parent[j];
-        if (pj == (a ^ 1u))
+        if (j != NO_NODE && (b->tree[j] & TREES) == X && b->parent[j] == (a ^ 1u))
             set_orphan(b, j);
     }
-    b->tree[v] &= (uint8_t)~TREES;
-    b->parent[v] = P_NONE;
+    if (amin == P_NONE || lmin >= L->D) {
+        b->tree[v] &= (uint8_t)~TREES;
+        b->parent[v] = P_NONE;
+        return;
+    }
+    b->parent[v] = (uint8_t)amin;
+    b->up[v] = nb(b, v, amin);
+    b->lev[v] = lmin + 1;
+    if (lmin + 1 == L->D)
+        ring_push(b, L, v);
 }
 
-static void bk_free(bk *b)
+/* Scan node v of tree X at level `level` (the one being grown): its free
+ * neighbours join X a level below, and each arc to the other tree is
+ * augmented until it is saturated or v has left the level. */
+static void scan(ibfs *b, unsigned X, uint32_t v, uint32_t level, level_ring *L)
+{
+    for (unsigned a = 0; a < 6; a++) {
+        const uint32_t q = nb(b, v, a);
+        if (q == NO_NODE)
+            continue;
+        for (;;) {
+            int32_t c = X == TREE_S ? b->rc[6 * (size_t)v + a] : b->rc[6 * (size_t)q + (a ^ 1u)];
+            const unsigned Y = b->tree[q] & TREES;
+            if (c <= 0 || Y == X)
+                break;
+            if (!Y) {
+                b->tree[q] |= (uint8_t)X;
+                b->parent[q] = (uint8_t)(a ^ 1u);
+                b->up[q] = v;
+                b->lev[q] = level + 1;
+                ring_push(b, L, q);
+                break;
+            }
+            if (X == TREE_S)
+                augment(b, v, q, a);
+            else
+                augment(b, q, v, a ^ 1u);
+            while (b->oh != b->ot) {
+                uint32_t o = b->orphan[b->oh];
+                b->oh = b->oh == b->n ? 0 : b->oh + 1;
+                adopt(b, o);
+            }
+            if ((b->tree[v] & TREES) != X || b->lev[v] != level)
+                return;
+        }
+    }
+}
+
+/* Grow tree X by its pending level: the nodes in its ring now (those
+ * still at that level; one moved down to the next is kept for it). */
+static void grow(ibfs *b, unsigned X)
+{
+    level_ring *L = X == TREE_S ? &b->S : &b->T;
+    const uint32_t level = L->D;
+    size_t k = L->t >= L->h ? L->t - L->h : L->t + b->n + 1 - L->h;
+    L->D = level + 1;
+    while (k--) {
+        const uint32_t v = ring_pop(b, L);
+        if ((b->tree[v] & TREES) != X)
+            continue;
+        if (b->lev[v] == level)
+            scan(b, X, v, level, L);
+        else if (b->lev[v] == L->D)
+            ring_push(b, L, v);
+    }
+}
+
+/* S and T grow a level each in turn (S first: until then the roots that
+ * are not in the rings count as scanned) until S has no pending level. */
+static void maxflow(ibfs *b)
+{
+    while (b->S.h != b->S.t) {
+        grow(b, TREE_S);
+        if (b->T.h != b->T.t)
+            grow(b, TREE_T);
+    }
+}
+
+static void ibfs_free(ibfs *b)
 {
     free(b->nbr);
     free(b->rc);
@@ -237,87 +303,27 @@ static void bk_free(bk *b)
     free(b->tree);
     free(b->parent);
     free(b->up);
-    free(b->ts);
-    free(b->dist);
-    free(b->active);
+    free(b->lev);
+    free(b->S.q);
+    free(b->T.q);
     free(b->orphan);
-}
-
-static void maxflow(bk *b)
-{
-    uint32_t cur = NO_NODE;
-    for (;;) {
-        if (cur != NO_NODE && !(b->tree[cur] & TREES)) {
-            b->tree[cur] &= (uint8_t)~F_ACTIVE;
-            cur = NO_NODE;
-        }
-        if (cur == NO_NODE && (cur = next_active(b)) == NO_NODE)
-            break;
-        const unsigned X = b->tree[cur] & TREES;
-        uint32_t s = NO_NODE, t = NO_NODE;
-        unsigned arc = 0;
-        for (unsigned a = 0; a < 6; a++) {
-            uint32_t q = nb(b, cur, a);
-            if (q == NO_NODE)
-                continue;
-            int32_t c = X == TREE_S ? b->rc[6 * (size_t)cur + a] : b->rc[6 * (size_t)q + (a ^ 1u)];
-            if (c <= 0)
-                continue;
-            const unsigned Y = b->tree[q] & TREES;
-            if (!Y) {
-                b->tree[q] |= (uint8_t)X;
-                b->parent[q] = (uint8_t)(a ^ 1u);
-                b->up[q] = cur;
-                b->ts[q] = b->ts[cur];
-                b->dist[q] = b->dist[cur] + 1;
-                set_active(b, q);
-            } else if (Y != X) {
-                if (X == TREE_S) {
-                    s = cur;
-                    t = q;
-                    arc = a;
-                } else {
-                    s = q;
-                    t = cur;
-                    arc = a ^ 1u;
-                }
-                break;
-            } else if (b->ts[q] <= b->ts[cur] && b->dist[q] > b->dist[cur]) {
-                b->parent[q] = (uint8_t)(a ^ 1u);
-                b->up[q] = cur;
-                b->ts[q] = b->ts[cur];
-                b->dist[q] = b->dist[cur] + 1;
-            }
-        }
-        if (s == NO_NODE) {
-            b->tree[cur] &= (uint8_t)~F_ACTIVE;
-            cur = NO_NODE;
-            continue;
-        }
-        b->time++;
-        augment(b, s, t, arc);
-        while (b->oh != b->ot) {
-            uint32_t v = b->orphan[b->oh];
-            b->oh = b->oh == b->n ? 0 : b->oh + 1;
-            adopt(b, v);
-        }
-    }
 }
 
 /* The paths of one arc first (source -> u -> q -> sink for neighbours u
  * with terminal capacity from the source and q with capacity to the
  * sink, pushed in node order without the trees), then the trees' roots
- * (the nodes with terminal capacity left) and the active ones among
- * them: a root is active only if some neighbour is free or in the other
- * tree. A root among its own tree's roots alone has nothing to grow
- * into, and should a neighbour leave the tree later, adopt() activates
- * it then. Neither changes the cut: the S tree at the end is every node
- * the source reaches in the residual graph, the same set for every
- * maximum flow whatever its paths and their order (on b9_mesh at 7
- * cells, 274 K nodes: 534 -> 496 M Ir in the cut, the one-arc paths
- * sparing most of the trees' first augmentations, the inactive roots
+ * (the nodes with terminal capacity left, level 1) and the pending ones
+ * among them: a root is pending only if some neighbour is free or in the
+ * other tree. A root among its own tree's roots alone has nothing to grow
+ * into, and none of those neighbours can leave the tree while the root
+ * reaches it (adopt() keeps it a level below). Neither changes the cut:
+ * the S tree at the end is every node the source reaches in the residual
+ * graph, the same set for every maximum flow whatever its paths and their
+ * order (on b9_mesh at 7 cells, 274 K nodes, with Boykov and
+ * Kolmogorov's trees: 534 -> 496 M Ir in the cut, the one-arc paths
+ * sparing most of the trees' first augmentations, the roots left out
  * about 270 K scans of six same-tree neighbours). */
-static void plant_roots(bk *b)
+static void plant_roots(ibfs *b)
 {
     const size_t m = b->n;
     for (size_t u = 0; u < m; u++)
@@ -348,7 +354,7 @@ static void plant_roots(bk *b)
             other |= q != NO_NODE && (b->tree[q] & TREES) != X;
         }
         if (other)
-            set_active(b, (uint32_t)u);
+            ring_push(b, X == TREE_S ? &b->S : &b->T, (uint32_t)u);
     }
 }
 
@@ -392,7 +398,7 @@ static void node_caps(int32_t *cap, const st_grid *g, const uint32_t *vox, size_
  * one's number as v + 1's is u + 1 (storage order), and v + nx's and v +
  * nx ny's by cursors that only move forward (one binary search to start
  * each), since w rises with the node. */
-static void node_arcs(bk *b, const st_grid *g, const int8_t *label, const uint32_t *vox,
+static void node_arcs(ibfs *b, const st_grid *g, const int8_t *label, const uint32_t *vox,
                       const int32_t *vcap, size_t u0, size_t u1, const ptrdiff_t off[6],
                       const st_mincut_params *p, double s, int fixed, const int64_t *ecap)
 {
@@ -435,7 +441,7 @@ static void node_arcs(bk *b, const st_grid *g, const int8_t *label, const uint32
         if (t > INT32_MAX / 2 || t < -INT32_MAX / 2)
             t = t > 0 ? INT32_MAX / 2 : -INT32_MAX / 2;
         b->tr[u] = (int32_t)t;
-        b->dist[u] = 1;
+        b->lev[u] = 1;
     }
 }
 
@@ -482,8 +488,11 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
     for (size_t k = 0; k < nz; k++)
         first[k + 1] += first[k];
     const size_t m = first[nz];
-    bk b = {0};
+    ibfs b = {0};
     b.n = m;
+    b.S.flag = F_QS;
+    b.T.flag = F_QT;
+    b.S.D = b.T.D = 1;
     uint32_t *vox = st_malloc_array(m ? m : 1, sizeof *vox);
     b.nbr = st_malloc_array(6 * m + 1, sizeof *b.nbr);
     b.rc = st_malloc_array(6 * m + 1, sizeof *b.rc);
@@ -491,17 +500,17 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
     b.tree = st_malloc_array(m + 1, 1);
     b.parent = st_malloc_array(m + 1, 1);
     b.up = st_malloc_array(m + 1, sizeof *b.up);
-    b.ts = st_calloc_array(m + 1, sizeof *b.ts);
-    b.dist = st_malloc_array(m + 1, sizeof *b.dist);
-    b.active = st_malloc_array(m + 1, sizeof *b.active);
+    b.lev = st_malloc_array(m + 1, sizeof *b.lev);
+    b.S.q = st_malloc_array(m + 1, sizeof *b.S.q);
+    b.T.q = st_malloc_array(m + 1, sizeof *b.T.q);
     b.orphan = st_malloc_array(m + 1, sizeof *b.orphan);
     int32_t *vcap = st_malloc_array(m ? m : 1, sizeof *vcap);   /* each node's face capacity */
-    if (!vox || !b.nbr || !b.rc || !b.tr || !b.tree || !b.parent || !b.up || !b.ts || !b.dist ||
-        !b.active || !b.orphan || !vcap) {
+    if (!vox || !b.nbr || !b.rc || !b.tr || !b.tree || !b.parent || !b.up || !b.lev || !b.S.q ||
+        !b.T.q || !b.orphan || !vcap) {
         free(first);
         free(vox);
         free(vcap);
-        bk_free(&b);
+        ibfs_free(&b);
         return st_error_set(err, ST_ENOMEM, NULL, 0,
                             "out of memory for the cut (%zu undecided voxels)", m);
     }
@@ -541,6 +550,6 @@ st_status st_mincut_label(const st_grid *g, int8_t *label,
     if (flow)
         *flow = (double)b.flow;
     free(vox);
-    bk_free(&b);
+    ibfs_free(&b);
     return ST_OK;
 }
