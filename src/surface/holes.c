@@ -31,7 +31,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef __SSE2__
+#ifdef HOLES_AVX
+#include <immintrin.h>
+#elif defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
@@ -187,10 +189,58 @@ static int vector_area_above(const double *const *pts, size_t n, double lim)
 /* The least over the apexes k in (i, j) of w[i n + k] + w[k n + j] plus
  * the area of (pts[i], pts[k], pts[j]) by a plain square root: with the
  * loop's coordinates in xs, ys, zs and the table also transposed (wt[j n
- * + k] = w[k n + j]). Two apexes at a time with SSE2: each lane's
+ * + k] = w[k n + j]). Four apexes at a time with AVX where the processor
+ * has it (area_row4), then two at a time with SSE2: each lane's
  * operations are the scalar ones, in the same order (no fused
  * multiply-add), so every sum is the same to the bit, and the least of
  * them is the same in any order (none is NaN where it is taken). */
+
+/* The lanes' broadcasts for area_row's row (i, j) (P: the intrinsics'
+ * prefix, _mm for SSE2's two lanes, _mm256 for AVX's four; T their type),
+ * and the step that takes the apexes from q on into vm, the least so far
+ * (min_pd: t < vm ? t : vm, lane by lane). */
+#define AREA_SETUP(P, T)                                                            \
+    const T vp0 = P##_set1_pd(xs[i]), vp1 = P##_set1_pd(ys[i]);                     \
+    const T vp2 = P##_set1_pd(zs[i]), half = P##_set1_pd(0.5);                      \
+    const T vf0 = P##_set1_pd(xs[j] - xs[i]), vf1 = P##_set1_pd(ys[j] - ys[i]);     \
+    const T vf2 = P##_set1_pd(zs[j] - zs[i])
+#define AREA_STEP(P, T, q)                                                          \
+    do {                                                                            \
+        const T s_ = P##_add_pd(P##_loadu_pd(wi + (q)), P##_loadu_pd(wj + (q)));    \
+        const T e0 = P##_sub_pd(P##_loadu_pd(xs + (q)), vp0);                       \
+        const T e1 = P##_sub_pd(P##_loadu_pd(ys + (q)), vp1);                       \
+        const T e2 = P##_sub_pd(P##_loadu_pd(zs + (q)), vp2);                       \
+        const T c0 = P##_sub_pd(P##_mul_pd(e1, vf2), P##_mul_pd(e2, vf1));          \
+        const T c1 = P##_sub_pd(P##_mul_pd(e2, vf0), P##_mul_pd(e0, vf2));          \
+        const T c2 = P##_sub_pd(P##_mul_pd(e0, vf1), P##_mul_pd(e1, vf0));          \
+        const T dd = P##_add_pd(P##_add_pd(P##_mul_pd(c0, c0), P##_mul_pd(c1, c1)), \
+                                P##_mul_pd(c2, c2));                                \
+        const T t_ = P##_add_pd(s_, P##_mul_pd(half, P##_sqrt_pd(dd)));             \
+        vm = P##_min_pd(t_, vm);                                                    \
+    } while (0)
+
+#ifdef HOLES_AVX
+/* area_row's least over the apexes *k, *k + 1, ... four at a time (AVX),
+ * while four are left before j; *k moved past them. */
+static HOLES_AVX_FN double area_row4(const double *xs, const double *ys, const double *zs,
+                                     const double *wi, const double *wj, size_t i, size_t j,
+                                     size_t *k)
+{
+    AREA_SETUP(_mm256, __m256d);
+    __m256d vm = _mm256_set1_pd(INFINITY);
+    size_t q = *k;
+    for (; q + 3 < j; q += 4)
+        AREA_STEP(_mm256, __m256d, q);
+    *k = q;
+    double lanes[4];
+    _mm256_storeu_pd(lanes, vm);
+    double m = lanes[0];
+    for (int l = 1; l < 4; l++)
+        m = lanes[l] < m ? lanes[l] : m;
+    return m;
+}
+#endif
+
 static double area_row(const double *xs, const double *ys, const double *zs, const double *w,
                        const double *wt, size_t n, size_t i, size_t j)
 {
@@ -199,25 +249,15 @@ static double area_row(const double *xs, const double *ys, const double *zs, con
     const double *wi = w + i * n, *wj = wt + j * n;
     double m = INFINITY;
     size_t k = i + 1;
+#ifdef HOLES_AVX
+    if (k + 3 < j && holes_avx())
+        m = area_row4(xs, ys, zs, wi, wj, i, j, &k);
+#endif
 #ifdef __SSE2__
-    const __m128d vp0 = _mm_set1_pd(p0), vp1 = _mm_set1_pd(p1), vp2 = _mm_set1_pd(p2);
-    const __m128d vf0 = _mm_set1_pd(f0), vf1 = _mm_set1_pd(f1), vf2 = _mm_set1_pd(f2);
-    const __m128d half = _mm_set1_pd(0.5);
-    __m128d vm = _mm_set1_pd(INFINITY);
-    for (; k + 1 < j; k += 2) {
-        const __m128d s = _mm_add_pd(_mm_loadu_pd(wi + k), _mm_loadu_pd(wj + k));
-        const __m128d e0 = _mm_sub_pd(_mm_loadu_pd(xs + k), vp0);
-        const __m128d e1 = _mm_sub_pd(_mm_loadu_pd(ys + k), vp1);
-        const __m128d e2 = _mm_sub_pd(_mm_loadu_pd(zs + k), vp2);
-        const __m128d c0 = _mm_sub_pd(_mm_mul_pd(e1, vf2), _mm_mul_pd(e2, vf1));
-        const __m128d c1 = _mm_sub_pd(_mm_mul_pd(e2, vf0), _mm_mul_pd(e0, vf2));
-        const __m128d c2 = _mm_sub_pd(_mm_mul_pd(e0, vf1), _mm_mul_pd(e1, vf0));
-        const __m128d dd = _mm_add_pd(_mm_add_pd(_mm_mul_pd(c0, c0), _mm_mul_pd(c1, c1)),
-                                      _mm_mul_pd(c2, c2));
-        const __m128d t = _mm_add_pd(s, _mm_mul_pd(half, _mm_sqrt_pd(dd)));
-        const __m128d lt = _mm_cmplt_pd(t, vm);
-        vm = _mm_or_pd(_mm_and_pd(lt, t), _mm_andnot_pd(lt, vm));
-    }
+    AREA_SETUP(_mm, __m128d);
+    __m128d vm = _mm_set1_pd(m);
+    for (; k + 1 < j; k += 2)
+        AREA_STEP(_mm, __m128d, k);
     double lanes[2];
     _mm_storeu_pd(lanes, vm);
     m = lanes[1] < lanes[0] ? lanes[1] : lanes[0];

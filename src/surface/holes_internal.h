@@ -15,6 +15,20 @@
 #include "souptet/geom.h"
 #include "souptet/soup.h"
 
+/* AVX, four lanes of doubles, where the processor has it (checked when
+ * called, holes_avx): the loops that take two edges or apexes at a time
+ * with SSE2 take four, each lane the scalar operations in the same order
+ * (no contraction: the Makefile's FP_EXACT), so every answer is the same
+ * to the bit (doc/design/holes.md, "Costs"). */
+#if defined(__GNUC__) && defined(__x86_64__)
+#define HOLES_AVX 1
+#define HOLES_AVX_FN __attribute__((target("avx")))
+static inline int holes_avx(void)
+{
+    return __builtin_cpu_supports("avx");
+}
+#endif
+
 /* The distance between a and b. */
 static inline double dist3(const double *a, const double *b)
 {

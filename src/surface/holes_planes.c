@@ -61,7 +61,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef __SSE2__
+#ifdef HOLES_AVX
+#include <immintrin.h>
+#elif defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
@@ -178,12 +180,78 @@ static int cone_term(double *lb, double *len, double ee, double l, double term, 
  * edges at a time (SSE2: each lane the scalar operations in the same
  * order), summed one by one in order as before (cone_term; there
  * the terms that do not count add 0). */
+#ifdef HOLES_AVX
+/* st_holes_cone_above's terms four edges at a time (AVX) from the first,
+ * summed one by one in order into *lb and *len: 1 as soon as they reach
+ * below, else 0 with *i where it stopped (a multiple of four: before
+ * four with an edge out of range, or with fewer than four left). */
+static HOLES_AVX_FN int cone_above4(const double *apex, const st_holes_cone_rim *cr, size_t n,
+                                    double below, double *lb, double *len, size_t *i)
+{
+    const double *px = cr->p, *py = cr->p + n + 1, *pz = cr->p + 2 * (n + 1);
+    const double *rx = cr->r, *ry = cr->r + n, *rz = cr->r + 2 * n;
+    const __m256d ax = _mm256_set1_pd(apex[0]), ay = _mm256_set1_pd(apex[1]);
+    const __m256d az = _mm256_set1_pd(apex[2]);
+    const __m256d tiny = _mm256_set1_pd(1e-200), huge = _mm256_set1_pd(1e200);
+    const __m256d right = _mm256_set1_pd(0.5 * M_PI), zero = _mm256_setzero_pd();
+    size_t q = 0;
+    for (; q + 3 < n; q += 4) {
+#define L_(a) _mm256_loadu_pd(a)
+#define M_(a, b) _mm256_mul_pd(a, b)
+#define S_(a, b) _mm256_sub_pd(a, b)
+#define A_(a, b) _mm256_add_pd(a, b)
+        const __m256d p0 = L_(px + q), p1 = L_(py + q), p2 = L_(pz + q);
+        const __m256d e0 = S_(L_(px + q + 1), p0), e1 = S_(L_(py + q + 1), p1);
+        const __m256d e2 = S_(L_(pz + q + 1), p2);
+        const __m256d f0 = S_(ax, p0), f1 = S_(ay, p1), f2 = S_(az, p2);
+        const __m256d u0 = S_(M_(e1, f2), M_(e2, f1)), u1 = S_(M_(e2, f0), M_(e0, f2));
+        const __m256d u2 = S_(M_(e0, f1), M_(e1, f0));
+        const __m256d r0 = L_(rx + q), r1 = L_(ry + q), r2 = L_(rz + q);
+        const __m256d x0 = S_(M_(u1, r2), M_(u2, r1)), x1 = S_(M_(u2, r0), M_(u0, r2));
+        const __m256d x2 = S_(M_(u0, r1), M_(u1, r0));
+        const __m256d ee = A_(A_(M_(e0, e0), M_(e1, e1)), M_(e2, e2));
+        const __m256d uu = A_(A_(M_(u0, u0), M_(u1, u1)), M_(u2, u2));
+        const __m256d d = A_(A_(M_(u0, r0), M_(u1, r1)), M_(u2, r2));
+        const __m256d xx = A_(A_(M_(x0, x0), M_(x1, x1)), M_(x2, x2));
+#undef L_
+#undef M_
+#undef S_
+#undef A_
+        const __m256d l = _mm256_sqrt_pd(ee), pos = _mm256_cmp_pd(d, zero, _CMP_GT_OS);
+        const __m256d sn = _mm256_sqrt_pd(_mm256_div_pd(xx, uu));
+        const __m256d uu_in = _mm256_and_pd(_mm256_cmp_pd(uu, tiny, _CMP_GT_OS),
+                                            _mm256_cmp_pd(uu, huge, _CMP_LT_OS));
+        const __m256d counts = _mm256_and_pd(uu_in, _mm256_loadu_pd(cr->mask + q));
+        const __m256d t = _mm256_and_pd(
+            counts, _mm256_mul_pd(l, _mm256_blendv_pd(right, sn, pos)));
+        if (_mm256_movemask_pd(_mm256_and_pd(_mm256_cmp_pd(ee, tiny, _CMP_GT_OS),
+                                             _mm256_cmp_pd(ee, huge, _CMP_LT_OS))) != 15)
+            break;      /* an edge out of range: the scalar loop says where */
+        double ls[4], ts[4];
+        _mm256_storeu_pd(ls, l);
+        _mm256_storeu_pd(ts, t);
+        for (int k = 0; k < 4; k++) {
+            *len += ls[k];
+            *lb += ts[k];
+            if (*lb * (1.0 - 1e-10) - 1e-12 * *len >= below)
+                return 1;
+        }
+    }
+    *i = q;
+    return 0;
+}
+#endif
+
 int st_holes_cone_above(const double *apex, const st_holes_cone_rim *cr, size_t n, double below)
 {
     const double *px = cr->p, *py = cr->p + n + 1, *pz = cr->p + 2 * (n + 1);
     const double *rx = cr->r, *ry = cr->r + n, *rz = cr->r + 2 * n;
     double lb = 0.0, len = 0.0;
     size_t i = 0;
+#ifdef HOLES_AVX
+    if (n >= 4 && holes_avx() && cone_above4(apex, cr, n, below, &lb, &len, &i))
+        return 1;
+#endif
 #ifdef __SSE2__
     const __m128d ax = _mm_set1_pd(apex[0]), ay = _mm_set1_pd(apex[1]), az = _mm_set1_pd(apex[2]);
     const __m128d tiny = _mm_set1_pd(1e-200), huge = _mm_set1_pd(1e200);
@@ -603,11 +671,47 @@ static void fan_screen(double *scr, const fan_v *v, const double *rim, size_t n)
     }
 }
 
+#ifdef HOLES_AVX
+/* st_holes_fan_near's screen four edges at a time (AVX), from the first:
+ * those passed appended to near[*k..] in order; returns where it
+ * stopped (a multiple of four, the edges left fewer than four). */
+static HOLES_AVX_FN size_t fan_near4(size_t *near, size_t *k, const double *scr, size_t n,
+                                     const double *apex)
+{
+    const double *a0 = scr, *a1 = scr + n, *a2 = scr + 2 * n;
+    const double *r0 = scr + 3 * n, *r1 = scr + 4 * n, *r2 = scr + 5 * n, *ll = scr + 6 * n;
+    const __m256d x0 = _mm256_set1_pd(apex[0]), x1 = _mm256_set1_pd(apex[1]);
+    const __m256d x2 = _mm256_set1_pd(apex[2]);
+    size_t i = 0;
+    for (; i + 3 < n; i += 4) {
+        const __m256d f0 = _mm256_sub_pd(x0, _mm256_loadu_pd(a0 + i));
+        const __m256d f1 = _mm256_sub_pd(x1, _mm256_loadu_pd(a1 + i));
+        const __m256d f2 = _mm256_sub_pd(x2, _mm256_loadu_pd(a2 + i));
+        const __m256d sv = _mm256_add_pd(
+            _mm256_add_pd(_mm256_mul_pd(f0, _mm256_loadu_pd(r0 + i)),
+                          _mm256_mul_pd(f1, _mm256_loadu_pd(r1 + i))),
+            _mm256_mul_pd(f2, _mm256_loadu_pd(r2 + i)));
+        const __m256d ff = _mm256_add_pd(
+            _mm256_add_pd(_mm256_mul_pd(f0, f0), _mm256_mul_pd(f1, f1)), _mm256_mul_pd(f2, f2));
+        const int pass = _mm256_movemask_pd(_mm256_cmp_pd(
+            _mm256_mul_pd(sv, sv), _mm256_mul_pd(_mm256_loadu_pd(ll + i), ff), _CMP_NGT_US));
+        for (int l = 0; pass && l < 4; l++)     /* most pass none */
+            if (pass >> l & 1)
+                near[(*k)++] = i + (size_t)l;
+    }
+    return i;
+}
+#endif
+
 size_t st_holes_fan_near(size_t *near, const double *scr, size_t n, const double *apex)
 {
     const double *a0 = scr, *a1 = scr + n, *a2 = scr + 2 * n;
     const double *r0 = scr + 3 * n, *r1 = scr + 4 * n, *r2 = scr + 5 * n, *ll = scr + 6 * n;
     size_t k = 0, i = 0;
+#ifdef HOLES_AVX
+    if (n >= 4 && holes_avx())
+        i = fan_near4(near, &k, scr, n, apex);
+#endif
 #ifdef __SSE2__
     const __m128d x0 = _mm_set1_pd(apex[0]), x1 = _mm_set1_pd(apex[1]), x2 = _mm_set1_pd(apex[2]);
     for (; i + 1 < n; i += 2) {
