@@ -73,9 +73,28 @@ static void normalize(double v[3])
             v[a] /= l;
 }
 
-void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
-                       int w, double out[3])
+/* A symmetry by one angle, its turn's cosine and sine made once: the
+ * counts apply one map to every sample, and the two library calls cost
+ * about as much as the rest of the map. map_apply is st_symmetry_apply's
+ * arithmetic on the same doubles. */
+typedef struct sym_map {
+    const st_symmetry *y;
+    double angle, c, s;
+} sym_map;
+
+static sym_map map_of(const st_symmetry *y, double angle)
 {
+    sym_map m = {y, angle, 1.0, 0.0};
+    if (y->kind != ST_SYMMETRY_MIRROR) {
+        m.c = cos(angle);
+        m.s = sin(angle);
+    }
+    return m;
+}
+
+static void map_apply(const sym_map *m, const double x[3], int w, double out[3])
+{
+    const st_symmetry *y = m->y;
     const double *n = y->dir;
     double r[3];
     for (int a = 0; a < 3; a++)
@@ -86,16 +105,23 @@ void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
             r[a] -= d * n[a];
     } else {
         /* Rodrigues */
-        double c = cos(angle), s = sin(angle), k[3], d = st_dot3(n, r);
+        double c = m->c, s = m->s, k[3], d = st_dot3(n, r);
         st_cross3(k, n, r);
         for (int a = 0; a < 3; a++)
             r[a] = r[a] * c + k[a] * s + n[a] * d * (1.0 - c);
         if (y->kind == ST_SYMMETRY_HELIX && w)
             for (int a = 0; a < 3; a++)
-                r[a] += n[a] * angle * y->pitch / (2.0 * PI);
+                r[a] += n[a] * m->angle * y->pitch / (2.0 * PI);
     }
     for (int a = 0; a < 3; a++)
         out[a] = r[a] + (w ? y->point[a] : 0.0);
+}
+
+void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
+                       int w, double out[3])
+{
+    const sym_map m = map_of(y, angle);
+    map_apply(&m, x, w, out);
 }
 
 void st_symmetry_describe(const st_symmetry *y, char *buf, size_t size)
@@ -713,17 +739,18 @@ static block_count measure_block(const ctx *C, const st_symmetry *y, double angl
                                  size_t stride, int full, size_t j0, size_t j1)
 {
     const samples *S = C->S;
+    const sym_map map = map_of(y, angle);
     block_count r = {0, 0, 0, 0};
     for (size_t j = j0; j < j1; j++) {
         const size_t k = j * stride;
         double q[3], nq[3], cl[3], d[3];
         r.a++;
-        st_symmetry_apply(y, angle, S->p + 3 * k, 1, q);
+        map_apply(&map, S->p + 3 * k, 1, q);
         st_sub3(d, q, S->p + 3 * k);
         double l = st_norm3(d);
         if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
             continue;
-        st_symmetry_apply(y, angle, S->nrm + 3 * k, 0, nq);
+        map_apply(&map, S->nrm + 3 * k, 0, nq);
         int64_t t;
         int hit = lands_tri(C, q, nq, C->tol, cl, &t);
         r.h += hit;
@@ -916,22 +943,22 @@ static st_symmetry mirror_of(const double n[3], double off)
     return y;
 }
 
-/* A refinement's match of sample k under mirror y: its image q, and the
+/* A refinement's match of sample k under mirror map->y: its image q, and the
  * nearest point c (triangle *t) of the soup where the image lands within
  * the round's reach with a matching normal. 0 where the sample lies on the
  * plane or slides along it (no evidence for the plane), or does not land. */
-static int image_lands(const ctx *C, const st_symmetry *y, size_t k, int coarse,
+static int image_lands(const ctx *C, const sym_map *map, size_t k, int coarse,
                        double q[3], double c[3], int64_t *t)
 {
     const samples *S = C->S;
     const double *p = S->p + 3 * k;
     double nq[3], d[3];
-    st_symmetry_apply(y, 0.0, p, 1, q);
+    map_apply(map, p, 1, q);
     st_sub3(d, q, p);
     double l = st_norm3(d);
     if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
         return 0;
-    st_symmetry_apply(y, 0.0, S->nrm + 3 * k, 0, nq);
+    map_apply(map, S->nrm + 3 * k, 0, nq);
     return lands_at(C, q, nq, (coarse ? REFINE_WIDE : REFINE_REACH) * C->tol, c, t);
 }
 
@@ -947,13 +974,14 @@ static void refine_mirror_mid(const ctx *C, st_symmetry *y, int coarse_rounds)
         const int coarse = round < coarse_rounds;
         double mean[3] = {0, 0, 0};
         size_t m = 0;
+        const sym_map map = map_of(y, 0.0);
         /* sequential: the sums are in sample order, independent of
          * threads */
         for (size_t k = 0; k < S->n; k += coarse ? REFINE_COARSE_STRIDE : REFINE_STRIDE) {
             double q[3], c[3];
             const double *p = S->p + 3 * k;
             int64_t t;
-            if (!image_lands(C, y, k, coarse, q, c, &t))
+            if (!image_lands(C, &map, k, coarse, q, c, &t))
                 continue;
             for (int x = 0; x < 3; x++) {
                 mid[3 * m + x] = 0.5 * (p[x] + c[x]);
@@ -1122,13 +1150,14 @@ static void refine_mirror_plane(const ctx *C, st_symmetry *y, int coarse_rounds)
         const int coarse = round < coarse_rounds;
         plane_step F;
         step_start(&F, y, S->c, L);
+        const sym_map map = map_of(y, 0.0);
         /* sequential: the sums are in sample order, independent of
          * threads */
         for (size_t k = 0; k < S->n; k += coarse ? REFINE_COARSE_STRIDE : REFINE_STRIDE) {
             double q[3], c[3];
             const double *p = S->p + 3 * k;
             int64_t t;
-            if (!image_lands(C, y, k, coarse, q, c, &t))
+            if (!image_lands(C, &map, k, coarse, q, c, &t))
                 continue;
             step_add(&F, p, q, c, C->tn + 3 * (size_t)t);
         }
@@ -1739,16 +1768,17 @@ static void refine_pitch(const ctx *C, st_symmetry *y)
         double num = 0.0, den = 0.0;
         size_t m = 0;
         /* sequential: the sums in sample order, whatever the threads */
-        for (int j = 0; j < 2; j++)
+        for (int j = 0; j < 2; j++) {
+            const sym_map map = map_of(y, turn[j]);
             for (size_t k = 0; k < S->n; k += REFINE_STRIDE) {
                 double q[3], nq[3], c[3], d[3];
                 const double *p = S->p + 3 * k;
-                st_symmetry_apply(y, turn[j], p, 1, q);
+                map_apply(&map, p, 1, q);
                 st_sub3(d, q, p);
                 double l = st_norm3(d);
                 if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
                     continue;
-                st_symmetry_apply(y, turn[j], S->nrm + 3 * k, 0, nq);
+                map_apply(&map, S->nrm + 3 * k, 0, nq);
                 int64_t t;
                 double reach = REFINE_REACH * C->tol;
                 nearest(C, q, reach, &t, c);
@@ -1763,6 +1793,7 @@ static void refine_pitch(const ctx *C, st_symmetry *y)
                 den += g * g;
                 m++;
             }
+        }
         if (m < 16 || !(den > 0.0))
             return;
         double step = num / den;
