@@ -73,9 +73,28 @@ static void normalize(double v[3])
             v[a] /= l;
 }
 
-void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
-                       int w, double out[3])
+/* A symmetry by one angle, its turn's cosine and sine made once: the
+ * counts apply one map to every sample, and the two library calls cost
+ * about as much as the rest of the map. map_apply is st_symmetry_apply's
+ * arithmetic on the same doubles. */
+typedef struct sym_map {
+    const st_symmetry *y;
+    double angle, c, s;
+} sym_map;
+
+static sym_map map_of(const st_symmetry *y, double angle)
 {
+    sym_map m = {y, angle, 1.0, 0.0};
+    if (y->kind != ST_SYMMETRY_MIRROR) {
+        m.c = cos(angle);
+        m.s = sin(angle);
+    }
+    return m;
+}
+
+static void map_apply(const sym_map *m, const double x[3], int w, double out[3])
+{
+    const st_symmetry *y = m->y;
     const double *n = y->dir;
     double r[3];
     for (int a = 0; a < 3; a++)
@@ -86,16 +105,23 @@ void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
             r[a] -= d * n[a];
     } else {
         /* Rodrigues */
-        double c = cos(angle), s = sin(angle), k[3], d = st_dot3(n, r);
+        double c = m->c, s = m->s, k[3], d = st_dot3(n, r);
         st_cross3(k, n, r);
         for (int a = 0; a < 3; a++)
             r[a] = r[a] * c + k[a] * s + n[a] * d * (1.0 - c);
         if (y->kind == ST_SYMMETRY_HELIX && w)
             for (int a = 0; a < 3; a++)
-                r[a] += n[a] * angle * y->pitch / (2.0 * PI);
+                r[a] += n[a] * m->angle * y->pitch / (2.0 * PI);
     }
     for (int a = 0; a < 3; a++)
         out[a] = r[a] + (w ? y->point[a] : 0.0);
+}
+
+void st_symmetry_apply(const st_symmetry *y, double angle, const double x[3],
+                       int w, double out[3])
+{
+    const sym_map m = map_of(y, angle);
+    map_apply(&m, x, w, out);
 }
 
 void st_symmetry_describe(const st_symmetry *y, char *buf, size_t size)
@@ -701,58 +727,139 @@ static int contra_decided(const tally *known, long c, long rest)
     const tally lo = {0, 0, known->verified, c}, hi = {0, 0, known->verified, c + rest};
     return contradiction(&lo) > MAX_CONTRA || contradiction(&hi) <= MAX_CONTRA;
 }
+/* One block's counts (measure_run): samples, informative, verified,
+ * contradicted. */
+typedef struct block_count {
+    long a, m, h, c;
+} block_count;
+
+/* The strided samples j0 <= j < j1 under y: what their images find
+ * (measure_run). */
+static block_count measure_block(const ctx *C, const st_symmetry *y, double angle,
+                                 size_t stride, int full, size_t j0, size_t j1)
+{
+    const samples *S = C->S;
+    const sym_map map = map_of(y, angle);
+    block_count r = {0, 0, 0, 0};
+    for (size_t j = j0; j < j1; j++) {
+        const size_t k = j * stride;
+        double q[3], nq[3], cl[3], d[3];
+        r.a++;
+        map_apply(&map, S->p + 3 * k, 1, q);
+        st_sub3(d, q, S->p + 3 * k);
+        double l = st_norm3(d);
+        if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
+            continue;
+        map_apply(&map, S->nrm + 3 * k, 0, nq);
+        int64_t t;
+        int hit = lands_tri(C, q, nq, C->tol, cl, &t);
+        r.h += hit;
+        if (full && !hit) {
+            st_bvh_nearest(C->bvh, q, INFINITY, &t, cl);
+            r.c += t >= 0 && !on_rim(C, t, cl);
+        }
+        r.m++;
+    }
+    return r;
+}
+
+/* The blocks' counts summed in block order (measure_run), and the
+ * block end where the stop rule fired, if it did. */
+typedef struct block_sums {
+    block_count sum;  /* of blocks [0, front) */
+    size_t front;     /* the first block not yet summed */
+    int stop;         /* 0; 1: the share is below need; 2: the
+                       * contradiction is decided */
+} block_sums;
+
+/* Block b's counts done: the blocks done in order from the front summed,
+ * the stop rule tested at each block end (measure_run). */
+static void block_done(block_sums *B, const block_count *cnt, unsigned char *done,
+                       size_t b, size_t nb, size_t block, size_t total, double need,
+                       const tally *known)
+{
+    done[b] = 1;
+    while (!B->stop && B->front < nb && done[B->front]) {
+        const block_count *k = cnt + B->front++;
+        B->sum.a += k->a;
+        B->sum.m += k->m;
+        B->sum.h += k->h;
+        B->sum.c += k->c;
+        const size_t j1 = B->front * block < total ? B->front * block : total;
+        const double rest = (double)(total - j1);
+        if ((double)B->sum.h + rest < need * (1.0 - 1e-9) * ((double)B->sum.m + rest))
+            B->stop = 1;
+        else if (known && contra_decided(known, B->sum.c, (long)(total - j1)))
+            B->stop = 2;
+    }
+}
+
 /* With need > 0, the samples go in blocks of MEASURE_BLOCK, and after
  * each the count stops once even the rest all landing (each informative
  * and verified) would leave the share below need (times 1 - 1e-9, so no
  * rounding of the share can reach it): the tally is then one whose share
  * is 0. Callers compare the share with thresholds of at least need, so
- * they decide as on the whole count. The counts at the block ends are
- * sums, the same for any thread count. */
+ * they decide as on the whole count. With known (measure_contra), the
+ * count stops where contra_decided settles accepted()'s bound.
+ *
+ * One parallel region per count: the threads take the blocks in order
+ * and go on without waiting for each other; the blocks' counts are summed
+ * in block order and the rules tested at each block end, as one thread
+ * would, so where the count stops and what it returns are the same for
+ * any thread count (blocks taken past the stop are not read). Without
+ * memory for the blocks' counts, one block: the whole count, which
+ * decides the same. */
 static tally measure_run(const ctx *C, const st_symmetry *y, double angle,
                          size_t stride, int full, double need, const tally *known)
 {
-    const samples *S = C->S;
-    const size_t total = (S->n + stride - 1) / stride;
-    const size_t block = need > 0.0 || known ? MEASURE_BLOCK : (total ? total : 1);
-    long hits = 0, n = 0, all = 0, contra = 0;
-    for (size_t j0 = 0; j0 < total; j0 += block) {
-        const size_t j1 = total - j0 > block ? j0 + block : total;
-        long h = 0, m = 0, a = 0, c = 0;
-#pragma omp parallel for schedule(static) reduction(+ : h, m, a, c)
-        for (size_t j = j0; j < j1; j++) {
-            const size_t k = j * stride;
-            double q[3], nq[3], cl[3], d[3];
-            a++;
-            st_symmetry_apply(y, angle, S->p + 3 * k, 1, q);
-            st_sub3(d, q, S->p + 3 * k);
-            double l = st_norm3(d);
-            if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
-                continue;
-            st_symmetry_apply(y, angle, S->nrm + 3 * k, 0, nq);
-            int64_t t;
-            int hit = lands_tri(C, q, nq, C->tol, cl, &t);
-            h += hit;
-            if (full && !hit) {
-                st_bvh_nearest(C->bvh, q, INFINITY, &t, cl);
-                c += t >= 0 && !on_rim(C, t, cl);
+    const size_t total = (C->S->n + stride - 1) / stride;
+    size_t block = MEASURE_BLOCK, nb = (total + block - 1) / block;
+    block_count one, *cnt = nb > 1 ? st_malloc_array(nb, sizeof *cnt) : NULL;
+    unsigned char one_done, *done = cnt ? calloc(nb, 1) : NULL;
+    if (!done) {
+        free(cnt);
+        cnt = &one;
+        done = &one_done;
+        block = total ? total : 1;
+        nb = total ? 1 : 0;
+    }
+    block_sums B = {{0, 0, 0, 0}, 0, 0};
+    size_t next = 0;
+    int stop = 0;
+#pragma omp parallel if (nb > 1)
+    for (;;) {
+        size_t b;
+#pragma omp atomic capture
+        b = next++;
+        int halt;
+#pragma omp atomic read
+        halt = stop;
+        if (b >= nb || halt)
+            break;
+        const size_t j0 = b * block, j1 = total - j0 > block ? j0 + block : total;
+        cnt[b] = measure_block(C, y, angle, stride, full, j0, j1);
+#pragma omp critical(st_symmetry_measure)
+        {
+            block_done(&B, cnt, done, b, nb, block, total, need, known);
+            if (B.stop) {
+#pragma omp atomic write
+                stop = 1;
             }
-            m++;
-        }
-        hits += h;
-        n += m;
-        all += a;
-        contra += c;
-        const double rest = (double)(total - j1);
-        if ((double)hits + rest < need * (1.0 - 1e-9) * ((double)n + rest)) {
-            tally none = {(long)total, 0, 0, 0};
-            return none;
-        }
-        if (known && contra_decided(known, contra, (long)(total - j1))) {
-            tally r = {known->all, known->informative, known->verified, contra};
-            return r;
         }
     }
-    tally r = {all, n, hits, full ? contra : 0};
+    if (cnt != &one) {
+        free(cnt);
+        free(done);
+    }
+    if (B.stop == 1) {
+        tally none = {(long)total, 0, 0, 0};
+        return none;
+    }
+    if (B.stop == 2) {
+        tally r = {known->all, known->informative, known->verified, B.sum.c};
+        return r;
+    }
+    tally r = {B.sum.a, B.sum.m, B.sum.h, full ? B.sum.c : 0};
     return r;
 }
 
@@ -836,22 +943,22 @@ static st_symmetry mirror_of(const double n[3], double off)
     return y;
 }
 
-/* A refinement's match of sample k under mirror y: its image q, and the
+/* A refinement's match of sample k under mirror map->y: its image q, and the
  * nearest point c (triangle *t) of the soup where the image lands within
  * the round's reach with a matching normal. 0 where the sample lies on the
  * plane or slides along it (no evidence for the plane), or does not land. */
-static int image_lands(const ctx *C, const st_symmetry *y, size_t k, int coarse,
+static int image_lands(const ctx *C, const sym_map *map, size_t k, int coarse,
                        double q[3], double c[3], int64_t *t)
 {
     const samples *S = C->S;
     const double *p = S->p + 3 * k;
     double nq[3], d[3];
-    st_symmetry_apply(y, 0.0, p, 1, q);
+    map_apply(map, p, 1, q);
     st_sub3(d, q, p);
     double l = st_norm3(d);
     if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
         return 0;
-    st_symmetry_apply(y, 0.0, S->nrm + 3 * k, 0, nq);
+    map_apply(map, S->nrm + 3 * k, 0, nq);
     return lands_at(C, q, nq, (coarse ? REFINE_WIDE : REFINE_REACH) * C->tol, c, t);
 }
 
@@ -867,13 +974,14 @@ static void refine_mirror_mid(const ctx *C, st_symmetry *y, int coarse_rounds)
         const int coarse = round < coarse_rounds;
         double mean[3] = {0, 0, 0};
         size_t m = 0;
+        const sym_map map = map_of(y, 0.0);
         /* sequential: the sums are in sample order, independent of
          * threads */
         for (size_t k = 0; k < S->n; k += coarse ? REFINE_COARSE_STRIDE : REFINE_STRIDE) {
             double q[3], c[3];
             const double *p = S->p + 3 * k;
             int64_t t;
-            if (!image_lands(C, y, k, coarse, q, c, &t))
+            if (!image_lands(C, &map, k, coarse, q, c, &t))
                 continue;
             for (int x = 0; x < 3; x++) {
                 mid[3 * m + x] = 0.5 * (p[x] + c[x]);
@@ -1042,13 +1150,14 @@ static void refine_mirror_plane(const ctx *C, st_symmetry *y, int coarse_rounds)
         const int coarse = round < coarse_rounds;
         plane_step F;
         step_start(&F, y, S->c, L);
+        const sym_map map = map_of(y, 0.0);
         /* sequential: the sums are in sample order, independent of
          * threads */
         for (size_t k = 0; k < S->n; k += coarse ? REFINE_COARSE_STRIDE : REFINE_STRIDE) {
             double q[3], c[3];
             const double *p = S->p + 3 * k;
             int64_t t;
-            if (!image_lands(C, y, k, coarse, q, c, &t))
+            if (!image_lands(C, &map, k, coarse, q, c, &t))
                 continue;
             step_add(&F, p, q, c, C->tn + 3 * (size_t)t);
         }
@@ -1659,16 +1768,17 @@ static void refine_pitch(const ctx *C, st_symmetry *y)
         double num = 0.0, den = 0.0;
         size_t m = 0;
         /* sequential: the sums in sample order, whatever the threads */
-        for (int j = 0; j < 2; j++)
+        for (int j = 0; j < 2; j++) {
+            const sym_map map = map_of(y, turn[j]);
             for (size_t k = 0; k < S->n; k += REFINE_STRIDE) {
                 double q[3], nq[3], c[3], d[3];
                 const double *p = S->p + 3 * k;
-                st_symmetry_apply(y, turn[j], p, 1, q);
+                map_apply(&map, p, 1, q);
                 st_sub3(d, q, p);
                 double l = st_norm3(d);
                 if (!(l > C->tol) || fabs(st_dot3(d, S->nrm + 3 * k)) < INFORM_SIN * l)
                     continue;
-                st_symmetry_apply(y, turn[j], S->nrm + 3 * k, 0, nq);
+                map_apply(&map, S->nrm + 3 * k, 0, nq);
                 int64_t t;
                 double reach = REFINE_REACH * C->tol;
                 nearest(C, q, reach, &t, c);
@@ -1683,6 +1793,7 @@ static void refine_pitch(const ctx *C, st_symmetry *y)
                 den += g * g;
                 m++;
             }
+        }
         if (m < 16 || !(den > 0.0))
             return;
         double step = num / den;
