@@ -692,7 +692,8 @@ static inline void band_try(const tri_setup *t, const double p[3],
     }
 }
 
-/* For candidate q of w and the voxels e of a band group: bit e of *live
+/* For a candidate (ball c, r, bound bd) and the voxels e of a band group:
+ * bit e of *live
  * when walk_box's stop test lets voxel e go on (its bound, less the
  * voxel's offset, below its best distance), and of *pass when it is live
  * and the candidate's ball comes within its best distance too. The same
@@ -700,13 +701,13 @@ static inline void band_try(const tri_setup *t, const double p[3],
  * where SSE2 is there. */
 static inline void band_masks(const double *px, const double *py,
                               const double *pz, const double *off,
-                              const double *curd, const walk_list *w,
-                              size_t q, unsigned *live, unsigned *pass)
+                              const double *curd, double bd, const double c[3],
+                              double r, unsigned *live, unsigned *pass)
 {
 #ifdef __SSE2__
-    const __m128d bq = _mm_set1_pd(w->bound[q]), xq = _mm_set1_pd(w->x[q]),
-                  yq = _mm_set1_pd(w->y[q]), zq = _mm_set1_pd(w->z[q]),
-                  rq = _mm_set1_pd(w->r[q]);
+    const __m128d bq = _mm_set1_pd(bd), xq = _mm_set1_pd(c[0]),
+                  yq = _mm_set1_pd(c[1]), zq = _mm_set1_pd(c[2]),
+                  rq = _mm_set1_pd(r);
     unsigned l = 0, p = 0;
     /* Unrolled: the shifts are constants. */
 #define BAND_PAIR(e)                                                          \
@@ -735,8 +736,7 @@ static inline void band_masks(const double *px, const double *py,
     *live = l;
     *pass = p;
 #else
-    const double bq = w->bound[q], xq = w->x[q], yq = w->y[q], zq = w->z[q],
-                 rq = w->r[q];
+    const double bq = bd, xq = c[0], yq = c[1], zq = c[2], rq = r;
     unsigned l = 0, p = 0;
     for (unsigned e = 0; e < BAND_NV; e++) {
         const double dx = px[e] - xq, dy = py[e] - yq, dz = pz[e] - zq;
@@ -797,13 +797,16 @@ static void walk_band(const st_grid *g, const brick_out *o, const st_soup *s,
     uint32_t nsetup = sc->nsetup;
     for (size_t q = 0; q < w->n; q++) {
         unsigned live, pass;
-        band_masks(px, py, pz, off, curd, w, q, &live, &pass);
+        const uint32_t c = w->at[q];
+        const double ball[3] = {sc->bx[c], sc->by[c], sc->bz[c]};
+        band_masks(px, py, pz, off, curd, w->bound[q], ball, sc->br[c], &live,
+                   &pass);
         if (!live)
             break;              /* no later one is closer to any voxel */
         if (!pass)
             continue;
         /* Set up once for the group's voxels it may reach. */
-        const tri_setup *t = band_setup(s, sc, &nsetup, w->at[q]);
+        const tri_setup *t = band_setup(s, sc, &nsetup, c);
         do {
             const unsigned e = (unsigned)__builtin_ctz(pass);
             pass &= pass - 1;
@@ -983,7 +986,7 @@ static void walk_group(const st_grid *g, const brick_out *o,
     const double *const dd2 = sc->gdd + ge * sc->cap;
     const uint32_t nkept = (uint32_t)gr->nkept[ge];
     uint8_t *bucket = sc->bucket;
-    const double *bx = sc->bx, *by = sc->by, *bz = sc->bz, *br = sc->br;
+    const double *br = sc->br;
     for (uint32_t e = 0; e < nkept; e++) {
         const double k = sqrt(dd2[e]) - br[kept[e]];
         /* Nondecreasing in k: a later bucket's keys are never below an
@@ -1003,10 +1006,7 @@ static void walk_group(const st_grid *g, const brick_out *o,
     walk_list *wl = &sc->w;
     for (uint32_t e = 0; e < nkept; e++) {
         const uint32_t q = kept[e], at = count[bucket[e]]++;
-        wl->x[at] = bx[q];
-        wl->y[at] = by[q];
-        wl->z[at] = bz[q];
-        wl->r[at] = br[q];
+        /* The balls stay where they are: the walk may stop early. */
         wl->bound[at] = lo[bucket[e]];
         wl->at[at] = q;
     }
