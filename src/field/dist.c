@@ -419,6 +419,7 @@ static void sort_cand_keys(cand_key *k, cand_key *tmp, size_t m)
  * so it walks the whole brick in that order, each candidate a bucket. */
 #define GROUP 2
 #define NBUCKET 32
+enum { BAND_NV = GROUP * GROUP * GROUP };
 
 /* One group's candidates in walk order: balls, structure of arrays. */
 typedef struct walk_list {
@@ -434,8 +435,10 @@ typedef struct brick_scratch {
     uint32_t *slot;          /* where each one's setup is cached, or UINT32_MAX */
     double *bx, *by, *bz, *br; /* their balls */
     cand_key *keys;          /* 2 * cap: a full field's keys and the merge's scratch */
-    uint32_t *kept;          /* a group's candidates */
-    uint8_t *bucket;         /* and their buckets */
+    uint32_t *kept;          /* BAND_NV * cap: the groups' candidates
+                              * (brick_group_balls), group e's at e * cap */
+    double *gdd;             /* and their squared distances from its center */
+    uint8_t *bucket;         /* a group's candidates' buckets */
     walk_list w;
     tri_setup *setups;
     uint32_t nsetup;
@@ -466,6 +469,7 @@ static void scratch_free(brick_scratch *sc)
     free(sc->w.bound);
     free(sc->kept);
     free(sc->bucket);
+    free(sc->gdd);
     free(sc->setups);
     free(sc->table);
     free(sc->spos);
@@ -495,7 +499,8 @@ static int scratch_reserve(brick_scratch *sc, size_t m)
     for (size_t i = 0; i < sizeof u / sizeof u[0]; i++)
         if (scratch_grow(u[i], cap, sizeof(uint32_t)))
             return -1;
-    if (scratch_grow((void **)&sc->kept, cap, sizeof(uint32_t)) ||
+    if (scratch_grow((void **)&sc->kept, (size_t)BAND_NV * cap, sizeof(uint32_t)) ||
+        scratch_grow((void **)&sc->gdd, (size_t)BAND_NV * cap, sizeof(double)) ||
         scratch_grow((void **)&sc->bucket, cap, 1) ||
         scratch_grow((void **)&sc->keys, 2 * cap, sizeof(cand_key)))
         return -1;
@@ -687,9 +692,8 @@ static inline void band_try(const tri_setup *t, const double p[3],
     }
 }
 
-enum { BAND_NV = GROUP * GROUP * GROUP };
-
-/* For candidate q of w and the voxels e of a band group: bit e of *live
+/* For a candidate (ball c, r, bound bd) and the voxels e of a band group:
+ * bit e of *live
  * when walk_box's stop test lets voxel e go on (its bound, less the
  * voxel's offset, below its best distance), and of *pass when it is live
  * and the candidate's ball comes within its best distance too. The same
@@ -697,13 +701,13 @@ enum { BAND_NV = GROUP * GROUP * GROUP };
  * where SSE2 is there. */
 static inline void band_masks(const double *px, const double *py,
                               const double *pz, const double *off,
-                              const double *curd, const walk_list *w,
-                              size_t q, unsigned *live, unsigned *pass)
+                              const double *curd, double bd, const double c[3],
+                              double r, unsigned *live, unsigned *pass)
 {
 #ifdef __SSE2__
-    const __m128d bq = _mm_set1_pd(w->bound[q]), xq = _mm_set1_pd(w->x[q]),
-                  yq = _mm_set1_pd(w->y[q]), zq = _mm_set1_pd(w->z[q]),
-                  rq = _mm_set1_pd(w->r[q]);
+    const __m128d bq = _mm_set1_pd(bd), xq = _mm_set1_pd(c[0]),
+                  yq = _mm_set1_pd(c[1]), zq = _mm_set1_pd(c[2]),
+                  rq = _mm_set1_pd(r);
     unsigned l = 0, p = 0;
     /* Unrolled: the shifts are constants. */
 #define BAND_PAIR(e)                                                          \
@@ -732,8 +736,7 @@ static inline void band_masks(const double *px, const double *py,
     *live = l;
     *pass = p;
 #else
-    const double bq = w->bound[q], xq = w->x[q], yq = w->y[q], zq = w->z[q],
-                 rq = w->r[q];
+    const double bq = bd, xq = c[0], yq = c[1], zq = c[2], rq = r;
     unsigned l = 0, p = 0;
     for (unsigned e = 0; e < BAND_NV; e++) {
         const double dx = px[e] - xq, dy = py[e] - yq, dz = pz[e] - zq;
@@ -794,13 +797,16 @@ static void walk_band(const st_grid *g, const brick_out *o, const st_soup *s,
     uint32_t nsetup = sc->nsetup;
     for (size_t q = 0; q < w->n; q++) {
         unsigned live, pass;
-        band_masks(px, py, pz, off, curd, w, q, &live, &pass);
+        const uint32_t c = w->at[q];
+        const double ball[3] = {sc->bx[c], sc->by[c], sc->bz[c]};
+        band_masks(px, py, pz, off, curd, w->bound[q], ball, sc->br[c], &live,
+                   &pass);
         if (!live)
             break;              /* no later one is closer to any voxel */
         if (!pass)
             continue;
         /* Set up once for the group's voxels it may reach. */
-        const tri_setup *t = band_setup(s, sc, &nsetup, w->at[q]);
+        const tri_setup *t = band_setup(s, sc, &nsetup, c);
         do {
             const unsigned e = (unsigned)__builtin_ctz(pass);
             pass &= pass - 1;
@@ -855,42 +861,132 @@ static void walk_sorted(const st_grid *g, const brick_out *o,
     walk_box(g, o, s, v, wl, B, sc);
 }
 
-/* A band field's group v: the candidates whose ball comes within B of one
- * of its voxels, bucketed by their bound from its center. */
+/* A band brick's groups, GROUP per axis (fewer where the grid ends):
+ * group e = ex + GROUP (ey + GROUP ez) has the box box[e], its center
+ * c[a][e_a] along each axis and its reach R[e]: beyond R + r from its
+ * center, a ball is beyond B from every voxel of it. */
+typedef struct brick_groups {
+    voxel_box box[BAND_NV];
+    double c[3][GROUP];
+    double R[BAND_NV];
+    unsigned n[3];
+    size_t nkept[BAND_NV];  /* its candidates (brick_group_balls) */
+} brick_groups;
+
+static void brick_group_boxes(brick_groups *gr, const st_grid *g,
+                              const voxel_box *v, double B)
+{
+    for (int a = 0; a < 3; a++)
+        gr->n[a] = (unsigned)((v->hi[a] - v->lo[a] + GROUP - 1) / GROUP);
+    for (unsigned e = 0; e < BAND_NV; e++) {
+        const unsigned at[3] = {e % GROUP, e / GROUP % GROUP, e / (GROUP * GROUP)};
+        voxel_box *u = &gr->box[e];
+        double half = 0.0;
+        for (int a = 0; a < 3; a++) {
+            /* A missing group repeats the last one: never walked. */
+            const unsigned i = at[a] < gr->n[a] ? at[a] : gr->n[a] - 1;
+            u->lo[a] = v->lo[a] + GROUP * (size_t)i;
+            u->hi[a] = u->lo[a] + GROUP < v->hi[a] ? u->lo[a] + GROUP : v->hi[a];
+            const double h = 0.5 * g->voxel * (double)(u->hi[a] - u->lo[a] - 1);
+            half += h * h;
+        }
+        box_center(g, u);
+        for (int a = 0; a < 3; a++)
+            gr->c[a][at[a]] = u->c[a];
+        /* The slack only keeps more. */
+        gr->R[e] = (B + sqrt(half)) * (1.0 + 1e-9) + 1e-12 * g->voxel;
+    }
+}
+
+/* Group e's candidates (in sc->kept from e * cap, gr->nkept[e] of them):
+ * those of the brick's m whose ball's squared distance from its center
+ * (in sc->gdd beside them) is below (R[e] + r)^2. The same IEEE
+ * operations, in the same order, as one group's own pass over them, the
+ * axes' squares shared by the groups with a center in common along it. */
+static void brick_group_balls(brick_groups *gr, size_t m, brick_scratch *sc)
+{
+    _Static_assert(GROUP == 2 && BAND_NV == 8, "two groups per axis");
+    const double *bx = sc->bx, *by = sc->by, *bz = sc->bz, *br = sc->br;
+    uint32_t *const kept = sc->kept;
+    double *const gdd = sc->gdd;
+    size_t n[BAND_NV] = {0};
+#ifdef __SSE2__
+    const __m128d cx = _mm_loadu_pd(gr->c[0]), cy = _mm_loadu_pd(gr->c[1]),
+                  cz = _mm_loadu_pd(gr->c[2]);
+    const __m128d R0 = _mm_loadu_pd(gr->R), R2 = _mm_loadu_pd(gr->R + 2),
+                  R4 = _mm_loadu_pd(gr->R + 4), R6 = _mm_loadu_pd(gr->R + 6);
+#endif
+    for (size_t q = 0; q < m; q++) {
+        double dd[BAND_NV];
+        unsigned mask;
+#ifdef __SSE2__
+        const __m128d dx = _mm_sub_pd(cx, _mm_set1_pd(bx[q])),
+                      dy = _mm_sub_pd(cy, _mm_set1_pd(by[q])),
+                      dz = _mm_sub_pd(cz, _mm_set1_pd(bz[q]));
+        const __m128d sx = _mm_mul_pd(dx, dx), sy = _mm_mul_pd(dy, dy),
+                      sz = _mm_mul_pd(dz, dz);
+        /* (x^2 + y^2) + z^2, x fastest: groups 2 i and 2 i + 1. */
+        const __m128d sxy0 = _mm_add_pd(sx, _mm_unpacklo_pd(sy, sy)),
+                      sxy1 = _mm_add_pd(sx, _mm_unpackhi_pd(sy, sy));
+        const __m128d z0 = _mm_unpacklo_pd(sz, sz), z1 = _mm_unpackhi_pd(sz, sz);
+        const __m128d d0 = _mm_add_pd(sxy0, z0), d2 = _mm_add_pd(sxy1, z0),
+                      d4 = _mm_add_pd(sxy0, z1), d6 = _mm_add_pd(sxy1, z1);
+        const __m128d r = _mm_set1_pd(br[q]);
+        const __m128d a0 = _mm_add_pd(R0, r), a2 = _mm_add_pd(R2, r),
+                      a4 = _mm_add_pd(R4, r), a6 = _mm_add_pd(R6, r);
+        _mm_storeu_pd(dd, d0);
+        _mm_storeu_pd(dd + 2, d2);
+        _mm_storeu_pd(dd + 4, d4);
+        _mm_storeu_pd(dd + 6, d6);
+        mask = (unsigned)(_mm_movemask_pd(_mm_cmplt_pd(d0, _mm_mul_pd(a0, a0))) |
+                          _mm_movemask_pd(_mm_cmplt_pd(d2, _mm_mul_pd(a2, a2))) << 2 |
+                          _mm_movemask_pd(_mm_cmplt_pd(d4, _mm_mul_pd(a4, a4))) << 4 |
+                          _mm_movemask_pd(_mm_cmplt_pd(d6, _mm_mul_pd(a6, a6))) << 6);
+#else
+        double sx[GROUP], sy[GROUP], sz[GROUP];
+        for (unsigned i = 0; i < GROUP; i++) {
+            const double dx = gr->c[0][i] - bx[q], dy = gr->c[1][i] - by[q],
+                         dz = gr->c[2][i] - bz[q];
+            sx[i] = dx * dx;
+            sy[i] = dy * dy;
+            sz[i] = dz * dz;
+        }
+        mask = 0;
+        for (unsigned e = 0; e < BAND_NV; e++) {
+            const double reach = gr->R[e] + br[q];
+            dd[e] = sx[e & 1] + sy[(e >> 1) & 1] + sz[e >> 2];
+            mask |= (unsigned)(dd[e] < reach * reach) << e;
+        }
+#endif
+        while (mask) {
+            const unsigned e = (unsigned)__builtin_ctz(mask);
+            mask &= mask - 1;
+            kept[e * sc->cap + n[e]] = (uint32_t)q;
+            gdd[e * sc->cap + n[e]++] = dd[e];
+        }
+    }
+    memcpy(gr->nkept, n, sizeof n);
+}
+
+/* A band field's group e of gr: the candidates whose ball comes within B
+ * of one of its voxels (brick_group_balls), bucketed by their bound from
+ * its center. */
 static void walk_group(const st_grid *g, const brick_out *o,
-                       const st_soup *s, const voxel_box *v, size_t m,
+                       const st_soup *s, const brick_groups *gr, unsigned ge,
                        double B, brick_scratch *sc)
 {
-    double half = 0.0;
-    for (int a = 0; a < 3; a++) {
-        const double e = 0.5 * g->voxel * (double)(v->hi[a] - v->lo[a] - 1);
-        half += e * e;
-    }
-    /* Beyond R + r from the center, a ball is beyond B from every voxel
-     * (the slack only keeps more). */
-    const double R = (B + sqrt(half)) * (1.0 + 1e-9) + 1e-12 * g->voxel;
-    const double width = R / (double)(NBUCKET - 1);
+    const voxel_box *v = &gr->box[ge];
+    const double width = gr->R[ge] / (double)(NBUCKET - 1);
     uint32_t count[NBUCKET + 1] = {0};
     double lo[NBUCKET];
     for (int b = 0; b < NBUCKET; b++)
         lo[b] = INFINITY;
-    /* The kept candidates and their buckets, and the count and smallest
-     * key of each bucket. */
-    uint32_t *kept = sc->kept, nkept = 0;
+    /* The count and smallest key of each bucket. */
+    const uint32_t *const kept = sc->kept + ge * sc->cap;
+    const double *const dd2 = sc->gdd + ge * sc->cap;
+    const uint32_t nkept = (uint32_t)gr->nkept[ge];
     uint8_t *bucket = sc->bucket;
-    const double *bx = sc->bx, *by = sc->by, *bz = sc->bz, *br = sc->br;
-    /* First the kept ones, without a branch (about half are kept, in no
-     * pattern a predictor learns), their squared distances in the walk
-     * list's bounds until the scatter below sets them. */
-    double *dd2 = sc->w.bound;
-    for (size_t q = 0; q < m; q++) {
-        const double dx = v->c[0] - bx[q], dy = v->c[1] - by[q],
-                     dz = v->c[2] - bz[q];
-        const double dd = dx * dx + dy * dy + dz * dz, reach = R + br[q];
-        kept[nkept] = (uint32_t)q;
-        dd2[nkept] = dd;
-        nkept += dd < reach * reach;
-    }
+    const double *br = sc->br;
     for (uint32_t e = 0; e < nkept; e++) {
         const double k = sqrt(dd2[e]) - br[kept[e]];
         /* Nondecreasing in k: a later bucket's keys are never below an
@@ -910,10 +1006,7 @@ static void walk_group(const st_grid *g, const brick_out *o,
     walk_list *wl = &sc->w;
     for (uint32_t e = 0; e < nkept; e++) {
         const uint32_t q = kept[e], at = count[bucket[e]]++;
-        wl->x[at] = bx[q];
-        wl->y[at] = by[q];
-        wl->z[at] = bz[q];
-        wl->r[at] = br[q];
+        /* The balls stay where they are: the walk may stop early. */
         wl->bound[at] = lo[bucket[e]];
         wl->at[at] = q;
     }
@@ -983,18 +1076,13 @@ static void process_brick(const st_grid *g, const brick_out *o,
         walk_sorted(g, o, s, &v, m, B, sc);
         return;
     }
-    voxel_box u;
-    for (size_t z = v.lo[2]; z < v.hi[2]; z += GROUP)
-        for (size_t y = v.lo[1]; y < v.hi[1]; y += GROUP)
-            for (size_t x = v.lo[0]; x < v.hi[0]; x += GROUP) {
-                const size_t at[3] = {x, y, z};
-                for (int a = 0; a < 3; a++) {
-                    u.lo[a] = at[a];
-                    u.hi[a] = at[a] + GROUP < v.hi[a] ? at[a] + GROUP : v.hi[a];
-                }
-                box_center(g, &u);
-                walk_group(g, o, s, &u, m, B, sc);
-            }
+    brick_groups gr;
+    brick_group_boxes(&gr, g, &v, B);
+    brick_group_balls(&gr, m, sc);
+    for (unsigned ez = 0; ez < gr.n[2]; ez++)
+        for (unsigned ey = 0; ey < gr.n[1]; ey++)
+            for (unsigned ex = 0; ex < gr.n[0]; ex++)
+                walk_group(g, o, s, &gr, ex + GROUP * (ey + GROUP * ez), B, sc);
 }
 
 /* Bin s's triangles into the bricks of g (see triangle_bricks): bb gets
