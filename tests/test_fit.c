@@ -23,6 +23,7 @@
 #include "shapes.h"
 #include "tap.h"
 #include "../src/tet/fit_swept.h"
+#include "../src/tet/invariant.h"
 #include "../src/tet/pgrid.h"
 #include "../src/tet/smooth_mesh.h"
 
@@ -1047,6 +1048,109 @@ static void test_swept(void)
     st_soup_free(s);
 }
 
+/* 1 when boundary face f (an index into vf) of v's star, with v at y,
+ * meets S triangle t (closed, exact). */
+static int brute_face_meets(const sm_mesh *sm, const st_soup *s, size_t f, uint32_t v,
+                            const double y[3], size_t t)
+{
+    const uint32_t *k = sm->bf + 3 * (size_t)sm->vf[f];
+    const double *c[3];
+    for (int i = 0; i < 3; i++)
+        c[i] = k[i] == v ? y : sm->m->xyz + 3 * (size_t)k[i];
+    const uint32_t *w = s->tris + 3 * t;
+    return st_tri_tri_intersect(c[0], c[1], c[2], s->xyz + 3 * (size_t)w[0],
+                                s->xyz + 3 * (size_t)w[1], s->xyz + 3 * (size_t)w[2]);
+}
+
+/* The move invariant by brute force (invariant.c's header): v's star
+ * positive at p, every S vertex of the closed star at x in the closed star
+ * at p, and no boundary face of the star newly meeting an S triangle; every
+ * point and triangle tested. *faces_only: only the last part fails. */
+static int brute_move_ok(const sm_mesh *sm, const st_soup *s, uint32_t v, const double p[3],
+                         int *faces_only)
+{
+    const double *x = sm->m->xyz + 3 * (size_t)v;
+    *faces_only = 0;
+    if (!sm_star_positive(sm, v, p))
+        return 0;
+    for (size_t i = 0; i < s->nverts; i++)
+        if (brute_in_star(sm, v, x, s->xyz + 3 * i) && !brute_in_star(sm, v, p, s->xyz + 3 * i))
+            return 0;
+    for (size_t f = sm->vf_off[v]; f < sm->vf_off[v + 1]; f++)
+        for (size_t t = 0; t < s->ntris; t++)
+            if (brute_face_meets(sm, s, f, v, p, t) && !brute_face_meets(sm, s, f, v, x, t)) {
+                *faces_only = 1;
+                return 0;
+            }
+    return 1;
+}
+
+/* sm_move_ok against brute_move_ok: triangles a fifth to a half of a cell
+ * across in the shell the boundary crosses (some meeting it already), so
+ * that boundary faces sweep into them; each boundary vertex tried at four
+ * positions in a row, a fiftieth to 0.4 of a cell away, as the fit tries
+ * its halvings (the blockers on). The answers must be the brute force's,
+ * and the face test must be what refuses many of the moves. */
+static void test_move_brute(void)
+{
+    const double h = 0.5;
+    st_tetmesh *m = ball_mesh(h, 1.6);
+    st_soup *s = st_soup_new();
+    uint64_t seed = 4242;
+    double u[12];
+    for (int i = 0; i < 500; i++) {
+        double c[3], r2, e[3][3];
+        do {
+            for (int k = 0; k < 12; k++) {
+                seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+                u[k] = (double)(seed >> 11) / 9007199254740992.0;
+            }
+            for (int k = 0; k < 3; k++)
+                c[k] = -2.0 + 4.0 * u[k];
+            r2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        } while (r2 < 1.5 * 1.5 || r2 > 2.1 * 2.1);
+        const double size = h * (0.2 + 0.3 * u[3]);
+        for (int j = 0; j < 3; j++)
+            for (int k = 0; k < 3; k++)
+                e[j][k] = c[k] + size * (u[3 + 3 * j + k] - 0.5);
+        add_tri(s, e[0], e[1], e[2], 0);
+    }
+    fit_ctx c;
+    st_error err;
+    TAP_CHECK(sm_fit_ctx_open(&c, m, s, NULL, NULL, NULL, h, 0.4 * h, NULL, &err) == ST_OK,
+              "the invariant's context over %zu triangles", s->ntris);
+    static const double scale[] = {0.02, 0.1, 0.25, 0.4};
+    size_t tried = 0, ok = 0, faces = 0, wrong = 0;
+    star_pts sp = STAR_PTS_INIT;
+    for (uint32_t v = 0; v < c.sm.nv; v += 2) {
+        if (!c.sm.onb[v])
+            continue;
+        const double *x = m->xyz + 3 * (size_t)v;
+        sm_star_pts_collect(&c, v, &sp);
+        for (int t = 0; t < 4; t++) {
+            double p[3];
+            for (int k = 0; k < 3; k++) {
+                seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+                p[k] = x[k] + scale[t] * h * (2.0 * (double)(seed >> 11) / 9007199254740992.0 - 1.0);
+            }
+            int faces_only;
+            int want = brute_move_ok(&c.sm, s, v, p, &faces_only);
+            tried++;
+            ok += want;
+            faces += faces_only;
+            wrong += sm_move_ok(&c, v, p, &sp) != want;
+        }
+    }
+    TAP_CHECK(tried > 300 && ok > 30 && faces > 30,
+              "%zu moves of boundary vertices: %zu keep the invariant, %zu refused by the "
+              "face test alone", tried, ok, faces);
+    TAP_CHECK(wrong == 0, "sm_move_ok answers as the brute force every time (%zu differ)", wrong);
+    free(sp.list);
+    sm_fit_ctx_close(&c);
+    st_tetmesh_free(m);
+    st_soup_free(s);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(quality_reports),
@@ -1054,6 +1158,6 @@ int main(int argc, char **argv)
                                      TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
                                      TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), TAP_TEST(shared),
                                      TAP_TEST(stall),
-                                     TAP_TEST(swept), {0}};
+                                     TAP_TEST(swept), TAP_TEST(move_brute), {0}};
     return tap_main(argc, argv, tests);
 }

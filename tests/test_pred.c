@@ -464,6 +464,45 @@ static void test_coplanar_perturbed_scales(void)
     test_coplanar_perturbed(498, "coordinates near 1e150");
 }
 
+/* st_plane_filter_sign: wherever it decides, the side is orient3d's
+ * (+1 where st_orient3d(o, a, b, q) < 0), on points far from the plane
+ * and on points a unit or so off it at 2^53 (near-ties the filter must
+ * leave undecided); on the plane's own corners it decides nothing. */
+static void test_plane_filter_sign(void)
+{
+    const int64_t R = (int64_t)1 << 53;
+    int wrong = 0, decided_far = 0, decided_near = 0, on_plane = 0;
+    for (int it = 0; it < 20000; it++) {
+        double p[3][3], far[3], near[3];
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++)
+                p[i][k] = (double)rng_int(R);
+        for (int k = 0; k < 3; k++) {
+            far[k] = (double)rng_int(R);
+            int64_t sum = ((int64_t)p[0][k] + (int64_t)p[1][k] + (int64_t)p[2][k]) / 3;
+            near[k] = (double)(sum + rng_int(1));
+        }
+        st_plane_filter pl;
+        st_plane_filter_plane(&pl, p[0], p[1], p[2]);
+        const double *q[2] = {far, near};
+        for (int j = 0; j < 2; j++) {
+            int s = st_plane_filter_sign(&pl, q[j]);
+            int o = st_sign(st_orient3d(p[0], p[1], p[2], q[j]));
+            wrong += s != 0 && s != -o;
+            decided_far += j == 0 && s != 0;
+            decided_near += j == 1 && s != 0;
+        }
+        for (int i = 0; i < 3; i++)
+            on_plane += st_plane_filter_sign(&pl, p[i]) != 0;
+    }
+    TAP_CHECK(wrong == 0 && on_plane == 0,
+              "the plane filter's sign is orient3d's wherever it decides (%d wrong, %d "
+              "decided on a corner)", wrong, on_plane);
+    TAP_CHECK(decided_far > 19900 && decided_near < 20000,
+              "it decides almost every far point (%d of 20000) and leaves near-ties (%d "
+              "of 20000 near points decided)", decided_far, decided_near);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(random_integers), TAP_TEST(drop_axes),
@@ -471,6 +510,7 @@ int main(int argc, char **argv)
                                      {"collinear_perturbed", test_collinear_perturbed_scales},
                                      {"coplanar_perturbed", test_coplanar_perturbed_scales},
                                      TAP_TEST(mixed_scales), TAP_TEST(symmetries),
-                                     TAP_TEST(exact_counter), TAP_TEST(speed), {0}};
+                                     TAP_TEST(exact_counter), TAP_TEST(plane_filter_sign),
+                                     TAP_TEST(speed), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -96,6 +96,7 @@ typedef struct st_tri_box_filter {
     double ax[9][2];         /* axis k, edge j: (au, aw) */
     double aabs[9][2];       /* their magnitudes */
     double pmin[9], pmax[9]; /* the vertices' projections on each axis */
+    double v[3][3];          /* the vertices (copied) */
     int ok;                  /* 0: keep every box (non-finite or out of range) */
 } st_tri_box_filter;
 

@@ -98,22 +98,31 @@ typedef struct st_plane_filter {
 
 void st_plane_filter_init(st_plane_filter *pl, const double o[3], const double a[3],
                           const double b[3], const double r[3]);
+/* The plane alone, without a reference point (side 0): st_plane_filter_init
+ * without its orient3d, for st_plane_filter_sign. */
+void st_plane_filter_plane(st_plane_filter *pl, const double o[3], const double a[3],
+                           const double b[3]);
 
-/* 1 when q certainly lies strictly on the other side of the plane from r
- * (when r is on the plane: strictly off it); 0 when it may not, or the
- * filter cannot tell. */
-static inline int st_plane_filter_rejects(const st_plane_filter *pl, const double q[3])
+/* +1 or -1 when the filter certifies the side of the plane q lies on, in
+ * the units of pl->side (+1: st_orient3d(o, a, b, q) < 0, -1: > 0); 0 when
+ * q may be on the plane or the filter cannot tell. */
+static inline int st_plane_filter_sign(const st_plane_filter *pl, const double q[3])
 {
     double d0 = q[0] - pl->o[0], d1 = q[1] - pl->o[1], d2 = q[2] - pl->o[2];
     double det = d0 * pl->n[0] + d1 * pl->n[1] + d2 * pl->n[2];
     double a0 = d0 < 0 ? -d0 : d0, a1 = d1 < 0 ? -d1 : d1, a2 = d2 < 0 ? -d2 : d2;
     double perm = a0 * pl->an[0] + a1 * pl->an[1] + a2 * pl->an[2];
     double bound = ST_PLANE_FILTER_REL * perm + (a0 + a1 + a2 + 1.0) * ST_PLANE_FILTER_ABS;
-    if (det > bound)
-        return pl->side <= 0;
-    if (-det > bound)
-        return pl->side >= 0;
-    return 0;
+    return det > bound ? 1 : (-det > bound ? -1 : 0);
+}
+
+/* 1 when q certainly lies strictly on the other side of the plane from r
+ * (when r is on the plane: strictly off it); 0 when it may not, or the
+ * filter cannot tell. */
+static inline int st_plane_filter_rejects(const st_plane_filter *pl, const double q[3])
+{
+    const int s = st_plane_filter_sign(pl, q);
+    return s != 0 && s != pl->side;
 }
 
 /* How many calls, since the program started, the filter could not decide

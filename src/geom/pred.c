@@ -431,8 +431,8 @@ double st_orient3d(const double a[3], const double b[3], const double c[3],
     return orient3d_exact(a, b, c, d);
 }
 
-void st_plane_filter_init(st_plane_filter *pl, const double o[3], const double a[3],
-                          const double b[3], const double r[3])
+void st_plane_filter_plane(st_plane_filter *pl, const double o[3], const double a[3],
+                           const double b[3])
 {
     double e1[3], e2[3];
     for (int k = 0; k < 3; k++) {
@@ -446,6 +446,13 @@ void st_plane_filter_init(st_plane_filter *pl, const double o[3], const double a
         pl->an[k] = fabs(m[2 * k]) + fabs(m[2 * k + 1]);
     }
     pl->o = o;
+    pl->side = 0;
+}
+
+void st_plane_filter_init(st_plane_filter *pl, const double o[3], const double a[3],
+                          const double b[3], const double r[3])
+{
+    st_plane_filter_plane(pl, o, a, b);
     /* orient3d(o, a, b, r) = -det [a - o; b - o; r - o] */
     double s = st_orient3d(o, a, b, r);
     pl->side = s < 0 ? 1 : (s > 0 ? -1 : 0);
