@@ -58,9 +58,9 @@ static st_soup *ringed(int c0, int nc, int r0, int nr, int half)
 
 /* The cylinder's symmetries: its continuous axis and two mirror planes. */
 static const st_symmetry_set cylinder_set = {
-    {{ST_SYMMETRY_ROTATION, {0, 0, 0}, {0, 0, 1}, 0, 0.9, 0.0},
-     {ST_SYMMETRY_MIRROR, {0, 0, 0}, {0, 0, 1}, 0, 0.9, 0.0},
-     {ST_SYMMETRY_MIRROR, {0, 0, 0}, {0, 1, 0}, 0, 0.9, 0.0}},
+    {{ST_SYMMETRY_ROTATION, {0, 0, 0}, {0, 0, 1}, 0, 0.9, 0.0, 1.0},
+     {ST_SYMMETRY_MIRROR, {0, 0, 0}, {0, 0, 1}, 0, 0.9, 0.0, 0.0},
+     {ST_SYMMETRY_MIRROR, {0, 0, 0}, {0, 1, 0}, 0, 0.9, 0.0, 0.0}},
     3, 3};
 
 typedef struct outcome {

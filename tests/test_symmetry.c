@@ -217,7 +217,7 @@ static void test_asymmetric(void)
 static void test_nearly(void)
 {
     const double tol = 0.04;
-    double sup[2] = {0, 0}, at[2] = {1, 1};
+    double sup[2] = {0, 0}, at[2] = {1, 1}, con[2] = {-1, -1};
     for (int moved = 0; moved < 2; moved++) {
         st_soup *s = st_soup_new();
         add_box(s, (double[3]){-1.7, 0, 0}, (double[3]){2.3, 1, 1});
@@ -231,6 +231,7 @@ static void test_nearly(void)
         const st_symmetry *mx = mirror_along(&set, 0);
         sup[moved] = mx ? mx->support : 0.0;
         at[moved] = mx ? fabs(crossing(mx, 0) - 0.3) : 1.0;
+        con[moved] = mx ? mx->contradiction : -1.0;
         st_soup_free(s);
     }
     TAP_CHECK(sup[0] > 0.95 && at[0] < 0.5 * tol,
@@ -238,6 +239,13 @@ static void test_nearly(void)
     TAP_CHECK(sup[1] >= ST_SYMMETRY_DEFAULT_MIN_SUPPORT && sup[1] < sup[0] && at[1] < tol,
               "one cube moved by 2 voxels: the plane holds where it was, weaker (%.3f off, "
               "support %.3f against %.3f)", at[1], sup[1], sup[0]);
+    /* a closed soup has no rims: every image not verified is contradicted,
+     * so contradiction = 1 - support, counted though the support alone
+     * accepts the plane */
+    TAP_CHECK(con[1] > 0.0 && fabs(con[1] - (1.0 - sup[1])) < 1e-9 &&
+                  fabs(con[0] - (1.0 - sup[0])) < 1e-9,
+              "its contradiction is counted: %.4f = 1 - support (in place %.4f)", con[1],
+              con[0]);
 }
 
 /* An axis-aligned box whose faces are split into k x k squares, those

@@ -164,7 +164,7 @@ static void test_open_hole(void)
     const double hole[2] = {0.0, 110.0};
     int missing;
     st_soup *s = cylinder(hole, 1, &missing);
-    const st_symmetry_set set = {{{ST_SYMMETRY_ROTATION, {0, 0, 0}, {0, 0, 1}, 0, 0.74, 0.0}}, 1, 1};
+    const st_symmetry_set set = {{{ST_SYMMETRY_ROTATION, {0, 0, 0}, {0, 0, 1}, 0, 0.74, 0.0, 1.0}}, 1, 1};
     run r;
     TAP_CHECK(fill_of(&r, s, &set) == 0, "110 degrees missing: the fill runs");
     TAP_CHECK(r.caps->ntris == 0 && r.st.open == 1,
@@ -210,7 +210,7 @@ static void test_rim_in_hole(void)
     const double hole[2] = {160.0, 360.0}, h = 4.0;
     int missing;
     st_soup *s = tall_cylinder(h, hole, 1, &missing);
-    const st_symmetry_set set = {{{ST_SYMMETRY_ROTATION, {0, 0, 0}, {0, 0, 1}, 0, 0.5, 0.0}}, 1, 1};
+    const st_symmetry_set set = {{{ST_SYMMETRY_ROTATION, {0, 0, 0}, {0, 0, 1}, 0, 0.5, 0.0, 1.0}}, 1, 1};
     run r;
     TAP_CHECK(fill_of(&r, s, &set) == 0, "200 degrees missing: the fill runs");
     TAP_CHECK(r.caps->ntris == 0 && r.st.open == 1, "one open rim (%zu cap triangles, %zu open)",
@@ -231,7 +231,7 @@ static void mirror_case(int copy_holed)
     const double ranges[4] = {325.0, 35.0, 170.0, 190.0};
     int missing;
     st_soup *s = cylinder(ranges, copy_holed ? 2 : 1, &missing);
-    const st_symmetry_set set = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8, 0.0}}, 1, 1};
+    const st_symmetry_set set = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8, 0.0, 0.0}}, 1, 1};
     run r;
     TAP_CHECK(fill_of(&r, s, &set) == 0, "%s: the fill runs",
               copy_holed ? "copy holed" : "copy whole");
@@ -287,8 +287,8 @@ static void test_mirror_turn(void)
     st_soup *s = cylinder(hole, 1, &missing);
     const double b1 = -5.625 * M_PI / 180.0, b2 = 28.125 * M_PI / 180.0;
     const st_symmetry_set set = {
-        {{ST_SYMMETRY_MIRROR, {0, 0, 0}, {-sin(b1), cos(b1), 0}, 0, 0.8, 0.0},
-         {ST_SYMMETRY_MIRROR, {0, 0, 0}, {-sin(b2), cos(b2), 0}, 0, 0.8, 0.0}},
+        {{ST_SYMMETRY_MIRROR, {0, 0, 0}, {-sin(b1), cos(b1), 0}, 0, 0.8, 0.0, 0.0},
+         {ST_SYMMETRY_MIRROR, {0, 0, 0}, {-sin(b2), cos(b2), 0}, 0, 0.8, 0.0, 0.0}},
         2, 2};
     run r;
     TAP_CHECK(fill_of(&r, s, &set) == 0, "120 degrees missing, two mirrors: the fill runs");
@@ -316,9 +316,9 @@ static void test_turns_unread(void)
     const double ranges[2] = {325.0, 35.0};
     int missing;
     st_soup *s = cylinder(ranges, 1, &missing);
-    const st_symmetry_set one = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8, 0.0}}, 1, 1};
-    const st_symmetry_set two = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8, 0.0},
-                                  {ST_SYMMETRY_MIRROR, {0, 0, 0}, {0, 1, 0}, 0, 0.8, 0.0}},
+    const st_symmetry_set one = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8, 0.0, 0.0}}, 1, 1};
+    const st_symmetry_set two = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8, 0.0, 0.0},
+                                  {ST_SYMMETRY_MIRROR, {0, 0, 0}, {0, 1, 0}, 0, 0.8, 0.0, 0.0}},
                                  2, 2};
     run a, b;
     TAP_CHECK(fill_of(&a, s, &one) == 0 && fill_of(&b, s, &two) == 0,
@@ -365,7 +365,7 @@ static void test_straddles(void)
         s->tris[3 * t + 1] = s->tris[3 * t + 2];
         s->tris[3 * t + 2] = v;
     }
-    const st_symmetry_set set = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8, 0.0}}, 1, 1};
+    const st_symmetry_set set = {{{ST_SYMMETRY_MIRROR, {0, 0, 0}, {1, 0, 0}, 0, 0.8, 0.0, 0.0}}, 1, 1};
     run r;
     TAP_CHECK(fill_of(&r, s, &set) == 0, "a hole across the plane: the fill runs");
     TAP_CHECK(r.st.caps == 1 && r.st.open == 0, "one capped hole (%zu)", r.st.caps);

@@ -45,6 +45,9 @@ extern "C" {
  * verified and at most 0.2 of what the soup can check contradicts it
  * (the rest land in the soup's holes): doc/design/symmetry.md. */
 #define ST_SYMMETRY_DEFAULT_MIN_SUPPORT 0.6
+/* The contradiction a mirror accepted below min_support may have (at
+ * least 0.4 of the informative samples verified): the bound above. */
+#define ST_SYMMETRY_MAX_CONTRADICTION 0.2
 #define ST_SYMMETRY_DEFAULT_MAX_ORDER 48
 #define ST_SYMMETRY_MAX 16          /* symmetries kept, best first */
 
@@ -66,6 +69,12 @@ typedef struct st_symmetry {
     double pitch;        /* helix: the move along dir per full turn, model
                             units, > 0 right-handed, < 0 left-handed (the
                             same for -dir); else 0 */
+    double contradiction; /* mirror (accepted by st_symmetry_detect): the
+                            share of the images the soup can check
+                            (verified or contradicted) that it
+                            contradicts, counted on every sample; 1 when
+                            it can check none; rotations and helices 1
+                            (not counted) */
 } st_symmetry;
 
 typedef struct st_symmetry_params {

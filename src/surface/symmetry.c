@@ -129,9 +129,9 @@ void st_symmetry_describe(const st_symmetry *y, char *buf, size_t size)
     if (y->kind == ST_SYMMETRY_MIRROR)
         snprintf(buf, size,
                  "mirror plane through (%.6g, %.6g, %.6g), normal (%.4f, "
-                 "%.4f, %.4f), support %.3f",
+                 "%.4f, %.4f), support %.3f, contradiction %.3f",
                  y->point[0], y->point[1], y->point[2], y->dir[0], y->dir[1],
-                 y->dir[2], y->support);
+                 y->dir[2], y->support, y->contradiction);
     else if (y->kind == ST_SYMMETRY_HELIX)
         snprintf(buf, size,
                  "helix axis through (%.6g, %.6g, %.6g), direction (%.4f, "
@@ -693,7 +693,7 @@ typedef struct tally {
 
 /* accepted()'s shares (below) */
 #define MIN_VERIFIED 0.4
-#define MAX_CONTRA 0.2
+#define MAX_CONTRA ST_SYMMETRY_MAX_CONTRADICTION
 
 /* The contradicted share of what the soup could check (verified or
  * contradicted); 1 when it could check nothing. */
@@ -1930,6 +1930,23 @@ static void one_screw_per_line(st_symmetry_set *out, double tol)
     }
 }
 
+/* Each accepted mirror's contradiction (st_symmetry.contradiction),
+ * counted on every sample (the soup's rims made if no count made them);
+ * rotations and helices 1, not counted. A sum per mirror: the same for
+ * any thread count. */
+static void mirror_contradictions(const ctx *C, st_symmetry_set *out)
+{
+    for (size_t i = 0; i < out->n; i++) {
+        st_symmetry *y = out->items + i;
+        y->contradiction = 1.0;
+        if (y->kind != ST_SYMMETRY_MIRROR)
+            continue;
+        rims_need(C);
+        const tally t = measure_run(C, y, 0.0, 1, 1, 0.0, NULL);
+        y->contradiction = contradiction(&t);
+    }
+}
+
 /* The samples and each triangle's unit normal (the rims come later:
  * rims_need). */
 static st_status ctx_make(ctx *C, const st_soup *s, samples *S, size_t want, st_error *err)
@@ -2066,6 +2083,7 @@ st_status st_symmetry_detect(st_symmetry_set *out, const st_soup *s,
     }
     one_screw_per_line(out, p->tolerance);
     qsort(out->items, out->n, sizeof *out->items, cmp_sym);
+    mirror_contradictions(&C, out);
     const int rims_failed = R.tried && !R.rim;
     ctx_free(&C, &S);
     if (rims_failed) {
