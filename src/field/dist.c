@@ -421,9 +421,11 @@ static void sort_cand_keys(cand_key *k, cand_key *tmp, size_t m)
 #define NBUCKET 32
 enum { BAND_NV = GROUP * GROUP * GROUP };
 
-/* One group's candidates in walk order: balls, structure of arrays. */
+/* One group's candidates in walk order, structure of arrays. A band
+ * group's list holds only bound and at (its balls are read from the
+ * brick's arrays through at); a full field's holds the balls too. */
 typedef struct walk_list {
-    double *x, *y, *z, *r;   /* ball center and radius */
+    double *x, *y, *z, *r;   /* ball center and radius (full fields) */
     double *bound;           /* a lower bound of its key, nondecreasing */
     uint32_t *at;            /* index into the brick's candidates */
     size_t n;
