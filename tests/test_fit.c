@@ -494,6 +494,59 @@ static void test_bvh_query_tet(void)
     st_soup_free(s);
 }
 
+/* A flat tet (four corners in the plane z = c, exactly): its closed set
+ * is the union of its four faces, and the tet query visits every sphere
+ * triangle that meets one of them (bvh.h: a superset of the triangles
+ * that meet the closed tet; a face whose opposite corner lies on its
+ * plane must not take every point off that plane as outside). */
+static void test_bvh_query_flat_tet(void)
+{
+    st_soup *s = st_soup_new();
+    add_sphere(s, 1.0, 2.0);
+    st_bvh *b = NULL;
+    st_error err;
+    TAP_CHECK(st_bvh_build(&b, s, &err) == ST_OK, "bvh over the sphere");
+    tet_seen h = {0, calloc(s->ntris, 1)};
+    size_t missed = 0, meeting = 0;
+    unsigned rng = 777u;
+    for (int k = 0; k < 100; k++) {
+        double p[4][3];
+        rng = rng * 1103515245u + 12345u;
+        const double z = -0.9 + 1.8 * (double)(rng >> 8) / (double)(1u << 24);
+        for (int i = 0; i < 4; i++) {
+            for (int a = 0; a < 2; a++) {
+                rng = rng * 1103515245u + 12345u;
+                p[i][a] = 2.4 * ((double)(rng >> 8) / (double)(1u << 24) - 0.5);
+            }
+            p[i][2] = z;
+        }
+        const double *q[4] = {p[0], p[1], p[2], p[3]};
+        memset(h.seen, 0, s->ntris);
+        st_bvh_query_tet(b, q, tet_visit, &h);
+        for (size_t t = 0; t < s->ntris; t++) {
+            const double *v[3];
+            for (int i = 0; i < 3; i++)
+                v[i] = s->xyz + 3 * (size_t)s->tris[3 * t + (size_t)i];
+            int meets = 0;
+            for (int f = 0; f < 4 && !meets; f++) {
+                const double *r[3];
+                for (int c = 0, n = 0; c < 4; c++)
+                    if (c != f)
+                        r[n++] = p[c];
+                meets = st_tri_tri_intersect(v[0], v[1], v[2], r[0], r[1], r[2]);
+            }
+            meeting += (size_t)meets;
+            missed += (size_t)(meets && !h.seen[t]);
+        }
+    }
+    TAP_CHECK(missed == 0 && meeting > 0,
+              "a flat tet's query visits every triangle that meets it (%zu meet, %zu missed)",
+              meeting, missed);
+    free(h.seen);
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
 typedef struct band_watch {
     st_tetmesh *m;
     const st_bvh *b;
@@ -1156,6 +1209,7 @@ int main(int argc, char **argv)
     static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(quality_reports),
                                      TAP_TEST(not_enclosing), TAP_TEST(refusals),
                                      TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
+                                     TAP_TEST(bvh_query_flat_tet),
                                      TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), TAP_TEST(shared),
                                      TAP_TEST(stall),
                                      TAP_TEST(swept), TAP_TEST(move_brute), {0}};

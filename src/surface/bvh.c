@@ -649,6 +649,11 @@ int st_bvh_query_tri(const st_bvh *b, const double a[3], const double bb[3],
 static int box_outside_tet(const st_plane_filter pl[4], const double lo[3], const double hi[3])
 {
     for (int f = 0; f < 4; f++) {
+        /* A flat tet (its corner on this face's plane, side 0): rejects
+         * would take every point strictly off the plane, on either side,
+         * as outside; the face cannot exclude anything on its own. */
+        if (pl[f].side == 0)
+            continue;
         int first = 0;
         for (int k = 0; k < 3; k++)
             if (pl[f].n[k] * (double)pl[f].side > 0.0)
