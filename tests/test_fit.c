@@ -367,16 +367,31 @@ static int box_visit(void *ctx, uint32_t t)
     return 0;
 }
 
+/* The next of the tests' linear congruential draws, in [0, 1). */
+static double unit_draw(unsigned *rng)
+{
+    *rng = *rng * 1103515245u + 12345u;
+    return (double)(*rng >> 8) / (double)(1u << 24);
+}
+
+/* The BVH query tests' soup: a sphere of radius 1 (add_sphere) and its BVH. */
+static st_bvh *sphere_bvh(st_soup **s)
+{
+    *s = st_soup_new();
+    add_sphere(*s, 1.0, 2.0);
+    st_bvh *b = NULL;
+    st_error err;
+    TAP_CHECK(st_bvh_build(&b, *s, &err) == ST_OK, "bvh over the sphere");
+    return b;
+}
+
 /* st_bvh_query_tri against brute force: every sphere triangle that meets
  * a query triangle (large, slanted, some through the sphere, some touching
  * it at a vertex) is visited; and it visits far fewer than the box query. */
 static void test_bvh_query_tri(void)
 {
-    st_soup *s = st_soup_new();
-    add_sphere(s, 1.0, 2.0);
-    st_bvh *b = NULL;
-    st_error err;
-    TAP_CHECK(st_bvh_build(&b, s, &err) == ST_OK, "bvh over the sphere");
+    st_soup *s;
+    st_bvh *b = sphere_bvh(&s);
     unsigned char *seen = calloc(s->ntris, 1);
     size_t missed = 0, meeting = 0, visited = 0, boxed = 0;
     unsigned rng = 12345u;
@@ -384,8 +399,7 @@ static void test_bvh_query_tri(void)
         double p[3][3];
         for (int i = 0; i < 3; i++)
             for (int a = 0; a < 3; a++) {
-                rng = rng * 1103515245u + 12345u;
-                p[i][a] = -1.5 + 3.0 * (double)(rng >> 8) / (double)(1u << 24);
+                p[i][a] = -1.5 + 3.0 * unit_draw(&rng);
             }
         if (k % 10 == 0)   /* a corner exactly on a sphere vertex */
             memcpy(p[0], s->xyz + 3 * (size_t)s->tris[3 * (size_t)k], sizeof p[0]);
@@ -437,11 +451,8 @@ static int tet_visit(void *ctx, uint32_t t)
  * visited; and it visits far fewer than the box query of the tet's box. */
 static void test_bvh_query_tet(void)
 {
-    st_soup *s = st_soup_new();
-    add_sphere(s, 1.0, 2.0);
-    st_bvh *b = NULL;
-    st_error err;
-    TAP_CHECK(st_bvh_build(&b, s, &err) == ST_OK, "bvh over the sphere");
+    st_soup *s;
+    st_bvh *b = sphere_bvh(&s);
     tet_seen h = {0, calloc(s->ntris, 1)};
     size_t missed = 0, meeting = 0, boxed = 0;
     unsigned rng = 4242u;
@@ -450,13 +461,11 @@ static void test_bvh_query_tet(void)
         const double size = k % 3 == 0 ? 0.3 : 2.0;
         double c[3];
         for (int a = 0; a < 3; a++) {
-            rng = rng * 1103515245u + 12345u;
-            c[a] = -1.2 + 2.4 * (double)(rng >> 8) / (double)(1u << 24);
+            c[a] = -1.2 + 2.4 * unit_draw(&rng);
         }
         for (int i = 0; i < 4; i++)
             for (int a = 0; a < 3; a++) {
-                rng = rng * 1103515245u + 12345u;
-                p[i][a] = c[a] + size * ((double)(rng >> 8) / (double)(1u << 24) - 0.5);
+                p[i][a] = c[a] + size * (unit_draw(&rng) - 0.5);
             }
         const uint32_t *tv = s->tris + 3 * (size_t)(k % s->ntris);
         if (k % 10 == 1)   /* a corner exactly on a sphere vertex */
@@ -501,22 +510,17 @@ static void test_bvh_query_tet(void)
  * plane must not take every point off that plane as outside). */
 static void test_bvh_query_flat_tet(void)
 {
-    st_soup *s = st_soup_new();
-    add_sphere(s, 1.0, 2.0);
-    st_bvh *b = NULL;
-    st_error err;
-    TAP_CHECK(st_bvh_build(&b, s, &err) == ST_OK, "bvh over the sphere");
+    st_soup *s;
+    st_bvh *b = sphere_bvh(&s);
     tet_seen h = {0, calloc(s->ntris, 1)};
     size_t missed = 0, meeting = 0;
     unsigned rng = 777u;
     for (int k = 0; k < 100; k++) {
         double p[4][3];
-        rng = rng * 1103515245u + 12345u;
-        const double z = -0.9 + 1.8 * (double)(rng >> 8) / (double)(1u << 24);
+        const double z = -0.9 + 1.8 * unit_draw(&rng);
         for (int i = 0; i < 4; i++) {
             for (int a = 0; a < 2; a++) {
-                rng = rng * 1103515245u + 12345u;
-                p[i][a] = 2.4 * ((double)(rng >> 8) / (double)(1u << 24) - 0.5);
+                p[i][a] = 2.4 * (unit_draw(&rng) - 0.5);
             }
             p[i][2] = z;
         }
