@@ -59,6 +59,9 @@
 /* Boundary faces of a vertex handled here; a vertex with more (none in a
  * lattice) takes the gathering path. */
 #define SWEPT_MAX_FACES 48
+/* Bins an axis whose extents sm_swept_kept keeps at once: sm_pgrid_build
+ * makes at most 256. */
+#define SWEPT_SPAN 256
 /* 1 when q lies in the closed star of v with v at y. */
 static int in_closed_star(const sm_mesh *sm, uint32_t v, const double y[3], const double q[3])
 {
@@ -73,29 +76,66 @@ static int in_closed_star(const sm_mesh *sm, uint32_t v, const double y[3], cons
     return 0;
 }
 
-/* 1 when the filter certifies every point of the box lo..hi strictly on
- * the side that rejects (st_plane_filter_rejects at all eight corners:
- * with r off the plane a rejected corner is on the side opposite r, so all
- * are on one side; with r on it, corners could straddle it, and nothing is
- * claimed). */
-static int box_rejected(const st_plane_filter *pl, const double lo[3], const double hi[3])
+/* The smaller and the larger of two coordinates (finite here; libm's fmin
+ * and fmax are calls). */
+static inline double dmin(double a, double b)
 {
-    if (pl->side == 0)
-        return 0;
-    /* The corner furthest toward r's side first (bit k: hi along k where
-     * the plane's normal leans that way): where any corner is kept, that
-     * one is the likeliest, and most bins end after one test. The answer
-     * is the same whichever order (all eight must be rejected). */
-    int first = 0;
-    for (int k = 0; k < 3; k++)
-        if ((double)pl->side * pl->n[k] > 0.0)
-            first |= 1 << k;
-    for (int i = 0; i < 8; i++) {
-        const int c = i ^ first;
-        const double q[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
-        if (!st_plane_filter_rejects(pl, q))
-            return 0;
+    return a < b ? a : b;
+}
+
+static inline double dmax(double a, double b)
+{
+    return a > b ? a : b;
+}
+
+/* A face's plane filter with its box test's corner choice (box_rejected). */
+typedef struct box_plane {
+    st_plane_filter pl;
+    int first;    /* bit k: hi along axis k where side * n_k > 0 */
+    int unsure;   /* bit k: n_k's sign not certain */
+} box_plane;
+
+/* pl from st_plane_filter_init(o, a, b, r) and its corner choice. */
+static void box_plane_init(box_plane *bp, const double o[3], const double a[3],
+                           const double b[3], const double r[3])
+{
+    st_plane_filter_init(&bp->pl, o, a, b, r);
+    bp->first = bp->unsure = 0;
+    for (int k = 0; k < 3; k++) {
+        if ((double)bp->pl.side * bp->pl.n[k] > 0.0)
+            bp->first |= 1 << k;
+        if (!(fabs(bp->pl.n[k]) > ST_PLANE_FILTER_REL * bp->pl.an[k] + ST_PLANE_FILTER_ABS))
+            bp->unsure |= 1 << k;
     }
+}
+
+/* 1 when the filter certifies every point of the box lo..hi strictly on
+ * the side that rejects (with r on the plane nothing is claimed).
+ *
+ * The plane's exact determinant at q is N . (q - o), N the exact cross
+ * product the filter's n rounds, affine in q: over the box, side * N . q is
+ * largest at the corner that takes hi along the axes where side * N_k > 0
+ * and lo where it is < 0 (either where N_k = 0). Where n_k's sign is
+ * certain (|n_k| beyond the rounding of its two products of rounded
+ * differences and their difference, about 4 u an_k, here 16 u an_k and
+ * 2^-1000 for underflow), N_k has it; where it is not, both ends are
+ * tried. When the filter rejects each corner tried, the exact determinant
+ * is strictly on the rejecting side at the box's largest corner, so at
+ * every point of it: the claim of rejecting all eight corners (until
+ * session 57), with one test for most faces. */
+static inline int box_rejected(const box_plane *bp, const double lo[3], const double hi[3])
+{
+    if (bp->pl.side == 0)
+        return 0;
+    /* the subsets s of the unsure axes, the empty one first */
+    int s = 0;
+    do {
+        const int c = bp->first ^ s;
+        const double q[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
+        if (!st_plane_filter_rejects(&bp->pl, q))
+            return 0;
+        s = (s - bp->unsure) & bp->unsure;
+    } while (s != 0);
     return 1;
 }
 
@@ -116,14 +156,14 @@ static void bin_extent(const pgrid *g, size_t i, int a, double m, double lo, dou
 {
     double b0 = i == 0 ? -INFINITY : g->lo[a] + (double)i * g->cell - m;
     double b1 = i + 1 >= g->n[a] ? INFINITY : g->lo[a] + (double)(i + 1) * g->cell + m;
-    out[0] = fmax(b0, lo);
-    out[1] = fmin(b1, hi);
+    out[0] = dmax(b0, lo);
+    out[1] = dmin(b1, hi);
 }
 
 /* The faces (bits) that may hold a point of the bin box blo..bhi; 0 when
  * none can (or the box is empty). */
-static uint64_t bin_faces(size_t nf, const double (*box)[6], const st_plane_filter *in,
-                          const st_plane_filter *out, const double blo[3], const double bhi[3])
+static uint64_t bin_faces(size_t nf, const double (*box)[6], const box_plane *in,
+                          const box_plane *out, const double blo[3], const double bhi[3])
 {
     uint64_t keep = 0;
     for (int a = 0; a < 3; a++)
@@ -155,13 +195,13 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
     if (g->npts == 0 || nf == 0)
         return 1;
     const double *x = sm->m->xyz + 3 * (size_t)v;
-    st_plane_filter in[SWEPT_MAX_FACES], out[SWEPT_MAX_FACES];
+    box_plane in[SWEPT_MAX_FACES], out[SWEPT_MAX_FACES];
     double box[SWEPT_MAX_FACES][6];
     const double *ab[SWEPT_MAX_FACES][2];
     double lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
-        lo[a] = fmin(x[a], p[a]);
-        hi[a] = fmax(x[a], p[a]);
+        lo[a] = dmin(x[a], p[a]);
+        hi[a] = dmax(x[a], p[a]);
     }
     for (size_t i = 0; i < nf; i++) {
         const uint32_t *k = sm->bf + 3 * (size_t)sm->vf[sm->vf_off[v] + i];
@@ -171,13 +211,13 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
                 ab[i][n++] = sm->m->xyz + 3 * (size_t)k[j];
         if (n != 2)
             return -1;   /* not a face of v: leave it to the full test */
-        st_plane_filter_init(&in[i], x, ab[i][0], ab[i][1], p);
-        st_plane_filter_init(&out[i], p, ab[i][0], ab[i][1], x);
+        box_plane_init(&in[i], x, ab[i][0], ab[i][1], p);
+        box_plane_init(&out[i], p, ab[i][0], ab[i][1], x);
         for (int a = 0; a < 3; a++) {
-            box[i][a] = fmin(fmin(x[a], p[a]), fmin(ab[i][0][a], ab[i][1][a]));
-            box[i][3 + a] = fmax(fmax(x[a], p[a]), fmax(ab[i][0][a], ab[i][1][a]));
-            lo[a] = fmin(lo[a], box[i][a]);
-            hi[a] = fmax(hi[a], box[i][3 + a]);
+            box[i][a] = dmin(dmin(x[a], p[a]), dmin(ab[i][0][a], ab[i][1][a]));
+            box[i][3 + a] = dmax(dmax(x[a], p[a]), dmax(ab[i][0][a], ab[i][1][a]));
+            lo[a] = dmin(lo[a], box[i][a]);
+            hi[a] = dmax(hi[a], box[i][3 + a]);
         }
     }
     size_t a0[3], a1[3];
@@ -186,23 +226,29 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
         a1[a] = sm_pgrid_coord(g, hi[a], a);
     }
     const uint64_t all = ((uint64_t)1 << nf) - 1;   /* nf <= SWEPT_MAX_FACES < 64 */
-    /* the margins once per call, each axis's extent once per row */
+    /* the margins and each scanned bin's extent along each axis, once per
+     * call (the grid has at most SWEPT_SPAN bins an axis: pgrid.c) */
     const double m[3] = {bin_margin(g, 0), bin_margin(g, 1), bin_margin(g, 2)};
-    const int whole_bins = !isnan(m[0]) && !isnan(m[1]) && !isnan(m[2]);
-    double ez[2], ey[2], ex[2];
+    int whole_bins = !isnan(m[0]) && !isnan(m[1]) && !isnan(m[2]);
+    double ext[3][SWEPT_SPAN][2];
+    for (int a = 0; a < 3 && whole_bins; a++) {
+        if (a1[a] - a0[a] >= SWEPT_SPAN) {
+            whole_bins = 0;   /* not from sm_pgrid_build: scan every bin */
+            break;
+        }
+        for (size_t i = a0[a]; i <= a1[a]; i++)
+            bin_extent(g, i, a, m[a], lo[a], hi[a], ext[a][i - a0[a]]);
+    }
     for (size_t iz = a0[2]; iz <= a1[2]; iz++) {
-        if (whole_bins)
-            bin_extent(g, iz, 2, m[2], lo[2], hi[2], ez);
         for (size_t iy = a0[1]; iy <= a1[1]; iy++) {
-            if (whole_bins)
-                bin_extent(g, iy, 1, m[1], lo[1], hi[1], ey);
             for (size_t ix = a0[0]; ix <= a1[0]; ix++) {
                 size_t b = ix + g->n[0] * (iy + g->n[1] * iz);
                 if (g->off[b] == g->off[b + 1])
                     continue;
                 uint64_t keep = all;
                 if (whole_bins) {
-                    bin_extent(g, ix, 0, m[0], lo[0], hi[0], ex);
+                    const double *ex = ext[0][ix - a0[0]], *ey = ext[1][iy - a0[1]],
+                                 *ez = ext[2][iz - a0[2]];
                     const double blo[3] = {ex[0], ey[0], ez[0]}, bhi[3] = {ex[1], ey[1], ez[1]};
                     keep = bin_faces(nf, (const double(*)[6])box, in, out, blo, bhi);
                 }
@@ -219,7 +265,8 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
                         if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] || q[0] > bx[3] ||
                             q[1] > bx[4] || q[2] > bx[5])
                             continue;
-                        if (st_plane_filter_rejects(&in[i], q) || st_plane_filter_rejects(&out[i], q))
+                        if (st_plane_filter_rejects(&in[i].pl, q) ||
+                            st_plane_filter_rejects(&out[i].pl, q))
                             continue;
                         swept = st_point_in_tet(q, x, p, ab[i][0], ab[i][1]) != ST_OUTSIDE;
                     }
