@@ -425,6 +425,7 @@ void sm_star_pts_collect(const fit_ctx *c, uint32_t v, star_pts *sp)
     (void)c;
     sp->have = 0;
     sp->v = v;
+    sp->bq = UINT32_MAX;
 }
 
 /* The whole invariant for moving v to p, cheapest test first. */
@@ -436,14 +437,20 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
         return 0;
     /* The S vertex that stopped v last time usually stops it again: when
      * it is in the star now and would not be, the move fails whatever the
-     * others do, and the star's points need not be gathered. The star
-     * with v at p is positive (just tested): in_pos_star's answer, two
-     * orient3d calls fewer a tet. */
+     * others do, and the star's points need not be gathered. Where it is
+     * in the star as it is does not change while v's moves are tried
+     * (sm_star_pts_collect starts them): found once (sp->bq, sp->bt), and
+     * a blocker outside the star needs no test at p. The star with v at p
+     * is positive (just tested): in_pos_star's answer, two orient3d calls
+     * fewer a tet, its tet as it is tried first. */
     uint32_t b = c->blocker ? c->blocker[v] : UINT32_MAX;
     if (b != UINT32_MAX && c->s && (c->sm.onb[v] || c->full_check)) {
         const double *q = c->pg->pts + 3 * (size_t)b;
-        const double *x = c->sm.m->xyz + 3 * (size_t)v;
-        if (in_pos_star(&c->sm, v, p, q, -1, 0) < 0 && in_star(&c->sm, v, x, q, -1) >= 0)
+        if (sp->bq != b) {
+            sp->bq = b;
+            sp->bt = in_star(&c->sm, v, c->sm.m->xyz + 3 * (size_t)v, q, -1);
+        }
+        if (sp->bt >= 0 && in_pos_star(&c->sm, v, p, q, sp->bt, 0) < 0)
             return 0;
     }
     if (c->s && c->sm.onb[v] && !tblocker_clear(c, v, p))
