@@ -187,8 +187,12 @@ int sm_swept_applies(const sm_mesh *sm, uint32_t v)
 }
 
 int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[3],
-                  uint32_t *failed)
+                  uint32_t *failed, int *empty)
 {
+    int scratch;
+    if (!empty)
+        empty = &scratch;
+    *empty = 0;
     const size_t nf = sm->vf_off[v + 1] - sm->vf_off[v];
     if (nf > SWEPT_MAX_FACES)
         return -1;
@@ -225,6 +229,10 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
         a0[a] = sm_pgrid_coord(g, lo[a], a);
         a1[a] = sm_pgrid_coord(g, hi[a], a);
     }
+    int flat = 0;   /* a degenerate swept tet: p on its face's plane */
+    for (size_t i = 0; i < nf; i++)
+        flat |= in[i].pl.side == 0;
+    int met = 0;    /* an S vertex in a swept tet */
     const uint64_t all = ((uint64_t)1 << nf) - 1;   /* nf <= SWEPT_MAX_FACES < 64 */
     /* the margins and each scanned bin's extent along each axis, once per
      * call (the grid has at most SWEPT_SPAN bins an axis: pgrid.c) */
@@ -270,6 +278,7 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
                             continue;
                         swept = st_point_in_tet(q, x, p, ab[i][0], ab[i][1]) != ST_OUTSIDE;
                     }
+                    met |= swept;
                     if (swept && in_closed_star(sm, v, x, q) && !in_closed_star(sm, v, p, q)) {
                         *failed = g->idx[j];
                         return 0;
@@ -278,5 +287,6 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
             }
         }
     }
+    *empty = !flat && !met;
     return 1;
 }

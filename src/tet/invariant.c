@@ -34,7 +34,9 @@
  * after a small move is one tet test; a vertex whose last attempt failed
  * and whose star has not moved since is not tried again (the dirty set);
  * faces are checked through the BVH's triangle query (nodes pruned by the
- * face itself, not its box); boundary distances are searched within the
+ * face itself, not its box), and when the swept test found no S vertex in
+ * the swept tets, through the thin side triangles of those tets instead
+ * (sides_clear); boundary distances are searched within the
  * old distance plus the way the vertex moved. None of these changes a
  * result.
  */
@@ -390,6 +392,75 @@ static int faces_clear(const fit_ctx *c, uint32_t v, const double p[3])
     return 1;
 }
 
+/* 1 (stop) when S triangle tri meets the side triangle in q->f (q->pl its
+ * plane, the corners certified on one side first, as face_visit). */
+static int side_visit(void *ctx, uint32_t tri)
+{
+    face_query *q = ctx;
+    const uint32_t *t = q->s->tris + 3 * (size_t)tri;
+    const double *a = q->s->xyz + 3 * (size_t)t[0], *b = q->s->xyz + 3 * (size_t)t[1],
+                 *d = q->s->xyz + 3 * (size_t)t[2];
+    const int sa = st_plane_filter_sign(&q->pl, a);
+    if (sa != 0 && st_plane_filter_sign(&q->pl, b) == sa && st_plane_filter_sign(&q->pl, d) == sa)
+        return 0;
+    if (!st_tri_tri_intersect(q->f[0], q->f[1], q->f[2], a, b, d))
+        return 0;
+    q->hit = tri;
+    return 1;
+}
+
+/* Boundary link vertices a side test visits at most (a lattice vertex has
+ * far fewer); with more, sides_clear answers 0 (the face walks decide). */
+#define SIDES_MAX 64
+
+/* 1 when no triangle of S meets a side triangle (x, p, a) of the swept
+ * tets (x, p, a, b), x where v is, (x, a, b) its boundary faces, each
+ * boundary link vertex a once. With sm_swept_kept's *empty (no S vertex
+ * in any closed swept tet K = (x, p, a, b), none degenerate), every face
+ * (p, a, b) is then clear: a triangle T meeting F' = (p, a, b) at y with
+ * no vertex in K meets F = (x, a, b) or a side. If y lies on an edge of
+ * F', that edge is in F or a side. Else, when a corner t of T lies
+ * strictly on x's side of F''s plane, the segment y t enters K's interior
+ * (y inside F', K non-degenerate) and leaves it before t (t not in K) at
+ * a point of T off that plane: on F or a side. Else T lies on the closed
+ * other side, so T meets K only on F''s plane: T's corners on it are not
+ * in F' and span an edge of T crossing F''s edges, or T is in the plane
+ * and holds F' (a corner of F in T) or crosses its edges. A triangle
+ * meeting F met it before the move: not new. So the face walks
+ * (faces_clear) would find nothing; the thin sides meet far fewer BVH
+ * nodes than the faces. 0 when a triangle meets a side (faces_clear
+ * decides then). */
+static int sides_clear(const fit_ctx *c, uint32_t v, const double p[3])
+{
+    const sm_mesh *sm = &c->sm;
+    const double *x = sm->m->xyz + 3 * (size_t)v;
+    uint32_t seen[SIDES_MAX];
+    size_t ns = 0;
+    face_query q;
+    q.s = c->s;
+    q.f[0] = x;
+    q.f[1] = p;
+    for (size_t j = sm->vf_off[v]; j < sm->vf_off[v + 1]; j++) {
+        const uint32_t *k = sm->bf + 3 * (size_t)sm->vf[j];
+        for (int i = 0; i < 3; i++) {
+            if (k[i] == v)
+                continue;
+            size_t u = 0;
+            while (u < ns && seen[u] != k[i])
+                u++;
+            if (u < ns)
+                continue;
+            if (ns == SIDES_MAX)
+                return 0;
+            seen[ns++] = k[i];
+            q.f[2] = sm->m->xyz + 3 * (size_t)k[i];
+            st_plane_filter_plane(&q.pl, q.f[0], q.f[1], q.f[2]);
+            if (st_bvh_query_tri(c->bvh, q.f[0], q.f[1], q.f[2], side_visit, &q))
+                return 0;
+        }
+    }
+    return 1;
+}
 
 /* Collect the S vertices v's star holds now. Only a boundary vertex (or
  * any vertex of a non-conforming mesh) needs them: the faces of an
@@ -458,7 +529,8 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
     if (!sp->have)
         star_pts_fill(c, sp, 1);
     uint32_t failed;
-    int kept = sp->swept ? sm_swept_kept(&c->sm, c->pg, v, p, &failed) : -1;
+    int empty = 0;
+    int kept = sp->swept ? sm_swept_kept(&c->sm, c->pg, v, p, &failed, &empty) : -1;
     if (kept < 0 && sp->swept)
         star_pts_fill(c, sp, 0);
     if (!sp->ok)
@@ -470,7 +542,7 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
             c->blocker[v] = failed;   /* v's own slot: v's colour writes it */
         return 0;
     }
-    if (c->s && c->sm.onb[v] && !faces_clear(c, v, p))
+    if (c->s && c->sm.onb[v] && !(empty && sides_clear(c, v, p)) && !faces_clear(c, v, p))
         return 0;
     return 1;
 }
