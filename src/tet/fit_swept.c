@@ -156,6 +156,34 @@ static inline int box_rejected(const box_plane *bp, const double lo[3], const do
     return 1;
 }
 
+/* A bound on st_plane_filter_sign's error bound for every point q of the
+ * box lo..hi: its expression at A_k = max |fl(lo_k - o_k)|, |fl(hi_k -
+ * o_k)|. Rounding is monotone, so |fl(q_k - o_k)| <= A_k, and the
+ * expression (sums and products of non-negative terms, each rounded) does
+ * not decrease as any |d_k| grows. */
+static double box_bound(const st_plane_filter *pl, const double lo[3], const double hi[3])
+{
+    double A[3];
+    for (int k = 0; k < 3; k++)
+        A[k] = dmax(fabs(lo[k] - pl->o[k]), fabs(hi[k] - pl->o[k]));
+    double perm = A[0] * pl->an[0] + A[1] * pl->an[1] + A[2] * pl->an[2];
+    return ST_PLANE_FILTER_REL * perm + (A[0] + A[1] + A[2] + 1.0) * ST_PLANE_FILTER_ABS;
+}
+
+/* st_plane_filter_rejects(pl, q) for q in a box whose box_bound is B: the
+ * filter's determinant beyond B is beyond q's own bound too, so the sign
+ * is the filter's without its bound; within B, the filter decides. */
+static inline int rejects_within(const st_plane_filter *pl, double B, const double q[3])
+{
+    const double det = (q[0] - pl->o[0]) * pl->n[0] + (q[1] - pl->o[1]) * pl->n[1] +
+                       (q[2] - pl->o[2]) * pl->n[2];
+    if (det > B)
+        return pl->side != 1;
+    if (-det > B)
+        return pl->side != -1;
+    return st_plane_filter_rejects(pl, q);
+}
+
 /* The margin of the bins' extents along axis a: m = 1e-10 of the grid's
  * coordinates (sm_pgrid_coord's rounding is a few units of 2^-53 of them).
  * NaN when m is not small beside a bin (then nothing is skipped). */
@@ -245,6 +273,11 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
         a0[a] = sm_pgrid_coord(g, lo[a], a);
         a1[a] = sm_pgrid_coord(g, hi[a], a);
     }
+    /* per face, the bin's bounds of its two planes' filters (box_bound;
+     * infinite: the filter decides every point) */
+    double bnd[SWEPT_MAX_FACES][2];
+    for (size_t i = 0; i < nf; i++)
+        bnd[i][0] = bnd[i][1] = INFINITY;
     int flat = 0;   /* a degenerate swept tet: p on its face's plane */
     for (size_t i = 0; i < nf; i++)
         flat |= pl[i][0].pl.side == 0;
@@ -275,6 +308,13 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
                                  *ez = ext[2][iz - a0[2]];
                     const double blo[3] = {ex[0], ey[0], ez[0]}, bhi[3] = {ex[1], ey[1], ez[1]};
                     keep = bin_faces(nf, (const double(*)[6])box, (const box_plane(*)[2])pl, blo, bhi);
+                    /* the bin's points lie in blo..bhi (cut to lo..hi,
+                     * which the scan below checks first) */
+                    for (uint64_t kb = keep; kb; kb &= kb - 1) {
+                        const size_t i = (size_t)st_lowest_bit(kb);
+                        bnd[i][0] = box_bound(&pl[i][0].pl, blo, bhi);
+                        bnd[i][1] = box_bound(&pl[i][1].pl, blo, bhi);
+                    }
                 }
                 for (size_t j = g->off[b]; keep && j < g->off[b + 1]; j++) {
                     const double *q = g->bpts + 3 * j;
@@ -289,8 +329,8 @@ int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[
                         if (q[0] < bx[0] || q[1] < bx[1] || q[2] < bx[2] || q[0] > bx[3] ||
                             q[1] > bx[4] || q[2] > bx[5])
                             continue;
-                        if (st_plane_filter_rejects(&pl[i][0].pl, q) ||
-                            st_plane_filter_rejects(&pl[i][1].pl, q))
+                        if (rejects_within(&pl[i][0].pl, bnd[i][0], q) ||
+                            rejects_within(&pl[i][1].pl, bnd[i][1], q))
                             continue;
                         swept = st_point_in_tet(q, x, p, ab[i][0], ab[i][1]) != ST_OUTSIDE;
                     }
