@@ -1072,7 +1072,7 @@ static void test_swept(void)
             if (!sm_star_positive(&sm, v, p))
                 continue;
             uint32_t failed = UINT32_MAX;
-            int r = sm_swept_kept(&sm, &g, v, p, &failed);
+            int r = sm_swept_kept(&sm, &g, v, p, &failed, NULL);
             int leaves_none = 1;
             for (size_t i = 0; i < g.npts && leaves_none; i++) {
                 const double *q = g.pts + 3 * i;
@@ -1208,6 +1208,92 @@ static void test_move_brute(void)
     st_soup_free(s);
 }
 
+/* The side test (invariant.c, sides_clear) must not clear a face that a
+ * triangle newly meets with no S vertex in the swept tet: one boundary
+ * face F = (x, a, b) of a vertex v, v moved to p a twentieth of a cell
+ * along F's normal (tilted a little), and one long triangle T through the middle of the
+ * swept tet K = (x, p, a, b), parallel to F below its plane's lift (two
+ * corners 2 h away on either side) and up through F' = (p, a, b) (the
+ * third 2 h above): T meets F' and not F, and none of its corners is in K,
+ * so the swept test finds K empty. sm_move_ok must refuse as the brute
+ * force does (the face walks decide after the sides meet T). */
+static void test_sides(void)
+{
+    const double h = 0.5;
+    st_tetmesh *m = ball_mesh(h, 1.6);
+    sm_mesh sm;
+    st_error err;
+    TAP_CHECK(sm_mesh_build(&sm, m, &err) == ST_OK, "the ball's incidence");
+    size_t tried = 0, empty_refused = 0, wrong = 0;
+    for (uint32_t v = 0; v < sm.nv && tried < 40; v += 7) {
+        if (!sm.onb[v] || !sm_swept_applies(&sm, v))
+            continue;
+        const double *x = m->xyz + 3 * (size_t)v;
+        const uint32_t *k = sm.bf + 3 * (size_t)sm.vf[sm.vf_off[v]];
+        const double *c0 = m->xyz + 3 * (size_t)k[0], *c1 = m->xyz + 3 * (size_t)k[1],
+                     *c2 = m->xyz + 3 * (size_t)k[2];
+        const double *ab[2];
+        for (int i = 0, n = 0; i < 3; i++)
+            if (k[i] != v)
+                ab[n++] = m->xyz + 3 * (size_t)k[i];
+        double e1[3], e2[3], nrm[3], p[3], w[3], u[3], t[3][3];
+        /* off F's normal a little: no other face of the star keeps p in
+         * its plane (a flat swept tet: the faces decide alone) */
+        const double tilt[3] = {0.11, -0.07, 0.05};
+        for (int a = 0; a < 3; a++) {
+            e1[a] = c1[a] - c0[a];
+            e2[a] = c2[a] - c0[a];
+        }
+        nrm[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        nrm[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        nrm[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double ln = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]), lu = 0.0;
+        for (int a = 0; a < 3; a++) {
+            nrm[a] /= ln;
+            p[a] = x[a] + 0.05 * h * (nrm[a] + tilt[a]);
+            w[a] = 0.25 * (x[a] + p[a] + ab[0][a] + ab[1][a]);
+            u[a] = ab[0][a] - ab[1][a];
+            lu += u[a] * u[a];
+        }
+        for (int a = 0; a < 3; a++) {
+            u[a] /= sqrt(lu);
+            t[0][a] = w[a] - 2.0 * h * u[a];
+            t[1][a] = w[a] + 2.0 * h * u[a];
+            t[2][a] = w[a] + 2.0 * h * nrm[a];
+        }
+        if (!sm_star_positive(&sm, v, x) || !sm_star_positive(&sm, v, p))
+            continue;
+        st_soup *s = st_soup_new();
+        add_tri(s, t[0], t[1], t[2], 0);
+        fit_ctx c;
+        if (sm_fit_ctx_open(&c, m, s, NULL, NULL, NULL, h, 0.4 * h, NULL, &err) != ST_OK) {
+            sm_fit_ctx_close(&c);
+            st_soup_free(s);
+            continue;
+        }
+        uint32_t failed;
+        int empty = 0;
+        int kept = sm_swept_kept(&c.sm, c.pg, v, p, &failed, &empty);
+        int faces_only;
+        int want = brute_move_ok(&c.sm, s, v, p, &faces_only);
+        star_pts sp = STAR_PTS_INIT;
+        sm_star_pts_collect(&c, v, &sp);
+        int got = sm_move_ok(&c, v, p, &sp);
+        tried++;
+        empty_refused += kept == 1 && empty && !want && faces_only;
+        wrong += got != want;
+        free(sp.list);
+        sm_fit_ctx_close(&c);
+        st_soup_free(s);
+    }
+    TAP_CHECK(tried >= 20 && empty_refused * 2 >= tried,
+              "%zu moves, %zu with no S vertex in a swept tet refused by a face alone", tried,
+              empty_refused);
+    TAP_CHECK(wrong == 0, "sm_move_ok answers as the brute force every time (%zu differ)", wrong);
+    sm_mesh_free(&sm);
+    st_tetmesh_free(m);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(quality_reports),
@@ -1216,6 +1302,7 @@ int main(int argc, char **argv)
                                      TAP_TEST(bvh_query_flat_tet),
                                      TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), TAP_TEST(shared),
                                      TAP_TEST(stall),
-                                     TAP_TEST(swept), TAP_TEST(move_brute), {0}};
+                                     TAP_TEST(swept), TAP_TEST(move_brute),
+                                     TAP_TEST(sides), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -24,8 +24,10 @@ int sm_swept_applies(const sm_mesh *sm, uint32_t v);
  * is positive with v where it is and with v at p: 1 when every S vertex
  * (the points of g) in the closed star stays in it with v at p, else 0
  * with *failed a point grid index that would leave; -1 when it cannot
- * tell. Exact. */
+ * tell. Exact. *empty (may be NULL) is 1 when it returns 1, every swept
+ * tet (x, p, a, b) of a boundary face (x, a, b) is non-degenerate and no
+ * S vertex lies in any of them (closed), else 0. */
 int sm_swept_kept(const sm_mesh *sm, const pgrid *g, uint32_t v, const double p[3],
-                  uint32_t *failed);
+                  uint32_t *failed, int *empty);
 
 #endif

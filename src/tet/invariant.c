@@ -34,7 +34,9 @@
  * after a small move is one tet test; a vertex whose last attempt failed
  * and whose star has not moved since is not tried again (the dirty set);
  * faces are checked through the BVH's triangle query (nodes pruned by the
- * face itself, not its box); boundary distances are searched within the
+ * face itself, not its box), and when the swept test found no S vertex in
+ * the swept tets, through the thin side triangles of those tets instead
+ * (sides_clear); boundary distances are searched within the
  * old distance plus the way the vertex moved. None of these changes a
  * result.
  */
@@ -390,6 +392,75 @@ static int faces_clear(const fit_ctx *c, uint32_t v, const double p[3])
     return 1;
 }
 
+/* 1 (stop) when S triangle tri meets the side triangle in q->f (q->pl its
+ * plane, the corners certified on one side first, as face_visit). */
+static int side_visit(void *ctx, uint32_t tri)
+{
+    face_query *q = ctx;
+    const uint32_t *t = q->s->tris + 3 * (size_t)tri;
+    const double *a = q->s->xyz + 3 * (size_t)t[0], *b = q->s->xyz + 3 * (size_t)t[1],
+                 *d = q->s->xyz + 3 * (size_t)t[2];
+    const int sa = st_plane_filter_sign(&q->pl, a);
+    if (sa != 0 && st_plane_filter_sign(&q->pl, b) == sa && st_plane_filter_sign(&q->pl, d) == sa)
+        return 0;
+    if (!st_tri_tri_intersect(q->f[0], q->f[1], q->f[2], a, b, d))
+        return 0;
+    q->hit = tri;
+    return 1;
+}
+
+/* Boundary link vertices a side test visits at most (a lattice vertex has
+ * far fewer); with more, sides_clear answers 0 (the face walks decide). */
+#define SIDES_MAX 64
+
+/* 1 when no triangle of S meets a side triangle (x, p, a) of the swept
+ * tets (x, p, a, b), x where v is, (x, a, b) its boundary faces, each
+ * boundary link vertex a once. With sm_swept_kept's *empty (no S vertex
+ * in any closed swept tet K = (x, p, a, b), none degenerate), every face
+ * (p, a, b) is then clear: a triangle T meeting F' = (p, a, b) at y with
+ * no vertex in K meets F = (x, a, b) or a side. If y lies on an edge of
+ * F', that edge is in F or a side. Else, when a corner t of T lies
+ * strictly on x's side of F''s plane, the segment y t enters K's interior
+ * (y inside F', K non-degenerate) and leaves it before t (t not in K) at
+ * a point of T off that plane: on F or a side. Else T lies on the closed
+ * other side, so T meets K only on F''s plane: T's corners on it are not
+ * in F' and span an edge of T crossing F''s edges, or T is in the plane
+ * and holds F' (a corner of F in T) or crosses its edges. A triangle
+ * meeting F met it before the move: not new. So the face walks
+ * (faces_clear) would find nothing; the thin sides meet far fewer BVH
+ * nodes than the faces. 0 when a triangle meets a side (faces_clear
+ * decides then). */
+static int sides_clear(const fit_ctx *c, uint32_t v, const double p[3])
+{
+    const sm_mesh *sm = &c->sm;
+    const double *x = sm->m->xyz + 3 * (size_t)v;
+    uint32_t seen[SIDES_MAX];
+    size_t ns = 0;
+    face_query q;
+    q.s = c->s;
+    q.f[0] = x;
+    q.f[1] = p;
+    for (size_t j = sm->vf_off[v]; j < sm->vf_off[v + 1]; j++) {
+        const uint32_t *k = sm->bf + 3 * (size_t)sm->vf[j];
+        for (int i = 0; i < 3; i++) {
+            if (k[i] == v)
+                continue;
+            size_t u = 0;
+            while (u < ns && seen[u] != k[i])
+                u++;
+            if (u < ns)
+                continue;
+            if (ns == SIDES_MAX)
+                return 0;
+            seen[ns++] = k[i];
+            q.f[2] = sm->m->xyz + 3 * (size_t)k[i];
+            st_plane_filter_plane(&q.pl, q.f[0], q.f[1], q.f[2]);
+            if (st_bvh_query_tri(c->bvh, q.f[0], q.f[1], q.f[2], side_visit, &q))
+                return 0;
+        }
+    }
+    return 1;
+}
 
 /* Collect the S vertices v's star holds now. Only a boundary vertex (or
  * any vertex of a non-conforming mesh) needs them: the faces of an
@@ -425,6 +496,7 @@ void sm_star_pts_collect(const fit_ctx *c, uint32_t v, star_pts *sp)
     (void)c;
     sp->have = 0;
     sp->v = v;
+    sp->bq = UINT32_MAX;
 }
 
 /* The whole invariant for moving v to p, cheapest test first. */
@@ -432,26 +504,37 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
 {
     if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])))
         return 0;
-    if (!sm_star_positive(&c->sm, v, p))
-        return 0;
     /* The S vertex that stopped v last time usually stops it again: when
      * it is in the star now and would not be, the move fails whatever the
-     * others do, and the star's points need not be gathered. The star
-     * with v at p is positive (just tested): in_pos_star's answer, two
-     * orient3d calls fewer a tet. */
+     * others do, and the star's points need not be gathered. Where it is
+     * in the star as it is does not change while v's moves are tried
+     * (sm_star_pts_collect starts them): found once (sp->bq, sp->bt), and
+     * a blocker outside the star needs no test at p. At p it is located
+     * by in_pos_star (two orient3d calls fewer a tet, its tet as it is
+     * tried first), whose answer is in_star's when the star with v at p is
+     * positive; when it is not, the move fails whatever in_pos_star says
+     * (sm_star_positive after), so the blocker is asked first: three in
+     * four trial moves end there (armadillo 7) without the star's
+     * orientations. */
     uint32_t b = c->blocker ? c->blocker[v] : UINT32_MAX;
     if (b != UINT32_MAX && c->s && (c->sm.onb[v] || c->full_check)) {
         const double *q = c->pg->pts + 3 * (size_t)b;
-        const double *x = c->sm.m->xyz + 3 * (size_t)v;
-        if (in_pos_star(&c->sm, v, p, q, -1, 0) < 0 && in_star(&c->sm, v, x, q, -1) >= 0)
+        if (sp->bq != b) {
+            sp->bq = b;
+            sp->bt = in_star(&c->sm, v, c->sm.m->xyz + 3 * (size_t)v, q, -1);
+        }
+        if (sp->bt >= 0 && in_pos_star(&c->sm, v, p, q, sp->bt, 0) < 0)
             return 0;
     }
+    if (!sm_star_positive(&c->sm, v, p))
+        return 0;
     if (c->s && c->sm.onb[v] && !tblocker_clear(c, v, p))
         return 0;
     if (!sp->have)
         star_pts_fill(c, sp, 1);
     uint32_t failed;
-    int kept = sp->swept ? sm_swept_kept(&c->sm, c->pg, v, p, &failed) : -1;
+    int empty = 0;
+    int kept = sp->swept ? sm_swept_kept(&c->sm, c->pg, v, p, &failed, &empty) : -1;
     if (kept < 0 && sp->swept)
         star_pts_fill(c, sp, 0);
     if (!sp->ok)
@@ -463,7 +546,7 @@ int sm_move_ok(const fit_ctx *c, uint32_t v, const double p[3], star_pts *sp)
             c->blocker[v] = failed;   /* v's own slot: v's colour writes it */
         return 0;
     }
-    if (c->s && c->sm.onb[v] && !faces_clear(c, v, p))
+    if (c->s && c->sm.onb[v] && !(empty && sides_clear(c, v, p)) && !faces_clear(c, v, p))
         return 0;
     return 1;
 }

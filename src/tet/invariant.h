@@ -120,8 +120,11 @@ typedef struct star_pts {
     int positive;    /* the star as it is: every tet positive */
     uint32_t v;
     int swept;       /* 1: no list; moves are checked by sm_swept_kept */
+    uint32_t bq;     /* the blocker (fit_ctx.blocker) whose place in the
+                        star as it is bt holds, or UINT32_MAX: none yet */
+    ptrdiff_t bt;    /* its tet (from vt_off[v]), -1: outside the star */
 } star_pts;
-#define STAR_PTS_INIT {NULL, 0, 0, 1, 0, 0, 0, 0}
+#define STAR_PTS_INIT {NULL, 0, 0, 1, 0, 0, 0, 0, UINT32_MAX, -1}
 
 /* Start the moves of v (the list of S vertices is filled when a move
  * first needs it). */
