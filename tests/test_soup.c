@@ -1454,12 +1454,57 @@ static int compare_main(const char *want, const char *got)
     return bad;
 }
 
+/* st_soup_bounds against the comparisons written out (lo moves only where
+ * a coordinate is strictly below it, hi strictly above), bit for bit: the
+ * first of equal values stays, so -0.0 and 0.0 in either order, and only
+ * the vertices of triangles count. */
+static void test_bounds(void)
+{
+    static const double vals[] = {-0.0, 0.0, 1.0, -1.0, 0.5, -2.5, 3.0};
+    uint64_t r = 12345;
+    size_t bad = 0;
+    const int N = 2000;
+    for (int k = 0; k < N; k++) {
+        st_soup *s = st_soup_new();
+        if (!s)
+            abort();
+        size_t nv = 3 + (size_t)(k % 9);
+        for (size_t v = 0; v < nv; v++) {
+            double c[3];
+            for (int a = 0; a < 3; a++) {
+                r = r * 6364136223846793005ULL + 1442695040888963407ULL;
+                c[a] = vals[(r >> 33) % (sizeof vals / sizeof *vals)];
+            }
+            st_soup_add_vertex(s, c[0], c[1], c[2], NULL);
+        }
+        for (size_t t = 0; t + 2 < nv; t += 2)   /* the last vertex or two unused */
+            st_soup_add_triangle(s, (uint32_t)t, (uint32_t)t + 1, (uint32_t)t + 2, NULL);
+        double lo[3], hi[3], rlo[3] = {INFINITY, INFINITY, INFINITY},
+                             rhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < 3 * s->ntris; i++)
+            for (int a = 0; a < 3; a++) {
+                double x = s->xyz[3 * (size_t)s->tris[i] + a];
+                if (x < rlo[a])
+                    rlo[a] = x;
+                if (x > rhi[a])
+                    rhi[a] = x;
+            }
+        if (st_soup_bounds(s, lo, hi, NULL) != ST_OK || memcmp(lo, rlo, sizeof lo) != 0 ||
+            memcmp(hi, rhi, sizeof hi) != 0)
+            bad++;
+        st_soup_free(s);
+    }
+    TAP_CHECK(bad == 0, "st_soup_bounds: %d of %d soups of signed zeros and repeats bit for bit "
+              "as the comparisons", N - (int)bad, N);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(soup_api), TAP_TEST(formats), TAP_TEST(obj),
                                      TAP_TEST(numbers), TAP_TEST(off), TAP_TEST(ply),
                                      TAP_TEST(stl), TAP_TEST(cube_everywhere),
-                                     TAP_TEST(read_errors), TAP_TEST(robust), {0}};
+                                     TAP_TEST(read_errors), TAP_TEST(robust), TAP_TEST(bounds),
+                                     {0}};
     if (argc == 4 && strcmp(argv[1], "--compare") == 0)
         return compare_main(argv[2], argv[3]);
     tap_select(argc, argv, tests);

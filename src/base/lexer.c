@@ -13,6 +13,12 @@
 
 /* ---- text cursor ------------------------------------------------------- */
 
+const unsigned char st_text_class[256] = {
+    ['\0'] = ST_TEXT_C_BLANK, ['\t'] = ST_TEXT_C_BLANK, ['\n'] = ST_TEXT_C_NL,
+    ['\v'] = ST_TEXT_C_BLANK, ['\f'] = ST_TEXT_C_BLANK, ['\r'] = ST_TEXT_C_BLANK,
+    [' '] = ST_TEXT_C_BLANK,
+};
+
 void st_text_init(st_text *t, const unsigned char *data,
                   size_t size, unsigned flags)
 {
@@ -125,21 +131,42 @@ st_status st_text_double(const unsigned char *tok, size_t n, double *out)
         neg = tok[i] == '-';
         i++;
     }
+    /* At most 19 digits in all (every coordinate of the usual files):
+     * take_digit would take each into m, leading zeros included (they add
+     * nothing), and count the ones after the point in e10; so do that
+     * without its tests. More digits: again, digit by digit. */
+    const size_t start = i;
     uint64_t m = 0;
-    int nd = 0, digits = 0, inexact = 0;
+    int nd = 0, inexact = 0;
     long e10 = 0;
-    for (; i < n && tok[i] >= '0' && tok[i] <= '9'; i++) {
-        digits = 1;
-        take_digit(&m, &nd, &e10, &inexact, (unsigned)(tok[i] - '0'), 0);
+    size_t all = 0;
+    for (; i < n; i++, all++) {
+        unsigned d = (unsigned)tok[i] - '0';
+        if (d > 9)
+            break;
+        m = m * 10 + d;
     }
     if (i < n && tok[i] == '.') {
-        for (i++; i < n && tok[i] >= '0' && tok[i] <= '9'; i++) {
-            digits = 1;
-            take_digit(&m, &nd, &e10, &inexact, (unsigned)(tok[i] - '0'), 1);
+        for (i++; i < n; i++, all++, e10--) {
+            unsigned d = (unsigned)tok[i] - '0';
+            if (d > 9)
+                break;
+            m = m * 10 + d;
         }
     }
-    if (!digits)
+    if (all == 0)
         goto slow;
+    if (all > 19) {
+        i = start;
+        m = 0;
+        e10 = 0;
+        for (; i < n && tok[i] >= '0' && tok[i] <= '9'; i++)
+            take_digit(&m, &nd, &e10, &inexact, (unsigned)(tok[i] - '0'), 0);
+        if (i < n && tok[i] == '.') {
+            for (i++; i < n && tok[i] >= '0' && tok[i] <= '9'; i++)
+                take_digit(&m, &nd, &e10, &inexact, (unsigned)(tok[i] - '0'), 1);
+        }
+    }
     if (i < n && (tok[i] == 'e' || tok[i] == 'E')) {
         i++;
         int eneg = 0;
@@ -181,7 +208,7 @@ slow:;
     return ST_OK;
 }
 
-st_status st_text_int(const unsigned char *tok, size_t n, long long *out)
+st_status st_text_int_any(const unsigned char *tok, size_t n, long long *out)
 {
     size_t i = 0;
     int neg = 0;

@@ -1901,7 +1901,9 @@ static void lower_layer(st_grid *g, const st_soup *s, const lower_tri *r, size_t
                 if (!(*v > 0.0f))
                     continue;   /* no distance is below it */
                 const double p[3] = {g->origin[0] + h * (double)i, y, z};
-                if (lower_beyond(r + u, a, p, fmin(reach, (double)*v)))
+                /* fmin(reach, *v) without the libm call (both above 0) */
+                const double lim = (double)*v < reach ? (double)*v : reach;
+                if (lower_beyond(r + u, a, p, lim))
                     continue;
                 const double d2 = st_point_triangle_dist2(p, a, b, cc, NULL);
                 if (!(d2 < reach * reach))

