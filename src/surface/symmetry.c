@@ -342,6 +342,8 @@ typedef struct ctx {
     const samples *S;
     double tol;
     double *tn;      /* unit normal per soup triangle */
+    st_tri_frame *fr; /* per soup triangle: its frame for the distances
+                         (st_bvh_nearest_framed, the grid's scans) */
     rims *R;         /* made when first needed (rims_need) */
     near_grid grid;
 } ctx;
@@ -572,7 +574,7 @@ static double nearest(const ctx *C, const double p[3], double reach, int64_t *tr
     const near_grid *G = &C->grid;
     const double r2 = reach * reach;
     if (!G->start || !(reach <= G->reach))
-        return st_bvh_nearest(C->bvh, p, r2, tri, closest);
+        return st_bvh_nearest_framed(C->bvh, C->fr, p, r2, tri, closest);
     long c[3];
     for (int k = 0; k < 3; k++) {
         const double f = floor((p[k] - G->lo[k]) / G->h);
@@ -597,8 +599,9 @@ static double nearest(const ctx *C, const double p[3], double reach, int64_t *tr
         if (d2 > lim * lim)
             continue;
         const uint32_t *v = C->s->tris + 3 * (size_t)t;
-        d2 = st_point_triangle_dist2(p, C->s->xyz + 3 * (size_t)v[0], C->s->xyz + 3 * (size_t)v[1],
-                                     C->s->xyz + 3 * (size_t)v[2], q);
+        d2 = st_point_triangle_dist2_framed(p, C->s->xyz + 3 * (size_t)v[0],
+                                            C->s->xyz + 3 * (size_t)v[1],
+                                            C->s->xyz + 3 * (size_t)v[2], C->fr + t, q);
         if (d2 < best) {
             second = best;
             best = d2;
@@ -614,7 +617,7 @@ static double nearest(const ctx *C, const double p[3], double reach, int64_t *tr
         return r2;
     }
     if (second <= best + GRID_TIE * best + s2 || !(best < r2 - GRID_TIE * r2 - s2))
-        return st_bvh_nearest(C->bvh, p, r2, tri, closest);
+        return st_bvh_nearest_framed(C->bvh, C->fr, p, r2, tri, closest);
     *tri = bt;
     if (closest)
         memcpy(closest, bq, sizeof bq);
@@ -792,7 +795,7 @@ static block_count measure_block(const ctx *C, const st_symmetry *y, double angl
         int hit = lands_tri(C, q, nq, C->tol, cl, &t);
         r.h += hit;
         if (full && !hit) {
-            st_bvh_nearest(C->bvh, q, INFINITY, &t, cl);
+            st_bvh_nearest_framed(C->bvh, C->fr, q, INFINITY, &t, cl);
             r.c += t >= 0 && !on_rim(C, t, cl);
         }
         r.m++;
@@ -1990,7 +1993,8 @@ static st_status ctx_make(ctx *C, const st_soup *s, samples *S, size_t want, st_
 {
     memset(S, 0, sizeof *S);
     C->tn = st_malloc_array(3 * (s->ntris ? s->ntris : 1), sizeof *C->tn);
-    if (!C->tn || samples_make(S, s, want))
+    C->fr = st_malloc_array(s->ntris ? s->ntris : 1, sizeof *C->fr);
+    if (!C->tn || !C->fr || samples_make(S, s, want))
         return st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the symmetry samples");
     if (S->n == 0)
         return ST_OK;
@@ -2001,6 +2005,8 @@ static st_status ctx_make(ctx *C, const st_soup *s, samples *S, size_t want, st_
         st_sub3(w, s->xyz + 3 * (size_t)v[2], s->xyz + 3 * (size_t)v[0]);
         st_cross3(C->tn + 3 * t, u, w);
         normalize(C->tn + 3 * t);
+        st_tri_frame_make(C->fr + t, s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
+                          s->xyz + 3 * (size_t)v[2]);
     }
     grid_make(&C->grid, s, C->tol, S->area);
     return ST_OK;
@@ -2010,6 +2016,7 @@ static void ctx_free(ctx *C, samples *S)
 {
     grid_free(&C->grid);
     free(C->tn);
+    free(C->fr);
     free(C->R->rim);
     samples_free(S);
 }
