@@ -432,6 +432,50 @@ static void test_bvh_query_tri(void)
     st_soup_free(s);
 }
 
+/* st_bvh_nearest_framed with every sphere triangle's frame answers as
+ * st_bvh_nearest, bit for bit (distance, triangle and closest point), at
+ * random points near the sphere and far, at its vertices and on its
+ * edges' midpoints (ties between triangles: the walk's first), within
+ * reaches from a hundredth to no limit. */
+static void test_bvh_nearest_framed(void)
+{
+    st_soup *s;
+    st_bvh *b = sphere_bvh(&s);
+    st_tri_frame *f = malloc(s->ntris * sizeof *f);
+    for (size_t t = 0; t < s->ntris; t++) {
+        const uint32_t *v = s->tris + 3 * t;
+        st_tri_frame_make(f + t, s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
+                          s->xyz + 3 * (size_t)v[2]);
+    }
+    static const double reach[] = {0.01, 0.1, 0.5, INFINITY};
+    size_t bad = 0, found = 0, cases = 0;
+    unsigned rng = 4711u;
+    for (int k = 0; k < 4000; k++) {
+        double p[3];
+        const uint32_t *v = s->tris + 3 * ((size_t)k % s->ntris);
+        const double *x0 = s->xyz + 3 * (size_t)v[0], *x1 = s->xyz + 3 * (size_t)v[1];
+        for (int a = 0; a < 3; a++)
+            p[a] = k % 4 == 0 ? x0[a] : k % 4 == 1 ? 0.5 * (x0[a] + x1[a])
+                 : (k % 4 == 2 ? 1.2 : 3.0) * (unit_draw(&rng) - 0.5) * 2.0;
+        for (size_t r = 0; r < sizeof reach / sizeof *reach; r++) {
+            int64_t t0 = -2, t1 = -3;
+            double q0[3] = {0, 0, 0}, q1[3] = {0, 0, 0};
+            const double r2 = reach[r] * reach[r];
+            const double d0 = st_bvh_nearest(b, p, r2, &t0, q0);
+            const double d1 = st_bvh_nearest_framed(b, f, p, r2, &t1, q1);
+            cases++;
+            found += t0 >= 0;
+            bad += t0 != t1 || memcmp(&d0, &d1, sizeof d0) != 0 || memcmp(q0, q1, sizeof q0) != 0;
+        }
+    }
+    TAP_CHECK(bad == 0 && found > cases / 2,
+              "framed nearest queries answer as st_bvh_nearest (%zu of %zu differ, %zu found)",
+              bad, cases, found);
+    free(f);
+    st_bvh_free(b);
+    st_soup_free(s);
+}
+
 typedef struct tet_seen {
     size_t visited;
     unsigned char *seen;
@@ -1299,7 +1343,7 @@ int main(int argc, char **argv)
     static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(quality_reports),
                                      TAP_TEST(not_enclosing), TAP_TEST(refusals),
                                      TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
-                                     TAP_TEST(bvh_query_flat_tet),
+                                     TAP_TEST(bvh_query_flat_tet), TAP_TEST(bvh_nearest_framed),
                                      TAP_TEST(band_edge), TAP_TEST(peel), TAP_TEST(fill), TAP_TEST(shared),
                                      TAP_TEST(stall),
                                      TAP_TEST(swept), TAP_TEST(move_brute),

@@ -181,6 +181,36 @@ static double ref_tri_dist2(const double p[3], const double a[3], const double b
     return best;
 }
 
+/* Case t at scale sc (test_screen_bit_identical, test_framed): a
+ * triangle v near the degeneracy threshold (t % 5 of 0, 1), collinear or
+ * with a repeated vertex (2) or random, and a point p around or across
+ * it; returns t % 5. */
+static int draw_case(int t, double sc, unsigned *seed, double v[3][3], double p[3])
+{
+    for (int k = 0; k < 3; k++)
+        for (int a = 0; a < 3; a++)
+            v[k][a] = sc * (urand(seed) * 2 - 1);
+    const int kind = t % 5;
+    if (kind <= 1) {   /* near the threshold: base L along u, height h along w */
+        double L = sc * (0.5 + urand(seed)), rel = (urand(seed) * 2 - 1) * 1e-5;
+        if (kind == 1)
+            rel *= 1e-3;   /* inside the +-1e-6 band */
+        double h = ST_DEGENERATE_AREA_RATIO * L * (1.0 + rel);
+        double mid = 0.2 + 0.6 * urand(seed);
+        for (int a = 0; a < 3; a++) {
+            v[1][a] = v[0][a] + (a == t % 3 ? L : 0.0);
+            v[2][a] = v[0][a] + (a == t % 3 ? mid * L : 0.0) + (a == (t + 1) % 3 ? h : 0.0);
+        }
+    } else if (kind == 2) {   /* collinear, or a repeated vertex */
+        for (int a = 0; a < 3; a++)
+            v[2][a] = t % 2 ? v[1][a] : v[0][a] + 0.5 * (v[1][a] - v[0][a]);
+    }
+    for (int a = 0; a < 3; a++)   /* around the triangle and across it */
+        p[a] = (v[0][a] + v[1][a] + v[2][a]) / 3.0 + sc * (urand(seed) * 2 - 1) *
+                                                           (t % 3 ? 1e-6 : 1.0);
+    return kind;
+}
+
 /* Triangles right at the degeneracy threshold (height within 1e-5
  * relative of ST_DEGENERATE_AREA_RATIO times the base: both sides of it,
  * in and beyond the screen's undecided band), slivers, collinear and
@@ -196,27 +226,7 @@ static void test_screen_bit_identical(void)
         const double sc = scales[si];
         for (int t = 0; t < 4000; t++) {
             double v[3][3], p[3];
-            for (int k = 0; k < 3; k++)
-                for (int a = 0; a < 3; a++)
-                    v[k][a] = sc * (urand(&seed) * 2 - 1);
-            const int kind = t % 5;
-            if (kind <= 1) {   /* near the threshold: base L along u, height h along w */
-                double L = sc * (0.5 + urand(&seed)), rel = (urand(&seed) * 2 - 1) * 1e-5;
-                if (kind == 1)
-                    rel *= 1e-3;   /* inside the +-1e-6 band */
-                double h = ST_DEGENERATE_AREA_RATIO * L * (1.0 + rel);
-                double mid = 0.2 + 0.6 * urand(&seed);
-                for (int a = 0; a < 3; a++) {
-                    v[1][a] = v[0][a] + (a == t % 3 ? L : 0.0);
-                    v[2][a] = v[0][a] + (a == t % 3 ? mid * L : 0.0) + (a == (t + 1) % 3 ? h : 0.0);
-                }
-            } else if (kind == 2) {   /* collinear, or a repeated vertex */
-                for (int a = 0; a < 3; a++)
-                    v[2][a] = t % 2 ? v[1][a] : v[0][a] + 0.5 * (v[1][a] - v[0][a]);
-            }
-            for (int a = 0; a < 3; a++)   /* around the triangle and across it */
-                p[a] = (v[0][a] + v[1][a] + v[2][a]) / 3.0 + sc * (urand(&seed) * 2 - 1) *
-                                                                   (t % 3 ? 1e-6 : 1.0);
+            const int kind = draw_case(t, sc, &seed, v, p);
             double q[3] = {0, 0, 0}, rq[3] = {0, 0, 0};
             double d2 = st_point_triangle_dist2(p, v[0], v[1], v[2], q);
             double r2 = ref_tri_dist2(p, v[0], v[1], v[2], rq);
@@ -255,10 +265,51 @@ static void test_screen_bit_identical(void)
               degenerate, flat);
 }
 
+/* st_point_triangle_dist2_framed with the triangle's st_tri_frame: the
+ * distance and closest point of st_point_triangle_dist2, bit for bit, on
+ * test_screen_bit_identical's cases (each triangle's frame measured from
+ * five points: on its plane inside, on an edge's line, at a vertex, and
+ * two off it), inside the prism and out, and from points on the plane of
+ * a flat one. */
+static void test_framed(void)
+{
+    unsigned seed = 977;
+    static const double scales[] = {1e-200, 1e-30, 1e-3, 1.0, 7.0, 1e30, 1e200};
+    size_t bad = 0, cases = 0, inside = 0;
+    for (size_t si = 0; si < sizeof scales / sizeof *scales; si++)
+        for (int t = 0; t < 3000; t++) {
+            double v[3][3], p[3];
+            (void)draw_case(t, scales[si], &seed, v, p);
+            st_tri_frame f;
+            st_tri_frame_make(&f, v[0], v[1], v[2]);
+            for (int j = 0; j < 5; j++) {
+                double x[3];
+                for (int a = 0; a < 3; a++) {
+                    const double c = (v[0][a] + v[1][a] + v[2][a]) / 3.0;
+                    x[a] = j == 0 ? p[a] : j == 1 ? c : j == 2 ? 0.5 * (v[0][a] + v[1][a])
+                           : j == 3 ? v[2][a] : 2.0 * c - p[a];
+                }
+                double q[3] = {0, 0, 0}, fq[3] = {0, 0, 0};
+                const double d2 = st_point_triangle_dist2(x, v[0], v[1], v[2], q);
+                const double f2 = st_point_triangle_dist2_framed(x, v[0], v[1], v[2], &f, fq);
+                cases++;
+                inside += !f.degenerate && j == 1;
+                bad += memcmp(&d2, &f2, sizeof d2) != 0 || memcmp(q, fq, sizeof q) != 0;
+                /* without the closest point: the same distance */
+                const double g2 = st_point_triangle_dist2_framed(x, v[0], v[1], v[2], &f, NULL);
+                bad += memcmp(&d2, &g2, sizeof d2) != 0;
+            }
+        }
+    TAP_CHECK(bad == 0, "framed distances: bit for bit st_point_triangle_dist2's (%zu of %zu "
+              "differ)", bad, cases);
+    TAP_CHECK(inside > cases / 20, "the cases reach the face region (%zu centroids of "
+              "non-degenerate triangles)", inside);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(voronoi_regions), TAP_TEST(degenerate_triangles),
                                      TAP_TEST(segment), TAP_TEST(random_against_sampling),
-                                     TAP_TEST(screen_bit_identical), {0}};
+                                     TAP_TEST(screen_bit_identical), TAP_TEST(framed), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -20,6 +20,7 @@
 #include <stdint.h>
 #include "souptet/err.h"
 #include "souptet/soup.h"
+#include "souptet/geom.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -52,6 +53,12 @@ void st_bvh_free(st_bvh *b);   /* safe on NULL */
  * INFINITY for an unbounded search; a tight max_d2 makes it fast. */
 double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
                       int64_t *tri, double closest[3]);
+
+/* st_bvh_nearest's answer, bit for bit, with frames[t] the soup's triangle
+ * t's st_tri_frame (geom.h): for many queries against one soup, its
+ * triangles' normals are not computed again at each. */
+double st_bvh_nearest_framed(const st_bvh *b, const st_tri_frame *frames, const double p[3],
+                             double max_d2, int64_t *tri, double closest[3]);
 
 /* Whether some triangle is closer to p than sqrt(max_d2): exactly when
  * st_bvh_nearest(b, p, max_d2, ...) sets *tri >= 0, found at the first

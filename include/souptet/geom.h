@@ -72,6 +72,26 @@ double st_point_triangle_dist2(const double p[3], const double a[3],
                                const double b[3], const double c[3],
                                double closest[3]);
 
+/* What st_point_triangle_dist2 computes from the triangle alone, kept for
+ * a triangle that many points are measured against: its unit normal n,
+ * whether it is degenerate (as above), and the in-plane normals of its
+ * edges ab, bc, ca (n x (b - a) and so on; unset when degenerate). */
+typedef struct st_tri_frame {
+    double n[3];
+    double m[3][3];
+    int degenerate;
+} st_tri_frame;
+
+void st_tri_frame_make(st_tri_frame *f, const double a[3], const double b[3],
+                       const double c[3]);
+
+/* st_point_triangle_dist2(p, a, b, c, closest) for the triangle f was made
+ * from (st_tri_frame_make(f, a, b, c)): the same distance and closest
+ * point, bit for bit. */
+double st_point_triangle_dist2_framed(const double p[3], const double a[3],
+                                      const double b[3], const double c[3],
+                                      const st_tri_frame *f, double closest[3]);
+
 #ifdef __cplusplus
 }
 #endif

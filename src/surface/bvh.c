@@ -392,7 +392,10 @@ static void box_dist2_pair(const st_bvh_node *l, const st_bvh_node *r, const dou
 #define TRI_SKIP_REL 1e-4
 #define TRI_SKIP_SIDE 1e-4
 #define TRI_SKIP_ABS 3e-14
-static int tri_beyond(const double *tb, const double p[3], double reach, double m)
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline int tri_beyond(const double *tb, const double p[3], double reach, double m)
 {
     double side = tb[3] - tb[0];
     side = tb[4] - tb[1] > side ? tb[4] - tb[1] : side;
@@ -418,8 +421,9 @@ static double magnitude(const st_bvh *b)
  * `any`, it stops at the first triangle closer than sqrt(max_d2): the
  * walk to it is the nearest search's while best is still max_d2, so it
  * finds a triangle exactly when that search does. */
-static double nearest_walk(const st_bvh *b, const double p[3], double max_d2, int any,
-                           int64_t *tri, double closest[3], uint32_t *slot)
+static double nearest_walk(const st_bvh *b, const st_tri_frame *frames, const double p[3],
+                           double max_d2, int any, int64_t *tri, double closest[3],
+                           uint32_t *slot)
 {
     const st_soup *s = b->soup;
     double best = max_d2;
@@ -446,9 +450,10 @@ static double nearest_walk(const st_bvh *b, const double p[3], double max_d2, in
                 uint32_t t = b->order[n->start + i];
                 const uint32_t *v = s->tris + 3 * (size_t)t;
                 double q[3];
-                double d2 = st_point_triangle_dist2(
-                    p, s->xyz + 3 * (size_t)v[0], s->xyz + 3 * (size_t)v[1],
-                    s->xyz + 3 * (size_t)v[2], q);
+                const double *x0 = s->xyz + 3 * (size_t)v[0], *x1 = s->xyz + 3 * (size_t)v[1],
+                             *x2 = s->xyz + 3 * (size_t)v[2];
+                double d2 = frames ? st_point_triangle_dist2_framed(p, x0, x1, x2, frames + t, q)
+                                   : st_point_triangle_dist2(p, x0, x1, x2, q);
                 if (d2 < best) {
                     best = d2;
                     reach = sqrt(best);
@@ -489,13 +494,19 @@ static double nearest_walk(const st_bvh *b, const double p[3], double max_d2, in
 double st_bvh_nearest(const st_bvh *b, const double p[3], double max_d2,
                       int64_t *tri, double closest[3])
 {
-    return nearest_walk(b, p, max_d2, 0, tri, closest, NULL);
+    return nearest_walk(b, NULL, p, max_d2, 0, tri, closest, NULL);
+}
+
+double st_bvh_nearest_framed(const st_bvh *b, const st_tri_frame *frames, const double p[3],
+                             double max_d2, int64_t *tri, double closest[3])
+{
+    return nearest_walk(b, frames, p, max_d2, 0, tri, closest, NULL);
 }
 
 int st_bvh_within(const st_bvh *b, const double p[3], double max_d2)
 {
     int64_t tri;
-    (void)nearest_walk(b, p, max_d2, 1, &tri, NULL, NULL);
+    (void)nearest_walk(b, NULL, p, max_d2, 1, &tri, NULL, NULL);
     return tri >= 0;
 }
 
@@ -531,7 +542,7 @@ int st_bvh_within_hint(const st_bvh *b, const double p[3], double max_d2,
         }
     int64_t tri;
     *found = ST_BVH_NO_HINT;
-    (void)nearest_walk(b, p, max_d2, 1, &tri, NULL, found);
+    (void)nearest_walk(b, NULL, p, max_d2, 1, &tri, NULL, found);
     return tri >= 0;
 }
 
