@@ -387,6 +387,7 @@ static st_status pseudo_sign(st_grid *g, const st_soup *s, const st_pseudo_param
 count_inside:;
     size_t inside = 0;
     const size_t n = st_grid_count(g);
+    #pragma omp parallel for reduction(+ : inside) schedule(static) if (n >= 65536)
     for (size_t i = 0; i < n; i++)
         inside += g->data[i] < 0.0f;
     st->inside = inside;

@@ -480,7 +480,7 @@ st_status st_sides_mirror(st_grid *g, const st_soup *soup, size_t seen_triangles
 }
 
 /* The steps of st_sides_evidence_edges (defined after it). */
-static void region_scores(double *score, const st_grid *g, const uint8_t *votes,
+static void region_scores(double *score, double *share, const st_grid *g, const uint8_t *votes,
                           const st_soup *s, const st_soup_edges *E, const uint8_t *flip,
                           const uint32_t *region);
 static st_status oriented_soup(st_soup *o, uint8_t *rim, size_t *nview, st_sides_stats *st,
@@ -522,9 +522,10 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
     uint32_t *region = st_malloc_array(nt + 1, sizeof *region);
     uint32_t *queue = st_malloc_array(nt + 1, sizeof *queue);
     double *score = st_calloc_array(nt + 1, sizeof *score);
+    double *share = st_malloc_array(nt + 1, sizeof *share);
     st_soup *o = st_soup_new();
     st_bvh *bvh = NULL;
-    if (!nbr || !same || !flip || !rim || !region || !queue || !score || !o) {
+    if (!nbr || !same || !flip || !rim || !region || !queue || !score || !share || !o) {
         rc = st_error_set(err, ST_ENOMEM, NULL, 0, "out of memory for the soup's sides");
         goto done;
     }
@@ -535,7 +536,7 @@ st_status st_sides_evidence_edges(int8_t *evidence, const st_grid *g, const uint
     for (size_t t = 0; t < nt; t++)
         st->regions += E.kept[t] && region[t] == t;
     /* 2. each region turned to the votes' reading */
-    region_scores(score, g, votes, s, &E, flip, region);
+    region_scores(score, share, g, votes, s, &E, flip, region);
     size_t nview = 0;
     if ((rc = oriented_soup(o, rim, &nview, st, s, &E, nbr, flip, region, score, p, err)))
         goto done;
@@ -558,46 +559,62 @@ done:
     free(region);
     free(queue);
     free(score);
+    free(share);
     return rc;
 }
 
-/* 2. Each region's score: the votes' reading of its triangles' sides
- * (front outside, back inside: agrees), weighted by area. */
-static void region_scores(double *score, const st_grid *g, const uint8_t *votes,
+/* 2. Triangle t's share of its region's score: the votes' reading of its
+ * sides (front outside, back inside: agrees), its half area, signed; 0
+ * where it has none (left out, no area, or both sides read alike). */
+static double triangle_share(const st_grid *g, const uint8_t *votes, const st_soup *s,
+                             const st_soup_edges *E, const uint8_t *flip, size_t t)
+{
+    if (!E->kept[t])
+        return 0.0;
+    const double off = 1.5 * g->voxel;
+    const uint32_t *v = s->tris + 3 * t;
+    const double *A = s->xyz + 3 * (size_t)v[0], *B = s->xyz + 3 * (size_t)v[1],
+                 *C = s->xyz + 3 * (size_t)v[2];
+    double u[3], w[3], nrm[3], c[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = B[k] - A[k];
+        w[k] = C[k] - A[k];
+        c[k] = (A[k] + B[k] + C[k]) / 3.0;
+    }
+    nrm[0] = u[1] * w[2] - u[2] * w[1];
+    nrm[1] = u[2] * w[0] - u[0] * w[2];
+    nrm[2] = u[0] * w[1] - u[1] * w[0];
+    const double len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (!(len > 0.0))
+        return 0.0;
+    const double sgn = flip[t] ? -1.0 : 1.0;
+    double front[3], back[3];
+    for (int k = 0; k < 3; k++) {
+        front[k] = c[k] + sgn * off * nrm[k] / len;
+        back[k] = c[k] - sgn * off * nrm[k] / len;
+    }
+    const size_t fi = voxel_at(g, front), bi = voxel_at(g, back);
+    const int fin = fi != SIZE_MAX && (votes[fi] & ST_SIGN_VOTES_INSIDE);
+    const int bin = bi != SIZE_MAX && (votes[bi] & ST_SIGN_VOTES_INSIDE);
+    if (fin == bin)
+        return 0.0;
+    return bin ? 0.5 * len : -0.5 * len;   /* front outside, back inside: agrees */
+}
+
+/* 2. Each region's score: its triangles' shares (triangle_share), taken
+ * in parallel into share[], then added in triangle order (the sums of one
+ * loop, bit for bit: a share of 0 adds nothing). */
+static void region_scores(double *score, double *share, const st_grid *g, const uint8_t *votes,
                           const st_soup *s, const st_soup_edges *E, const uint8_t *flip,
                           const uint32_t *region)
 {
-    const double off = 1.5 * g->voxel;
-    for (size_t t = 0; t < s->ntris; t++) {
-        if (!E->kept[t])
-            continue;
-        const uint32_t *v = s->tris + 3 * t;
-        const double *A = s->xyz + 3 * (size_t)v[0], *B = s->xyz + 3 * (size_t)v[1],
-                     *C = s->xyz + 3 * (size_t)v[2];
-        double u[3], w[3], nrm[3], c[3];
-        for (int k = 0; k < 3; k++) {
-            u[k] = B[k] - A[k];
-            w[k] = C[k] - A[k];
-            c[k] = (A[k] + B[k] + C[k]) / 3.0;
-        }
-        nrm[0] = u[1] * w[2] - u[2] * w[1];
-        nrm[1] = u[2] * w[0] - u[0] * w[2];
-        nrm[2] = u[0] * w[1] - u[1] * w[0];
-        const double len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-        if (!(len > 0.0))
-            continue;
-        const double sgn = flip[t] ? -1.0 : 1.0;
-        double front[3], back[3];
-        for (int k = 0; k < 3; k++) {
-            front[k] = c[k] + sgn * off * nrm[k] / len;
-            back[k] = c[k] - sgn * off * nrm[k] / len;
-        }
-        const size_t fi = voxel_at(g, front), bi = voxel_at(g, back);
-        const int fin = fi != SIZE_MAX && (votes[fi] & ST_SIGN_VOTES_INSIDE);
-        const int bin = bi != SIZE_MAX && (votes[bi] & ST_SIGN_VOTES_INSIDE);
-        if (fin != bin)   /* front outside, back inside: agrees */
-            score[region[t]] += bin ? 0.5 * len : -0.5 * len;
-    }
+    const ptrdiff_t nt = (ptrdiff_t)s->ntris;
+    #pragma omp parallel for schedule(static) if (nt >= 4096)
+    for (ptrdiff_t t = 0; t < nt; t++)
+        share[t] = triangle_share(g, votes, s, E, flip, (size_t)t);
+    for (size_t t = 0; t < s->ntris; t++)
+        if (share[t] != 0.0)
+            score[region[t]] += share[t];
 }
 
 /* The soup s oriented (o: each region turned to its score), the rim of
