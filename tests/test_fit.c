@@ -240,6 +240,59 @@ static void test_threads(void)
 #endif
 }
 
+
+/* Few vertices per colour (a coarse ball: every colour set at most 64,
+ * where until batch 57 the fit and quality loops ran serially): the
+ * colour steps whose vertices to try number PAR_CHECKED run on 2 threads,
+ * and 1, 2 and 3 threads give bit-identical points and counts. */
+static void test_threads_small(void)
+{
+#ifdef _OPENMP
+    st_soup *s = st_soup_new();
+    add_sphere(s, 1.0, 2.0);
+    st_tetmesh *m[3];
+    for (int k = 0; k < 3; k++)
+        m[k] = ball_mesh(0.5, 0.9);
+    size_t big = largest_colour(m[0]);
+    TAP_CHECK(big > 1 && big <= 64, "the largest colour set holds %zu vertices (2..64)", big);
+    TAP_CHECK(PAR_CHECKED(big / 4), "a colour step trying a quarter of it (%zu) takes the "
+              "parallel path", big / 4);
+    int nt = omp_get_max_threads(), forked = 0;
+    omp_set_num_threads(2);
+    #pragma omp parallel if (PAR_CHECKED(big / 4))
+    {
+        #pragma omp atomic
+        forked++;
+    }
+    TAP_CHECK(forked == 2, "that path runs on 2 threads (%d)", forked);
+    st_fit_params p = st_fit_params_default();
+    p.quality_rounds = 10;
+    st_fit_stats st[3];
+    st_status rc[3];
+    st_error err;
+    for (int k = 0; k < 3; k++) {
+        omp_set_num_threads(k + 1);
+        rc[k] = st_fit(m[k], s, NULL, &p, &st[k], NULL, &err);
+    }
+    omp_set_num_threads(nt);
+    TAP_CHECK(rc[0] == ST_OK && rc[1] == ST_OK && rc[2] == ST_OK && st[0].moves > 0 &&
+                  st[0].quality_moves > 0,
+              "the fits ran: %zu fit moves, %zu quality moves", st[0].moves,
+              st[0].quality_moves);
+    int same = 1;
+    for (int k = 1; k < 3; k++)
+        same &= rc[k] == ST_OK && m[k]->npoints == m[0]->npoints &&
+                memcmp(m[k]->xyz, m[0]->xyz, 3 * m[0]->npoints * sizeof(double)) == 0 &&
+                st[k].moves == st[0].moves && st[k].rejected == st[0].rejected &&
+                st[k].skipped == st[0].skipped && st[k].quality_moves == st[0].quality_moves;
+    TAP_CHECK(same, "1, 2 and 3 threads give bit-identical points and the same counts");
+    for (int k = 0; k < 3; k++)
+        st_tetmesh_free(m[k]);
+    st_soup_free(s);
+#else
+    TAP_CHECK(1, "1, 2 and 3 threads give bit-identical points # SKIP no OpenMP");
+#endif
+}
 /* The quality pass reports each round (stage "quality", rounds done out
  * of quality_rounds): the pipeline's candidates take threads freed by
  * the others at these reports (pipeline.c, candidate_threads). */
@@ -1210,7 +1263,8 @@ static void test_move_brute(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(quality_reports),
+    static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(threads_small),
+                                     TAP_TEST(quality_reports),
                                      TAP_TEST(not_enclosing), TAP_TEST(refusals),
                                      TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
                                      TAP_TEST(bvh_query_flat_tet),

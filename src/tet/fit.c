@@ -733,24 +733,24 @@ static void fit_close(fit_run *r)
     sm_fit_ctx_close(&r->c);
 }
 
-/* One colour set's fit moves, in parallel; *n counts. */
+/* One colour set's fit moves, in parallel over the vertices to try
+ * (sm_dirty_todo); *n counts. */
 static void fit_colour(fit_run *r, size_t col, fit_counts *n)
 {
     const fit_ctx *c = &r->c;
     size_t moved = 0, rejected = 0, skipped = 0;
     r->dy.step++;
-    #pragma omp parallel reduction(+ : moved, rejected, skipped) \
-        if (PAR_CHECKED(c->sm.col_off[col + 1] - c->sm.col_off[col]))
+    const size_t nt = sm_dirty_todo(&r->dy, &c->sm, col, NULL);
+    const uint32_t *todo = r->dy.todo;
+    /* the rest would fail as they did */
+    n->skipped += c->sm.col_off[col + 1] - c->sm.col_off[col] - nt;
+    #pragma omp parallel reduction(+ : moved, rejected, skipped) if (PAR_CHECKED(nt))
     {
         star_pts sp = STAR_PTS_INIT;
-        #pragma omp for schedule(dynamic, 4)
-        for (size_t j = c->sm.col_off[col]; j < c->sm.col_off[col + 1]; j++) {
+        #pragma omp for schedule(dynamic, 1)
+        for (size_t j = 0; j < nt; j++) {
             fit_counts k = {0, 0, 0};
-            uint32_t v = c->sm.col_v[j];
-            if (sm_dirty_unchanged(&r->dy, &c->sm, v)) {
-                skipped++;   /* it would fail as it did */
-                continue;
-            }
+            uint32_t v = todo[j];
             sm_dirty_mark(&r->dy, v, fit_vertex(c, v, r->p.step, r->dist, &sp, &k));
             moved += k.moved;
             rejected += k.rejected;

@@ -404,26 +404,25 @@ static size_t qual_mark(const st_tetmesh *m, double goal, unsigned char *mark)
     return nbad;
 }
 
-/* One colour set's quality moves of the marked vertices, in parallel;
- * *moved and *rejected count. */
+/* One colour set's quality moves of the marked vertices, in parallel over
+ * those to try (sm_dirty_todo); *moved and *rejected count. */
 static void qual_colour(const fit_ctx *c, size_t col, const unsigned char *mark, dirty *dy,
                         size_t *moved, size_t *rejected)
 {
     const sm_mesh *sm = &c->sm;
     size_t mv = 0, rj = 0;
     dy->step++;
-    #pragma omp parallel reduction(+ : mv, rj) \
-        if (PAR_CHECKED(sm->col_off[col + 1] - sm->col_off[col]))
+    const size_t nt = sm_dirty_todo(dy, sm, col, mark);
+    const uint32_t *todo = dy->todo;
+    #pragma omp parallel reduction(+ : mv, rj) if (PAR_CHECKED(nt))
     {
         star_pts sp = STAR_PTS_INIT;
-        #pragma omp for schedule(dynamic, 8)
-        for (size_t j = sm->col_off[col]; j < sm->col_off[col + 1]; j++) {
-            uint32_t v = sm->col_v[j];
-            if (mark[v] && !sm_dirty_unchanged(dy, sm, v)) {
-                int k = quality_vertex(c, v, &sp, &rj);
-                sm_dirty_mark(dy, v, k);
-                mv += (size_t)k;
-            }
+        #pragma omp for schedule(dynamic, 1)
+        for (size_t j = 0; j < nt; j++) {
+            uint32_t v = todo[j];
+            int k = quality_vertex(c, v, &sp, &rj);
+            sm_dirty_mark(dy, v, k);
+            mv += (size_t)k;
         }
         free(sp.list);
     }

@@ -24,13 +24,20 @@
 /* When a loop is worth a parallel region: each region costs a barrier,
  * and on a loaded machine a barrier among spinning threads costs
  * milliseconds (fairing the bunny at 12 cells took 14 s on 2 threads under
- * load, 0.5 s on one), so small colour sets run serially. The thresholds
- * are items per region for cheap items (a few flops), vertex moves (a star
- * of ~20 tets) and checked moves (exact tests against the surface). The
- * result does not depend on them. */
+ * load, 0.5 s on one), so small sets of cheap items run serially. The
+ * thresholds are items per region for cheap items (a few flops) and
+ * vertex moves (a star of ~20 tets). A checked move (exact tests against
+ * the surface; the fit's and the quality pass's, counted over the
+ * vertices to try, sm_dirty_todo) costs 100k-400k instructions, 30-100 us
+ * (callgrind, man at 6 cells), against 1-3 us for a region of 2 hot
+ * threads, so two such moves are worth one. A boundary vertex's nearest
+ * point on the surface (sm_boundary_distances) costs ~10k-30k
+ * instructions when it moved, none when not, so a few dozen boundary
+ * vertices are. The result does not depend on them. */
 #define PAR_CHEAP(n) ((n) > 8192)
 #define PAR_MOVES(n) ((n) > 512)
-#define PAR_CHECKED(n) ((n) > 64)
+#define PAR_CHECKED(n) ((n) > 1)
+#define PAR_QUERIES(n) ((n) > 32)
 
 typedef struct sm_mesh {
     st_tetmesh *m;            /* borrowed; xyz is moved in place */
