@@ -40,6 +40,7 @@
 #include "souptet/smooth.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -225,6 +226,56 @@ static int cmp_rescue(const void *a, const void *b)
     return (x[4] > y[4]) - (x[4] < y[4]);
 }
 
+/* The rescue's search (rescue_vertex) over its candidates cd[0 .. nc),
+ * sorted by their distance's lower bound: the index of the first by
+ * (distance to S, order) of those closer than dd that keep the star's
+ * score floor and the invariant; SIZE_MAX when none does. The threads
+ * take the candidates in the bound's order, each while its bound is no
+ * more than the best distance found yet (which only falls: the rest are
+ * past it too, so nothing closer is left), and a candidate closer than
+ * the best, or as close and earlier in order, replaces it: the result is
+ * the serial search's. sp (v's, the caller's) serves the first thread. */
+static size_t rescue_search(const fit_ctx *c, uint32_t v, double (*cd)[5], size_t nc,
+                            double dd, size_t worst, double floor_score, star_pts *sp)
+{
+    const sm_mesh *sm = &c->sm;
+    double best = dd, best_ord = INFINITY;
+    size_t bi = SIZE_MAX, next = 0;
+    #pragma omp parallel if (PAR_CHECKED(nc))
+    {
+        star_pts own = STAR_PTS_INIT;
+        star_pts *tp = omp_get_thread_num() == 0 ? sp : &own;
+        sm_star_pts_collect(c, v, tp);
+        for (;;) {
+            size_t i;
+            double b;
+            #pragma omp atomic capture
+            i = next++;
+            #pragma omp atomic read
+            b = best;
+            if (i >= nc || cd[i][0] > b)
+                break;
+            if (!star_keeps_floor(sm, v, cd[i] + 1, worst, floor_score) ||
+                !sm_move_ok(c, v, cd[i] + 1, tp))
+                continue;
+            int64_t tri;
+            double d2 = sm_nearest_d2(c, cd[i] + 1, dd * dd, &tri, NULL);
+            double d = tri >= 0 ? sqrt(d2) : INFINITY;
+            if (!(d < dd))
+                continue;
+            #pragma omp critical(st_fit_rescue_best)
+            if (d < best || (d == best && cd[i][4] < best_ord)) {
+                #pragma omp atomic write
+                best = d;
+                best_ord = cd[i][4];
+                bi = i;
+            }
+        }
+        free(own.list);
+    }
+    return bi;
+}
+
 /* A boundary vertex v beyond d_offset whose ODT-plus-pull step the
  * invariant refused is held by S near its star; a step along another
  * direction that still brings it closer to S often passes (it slides past
@@ -291,24 +342,11 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
      * invariant of the candidates whose bound is past it. A candidate that
      * fails the floor changes nothing of the search, so the candidates
      * tested past it, and the one taken, are those of filtering by the
-     * floor before the sort (as until batch 55). */
+     * floor before the sort (as until batch 55). The candidate taken is so
+     * the first by (distance, order) of all that qualify, whatever order
+     * they are tested in: rescue_search tests them on several threads. */
     qsort(cd, nc, sizeof cd[0], cmp_rescue);
-    sm_star_pts_collect(c, v, sp);
-    double best = dd, best_ord = INFINITY;
-    size_t bi = SIZE_MAX;
-    for (size_t i = 0; i < nc && !(cd[i][0] > best); i++) {
-        if (!star_keeps_floor(sm, v, cd[i] + 1, worst, floor_score) ||
-            !sm_move_ok(c, v, cd[i] + 1, sp))
-            continue;
-        int64_t tri;
-        double d2 = sm_nearest_d2(c, cd[i] + 1, dd * dd, &tri, NULL);
-        double d = tri >= 0 ? sqrt(d2) : INFINITY;
-        if (d < dd && (d < best || (d == best && cd[i][4] < best_ord))) {
-            best = d;
-            best_ord = cd[i][4];
-            bi = i;
-        }
-    }
+    size_t bi = rescue_search(c, v, cd, nc, dd, worst, floor_score, sp);
     if (bi == SIZE_MAX)
         return 0;
     memcpy(x, cd[bi] + 1, 3 * sizeof *x);
