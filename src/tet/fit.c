@@ -241,8 +241,15 @@ static size_t rescue_search(const fit_ctx *c, uint32_t v, double (*cd)[5], size_
     const sm_mesh *sm = &c->sm;
     double best = dd, best_ord = INFINITY;
     size_t bi = SIZE_MAX, next = 0;
-    #pragma omp parallel if (PAR_CHECKED(nc))
+    const int par = sm_par_gate_open(c->gate, nc);
+    const double t0 = par ? omp_get_wtime() : 0.0;
+    double busy = 0.0;
+    int team = 1;
+    #pragma omp parallel reduction(+ : busy) if (par)
     {
+        const double b0 = par ? omp_get_wtime() : 0.0;
+        if (omp_get_thread_num() == 0)
+            team = omp_get_num_threads();
         star_pts own = STAR_PTS_INIT;
         star_pts *tp = omp_get_thread_num() == 0 ? sp : &own;
         sm_star_pts_collect(c, v, tp);
@@ -271,8 +278,12 @@ static size_t rescue_search(const fit_ctx *c, uint32_t v, double (*cd)[5], size_
                 bi = i;
             }
         }
+        if (par)
+            busy += omp_get_wtime() - b0;
         free(own.list);
     }
+    if (par)
+        sm_par_gate_note(c->gate, team, omp_get_wtime() - t0, busy);
     return bi;
 }
 
@@ -782,10 +793,17 @@ static void fit_colour(fit_run *r, size_t col, fit_counts *n)
     const uint32_t *todo = r->dy.todo;
     /* the rest would fail as they did */
     n->skipped += c->sm.col_off[col + 1] - c->sm.col_off[col] - nt;
-    #pragma omp parallel reduction(+ : moved, rejected, skipped) if (PAR_CHECKED(nt))
+    const int par = sm_par_gate_open(c->gate, nt);
+    const double t0 = par ? omp_get_wtime() : 0.0;
+    double busy = 0.0;
+    int team = 1;
+    #pragma omp parallel reduction(+ : moved, rejected, skipped, busy) if (par)
     {
+        const double b0 = par ? omp_get_wtime() : 0.0;
         star_pts sp = STAR_PTS_INIT;
-        #pragma omp for schedule(dynamic, 1)
+        if (omp_get_thread_num() == 0)
+            team = omp_get_num_threads();
+        #pragma omp for schedule(dynamic, 1) nowait
         for (size_t j = 0; j < nt; j++) {
             fit_counts k = {0, 0, 0};
             uint32_t v = todo[j];
@@ -794,8 +812,12 @@ static void fit_colour(fit_run *r, size_t col, fit_counts *n)
             rejected += k.rejected;
             skipped += k.skipped;
         }
+        if (par)
+            busy += omp_get_wtime() - b0;
         free(sp.list);
     }
+    if (par)
+        sm_par_gate_note(c->gate, team, omp_get_wtime() - t0, busy);
     n->moved += moved;
     n->rejected += rejected;
     n->skipped += skipped;

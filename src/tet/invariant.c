@@ -585,6 +585,7 @@ st_status sm_fit_ctx_open(fit_ctx *c, st_tetmesh *m, const st_soup *s, const st_
     c->h = h;
     c->d_offset = d_offset;
     c->prog = prog;
+    c->gate = &c->own_gate;
     int64_t *nbr = NULL;
     size_t nonmanifold = 0;
     st_status rc = ST_OK;

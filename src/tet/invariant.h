@@ -60,6 +60,9 @@ typedef struct fit_ctx {
                             their tangent plane only (sm_quality_fair) */
     const st_progress *prog;   /* its cancel flag stops the fit between
                                   iterations and rounds (may be NULL) */
+    sm_par_gate *gate;   /* the small loops' team gate (&own_gate, or NULL:
+                            PAR_CHECKED alone) */
+    sm_par_gate own_gate;
     st_bvh *own_bvh, *own_fbvh;   /* the BVHs sm_fit_ctx_open built */
     pgrid own_pg;                 /* the point grid it built */
 } fit_ctx;

@@ -36,6 +36,7 @@
 #include "souptet/mem.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -414,18 +415,29 @@ static void qual_colour(const fit_ctx *c, size_t col, const unsigned char *mark,
     dy->step++;
     const size_t nt = sm_dirty_todo(dy, sm, col, mark);
     const uint32_t *todo = dy->todo;
-    #pragma omp parallel reduction(+ : mv, rj) if (PAR_CHECKED(nt))
+    const int par = sm_par_gate_open(c->gate, nt);
+    const double t0 = par ? omp_get_wtime() : 0.0;
+    double busy = 0.0;
+    int team = 1;
+    #pragma omp parallel reduction(+ : mv, rj, busy) if (par)
     {
+        const double b0 = par ? omp_get_wtime() : 0.0;
         star_pts sp = STAR_PTS_INIT;
-        #pragma omp for schedule(dynamic, 1)
+        if (omp_get_thread_num() == 0)
+            team = omp_get_num_threads();
+        #pragma omp for schedule(dynamic, 1) nowait
         for (size_t j = 0; j < nt; j++) {
             uint32_t v = todo[j];
             int k = quality_vertex(c, v, &sp, &rj);
             sm_dirty_mark(dy, v, k);
             mv += (size_t)k;
         }
+        if (par)
+            busy += omp_get_wtime() - b0;
         free(sp.list);
     }
+    if (par)
+        sm_par_gate_note(c->gate, team, omp_get_wtime() - t0, busy);
     *moved += mv;
     *rejected += rj;
 }
@@ -481,6 +493,7 @@ static st_status quality_on(sm_mesh *sm, double h, int rounds, double goal, int 
     fit_ctx c;
     memset(&c, 0, sizeof c);
     c.sm = *sm;   /* borrowed: not freed here */
+    c.gate = &c.own_gate;
     c.pg = &c.own_pg;   /* empty: no surface */
     c.h = h;
     c.fair_boundary = boundary;
