@@ -1,7 +1,8 @@
 /* test_fit.c - st_fit: the mesh encloses the surface after every iteration
  * (checked by brute force here, independently of fit.c's local checks),
  * the boundary reaches the offset on a convex shape, the quality pass
- * raises the worst angles, results do not depend on the thread count, and
+ * raises the worst angles, results do not depend on the thread count (also
+ * with a few vertices per colour, where the colour steps now fork), and
  * what did not hold on entry does not get worse; the BVH's triangle query
  * (the fit's face check) misses no triangle; the quality pass keeps every
  * boundary vertex within max(d_offset, where the fit left it) of S while
@@ -292,6 +293,35 @@ static void test_threads_small(void)
 #else
     TAP_CHECK(1, "1, 2 and 3 threads give bit-identical points # SKIP no OpenMP");
 #endif
+}
+
+/* The small loops' team gate (sm_par_gate): open below its slack, closed
+ * for 16 steps after a region that waited (a thread without a core),
+ * then 32 after a slow probe, and the wait halved by a fast one; a
+ * region of one thread tells nothing; PAR_CHECKED still applies. */
+static void test_par_gate(void)
+{
+    sm_par_gate g = {0, 0};
+    TAP_CHECK(sm_par_gate_open(&g, 2) && !sm_par_gate_open(&g, 1) &&
+                  sm_par_gate_open(NULL, 2),
+              "open from 2 items (PAR_CHECKED), also without a gate");
+    sm_par_gate_note(&g, 2, 0.0005, 0.0004);   /* 0.1 ms over: not a wait */
+    sm_par_gate_note(&g, 2, 0.004, 0.0009);    /* 3 ms over: a thread waited */
+    int open = sm_par_gate_open(&g, 8);
+    sm_par_gate_note(&g, 1, 0.5, 0.001);       /* 1 thread: no evidence */
+    TAP_CHECK(open == 0 && g.wait == 15 && g.backoff == 16,
+              "a region 3 ms over its 0.9 ms of work closes the gate for 16 steps (%u, %u)",
+              g.wait, g.backoff);
+    int closed = 0;
+    for (int k = 0; k < 15; k++)
+        closed += !sm_par_gate_open(&g, 8);
+    TAP_CHECK(closed == 15 && sm_par_gate_open(&g, 8), "it reopens for a probe after them");
+    sm_par_gate_note(&g, 2, 0.02, 0.001);
+    TAP_CHECK(g.wait == 32, "a slow probe doubles the wait (%u)", g.wait);
+    g.wait = 0;
+    sm_par_gate_note(&g, 2, 0.0006, 0.001);
+    TAP_CHECK(g.wait == 0 && g.backoff == 16 && sm_par_gate_open(&g, 8),
+              "a fast region halves the next wait (%u) and leaves the gate open", g.backoff);
 }
 /* The quality pass reports each round (stage "quality", rounds done out
  * of quality_rounds): the pipeline's candidates take threads freed by
@@ -1264,6 +1294,7 @@ static void test_move_brute(void)
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(threads_small),
+                                     TAP_TEST(par_gate),
                                      TAP_TEST(quality_reports),
                                      TAP_TEST(not_enclosing), TAP_TEST(refusals),
                                      TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
