@@ -1,7 +1,8 @@
 /* test_fit.c - st_fit: the mesh encloses the surface after every iteration
  * (checked by brute force here, independently of fit.c's local checks),
  * the boundary reaches the offset on a convex shape, the quality pass
- * raises the worst angles, results do not depend on the thread count, and
+ * raises the worst angles, results do not depend on the thread count (also
+ * with a few vertices per colour, where the colour steps now fork), and
  * what did not hold on entry does not get worse; the BVH's triangle query
  * (the fit's face check) misses no triangle; the quality pass keeps every
  * boundary vertex within max(d_offset, where the fit left it) of S while
@@ -240,6 +241,88 @@ static void test_threads(void)
 #endif
 }
 
+
+/* Few vertices per colour (a coarse ball: every colour set at most 64,
+ * where until batch 57 the fit and quality loops ran serially): the
+ * colour steps whose vertices to try number PAR_CHECKED run on 2 threads,
+ * and 1, 2 and 3 threads give bit-identical points and counts. */
+static void test_threads_small(void)
+{
+#ifdef _OPENMP
+    st_soup *s = st_soup_new();
+    add_sphere(s, 1.0, 2.0);
+    st_tetmesh *m[3];
+    for (int k = 0; k < 3; k++)
+        m[k] = ball_mesh(0.5, 0.9);
+    size_t big = largest_colour(m[0]);
+    TAP_CHECK(big > 1 && big <= 64, "the largest colour set holds %zu vertices (2..64)", big);
+    TAP_CHECK(PAR_CHECKED(big / 4), "a colour step trying a quarter of it (%zu) takes the "
+              "parallel path", big / 4);
+    int nt = omp_get_max_threads(), forked = 0;
+    omp_set_num_threads(2);
+    #pragma omp parallel if (PAR_CHECKED(big / 4))
+    {
+        #pragma omp atomic
+        forked++;
+    }
+    TAP_CHECK(forked == 2, "that path runs on 2 threads (%d)", forked);
+    st_fit_params p = st_fit_params_default();
+    p.quality_rounds = 10;
+    st_fit_stats st[3];
+    st_status rc[3];
+    st_error err;
+    for (int k = 0; k < 3; k++) {
+        omp_set_num_threads(k + 1);
+        rc[k] = st_fit(m[k], s, NULL, &p, &st[k], NULL, &err);
+    }
+    omp_set_num_threads(nt);
+    TAP_CHECK(rc[0] == ST_OK && rc[1] == ST_OK && rc[2] == ST_OK && st[0].moves > 0 &&
+                  st[0].quality_moves > 0,
+              "the fits ran: %zu fit moves, %zu quality moves", st[0].moves,
+              st[0].quality_moves);
+    int same = 1;
+    for (int k = 1; k < 3; k++)
+        same &= rc[k] == ST_OK && m[k]->npoints == m[0]->npoints &&
+                memcmp(m[k]->xyz, m[0]->xyz, 3 * m[0]->npoints * sizeof(double)) == 0 &&
+                st[k].moves == st[0].moves && st[k].rejected == st[0].rejected &&
+                st[k].skipped == st[0].skipped && st[k].quality_moves == st[0].quality_moves;
+    TAP_CHECK(same, "1, 2 and 3 threads give bit-identical points and the same counts");
+    for (int k = 0; k < 3; k++)
+        st_tetmesh_free(m[k]);
+    st_soup_free(s);
+#else
+    TAP_CHECK(1, "1, 2 and 3 threads give bit-identical points # SKIP no OpenMP");
+#endif
+}
+
+/* The small loops' team gate (sm_par_gate): open below its slack, closed
+ * for 16 steps after a region that waited (a thread without a core),
+ * then 32 after a slow probe, and the wait halved by a fast one; a
+ * region of one thread tells nothing; PAR_CHECKED still applies. */
+static void test_par_gate(void)
+{
+    sm_par_gate g = {0, 0};
+    TAP_CHECK(sm_par_gate_open(&g, 2) && !sm_par_gate_open(&g, 1) &&
+                  sm_par_gate_open(NULL, 2),
+              "open from 2 items (PAR_CHECKED), also without a gate");
+    sm_par_gate_note(&g, 2, 0.0005, 0.0004);   /* 0.1 ms over: not a wait */
+    sm_par_gate_note(&g, 2, 0.004, 0.0009);    /* 3 ms over: a thread waited */
+    int open = sm_par_gate_open(&g, 8);
+    sm_par_gate_note(&g, 1, 0.5, 0.001);       /* 1 thread: no evidence */
+    TAP_CHECK(open == 0 && g.wait == 15 && g.backoff == 16,
+              "a region 3 ms over its 0.9 ms of work closes the gate for 16 steps (%u, %u)",
+              g.wait, g.backoff);
+    int closed = 0;
+    for (int k = 0; k < 15; k++)
+        closed += !sm_par_gate_open(&g, 8);
+    TAP_CHECK(closed == 15 && sm_par_gate_open(&g, 8), "it reopens for a probe after them");
+    sm_par_gate_note(&g, 2, 0.02, 0.001);
+    TAP_CHECK(g.wait == 32, "a slow probe doubles the wait (%u)", g.wait);
+    g.wait = 0;
+    sm_par_gate_note(&g, 2, 0.0006, 0.001);
+    TAP_CHECK(g.wait == 0 && g.backoff == 16 && sm_par_gate_open(&g, 8),
+              "a fast region halves the next wait (%u) and leaves the gate open", g.backoff);
+}
 /* The quality pass reports each round (stage "quality", rounds done out
  * of quality_rounds): the pipeline's candidates take threads freed by
  * the others at these reports (pipeline.c, candidate_threads). */
@@ -1340,7 +1423,9 @@ static void test_sides(void)
 
 int main(int argc, char **argv)
 {
-    static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(quality_reports),
+    static const tap_test tests[] = {TAP_TEST(sphere), TAP_TEST(threads), TAP_TEST(threads_small),
+                                     TAP_TEST(par_gate),
+                                     TAP_TEST(quality_reports),
                                      TAP_TEST(not_enclosing), TAP_TEST(refusals),
                                      TAP_TEST(bvh_query_tri), TAP_TEST(bvh_query_tet),
                                      TAP_TEST(bvh_query_flat_tet), TAP_TEST(bvh_nearest_framed),

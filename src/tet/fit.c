@@ -40,6 +40,7 @@
 #include "souptet/smooth.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -225,6 +226,67 @@ static int cmp_rescue(const void *a, const void *b)
     return (x[4] > y[4]) - (x[4] < y[4]);
 }
 
+/* The rescue's search (rescue_vertex) over its candidates cd[0 .. nc),
+ * sorted by their distance's lower bound: the index of the first by
+ * (distance to S, order) of those closer than dd that keep the star's
+ * score floor and the invariant; SIZE_MAX when none does. The threads
+ * take the candidates in the bound's order, each while its bound is no
+ * more than the best distance found yet (which only falls: the rest are
+ * past it too, so nothing closer is left), and a candidate closer than
+ * the best, or as close and earlier in order, replaces it: the result is
+ * the serial search's. sp (v's, the caller's) serves the first thread. */
+static size_t rescue_search(const fit_ctx *c, uint32_t v, double (*cd)[5], size_t nc,
+                            double dd, size_t worst, double floor_score, star_pts *sp)
+{
+    const sm_mesh *sm = &c->sm;
+    double best = dd, best_ord = INFINITY;
+    size_t bi = SIZE_MAX, next = 0;
+    const int par = sm_par_gate_open(c->gate, nc);
+    const double t0 = par ? omp_get_wtime() : 0.0;
+    double busy = 0.0;
+    int team = 1;
+    #pragma omp parallel reduction(+ : busy) if (par)
+    {
+        const double b0 = par ? omp_get_wtime() : 0.0;
+        if (omp_get_thread_num() == 0)
+            team = omp_get_num_threads();
+        star_pts own = STAR_PTS_INIT;
+        star_pts *tp = omp_get_thread_num() == 0 ? sp : &own;
+        sm_star_pts_collect(c, v, tp);
+        for (;;) {
+            size_t i;
+            double b;
+            #pragma omp atomic capture
+            i = next++;
+            #pragma omp atomic read
+            b = best;
+            if (i >= nc || cd[i][0] > b)
+                break;
+            if (!star_keeps_floor(sm, v, cd[i] + 1, worst, floor_score) ||
+                !sm_move_ok(c, v, cd[i] + 1, tp))
+                continue;
+            int64_t tri;
+            double d2 = sm_nearest_d2(c, cd[i] + 1, dd * dd, &tri, NULL);
+            double d = tri >= 0 ? sqrt(d2) : INFINITY;
+            if (!(d < dd))
+                continue;
+            #pragma omp critical(st_fit_rescue_best)
+            if (d < best || (d == best && cd[i][4] < best_ord)) {
+                #pragma omp atomic write
+                best = d;
+                best_ord = cd[i][4];
+                bi = i;
+            }
+        }
+        if (par)
+            busy += omp_get_wtime() - b0;
+        free(own.list);
+    }
+    if (par)
+        sm_par_gate_note(c->gate, team, omp_get_wtime() - t0, busy);
+    return bi;
+}
+
 /* A boundary vertex v beyond d_offset whose ODT-plus-pull step the
  * invariant refused is held by S near its star; a step along another
  * direction that still brings it closer to S often passes (it slides past
@@ -291,24 +353,11 @@ static int rescue_vertex(const fit_ctx *c, uint32_t v, star_pts *sp)
      * invariant of the candidates whose bound is past it. A candidate that
      * fails the floor changes nothing of the search, so the candidates
      * tested past it, and the one taken, are those of filtering by the
-     * floor before the sort (as until batch 55). */
+     * floor before the sort (as until batch 55). The candidate taken is so
+     * the first by (distance, order) of all that qualify, whatever order
+     * they are tested in: rescue_search tests them on several threads. */
     qsort(cd, nc, sizeof cd[0], cmp_rescue);
-    sm_star_pts_collect(c, v, sp);
-    double best = dd, best_ord = INFINITY;
-    size_t bi = SIZE_MAX;
-    for (size_t i = 0; i < nc && !(cd[i][0] > best); i++) {
-        if (!star_keeps_floor(sm, v, cd[i] + 1, worst, floor_score) ||
-            !sm_move_ok(c, v, cd[i] + 1, sp))
-            continue;
-        int64_t tri;
-        double d2 = sm_nearest_d2(c, cd[i] + 1, dd * dd, &tri, NULL);
-        double d = tri >= 0 ? sqrt(d2) : INFINITY;
-        if (d < dd && (d < best || (d == best && cd[i][4] < best_ord))) {
-            best = d;
-            best_ord = cd[i][4];
-            bi = i;
-        }
-    }
+    size_t bi = rescue_search(c, v, cd, nc, dd, worst, floor_score, sp);
     if (bi == SIZE_MAX)
         return 0;
     memcpy(x, cd[bi] + 1, 3 * sizeof *x);
@@ -733,31 +782,42 @@ static void fit_close(fit_run *r)
     sm_fit_ctx_close(&r->c);
 }
 
-/* One colour set's fit moves, in parallel; *n counts. */
+/* One colour set's fit moves, in parallel over the vertices to try
+ * (sm_dirty_todo); *n counts. */
 static void fit_colour(fit_run *r, size_t col, fit_counts *n)
 {
     const fit_ctx *c = &r->c;
     size_t moved = 0, rejected = 0, skipped = 0;
     r->dy.step++;
-    #pragma omp parallel reduction(+ : moved, rejected, skipped) \
-        if (PAR_CHECKED(c->sm.col_off[col + 1] - c->sm.col_off[col]))
+    const size_t nt = sm_dirty_todo(&r->dy, &c->sm, col, NULL);
+    const uint32_t *todo = r->dy.todo;
+    /* the rest would fail as they did */
+    n->skipped += c->sm.col_off[col + 1] - c->sm.col_off[col] - nt;
+    const int par = sm_par_gate_open(c->gate, nt);
+    const double t0 = par ? omp_get_wtime() : 0.0;
+    double busy = 0.0;
+    int team = 1;
+    #pragma omp parallel reduction(+ : moved, rejected, skipped, busy) if (par)
     {
+        const double b0 = par ? omp_get_wtime() : 0.0;
         star_pts sp = STAR_PTS_INIT;
-        #pragma omp for schedule(dynamic, 4)
-        for (size_t j = c->sm.col_off[col]; j < c->sm.col_off[col + 1]; j++) {
+        if (omp_get_thread_num() == 0)
+            team = omp_get_num_threads();
+        #pragma omp for schedule(dynamic, 1) nowait
+        for (size_t j = 0; j < nt; j++) {
             fit_counts k = {0, 0, 0};
-            uint32_t v = c->sm.col_v[j];
-            if (sm_dirty_unchanged(&r->dy, &c->sm, v)) {
-                skipped++;   /* it would fail as it did */
-                continue;
-            }
+            uint32_t v = todo[j];
             sm_dirty_mark(&r->dy, v, fit_vertex(c, v, r->p.step, r->dist, &sp, &k));
             moved += k.moved;
             rejected += k.rejected;
             skipped += k.skipped;
         }
+        if (par)
+            busy += omp_get_wtime() - b0;
         free(sp.list);
     }
+    if (par)
+        sm_par_gate_note(c->gate, team, omp_get_wtime() - t0, busy);
     n->moved += moved;
     n->rejected += rejected;
     n->skipped += skipped;

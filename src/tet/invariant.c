@@ -59,13 +59,15 @@ st_status sm_dirty_init(dirty *d, size_t nv)
     d->step = 0;
     d->moved_at = st_calloc_array(nv ? nv : 1, sizeof *d->moved_at);
     d->tried_at = st_calloc_array(nv ? nv : 1, sizeof *d->tried_at);
-    return d->moved_at && d->tried_at ? ST_OK : ST_ENOMEM;
+    d->todo = st_malloc_array(nv ? nv : 1, sizeof *d->todo);
+    return d->moved_at && d->tried_at && d->todo ? ST_OK : ST_ENOMEM;
 }
 
 void sm_dirty_free(dirty *d)
 {
     free(d->moved_at);
     free(d->tried_at);
+    free(d->todo);
     memset(d, 0, sizeof *d);
 }
 
@@ -87,6 +89,17 @@ void sm_dirty_mark(dirty *d, uint32_t v, int moved)
         d->moved_at[v] = d->step;
     else
         d->tried_at[v] = d->step;
+}
+
+size_t sm_dirty_todo(dirty *d, const sm_mesh *sm, size_t col, const unsigned char *mark)
+{
+    size_t n = 0;
+    for (size_t j = sm->col_off[col]; j < sm->col_off[col + 1]; j++) {
+        uint32_t v = sm->col_v[j];
+        if ((!mark || mark[v]) && !sm_dirty_unchanged(d, sm, v))
+            d->todo[n++] = v;
+    }
+    return n;
 }
 
 /* ---- the invariant -------------------------------------------------- */
@@ -584,8 +597,8 @@ dist_summary sm_boundary_distances(const fit_ctx *c, double *dist)
     const sm_mesh *sm = &c->sm;
     size_t within = 0;
     double mx = 0.0;
-    #pragma omp parallel for schedule(dynamic, 64) reduction(+ : within) reduction(max : mx) \
-        if (PAR_MOVES(sm->nv))
+    #pragma omp parallel for schedule(dynamic, 16) reduction(+ : within) reduction(max : mx) \
+        if (PAR_QUERIES(sm->nbv))
     for (size_t v = 0; v < sm->nv; v++) {
         if (!sm->onb[v]) {
             dist[v] = 0.0;
@@ -655,6 +668,7 @@ st_status sm_fit_ctx_open(fit_ctx *c, st_tetmesh *m, const st_soup *s, const st_
     c->h = h;
     c->d_offset = d_offset;
     c->prog = prog;
+    c->gate = &c->own_gate;
     int64_t *nbr = NULL;
     size_t nonmanifold = 0;
     st_status rc = ST_OK;

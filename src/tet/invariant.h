@@ -60,6 +60,9 @@ typedef struct fit_ctx {
                             their tangent plane only (sm_quality_fair) */
     const st_progress *prog;   /* its cancel flag stops the fit between
                                   iterations and rounds (may be NULL) */
+    sm_par_gate *gate;   /* the small loops' team gate (&own_gate, or NULL:
+                            PAR_CHECKED alone) */
+    sm_par_gate own_gate;
     st_bvh *own_bvh, *own_fbvh;   /* the BVHs sm_fit_ctx_open built */
     pgrid own_pg;                 /* the point grid it built */
 } fit_ctx;
@@ -94,6 +97,7 @@ void sm_fit_ctx_close(fit_ctx *c);
 typedef struct dirty {
     uint32_t *moved_at;   /* step of the last move (0: never) */
     uint32_t *tried_at;   /* step of the last attempt that did not move */
+    uint32_t *todo;       /* a colour step's vertices to try (sm_dirty_todo) */
     uint32_t step;
 } dirty;
 
@@ -103,6 +107,13 @@ void sm_dirty_free(dirty *d);
 /* 1 when an attempt to move v would repeat one that did not move. */
 int sm_dirty_unchanged(const dirty *d, const sm_mesh *sm, uint32_t v);
 void sm_dirty_mark(dirty *d, uint32_t v, int moved);
+/* The vertices of colour col worth an attempt at this step, in colour
+ * order, into d->todo: those with mark[v] (every one when mark is NULL)
+ * that sm_dirty_unchanged does not skip; their count. A colour's vertices
+ * share no edge, so an attempt in the colour changes no other's answer:
+ * the list is the one the colour step would find vertex by vertex, and
+ * its length, not the colour's, is the work a parallel region holds. */
+size_t sm_dirty_todo(dirty *d, const sm_mesh *sm, size_t col, const unsigned char *mark);
 
 /* An S vertex in a star and the star tet that held it. */
 typedef struct star_pt {

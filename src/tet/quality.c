@@ -36,6 +36,7 @@
 #include "souptet/mem.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -404,29 +405,39 @@ static size_t qual_mark(const st_tetmesh *m, double goal, unsigned char *mark)
     return nbad;
 }
 
-/* One colour set's quality moves of the marked vertices, in parallel;
- * *moved and *rejected count. */
+/* One colour set's quality moves of the marked vertices, in parallel over
+ * those to try (sm_dirty_todo); *moved and *rejected count. */
 static void qual_colour(const fit_ctx *c, size_t col, const unsigned char *mark, dirty *dy,
                         size_t *moved, size_t *rejected)
 {
     const sm_mesh *sm = &c->sm;
     size_t mv = 0, rj = 0;
     dy->step++;
-    #pragma omp parallel reduction(+ : mv, rj) \
-        if (PAR_CHECKED(sm->col_off[col + 1] - sm->col_off[col]))
+    const size_t nt = sm_dirty_todo(dy, sm, col, mark);
+    const uint32_t *todo = dy->todo;
+    const int par = sm_par_gate_open(c->gate, nt);
+    const double t0 = par ? omp_get_wtime() : 0.0;
+    double busy = 0.0;
+    int team = 1;
+    #pragma omp parallel reduction(+ : mv, rj, busy) if (par)
     {
+        const double b0 = par ? omp_get_wtime() : 0.0;
         star_pts sp = STAR_PTS_INIT;
-        #pragma omp for schedule(dynamic, 8)
-        for (size_t j = sm->col_off[col]; j < sm->col_off[col + 1]; j++) {
-            uint32_t v = sm->col_v[j];
-            if (mark[v] && !sm_dirty_unchanged(dy, sm, v)) {
-                int k = quality_vertex(c, v, &sp, &rj);
-                sm_dirty_mark(dy, v, k);
-                mv += (size_t)k;
-            }
+        if (omp_get_thread_num() == 0)
+            team = omp_get_num_threads();
+        #pragma omp for schedule(dynamic, 1) nowait
+        for (size_t j = 0; j < nt; j++) {
+            uint32_t v = todo[j];
+            int k = quality_vertex(c, v, &sp, &rj);
+            sm_dirty_mark(dy, v, k);
+            mv += (size_t)k;
         }
+        if (par)
+            busy += omp_get_wtime() - b0;
         free(sp.list);
     }
+    if (par)
+        sm_par_gate_note(c->gate, team, omp_get_wtime() - t0, busy);
     *moved += mv;
     *rejected += rj;
 }
@@ -482,6 +493,7 @@ static st_status quality_on(sm_mesh *sm, double h, int rounds, double goal, int 
     fit_ctx c;
     memset(&c, 0, sizeof c);
     c.sm = *sm;   /* borrowed: not freed here */
+    c.gate = &c.own_gate;
     c.pg = &c.own_pg;   /* empty: no surface */
     c.h = h;
     c.fair_boundary = boundary;

@@ -543,3 +543,26 @@ double sm_now(void)
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
+
+int sm_par_gate_open(sm_par_gate *g, size_t n)
+{
+    if (!PAR_CHECKED(n))
+        return 0;
+    if (g && g->wait) {
+        g->wait--;
+        return 0;
+    }
+    return 1;
+}
+
+void sm_par_gate_note(sm_par_gate *g, int team, double wall, double busy)
+{
+    if (!g || team < 2)
+        return;
+    if (wall - busy > fmax(PAR_GATE_SLACK, busy)) {
+        g->backoff = g->backoff ? (g->backoff < 2048 ? 2 * g->backoff : 4096) : 16;
+        g->wait = g->backoff;
+    } else {
+        g->backoff /= 2;
+    }
+}

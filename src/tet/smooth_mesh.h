@@ -24,13 +24,48 @@
 /* When a loop is worth a parallel region: each region costs a barrier,
  * and on a loaded machine a barrier among spinning threads costs
  * milliseconds (fairing the bunny at 12 cells took 14 s on 2 threads under
- * load, 0.5 s on one), so small colour sets run serially. The thresholds
- * are items per region for cheap items (a few flops), vertex moves (a star
- * of ~20 tets) and checked moves (exact tests against the surface). The
- * result does not depend on them. */
+ * load, 0.5 s on one), so small sets of cheap items run serially. The
+ * thresholds are items per region for cheap items (a few flops) and
+ * vertex moves (a star of ~20 tets). A checked move (exact tests against
+ * the surface; the fit's and the quality pass's, counted over the
+ * vertices to try, sm_dirty_todo) costs 100k-400k instructions, 30-100 us
+ * (callgrind, man at 6 cells), against 1-3 us for a region of 2 hot
+ * threads, so two such moves are worth one. A boundary vertex's nearest
+ * point on the surface (sm_boundary_distances) costs ~10k-30k
+ * instructions when it moved, none when not, so a few dozen boundary
+ * vertices are. The result does not depend on them. */
 #define PAR_CHEAP(n) ((n) > 8192)
 #define PAR_MOVES(n) ((n) > 512)
-#define PAR_CHECKED(n) ((n) > 64)
+#define PAR_CHECKED(n) ((n) > 1)
+#define PAR_QUERIES(n) ((n) > 32)
+
+/* Whether a loop of few checked moves gets a team, beyond PAR_CHECKED: on
+ * a loaded machine a thread of the team can wait a time slice (ms) to
+ * run, and one spinning at a barrier loses its slice, so a colour step of
+ * a few hundred us takes ms (man at 6 cells, 2 threads under load 18,
+ * without the gate: 1.8 s -> 9.3 s). After each region of 2 threads or
+ * more, the gate compares its wall time with its threads' summed busy
+ * time (the serial estimate): a region that took longer than that by more
+ * than the estimate itself and PAR_GATE_SLACK (1 ms, a time slice's
+ * order: a thread waited for a core; under callgrind, whose serialized
+ * threads make every item ~50 times slower but not the waits, the gate
+ * stays open and the per-thread counts show the team's split) closes it
+ * for 16 steps, then 32, 64, ... up to 4096 while the probes stay slow; a
+ * region faster halves the next wait. It decides thread counts only: no
+ * result depends on it. Used by the master thread alone, outside the
+ * regions. */
+#define PAR_GATE_SLACK 1e-3
+typedef struct sm_par_gate {
+    unsigned wait;      /* steps left to run serially */
+    unsigned backoff;   /* the wait after the last slow region (0: none) */
+} sm_par_gate;
+
+/* 1 when a loop of n checked moves should fork: PAR_CHECKED(n) and g open
+ * (g may be NULL: the threshold alone); a closed gate counts the step. */
+int sm_par_gate_open(sm_par_gate *g, size_t n);
+/* Record a region's wall time and its threads' summed busy time (both in
+ * seconds) when it ran on team threads (g may be NULL). */
+void sm_par_gate_note(sm_par_gate *g, int team, double wall, double busy);
 
 typedef struct sm_mesh {
     st_tetmesh *m;            /* borrowed; xyz is moved in place */
