@@ -1728,6 +1728,79 @@ static void test_threads_same(void)
     st_soup_free(s);
 }
 
+/* The first caps of c (a's triangles, from a's vertex 0 on) are a's, to
+ * the bit. */
+static int caps_begin_with(const st_soup *c, const st_soup *a)
+{
+    return c->ntris >= a->ntris && c->nverts >= a->nverts &&
+           !memcmp(c->xyz, a->xyz, 3 * a->nverts * sizeof *a->xyz) &&
+           !memcmp(c->tris, a->tris, 3 * a->ntris * sizeof *a->tris);
+}
+
+/* Issue 41: a cylinder's cap may not pierce the caps before it
+ * (holes_cyl.c). The threads make each loop's cap without the others';
+ * where a cylinder's then pierces one before it, it is made again against
+ * them. The box [-2, 2]^2 x [-1, 0.15] without its top face (a flat
+ * hole, capped first: its cap the face) around the washer without an arc
+ * (test_cylinder: capped alone along its cylinder), which crosses the
+ * box's top: the washer's cylinder cap would pierce the box's cap, and is
+ * not taken, at any number of threads. */
+static void test_threads_cylinder(void)
+{
+    st_soup *box = st_soup_new(), *s = st_soup_new();
+    static const double R[][3][3] = {
+        {{-2, -2, -1}, {0, 4, 0}, {4, 0, 0}},       /* bottom */
+        {{-2, -2, -1}, {4, 0, 0}, {0, 0, 1.15}},    /* sides */
+        {{-2, 2, -1}, {4, 0, 0}, {0, 0, 1.15}},
+        {{-2, -2, -1}, {0, 4, 0}, {0, 0, 1.15}},
+        {{2, -2, -1}, {0, 4, 0}, {0, 0, 1.15}},
+    };
+    for (size_t r = 0; r < sizeof R / sizeof R[0]; r++)
+        t_rect(box, R[r][0], R[r][1], R[r][2], 0);
+    st_soup_append(s, box, NULL);
+    add_moved(s, washer(1), (const double[3]){0, 0, 0});
+    st_soup *w = washer(1), *cb = NULL, *cw = NULL, *c1 = NULL;
+    st_holes_params hp = st_holes_params_default();
+    st_holes_stats hs;
+    st_error err;
+#ifdef _OPENMP
+    const int was = omp_get_max_threads();
+    omp_set_num_threads(1);
+#endif
+    st_holes_params hb = hp;    /* the box alone is one-sided along z */
+    hb.onesided = 0.0;
+    int ok = !st_soup_hole_caps(&cb, box, &hb, &hs, &err) &&
+             !st_soup_hole_caps(&cw, w, &hp, &hs, &err) &&
+             !st_soup_hole_caps(&c1, s, &hp, &hs, &err);
+    TAP_CHECK(ok && hs.loops == 2 && hs.filled == 2 && caps_begin_with(c1, cb),
+              "the box around the washer: two loops capped, the box's first, its cap as alone "
+              "(%zu of %zu)", ok ? hs.filled : 0, ok ? hs.loops : 0);
+    /* the washer's cap alone: the cylinder's (test_cylinder) */
+    const int cyl_cap = ok && c1->ntris == cb->ntris + cw->ntris &&
+                        !memcmp(c1->xyz + 3 * cb->nverts, cw->xyz,
+                                3 * cw->nverts * sizeof *cw->xyz);
+    TAP_CHECK(ok && !cyl_cap, "the washer's cap is not its cylinder's (%zu triangles, alone %zu), "
+              "which would pierce the box's", ok ? c1->ntris - cb->ntris : 0,
+              ok ? cw->ntris : 0);
+    for (int t = 2; ok && t <= 3; t++) {
+#ifdef _OPENMP
+        omp_set_num_threads(t);
+#endif
+        st_soup *ct = NULL;
+        const int okt = !st_soup_hole_caps(&ct, s, &hp, &hs, &err);
+        TAP_CHECK(okt && ct->nverts == c1->nverts && ct->ntris == c1->ntris &&
+                  !memcmp(ct->xyz, c1->xyz, 3 * c1->nverts * sizeof *c1->xyz) &&
+                  !memcmp(ct->tris, c1->tris, 3 * c1->ntris * sizeof *c1->tris),
+                  "%d threads: the same caps, to the bit", t);
+        st_soup_free(ct);
+    }
+#ifdef _OPENMP
+    omp_set_num_threads(was);
+#endif
+    st_soup_free(c1), st_soup_free(cw), st_soup_free(cb);
+    st_soup_free(w), st_soup_free(s), st_soup_free(box);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
@@ -1738,6 +1811,6 @@ int main(int argc, char **argv)
                                      TAP_TEST(bend_same), TAP_TEST(fair),
                                      TAP_TEST(fans_merged), TAP_TEST(fair_irregular),
                                      TAP_TEST(cylinder), TAP_TEST(crease),
-                                     TAP_TEST(threads_same), {0}};
+                                     TAP_TEST(threads_same), TAP_TEST(threads_cylinder), {0}};
     return tap_main(argc, argv, tests);
 }
