@@ -16,7 +16,9 @@
  *
  * st_soup_hole_caps_shared reads as these steps around one state (a
  * capper: the rim, the loop being capped, the caps): rim_build (2),
- * rim_intact, rim_pair and trace_loop (3), cap_loop (4).
+ * rim_intact, rim_pair and trace_loops (3, on one thread), cap_all (4:
+ * cap_loop on each loop by the threads, each into its own soup, the caps
+ * appended in loop order; doc/design/holes.md, "Threads").
  */
 #include "souptet/holes.h"
 #include "../base/fpenv.h"
