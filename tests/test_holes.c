@@ -14,6 +14,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 /* A unit UV sphere as an exact soup, every other triangle flipped,
  * without the faces above z_cut. Not shapes.h's: there sin(pi) and
@@ -1630,6 +1633,174 @@ static void test_crease(void)
     st_soup_free(whole);
 }
 
+/* A UV sphere of radius r around c (exact where its rows meet, as
+ * sphere()'s) without the quads of rows i = 2 mod 4 and columns j = 3
+ * mod 8: 12 holes of four edges each, apart from one another. */
+static void add_pocked_sphere(st_soup *s, const double *c, double r)
+{
+    const int nu = 32, nv = 16;
+    for (int i = 0; i < nv; i++)
+        for (int j = 0; j < nu; j++) {
+            if (i % 4 == 2 && j % 8 == 3)
+                continue;
+            double p[4][3];
+            for (int k = 0; k < 4; k++) {
+                int ii = i + (k >= 2), jj = j + (k == 1 || k == 2);
+                double th = M_PI * ii / nv, ph = 2 * M_PI * (jj % nu) / nu;
+                double rr = ii == 0 || ii == nv ? 0.0 : sin(th);
+                p[k][0] = c[0] + r * rr * cos(ph);
+                p[k][1] = c[1] + r * rr * sin(ph);
+                p[k][2] = c[2] + r * (ii == nv ? -1.0 : cos(th));
+            }
+            if (i > 0)
+                add_tri(s, p[0], p[1], p[2], (i + j) & 1);
+            if (i < nv - 1)
+                add_tri(s, p[0], p[2], p[3], 0);
+        }
+}
+
+/* piece appended to s moved by d; piece freed. */
+static void add_moved(st_soup *s, st_soup *piece, const double *d)
+{
+    const size_t v0 = s->nverts;
+    st_soup_append(s, piece, NULL);
+    for (size_t v = v0; v < s->nverts; v++)
+        for (int k = 0; k < 3; k++)
+            s->xyz[3 * v + k] += d[k];
+    st_soup_free(piece);
+}
+
+/* Issue 41: the loops are capped by the threads, each into its own soup,
+ * and the caps appended in loop order: the same caps, to the bit, and the
+ * same counts for any number of threads. A soup with many holes of every
+ * kind (the loops of a washer's lost arc, capped along its cylinder, of a
+ * box's lost corner and lost edge, rebuilt from the planes, of the
+ * tunnelled block's lost edge along the tunnels' mouths, and a sphere's
+ * small holes), two of each and the spheres' 48, capped with 1
+ * thread and with 2, 3 and 4. */
+static void test_threads_same(void)
+{
+    static const double ehi[3] = {1, 1, 1};
+    static const int en[3] = {10, 10, 10};
+    st_soup *s = st_soup_new();
+    for (int copy = 0; copy < 2; copy++) {
+        const double y = 40.0 * copy;
+        add_moved(s, washer(1), (const double[3]){0, y, 0});
+        add_moved(s, cornered_box(1), (const double[3]){4, y, 0});
+        add_moved(s, gridded_box(ehi, en, edge_keep, 1), (const double[3]){8, y, 0});
+        add_moved(s, tunnelled_block(1), (const double[3]){12, y, 0});
+    }
+    for (int k = 0; k < 3; k++)
+        add_pocked_sphere(s, (const double[3]){4.0 * k, 20, 0}, 1.5);
+    st_holes_params hp = st_holes_params_default();
+    st_holes_stats h1, ht;
+    st_error err;
+    st_soup *c1 = NULL;
+#ifdef _OPENMP
+    const int was = omp_get_max_threads();
+    omp_set_num_threads(1);
+#endif
+    int ok = !st_soup_hole_caps(&c1, s, &hp, &h1, &err);
+    TAP_CHECK(ok && h1.continued && h1.loops == 56 && h1.filled == 56 && h1.rebuilt >= 8,
+              "1 thread: %zu of %zu loops capped, %zu rebuilt, %zu triangles", ok ? h1.filled : 0,
+              ok ? h1.loops : 0, ok ? h1.rebuilt : 0, ok ? c1->ntris : 0);
+    for (int t = 2; ok && t <= 4; t++) {
+#ifdef _OPENMP
+        omp_set_num_threads(t);
+#endif
+        st_soup *ct = NULL;
+        const int okt = !st_soup_hole_caps(&ct, s, &hp, &ht, &err);
+        const int same = okt && ct->nverts == c1->nverts && ct->ntris == c1->ntris &&
+                         !memcmp(ct->xyz, c1->xyz, 3 * c1->nverts * sizeof *c1->xyz) &&
+                         !memcmp(ct->tris, c1->tris, 3 * c1->ntris * sizeof *c1->tris);
+        const int counts = okt && ht.loops == h1.loops && ht.filled == h1.filled &&
+                           ht.rebuilt == h1.rebuilt && ht.too_large == h1.too_large &&
+                           ht.too_long == h1.too_long && ht.pinched == h1.pinched;
+        TAP_CHECK(same && counts, "%d threads: the same caps, to the bit (%zu triangles), and "
+                  "counts (%zu capped, %zu rebuilt)", t, okt ? ct->ntris : 0,
+                  okt ? ht.filled : 0, okt ? ht.rebuilt : 0);
+        st_soup_free(ct);
+    }
+#ifdef _OPENMP
+    omp_set_num_threads(was);
+#endif
+    st_soup_free(c1);
+    st_soup_free(s);
+}
+
+/* The first caps of c (a's triangles, from a's vertex 0 on) are a's, to
+ * the bit. */
+static int caps_begin_with(const st_soup *c, const st_soup *a)
+{
+    return c->ntris >= a->ntris && c->nverts >= a->nverts &&
+           !memcmp(c->xyz, a->xyz, 3 * a->nverts * sizeof *a->xyz) &&
+           !memcmp(c->tris, a->tris, 3 * a->ntris * sizeof *a->tris);
+}
+
+/* Issue 41: a cylinder's cap may not pierce the caps before it
+ * (holes_cyl.c). The threads make each loop's cap without the others';
+ * where a cylinder's then pierces one before it, it is made again against
+ * them. The box [-2, 2]^2 x [-1, 0.15] without its top face (a flat
+ * hole, capped first: its cap the face) around the washer without an arc
+ * (test_cylinder: capped alone along its cylinder), which crosses the
+ * box's top: the washer's cylinder cap would pierce the box's cap, and is
+ * not taken, at any number of threads. */
+static void test_threads_cylinder(void)
+{
+    st_soup *box = st_soup_new(), *s = st_soup_new();
+    static const double R[][3][3] = {
+        {{-2, -2, -1}, {0, 4, 0}, {4, 0, 0}},       /* bottom */
+        {{-2, -2, -1}, {4, 0, 0}, {0, 0, 1.15}},    /* sides */
+        {{-2, 2, -1}, {4, 0, 0}, {0, 0, 1.15}},
+        {{-2, -2, -1}, {0, 4, 0}, {0, 0, 1.15}},
+        {{2, -2, -1}, {0, 4, 0}, {0, 0, 1.15}},
+    };
+    for (size_t r = 0; r < sizeof R / sizeof R[0]; r++)
+        t_rect(box, R[r][0], R[r][1], R[r][2], 0);
+    st_soup_append(s, box, NULL);
+    add_moved(s, washer(1), (const double[3]){0, 0, 0});
+    st_soup *w = washer(1), *cb = NULL, *cw = NULL, *c1 = NULL;
+    st_holes_params hp = st_holes_params_default();
+    st_holes_stats hs;
+    st_error err;
+#ifdef _OPENMP
+    const int was = omp_get_max_threads();
+    omp_set_num_threads(1);
+#endif
+    st_holes_params hb = hp;    /* the box alone is one-sided along z */
+    hb.onesided = 0.0;
+    int ok = !st_soup_hole_caps(&cb, box, &hb, &hs, &err) &&
+             !st_soup_hole_caps(&cw, w, &hp, &hs, &err) &&
+             !st_soup_hole_caps(&c1, s, &hp, &hs, &err);
+    TAP_CHECK(ok && hs.loops == 2 && hs.filled == 2 && caps_begin_with(c1, cb),
+              "the box around the washer: two loops capped, the box's first, its cap as alone "
+              "(%zu of %zu)", ok ? hs.filled : 0, ok ? hs.loops : 0);
+    /* the washer's cap alone: the cylinder's (test_cylinder) */
+    const int cyl_cap = ok && c1->ntris == cb->ntris + cw->ntris &&
+                        !memcmp(c1->xyz + 3 * cb->nverts, cw->xyz,
+                                3 * cw->nverts * sizeof *cw->xyz);
+    TAP_CHECK(ok && !cyl_cap, "the washer's cap is not its cylinder's (%zu triangles, alone %zu), "
+              "which would pierce the box's", ok ? c1->ntris - cb->ntris : 0,
+              ok ? cw->ntris : 0);
+    for (int t = 2; ok && t <= 3; t++) {
+#ifdef _OPENMP
+        omp_set_num_threads(t);
+#endif
+        st_soup *ct = NULL;
+        const int okt = !st_soup_hole_caps(&ct, s, &hp, &hs, &err);
+        TAP_CHECK(okt && ct->nverts == c1->nverts && ct->ntris == c1->ntris &&
+                  !memcmp(ct->xyz, c1->xyz, 3 * c1->nverts * sizeof *c1->xyz) &&
+                  !memcmp(ct->tris, c1->tris, 3 * c1->ntris * sizeof *c1->tris),
+                  "%d threads: the same caps, to the bit", t);
+        st_soup_free(ct);
+    }
+#ifdef _OPENMP
+    omp_set_num_threads(was);
+#endif
+    st_soup_free(c1), st_soup_free(cw), st_soup_free(cb);
+    st_soup_free(w), st_soup_free(s), st_soup_free(box);
+}
+
 int main(int argc, char **argv)
 {
     static const tap_test tests[] = {TAP_TEST(which_loops), TAP_TEST(pseudo_volume),
@@ -1639,6 +1810,7 @@ int main(int argc, char **argv)
                                      TAP_TEST(cone_same),
                                      TAP_TEST(bend_same), TAP_TEST(fair),
                                      TAP_TEST(fans_merged), TAP_TEST(fair_irregular),
-                                     TAP_TEST(cylinder), TAP_TEST(crease), {0}};
+                                     TAP_TEST(cylinder), TAP_TEST(crease),
+                                     TAP_TEST(threads_same), TAP_TEST(threads_cylinder), {0}};
     return tap_main(argc, argv, tests);
 }

@@ -16,7 +16,9 @@
  *
  * st_soup_hole_caps_shared reads as these steps around one state (a
  * capper: the rim, the loop being capped, the caps): rim_build (2),
- * rim_intact, rim_pair and trace_loop (3), cap_loop (4).
+ * rim_intact, rim_pair and trace_loops (3, on one thread), cap_all (4:
+ * cap_loop on each loop by the threads, each into its own soup, the caps
+ * appended in loop order; doc/design/holes.md, "Threads").
  */
 #include "souptet/holes.h"
 #include "../base/fpenv.h"
@@ -35,6 +37,9 @@
 #include <immintrin.h>
 #elif defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#ifdef _OPENMP
+#include <omp.h>
 #endif
 
 #define NONE UINT32_MAX
@@ -1014,37 +1019,38 @@ static st_status rim_intact(int *intact, const rim *r, const st_soup *s, const s
     return ST_OK;
 }
 
-/* One loop of the rim: its welded vertices and boundary edges, their
- * points (a soup vertex welded to each), the third point of the soup's
- * triangle beside each edge, and a triangulation. */
+/* One loop of the rim: its welded vertices and boundary edges (n each,
+ * in a queue's arrays), their points (a soup vertex welded to each), the
+ * third point of the soup's triangle beside each edge, and a
+ * triangulation: the working arrays of one thread. */
 typedef struct loop {
     size_t n;
-    uint32_t *v, *e;            /* nb + 1 each */
+    uint32_t *v, *e;            /* n each */
     const double **pts, **side; /* max_loop + 1 each */
     uint32_t *tri;              /* 3 (max_loop + 1) */
     double *crease;             /* 6 (max_loop + 1): st_holes_creases */
 } loop;
 
-static st_status loop_alloc(loop *l, size_t nb, size_t max_loop, st_error *err)
+static st_status loop_alloc(loop *l, size_t max_loop, st_error *err)
 {
-    l->v = st_malloc_array(nb + 1, sizeof *l->v);
-    l->e = st_malloc_array(nb + 1, sizeof *l->e);
+    l->v = l->e = NULL;
     l->pts = st_malloc_array(max_loop + 1, sizeof *l->pts);
     l->side = st_malloc_array(max_loop + 1, sizeof *l->side);
     l->tri = st_malloc_array(3 * (max_loop + 1), sizeof *l->tri);
     l->crease = st_malloc_array(6 * (max_loop + 1), sizeof *l->crease);
-    return l->v && l->e && l->pts && l->side && l->tri && l->crease ? ST_OK : oom(err);
+    return l->pts && l->side && l->tri && l->crease ? ST_OK : oom(err);
 }
 
 static void loop_free(loop *l)
 {
-    free(l->v), free(l->e), free(l->pts), free(l->side), free(l->tri), free(l->crease);
+    free(l->pts), free(l->side), free(l->tri), free(l->crease);
 }
 
 /* Walks the loop from boundary edge e0 (not used yet) by the partners,
- * marking its edges used, into l (l->n edges). Returns 1 when it closes,
- * 0 when it is pinched (an odd vertex, one not paired, or an edge met
- * twice). */
+ * marking its edges used, into l->v and l->e (l->n edges; each edge is
+ * walked once, so all the loops take at most nb entries). Returns 1 when
+ * it closes, 0 when it is pinched (an odd vertex, one not paired, or an
+ * edge met twice). */
 static int trace_loop(rim *r, size_t e0, loop *l)
 {
     size_t n = 0;
@@ -1076,17 +1082,20 @@ static int trace_loop(rim *r, size_t e0, loop *l)
     return closed;
 }
 
-/* Capping the loops of one soup: what cap_loop reads and fills. */
+/* Capping the loops of one soup: what cap_loop reads (the soup, its
+ * edges, BVH and rim, shared by the threads) and fills (the loop's
+ * working arrays, the caps and their counts, one thread's). */
 typedef struct capper {
     const st_soup *s;
     const st_soup_edges *E;
     const st_bvh *bvh;
     const st_holes_params *p;
     int bend, planes;           /* how the caps continue the faces */
-    rim r;
+    rim *r;                     /* read only while the loops are capped */
     loop l;
     st_soup *out;               /* the caps */
     st_holes_stats st;
+    int cyl;                    /* the last cap is the cylinder's */
 } capper;
 
 /* The loop's points (pts) and, beside each edge, the third point of the
@@ -1097,7 +1106,7 @@ static void loop_points(capper *c, int sides)
     const uint32_t *weld = c->E->weld;
     loop *l = &c->l;
     for (size_t i = 0; i < l->n; i++) {
-        const uint32_t *tv = s->tris + 3 * (size_t)c->r.t[l->e[i]];
+        const uint32_t *tv = s->tris + 3 * (size_t)c->r->t[l->e[i]];
         if (!sides) {
             const double *q = NULL;
             for (int k = 0; k < 3; k++)
@@ -1134,7 +1143,7 @@ static double around_loop(capper *c, size_t e0)
         blo[q] -= 0.25 * ext;
         bhi[q] += 0.25 * ext;
     }
-    around_ctx ac = {c->E->kept, c->E->piece, c->r.stamp, (uint32_t)e0, c->r.piece_area, 0.0};
+    around_ctx ac = {c->E->kept, c->E->piece, c->r->stamp, (uint32_t)e0, c->r->piece_area, 0.0};
     st_bvh_query_box(c->bvh, blo, bhi, add_piece, &ac);
     return ac.around;
 }
@@ -1173,35 +1182,31 @@ done:
     return rc;
 }
 
-/* 4. The cap of the closed loop from e0 in c->l: by least area, kept if
+/* 4. The cap of the closed loop in c->l (3 to max_loop edges; lim: the
+ * largest cap, max_cap_ratio times around_loop): by least area, kept if
  * small beside the surface around it (or a flat hole); then with planes
  * rebuilt from the planes along it, else with bend spanned by the least
- * bend. Appended to c->out; counted in c->st. */
-static st_status cap_loop(capper *c, size_t e0, st_error *err)
+ * bend. Appended to c->out (c->cyl 1 where it is the cylinder's);
+ * counted in c->st. */
+static st_status cap_loop(capper *c, double lim, st_error *err)
 {
     const st_holes_params *p = c->p;
     loop *l = &c->l;
     const size_t n = l->n;
-    if (n < 3)
-        return ST_OK;
-    if (n > p->max_loop) {
-        c->st.too_long++;
-        return ST_OK;
-    }
+    c->cyl = 0;
     loop_points(c, 0);
     double cap, bent;
-    const double lim = p->max_cap_ratio * around_loop(c, e0);
     /* a loop surely too large needs no triangulation (least_area is
      * O(n^3)); else least_area decides, as it always did */
     if (st_holes_area_above(l->pts, n, lim) &&
-        !flat_hole(c->s, l->pts, n, c->r.t, l->e, p->flat)) {
+        !flat_hole(c->s, l->pts, n, c->r->t, l->e, p->flat)) {
         c->st.too_large++;
         return ST_OK;
     }
     st_status rc = st_holes_least_area(&cap, l->pts, n, l->tri, err);
     if (rc)
         return rc;
-    if (!(cap > 0.0) || (cap > lim && !flat_hole(c->s, l->pts, n, c->r.t, l->e, p->flat))) {
+    if (!(cap > 0.0) || (cap > lim && !flat_hole(c->s, l->pts, n, c->r->t, l->e, p->flat))) {
         c->st.too_large++;
         return ST_OK;
     }
@@ -1227,6 +1232,7 @@ static st_status cap_loop(capper *c, size_t e0, st_error *err)
     if (rebuilt || cyl) {
         c->st.filled++;
         c->st.rebuilt++;
+        c->cyl = cyl;
         return ST_OK;
     }
     /* on an intact soup, a cap of the loop's points faired where the
@@ -1250,6 +1256,234 @@ static st_status cap_loop(capper *c, size_t e0, st_error *err)
             return rc;
     c->st.filled++;
     return ST_OK;
+}
+
+/* The closed loops to cap (3 to max_loop edges), in the order they were
+ * traced: loop k's welded vertices and boundary edges at v + off[k] and
+ * e + off[k] (n[k] each) and the largest cap it may take (lim[k]); the
+ * order the threads take them in, the longest first (ord: pairs of a
+ * loop's length and its index, sorted). */
+typedef struct queue {
+    size_t nq;
+    size_t *off, *n, *ord;
+    double *lim;
+    uint32_t *v, *e;
+} queue;
+
+static st_status queue_alloc(queue *q, size_t nb, st_error *err)
+{
+    const size_t m = nb + 1;
+    q->nq = 0;
+    q->off = st_malloc_array(m, sizeof *q->off);
+    q->n = st_malloc_array(m, sizeof *q->n);
+    q->ord = st_malloc_array(2 * m, sizeof *q->ord);
+    q->lim = st_malloc_array(m, sizeof *q->lim);
+    q->v = st_malloc_array(m, sizeof *q->v);
+    q->e = st_malloc_array(m, sizeof *q->e);
+    return q->off && q->n && q->ord && q->lim && q->v && q->e ? ST_OK : oom(err);
+}
+
+static void queue_free(queue *q)
+{
+    free(q->off), free(q->n), free(q->ord), free(q->lim), free(q->v), free(q->e);
+}
+
+/* The longer loop first, then the one traced first. */
+static int longer_first(const void *a, const void *b)
+{
+    const size_t *x = a, *y = b;
+    return x[0] != y[0] ? (x[0] < y[0] ? 1 : -1) : (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+/* 3. Walks the rim's loops (from each boundary edge not walked yet, in
+ * order) into q: the closed ones of 3 to max_loop edges, each with the
+ * largest cap it may take (max_cap_ratio times the surface around it,
+ * around_loop, whose stamps are the rim's: here, on one thread); the
+ * others counted in c->st. */
+static void trace_loops(capper *c, queue *q)
+{
+    rim *r = c->r;
+    size_t pos = 0;
+    for (size_t e0 = 0; e0 < r->nb; e0++) {
+        if (r->used[e0])
+            continue;
+        c->l.v = q->v + pos;
+        c->l.e = q->e + pos;
+        if (!trace_loop(r, e0, &c->l)) {
+            c->st.pinched += c->l.n;
+            continue;
+        }
+        c->st.loops++;
+        const size_t n = c->l.n;
+        if (n < 3)
+            continue;
+        if (n > c->p->max_loop) {
+            c->st.too_long++;
+            continue;
+        }
+        loop_points(c, 0);
+        q->off[q->nq] = pos;
+        q->n[q->nq] = n;
+        q->lim[q->nq] = c->p->max_cap_ratio * around_loop(c, e0);
+        q->ord[2 * q->nq] = n;
+        q->ord[2 * q->nq + 1] = q->nq;
+        q->nq++;
+        pos += n;
+    }
+    qsort(q->ord, q->nq, 2 * sizeof *q->ord, longer_first);
+}
+
+/* Loop k of q in c->l. */
+static void loop_of(capper *c, const queue *q, size_t k)
+{
+    c->l.v = q->v + q->off[k];
+    c->l.e = q->e + q->off[k];
+    c->l.n = q->n[k];
+}
+
+/* One loop's cap as a thread made it: its triangles (NULL: none), its
+ * counts, and whether it is the cylinder's (made without the caps before
+ * it, which it must not pierce: merge_caps tests that). */
+typedef struct loop_cap {
+    st_soup *cap;
+    size_t too_large, filled, rebuilt;
+    int cyl;
+} loop_cap;
+
+/* The first failure in loop order: its loop (SIZE_MAX: none), status
+ * and error. */
+typedef struct first_fail {
+    size_t k;
+    st_status rc;
+    st_error err;
+} first_fail;
+
+/* Loop k of q capped by w (one thread's capper, its own loop arrays) into
+ * a soup of its own, res. */
+static st_status cap_one(capper *w, const queue *q, size_t k, loop_cap *res, st_error *err)
+{
+    loop_of(w, q, k);
+    memset(&w->st, 0, sizeof w->st);
+    st_status rc = (w->out = st_soup_new()) ? cap_loop(w, q->lim[k], err) : oom(err);
+    res->too_large = w->st.too_large;
+    res->filled = w->st.filled;
+    res->rebuilt = w->st.rebuilt;
+    res->cyl = w->cyl;
+    if (rc || !w->out->ntris) {
+        st_soup_free(w->out);
+        w->out = NULL;
+    }
+    res->cap = w->out;
+    w->out = NULL;
+    return rc;
+}
+
+static int thread_num(void)
+{
+#ifdef _OPENMP
+    return omp_get_thread_num();
+#else
+    return 0;
+#endif
+}
+
+/* 4. Every loop of q capped (cap_one) into res[k], by the threads, the
+ * longest loops first (a loop's cap reads the soup, its edges, BVH and
+ * rim, and writes only its own arrays, ls[thread], and soup); the first
+ * failure in loop order into *f (a loop after one that failed is not
+ * capped). */
+static void cap_loops(const capper *c, const queue *q, const loop *ls, loop_cap *res,
+                      first_fail *f)
+{
+    f->k = SIZE_MAX;
+    #pragma omp parallel if (q->nq > 1)
+    {
+        capper w = *c;
+        w.l = ls[thread_num()];
+        st_error e;
+        #pragma omp for schedule(dynamic, 1)
+        for (size_t j = 0; j < q->nq; j++) {
+            const size_t k = q->ord[2 * j + 1];
+            size_t fk;
+            #pragma omp atomic read
+            fk = f->k;
+            if (k > fk)
+                continue;
+            const st_status rc = cap_one(&w, q, k, res + k, &e);
+            if (rc) {
+                #pragma omp critical(holes_first_fail)
+                if (k < f->k) {
+                    f->rc = rc;
+                    f->err = e;
+                    #pragma omp atomic write
+                    f->k = k;
+                }
+            }
+        }
+    }
+}
+
+/* The loops' caps (res) appended to c->out in loop order, their counts
+ * to c->st: the caps are those the loops capped one after another make.
+ * A cylinder's cap (holes_cyl.c) may not pierce the caps before it: one
+ * that does is made again here against them, as cap_loop makes it then
+ * (the cylinder then not taken; a cylinder's cap that pierces none is the
+ * same either way, the test the only part that reads them). Stops at f's
+ * failure, and returns it. */
+static st_status merge_caps(capper *c, const queue *q, const loop_cap *res, const first_fail *f,
+                            st_error *err)
+{
+    for (size_t k = 0; k < q->nq; k++) {
+        if (k == f->k) {
+            if (err)
+                *err = f->err;
+            return f->rc;
+        }
+        const loop_cap *r = res + k;
+        st_status rc = ST_OK;
+        if (r->cyl && st_holes_caps_cross(c->out, r->cap)) {
+            loop_of(c, q, k);
+            rc = cap_loop(c, q->lim[k], err);
+        } else {
+            c->st.too_large += r->too_large;
+            c->st.filled += r->filled;
+            c->st.rebuilt += r->rebuilt;
+            if (r->cap)
+                rc = st_soup_append(c->out, r->cap, err);
+        }
+        if (rc)
+            return rc;
+    }
+    return ST_OK;
+}
+
+/* 4. The caps of q's loops into c->out: made by the threads (cap_loops),
+ * each with its own loop arrays, appended in loop order (merge_caps):
+ * the same caps for any number of threads. */
+static st_status cap_all(capper *c, const queue *q, st_error *err)
+{
+#ifdef _OPENMP
+    const size_t nth = q->nq > 1 ? (size_t)omp_get_max_threads() : 1;
+#else
+    const size_t nth = 1;
+#endif
+    loop *ls = st_calloc_array(nth, sizeof *ls);
+    loop_cap *res = st_calloc_array(q->nq + 1, sizeof *res);
+    first_fail f;
+    st_status rc = ls && res ? ST_OK : oom(err);
+    for (size_t t = 0; t < nth && !rc; t++)
+        rc = loop_alloc(ls + t, c->p->max_loop, err);
+    if (!rc) {
+        cap_loops(c, q, ls, res, &f);
+        rc = merge_caps(c, q, res, &f, err);
+    }
+    for (size_t t = 0; ls && t < nth; t++)
+        loop_free(ls + t);
+    for (size_t k = 0; res && k < q->nq; k++)
+        st_soup_free(res[k].cap);
+    free(ls);
+    free(res);
+    return rc;
 }
 
 st_status st_soup_hole_caps(st_soup **caps, const st_soup *s,
@@ -1278,10 +1512,15 @@ st_status st_soup_hole_caps_shared(st_soup **caps, const st_soup *s,
         return rc;
     capper c;
     memset(&c, 0, sizeof c);
+    rim r;
+    memset(&r, 0, sizeof r);
+    queue q;
+    memset(&q, 0, sizeof q);
     c.s = s;
     c.E = edges ? edges : &own_edges;
     c.bvh = shared_bvh;
     c.p = p;
+    c.r = &r;
     st_bvh *own_bvh = NULL;
     int intact = 0;
     if (!(c.out = st_soup_new())) {
@@ -1292,33 +1531,25 @@ st_status st_soup_hole_caps_shared(st_soup **caps, const st_soup *s,
         goto done;
     c.bvh = c.bvh ? c.bvh : own_bvh;
     /* 2, 3. the rim, its pairs and loops; 4. their caps */
-    if ((rc = rim_build(&c.r, s, c.E, err)) || (rc = loop_alloc(&c.l, c.r.nb, p->max_loop, err)))
+    if ((rc = rim_build(&r, s, c.E, err)) || (rc = loop_alloc(&c.l, p->max_loop, err)))
         goto done;
-    c.st.boundary_edges = c.r.nb;
-    if ((rc = rim_intact(&intact, &c.r, s, c.E, p, &c.st, err)))
+    c.st.boundary_edges = r.nb;
+    if ((rc = rim_intact(&intact, &r, s, c.E, p, &c.st, err)))
         goto done;
     c.bend = p->bend && intact;
     c.planes = p->planes && intact;
     c.st.continued = c.bend || c.planes;
-    if ((rc = rim_pair(&c.r, s, c.E, err)))
+    if ((rc = rim_pair(&r, s, c.E, err)) || (rc = queue_alloc(&q, r.nb, err)))
         goto done;
-    for (size_t e0 = 0; e0 < c.r.nb; e0++) {
-        if (c.r.used[e0])
-            continue;
-        if (!trace_loop(&c.r, e0, &c.l)) {
-            c.st.pinched += c.l.n;
-            continue;
-        }
-        c.st.loops++;
-        if ((rc = cap_loop(&c, e0, err)))
-            goto done;
-    }
+    trace_loops(&c, &q);
+    rc = cap_all(&c, &q, err);
 done:
     if (!edges)
         st_soup_edges_free(&own_edges);
     st_bvh_free(own_bvh);
-    rim_free(&c.r);
+    rim_free(&r);
     loop_free(&c.l);
+    queue_free(&q);
     if (rc) {
         st_soup_free(c.out);
         return rc;

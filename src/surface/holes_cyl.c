@@ -716,6 +716,18 @@ static int cross_caps(const st_soup *out, size_t nt, const double *x)
     return 0;
 }
 
+int st_holes_caps_cross(const st_soup *caps, const st_soup *cap)
+{
+    for (size_t t = 0; cap && t < cap->ntris; t++) {
+        double x[9];
+        for (int k = 0; k < 3; k++)
+            memcpy(x + 3 * k, cap->xyz + 3 * (size_t)cap->tris[3 * t + k], 3 * sizeof *x);
+        if (cross_caps(caps, caps->ntris, x))
+            return 1;
+    }
+    return 0;
+}
+
 static int by_lo_x(const void *a, const void *b)
 {
     const double *x = a, *y = b;

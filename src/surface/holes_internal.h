@@ -199,6 +199,11 @@ st_status st_holes_cyl_cap(st_soup *out, int *done, size_t vbase, size_t tbase,
                            double below, st_holes_fill fill, const st_holes_guard *guard,
                            st_error *err);
 
+/* 1 when a triangle of cap (NULL: none) pierces one of caps'
+ * (st_tri_tri_cross, as st_holes_cyl_cap tests its cap against the caps
+ * before it; holes_cyl.c). */
+int st_holes_caps_cross(const st_soup *caps, const st_soup *cap);
+
 /* What a faired cap reads of the soup around its loop: the soup, its edge
  * table, its BVH, and the loop's welded points (lv[0..n), one per point of
  * pts, see holes_fair.c). */
