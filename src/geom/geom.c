@@ -120,6 +120,41 @@ static inline void nearer_edge(const double p[3], const double u[3], const doubl
     }
 }
 
+/* The squared distance from p to the triangle (a, b, c) of unit normal n,
+ * given on which sides of its edges ab, bc, ca p lies (outside[k]; all 1
+ * for a degenerate triangle): the plane's where p is inside all three,
+ * else the nearest of the edges it lies outside, the first of equals in
+ * the order ab, bc, ca; its closest point into closest (when not NULL).
+ * (Always inlined, as tri_degenerate: both distances call it.) */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline double dist2_given_sides(const double p[3], const double a[3],
+                                       const double b[3], const double c[3],
+                                       const double n[3], const int outside[3],
+                                       double closest[3])
+{
+    if (!(outside[0] | outside[1] | outside[2])) {
+        double ap[3];
+        st_sub3(ap, p, a);
+        double s = st_dot3(ap, n);
+        if (closest) {
+            closest[0] = p[0] - s * n[0];
+            closest[1] = p[1] - s * n[1];
+            closest[2] = p[2] - s * n[2];
+        }
+        return s * s;
+    }
+    double best = INFINITY;
+    if (outside[0])
+        nearer_edge(p, a, b, &best, closest);
+    if (outside[1])
+        nearer_edge(p, b, c, &best, closest);
+    if (outside[2])
+        nearer_edge(p, c, a, &best, closest);
+    return best;
+}
+
 double st_point_triangle_dist2(const double p[3], const double a[3],
                                const double b[3], const double c[3],
                                double closest[3])
@@ -142,26 +177,8 @@ double st_point_triangle_dist2(const double p[3], const double a[3],
         outside[0] = edge_outside(n, e[0], p, a);
         outside[1] = edge_outside(n, e[1], p, b);
         outside[2] = edge_outside(n, e[2], p, c);
-        if (!(outside[0] | outside[1] | outside[2])) {
-            double ap[3];
-            st_sub3(ap, p, a);
-            double s = st_dot3(ap, n);
-            if (closest) {
-                closest[0] = p[0] - s * n[0];
-                closest[1] = p[1] - s * n[1];
-                closest[2] = p[2] - s * n[2];
-            }
-            return s * s;
-        }
     }
-    double best = INFINITY;   /* the edges in order ab, bc, ca; the first of equals */
-    if (outside[0])
-        nearer_edge(p, a, b, &best, closest);
-    if (outside[1])
-        nearer_edge(p, b, c, &best, closest);
-    if (outside[2])
-        nearer_edge(p, c, a, &best, closest);
-    return best;
+    return dist2_given_sides(p, a, b, c, n, outside, closest);
 }
 
 /* The frame: st_point_triangle_dist2's normal, degeneracy test and the
@@ -203,28 +220,9 @@ double st_point_triangle_dist2_framed(const double p[3], const double a[3],
 {
     int outside[3] = {1, 1, 1};
     if (!f->degenerate) {
-        const double *n = f->n;
         outside[0] = framed_outside(f->m[0], p, a);
         outside[1] = framed_outside(f->m[1], p, b);
         outside[2] = framed_outside(f->m[2], p, c);
-        if (!(outside[0] | outside[1] | outside[2])) {
-            double ap[3];
-            st_sub3(ap, p, a);
-            double s = st_dot3(ap, n);
-            if (closest) {
-                closest[0] = p[0] - s * n[0];
-                closest[1] = p[1] - s * n[1];
-                closest[2] = p[2] - s * n[2];
-            }
-            return s * s;
-        }
     }
-    double best = INFINITY;   /* the edges in order ab, bc, ca; the first of equals */
-    if (outside[0])
-        nearer_edge(p, a, b, &best, closest);
-    if (outside[1])
-        nearer_edge(p, b, c, &best, closest);
-    if (outside[2])
-        nearer_edge(p, c, a, &best, closest);
-    return best;
+    return dist2_given_sides(p, a, b, c, f->n, outside, closest);
 }

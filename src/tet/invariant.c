@@ -329,6 +329,24 @@ typedef struct face_query {
     uint32_t hit;           /* the triangle face_visit stopped at */
 } face_query;
 
+/* Whether S triangle tri (its corners into *a, *b, *d) meets the triangle
+ * q->f: first the plane filter on q->pl, which certifies most triangles
+ * strictly on one side of its plane for some 60 instructions, then the
+ * exact test. */
+static inline int meets_f(const face_query *q, uint32_t tri, const double **a,
+                          const double **b, const double **d)
+{
+    const uint32_t *t = q->s->tris + 3 * (size_t)tri;
+    *a = q->s->xyz + 3 * (size_t)t[0];
+    *b = q->s->xyz + 3 * (size_t)t[1];
+    *d = q->s->xyz + 3 * (size_t)t[2];
+    const int sa = st_plane_filter_sign(&q->pl, *a);
+    if (sa != 0 && st_plane_filter_sign(&q->pl, *b) == sa &&
+        st_plane_filter_sign(&q->pl, *d) == sa)
+        return 0;
+    return st_tri_tri_intersect(q->f[0], q->f[1], q->f[2], *a, *b, *d);
+}
+
 /* 1 (stop) when S triangle tri meets the new face but did not meet the
  * old one. A triangle the plane filter certifies strictly on one side of
  * the new face's plane does not meet it: st_tri_tri_intersect's first
@@ -338,13 +356,8 @@ typedef struct face_query {
 static int face_visit(void *ctx, uint32_t tri)
 {
     face_query *q = ctx;
-    const uint32_t *t = q->s->tris + 3 * (size_t)tri;
-    const double *a = q->s->xyz + 3 * (size_t)t[0], *b = q->s->xyz + 3 * (size_t)t[1],
-                 *d = q->s->xyz + 3 * (size_t)t[2];
-    const int sa = st_plane_filter_sign(&q->pl, a);
-    if (sa != 0 && st_plane_filter_sign(&q->pl, b) == sa && st_plane_filter_sign(&q->pl, d) == sa)
-        return 0;
-    if (!st_tri_tri_intersect(q->f[0], q->f[1], q->f[2], a, b, d))
+    const double *a, *b, *d;
+    if (!meets_f(q, tri, &a, &b, &d))
         return 0;
     if (st_tri_tri_intersect(q->g[0], q->g[1], q->g[2], a, b, d))
         return 0;
@@ -410,13 +423,8 @@ static int faces_clear(const fit_ctx *c, uint32_t v, const double p[3])
 static int side_visit(void *ctx, uint32_t tri)
 {
     face_query *q = ctx;
-    const uint32_t *t = q->s->tris + 3 * (size_t)tri;
-    const double *a = q->s->xyz + 3 * (size_t)t[0], *b = q->s->xyz + 3 * (size_t)t[1],
-                 *d = q->s->xyz + 3 * (size_t)t[2];
-    const int sa = st_plane_filter_sign(&q->pl, a);
-    if (sa != 0 && st_plane_filter_sign(&q->pl, b) == sa && st_plane_filter_sign(&q->pl, d) == sa)
-        return 0;
-    if (!st_tri_tri_intersect(q->f[0], q->f[1], q->f[2], a, b, d))
+    const double *a, *b, *d;
+    if (!meets_f(q, tri, &a, &b, &d))
         return 0;
     q->hit = tri;
     return 1;
