@@ -118,22 +118,33 @@ def test_ctrl_c(call):
 def test_cancel_object_stops_a_run_from_another_thread(bunny):
     # a UI's event loop sets souptet.Cancel while mesh() runs in a worker
     # thread: the library polls the flag itself (progress.h)
+    # The flag is set while the run is surely under way: its first
+    # "sculpted" event holds the run (the callback waits, GIL released)
+    # until this thread has set it, so a fast machine cannot finish the
+    # run before the set (a fixed sleep did, once the run got faster).
     c = souptet.Cancel()
     assert not c.is_set()
     out = {}
+    under_way, was_set = threading.Event(), threading.Event()
+
+    def hold(ev):
+        if ev["what"] == "sculpted" and not under_way.is_set():
+            under_way.set()
+            was_set.wait(30)
 
     def work():
         try:
-            souptet.mesh(*bunny, cells=30, tries=2, cancel=c)
+            souptet.mesh(*bunny, cells=30, tries=2, cancel=c, progress=hold)
             out["r"] = "finished"
         except souptet.Cancelled:
             out["r"] = "cancelled"
         out["t"] = time.monotonic()
     t = threading.Thread(target=work)
     t.start()
-    time.sleep(1.5)
+    assert under_way.wait(60)
     t_set = time.monotonic()
     c.set()
+    was_set.set()
     t.join(30)
     assert out.get("r") == "cancelled", out
     # about 0.1 s of work; a loaded machine gets slack (1-1.5 s measured at
