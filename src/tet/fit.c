@@ -245,6 +245,13 @@ static size_t rescue_search(const fit_ctx *c, uint32_t v, double (*cd)[5], size_
     const double t0 = par ? omp_get_wtime() : 0.0;
     double busy = 0.0;
     int team = 1;
+    /* v's blocker slots (blocker[v], tblocker[v]) are read and written by
+     * sm_move_ok as v's own: here every thread tests v, so only the first
+     * uses them; the others test without (they only order exact tests:
+     * the same answers) */
+    fit_ctx unslotted = *c;
+    unslotted.blocker = NULL;
+    unslotted.tblocker = NULL;
     #pragma omp parallel reduction(+ : busy) if (par)
     {
         const double b0 = par ? omp_get_wtime() : 0.0;
@@ -252,6 +259,7 @@ static size_t rescue_search(const fit_ctx *c, uint32_t v, double (*cd)[5], size_
             team = omp_get_num_threads();
         star_pts own = STAR_PTS_INIT;
         star_pts *tp = omp_get_thread_num() == 0 ? sp : &own;
+        const fit_ctx *tc = omp_get_thread_num() == 0 ? c : &unslotted;
         sm_star_pts_collect(c, v, tp);
         for (;;) {
             size_t i;
@@ -263,7 +271,7 @@ static size_t rescue_search(const fit_ctx *c, uint32_t v, double (*cd)[5], size_
             if (i >= nc || cd[i][0] > b)
                 break;
             if (!star_keeps_floor(sm, v, cd[i] + 1, worst, floor_score) ||
-                !sm_move_ok(c, v, cd[i] + 1, tp))
+                !sm_move_ok(tc, v, cd[i] + 1, tp))
                 continue;
             int64_t tri;
             double d2 = sm_nearest_d2(c, cd[i] + 1, dd * dd, &tri, NULL);
